@@ -1,0 +1,245 @@
+"""Running lessons: headless renders, and the interactive window loop.
+
+Headless: :class:`HeadlessRenderer` keeps one context and renders any number
+of lessons into offscreen targets. Window: :func:`run_window` is the course's
+render loop (clear, draw, swap), with ESC to quit, F12 for a screenshot, R to
+reload shaders, the frame rate in the title, and resizing.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time as _time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from glsandbox.errors import SandboxError
+from glsandbox.gl.context import BACKENDS, GLHost, open_context
+from glsandbox.gl.executor import Executor
+from glsandbox.gl.target import OffscreenTarget
+from glsandbox.golden import save_png
+from glsandbox.lesson import Lesson
+from glsandbox.plan import Buffers, Plan, plan
+from glsandbox.scene import Scene
+
+DEFAULT_SIZE = (640, 480)
+
+
+@dataclass
+class Frame:
+    """One rendered frame: the pixels, the plan that made them, and its cost."""
+
+    image: np.ndarray  # (H, W, 4) uint8, top row first
+    plan: Plan
+    seconds: float
+
+
+def with_samples(scene: Scene, samples: int) -> Scene:
+    """The scene with the requested MSAA sample count (0 or 1: none)."""
+    if samples < 0:
+        raise SandboxError(f"--samples {samples}: must be 0 or more")
+    from dataclasses import replace
+
+    return replace(scene, samples=samples) if samples != scene.samples else scene
+
+
+class HeadlessRenderer:
+    """Renders lessons offscreen on one context, reusing programs and targets."""
+
+    def __init__(self, backend: str | None = None) -> None:
+        self.host: GLHost = open_context(backend)
+        self.executor = Executor(self.host)
+        self._targets: dict[tuple[tuple[int, int], Buffers], OffscreenTarget] = {}
+
+    def target(self, size: tuple[int, int], buffers: Buffers) -> OffscreenTarget:
+        key = (size, buffers)
+        if key not in self._targets:
+            self._targets[key] = OffscreenTarget(self.host, size, buffers)
+        return self._targets[key]
+
+    def render_scene(self, scene: Scene, size: tuple[int, int]) -> Frame:
+        start = _time.perf_counter()
+        frame_plan = plan(scene)
+        target = self.target(size, frame_plan.buffers)
+        self.executor.render(scene, target.framebuffer, size, frame_plan)
+        image = target.read()
+        return Frame(image, frame_plan, _time.perf_counter() - start)
+
+    def render(self, lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: int = 0) -> Frame:
+        return self.render_scene(with_samples(lesson.scene(), samples), size)
+
+    def close(self) -> None:
+        for target in self._targets.values():
+            target.release()
+        self._targets.clear()
+        self.executor.release()
+        self.host.release()
+
+    def __enter__(self) -> HeadlessRenderer:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def check_writable(path: Path) -> None:
+    """Refuse an output path we cannot write, before any work is done."""
+    import os
+
+    parent = path.parent if str(path.parent) else Path(".")
+    if path.is_dir():
+        raise SandboxError(f"--out {path}: is a folder, expected a .png file name")
+    if path.suffix.lower() != ".png":
+        raise SandboxError(f"--out {path}: the output must be a .png file")
+    if not parent.is_dir():
+        raise SandboxError(f"--out {path}: folder {parent} does not exist")
+    if not os.access(parent, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
+        raise SandboxError(f"--out {path}: not writable")
+
+
+def render_to_file(lesson: Lesson, out: Path, size: tuple[int, int], samples: int = 0,
+                   backend: str | None = None) -> Frame:
+    """Render one lesson headless and write it as a PNG (atomically)."""
+    check_writable(out)
+    with HeadlessRenderer(backend) as renderer:
+        frame = renderer.render(lesson, size, samples)
+    save_png(frame.image, out)
+    return frame
+
+
+# --- the window -------------------------------------------------------------
+
+
+def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: int = 0,
+               backend: str | None = None, screenshot_dir: Path = Path("screenshots"),
+               max_frames: int | None = None) -> None:
+    """Open a window and run the lesson until ESC or the window closes.
+
+    Keys: ESC quits; F12 writes ``screenshots/<lesson>-<n>.png``; R reloads the
+    shaders from disk (a broken shader keeps the last good program and shows
+    its error in the title and on stderr); other keys go to the lesson.
+    """
+    import glfw
+
+    host = open_context(backend if backend not in (None, "auto") else "auto", window=True, size=size,
+                        title=f"glsandbox: {lesson.name}", samples=samples)
+    if host.backend != "window":
+        host.release()
+        raise SandboxError("no display for a window: set DISPLAY or run under Xvfb, or use --headless")
+    executor = Executor(host)
+    state = {"lesson": lesson, "error": "", "shots": 0}
+    start_time = lesson.time
+    clock_start = glfw.get_time()
+    pending: list[int] = []
+
+    def on_key(window: object, key: int, scancode: int, action: int, mods: int) -> None:
+        if action == glfw.PRESS:
+            pending.append(key)
+
+    glfw.set_key_callback(host.window, on_key)
+
+    def handle(key: int) -> None:
+        if key == glfw.KEY_ESCAPE:
+            glfw.set_window_should_close(host.window, True)
+        elif key == glfw.KEY_F12:
+            screenshot_dir.mkdir(parents=True, exist_ok=True)
+            state["shots"] += 1
+            path = screenshot_dir / f"{lesson.name}-{state['shots']}.png"
+            width, height = glfw.get_framebuffer_size(host.window)
+            data = host.ctx.screen.read(viewport=(0, 0, width, height), components=4, alignment=1)
+            image = np.frombuffer(data, dtype=np.uint8).reshape(height, width, 4)[::-1]
+            save_png(np.ascontiguousarray(image), path)
+            print(f"screenshot: {path}", file=sys.stderr, flush=True)
+        elif key == glfw.KEY_R:
+            try:
+                executor.reload_shaders()
+                state["error"] = ""
+                print("shaders reloaded", file=sys.stderr, flush=True)
+            except SandboxError as exc:
+                state["error"] = str(exc)
+                print(f"error: {exc}", file=sys.stderr, flush=True)
+        else:
+            name = glfw.get_key_name(key, 0) or {glfw.KEY_TAB: "tab", glfw.KEY_SPACE: "space"}.get(key, "")
+            if name:
+                state["lesson"].on_key(name)
+
+    frames, fps_frames, fps_start, fps = 0, 0, _time.perf_counter(), 0.0
+    try:
+        while not glfw.window_should_close(host.window):
+            glfw.poll_events()
+            while pending:
+                handle(pending.pop(0))
+            current: Lesson = state["lesson"]
+            if current.animated:
+                current.values["time"] = start_time + glfw.get_time() - clock_start
+            width, height = glfw.get_framebuffer_size(host.window)
+            if width > 0 and height > 0:  # minimised windows have no framebuffer
+                scene = with_samples(current.scene(), 0)  # the window's own MSAA does the sampling
+                executor.render(scene, host.ctx.screen, (width, height))
+                glfw.swap_buffers(host.window)
+            frames += 1
+            fps_frames += 1
+            now = _time.perf_counter()
+            if now - fps_start >= 0.5:
+                fps = fps_frames / (now - fps_start)
+                fps_frames, fps_start = 0, now
+                suffix = f" | shader error: {state['error']}" if state["error"] else ""
+                glfw.set_window_title(host.window, f"glsandbox: {current.name} | {fps:.0f} fps{suffix}")
+            if max_frames is not None and frames >= max_frames:
+                break
+    finally:
+        executor.release()
+        host.release()
+
+
+# --- ``python -m lessons.<module>`` ----------------------------------------
+
+
+def parse_size(text: str) -> tuple[int, int]:
+    """``WxH`` -> (W, H), refusing anything else with the value named."""
+    w, sep, h = text.lower().partition("x")
+    try:
+        size = (int(w), int(h))
+    except ValueError:
+        size = (0, 0)
+    if not sep or size[0] <= 0 or size[1] <= 0 or max(size) > 16384:
+        raise SandboxError(f"--size {text!r}: expected WIDTHxHEIGHT with positive integers, e.g. 640x480")
+    return size
+
+
+def add_render_options(parser: argparse.ArgumentParser) -> None:
+    """The options shared by every command that renders."""
+    parser.add_argument("--size", default=None, help="frame size WxH (default 640x480)")
+    parser.add_argument("--samples", type=int, default=0, help="MSAA samples (0: none)")
+    parser.add_argument("--backend", default=None, help=f"one of {', '.join(BACKENDS)} "
+                        "(default: GLSANDBOX_BACKEND or auto)")
+    parser.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
+                        help="a lesson parameter (repeatable); every lesson has time=SECONDS")
+
+
+def lesson_main(lesson_cls: type[Lesson], argv: list[str] | None = None) -> int:
+    """Entry point of a lesson module: a window, or ``--headless --out FILE.png``."""
+    from glsandbox.cli import run_guarded
+
+    parser = argparse.ArgumentParser(prog=f"python -m lessons.{lesson_cls.name}",
+                                     description=f"{lesson_cls.title} ({lesson_cls.course_section})")
+    add_render_options(parser)
+    parser.add_argument("--headless", action="store_true", help="render offscreen instead of opening a window")
+    parser.add_argument("--out", type=Path, default=None, help="with --headless: the PNG to write")
+    args = parser.parse_args(argv)
+
+    def body() -> int:
+        lesson = lesson_cls.from_settings(args.settings)
+        size = parse_size(args.size) if args.size else DEFAULT_SIZE
+        if args.headless:
+            out = args.out or Path(f"{lesson_cls.name}.png")
+            frame = render_to_file(lesson, out, size, args.samples, args.backend)
+            print(f"wrote {out} ({size[0]}x{size[1]}, {frame.seconds * 1000:.1f} ms)")
+        else:
+            run_window(lesson, size, args.samples, args.backend)
+        return 0
+
+    return run_guarded(body)

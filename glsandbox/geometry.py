@@ -1,0 +1,178 @@
+"""Meshes as plain numpy arrays, and the course's shapes.
+
+Everything here is already in OpenGL's right-handed, counter-clockwise-front
+convention; shapes the course gives in DirectX form go through
+:func:`glsandbox.transforms.from_directx_mesh` exactly once, here.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from glsandbox.errors import SandboxError
+from glsandbox.transforms import from_directx_mesh
+
+#: Primitive topologies a mesh can use (the course's D3D11_PRIMITIVE_TOPOLOGY_*).
+MODES = ("triangles", "triangle_strip")
+
+
+@dataclass(frozen=True, eq=False)
+class Mesh:
+    """Vertex arrays and an optional index buffer.
+
+    ``positions`` is (N, 3); ``normals`` (N, 3), ``uvs`` (N, 2) and ``colors``
+    (N, 3) are optional;
+    ``indices`` is a flat array, three per triangle for ``"triangles"``.
+    ``name`` identifies the mesh (GPU buffers are cached by it).
+    """
+
+    name: str
+    positions: np.ndarray
+    indices: np.ndarray | None = None
+    normals: np.ndarray | None = None
+    uvs: np.ndarray | None = None
+    colors: np.ndarray | None = None
+    mode: str = "triangles"
+
+    def __post_init__(self) -> None:
+        if self.mode not in MODES:
+            raise SandboxError(f"mesh {self.name!r}: unknown mode {self.mode!r}; use one of {', '.join(MODES)}")
+
+    @property
+    def vertex_count(self) -> int:
+        return len(self.positions)
+
+    @property
+    def element_count(self) -> int:
+        """Vertices drawn: the index count, or the vertex count when not indexed."""
+        return len(self.indices) if self.indices is not None else len(self.positions)
+
+    def triangles(self) -> np.ndarray:
+        """The triangles as (T, 3, 3) positions, whatever the topology.
+
+        A strip's triangle k uses vertices (k, k+1, k+2), with every odd
+        triangle's first two swapped so all keep the strip's winding.
+        """
+        order = self.indices if self.indices is not None else np.arange(self.vertex_count)
+        if self.mode == "triangles":
+            tri = np.asarray(order).reshape(-1, 3)
+        else:
+            tri = np.array([
+                (order[k + 1], order[k], order[k + 2]) if k % 2 else (order[k], order[k + 1], order[k + 2])
+                for k in range(len(order) - 2)
+            ])
+        return self.positions[tri]
+
+
+# --- the course's indexed cube (DirectX SDK Tutorial 04) --------------------
+
+#: The eight corners as the course lists them, in DirectX (left-handed) form.
+COURSE_CUBE_VERTICES = np.array(
+    [(-1, 1, -1), (1, 1, -1), (1, 1, 1), (-1, 1, 1),
+     (-1, -1, -1), (1, -1, -1), (1, -1, 1), (-1, -1, 1)],
+    dtype=np.float64,
+)
+#: The 36 indices, three per triangle, clockwise front faces (DirectX).
+COURSE_CUBE_INDICES = np.array(
+    [3, 1, 0, 2, 1, 3, 0, 5, 4, 1, 5, 0, 3, 4, 7, 0, 4, 3,
+     1, 6, 5, 2, 6, 1, 2, 7, 6, 3, 7, 2, 6, 4, 5, 7, 4, 6],
+    dtype=np.int64,
+)
+
+
+#: Tutorial 04's per-vertex colours, so each face shows a distinct gradient.
+COURSE_CUBE_COLORS = np.array(
+    [(0, 0, 1), (0, 1, 0), (0, 1, 1), (1, 0, 0), (1, 0, 1), (1, 1, 0), (1, 1, 1), (0, 0, 0)],
+    dtype=np.float64,
+)
+
+
+def cube() -> Mesh:
+    """The course's indexed cube: 8 vertices, 36 indices, converted to OpenGL."""
+    pos, idx = from_directx_mesh(COURSE_CUBE_VERTICES, COURSE_CUBE_INDICES)
+    return Mesh("cube", pos, idx.astype(np.uint32), colors=COURSE_CUBE_COLORS.copy())
+
+
+def cube24() -> Mesh:
+    """A cube with 24 vertices: per-face normals and uv (0..1 on every face).
+
+    Corners are shared by three faces with different normals and uv, so a
+    face needs its own four vertices (the course's textured cube).
+    """
+    faces = [  # (normal, u axis, v axis): u right and v up as seen from outside
+        ((0, 0, 1), (1, 0, 0), (0, 1, 0)),
+        ((0, 0, -1), (-1, 0, 0), (0, 1, 0)),
+        ((1, 0, 0), (0, 0, -1), (0, 1, 0)),
+        ((-1, 0, 0), (0, 0, 1), (0, 1, 0)),
+        ((0, 1, 0), (1, 0, 0), (0, 0, -1)),
+        ((0, -1, 0), (1, 0, 0), (0, 0, 1)),
+    ]
+    positions, normals, uvs, indices = [], [], [], []
+    for n, u, v in faces:
+        n, u, v = (np.array(a, dtype=np.float64) for a in (n, u, v))
+        base = len(positions)
+        for su, sv in ((0, 0), (1, 0), (1, 1), (0, 1)):
+            positions.append(n + (2 * su - 1) * u + (2 * sv - 1) * v)
+            normals.append(n)
+            uvs.append((su, 1 - sv))  # image row 0 at the top, as textures are stored
+        indices += [base, base + 1, base + 2, base, base + 2, base + 3]
+    return Mesh("cube24", np.array(positions), np.array(indices, dtype=np.uint32),
+                np.array(normals), np.array(uvs, dtype=np.float64))
+
+
+# --- quads: the strip-versus-list lesson ------------------------------------
+
+_QUAD_CORNERS = np.array([(-0.5, -0.5, 0), (0.5, -0.5, 0), (-0.5, 0.5, 0), (0.5, 0.5, 0)], dtype=np.float64)
+
+
+def quad_strip() -> Mesh:
+    """A unit quad as a 4-vertex triangle strip (TRIANGLESTRIP)."""
+    return Mesh("quad_strip", _QUAD_CORNERS.copy(), mode="triangle_strip")
+
+
+def quad_list() -> Mesh:
+    """The same quad as a 6-vertex triangle list (TRIANGLELIST): two corners repeat."""
+    c = _QUAD_CORNERS
+    return Mesh("quad_list", np.array([c[0], c[1], c[2], c[2], c[1], c[3]]))
+
+
+def quad_list_swapped() -> Mesh:
+    """The list quad with its second triangle's winding swapped: a back face."""
+    c = _QUAD_CORNERS
+    return Mesh("quad_list_swapped", np.array([c[0], c[1], c[2], c[2], c[3], c[1]]))
+
+
+def triangle() -> Mesh:
+    """The course's first triangle, counter-clockwise."""
+    return Mesh("triangle", np.array([(-0.5, -0.5, 0.0), (0.5, -0.5, 0.0), (0.0, 0.5, 0.0)]))
+
+
+def plane(size: float = 1.0) -> Mesh:
+    """A square in the xz plane, facing +y, with uv 0..1."""
+    h = size / 2.0
+    pos = np.array([(-h, 0, h), (h, 0, h), (h, 0, -h), (-h, 0, -h)], dtype=np.float64)
+    return Mesh("plane", pos, np.array([0, 1, 2, 0, 2, 3], dtype=np.uint32),
+                np.tile([0.0, 1.0, 0.0], (4, 1)), np.array([(0, 1), (1, 1), (1, 0), (0, 0)], dtype=np.float64))
+
+
+#: Built-in meshes by name, for scene files.
+BUILTIN_MESHES: dict[str, Callable[[], Mesh]] = {
+    "cube": cube,
+    "cube24": cube24,
+    "quad_strip": quad_strip,
+    "quad_list": quad_list,
+    "quad_list_swapped": quad_list_swapped,
+    "triangle": triangle,
+    "plane": plane,
+}
+
+
+def builtin_mesh(name: str) -> Mesh:
+    """A built-in mesh by name; :class:`SandboxError` lists the names otherwise."""
+    try:
+        return BUILTIN_MESHES[name]()
+    except KeyError:
+        raise SandboxError(f"unknown mesh {name!r}; built-in meshes: {', '.join(BUILTIN_MESHES)}") from None

@@ -1,0 +1,1 @@
+"""Everything that talks to OpenGL: contexts, shaders, targets, the executor."""

@@ -1,0 +1,163 @@
+"""OpenGL contexts: headless EGL (default), headless OSMesa, or a glfw window.
+
+This is the course's "device, context, swap chain" step. ``auto`` picks a
+window when one is asked for and a display exists, else EGL, else OSMesa.
+The backend comes from ``--backend`` or the ``GLSANDBOX_BACKEND`` variable.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import moderngl
+
+from glsandbox.errors import SandboxError
+from glsandbox.gl.rawgl import RawGL
+
+BACKENDS = ("auto", "egl", "osmesa", "window")
+#: OpenGL 3.3 core is all the lessons need; llvmpipe gives 4.5.
+REQUIRED_GL = 330
+
+
+@dataclass
+class GLHost:
+    """A live context: moderngl's handle, how it was made, and its raw-GL loader."""
+
+    ctx: moderngl.Context
+    backend: str
+    get_proc: Callable[[str], int]
+    window: Any = None  # the glfw window, for the window backend
+    _on_release: Callable[[], None] | None = None
+    raw: RawGL = field(init=False)
+
+    def __post_init__(self) -> None:
+        self.raw = RawGL(self.get_proc)
+        self.raw.disable_dither()
+
+    @property
+    def renderer(self) -> str:
+        return f"{self.ctx.info['GL_RENDERER']} / {self.ctx.info['GL_VERSION']}"
+
+    def release(self) -> None:
+        """Free the context (and close the window)."""
+        try:
+            self.ctx.release()
+        finally:
+            if self._on_release is not None:
+                self._on_release()
+                self._on_release = None
+
+
+def requested_backend(backend: str | None) -> str:
+    """The backend asked for: the argument, else ``GLSANDBOX_BACKEND``, else auto."""
+    name = backend or os.environ.get("GLSANDBOX_BACKEND") or "auto"
+    name = name.strip().lower()
+    if name not in BACKENDS:
+        source = "--backend" if backend else "GLSANDBOX_BACKEND"
+        raise SandboxError(f"unknown backend {name!r} (from {source}); choose one of {', '.join(BACKENDS)}")
+    return name
+
+
+def has_display() -> bool:
+    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+
+
+def open_context(backend: str | None = None, *, window: bool = False, size: tuple[int, int] = (640, 480),
+                 title: str = "glsandbox", samples: int = 0) -> GLHost:
+    """Open a context. ``window=True`` asks for an on-screen window.
+
+    With ``auto``, a window is used when asked for and a display exists;
+    otherwise EGL, falling back to OSMesa. Errors say what is missing and
+    how to install it.
+    """
+    name = requested_backend(backend)
+    if name == "auto":
+        if window and has_display():
+            return _open_window(size, title, samples)
+        try:
+            return _open_egl()
+        except SandboxError as egl_error:
+            try:
+                return _open_osmesa()
+            except SandboxError as osmesa_error:
+                raise SandboxError(f"no OpenGL available: {egl_error}; {osmesa_error}") from None
+    if name == "window":
+        return _open_window(size, title, samples)
+    if window:
+        raise SandboxError(f"backend {name!r} is headless and cannot open a window; use --backend window "
+                           "or render with --headless")
+    return _open_egl() if name == "egl" else _open_osmesa()
+
+
+def _open_egl() -> GLHost:
+    try:
+        ctx = moderngl.create_standalone_context(backend="egl", require=REQUIRED_GL)
+    except Exception as exc:  # glcontext raises plain Exceptions with the reason
+        reason = " ".join(str(exc).split()) or type(exc).__name__
+        raise SandboxError(
+            f"EGL backend unavailable ({reason}); install EGL with: apt-get install libegl1 libegl-mesa0 "
+            "libgl1-mesa-dri"
+        ) from None
+    loader = ctx.mglo._context  # glcontext's EGL loader; it resolves any GL entry point
+    return GLHost(ctx, "egl", loader.load)
+
+
+def _open_osmesa() -> GLHost:
+    from glsandbox.gl.osmesa import OSMesaContext
+
+    osmesa = OSMesaContext()
+    try:
+        moderngl.init_context(osmesa)
+        ctx = moderngl.get_context()
+    except Exception as exc:
+        osmesa.release()
+        raise SandboxError(f"OSMesa backend unavailable: {' '.join(str(exc).split())}") from None
+    if ctx.version_code < REQUIRED_GL:
+        raise SandboxError(f"OSMesa gave OpenGL {ctx.version_code}, need {REQUIRED_GL}")
+    return GLHost(ctx, "osmesa", osmesa.load_opengl_function, _on_release=osmesa.release)
+
+
+def _open_window(size: tuple[int, int], title: str, samples: int) -> GLHost:
+    if not has_display():
+        raise SandboxError("no display for a window: set DISPLAY, or run under Xvfb "
+                           "(apt-get install xvfb; xvfb-run -a ...), or render with --headless")
+    try:
+        import glfw
+    except Exception as exc:  # the wheel bundles libglfw, but it needs X11 libraries
+        raise SandboxError(f"glfw is unavailable ({exc}); apt-get install libx11-6 libxrandr2 libxinerama1 "
+                           "libxcursor1 libxi6") from None
+    if not glfw.init():
+        raise SandboxError(f"glfw could not initialise on display {os.environ.get('DISPLAY')!r}; "
+                           "is the X server running?")
+    glfw.window_hint(glfw.CONTEXT_VERSION_MAJOR, 3)
+    glfw.window_hint(glfw.CONTEXT_VERSION_MINOR, 3)
+    glfw.window_hint(glfw.OPENGL_PROFILE, glfw.OPENGL_CORE_PROFILE)
+    glfw.window_hint(glfw.OPENGL_FORWARD_COMPAT, True)
+    glfw.window_hint(glfw.DEPTH_BITS, 24)
+    glfw.window_hint(glfw.STENCIL_BITS, 8)
+    glfw.window_hint(glfw.SAMPLES, samples if samples > 1 else 0)
+    glfw.window_hint(glfw.RESIZABLE, True)
+    handle = glfw.create_window(size[0], size[1], title, None, None)
+    if not handle:
+        glfw.terminate()
+        raise SandboxError("glfw could not create an OpenGL 3.3 core window on this display")
+    glfw.make_context_current(handle)
+    glfw.swap_interval(0)
+    try:
+        ctx = moderngl.create_context(require=REQUIRED_GL)
+    except Exception as exc:
+        glfw.destroy_window(handle)
+        glfw.terminate()
+        raise SandboxError(f"window context unusable: {' '.join(str(exc).split())}") from None
+
+    def close() -> None:
+        glfw.destroy_window(handle)
+        glfw.terminate()
+
+    def get_proc(name: str) -> int:
+        return glfw.get_proc_address(name) or 0
+
+    return GLHost(ctx, "window", get_proc, window=handle, _on_release=close)

@@ -1,0 +1,184 @@
+"""The raster executor: runs a Plan on a ModernGL context.
+
+It compiles the plan's program variants once, uploads each mesh once (cached
+by name and content), and walks the passes in order. It does what the plan
+says and nothing more; choosing passes is :func:`glsandbox.plan.plan`'s job.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass
+
+import moderngl
+import numpy as np
+
+from glsandbox import transforms
+from glsandbox.errors import SandboxError
+from glsandbox.geometry import Mesh
+from glsandbox.gl.context import GLHost
+from glsandbox.gl.shaders import compile_program
+from glsandbox.plan import Draw, Pass, Plan, ProgramVariant, plan as make_plan
+from glsandbox.scene import Node, Scene
+
+_MODES = {"triangles": moderngl.TRIANGLES, "triangle_strip": moderngl.TRIANGLE_STRIP}
+# Mesh arrays and the attribute names the shaders use for them.
+_ATTRIBUTES = (("positions", "in_position", 3), ("normals", "in_normal", 3),
+               ("uvs", "in_uv", 2), ("colors", "in_color", 3))
+
+
+def _mesh_key(mesh: Mesh) -> tuple[str, str]:
+    digest = hashlib.blake2b(digest_size=12)
+    for name, _, _ in _ATTRIBUTES:
+        array = getattr(mesh, name)
+        if array is not None:
+            digest.update(name.encode())
+            digest.update(np.ascontiguousarray(array).tobytes())
+    if mesh.indices is not None:
+        digest.update(np.ascontiguousarray(mesh.indices).tobytes())
+    digest.update(mesh.mode.encode())
+    return mesh.name, digest.hexdigest()
+
+
+@dataclass
+class _GpuMesh:
+    buffers: dict[str, moderngl.Buffer]
+    index: moderngl.Buffer | None
+    mode: int
+    count: int
+
+
+class Executor:
+    """Runs plans on one context, keeping programs and meshes between frames."""
+
+    def __init__(self, host: GLHost) -> None:
+        self.host = host
+        self.ctx = host.ctx
+        self._programs: dict[str, tuple[ProgramVariant, moderngl.Program]] = {}
+        self._meshes: dict[tuple[str, str], _GpuMesh] = {}
+        self._vaos: dict[tuple[tuple[str, str], str], moderngl.VertexArray] = {}
+
+    # --- resources ----------------------------------------------------------
+
+    def program(self, variant: ProgramVariant) -> moderngl.Program:
+        entry = self._programs.get(variant.key)
+        if entry is None:
+            entry = (variant, compile_program(self.ctx, variant))
+            self._programs[variant.key] = entry
+        return entry[1]
+
+    def reload_shaders(self) -> None:
+        """Recompile every program from disk. All or nothing: if one fails,
+        the old programs stay and the :class:`SandboxError` propagates."""
+        fresh = {key: (variant, compile_program(self.ctx, variant)) for key, (variant, _) in self._programs.items()}
+        for _, old in self._programs.values():
+            old.release()
+        for vao in self._vaos.values():
+            vao.release()
+        self._vaos.clear()
+        self._programs = fresh
+
+    def _gpu_mesh(self, mesh: Mesh) -> tuple[tuple[str, str], _GpuMesh]:
+        key = _mesh_key(mesh)
+        gpu = self._meshes.get(key)
+        if gpu is None:
+            buffers = {
+                attr: self.ctx.buffer(np.asarray(getattr(mesh, field), dtype="f4").tobytes())
+                for field, attr, _ in _ATTRIBUTES if getattr(mesh, field) is not None
+            }
+            index = None
+            if mesh.indices is not None:
+                index = self.ctx.buffer(np.asarray(mesh.indices, dtype="u4").tobytes())
+            gpu = _GpuMesh(buffers, index, _MODES[mesh.mode], mesh.element_count)
+            self._meshes[key] = gpu
+        return key, gpu
+
+    def _vao(self, mesh: Mesh, program_key: str) -> tuple[moderngl.VertexArray, _GpuMesh]:
+        key, gpu = self._gpu_mesh(mesh)
+        vao = self._vaos.get((key, program_key))
+        if vao is None:
+            program = self._programs[program_key][1]
+            content = []
+            for _, attr, width in _ATTRIBUTES:
+                if attr in program:
+                    if attr not in gpu.buffers:
+                        raise SandboxError(f"mesh {mesh.name!r} has no {attr[3:]} data, which {program_key} needs")
+                    content.append((gpu.buffers[attr], f"{width}f", attr))
+            vao = self.ctx.vertex_array(program, content, index_buffer=gpu.index)
+            self._vaos[(key, program_key)] = vao
+        return vao, gpu
+
+    # --- frames -------------------------------------------------------------
+
+    def render(self, scene: Scene, framebuffer: moderngl.Framebuffer, size: tuple[int, int],
+               frame_plan: Plan | None = None) -> Plan:
+        """Draw one frame of ``scene`` into ``framebuffer`` (``size`` pixels)."""
+        frame_plan = frame_plan or make_plan(scene)
+        for variant in frame_plan.programs:
+            self.program(variant)
+        nodes = {node.name: node for node in scene.nodes}
+        framebuffer.use()
+        for step in frame_plan.passes:
+            viewport = scene.viewports[step.viewport]
+            rect = viewport.pixels(*size)
+            if step.kind == "clear":
+                self._clear(framebuffer, step, rect)
+            else:
+                camera = viewport.camera or scene.camera
+                aspect = rect[2] / rect[3] if rect[3] else 1.0
+                view, proj = camera.view(), camera.projection(aspect)
+                framebuffer.viewport = rect
+                self._set_depth(step.depth_test)
+                for draw in step.draws:
+                    self._draw(nodes[draw.node], draw, view, proj)
+        framebuffer.viewport = (0, 0, *size)
+        self._set_depth(False)
+        self.ctx.disable(moderngl.CULL_FACE)
+        return frame_plan
+
+    def _clear(self, framebuffer: moderngl.Framebuffer, step: Pass, rect: tuple[int, int, int, int]) -> None:
+        r, g, b, a = step.clear_color or (0.0, 0.0, 0.0, 0.0)
+        # moderngl scissors the clear to the viewport rectangle.
+        framebuffer.clear(r, g, b, a, depth=1.0, viewport=rect)
+
+    def _set_depth(self, on: bool) -> None:
+        if on:
+            self.ctx.enable(moderngl.DEPTH_TEST)
+        else:
+            self.ctx.disable(moderngl.DEPTH_TEST)
+
+    def _draw(self, node: Node, draw: Draw, view: np.ndarray, proj: np.ndarray) -> None:
+        program = self._programs[draw.program][1]
+        vao, gpu = self._vao(node.mesh, draw.program)
+        if draw.cull_back_faces:
+            self.ctx.enable(moderngl.CULL_FACE)
+            self.ctx.cull_face = "back"
+            self.ctx.front_face = "ccw"
+        else:
+            self.ctx.disable(moderngl.CULL_FACE)
+        uniforms = {
+            "m_model": transforms.gl_bytes(node.model),
+            "m_view": transforms.gl_bytes(view),
+            "m_proj": transforms.gl_bytes(proj),
+            "u_color": np.asarray(node.material.color, dtype="f4").tobytes(),
+        }
+        if "m_normal" in program:
+            uniforms["m_normal"] = transforms.gl_bytes(transforms.normal_matrix(node.model))
+        for name, data in uniforms.items():
+            if name in program:
+                program[name].write(data)
+        vao.render(gpu.mode, vertices=gpu.count)
+
+    def release(self) -> None:
+        for vao in self._vaos.values():
+            vao.release()
+        for gpu in self._meshes.values():
+            for buf in gpu.buffers.values():
+                buf.release()
+            if gpu.index is not None:
+                gpu.index.release()
+        for _, program in self._programs.values():
+            program.release()
+        self._vaos.clear()
+        self._meshes.clear()
+        self._programs.clear()

@@ -1,0 +1,87 @@
+"""OSMesa: Mesa's off-screen software context, the second headless backend.
+
+glcontext has no OSMesa backend, so this makes an OSMesa core-profile context
+current with ctypes (Debian's ``libosmesa6``) and hands moderngl a loader whose
+``load_opengl_function`` answers with ``OSMesaGetProcAddress``. OSMesa always
+needs a client-memory colour buffer; we render into framebuffer objects, so a
+small one is enough.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import ctypes.util
+
+from glsandbox.errors import SandboxError
+
+OSMESA_RGBA = 0x1908
+OSMESA_FORMAT = 0x22
+OSMESA_DEPTH_BITS = 0x30
+OSMESA_STENCIL_BITS = 0x31
+OSMESA_ACCUM_BITS = 0x32
+OSMESA_PROFILE = 0x33
+OSMESA_CORE_PROFILE = 0x34
+OSMESA_CONTEXT_MAJOR_VERSION = 0x36
+OSMESA_CONTEXT_MINOR_VERSION = 0x37
+GL_UNSIGNED_BYTE = 0x1401
+
+INSTALL_HINT = "install it with: apt-get install libosmesa6"
+
+
+def _load_library() -> ctypes.CDLL:
+    names = ["libOSMesa.so.8", "libOSMesa.so.6", "libOSMesa.so"]
+    found = ctypes.util.find_library("OSMesa")
+    if found:
+        names.insert(0, found)
+    for name in names:
+        try:
+            return ctypes.CDLL(name)
+        except OSError:
+            continue
+    raise SandboxError(f"OSMesa backend unavailable: libOSMesa not found; {INSTALL_HINT}")
+
+
+class OSMesaContext:
+    """An OSMesa context made current on this thread, and moderngl's loader for it."""
+
+    def __init__(self, size: tuple[int, int] = (16, 16)) -> None:
+        lib = _load_library()
+        lib.OSMesaCreateContextAttribs.restype = ctypes.c_void_p
+        lib.OSMesaCreateContextAttribs.argtypes = [ctypes.POINTER(ctypes.c_int), ctypes.c_void_p]
+        lib.OSMesaMakeCurrent.restype = ctypes.c_ubyte
+        lib.OSMesaMakeCurrent.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_uint, ctypes.c_int, ctypes.c_int]
+        lib.OSMesaGetProcAddress.restype = ctypes.c_void_p
+        lib.OSMesaGetProcAddress.argtypes = [ctypes.c_char_p]
+        lib.OSMesaDestroyContext.argtypes = [ctypes.c_void_p]
+        attributes = [
+            OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 24, OSMESA_STENCIL_BITS, 8,
+            OSMESA_ACCUM_BITS, 0, OSMESA_PROFILE, OSMESA_CORE_PROFILE,
+            OSMESA_CONTEXT_MAJOR_VERSION, 3, OSMESA_CONTEXT_MINOR_VERSION, 3, 0,
+        ]
+        handle = lib.OSMesaCreateContextAttribs((ctypes.c_int * len(attributes))(*attributes), None)
+        if not handle:
+            raise SandboxError("OSMesa backend unavailable: could not create an OpenGL 3.3 core context")
+        self._lib = lib
+        self._handle = handle
+        self._buffer = (ctypes.c_ubyte * (4 * size[0] * size[1]))()
+        if not lib.OSMesaMakeCurrent(handle, self._buffer, GL_UNSIGNED_BYTE, size[0], size[1]):
+            lib.OSMesaDestroyContext(handle)
+            raise SandboxError("OSMesa backend unavailable: OSMesaMakeCurrent failed")
+
+    # moderngl's loader protocol
+    def load_opengl_function(self, name: str) -> int:
+        return self._lib.OSMesaGetProcAddress(name.encode("ascii")) or 0
+
+    def load(self, name: str) -> int:
+        return self.load_opengl_function(name)
+
+    def release(self) -> None:
+        if self._handle:
+            self._lib.OSMesaDestroyContext(self._handle)
+            self._handle = None
+
+    def __enter__(self) -> None:
+        return None
+
+    def __exit__(self, *exc: object) -> None:
+        return None

@@ -1,0 +1,137 @@
+"""The few raw OpenGL calls moderngl 5.13 does not offer, in one small module.
+
+moderngl has no stencil API and its renderbuffers are depth-only, so the
+depth-stencil attachment of offscreen targets and all stencil state are set
+here, through the context's own function loader (EGL's, OSMesa's or glfw's)
+and ctypes. Every function restores the bindings it changed.
+"""
+
+from __future__ import annotations
+
+import ctypes
+from collections.abc import Callable
+
+from glsandbox.errors import SandboxError
+
+GL_FRAMEBUFFER = 0x8D40
+GL_RENDERBUFFER = 0x8D41
+GL_FRAMEBUFFER_BINDING = 0x8CA6
+GL_RENDERBUFFER_BINDING = 0x8CA7
+GL_COLOR_ATTACHMENT0 = 0x8CE0
+GL_DEPTH_ATTACHMENT = 0x8D00
+GL_STENCIL_ATTACHMENT = 0x8D20
+GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE = 0x8CD0
+GL_NONE = 0
+GL_DEPTH_STENCIL_ATTACHMENT = 0x821A
+GL_FRAMEBUFFER_COMPLETE = 0x8CD5
+GL_DEPTH_COMPONENT24 = 0x81A6
+GL_DEPTH24_STENCIL8 = 0x88F0
+GL_FRAMEBUFFER_ATTACHMENT_DEPTH_SIZE = 0x8216
+GL_FRAMEBUFFER_ATTACHMENT_STENCIL_SIZE = 0x8217
+GL_DITHER = 0x0BD0
+GL_STENCIL_TEST = 0x0B90
+
+_VOID = None
+_UINT = ctypes.c_uint
+_INT = ctypes.c_int
+_SIGNATURES: dict[str, tuple] = {
+    "glGenFramebuffers": (_VOID, _INT, ctypes.POINTER(_UINT)),
+    "glDeleteFramebuffers": (_VOID, _INT, ctypes.POINTER(_UINT)),
+    "glBindFramebuffer": (_VOID, _UINT, _UINT),
+    "glCheckFramebufferStatus": (_UINT, _UINT),
+    "glFramebufferRenderbuffer": (_VOID, _UINT, _UINT, _UINT, _UINT),
+    "glGetFramebufferAttachmentParameteriv": (_VOID, _UINT, _UINT, _UINT, ctypes.POINTER(_INT)),
+    "glGenRenderbuffers": (_VOID, _INT, ctypes.POINTER(_UINT)),
+    "glDeleteRenderbuffers": (_VOID, _INT, ctypes.POINTER(_UINT)),
+    "glBindRenderbuffer": (_VOID, _UINT, _UINT),
+    "glRenderbufferStorageMultisample": (_VOID, _UINT, _INT, _UINT, _INT, _INT),
+    "glGetIntegerv": (_VOID, _UINT, ctypes.POINTER(_INT)),
+    "glEnable": (_VOID, _UINT),
+    "glDisable": (_VOID, _UINT),
+    "glIsEnabled": (ctypes.c_ubyte, _UINT),
+    "glStencilFunc": (_VOID, _UINT, _INT, _UINT),
+    "glStencilOp": (_VOID, _UINT, _UINT, _UINT),
+    "glStencilMask": (_VOID, _UINT),
+    "glClearStencil": (_VOID, _INT),
+    "glClear": (_VOID, _UINT),
+}
+
+
+class RawGL:
+    """Typed ctypes entry points, loaded on first use from ``get_proc``."""
+
+    def __init__(self, get_proc: Callable[[str], int]) -> None:
+        self._get_proc = get_proc
+        self._fns: dict[str, Callable] = {}
+
+    def __getattr__(self, name: str) -> Callable:
+        if not name.startswith("gl"):
+            raise AttributeError(name)
+        fn = self._fns.get(name)
+        if fn is None:
+            address = self._get_proc(name)
+            if not address:
+                raise SandboxError(f"OpenGL function {name} is not available from this context")
+            restype, *argtypes = _SIGNATURES[name]
+            fn = ctypes.CFUNCTYPE(restype, *argtypes)(address)
+            self._fns[name] = fn
+        return fn
+
+    def get_integer(self, pname: int) -> int:
+        value = _INT(0)
+        self.glGetIntegerv(pname, ctypes.byref(value))
+        return value.value
+
+    def disable_dither(self) -> None:
+        """Dithering is on by default in OpenGL; golden images want it off."""
+        self.glDisable(GL_DITHER)
+
+    def create_depth_framebuffer(self, color_renderbuffer: int, size: tuple[int, int], samples: int,
+                                 stencil: bool, depth: bool = True) -> tuple[int, int]:
+        """A framebuffer with moderngl's colour renderbuffer and our depth(-stencil) one.
+
+        Returns ``(framebuffer, depth_renderbuffer)`` GL names (0 when there is no depth).
+        """
+        old_fbo = self.get_integer(GL_FRAMEBUFFER_BINDING)
+        old_rb = self.get_integer(GL_RENDERBUFFER_BINDING)
+        fbo, rb = _UINT(0), _UINT(0)
+        self.glGenFramebuffers(1, ctypes.byref(fbo))
+        self.glBindFramebuffer(GL_FRAMEBUFFER, fbo.value)
+        self.glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color_renderbuffer)
+        if depth or stencil:
+            self.glGenRenderbuffers(1, ctypes.byref(rb))
+            self.glBindRenderbuffer(GL_RENDERBUFFER, rb.value)
+            fmt = GL_DEPTH24_STENCIL8 if stencil else GL_DEPTH_COMPONENT24
+            self.glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, fmt, size[0], size[1])
+            attachment = GL_DEPTH_STENCIL_ATTACHMENT if stencil else GL_DEPTH_ATTACHMENT
+            self.glFramebufferRenderbuffer(GL_FRAMEBUFFER, attachment, GL_RENDERBUFFER, rb.value)
+        status = self.glCheckFramebufferStatus(GL_FRAMEBUFFER)
+        self.glBindRenderbuffer(GL_RENDERBUFFER, old_rb)
+        self.glBindFramebuffer(GL_FRAMEBUFFER, old_fbo)
+        if status != GL_FRAMEBUFFER_COMPLETE:
+            self.delete_framebuffer(fbo.value, rb.value)
+            raise SandboxError(f"offscreen framebuffer {size[0]}x{size[1]} (samples {samples}) "
+                               f"is incomplete: status 0x{status:04X}")
+        return fbo.value, rb.value
+
+    def attachment_bits(self, fbo: int) -> tuple[int, int]:
+        """(depth bits, stencil bits) of a framebuffer's depth attachment."""
+        old = self.get_integer(GL_FRAMEBUFFER_BINDING)
+        self.glBindFramebuffer(GL_FRAMEBUFFER, fbo)
+        bits = []
+        for attachment, pname in ((GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_DEPTH_SIZE),
+                                  (GL_STENCIL_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_STENCIL_SIZE)):
+            kind, value = _INT(0), _INT(0)
+            self.glGetFramebufferAttachmentParameteriv(
+                GL_FRAMEBUFFER, attachment, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, ctypes.byref(kind))
+            if kind.value != GL_NONE:  # asking the size of a missing attachment is an error
+                self.glGetFramebufferAttachmentParameteriv(GL_FRAMEBUFFER, attachment, pname, ctypes.byref(value))
+            bits.append(value.value)
+        self.glBindFramebuffer(GL_FRAMEBUFFER, old)
+        return bits[0], bits[1]
+
+    def delete_framebuffer(self, fbo: int, renderbuffer: int) -> None:
+        if renderbuffer:
+            self.glDeleteRenderbuffers(1, ctypes.byref(_UINT(renderbuffer)))
+        if fbo:
+            self.glDeleteFramebuffers(1, ctypes.byref(_UINT(fbo)))

@@ -1,0 +1,63 @@
+"""Offscreen render targets: colour, and the depth and stencil a plan asks for.
+
+A target is a framebuffer object whose colour is a moderngl renderbuffer and
+whose depth (24 bits) or packed depth-stencil (24 + 8 bits) attachment comes
+from :mod:`glsandbox.gl.rawgl`. With MSAA the frame is resolved into a
+single-sample framebuffer before it is read back.
+"""
+
+from __future__ import annotations
+
+import moderngl
+import numpy as np
+
+from glsandbox.errors import SandboxError
+from glsandbox.gl.context import GLHost
+from glsandbox.plan import Buffers
+
+
+class OffscreenTarget:
+    """A framebuffer of ``size`` with the buffers the plan lists."""
+
+    def __init__(self, host: GLHost, size: tuple[int, int], buffers: Buffers) -> None:
+        ctx = host.ctx
+        width, height = size
+        limit = ctx.info["GL_MAX_RENDERBUFFER_SIZE"]
+        if not (0 < width <= limit and 0 < height <= limit):
+            raise SandboxError(f"size {width}x{height} is outside what this context allows (1..{limit})")
+        if buffers.samples > ctx.max_samples:
+            raise SandboxError(f"--samples {buffers.samples} is more than this context allows ({ctx.max_samples})")
+        self.host = host
+        self.size = size
+        self.buffers = buffers
+        samples = buffers.samples
+        self._color = ctx.renderbuffer(size, 4, samples=samples)
+        self._fbo_name, self._depth_name = host.raw.create_depth_framebuffer(
+            self._color.glo, size, samples, stencil=buffers.stencil, depth=buffers.depth)
+        self.framebuffer: moderngl.Framebuffer = ctx.detect_framebuffer(self._fbo_name)
+        self._resolved: moderngl.Framebuffer | None = None
+        if samples:
+            self._resolved = ctx.framebuffer(color_attachments=[ctx.renderbuffer(size, 4)])
+
+    def bits(self) -> tuple[int, int]:
+        """(depth bits, stencil bits) actually allocated."""
+        return self.host.raw.attachment_bits(self._fbo_name)
+
+    def read(self) -> np.ndarray:
+        """The frame as an (H, W, 4) uint8 RGBA array, top row first."""
+        source = self.framebuffer
+        if self._resolved is not None:
+            self.host.ctx.copy_framebuffer(self._resolved, self.framebuffer)
+            source = self._resolved
+        data = source.read(components=4, alignment=1)
+        image = np.frombuffer(data, dtype=np.uint8).reshape(self.size[1], self.size[0], 4)
+        return np.ascontiguousarray(image[::-1])
+
+    def release(self) -> None:
+        # The framebuffer object is ours (rawgl made it); moderngl only wraps it.
+        self.host.raw.delete_framebuffer(self._fbo_name, self._depth_name)
+        self._color.release()
+        if self._resolved is not None:
+            for rb in self._resolved.color_attachments:
+                rb.release()
+            self._resolved.release()

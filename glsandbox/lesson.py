@@ -1,0 +1,194 @@
+"""Lessons: a base class with typed parameters, and the registry.
+
+A lesson turns its parameter values (always including ``time``) into a
+:class:`~glsandbox.scene.Scene`. Rendering, windows and the CLI are elsewhere
+(:mod:`glsandbox.app`, :mod:`glsandbox.cli`); a lesson is only data and maths,
+so it renders the same moment exactly, headless or in a window.
+"""
+
+from __future__ import annotations
+
+import difflib
+import importlib
+import math
+import pkgutil
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, ClassVar
+
+from glsandbox.errors import SandboxError
+from glsandbox.scene import Scene, load_scene
+
+
+@dataclass(frozen=True)
+class Param:
+    """A lesson parameter, settable with ``--set name=value``."""
+
+    name: str
+    default: Any
+    help: str
+    choices: tuple[str, ...] | None = None
+    minimum: float | None = None
+    maximum: float | None = None
+
+    @property
+    def kind(self) -> type:
+        return type(self.default)
+
+    def parse(self, text: str) -> Any:
+        """Turn ``--set`` text into a value, or raise naming the value."""
+        where = f"--set {self.name}={text}"
+        if self.choices is not None:
+            if text not in self.choices:
+                raise SandboxError(f"{where}: expected one of {', '.join(self.choices)}")
+            return text
+        if self.kind is bool:
+            lowered = text.strip().lower()
+            if lowered in ("1", "true", "on", "yes"):
+                return True
+            if lowered in ("0", "false", "off", "no"):
+                return False
+            raise SandboxError(f"{where}: expected on or off")
+        if self.kind in (int, float):
+            try:
+                value = self.kind(text)
+            except ValueError:
+                noun = "an integer" if self.kind is int else "a number"
+                raise SandboxError(f"{where}: expected {noun}") from None
+            if not math.isfinite(value):
+                raise SandboxError(f"{where}: expected a finite number")
+            if self.minimum is not None and value < self.minimum:
+                raise SandboxError(f"{where}: must be at least {self.minimum:g}")
+            if self.maximum is not None and value > self.maximum:
+                raise SandboxError(f"{where}: must be at most {self.maximum:g}")
+            return value
+        return text
+
+    def describe(self) -> str:
+        options = f" ({'|'.join(self.choices)})" if self.choices else ""
+        default = ("on" if self.default else "off") if self.kind is bool else self.default
+        return f"{self.name}={default}{options}: {self.help}"
+
+
+#: Every lesson has ``time``: the moment to render, in seconds.
+TIME = Param("time", 0.0, "the moment to render, in seconds (animated lessons move with it)", minimum=0.0)
+
+
+class Lesson:
+    """Base class. Subclasses set the class attributes and implement :meth:`build`."""
+
+    name: ClassVar[str] = ""
+    title: ClassVar[str] = ""
+    course_section: ClassVar[str] = ""
+    #: Position in ``glsandbox list`` and the tour.
+    order: ClassVar[int] = 100
+    #: Whether the picture changes with ``time`` (the window advances it).
+    animated: ClassVar[bool] = False
+    params: ClassVar[tuple[Param, ...]] = ()
+
+    def __init__(self, **values: Any) -> None:
+        known = {p.name: p for p in self.all_params()}
+        self.values: dict[str, Any] = {p.name: p.default for p in known.values()}
+        for key, value in values.items():
+            if key not in known:
+                raise SandboxError(unknown_param_message(self, key))
+            self.values[key] = value
+
+    @classmethod
+    def all_params(cls) -> tuple[Param, ...]:
+        return (TIME, *cls.params)
+
+    @classmethod
+    def from_settings(cls, settings: Iterable[str]) -> Lesson:
+        """Build from ``key=value`` strings (the CLI's ``--set``)."""
+        known = {p.name: p for p in cls.all_params()}
+        values: dict[str, Any] = {}
+        for item in settings:
+            key, sep, text = item.partition("=")
+            key = key.strip()
+            if not sep or not key:
+                raise SandboxError(f"--set {item!r}: expected key=value")
+            if key not in known:
+                raise SandboxError(unknown_param_message(cls, key))
+            values[key] = known[key].parse(text.strip())
+        return cls(**values)
+
+    @property
+    def time(self) -> float:
+        return float(self.values["time"])
+
+    def at(self, time: float) -> Lesson:
+        """The same lesson at another moment."""
+        return type(self)(**{**self.values, "time": time})
+
+    def scene(self) -> Scene:
+        """The Scene for the current values."""
+        return self.build()
+
+    def build(self) -> Scene:
+        raise NotImplementedError
+
+    def on_key(self, key: str) -> bool:
+        """Window key hook (glfw key name, e.g. ``"1"``); return True when handled."""
+        return False
+
+
+def unknown_param_message(lesson: type[Lesson] | Lesson, key: str) -> str:
+    names = [p.name for p in lesson.all_params()]
+    close = difflib.get_close_matches(key, names, n=1)
+    hint = f"; did you mean {close[0]!r}?" if close else ""
+    return f"--set {key}: {lesson.name} has no parameter {key!r}{hint} (parameters: {', '.join(names)})"
+
+
+class SceneFileLesson(Lesson):
+    """A TOML scene file used as a lesson: static, only ``time``."""
+
+    course_section = "scene file"
+    path: ClassVar[Path]
+
+    def build(self) -> Scene:
+        return load_scene(self.path)
+
+
+def scene_file_lesson(path: Path) -> type[Lesson]:
+    """A lesson class for one scene file; the file is validated now."""
+    load_scene(path)  # fail early, with file and line
+    return type(f"SceneFile_{path.stem}", (SceneFileLesson,),
+                {"name": path.stem, "title": f"scene file {path}", "path": path})
+
+
+# --- the registry -----------------------------------------------------------
+
+_REGISTRY: dict[str, type[Lesson]] = {}
+
+
+def register(cls: type[Lesson]) -> type[Lesson]:
+    """Class decorator: make a lesson known to ``glsandbox list`` and the tour."""
+    if not cls.name:
+        raise ValueError(f"{cls.__qualname__} has no name")
+    _REGISTRY[cls.name] = cls
+    return cls
+
+
+def all_lessons() -> list[type[Lesson]]:
+    """Every lesson in the ``lessons`` package, in course order."""
+    import lessons
+
+    for module in pkgutil.iter_modules(lessons.__path__):
+        if not module.name.startswith("_"):
+            importlib.import_module(f"lessons.{module.name}")
+    return sorted(_REGISTRY.values(), key=lambda c: (c.order, c.name))
+
+
+def find_lesson(name_or_path: str) -> type[Lesson]:
+    """A lesson by name, or a scene ``.toml`` file; suggest the closest name."""
+    path = Path(name_or_path)
+    if name_or_path.endswith(".toml") or path.is_file():
+        return scene_file_lesson(path)
+    lessons_by_name = {cls.name: cls for cls in all_lessons()}
+    if name_or_path in lessons_by_name:
+        return lessons_by_name[name_or_path]
+    close = difflib.get_close_matches(name_or_path, list(lessons_by_name), n=1, cutoff=0.4)
+    hint = f"; did you mean {close[0]!r}?" if close else ""
+    raise SandboxError(f"unknown lesson {name_or_path!r}{hint} (see glsandbox list)")

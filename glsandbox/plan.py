@@ -1,0 +1,172 @@
+"""Scene -> Plan: only the passes, shader variants and buffers a scene needs.
+
+This is how "simulate only the effects a scene calls for" stays honest: the
+plan is a pure function of the Scene, printed by ``glsandbox plan LESSON`` and
+pinned per lesson by a test. Nothing in here touches GL; the executor in
+:mod:`glsandbox.gl.executor` runs a plan as written, and allocates only the
+buffers the plan lists.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from glsandbox.scene import Node, Scene
+
+
+@dataclass(frozen=True, order=True)
+class ProgramVariant:
+    """A shader file compiled with a set of ``#define`` lines."""
+
+    shader: str
+    defines: tuple[tuple[str, str], ...] = ()
+
+    @property
+    def key(self) -> str:
+        if not self.defines:
+            return self.shader
+        flags = ",".join(name if value == "" else f"{name}={value}" for name, value in self.defines)
+        return f"{self.shader}[{flags}]"
+
+
+@dataclass(frozen=True)
+class Buffers:
+    """What the render target must have. The stencil exists only when a pass uses it."""
+
+    depth: bool
+    stencil: bool
+    samples: int
+
+    def describe(self) -> str:
+        parts = ["colour RGBA8"]
+        if self.depth:
+            parts.append("depth 24")
+        if self.stencil:
+            parts.append("stencil 8")
+        parts.append(f"MSAA {self.samples}x" if self.samples > 1 else "no MSAA")
+        return ", ".join(parts)
+
+
+@dataclass(frozen=True)
+class Draw:
+    """One node drawn with one program variant."""
+
+    node: str
+    program: str  # a ProgramVariant key
+    cull_back_faces: bool
+
+
+@dataclass(frozen=True)
+class Pass:
+    """One step of the frame, restricted to one viewport."""
+
+    kind: str  # "clear" or "draw"
+    viewport: int
+    clear_color: tuple[float, float, float, float] | None = None
+    clear_depth: bool = False
+    clear_stencil: bool = False
+    draws: tuple[Draw, ...] = ()
+    depth_test: bool = False
+
+    def describe(self) -> str:
+        if self.kind == "clear":
+            what = []
+            if self.clear_color is not None:
+                what.append("colour (" + ", ".join(f"{c:g}" for c in self.clear_color) + ")")
+            if self.clear_depth:
+                what.append("depth")
+            if self.clear_stencil:
+                what.append("stencil")
+            return f"clear viewport {self.viewport}: " + " + ".join(what)
+        items = "; ".join(
+            f"{d.node} with {d.program}" + ("" if d.cull_back_faces else " (no culling)") for d in self.draws
+        )
+        depth = "depth test" if self.depth_test else "no depth test"
+        return f"draw viewport {self.viewport} ({depth}): {items}"
+
+
+@dataclass(frozen=True)
+class Plan:
+    """The passes of one frame, in order, and what they need."""
+
+    scene: str
+    buffers: Buffers
+    programs: tuple[ProgramVariant, ...]
+    passes: tuple[Pass, ...]
+
+    def describe(self) -> str:
+        """A readable listing, as ``glsandbox plan`` prints it."""
+        lines = [f"plan for {self.scene}", f"buffers: {self.buffers.describe()}", "programs:"]
+        lines += [f"  {p.key}" for p in self.programs] or ["  (none)"]
+        lines.append("passes:")
+        lines += [f"  {i}. {p.describe()}" for i, p in enumerate(self.passes, start=1)]
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "scene": self.scene,
+            "buffers": {"depth": self.buffers.depth, "stencil": self.buffers.stencil,
+                        "samples": self.buffers.samples},
+            "programs": [p.key for p in self.programs],
+            "passes": [p.describe() for p in self.passes],
+        }
+
+
+def program_for(node: Node) -> ProgramVariant:
+    """The shader variant a node needs: ``basic`` with its colour source."""
+    source = "VERTEX_COLOR" if node.material.shading == "vertex_color" else "SOLID_COLOR"
+    return ProgramVariant("basic", ((source, ""),))
+
+
+def _is_flat(node: Node) -> bool:
+    """Whether a mesh lies in one plane: then it cannot hide parts of itself."""
+    points = np.asarray(node.mesh.positions, dtype=np.float64)
+    spread = points - points.mean(axis=0)
+    singular = np.linalg.svd(spread, compute_uv=False)
+    return len(singular) < 3 or singular[2] <= 1e-9 * max(singular[0], 1e-300)
+
+
+def _needs_depth(scene: Scene) -> bool:
+    """A depth buffer is needed only where something can hide something else:
+    two nodes in one viewport, or one mesh that is not flat."""
+    if not scene.depth_test:
+        return False
+    for index in range(len(scene.viewports)):
+        shown = [n for n in scene.nodes if n.viewports is None or index in n.viewports]
+        if len(shown) > 1 or any(not _is_flat(n) for n in shown):
+            return True
+    return False
+
+
+def plan(scene: Scene) -> Plan:
+    """Plan a frame: per viewport a clear, then a draw of the nodes it shows.
+
+    Depth is allocated, cleared and tested only when something can hide
+    something else (see :func:`_needs_depth`); MSAA only when asked for; the
+    stencil only when a pass uses it (no pass in the foundation lessons does).
+    """
+    uses_depth = _needs_depth(scene)
+    passes: list[Pass] = []
+    programs: set[ProgramVariant] = set()
+    for index, viewport in enumerate(scene.viewports):
+        color = viewport.clear_color if viewport.clear_color is not None else scene.clear_color
+        passes.append(Pass("clear", index, clear_color=color, clear_depth=uses_depth))
+        draws = []
+        for node in scene.nodes:
+            if node.viewports is not None and index not in node.viewports:
+                continue
+            variant = program_for(node)
+            programs.add(variant)
+            draws.append(Draw(node.name, variant.key, node.cull_back_faces))
+        if draws:
+            passes.append(Pass("draw", index, draws=tuple(draws), depth_test=uses_depth))
+    samples = scene.samples if scene.samples > 1 else 0
+    return Plan(
+        scene=scene.name,
+        buffers=Buffers(depth=uses_depth, stencil=any(p.clear_stencil for p in passes), samples=samples),
+        programs=tuple(sorted(programs)),
+        passes=tuple(passes),
+    )

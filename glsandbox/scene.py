@@ -1,0 +1,336 @@
+"""The Scene: plain data that both renderers read. No GL here.
+
+A lesson builds a :class:`Scene` in Python; a TOML file can describe one too
+(:func:`load_scene`). Coordinates are OpenGL's (right-handed, camera looking
+down -z); see :mod:`glsandbox.transforms` for the course's DirectX form.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from glsandbox import transforms
+from glsandbox.errors import SandboxError
+from glsandbox.geometry import Mesh, builtin_mesh
+
+Color = tuple[float, float, float, float]
+
+#: The course's clear colour, ``{0.0f, 0.125f, 0.6f, 1.0f}`` ("DirectX 11").
+COURSE_BLUE: Color = (0.0, 0.125, 0.6, 1.0)
+
+#: How a node's surface gets its colour (each is a shader variant).
+SHADINGS = ("solid", "vertex_color")
+
+
+@dataclass(frozen=True)
+class Camera:
+    """A perspective camera. Defaults are the course's: eye (0,3,-10) in
+    DirectX, i.e. (0,3,10) in OpenGL, looking at the origin, up (0,1,0),
+    45° vertical field of view, near 0.01, far 100."""
+
+    eye: tuple[float, float, float] = (0.0, 3.0, 10.0)
+    target: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    up: tuple[float, float, float] = (0.0, 1.0, 0.0)
+    fov_y: float = 45.0
+    near: float = 0.01
+    far: float = 100.0
+
+    def view(self) -> np.ndarray:
+        return transforms.look_at(self.eye, self.target, self.up)
+
+    def projection(self, aspect: float) -> np.ndarray:
+        return transforms.perspective(self.fov_y, aspect, self.near, self.far)
+
+
+@dataclass(frozen=True)
+class Light:
+    """A point light."""
+
+    position: tuple[float, float, float]
+    color: tuple[float, float, float] = (1.0, 1.0, 1.0)
+
+
+@dataclass(frozen=True)
+class Material:
+    """How a surface is coloured: a flat colour or the mesh's vertex colours."""
+
+    color: Color = (1.0, 1.0, 1.0, 1.0)
+    shading: str = "solid"
+
+    def __post_init__(self) -> None:
+        if self.shading not in SHADINGS:
+            raise SandboxError(f"unknown shading {self.shading!r}; use one of {', '.join(SHADINGS)}")
+
+
+@dataclass(frozen=True, eq=False)
+class Node:
+    """A mesh placed in the world with a model matrix and a material.
+
+    ``cull_back_faces`` is the rasterizer state (on by default, as in the
+    course); ``viewports`` limits the node to some viewports (None: all).
+    """
+
+    name: str
+    mesh: Mesh
+    model: np.ndarray = field(default_factory=lambda: np.eye(4))
+    material: Material = Material()
+    cull_back_faces: bool = True
+    viewports: tuple[int, ...] | None = None
+
+
+@dataclass(frozen=True)
+class Viewport:
+    """A rectangle of the frame, in fractions of its size from the bottom left.
+
+    Several viewports make the course's split screen. Each may clear to its
+    own colour and look through its own camera (None: the scene's).
+    """
+
+    rect: tuple[float, float, float, float] = (0.0, 0.0, 1.0, 1.0)
+    clear_color: Color | None = None
+    camera: Camera | None = None
+    label: str = ""
+
+    def pixels(self, width: int, height: int) -> tuple[int, int, int, int]:
+        """(x, y, w, h) in pixels; edges are rounded so tiles meet without gaps."""
+        x0, y0 = round(self.rect[0] * width), round(self.rect[1] * height)
+        x1 = round((self.rect[0] + self.rect[2]) * width)
+        y1 = round((self.rect[1] + self.rect[3]) * height)
+        return x0, y0, x1 - x0, y1 - y0
+
+
+@dataclass(frozen=True, eq=False)
+class Scene:
+    """Everything a frame shows. Renderers never change it."""
+
+    name: str
+    nodes: tuple[Node, ...] = ()
+    camera: Camera = Camera()
+    lights: tuple[Light, ...] = ()
+    clear_color: Color = COURSE_BLUE
+    viewports: tuple[Viewport, ...] = (Viewport(),)
+    samples: int = 0
+    depth_test: bool = True
+
+
+# --- TOML scene files -------------------------------------------------------
+
+
+class _Locator:
+    """Finds the line of a key in a TOML text, for error messages.
+
+    tomllib gives no positions for values, so this walks the text once,
+    tracking the current ``[table]`` / ``[[array]]`` header.
+    """
+
+    _header = re.compile(r"^\s*(\[\[?)\s*([A-Za-z0-9_.\-]+)\s*\]\]?")
+    _key = re.compile(r"^\s*([A-Za-z0-9_\-]+)\s*=")
+
+    def __init__(self, text: str) -> None:
+        self.lines: dict[tuple[str, int, str], int] = {}
+        self.tables: dict[tuple[str, int], int] = {}
+        counts: dict[str, int] = {}
+        table, index = "", 0
+        for number, line in enumerate(text.splitlines(), start=1):
+            if m := self._header.match(line):
+                table = m.group(2)
+                if m.group(1) == "[[":
+                    index = counts.get(table, 0)
+                    counts[table] = index + 1
+                else:
+                    index = 0
+                self.tables[(table, index)] = number
+            elif m := self._key.match(line):
+                self.lines.setdefault((table, index, m.group(1)), number)
+
+    def line(self, table: str, index: int, key: str | None) -> int | None:
+        if key is not None and (table, index, key) in self.lines:
+            return self.lines[(table, index, key)]
+        return self.tables.get((table, index))
+
+
+class _SceneReader:
+    """Reads one scene file; every error names the file and line."""
+
+    def __init__(self, path: Path, text: str) -> None:
+        self.path = path
+        self.where = _Locator(text)
+
+    def fail(self, table: str, index: int, key: str | None, message: str) -> SandboxError:
+        line = self.where.line(table, index, key)
+        at = f"{self.path}:{line}" if line else str(self.path)
+        name = f"{table}[{index}]" if table in ("nodes", "lights", "viewports") else table
+        label = ".".join(p for p in (name, key) if p)
+        return SandboxError(f"{at}: {label}: {message}" if label else f"{at}: {message}")
+
+    def check_keys(self, data: dict[str, Any], allowed: set[str], table: str, index: int = 0) -> None:
+        for key in data:
+            if key not in allowed:
+                raise self.fail(table, index, key, f"unknown key; expected one of {', '.join(sorted(allowed))}")
+
+    def numbers(self, data: dict[str, Any], key: str, count: tuple[int, ...], table: str,
+                index: int = 0, default: Any = None) -> tuple[float, ...] | None:
+        if key not in data:
+            return default
+        value = data[key]
+        ok = isinstance(value, list) and len(value) in count and all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value)
+        if not ok:
+            want = " or ".join(str(c) for c in count)
+            raise self.fail(table, index, key, f"expected a list of {want} finite numbers, got {value!r}")
+        return tuple(float(v) for v in value)
+
+    def number(self, data: dict[str, Any], key: str, table: str, index: int = 0,
+               default: float | None = None) -> float | None:
+        if key not in data:
+            return default
+        value = data[key]
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise self.fail(table, index, key, f"expected a finite number, got {value!r}")
+        return float(value)
+
+    def color(self, data: dict[str, Any], key: str, table: str, index: int = 0,
+              default: Color | None = None) -> Color | None:
+        rgba = self.numbers(data, key, (3, 4), table, index)
+        if rgba is None:
+            return default
+        if any(not 0.0 <= c <= 1.0 for c in rgba):
+            raise self.fail(table, index, key, f"colour channels must lie in 0..1, got {list(rgba)}")
+        return (*rgba, 1.0) if len(rgba) == 3 else rgba  # type: ignore[return-value]
+
+    def camera(self, data: dict[str, Any]) -> Camera:
+        self.check_keys(data, {"eye", "target", "up", "fov_y", "near", "far"}, "camera")
+        base = Camera()
+        cam = Camera(
+            eye=self.numbers(data, "eye", (3,), "camera", default=base.eye),  # type: ignore[arg-type]
+            target=self.numbers(data, "target", (3,), "camera", default=base.target),  # type: ignore[arg-type]
+            up=self.numbers(data, "up", (3,), "camera", default=base.up),  # type: ignore[arg-type]
+            fov_y=self.number(data, "fov_y", "camera", default=base.fov_y),  # type: ignore[arg-type]
+            near=self.number(data, "near", "camera", default=base.near),  # type: ignore[arg-type]
+            far=self.number(data, "far", "camera", default=base.far),  # type: ignore[arg-type]
+        )
+        try:  # build both matrices once so a degenerate camera is reported here
+            cam.view()
+            cam.projection(1.0)
+        except SandboxError as exc:
+            raise self.fail("camera", 0, None, str(exc)) from None
+        return cam
+
+    def node(self, data: dict[str, Any], i: int) -> Node:
+        allowed = {"name", "mesh", "order", "scale", "translate", "rotate", "color", "shading",
+                   "cull_back_faces", "viewports"}
+        self.check_keys(data, allowed, "nodes", i)
+        mesh_name = data.get("mesh")
+        if not isinstance(mesh_name, str):
+            raise self.fail("nodes", i, "mesh" if "mesh" in data else None, "every node needs mesh = \"<name>\"")
+        try:
+            mesh = builtin_mesh(mesh_name)
+        except SandboxError as exc:
+            raise self.fail("nodes", i, "mesh", str(exc)) from None
+        order = data.get("order", "STR")
+        try:
+            order = transforms.parse_order(order) if isinstance(order, str) else transforms.parse_order(repr(order))
+        except SandboxError as exc:
+            raise self.fail("nodes", i, "order", str(exc)) from None
+        s = self.numbers(data, "scale", (3,), "nodes", i, default=(1.0, 1.0, 1.0))
+        t = self.numbers(data, "translate", (3,), "nodes", i, default=(0.0, 0.0, 0.0))
+        r = self.numbers(data, "rotate", (3,), "nodes", i, default=(0.0, 0.0, 0.0))
+        assert s is not None and t is not None and r is not None
+        rx, ry, rz = (math.radians(a) for a in r)
+        rotation = transforms.rotate_z(rz) @ transforms.rotate_y(ry) @ transforms.rotate_x(rx)
+        model = transforms.compose(order, S=transforms.scale(*s), T=transforms.translate(*t), R=rotation)
+        shading = data.get("shading", "vertex_color" if mesh.colors is not None else "solid")
+        if shading not in SHADINGS:
+            raise self.fail("nodes", i, "shading", f"unknown shading {shading!r}; use one of {', '.join(SHADINGS)}")
+        if shading == "vertex_color" and mesh.colors is None:
+            raise self.fail("nodes", i, "shading", f"mesh {mesh_name!r} has no vertex colours")
+        cull = data.get("cull_back_faces", True)
+        if not isinstance(cull, bool):
+            raise self.fail("nodes", i, "cull_back_faces", f"expected true or false, got {cull!r}")
+        views = data.get("viewports")
+        if views is not None and not (isinstance(views, list) and all(isinstance(v, int) for v in views)):
+            raise self.fail("nodes", i, "viewports", f"expected a list of viewport indices, got {views!r}")
+        return Node(
+            name=str(data.get("name", f"node{i}")),
+            mesh=mesh,
+            model=model,
+            material=Material(color=self.color(data, "color", "nodes", i, default=(1.0, 1.0, 1.0, 1.0)),  # type: ignore[arg-type]
+                              shading=shading),
+            cull_back_faces=cull,
+            viewports=tuple(views) if views is not None else None,
+        )
+
+    def viewport(self, data: dict[str, Any], i: int) -> Viewport:
+        self.check_keys(data, {"rect", "clear_color", "label"}, "viewports", i)
+        rect = self.numbers(data, "rect", (4,), "viewports", i, default=(0.0, 0.0, 1.0, 1.0))
+        assert rect is not None
+        x, y, w, h = rect
+        if w <= 0 or h <= 0 or x < 0 or y < 0 or x + w > 1 + 1e-9 or y + h > 1 + 1e-9:
+            raise self.fail("viewports", i, "rect", f"rect {list(rect)} must lie inside 0..1 with positive size")
+        return Viewport(rect=rect, clear_color=self.color(data, "clear_color", "viewports", i),  # type: ignore[arg-type]
+                        label=str(data.get("label", "")))
+
+    def light(self, data: dict[str, Any], i: int) -> Light:
+        self.check_keys(data, {"position", "color"}, "lights", i)
+        pos = self.numbers(data, "position", (3,), "lights", i)
+        if pos is None:
+            raise self.fail("lights", i, None, "every light needs position = [x, y, z]")
+        col = self.numbers(data, "color", (3,), "lights", i, default=(1.0, 1.0, 1.0))
+        return Light(position=pos, color=col)  # type: ignore[arg-type]
+
+    def scene(self, data: dict[str, Any]) -> Scene:
+        self.check_keys(data, {"name", "clear_color", "camera", "nodes", "lights", "viewports", "depth_test"}, "")
+        tables = {"camera": dict, "nodes": list, "lights": list, "viewports": list}
+        for key, kind in tables.items():
+            if key in data and not isinstance(data[key], kind):
+                shape = f"[{key}]" if kind is dict else f"[[{key}]]"
+                raise self.fail("", 0, key, f"expected a {shape} table")
+        viewports = tuple(self.viewport(v, i) for i, v in enumerate(data.get("viewports", []))) or (Viewport(),)
+        nodes = tuple(self.node(n, i) for i, n in enumerate(data.get("nodes", [])))
+        for i, n in enumerate(nodes):
+            for v in n.viewports or ():
+                if not 0 <= v < len(viewports):
+                    raise self.fail("nodes", i, "viewports", f"viewport {v} does not exist ({len(viewports)} defined)")
+        depth = data.get("depth_test", True)
+        if not isinstance(depth, bool):
+            raise self.fail("", 0, "depth_test", f"expected true or false, got {depth!r}")
+        return Scene(
+            name=str(data.get("name", self.path.stem)),
+            nodes=nodes,
+            camera=self.camera(data.get("camera", {})),
+            lights=tuple(self.light(v, i) for i, v in enumerate(data.get("lights", []))),
+            clear_color=self.color(data, "clear_color", "", default=COURSE_BLUE),  # type: ignore[arg-type]
+            viewports=viewports,
+            depth_test=depth,
+        )
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Read and validate a TOML scene file.
+
+    Errors raise :class:`SandboxError` naming the file and the line, e.g.
+    ``scene.toml:7: nodes[0].mesh: unknown mesh 'cbe'; ...``.
+    """
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise SandboxError(f"{p}: scene file not found") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise SandboxError(f"{p}: cannot read scene file ({exc})") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        # tomllib ends its message with "(at line L, column C)".
+        m = re.search(r"\(at line (\d+), column (\d+)\)", str(exc))
+        where = f"{p}:{m.group(1)}" if m else str(p)
+        reason = re.sub(r"\s*\(at line \d+, column \d+\)", "", str(exc)) or "malformed TOML"
+        raise SandboxError(f"{where}: malformed TOML: {reason}") from None
+    return _SceneReader(p, text).scene(data)

@@ -1,0 +1,238 @@
+"""Matrices: model transforms by order string, camera, projection, conversions.
+
+Conventions (pinned by ``tests/test_transforms.py``)
+----------------------------------------------------
+
+=====================  ==========================  ===============================
+                       the course (DirectX 11)     glsandbox (OpenGL)
+=====================  ==========================  ===============================
+handedness             left-handed, +z into screen right-handed, camera looks -z
+vectors                row vectors, ``v * M``      column vectors, ``M @ v``
+composition            ``S * T * R``: S first      ``R @ T @ S``: S first
+front faces            clockwise on screen         counter-clockwise on screen
+clip-space depth       0 .. 1                      -1 .. 1
+=====================  ==========================  ===============================
+
+The conversion happens in exactly one place, :func:`from_directx_mesh` and its
+helpers below: mirror z (``F = diag(1, 1, -1)``) and swap two indices of every
+triangle. Mirroring z maps the course's view space onto OpenGL's view space
+with the *same* picture on screen, so a triangle that looked clockwise in
+DirectX still looks clockwise; swapping two indices turns it counter-clockwise,
+OpenGL's default front face. A DirectX matrix ``M`` (row-vector form) becomes
+``F @ M.T @ F``: transposed for column vectors, conjugated by the mirror
+(which, for a rotation about y, flips the sign of the angle).
+
+Order strings
+-------------
+A transform order string lists transforms in the order they are *applied to a
+vertex*: ``"STR"`` scales, then translates, then rotates. That is the course's
+``mScale * mTranslate * mRotate`` (row vectors apply left to right) and the
+column-vector matrix ``R @ T @ S``.
+
+pyrr
+----
+This is the only module that imports pyrr. pyrr stores matrices for row
+vectors (translation in the last row) and its ``Matrix44 * Matrix44`` applies
+the *right* operand first; we use its plain functions and transpose their
+results into column-vector form in :func:`_from_pyrr`.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Sequence
+
+import numpy as np
+import pyrr
+
+from glsandbox.errors import SandboxError
+
+Matrix = np.ndarray  # a (4, 4) float64 array acting on column vectors
+
+#: Every permutation of S, T and R, the valid transform order strings.
+ORDERS: tuple[str, ...] = tuple("".join(p) for p in itertools.permutations("STR"))
+
+#: Mirror z: the change of basis between the course's left-handed coordinates
+#: and OpenGL's right-handed ones. It is its own inverse.
+MIRROR_Z: Matrix = np.diag([1.0, 1.0, -1.0, 1.0])
+
+
+def _vec3(value: Sequence[float] | np.ndarray, name: str = "vector") -> np.ndarray:
+    arr = np.asarray(value, dtype=np.float64).reshape(-1)
+    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
+        raise SandboxError(f"{name} must be three finite numbers, got {value!r}")
+    return arr
+
+
+# --- model transforms -------------------------------------------------------
+
+
+def identity() -> Matrix:
+    """The 4x4 identity."""
+    return np.eye(4)
+
+
+def translate(x: float, y: float, z: float) -> Matrix:
+    """Translation by (x, y, z): the last column carries the offset."""
+    m = np.eye(4)
+    m[:3, 3] = (x, y, z)
+    return m
+
+
+def scale(x: float, y: float, z: float) -> Matrix:
+    """Non-uniform scale along the axes."""
+    return np.diag([float(x), float(y), float(z), 1.0])
+
+
+def rotate_x(angle: float) -> Matrix:
+    """Right-handed rotation about +x by ``angle`` radians (y turns towards z)."""
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[1, 0, 0, 0], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1]], dtype=np.float64)
+
+
+def rotate_y(angle: float) -> Matrix:
+    """Right-handed rotation about +y by ``angle`` radians (z turns towards x)."""
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, 0, s, 0], [0, 1, 0, 0], [-s, 0, c, 0], [0, 0, 0, 1]], dtype=np.float64)
+
+
+def rotate_z(angle: float) -> Matrix:
+    """Right-handed rotation about +z by ``angle`` radians (x turns towards y)."""
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], dtype=np.float64)
+
+
+def parse_order(order: str) -> str:
+    """Validate a transform order string; return it upper-cased.
+
+    Raises :class:`SandboxError` listing the valid strings when ``order`` is
+    not a permutation of S, T and R.
+    """
+    text = str(order).strip().upper()
+    if text not in ORDERS:
+        raise SandboxError(
+            f"order {order!r} is not a permutation of S, T, R; valid orders: {', '.join(ORDERS)}"
+        )
+    return text
+
+
+def compose(order: str, *, S: Matrix, T: Matrix, R: Matrix) -> Matrix:
+    """Compose S, T and R in the order they are applied to a vertex.
+
+    ``compose("STR", ...)`` is ``R @ T @ S``, the course's
+    ``mScale * mTranslate * mRotate``: each later transform multiplies from the
+    left, because with column vectors the matrix nearest the vertex acts first.
+    """
+    parts = {"S": S, "T": T, "R": R}
+    m = np.eye(4)
+    for letter in parse_order(order):
+        m = parts[letter] @ m
+    return m
+
+
+def normal_matrix(model: Matrix) -> np.ndarray:
+    """The 3x3 inverse transpose of the model matrix's upper-left block.
+
+    Normals are covectors: under a non-uniform scale ``diag(a, b, c)`` a
+    tangent stretches by (a, b, c) but the normal must shrink by (1/a, 1/b,
+    1/c) to stay perpendicular. The course's ``mul(Input.Norm, world)`` is
+    only right for rotations and uniform scales (see COURSE.md errata).
+    """
+    block = np.asarray(model, dtype=np.float64)[:3, :3]
+    if abs(np.linalg.det(block)) < 1e-300:
+        raise SandboxError("model matrix is singular: its normal matrix does not exist")
+    return np.linalg.inv(block).T
+
+
+def transform_points(m: Matrix, points: np.ndarray) -> np.ndarray:
+    """Apply a 4x4 matrix to an (N, 3) array of points (w = 1), with the divide."""
+    pts = np.asarray(points, dtype=np.float64)
+    homo = np.hstack([pts, np.ones((len(pts), 1))]) @ np.asarray(m, dtype=np.float64).T
+    return homo[:, :3] / homo[:, 3:4]
+
+
+# --- camera and projection --------------------------------------------------
+
+
+def _from_pyrr(m: np.ndarray) -> Matrix:
+    """pyrr builds matrices for row vectors; transpose into column-vector form."""
+    return np.asarray(m, dtype=np.float64).T.copy()
+
+
+def look_at(eye: Sequence[float], target: Sequence[float], up: Sequence[float]) -> Matrix:
+    """A right-handed view matrix: the camera at ``eye`` looks at ``target``.
+
+    The view direction ``f = normalize(target - eye)`` and the up vector span
+    the camera's vertical plane; their cross product is the camera's right
+    axis. When ``up`` is parallel to ``f`` that cross product is zero and no
+    camera exists (the course's up (0,0,1) looking along z): that is refused
+    here with a clear message instead of silently producing NaNs.
+    """
+    e, t, u = _vec3(eye, "eye"), _vec3(target, "target"), _vec3(up, "up")
+    forward = t - e
+    f_len = float(np.linalg.norm(forward))
+    u_len = float(np.linalg.norm(u))
+    if f_len == 0.0:
+        raise SandboxError(f"camera eye and target are the same point {tuple(e)}")
+    if u_len == 0.0:
+        raise SandboxError("camera up vector is zero")
+    # sin of the angle between up and the view direction.
+    sin_angle = float(np.linalg.norm(np.cross(forward / f_len, u / u_len)))
+    if sin_angle < 1e-9:
+        raise SandboxError(
+            f"camera up {tuple(u)} is parallel to the view direction {tuple(forward / f_len)}: "
+            "no camera orientation exists; choose an up vector not along the view"
+        )
+    return _from_pyrr(pyrr.matrix44.create_look_at(e, t, u, dtype=np.float64))
+
+
+def perspective(fovy_degrees: float, aspect: float, near: float, far: float) -> Matrix:
+    """OpenGL perspective projection (clip-space depth -1..1).
+
+    The course's ``XMMatrixPerspectiveFovLH(XM_PIDIV4, w/h, 0.01, 100)`` maps
+    depth to 0..1 instead; the picture (x and y) is the same.
+    """
+    if not 0.0 < fovy_degrees < 180.0:
+        raise SandboxError(f"field of view must be between 0 and 180 degrees, got {fovy_degrees}")
+    if not 0.0 < near < far:
+        raise SandboxError(f"need 0 < near < far, got near={near}, far={far}")
+    if aspect <= 0.0:
+        raise SandboxError(f"aspect ratio must be positive, got {aspect}")
+    return _from_pyrr(
+        pyrr.matrix44.create_perspective_projection(fovy_degrees, aspect, near, far, dtype=np.float64)
+    )
+
+
+# --- the one DirectX -> OpenGL conversion -----------------------------------
+
+
+def from_directx_point(p: Sequence[float]) -> np.ndarray:
+    """A point or direction given in the course's left-handed coordinates."""
+    x, y, z = _vec3(p, "point")
+    return np.array([x, y, -z])
+
+
+def from_directx_matrix(m_row: np.ndarray) -> Matrix:
+    """A DirectX (row-vector, left-handed) 4x4 matrix in OpenGL form."""
+    return MIRROR_Z @ np.asarray(m_row, dtype=np.float64).T @ MIRROR_Z
+
+
+def from_directx_mesh(positions: np.ndarray, indices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Convert course vertex and index buffers: mirror z, swap two indices per triangle.
+
+    The clockwise-front triangle ``(a, b, c)`` of the course becomes
+    ``(a, c, b)``, counter-clockwise-front, OpenGL's default.
+    """
+    pos = np.asarray(positions, dtype=np.float64).copy()
+    pos[:, 2] = -pos[:, 2]
+    tri = np.asarray(indices, dtype=np.int64).reshape(-1, 3)[:, [0, 2, 1]]
+    return pos, tri.reshape(-1).copy()
+
+
+# --- upload -----------------------------------------------------------------
+
+
+def gl_bytes(m: np.ndarray) -> bytes:
+    """Bytes for a GLSL ``mat3``/``mat4`` uniform: float32, column-major."""
+    return np.ascontiguousarray(np.asarray(m, dtype=np.float32).T).tobytes()

@@ -1,0 +1,70 @@
+"""Lesson 3: the indexed cube, with world, view and projection.
+
+Course section "Küp: vertex + index buffer, 36 indices" and "Vertex/pixel
+shader; World, View, Projection". Eight corners go in a vertex buffer once;
+the index buffer lists them three per triangle, 36 indices for 12 triangles,
+instead of 36 full vertices. The camera is the course's: eye (0, 3, -10) in
+DirectX's left-handed coordinates, which is (0, 3, 10) in OpenGL's, looking
+at the origin, up (0, 1, 0), 45° field of view, near 0.01, far 100.
+``glsandbox.transforms`` documents the one place the conversion happens.
+
+The cube turns about y as the tutorial's ``XMMatrixRotationY(t)`` does. With
+``--set flip=front`` the two triangles of the face towards the camera get
+their winding swapped: they become back faces, culling drops them, and the
+hole shows the background (the inner sides of the other faces are back faces
+too).
+"""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+
+from glsandbox import geometry, transforms
+from glsandbox.app import lesson_main
+from glsandbox.lesson import Lesson, Param, register
+from glsandbox.scene import Camera, Material, Node, Scene
+
+#: Which two of the 12 triangles make each face, in the course's index order.
+FACE_TRIANGLES = {"top": (0, 1), "front": (2, 3)}
+
+
+def cube_with_flipped_face(face: str) -> geometry.Mesh:
+    """The course cube with one face's two triangles wound the other way."""
+    mesh = geometry.cube()
+    if face == "none":
+        return mesh
+    tri = mesh.indices.reshape(-1, 3).copy()
+    for k in FACE_TRIANGLES[face]:
+        tri[k] = tri[k][[0, 2, 1]]
+    return geometry.Mesh(f"cube_flip_{face}", mesh.positions, tri.reshape(-1), colors=mesh.colors)
+
+
+@register
+class IndexedCube(Lesson):
+    name = "indexed_cube"
+    title = "The indexed cube: 8 vertices, 36 indices"
+    course_section = "Küp: vertex + index buffer; World, View, Projection"
+    order = 30
+    animated = True
+    params = (
+        Param("speed", 1.0, "turn rate in radians per second (XMMatrixRotationY(t))"),
+        Param("flip", "none", "swap the winding of one face's triangles", choices=("none", "front", "top")),
+        Param("cull", True, "back-face culling"),
+    )
+
+    def build(self) -> Scene:
+        angle = float(self.values["speed"]) * self.time
+        # DirectX's XMMatrixRotationY(angle), converted by the z mirror.
+        dx_rotation = np.array([[np.cos(angle), 0, -np.sin(angle), 0], [0, 1, 0, 0],
+                                [np.sin(angle), 0, np.cos(angle), 0], [0, 0, 0, 1]])
+        model = transforms.from_directx_matrix(dx_rotation)
+        node = Node("cube", cube_with_flipped_face(self.values["flip"]), model,
+                    Material(shading="vertex_color"), cull_back_faces=bool(self.values["cull"]))
+        eye = tuple(transforms.from_directx_point((0.0, 3.0, -10.0)))
+        return Scene(self.name, nodes=(node,), camera=Camera(eye=eye, fov_y=45.0, near=0.01, far=100.0))
+
+
+if __name__ == "__main__":
+    sys.exit(lesson_main(IndexedCube))
