@@ -67,3 +67,71 @@ def golden(request: pytest.FixtureRequest) -> GoldenCheck:
         )
 
     return check
+
+
+# --- GL backends and displays ------------------------------------------------
+# Tests that need a GL backend or an X server skip locally when it is missing,
+# and fail when CI is set: on CI a missing backend is a broken set-up, never a
+# reason to pass.
+
+
+def need(resource: str, reason: str) -> None:
+    """Skip (locally) or fail (CI) because ``resource`` is unavailable."""
+    message = f"{resource} unavailable: {reason}"
+    if os.environ.get("CI"):
+        pytest.fail(f"{message} (CI is set, so this fails instead of skipping)", pytrace=False)
+    pytest.skip(message)
+
+
+@pytest.fixture(scope="session")
+def gl_renderer():
+    """A headless renderer on the default backend (EGL, else OSMesa), shared by the session."""
+    from glsandbox.app import HeadlessRenderer
+    from glsandbox.errors import SandboxError
+
+    try:
+        renderer = HeadlessRenderer()
+    except SandboxError as exc:
+        need("headless OpenGL", str(exc))
+    yield renderer
+    renderer.close()
+
+
+@pytest.fixture
+def gl(gl_renderer):
+    """The shared :class:`~glsandbox.app.HeadlessRenderer` (``gl.render(lesson, size)``)."""
+    return gl_renderer
+
+
+def backend_available(name: str) -> str | None:
+    """None when the backend starts here, else the reason (in a subprocess,
+    so a failed start cannot disturb this process's contexts)."""
+    import subprocess
+    import sys
+
+    code = ("from glsandbox.gl.context import open_context; import sys; "
+            f"h = open_context({name!r}); h.release()")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    return None if proc.returncode == 0 else (proc.stderr.strip().splitlines() or ["failed"])[-1]
+
+
+@pytest.fixture(scope="session")
+def xvfb_display():
+    """A private Xvfb server for window tests; yields its DISPLAY (e.g. ':5')."""
+    import shutil
+    import subprocess
+
+    if shutil.which("Xvfb") is None:
+        need("Xvfb", "the Xvfb binary is not installed (apt-get install xvfb)")
+    read_fd, write_fd = os.pipe()
+    proc = subprocess.Popen(["Xvfb", "-displayfd", str(write_fd), "-screen", "0", "800x600x24", "-nolisten", "tcp"],
+                            pass_fds=(write_fd,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    os.close(write_fd)
+    with os.fdopen(read_fd) as pipe:
+        number = pipe.readline().strip()
+    if not number:
+        proc.kill()
+        need("Xvfb", "the server did not start")
+    yield f":{number}"
+    proc.terminate()
+    proc.wait(timeout=10)
