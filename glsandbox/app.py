@@ -106,8 +106,16 @@ def render_to_file(lesson: Lesson, out: Path, size: tuple[int, int], samples: in
     check_writable(out)
     with HeadlessRenderer(backend) as renderer:
         frame = renderer.render(lesson, size, samples)
-    save_png(frame.image, out)
+    write_png(frame.image, out)
     return frame
+
+
+def write_png(image: np.ndarray, out: Path) -> None:
+    """Write a PNG atomically; an OS failure becomes a one-line error naming the file."""
+    try:
+        save_png(image, out)
+    except OSError as exc:
+        raise SandboxError(f"--out {out}: cannot write ({exc.strerror or exc})") from None
 
 
 # --- the window -------------------------------------------------------------

@@ -82,8 +82,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def cmd_tour(args: argparse.Namespace) -> int:
-    from glsandbox.app import HeadlessRenderer
-    from glsandbox.golden import save_png
+    from glsandbox.app import HeadlessRenderer, write_png
     from glsandbox.lesson import all_lessons
 
     out: Path = args.out
@@ -106,7 +105,7 @@ def cmd_tour(args: argparse.Namespace) -> int:
             try:
                 frame = renderer.render(cls(), size, args.samples)
                 image_path = out / f"{cls.name}.png"
-                save_png(frame.image, image_path)
+                write_png(frame.image, image_path)
                 entry.update(ok=True, image=image_path.name, render_ms=round(frame.seconds * 1000, 2),
                              plan=frame.plan.to_dict(), plan_text=frame.plan.describe())
                 print(f"{prefix}: ok, {frame.seconds * 1000:.1f} ms", file=sys.stderr, flush=True)

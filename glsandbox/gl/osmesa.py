@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import ctypes
 import ctypes.util
+import os
 
 from glsandbox.errors import SandboxError
 
@@ -29,6 +30,13 @@ INSTALL_HINT = "install it with: apt-get install libosmesa6"
 
 
 def _load_library() -> ctypes.CDLL:
+    """libOSMesa: ``GLSANDBOX_OSMESA`` (a path, for a custom Mesa build) or the system's."""
+    override = os.environ.get("GLSANDBOX_OSMESA")
+    if override:
+        try:
+            return ctypes.CDLL(override)
+        except OSError:
+            raise SandboxError(f"OSMesa backend unavailable: cannot load GLSANDBOX_OSMESA={override}") from None
     names = ["libOSMesa.so.8", "libOSMesa.so.6", "libOSMesa.so"]
     found = ctypes.util.find_library("OSMesa")
     if found:

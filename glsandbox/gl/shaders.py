@@ -12,15 +12,17 @@ compile::
     ...
     #endif
 
-Includes are spliced in with ``#line <line> <file-number>`` directives, so the
-compiler's messages (Mesa writes ``<file>:<line>(<col>): error: ...``) name the
-original file and line, which :func:`compile_program` puts into a one-line
-:class:`SandboxError`. GLSL 3.30 and later: after ``#line N``, the next line
-is line N.
+Includes are spliced in, and the loader keeps, for every line of the
+assembled text, the file and line it came from. The compiler's messages
+(Mesa writes ``<string>:<line>(<col>): error: ...``) are mapped through that
+table into a one-line :class:`SandboxError` naming the original file and
+line. (``#line`` directives with source-string numbers would do the same in
+theory, but Mesa 22 attributes some errors to the wrong string.)
 """
 
 from __future__ import annotations
 
+import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -37,9 +39,31 @@ _STAGES = {"vertex_shader": "VERTEX_SHADER", "fragment_shader": "FRAGMENT_SHADER
 _MESSAGE = re.compile(r"(?:ERROR:\s*)?(\d+)[:(](\d+)\)?(?:\(\d+\))?\s*:\s*(.*)")
 
 
+def shader_roots() -> list[Path]:
+    """Folders searched for shader files, first match wins: ``GLSANDBOX_SHADER_DIR``
+    (your own edited copies, e.g. to experiment and reload with R), then the
+    built-in ones."""
+    roots = []
+    override = os.environ.get("GLSANDBOX_SHADER_DIR")
+    if override:
+        if not Path(override).is_dir():
+            raise SandboxError(f"GLSANDBOX_SHADER_DIR={override} is not a folder")
+        roots.append(Path(override).resolve())
+    roots.append(shader_root())
+    return roots
+
+
+def find_shader_file(relative: str, roots: list[Path]) -> Path:
+    """The first existing ``root/relative``, else the built-in path (reported as missing)."""
+    for root in roots:
+        if (root / relative).is_file():
+            return root / relative
+    return roots[-1] / relative
+
+
 def shader_root() -> Path:
-    """Where the shader files are: inside the installed package (a wheel) or
-    the repository's ``shaders/`` folder (a source checkout)."""
+    """Where the built-in shader files are: inside the installed package (a
+    wheel) or the repository's ``shaders/`` folder (a source checkout)."""
     here = Path(__file__).resolve().parent.parent
     for candidate in (here / "shaders", here.parent / "shaders"):
         if candidate.is_dir():
@@ -49,26 +73,31 @@ def shader_root() -> Path:
 
 @dataclass
 class Source:
-    """A shader stage's text and the files its ``#line`` numbers refer to."""
+    """A shader stage's text, and for each of its lines the file and line it came from."""
 
     text: str
-    files: list[Path]
+    origins: list[tuple[Path, int]]
 
-    def file_name(self, number: int) -> str:
-        if 0 <= number < len(self.files):
-            path = self.files[number]
-            try:
-                return str(path.relative_to(shader_root().parent))
-            except ValueError:
-                return str(path)
-        return f"<source {number}>"
+    def locate(self, line: int) -> str:
+        """``file:line`` of line ``line`` (1-based) of the assembled text."""
+        if 1 <= line <= len(self.origins):
+            path, original = self.origins[line - 1]
+            return f"{path}:{original}"
+        return f"{self.origins[0][0]}:?" if self.origins else "<shader>"
 
 
 def assemble(name: str, stage: str, defines: tuple[tuple[str, str], ...] = (), root: Path | None = None) -> Source:
-    """Read ``<root>/<name>.glsl`` for one stage, with includes and defines."""
-    base = root or shader_root()
-    files: list[Path] = []
+    """Read ``<name>.glsl`` for one stage, with includes and defines.
+
+    ``root`` searches one folder only; by default :func:`shader_roots`.
+    """
+    roots = [root] if root is not None else shader_roots()
     out: list[str] = []
+    origins: list[tuple[Path, int]] = []
+
+    def emit(text: str, path: Path, line_no: int) -> None:
+        out.append(text)
+        origins.append((path, line_no))
 
     def read(path: Path, included_from: str | None, stack: tuple[Path, ...]) -> None:
         if path in stack:
@@ -78,32 +107,30 @@ def assemble(name: str, stage: str, defines: tuple[tuple[str, str], ...] = (), r
         except OSError:
             where = f"{included_from}: " if included_from else ""
             raise SandboxError(f"{where}shader file {path} not found") from None
-        number = len(files)
-        files.append(path)
         for line_no, line in enumerate(lines, start=1):
             if _VERSION.match(line):
                 if included_from is not None:
                     raise SandboxError(f"{path}:{line_no}: #version is only allowed in the top file")
-                out.append(line)
-                out.append(f"#define {_STAGES[stage]}")
-                out.extend(f"#define {k} {v}".rstrip() for k, v in defines)
-                out.append(f"#line {line_no + 1} {number}")
+                emit(line, path, line_no)
+                # Injected lines are attributed to the #version line.
+                emit(f"#define {_STAGES[stage]}", path, line_no)
+                for key, value in defines:
+                    emit(f"#define {key} {value}".rstrip(), path, line_no)
                 continue
             include = _INCLUDE.match(line)
             if include:
-                read(base / include.group(1), f"{path}:{line_no}", (*stack, path))
-                out.append(f"#line {line_no + 1} {number}")
+                read(find_shader_file(include.group(1), roots), f"{path}:{line_no}", (*stack, path))
                 continue
-            out.append(line)
+            emit(line, path, line_no)
 
-    top = base / f"{name}.glsl"
+    top = find_shader_file(f"{name}.glsl", roots)
     if not top.is_file():
-        known = sorted(p.stem for p in base.glob("*.glsl"))
-        raise SandboxError(f"shader {name!r} not found in {base}; known: {', '.join(known)}")
+        known = sorted({p.stem for r in roots for p in r.glob("*.glsl")})
+        raise SandboxError(f"shader {name!r} not found in {', '.join(map(str, roots))}; known: {', '.join(known)}")
     read(top, None, ())
     if not out or not _VERSION.match(out[0]):
         raise SandboxError(f"{top}:1: a shader file must start with #version")
-    return Source("\n".join(out) + "\n", files)
+    return Source("\n".join(out) + "\n", origins)
 
 
 def _first_error(log: str, source: Source, stage: str) -> str:
@@ -111,9 +138,9 @@ def _first_error(log: str, source: Source, stage: str) -> str:
         m = _MESSAGE.match(line.strip())
         if m and ("error" in m.group(3).lower() or line.strip().upper().startswith("ERROR")):
             message = re.sub(r"^error:\s*", "", m.group(3).strip(), flags=re.I)
-            return f"{source.file_name(int(m.group(1)))}:{m.group(2)}: {message} ({stage.replace('_', ' ')})"
+            return f"{source.locate(int(m.group(2)))}: {message} ({stage.replace('_', ' ')})"
     first = next((ln.strip() for ln in log.splitlines() if "error" in ln.lower()), log.strip())
-    return f"{source.file_name(0)}: {first} ({stage.replace('_', ' ')})"
+    return f"{source.locate(0)}: {first} ({stage.replace('_', ' ')})"
 
 
 def compile_program(ctx: moderngl.Context, variant: ProgramVariant, root: Path | None = None) -> moderngl.Program:
