@@ -1,0 +1,143 @@
+"""The interactive window under Xvfb: open a lesson, send keys, read the screen, quit."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import need
+
+from glsandbox.golden import compare_images, load_png
+from glsandbox.lesson import find_lesson
+
+REPO = Path(__file__).resolve().parent.parent
+COURSE_BLUE = (0, 32, 153)
+
+
+class LessonWindow:
+    """A lesson running in its own process on the test's X server."""
+
+    def __init__(self, display: str, cwd: Path, *args: str, env: dict | None = None) -> None:
+        self.env = {**os.environ, "DISPLAY": display, **(env or {})}
+        self.display = display
+        self.proc = subprocess.Popen([sys.executable, "-m", *args], cwd=cwd, env=self.env,
+                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.window = self._wait(lambda: self._xdotool("search", "--name", "glsandbox").split()[:1])[0]
+
+    def _xdotool(self, *args: str) -> str:
+        proc = subprocess.run(["xdotool", *args], capture_output=True, text=True, env=self.env, timeout=20)
+        return proc.stdout.strip()
+
+    def _wait(self, probe, timeout: float = 30.0):
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if self.proc.poll() is not None:
+                raise AssertionError(f"lesson exited early: {self.proc.stderr.read()}")
+            value = probe()
+            if value:
+                return value
+            time.sleep(0.1)
+        raise AssertionError("timed out waiting for the lesson window")
+
+    def title(self) -> str:
+        return self._xdotool("getwindowname", self.window)
+
+    def wait_title(self, predicate) -> str:
+        return self._wait(lambda: (t := self.title()) and predicate(t) and t)
+
+    def key(self, name: str) -> None:
+        self._xdotool("windowfocus", "--sync", self.window)
+        self._xdotool("key", "--window", self.window, name)
+
+    def screen(self) -> np.ndarray:
+        from PIL import ImageGrab
+
+        return np.asarray(ImageGrab.grab(xdisplay=self.display).convert("RGB"))
+
+    def close(self) -> int:
+        self.key("Escape")
+        try:
+            return self.proc.wait(timeout=20)
+        finally:
+            if self.proc.poll() is None:
+                self.proc.kill()
+
+
+@pytest.fixture
+def window_env(xvfb_display: str) -> str:
+    if shutil.which("xdotool") is None:
+        need("xdotool", "not installed (apt-get install xdotool)")
+    return xvfb_display
+
+
+def wait_for(path: Path, timeout: float = 20.0) -> Path:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if path.exists():
+            time.sleep(0.2)  # the file is written atomically; give the rename a moment
+            return path
+        time.sleep(0.1)
+    raise AssertionError(f"{path} was not written")
+
+
+def test_window_shows_the_lesson_saves_screenshots_resizes_and_quits(window_env: str, tmp_path: Path,
+                                                                      gl) -> None:
+    win = LessonWindow(window_env, tmp_path, "lessons.indexed_cube", "--size", "320x240", "--set", "speed=0")
+    try:
+        title = win.wait_title(lambda t: "fps" in t)
+        assert title.startswith("glsandbox: indexed_cube | ")
+        screen = win.screen()
+        # The window sits at the top left of the screen: course blue around a cube.
+        assert tuple(screen[5, 5]) == COURSE_BLUE
+        assert tuple(screen[120, 160]) != COURSE_BLUE
+        assert tuple(screen[300, 500]) != COURSE_BLUE  # outside the window: the X root
+
+        win.key("F12")
+        shot = load_png(wait_for(tmp_path / "screenshots" / "indexed_cube-1.png"))
+        assert shot.shape == (240, 320, 4)
+        headless = gl.render(find_lesson("indexed_cube")(speed=0.0), (320, 240)).image
+        assert compare_images(shot, headless).passed  # the window shows what headless renders
+
+        win._xdotool("windowsize", "--sync", win.window, "400", "300")
+        time.sleep(0.5)
+        win.key("F12")
+        resized = load_png(wait_for(tmp_path / "screenshots" / "indexed_cube-2.png"))
+        assert resized.shape == (300, 400, 4)
+        assert compare_images(resized, gl.render(find_lesson("indexed_cube")(speed=0.0), (400, 300)).image).passed
+    finally:
+        code = win.close()
+    assert code == 0
+
+
+def test_r_reloads_shaders_and_a_broken_one_keeps_the_last_good_program(window_env: str, tmp_path: Path) -> None:
+    shaders = tmp_path / "shaders"
+    shutil.copytree(REPO / "shaders", shaders)
+    basic = shaders / "basic.glsl"
+    good = basic.read_text()
+    win = LessonWindow(window_env, tmp_path, "lessons.triangle", "--size", "320x240",
+                       env={"GLSANDBOX_SHADER_DIR": str(shaders)})
+    try:
+        win.wait_title(lambda t: "fps" in t)
+        before = win.screen()[:240, :320]
+        basic.write_text(good.replace("frag_color = u_color;", "frag_color = u_color * broken;"))
+        win.key("r")
+        title = win.wait_title(lambda t: "shader error" in t)
+        assert "basic.glsl" in title and "broken" in title
+        time.sleep(0.3)
+        np.testing.assert_array_equal(win.screen()[:240, :320], before)  # still drawing with the old program
+        # A visible edit, then R again: the new shader is used and the error is gone.
+        basic.write_text(good.replace("frag_color = u_color;", "frag_color = vec4(0.0, 1.0, 0.0, 1.0);"))
+        win.key("r")
+        win.wait_title(lambda t: "fps" in t and "shader error" not in t)
+        time.sleep(0.3)
+        assert tuple(win.screen()[120, 80]) == (0, 255, 0)
+    finally:
+        code = win.close()
+    assert code == 0
+    assert "error: shader does not compile" in win.proc.stderr.read()
