@@ -1,0 +1,51 @@
+"""The built wheel carries the shaders and lessons: install it elsewhere and render."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import zipfile
+from pathlib import Path
+
+import pytest
+from conftest import need
+
+from glsandbox.golden import load_png
+
+REPO = Path(__file__).resolve().parent.parent
+
+
+def run(*args: str, cwd: Path) -> subprocess.CompletedProcess:
+    env = {k: v for k, v in os.environ.items() if k not in ("VIRTUAL_ENV", "GLSANDBOX_SHADER_DIR")}
+    proc = subprocess.run(args, cwd=cwd, capture_output=True, text=True, timeout=300, env=env)
+    assert proc.returncode == 0, f"{' '.join(args)}\n{proc.stdout}\n{proc.stderr}"
+    return proc
+
+
+def test_wheel_installs_in_a_fresh_venv_and_renders_outside_the_repository(tmp_path: Path, gl) -> None:
+    uv = shutil.which("uv")
+    if uv is None:
+        need("uv", "not on PATH")
+    dist = tmp_path / "dist"
+    run(uv, "build", "--wheel", "--out-dir", str(dist), str(REPO), cwd=tmp_path)
+    wheel = next(dist.glob("glsandbox-*.whl"))
+    names = zipfile.ZipFile(wheel).namelist()
+    assert "glsandbox/shaders/basic.glsl" in names and "glsandbox/shaders/common/transform.glsl" in names
+    assert "lessons/indexed_cube.py" in names
+
+    venv = tmp_path / "venv"
+    run(uv, "venv", "--quiet", str(venv), cwd=tmp_path)
+    python = venv / "bin" / "python"
+    run(uv, "pip", "install", "--quiet", "--python", str(python), str(wheel), cwd=tmp_path)
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    run(str(venv / "bin" / "glsandbox"), "render", "indexed_cube", "--size", "64x48", "--out", "cube.png",
+        cwd=elsewhere)
+    run(str(python), "-m", "lessons.triangle", "--headless", "--out", "tri.png", "--size", "64x48", cwd=elsewhere)
+    assert load_png(elsewhere / "cube.png").shape == (48, 64, 4)
+    assert load_png(elsewhere / "tri.png").shape == (48, 64, 4)
+    # The installed copy found its own shaders, not the repository's.
+    located = run(str(python), "-c", "from glsandbox.gl.shaders import shader_root; print(shader_root())",
+                  cwd=elsewhere).stdout.strip()
+    assert located.startswith(str(venv))
