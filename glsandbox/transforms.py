@@ -39,6 +39,7 @@ results into column-vector form in :func:`_from_pyrr`.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from collections.abc import Sequence
@@ -161,6 +162,18 @@ def _from_pyrr(m: np.ndarray) -> Matrix:
 
 
 def look_at(eye: Sequence[float], target: Sequence[float], up: Sequence[float]) -> Matrix:
+    """A right-handed view matrix (see :func:`_look_at`); cached by value,
+    since a camera usually stays put for many frames. Returns a fresh copy."""
+    key = (tuple(map(float, eye)), tuple(map(float, target)), tuple(map(float, up)))
+    return _look_at_cached(*key).copy()
+
+
+@functools.lru_cache(maxsize=256)
+def _look_at_cached(eye: tuple, target: tuple, up: tuple) -> Matrix:
+    return _look_at(eye, target, up)
+
+
+def _look_at(eye: Sequence[float], target: Sequence[float], up: Sequence[float]) -> Matrix:
     """A right-handed view matrix: the camera at ``eye`` looks at ``target``.
 
     The view direction ``f = normalize(target - eye)`` and the up vector span
@@ -188,6 +201,16 @@ def look_at(eye: Sequence[float], target: Sequence[float], up: Sequence[float]) 
 
 
 def perspective(fovy_degrees: float, aspect: float, near: float, far: float) -> Matrix:
+    """OpenGL perspective projection (see :func:`_perspective`), cached by value."""
+    return _perspective_cached(float(fovy_degrees), float(aspect), float(near), float(far)).copy()
+
+
+@functools.lru_cache(maxsize=256)
+def _perspective_cached(fovy_degrees: float, aspect: float, near: float, far: float) -> Matrix:
+    return _perspective(fovy_degrees, aspect, near, far)
+
+
+def _perspective(fovy_degrees: float, aspect: float, near: float, far: float) -> Matrix:
     """OpenGL perspective projection (clip-space depth -1..1).
 
     The course's ``XMMatrixPerspectiveFovLH(XM_PIDIV4, w/h, 0.01, 100)`` maps

@@ -44,14 +44,18 @@ class OffscreenTarget:
         return self.host.raw.attachment_bits(self._fbo_name)
 
     def read(self) -> np.ndarray:
-        """The frame as an (H, W, 4) uint8 RGBA array, top row first."""
+        """The frame as an (H, W, 4) uint8 RGBA array, top row first.
+
+        The array is a read-only view of the bytes GL returned, flipped by a
+        negative stride: copying a fresh 800x600 frame costs more than drawing
+        it (page faults on new memory), so nothing is copied here.
+        """
         source = self.framebuffer
         if self._resolved is not None:
             self.host.ctx.copy_framebuffer(self._resolved, self.framebuffer)
             source = self._resolved
         data = source.read(components=4, alignment=1)
-        image = np.frombuffer(data, dtype=np.uint8).reshape(self.size[1], self.size[0], 4)
-        return np.ascontiguousarray(image[::-1])
+        return np.frombuffer(data, dtype=np.uint8).reshape(self.size[1], self.size[0], 4)[::-1]
 
     def release(self) -> None:
         # The framebuffer object is ours (rawgl made it); moderngl only wraps it.

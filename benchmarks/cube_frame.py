@@ -1,0 +1,152 @@
+"""Benchmark: the indexed cube at 800x600, raw ModernGL versus glsandbox.
+
+Run: ``uv run python benchmarks/cube_frame.py [--frames N] [--rounds R]``
+
+Both sides draw the same frame (clear, the course cube with its vertex
+colours, depth test and back-face culling, the course camera, a rotation that
+changes every frame) into an 800x600 offscreen framebuffer and read the pixels
+back. The two are measured in alternating rounds in one process, on one
+context, so machine noise hits both alike; the figure is the ratio of medians.
+Goal (issue 2): glsandbox <= 1.10x raw. Cold start is process start to the
+first PNG written, for ``glsandbox render`` and for this script's raw path.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import moderngl
+import numpy as np
+
+SIZE = (800, 600)
+
+RAW_VERTEX = """#version 330 core
+uniform mat4 m_model; uniform mat4 m_view; uniform mat4 m_proj;
+in vec3 in_position; in vec3 in_color; out vec3 v_color;
+void main() { gl_Position = m_proj * m_view * m_model * vec4(in_position, 1.0); v_color = in_color; }
+"""
+RAW_FRAGMENT = """#version 330 core
+in vec3 v_color; out vec4 frag_color;
+void main() { frag_color = vec4(v_color, 1.0); }
+"""
+
+
+class RawCube:
+    """A hand-written ModernGL frame with no glsandbox code at all."""
+
+    def __init__(self, ctx: moderngl.Context) -> None:
+        self.ctx = ctx
+        # The course cube already converted to OpenGL (z mirrored, two indices swapped).
+        positions = np.array([(-1, 1, 1), (1, 1, 1), (1, 1, -1), (-1, 1, -1),
+                              (-1, -1, 1), (1, -1, 1), (1, -1, -1), (-1, -1, -1)], dtype="f4")
+        colors = np.array([(0, 0, 1), (0, 1, 0), (0, 1, 1), (1, 0, 0), (1, 0, 1), (1, 1, 0), (1, 1, 1), (0, 0, 0)],
+                          dtype="f4")
+        indices = np.array([3, 1, 0, 2, 1, 3, 0, 5, 4, 1, 5, 0, 3, 4, 7, 0, 4, 3, 1, 6, 5, 2, 6, 1, 2, 7, 6, 3, 7, 2,
+                            6, 4, 5, 7, 4, 6], dtype="u4").reshape(-1, 3)[:, [0, 2, 1]].copy()
+        self.program = ctx.program(vertex_shader=RAW_VERTEX, fragment_shader=RAW_FRAGMENT)
+        self.vao = ctx.vertex_array(self.program, [(ctx.buffer(positions.tobytes()), "3f", "in_position"),
+                                                   (ctx.buffer(colors.tobytes()), "3f", "in_color")],
+                                    index_buffer=ctx.buffer(indices.tobytes()))
+        self.fbo = ctx.framebuffer(color_attachments=[ctx.renderbuffer(SIZE, 4)],
+                                   depth_attachment=ctx.depth_renderbuffer(SIZE))
+        f = 1 / np.tan(np.radians(22.5))
+        near, far, aspect = 0.01, 100.0, SIZE[0] / SIZE[1]
+        proj = np.array([[f / aspect, 0, 0, 0], [0, f, 0, 0],
+                         [0, 0, (far + near) / (near - far), 2 * far * near / (near - far)], [0, 0, -1, 0]])
+        eye = np.array([0.0, 3.0, 10.0])
+        fwd = -eye / np.linalg.norm(eye)
+        right = np.cross(fwd, (0, 1, 0))
+        right /= np.linalg.norm(right)
+        up = np.cross(right, fwd)
+        view = np.eye(4)
+        view[0, :3], view[1, :3], view[2, :3] = right, up, -fwd
+        view[:3, 3] = -view[:3, :3] @ eye
+        self.program["m_view"].write(view.T.astype("f4").tobytes())
+        self.program["m_proj"].write(proj.T.astype("f4").tobytes())
+
+    def frame(self, t: float) -> np.ndarray:
+        c, s = np.cos(-t), np.sin(-t)
+        model = np.array([[c, 0, s, 0], [0, 1, 0, 0], [-s, 0, c, 0], [0, 0, 0, 1]], dtype="f4")
+        self.fbo.use()
+        self.fbo.clear(0.0, 0.125, 0.6, 1.0, depth=1.0)
+        self.ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
+        self.program["m_model"].write(model.T.tobytes())
+        self.vao.render(moderngl.TRIANGLES)
+        return np.frombuffer(self.fbo.read(components=4, alignment=1), dtype=np.uint8)
+
+
+def measure(frame, frames: int, start: float) -> float:
+    """Seconds per frame over ``frames`` consecutive frames."""
+    t0 = time.perf_counter()
+    for k in range(frames):
+        frame(start + 0.01 * k)
+    return (time.perf_counter() - t0) / frames
+
+
+def cold_start(command: list[str]) -> float:
+    t0 = time.perf_counter()
+    subprocess.run(command, check=True, capture_output=True)
+    return time.perf_counter() - t0
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--frames", type=int, default=100, help="frames per round (default 100)")
+    parser.add_argument("--rounds", type=int, default=7, help="alternating rounds (default 7)")
+    parser.add_argument("--raw-once", type=Path, help=argparse.SUPPRESS)
+    args = parser.parse_args()
+
+    if args.raw_once:  # the raw path's cold start: context, resources, one frame, one PNG
+        from PIL import Image
+
+        ctx = moderngl.create_standalone_context(backend="egl")
+        pixels = RawCube(ctx).frame(0.0).reshape(SIZE[1], SIZE[0], 4)[::-1]
+        Image.fromarray(pixels).save(args.raw_once)
+        return 0
+
+    from glsandbox.app import HeadlessRenderer
+    from glsandbox.lesson import find_lesson
+
+    renderer = HeadlessRenderer("egl")
+    raw = RawCube(renderer.host.ctx)
+    lesson = find_lesson("indexed_cube")()
+
+    def ours(t: float) -> np.ndarray:
+        return renderer.render(lesson.at(t), SIZE).image
+
+    # Same picture first: the comparison is only fair if both draw the same frame.
+    same = np.array_equal(raw.frame(0.3).reshape(SIZE[1], SIZE[0], 4)[::-1], ours(0.3))
+    for fn in (raw.frame, ours):  # warm-up
+        measure(fn, 10, 0.0)
+    raw_times, our_times = [], []
+    for r in range(args.rounds):
+        raw_times.append(measure(raw.frame, args.frames, r))
+        our_times.append(measure(ours, args.frames, r))
+    raw_ms, our_ms = statistics.median(raw_times) * 1e3, statistics.median(our_times) * 1e3
+    renderer.close()
+
+    with tempfile.TemporaryDirectory() as tmp:
+        ours_cold = statistics.median(cold_start([sys.executable, "-m", "glsandbox.cli", "render", "indexed_cube",
+                                                  "--size", "800x600", "--out", f"{tmp}/a.png"]) for _ in range(3))
+        raw_cold = statistics.median(cold_start([sys.executable, __file__, "--raw-once", f"{tmp}/b.png"])
+                                     for _ in range(3))
+
+    print(f"indexed cube, {SIZE[0]}x{SIZE[1]}, {args.rounds} alternating rounds of {args.frames} frames"
+          f" (identical pixels: {'yes' if same else 'NO'})")
+    print(f"{'':<22}{'raw ModernGL':>14}{'glsandbox':>12}{'ratio':>8}")
+    print(f"{'frame (median, ms)':<22}{raw_ms:>14.3f}{our_ms:>12.3f}{our_ms / raw_ms:>7.2f}x")
+    print(f"{'  spread (min-max)':<22}{min(raw_times) * 1e3:>6.3f}-{max(raw_times) * 1e3:<7.3f}"
+          f"{min(our_times) * 1e3:>5.3f}-{max(our_times) * 1e3:<6.3f}")
+    print(f"{'cold start (s)':<22}{raw_cold:>14.3f}{ours_cold:>12.3f}{ours_cold / raw_cold:>7.2f}x")
+    print("goal: frame ratio <= 1.10x:", "met" if our_ms / raw_ms <= 1.10 else "NOT met")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
