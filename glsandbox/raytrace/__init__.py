@@ -1,0 +1,79 @@
+"""The course's first half: a ray tracer from scratch, in numpy float64.
+
+Public API, in the course's words (see COURSE.md for the worked examples every
+one of these reproduces):
+
+- Vektörel işlemler: :func:`normalize`, :func:`dot`, :func:`cross`, :func:`length`;
+- the ray ``R = R0 + t·Rd``: :class:`Ray`;
+- shapes, each with ``intersect(ray) -> t | None`` (nearest ``t > 0``),
+  ``normal_at(point)`` and vectorized ``intersect_many(origins, directions)``:
+  :class:`Plane` (``N·P + D = 0``), :class:`Triangle` (six tests by name, see
+  :data:`INSIDE_TESTS`), :class:`Sphere` (geometric and stable), :class:`AABB`;
+  :class:`TriangleBatch` and :func:`moller_trumbore_many` for many triangles;
+- the nearest hit (``tDistances``/``min_indis``): :func:`nearest_hit`,
+  :func:`first_hit` (a :class:`Hit` record), :func:`nearest_hit_many`;
+- Yansıma vektörü :func:`reflect`, Phong boyama modeli :func:`phong`;
+- Gölge testi: :func:`in_shadow` (and :func:`shadow_ray`).
+
+Conventions: right-handed, float64 throughout; ``t`` is in units of the ray's
+direction as given; misses are ``None`` (scalar) or ``inf`` (vectorized).
+"""
+
+from __future__ import annotations
+
+from glsandbox.raytrace.aabb import AABB
+from glsandbox.raytrace.base import Shape
+from glsandbox.raytrace.errors import RayTraceError
+from glsandbox.raytrace.plane import Plane
+from glsandbox.raytrace.ray import Ray
+from glsandbox.raytrace.shading import diffuse_factor, phong, reflect, specular_factor
+from glsandbox.raytrace.sphere import SPHERE_METHODS, Sphere
+from glsandbox.raytrace.trace import (
+    SHADOW_EPSILON,
+    Hit,
+    first_hit,
+    in_shadow,
+    nearest_hit,
+    nearest_hit_many,
+    shadow_ray,
+)
+from glsandbox.raytrace.triangle import (
+    DEFAULT_METHOD,
+    INSIDE_TESTS,
+    POINT_IN_TRIANGLE,
+    Triangle,
+    TriangleBatch,
+    moller_trumbore_many,
+)
+from glsandbox.raytrace.vec import cross, dot, length, normalize
+
+__all__ = [
+    "AABB",
+    "DEFAULT_METHOD",
+    "INSIDE_TESTS",
+    "POINT_IN_TRIANGLE",
+    "SHADOW_EPSILON",
+    "SPHERE_METHODS",
+    "Hit",
+    "Plane",
+    "Ray",
+    "RayTraceError",
+    "Shape",
+    "Sphere",
+    "Triangle",
+    "TriangleBatch",
+    "cross",
+    "diffuse_factor",
+    "dot",
+    "first_hit",
+    "in_shadow",
+    "length",
+    "moller_trumbore_many",
+    "nearest_hit",
+    "nearest_hit_many",
+    "normalize",
+    "phong",
+    "reflect",
+    "shadow_ray",
+    "specular_factor",
+]

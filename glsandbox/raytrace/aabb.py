@@ -1,0 +1,121 @@
+"""Axis Aligned Bounding Box: the course's second acceleration method.
+
+The notes' ``AABB(R0, R1, B, u, v, w)`` takes the box's centre ``B`` and its
+half-sizes ``u, v, w`` (``AABB(-25, -20, 70, 15, 20, 30)``); here the box is
+stored by its two corners and :meth:`AABB.from_center` builds it the course's way.
+
+The slab test
+-------------
+The box is the intersection of three slabs ``min_i <= x_i <= max_i``. Along
+the ray, slab ``i`` is crossed between::
+
+    t_a = (min_i − O_i) / d_i,   t_b = (max_i − O_i) / d_i
+
+(swapped when ``d_i < 0``). The ray is inside the box on
+``[max of the entries, min of the exits]``; it hits when that interval is not
+empty and ends after ``t = 0``.
+
+IEEE arithmetic does the special cases for us, deliberately:
+
+- ``d_i = +0.0`` gives ``1/d_i = +inf`` and ``d_i = −0.0`` gives ``−inf``; a ray
+  parallel to a slab then gets ``t = ±inf`` for both planes: ``(−inf, +inf)`` if
+  the origin is between them (the slab never ends), an empty interval otherwise.
+  The sign bit, not ``d_i < 0``, picks which plane is the entry, so ``−0.0``
+  behaves as the negative direction it is.
+- An origin exactly *on* a slab plane with ``d_i = ±0`` gives ``0 · inf = NaN``.
+  The ray then runs inside the plane of a face; we count the boundary as part of
+  the box, so a NaN entry becomes ``−inf`` and a NaN exit ``+inf``.
+
+Boundaries are inclusive throughout (a ray through an edge or a corner hits).
+An origin inside the box (or on a face, heading in) returns the exit ``t``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from glsandbox.raytrace.base import broadcast_rays, finite_positive_or_none
+from glsandbox.raytrace.errors import RayTraceError
+from glsandbox.raytrace.ray import Ray
+from glsandbox.raytrace.vec import Vec3, as_vec3
+
+__all__ = ["AABB"]
+
+
+class AABB:
+    """An axis-aligned box between corners ``min`` and ``max`` (``min <= max``)."""
+
+    __slots__ = ("min", "max")
+
+    min: Vec3
+    max: Vec3
+
+    def __init__(self, min: ArrayLike, max: ArrayLike) -> None:  # noqa: A002 (the course's words)
+        self.min = as_vec3(min, "AABB min")
+        self.max = as_vec3(max, "AABB max")
+        if np.any(self.min > self.max):
+            raise RayTraceError(f"AABB min must not exceed max, got min={self.min.tolist()} max={self.max.tolist()}")
+
+    @classmethod
+    def from_center(cls, center: ArrayLike, half_size: ArrayLike) -> AABB:
+        """The course's form: centre ``B`` and half-sizes ``(u, v, w)``."""
+        c = as_vec3(center, "AABB center")
+        h = as_vec3(half_size, "AABB half size")
+        if np.any(h < 0.0):
+            raise RayTraceError(f"AABB half sizes must be >= 0, got {h.tolist()}")
+        return cls(c - h, c + h)
+
+    @property
+    def center(self) -> Vec3:
+        return (self.min + self.max) * 0.5
+
+    def contains(self, point: ArrayLike) -> bool:
+        """Whether ``point`` is in the box (boundary included)."""
+        p = as_vec3(point, "point")
+        return bool(np.all(self.min <= p) and np.all(p <= self.max))
+
+    def normal_at(self, point: ArrayLike) -> Vec3:
+        """Unit outward normal of the face nearest to ``point``.
+
+        The face is the axis where ``point`` sticks out most relative to the
+        box's half-size (ties go to the lowest axis).
+        """
+        p = as_vec3(point, "point")
+        half = (self.max - self.min) * 0.5
+        rel = np.abs(p - self.center) - half  # signed distance outside each slab
+        axis = int(np.argmax(rel))
+        n = np.zeros(3)
+        n[axis] = 1.0 if p[axis] >= self.center[axis] else -1.0
+        return n
+
+    def intersect(self, ray: Ray) -> float | None:
+        """Nearest ``t > 0``: the entry, or the exit for an origin inside; else ``None``."""
+        return finite_positive_or_none(self.intersect_many(ray.origin, ray.direction))
+
+    def slabs(self, origins: ArrayLike, directions: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """``(t_near, t_far)`` for ``N`` rays: the ray is in the box on ``[t_near, t_far]``.
+
+        Empty when ``t_near > t_far``. See the module docstring for ±0 and NaN.
+        """
+        o, d = broadcast_rays(origins, directions)
+        with np.errstate(divide="ignore"):
+            inv = 1.0 / d  # deliberate: 1/(+0) = +inf, 1/(−0) = −inf
+        with np.errstate(invalid="ignore"):
+            ta = (self.min - o) * inv  # 0·inf = NaN when O lies on the min plane
+            tb = (self.max - o) * inv
+        negative = np.signbit(d)  # true for −0.0 too
+        near = np.where(negative, tb, ta)
+        far = np.where(negative, ta, tb)
+        near = np.where(np.isnan(near), -np.inf, near)  # on the plane: the slab never starts
+        far = np.where(np.isnan(far), np.inf, far)  # ...and never ends
+        return near.max(axis=1), far.min(axis=1)
+
+    def intersect_many(self, origins: ArrayLike, directions: ArrayLike) -> NDArray[np.float64]:
+        """The slab test for ``N`` rays: a ``(N,)`` array of ``t``, ``inf`` for a miss."""
+        t_near, t_far = self.slabs(origins, directions)
+        t = np.where(t_near > 0.0, t_near, t_far)
+        return np.where((t_near <= t_far) & (t > 0.0), t, np.inf)
+
+    def __repr__(self) -> str:
+        return f"AABB(min={self.min.tolist()}, max={self.max.tolist()})"
