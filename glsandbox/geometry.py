@@ -158,6 +158,34 @@ def plane(size: float = 1.0) -> Mesh:
                 np.tile([0.0, 1.0, 0.0], (4, 1)), np.array([(0, 1), (1, 1), (1, 0), (0, 0)], dtype=np.float64))
 
 
+def sphere(stacks: int = 24, slices: int = 48) -> Mesh:
+    """A unit sphere (UV sphere) with outward normals and uv.
+
+    Vertex (i, j) sits at polar angle ``pi*i/stacks`` from +y and azimuth
+    ``2*pi*j/slices``; on a unit sphere the normal equals the position. The
+    seam column is duplicated so u runs 0..1 without wrapping back.
+    Triangles are counter-clockwise seen from outside (OpenGL's front).
+    """
+    theta = np.linspace(0.0, np.pi, stacks + 1)[:, None]  # from the north pole down
+    phi = np.linspace(0.0, 2.0 * np.pi, slices + 1)[None, :]
+    x = np.sin(theta) * np.sin(phi)
+    y = np.cos(theta) * np.ones_like(phi)
+    z = np.sin(theta) * np.cos(phi)
+    positions = np.stack([x, y, z], axis=-1).reshape(-1, 3)
+    u, v = np.meshgrid(np.linspace(0, 1, slices + 1), np.linspace(0, 1, stacks + 1))
+    uvs = np.stack([u, v], axis=-1).reshape(-1, 2)
+    indices = []
+    row = slices + 1
+    for i in range(stacks):
+        for j in range(slices):
+            a, b = i * row + j, (i + 1) * row + j  # a above b; a+1, b+1 one step east
+            if i > 0:
+                indices += [a, b, a + 1]
+            if i < stacks - 1:
+                indices += [a + 1, b, b + 1]
+    return Mesh("sphere", positions, np.array(indices, dtype=np.uint32), positions.copy(), uvs)
+
+
 #: Built-in meshes by name, for scene files.
 BUILTIN_MESHES: dict[str, Callable[[], Mesh]] = {
     "cube": cube,
@@ -167,6 +195,7 @@ BUILTIN_MESHES: dict[str, Callable[[], Mesh]] = {
     "quad_list_swapped": quad_list_swapped,
     "triangle": triangle,
     "plane": plane,
+    "sphere": sphere,
 }
 
 

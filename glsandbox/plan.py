@@ -57,6 +57,7 @@ class Draw:
     node: str
     program: str  # a ProgramVariant key
     cull_back_faces: bool
+    texture: str | None = None  # what texture unit 0 holds, only for textured nodes
 
 
 @dataclass(frozen=True)
@@ -82,7 +83,8 @@ class Pass:
                 what.append("stencil")
             return f"clear viewport {self.viewport}: " + " + ".join(what)
         items = "; ".join(
-            f"{d.node} with {d.program}" + ("" if d.cull_back_faces else " (no culling)") for d in self.draws
+            f"{d.node} with {d.program}" + ("" if d.cull_back_faces else " (no culling)")
+            + (f" + texture unit 0: {d.texture}" if d.texture else "") for d in self.draws
         )
         depth = "depth test" if self.depth_test else "no depth test"
         return f"draw viewport {self.viewport} ({depth}): {items}"
@@ -115,10 +117,38 @@ class Plan:
         }
 
 
-def program_for(node: Node) -> ProgramVariant:
-    """The shader variant a node needs: ``basic`` with its colour source."""
+def program_for(node: Node, lights: int = 0) -> ProgramVariant:
+    """The shader variant a node needs: ``basic`` with its colour source, or
+    ``phong`` (:func:`lit_program_for`) when its material is lit; ``TEXTURED``
+    only when it has a texture. ``lights`` is the number of lights in the scene."""
+    if node.material.lit:
+        return lit_program_for(node, lights)
     source = "VERTEX_COLOR" if node.material.shading == "vertex_color" else "SOLID_COLOR"
-    return ProgramVariant("basic", ((source, ""),))
+    return ProgramVariant("basic", ((source, ""), *_texture_defines(node)))
+
+
+def _texture_defines(node: Node) -> tuple[tuple[str, str], ...]:
+    return (("TEXTURED", ""),) if node.material.texture is not None else ()
+
+
+def lit_program_for(node: Node, lights: int) -> ProgramVariant:
+    """The ``phong`` variant for a lit node (course section "Lighting").
+
+    ``NUM_LIGHTS`` sizes the light loop to the lights present (no unused
+    slots are looped over); ``PER_VERTEX`` evaluates the formula at the
+    vertices (Gouraud), ``BLINN`` uses the half vector, ``NAIVE_NORMALS``
+    the course's ``mul(Input.Norm, world)`` instead of the normal matrix.
+    """
+    material = node.material
+    defines: list[tuple[str, str]] = [("NUM_LIGHTS", str(lights))]
+    if material.shading == "gouraud":
+        defines.append(("PER_VERTEX", ""))
+    if material.shading == "blinn_phong":
+        defines.append(("BLINN", ""))
+    if material.normals == "naive":
+        defines.append(("NAIVE_NORMALS", ""))
+    defines.extend(_texture_defines(node))
+    return ProgramVariant("phong", tuple(defines))
 
 
 def _is_flat(node: Node) -> bool:
@@ -158,9 +188,11 @@ def plan(scene: Scene) -> Plan:
         for node in scene.nodes:
             if node.viewports is not None and index not in node.viewports:
                 continue
-            variant = program_for(node)
+            variant = program_for(node, len(scene.lights))
             programs.add(variant)
-            draws.append(Draw(node.name, variant.key, node.cull_back_faces))
+            texture = node.material.texture
+            draws.append(Draw(node.name, variant.key, node.cull_back_faces,
+                              texture=texture.describe() if texture is not None else None))
         if draws:
             passes.append(Pass("draw", index, draws=tuple(draws), depth_test=uses_depth))
     samples = scene.samples if scene.samples > 1 else 0

@@ -25,8 +25,29 @@ Color = tuple[float, float, float, float]
 #: The course's clear colour, ``{0.0f, 0.125f, 0.6f, 1.0f}`` ("DirectX 11").
 COURSE_BLUE: Color = (0.0, 0.125, 0.6, 1.0)
 
+#: Shadings lit by the scene's lights (``shaders/phong.glsl``, course section
+#: "Lighting"): per-pixel Phong, per-vertex (Gouraud) and Blinn-Phong.
+LIT_SHADINGS = ("phong", "gouraud", "blinn_phong")
+
 #: How a node's surface gets its colour (each is a shader variant).
-SHADINGS = ("solid", "vertex_color")
+SHADINGS = ("solid", "vertex_color", *LIT_SHADINGS)
+
+#: How lit shaders turn normals into world space: "correct" uses the normal
+#: matrix (inverse transpose), "naive" the course's ``mul(Input.Norm, world)``.
+NORMAL_MODES = ("correct", "naive")
+
+#: Texture filters (course section "Texture Mapping", ``g_pSamplerLinear``):
+#: min/mag ``NEAREST``; ``LINEAR``; bilinear in the nearest mip level;
+#: trilinear (bilinear in the two nearest levels, blended); trilinear with
+#: 16x anisotropy.
+TEXTURE_FILTERS = ("nearest", "linear", "mip_nearest", "mip_linear", "anisotropic")
+
+#: What happens to uv outside 0..1: ``REPEAT``, ``MIRRORED_REPEAT``, ``CLAMP_TO_EDGE``.
+TEXTURE_WRAPS = ("repeat", "mirrored", "clamp")
+
+#: Images the project draws itself (:mod:`glsandbox.images`); any other
+#: texture source is an image file path.
+BUILTIN_TEXTURES = ("checker", "labels", "mip_levels")
 
 
 @dataclass(frozen=True)
@@ -58,15 +79,69 @@ class Light:
 
 
 @dataclass(frozen=True)
+class Texture:
+    """An image on a surface and the sampler that reads it.
+
+    ``source`` is a built-in image name (:data:`BUILTIN_TEXTURES`) or an image
+    file path; ``filter`` and ``wrap`` are the sampler state, data like the
+    rest of the scene, so one lesson can be rendered with each of them.
+    """
+
+    source: str = "checker"
+    filter: str = "mip_linear"
+    wrap: str = "repeat"
+
+    def __post_init__(self) -> None:
+        if self.filter not in TEXTURE_FILTERS:
+            raise SandboxError(f"unknown texture filter {self.filter!r}; use one of {', '.join(TEXTURE_FILTERS)}")
+        if self.wrap not in TEXTURE_WRAPS:
+            raise SandboxError(f"unknown texture wrap {self.wrap!r}; use one of {', '.join(TEXTURE_WRAPS)}")
+        if not str(self.source).strip():
+            raise SandboxError("texture source is empty: give a built-in image name or an image file path")
+
+    @property
+    def is_file(self) -> bool:
+        """Whether ``source`` names an image file rather than a built-in image."""
+        return self.source not in BUILTIN_TEXTURES
+
+    def describe(self) -> str:
+        return f"{self.source} ({self.filter}, {self.wrap})"
+
+
+@dataclass(frozen=True)
 class Material:
-    """How a surface is coloured: a flat colour or the mesh's vertex colours."""
+    """How a surface is coloured: a flat colour, the mesh's vertex colours, or lit.
+
+    Lit shadings use the course's per-light formula (section "Lighting")
+    ``min(ambient*mesh + diffuse*D + specular*S, 1)`` summed over the lights,
+    with ambient 0.1, diffuse 0.4, specular 0.3 and exponent 32 by default; a
+    coefficient of 0 switches its term off (the course's experiments).
+    ``texture`` replaces the flat colour's rgb by the sampled image times it.
+    """
 
     color: Color = (1.0, 1.0, 1.0, 1.0)
     shading: str = "solid"
+    ambient: float = 0.1
+    diffuse: float = 0.4
+    specular: float = 0.3
+    shininess: float = 32.0
+    normals: str = "correct"
+    texture: Texture | None = None
 
     def __post_init__(self) -> None:
         if self.shading not in SHADINGS:
             raise SandboxError(f"unknown shading {self.shading!r}; use one of {', '.join(SHADINGS)}")
+        if self.normals not in NORMAL_MODES:
+            raise SandboxError(f"unknown normals {self.normals!r}; use one of {', '.join(NORMAL_MODES)}")
+        for name in ("ambient", "diffuse", "specular", "shininess"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0.0):
+                raise SandboxError(f"material {name} must be a finite number >= 0, got {value!r}")
+
+    @property
+    def lit(self) -> bool:
+        """Whether the surface is shaded by the scene's lights."""
+        return self.shading in LIT_SHADINGS
 
 
 @dataclass(frozen=True, eq=False)

@@ -1,7 +1,8 @@
 #version 330 core
 // Unlit geometry: a flat colour (SOLID_COLOR) or the mesh's per-vertex
 // colours interpolated across each triangle (VERTEX_COLOR, the course's
-// Tutorial 04 cube).
+// Tutorial 04 cube). TEXTURED multiplies by the texture on unit 0 at the
+// mesh's uv (course section "Texture Mapping").
 
 #if defined(VERTEX_SHADER)
 #include "common/transform.glsl"
@@ -11,9 +12,16 @@ in vec3 in_position;
 in vec3 in_color;
 out vec3 v_color;
 #endif
+#ifdef TEXTURED
+in vec2 in_uv;
+out vec2 v_uv;
+#endif
 
 void main() {
     gl_Position = to_clip(in_position);
+#ifdef TEXTURED
+    v_uv = in_uv;
+#endif
 #ifdef VERTEX_COLOR
     v_color = in_color;
 #endif
@@ -24,6 +32,10 @@ uniform vec4 u_color;
 #ifdef VERTEX_COLOR
 in vec3 v_color;
 #endif
+#ifdef TEXTURED
+uniform sampler2D u_texture;
+in vec2 v_uv;
+#endif
 out vec4 frag_color;
 
 void main() {
@@ -31,6 +43,9 @@ void main() {
     frag_color = vec4(v_color, 1.0) * u_color;
 #else
     frag_color = u_color;
+#endif
+#ifdef TEXTURED
+    frag_color *= texture(u_texture, v_uv);
 #endif
 }
 #endif

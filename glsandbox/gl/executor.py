@@ -18,8 +18,9 @@ from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh
 from glsandbox.gl.context import GLHost
 from glsandbox.gl.shaders import compile_program
+from glsandbox.gl.textures import TextureCache
 from glsandbox.plan import Draw, Pass, Plan, ProgramVariant, plan as make_plan
-from glsandbox.scene import Node, Scene
+from glsandbox.scene import Light, Material, Node, Scene
 
 _MODES = {"triangles": moderngl.TRIANGLES, "triangle_strip": moderngl.TRIANGLE_STRIP}
 # Mesh arrays and the attribute names the shaders use for them.
@@ -57,6 +58,8 @@ class Executor:
         self._programs: dict[str, tuple[ProgramVariant, moderngl.Program]] = {}
         self._meshes: dict[tuple[str, str], _GpuMesh] = {}
         self._vaos: dict[tuple[tuple[str, str], str], moderngl.VertexArray] = {}
+        self._textures = TextureCache(host)
+        self._lights: tuple[Light, ...] = ()  # the lights of the frame being drawn
 
     # --- resources ----------------------------------------------------------
 
@@ -117,6 +120,7 @@ class Executor:
         for variant in frame_plan.programs:
             self.program(variant)
         nodes = {node.name: node for node in scene.nodes}
+        self._lights = scene.lights
         framebuffer.use()
         for step in frame_plan.passes:
             viewport = scene.viewports[step.viewport]
@@ -167,7 +171,17 @@ class Executor:
         for name, data in uniforms.items():
             if name in program:
                 program[name].write(data)
+        if node.material.lit:
+            write_light_uniforms(program, self._lights, view)
+            write_material_uniforms(program, node.material)
+        texture = node.material.texture
+        if texture is not None:
+            self._textures.bind(texture, 0)
+            if "u_texture" in program:
+                program["u_texture"].value = 0
         vao.render(gpu.mode, vertices=gpu.count)
+        if texture is not None:
+            self._textures.unbind(0)
 
     def release(self) -> None:
         for vao in self._vaos.values():
@@ -179,6 +193,41 @@ class Executor:
                 gpu.index.release()
         for _, program in self._programs.values():
             program.release()
+        self._textures.release()
         self._vaos.clear()
         self._meshes.clear()
         self._programs.clear()
+
+
+# --- lighting uniforms (course section "Lighting") --------------------------
+
+
+def eye_position(view: np.ndarray) -> np.ndarray:
+    """The camera position in world space: the view matrix maps it to the
+    origin, so it is the translation column of the inverse view matrix (the
+    course's ``vEyePos``)."""
+    return np.linalg.inv(np.asarray(view, dtype=np.float64))[:3, 3]
+
+
+def write_light_uniforms(program: moderngl.Program, lights: tuple[Light, ...], view: np.ndarray) -> None:
+    """The course's ``vLightPos[]``, ``vLightColor[]`` and ``vEyePos``, in world space.
+
+    The shader's arrays are sized by its ``NUM_LIGHTS`` define, which the plan
+    set to ``len(lights)``; with no lights they do not exist.
+    """
+    if "u_eye" in program:
+        program["u_eye"].write(eye_position(view).astype("f4").tobytes())
+    if lights and "u_light_pos" in program:
+        program["u_light_pos"].write(np.array([l.position for l in lights], dtype="f4").tobytes())
+    if lights and "u_light_color" in program:
+        program["u_light_color"].write(np.array([l.color for l in lights], dtype="f4").tobytes())
+
+
+def write_material_uniforms(program: moderngl.Program, material: Material) -> None:
+    """The coefficients of the course's ``0.1*mesh + 0.4*diffuse + 0.3*specular``
+    and the exponent (32); a zero coefficient switches its term off."""
+    values = {"u_ambient": material.ambient, "u_diffuse": material.diffuse,
+              "u_specular": material.specular, "u_shininess": material.shininess}
+    for name, value in values.items():
+        if name in program:  # a term the compiler removed has no uniform
+            program[name].value = float(value)

@@ -30,6 +30,8 @@ GL_FRAMEBUFFER_ATTACHMENT_DEPTH_SIZE = 0x8216
 GL_FRAMEBUFFER_ATTACHMENT_STENCIL_SIZE = 0x8217
 GL_DITHER = 0x0BD0
 GL_STENCIL_TEST = 0x0B90
+GL_TEXTURE_WRAP_S = 0x2802
+GL_TEXTURE_WRAP_T = 0x2803
 
 _VOID = None
 _UINT = ctypes.c_uint
@@ -54,6 +56,7 @@ _SIGNATURES: dict[str, tuple] = {
     "glStencilMask": (_VOID, _UINT),
     "glClearStencil": (_VOID, _INT),
     "glClear": (_VOID, _UINT),
+    "glSamplerParameteri": (_VOID, _UINT, _UINT, _INT),
 }
 
 
@@ -129,6 +132,12 @@ class RawGL:
             bits.append(value.value)
         self.glBindFramebuffer(GL_FRAMEBUFFER, old)
         return bits[0], bits[1]
+
+    def sampler_wrap(self, sampler: int, mode: int) -> None:
+        """Set a sampler object's s and t wrap modes (moderngl cannot set
+        ``GL_MIRRORED_REPEAT``)."""
+        self.glSamplerParameteri(sampler, GL_TEXTURE_WRAP_S, mode)
+        self.glSamplerParameteri(sampler, GL_TEXTURE_WRAP_T, mode)
 
     def delete_framebuffer(self, fbo: int, renderbuffer: int) -> None:
         if renderbuffer:

@@ -1,0 +1,140 @@
+"""Texture images: the ones the project draws itself, and user image files.
+
+No GL here: every function returns RGBA ``uint8`` arrays of shape (H, W, 4)
+with row 0 at the *top* of the picture, as image files store them. Course
+section "Texture Mapping": uv (0, 0) is the image's top-left corner and v
+grows downwards (DirectX's convention, which the course's cube uses); the
+texture upload in :mod:`glsandbox.gl.textures` keeps rows in this order, so
+the course's uv values need no flip.
+
+A texture is a list of mip levels: one image (the others are built by the
+GPU), or, for ``mip_levels``, every level drawn by hand in its own colour so
+a test can read back which level was sampled.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from PIL import Image, ImageDraw, ImageFont, UnidentifiedImageError
+
+from glsandbox.errors import SandboxError
+from glsandbox.scene import BUILTIN_TEXTURES
+
+#: The colours of the four quadrants of the ``labels`` image, by the uv
+#: corner they hold: (0,0) top-left red, (1,0) top-right green, (0,1)
+#: bottom-left blue, (1,1) bottom-right yellow.
+QUADRANT_COLORS: dict[tuple[int, int], tuple[int, int, int]] = {
+    (0, 0): (220, 40, 40),
+    (1, 0): (40, 170, 60),
+    (0, 1): (40, 80, 220),
+    (1, 1): (230, 200, 40),
+}
+
+#: The two colours of the ``checker`` image.
+CHECKER_COLORS = ((240, 240, 240), (30, 60, 150))
+
+#: One colour per mip level of the ``mip_levels`` image (level 0 first).
+MIP_COLORS: tuple[tuple[int, int, int], ...] = (
+    (255, 0, 0), (0, 255, 0), (0, 0, 255), (255, 255, 0), (255, 0, 255),
+    (0, 255, 255), (255, 255, 255), (128, 128, 128), (0, 0, 0),
+)
+
+
+def _rgba(rgb: np.ndarray) -> np.ndarray:
+    alpha = np.full(rgb.shape[:2] + (1,), 255, dtype=np.uint8)
+    return np.ascontiguousarray(np.concatenate([rgb.astype(np.uint8), alpha], axis=2))
+
+
+def checker(size: int = 256, squares: int = 8) -> np.ndarray:
+    """A ``squares`` x ``squares`` checkerboard, ``size`` pixels square.
+
+    High contrast and sharp edges: the picture where filters differ most
+    (magnified, nearest shows blocks and linear blends; minified at a grazing
+    angle, no mipmaps shimmer into moiré).
+    """
+    cell = np.arange(size) * squares // size
+    odd = (cell[:, None] + cell[None, :]) % 2 == 1
+    rgb = np.where(odd[..., None], np.array(CHECKER_COLORS[1]), np.array(CHECKER_COLORS[0]))
+    return _rgba(rgb)
+
+
+def labels(size: int = 256) -> np.ndarray:
+    """Four coloured quadrants, each labelled with the uv of its corner.
+
+    On the course's cube every face maps uv 0..1, so each face shows this
+    picture once; the labels tell which corner of the face got which uv, and
+    the colours let tests check the mapping without reading text.
+    """
+    image = Image.new("RGB", (size, size))
+    draw = ImageDraw.Draw(image)
+    half = size // 2
+    font = ImageFont.load_default(size=max(8, size // 7))
+    for (u, v), color in QUADRANT_COLORS.items():
+        x0, y0 = u * half, v * half
+        draw.rectangle((x0, y0, x0 + half - 1, y0 + half - 1), fill=color)
+        draw.text((x0 + half / 2, y0 + half / 2), f"{u},{v}", fill=(255, 255, 255), font=font, anchor="mm")
+    border = max(1, size // 64)
+    draw.rectangle((0, 0, size - 1, size - 1), outline=(255, 255, 255), width=border)
+    return _rgba(np.asarray(image))
+
+
+def mip_levels(size: int = 256) -> list[np.ndarray]:
+    """A full mip chain whose level k is one flat colour, ``MIP_COLORS[k]``.
+
+    Level k of a ``size`` texture is ``size >> k`` pixels square; the chain
+    ends at 1x1. Sampling returns the colour of the level the GPU chose.
+    """
+    levels = []
+    for k in range(size.bit_length()):
+        side = max(1, size >> k)
+        color = np.array(MIP_COLORS[k % len(MIP_COLORS)], dtype=np.uint8)
+        levels.append(_rgba(np.broadcast_to(color, (side, side, 3))))
+    return levels
+
+
+def builtin_levels(name: str) -> list[np.ndarray]:
+    """The mip levels of a built-in image (one level: the GPU builds the rest)."""
+    if name == "checker":
+        return [checker()]
+    if name == "labels":
+        return [labels()]
+    if name == "mip_levels":
+        return mip_levels()
+    raise SandboxError(f"unknown built-in texture {name!r}; use one of {', '.join(BUILTIN_TEXTURES)} "
+                       "or an image file path")
+
+
+def load_image(path: str | Path, max_size: int | None = None) -> np.ndarray:
+    """Read an image file as RGBA ``uint8`` (row 0 at the top).
+
+    Every failure is a one-line :class:`SandboxError` naming the file: not
+    found, a folder, unreadable, not an image or corrupt, or larger than
+    ``max_size`` on a side (checked from the header, before decoding).
+    """
+    p = Path(path)
+    if not p.exists():
+        raise SandboxError(f"texture file {p} not found")
+    if p.is_dir():
+        raise SandboxError(f"texture file {p} is a folder, expected an image file")
+    try:
+        with Image.open(p) as image:
+            width, height = image.size
+            if max_size is not None and max(width, height) > max_size:
+                raise SandboxError(f"texture file {p} is {width}x{height}, larger than this context "
+                                   f"allows ({max_size}x{max_size})")
+            rgba = np.asarray(image.convert("RGBA"), dtype=np.uint8)
+    except SandboxError:
+        raise
+    except UnidentifiedImageError:
+        raise SandboxError(f"texture file {p} is not an image Pillow can read") from None
+    except PermissionError:
+        raise SandboxError(f"texture file {p} is not readable (permission denied)") from None
+    except Image.DecompressionBombError as exc:
+        raise SandboxError(f"texture file {p} is too large to decode safely ({exc})") from None
+    except (OSError, SyntaxError, ValueError) as exc:  # truncated or corrupt data
+        raise SandboxError(f"texture file {p} is corrupt or unreadable ({' '.join(str(exc).split())})") from None
+    if rgba.ndim != 3 or rgba.shape[0] == 0 or rgba.shape[1] == 0:
+        raise SandboxError(f"texture file {p} has no pixels")
+    return np.ascontiguousarray(rgba)

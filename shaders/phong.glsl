@@ -1,0 +1,83 @@
+#version 330 core
+// Lit surfaces (course section "Lighting"): the per-light Phong formula of
+// common/lighting.glsl. Variants, set by the plan:
+//   NUM_LIGHTS n   the light loop's size: only the lights in the scene
+//   PER_VERTEX     Gouraud: the formula at the vertices, colours interpolated
+//                  (highlights smaller than a triangle get lost)
+//   BLINN          Blinn-Phong half vector instead of the reflection vector
+//   NAIVE_NORMALS  the course's Output.Norm = mul(Input.Norm, world); wrong
+//                  under non-uniform scale. Otherwise the normal matrix, the
+//                  inverse transpose of the model's 3x3 (m_normal).
+//   TEXTURED       the mesh colour is the texture (unit 0) times u_color
+
+#include "common/lighting.glsl"
+
+#if defined(VERTEX_SHADER)
+#include "common/transform.glsl"
+uniform mat3 m_normal;
+in vec3 in_position;
+in vec3 in_normal;
+#ifdef TEXTURED
+in vec2 in_uv;
+out vec2 v_uv;
+#endif
+#ifdef PER_VERTEX
+out vec3 v_color;
+#else
+out vec3 v_world;
+out vec3 v_normal;
+#endif
+
+vec3 world_normal(vec3 n) {
+#ifdef NAIVE_NORMALS
+    // A normal is not a position: a scale (a, b, c) must shrink it by
+    // (1/a, 1/b, 1/c), not stretch it. This tilts it towards the long axis.
+    return mat3(m_model) * n;
+#else
+    return m_normal * n;
+#endif
+}
+
+void main() {
+    vec4 world = m_model * vec4(in_position, 1.0);
+    gl_Position = m_proj * m_view * world;
+    vec3 normal = normalize(world_normal(in_normal));
+#ifdef TEXTURED
+    v_uv = in_uv;
+#endif
+#ifdef PER_VERTEX
+    v_color = shade(world.xyz, normal, u_color.rgb);
+#else
+    v_world = world.xyz;
+    v_normal = normal;
+#endif
+}
+
+#elif defined(FRAGMENT_SHADER)
+#ifdef TEXTURED
+uniform sampler2D u_texture;
+in vec2 v_uv;
+#endif
+#ifdef PER_VERTEX
+in vec3 v_color;
+#else
+in vec3 v_world;
+in vec3 v_normal;
+#endif
+out vec4 frag_color;
+
+void main() {
+    vec3 texel = vec3(1.0);
+#ifdef TEXTURED
+    texel = texture(u_texture, v_uv).rgb;
+#endif
+#ifdef PER_VERTEX
+    // Gouraud lit the vertices with u_color; the texture tints the result.
+    vec3 color = v_color * texel;
+#else
+    // Interpolation shortens normals: normalise again per pixel.
+    vec3 color = shade(v_world, normalize(v_normal), u_color.rgb * texel);
+#endif
+    frag_color = vec4(color, u_color.a);
+}
+#endif
