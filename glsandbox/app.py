@@ -11,11 +11,14 @@ from __future__ import annotations
 import argparse
 import sys
 import time as _time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
+from glsandbox.camera import CameraInput
 from glsandbox.errors import SandboxError
 from glsandbox.gl.context import BACKENDS, GLHost, open_context
 from glsandbox.gl.executor import Executor
@@ -144,10 +147,11 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
     pending: list[int] = []
 
     def on_key(window: object, key: int, scancode: int, action: int, mods: int) -> None:
-        if action == glfw.PRESS:
+        if action == glfw.PRESS or (action == glfw.REPEAT and key in repeat_keys):
             pending.append(key)
 
     glfw.set_key_callback(host.window, on_key)
+    camera_input, repeat_keys = attach_camera_input(host.window, lambda: state["lesson"].scene())
 
     def handle(key: int) -> None:
         if key == glfw.KEY_ESCAPE:
@@ -170,8 +174,9 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
                 state["error"] = str(exc)
                 print(f"error: {exc}", file=sys.stderr, flush=True)
         else:
-            name = glfw.get_key_name(key, 0) or {glfw.KEY_TAB: "tab", glfw.KEY_SPACE: "space"}.get(key, "")
-            if name:
+            name = glfw.get_key_name(key, 0) or {glfw.KEY_TAB: "tab", glfw.KEY_SPACE: "space"}.get(key, "") \
+                or _arrow_key_names(glfw).get(key, "")
+            if name and not camera_input.key(name, state["lesson"].scene()):
                 state["lesson"].on_key(name)
 
     frames, fps_frames, fps_start, fps = 0, 0, _time.perf_counter(), 0.0
@@ -185,7 +190,8 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
                 current.values["time"] = start_time + glfw.get_time() - clock_start
             width, height = glfw.get_framebuffer_size(host.window)
             if width > 0 and height > 0:  # minimised windows have no framebuffer
-                scene = with_samples(current.scene(), 0)  # the window's own MSAA does the sampling
+                # The window's own MSAA does the sampling; the camera keys' camera, once moved, replaces the scene's.
+                scene = camera_input.apply(with_samples(current.scene(), 0))
                 executor.render(scene, host.ctx.screen, (width, height))
                 glfw.swap_buffers(host.window)
             frames += 1
@@ -201,6 +207,44 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
     finally:
         executor.release()
         host.release()
+
+
+def _arrow_key_names(glfw: Any) -> dict[int, str]:
+    return {glfw.KEY_LEFT: "left", glfw.KEY_RIGHT: "right", glfw.KEY_UP: "up", glfw.KEY_DOWN: "down"}
+
+
+def attach_camera_input(window: Any, scene_source: Callable[[], Scene]) -> tuple[CameraInput, frozenset[int]]:
+    """Give a glfw window the shared camera controls (:mod:`glsandbox.camera`).
+
+    W/S move along the view, A/D turn 15° about the camera, Z/X move up and
+    down, arrow keys and a left-button drag orbit, the scroll wheel zooms.
+    Keys reach the camera through the window's key handler (which passes
+    them by name); this wires the mouse and returns the camera and the key
+    codes that repeat while held.
+    """
+    import glfw
+
+    camera_input = CameraInput()
+    drag: dict[str, Any] = {"last": None}
+
+    def on_button(win: object, button: int, action: int, mods: int) -> None:
+        if button == glfw.MOUSE_BUTTON_LEFT:
+            drag["last"] = glfw.get_cursor_pos(win) if action == glfw.PRESS else None
+
+    def on_cursor(win: object, x: float, y: float) -> None:
+        if drag["last"] is not None:
+            last_x, last_y = drag["last"]
+            drag["last"] = (x, y)
+            camera_input.drag(x - last_x, y - last_y, scene_source())
+
+    def on_scroll(win: object, dx: float, dy: float) -> None:
+        camera_input.scroll(dy, scene_source())
+
+    glfw.set_mouse_button_callback(window, on_button)
+    glfw.set_cursor_pos_callback(window, on_cursor)
+    glfw.set_scroll_callback(window, on_scroll)
+    letters = (glfw.KEY_W, glfw.KEY_A, glfw.KEY_S, glfw.KEY_D, glfw.KEY_Z, glfw.KEY_X)
+    return camera_input, frozenset((*letters, *_arrow_key_names(glfw)))
 
 
 # --- ``python -m lessons.<module>`` ----------------------------------------

@@ -13,6 +13,7 @@ import json
 import sys
 import time
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 from glsandbox.errors import SandboxError
@@ -78,6 +79,28 @@ def cmd_run(args: argparse.Namespace) -> int:
     from glsandbox.app import run_window
 
     run_window(_lesson(args), _size(args), args.samples, args.backend)
+    return 0
+
+
+def cmd_compare(args: argparse.Namespace) -> int:
+    """``glsandbox compare``: tiles side by side, then which are identical and how far apart."""
+    from glsandbox.app import HeadlessRenderer, check_writable, with_samples
+    from glsandbox.compare import build_variants, compare_variants, default_out
+    from glsandbox.golden import save_png
+    from glsandbox.lesson import find_lesson
+
+    lesson_cls = find_lesson(args.lesson)
+    out: Path = args.out or default_out(lesson_cls.name)
+    size = _size(args)
+    check_writable(out)
+    # Everything is parsed and every scene built before a context opens.
+    variants, columns = build_variants(lesson_cls, args.vary, args.settings)
+    variants = [replace(v, scene=with_samples(v.scene, args.samples)) for v in variants]
+    with HeadlessRenderer(args.backend) as renderer:
+        result = compare_variants(variants, columns, size, renderer)
+    save_png(result.image, out)
+    print(result.report())
+    print(f"wrote {out} ({size[0]}x{size[1]}, {len(variants)} tiles)")
     return 0
 
 
@@ -187,6 +210,14 @@ def build_parser() -> argparse.ArgumentParser:
     add_render_options(p)
     p.add_argument("--out", type=Path, default=Path("out"), help="output folder (default out/)")
     p.set_defaults(func=cmd_tour)
+
+    p = sub.add_parser("compare", help="render one lesson with several parameter values side by side")
+    p.add_argument("lesson", metavar="LESSON", help="a lesson name or a scene .toml file")
+    p.add_argument("--vary", action="append", default=[], metavar="KEY=V1,V2,...",
+                   help="a parameter and its values, one tile each (twice: a grid)")
+    add_render_options(p)
+    p.add_argument("--out", type=Path, default=None, help="the PNG to write (default compare_LESSON.png)")
+    p.set_defaults(func=cmd_compare)
     return parser
 
 

@@ -16,7 +16,8 @@ from glsandbox.errors import SandboxError
 from glsandbox.transforms import from_directx_mesh
 
 #: Primitive topologies a mesh can use (the course's D3D11_PRIMITIVE_TOPOLOGY_*).
-MODES = ("triangles", "triangle_strip")
+#: The line modes draw paths (the transform-order lesson's trail); they have no triangles.
+MODES = ("triangles", "triangle_strip", "lines", "line_strip")
 
 
 @dataclass(frozen=True, eq=False)
@@ -56,6 +57,8 @@ class Mesh:
         A strip's triangle k uses vertices (k, k+1, k+2), with every odd
         triangle's first two swapped so all keep the strip's winding.
         """
+        if self.mode in ("lines", "line_strip"):
+            return np.zeros((0, 3, 3))
         order = self.indices if self.indices is not None else np.arange(self.vertex_count)
         if self.mode == "triangles":
             tri = np.asarray(order).reshape(-1, 3)

@@ -64,7 +64,7 @@ class Draw:
 class Pass:
     """One step of the frame, restricted to one viewport."""
 
-    kind: str  # "clear" or "draw"
+    kind: str  # "clear", "draw" or "overlay" (viewport -1: the whole frame)
     viewport: int
     clear_color: tuple[float, float, float, float] | None = None
     clear_depth: bool = False
@@ -73,6 +73,8 @@ class Pass:
     depth_test: bool = False
 
     def describe(self) -> str:
+        if self.kind == "overlay":
+            return describe_overlay_pass(self)
         if self.kind == "clear":
             what = []
             if self.clear_color is not None:
@@ -195,6 +197,10 @@ def plan(scene: Scene) -> Plan:
                               texture=texture.describe() if texture is not None else None))
         if draws:
             passes.append(Pass("draw", index, draws=tuple(draws), depth_test=uses_depth))
+    overlay_steps = overlay_passes(scene)
+    if overlay_steps:
+        programs.add(OVERLAY_PROGRAM)
+    passes.extend(overlay_steps)
     samples = scene.samples if scene.samples > 1 else 0
     return Plan(
         scene=scene.name,
@@ -202,3 +208,29 @@ def plan(scene: Scene) -> Plan:
         programs=tuple(sorted(programs)),
         passes=tuple(passes),
     )
+
+# --- overlays (labels and figures over the frame) ----------------------------
+
+#: The program that draws overlay images texel for pixel (``shaders/overlay.glsl``).
+OVERLAY_PROGRAM = ProgramVariant("overlay")
+
+
+def overlay_passes(scene: Scene) -> list[Pass]:
+    """One ``overlay`` pass per region that has overlays, after every 3D pass.
+
+    The pass lists the overlays by name as draws of the overlay program; its
+    viewport is the region they are clipped to (-1: the whole frame). A scene
+    without overlays gets no pass and no overlay program.
+    """
+    regions: dict[int, list[Draw]] = {}
+    for overlay in scene.overlays:
+        region = -1 if overlay.viewport is None else overlay.viewport
+        regions.setdefault(region, []).append(Draw(overlay.name, OVERLAY_PROGRAM.key, False))
+    # Viewport regions in order, then the frame-wide ones, which may lie across several viewports.
+    order = sorted(regions, key=lambda region: (region < 0, region))
+    return [Pass("overlay", region, draws=tuple(regions[region])) for region in order]
+
+
+def describe_overlay_pass(step: Pass) -> str:
+    where = "frame" if step.viewport < 0 else f"viewport {step.viewport}"
+    return f"overlay {where} (blended, no depth test): " + ", ".join(d.node for d in step.draws)

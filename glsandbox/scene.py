@@ -19,6 +19,7 @@ import numpy as np
 from glsandbox import transforms
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh, builtin_mesh
+from glsandbox.overlay import Overlay
 
 Color = tuple[float, float, float, float]
 
@@ -193,6 +194,8 @@ class Scene:
     viewports: tuple[Viewport, ...] = (Viewport(),)
     samples: int = 0
     depth_test: bool = True
+    #: Labels and figures drawn over the frame (:mod:`glsandbox.overlay`).
+    overlays: tuple[Overlay, ...] = ()
 
 
 # --- TOML scene files -------------------------------------------------------

@@ -17,12 +17,14 @@ from glsandbox import transforms
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh
 from glsandbox.gl.context import GLHost
+from glsandbox.gl.overlay import OverlayDrawer
 from glsandbox.gl.shaders import compile_program
 from glsandbox.gl.textures import TextureCache
 from glsandbox.plan import Draw, Pass, Plan, ProgramVariant, plan as make_plan
 from glsandbox.scene import Light, Material, Node, Scene
 
-_MODES = {"triangles": moderngl.TRIANGLES, "triangle_strip": moderngl.TRIANGLE_STRIP}
+_MODES = {"triangles": moderngl.TRIANGLES, "triangle_strip": moderngl.TRIANGLE_STRIP,
+          "lines": moderngl.LINES, "line_strip": moderngl.LINE_STRIP}
 # Mesh arrays and the attribute names the shaders use for them.
 _ATTRIBUTES = (("positions", "in_position", 3), ("normals", "in_normal", 3),
                ("uvs", "in_uv", 2), ("colors", "in_color", 3))
@@ -58,6 +60,7 @@ class Executor:
         self._programs: dict[str, tuple[ProgramVariant, moderngl.Program]] = {}
         self._meshes: dict[tuple[str, str], _GpuMesh] = {}
         self._vaos: dict[tuple[tuple[str, str], str], moderngl.VertexArray] = {}
+        self._overlays: OverlayDrawer | None = None  # made on the first overlay pass
         self._textures = TextureCache(host)
         self._lights: tuple[Light, ...] = ()  # the lights of the frame being drawn
 
@@ -123,6 +126,9 @@ class Executor:
         self._lights = scene.lights
         framebuffer.use()
         for step in frame_plan.passes:
+            if step.kind == "overlay":
+                self._draw_overlays(scene, step, framebuffer, size)
+                continue
             viewport = scene.viewports[step.viewport]
             rect = viewport.pixels(*size)
             if step.kind == "clear":
@@ -183,7 +189,17 @@ class Executor:
         if texture is not None:
             self._textures.unbind(0)
 
+    def _draw_overlays(self, scene: Scene, step: Pass, framebuffer: moderngl.Framebuffer,
+                       size: tuple[int, int]) -> None:
+        """An ``overlay`` pass: labels and figures, blended over the frame (:mod:`glsandbox.gl.overlay`)."""
+        if self._overlays is None:
+            self._overlays = OverlayDrawer(self.ctx)
+        self._overlays.draw(scene, step, framebuffer, size, self._programs[step.draws[0].program][1])
+
     def release(self) -> None:
+        if self._overlays is not None:
+            self._overlays.release()
+            self._overlays = None
         for vao in self._vaos.values():
             vao.release()
         for gpu in self._meshes.values():

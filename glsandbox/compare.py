@@ -1,0 +1,235 @@
+"""Side by side: one lesson rendered with several values of its parameters.
+
+``glsandbox compare LESSON --vary key=v1,v2,... [--vary key2=...]`` builds one
+scene per combination of values and composes them into a single frame, one
+tile per variant (a grid for two ``--vary``): the course's split screen, made
+of viewports. Each variant's viewports are squeezed into its tile, its nodes
+restricted to them, and each looks through its own camera, so every variant
+renders exactly as it would alone (at the tile's size).
+
+It then tells which variants give identical pictures and how far apart the
+others are. Those figures come from each variant rendered alone at the tile
+size *without its overlays* (labels and matrices differ by design; the 3D
+picture is what is compared), using :mod:`glsandbox.metrics`.
+
+Every value is parsed by its parameter and every scene is built before
+anything renders, so a bad value is refused with nothing written.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from glsandbox import metrics
+from glsandbox.errors import SandboxError
+from glsandbox.lesson import Lesson, Param, unknown_param_message
+from glsandbox.overlay import Overlay, text_image
+from glsandbox.scene import Node, Scene, Viewport
+
+#: The tile labels' text colour (yellow, to stand apart from a lesson's own white text).
+LABEL_COLOR = (255, 230, 60, 255)
+#: More tiles than this would be unreadable, and slow.
+MAX_TILES = 64
+
+
+@dataclass(frozen=True)
+class Vary:
+    """One ``--vary key=v1,v2,...``: the parameter, the texts given and their parsed values."""
+
+    param: Param
+    texts: tuple[str, ...]
+    values: tuple[object, ...]
+
+
+@dataclass(frozen=True)
+class Variant:
+    """One tile: its settings, label and scene."""
+
+    settings: tuple[tuple[str, str], ...]
+    label: str
+    scene: Scene
+
+
+@dataclass
+class Comparison:
+    """The composed frame and the figures that compare the variants."""
+
+    image: np.ndarray  # (H, W, 4) uint8, top row first
+    variants: list[Variant]
+    groups: list[list[int]]  # indices of variants with identical pictures
+    pairs: list[dict[str, object]]  # one row per pair of groups: a, b and the metrics
+    tile_size: tuple[int, int]
+
+    def report(self) -> str:
+        """The text ``glsandbox compare`` prints: identical groups, then the difference table."""
+        labels = [v.label for v in self.variants]
+        lines = [f"{len(labels)} variants, compared at {self.tile_size[0]}x{self.tile_size[1]} without overlays"]
+        same = [g for g in self.groups if len(g) > 1]
+        lines.append("identical: " + ("; ".join(" = ".join(labels[i] for i in g) for g in same) if same
+                                      else "none"))
+        lines.append("distinct pictures: " + str(len(self.groups)))
+        if self.pairs:
+            header = ("a", "b", "differing px", "max diff", "RMSE", "PSNR dB")
+            rows = [header] + [(str(p["a"]), str(p["b"]), f"{100 * float(p['share']):.2f}%", str(p["max"]),
+                                f"{float(p['rmse']):.4f}", f"{float(p['psnr']):.1f}") for p in self.pairs]
+            widths = [max(len(r[c]) for r in rows) for c in range(len(header))]
+            lines.append("pixel differences between the distinct pictures:")
+            for r in rows:
+                lines.append("  " + "  ".join(cell.ljust(widths[c]) if c < 2 else cell.rjust(widths[c])
+                                               for c, cell in enumerate(r)))
+        return "\n".join(lines)
+
+
+def parse_vary(lesson_cls: type[Lesson], text: str) -> Vary:
+    """Parse ``key=v1,v2,...`` against the lesson's parameters; every value is validated."""
+    key, sep, rest = text.partition("=")
+    key = key.strip()
+    if not sep or not key:
+        raise SandboxError(f"--vary {text!r}: expected key=value1,value2,...")
+    params = {p.name: p for p in lesson_cls.all_params()}
+    if key not in params:
+        raise SandboxError(unknown_param_message(lesson_cls, key).replace("--set", "--vary", 1))
+    texts = tuple(t.strip() for t in rest.split(","))
+    if not texts or any(t == "" for t in texts):
+        raise SandboxError(f"--vary {text!r}: empty value; give values separated by commas")
+    try:
+        values = tuple(params[key].parse(t) for t in texts)
+    except SandboxError as exc:  # Param.parse names the value as --set; here it came from --vary
+        message = str(exc)
+        raise SandboxError("--vary " + message[len("--set "):] if message.startswith("--set ") else message) from None
+    return Vary(params[key], texts, values)
+
+
+def build_variants(lesson_cls: type[Lesson], varies: list[str], settings: list[str]) -> tuple[list[Variant], int]:
+    """Every combination's scene, built (and so validated) before any rendering.
+
+    Returns the variants in row-major order and the number of grid columns.
+    """
+    if not varies:
+        raise SandboxError("give at least one --vary key=v1,v2,...")
+    if len(varies) > 2:
+        raise SandboxError(f"--vary given {len(varies)} times; at most 2 (a grid)")
+    parsed = [parse_vary(lesson_cls, v) for v in varies]
+    keys = [v.param.name for v in parsed]
+    if len(set(keys)) != len(keys):
+        raise SandboxError(f"--vary {keys[0]} given twice; combine the values in one --vary")
+    for item in settings:
+        if item.partition("=")[0].strip() in keys:
+            raise SandboxError(f"--set {item}: {item.partition('=')[0].strip()} is already varied by --vary")
+    count = math.prod(len(v.texts) for v in parsed)
+    if count > MAX_TILES:
+        raise SandboxError(f"--vary makes {count} variants; at most {MAX_TILES}")
+    base = lesson_cls.from_settings(settings)  # validates --set
+    variants = []
+    # Two --vary: the first runs across the columns, the second down the rows (row-major tiles).
+    if len(parsed) == 1:
+        combos = [((keys[0], t),) for t in parsed[0].texts]
+    else:
+        combos = [((keys[0], c), (keys[1], r)) for r in parsed[1].texts for c in parsed[0].texts]
+    by_key = {v.param.name: dict(zip(v.texts, v.values)) for v in parsed}
+    for combo in combos:
+        values = {**base.values, **{k: by_key[k][t] for k, t in combo}}
+        lesson = lesson_cls(**values)
+        label = ", ".join(f"{k}={t}" for k, t in combo)
+        variants.append(Variant(tuple(combo), label, lesson.scene()))
+    columns = len(parsed[0].texts) if len(parsed) == 2 else math.ceil(math.sqrt(len(variants)))
+    return variants, columns
+
+
+def tile_rects(count: int, columns: int) -> list[tuple[float, float, float, float]]:
+    """Tile rectangles (fractions, from the bottom left), row-major from the top left."""
+    rows = math.ceil(count / columns)
+    w, h = 1.0 / columns, 1.0 / rows
+    return [((i % columns) * w, 1.0 - (i // columns + 1) * h, w, h) for i in range(count)]
+
+
+def compose(variants: list[Variant], columns: int, size: tuple[int, int], labels: bool = True) -> Scene:
+    """One scene with every variant in its tile: viewports mapped into the tile,
+    nodes and overlays renamed and restricted to their variant's viewports."""
+    viewports: list[Viewport] = []
+    nodes: list[Node] = []
+    overlays: list[Overlay] = []
+    for index, (variant, tile) in enumerate(zip(variants, tile_rects(len(variants), columns))):
+        scene = variant.scene
+        tx, ty, tw, th = tile
+        first = len(viewports)
+        for vp in scene.viewports:
+            x, y, w, h = vp.rect
+            viewports.append(Viewport(rect=(tx + x * tw, ty + y * th, w * tw, h * th),
+                                      clear_color=vp.clear_color if vp.clear_color is not None else scene.clear_color,
+                                      camera=vp.camera or scene.camera, label=vp.label))
+        mine = tuple(range(first, len(viewports)))
+        for node in scene.nodes:
+            views = mine if node.viewports is None else tuple(first + v for v in node.viewports)
+            nodes.append(replace(node, name=f"{index}/{node.name}", viewports=views))
+        for overlay in scene.overlays:
+            # A frame-wide overlay goes to the variant's first viewport (the whole tile when it has one).
+            region = first + (overlay.viewport or 0)
+            overlays.append(replace(overlay, name=f"{index}/{overlay.name}", viewport=region))
+        if labels:
+            # The tile's label at its bottom-right, in frame pixels (tiles may hold several viewports).
+            tile_px = Viewport(rect=tile).pixels(*size)
+            image = text_image([variant.label], color=LABEL_COLOR)
+            # Overlay positions count from the frame's top; the tile's bottom is size[1] - y there.
+            position = (tile_px[0] + tile_px[2] - image.shape[1] - 3, size[1] - tile_px[1] - image.shape[0] - 3)
+            overlays.append(Overlay(f"{index}/compare-label", image, None, position))
+    return Scene(
+        name="compare",
+        nodes=tuple(nodes),
+        camera=variants[0].scene.camera,
+        clear_color=variants[0].scene.clear_color,
+        viewports=tuple(viewports),
+        samples=max(v.scene.samples for v in variants),
+        depth_test=any(v.scene.depth_test for v in variants),
+        overlays=tuple(overlays),
+    )
+
+
+def group_identical(images: list[np.ndarray]) -> list[list[int]]:
+    """Indices grouped by exactly equal pixels, in first-seen order."""
+    groups: list[list[int]] = []
+    for i, image in enumerate(images):
+        for group in groups:
+            if np.array_equal(images[group[0]], image):
+                group.append(i)
+                break
+        else:
+            groups.append([i])
+    return groups
+
+
+def difference_rows(images: list[np.ndarray], labels: list[str], groups: list[list[int]]) -> list[dict[str, object]]:
+    """Metrics for every pair of groups (their first members)."""
+    rows = []
+    for g1, g2 in itertools.combinations(groups, 2):
+        a, b = images[g1[0]], images[g2[0]]
+        rows.append({"a": labels[g1[0]], "b": labels[g2[0]], "share": metrics.mismatch_share(a, b),
+                     "max": metrics.max_abs_diff(a, b), "rmse": metrics.rmse(a, b), "psnr": metrics.psnr(a, b)})
+    return rows
+
+
+def compare(lesson_cls: type[Lesson], varies: list[str], settings: list[str], size: tuple[int, int],
+            renderer) -> Comparison:  # renderer: glsandbox.app.HeadlessRenderer
+    """Render the composed frame and compare the variants (see the module doc)."""
+    variants, columns = build_variants(lesson_cls, varies, settings)
+    return compare_variants(variants, columns, size, renderer)
+
+
+def compare_variants(variants: list[Variant], columns: int, size: tuple[int, int], renderer) -> Comparison:
+    """Render already built variants: the composed frame, then each alone for the figures."""
+    rows = math.ceil(len(variants) / columns)
+    tile = (max(1, size[0] // columns), max(1, size[1] // rows))
+    frame = renderer.render_scene(compose(variants, columns, size), size)
+    alone = [renderer.render_scene(replace(v.scene, overlays=()), tile).image.copy() for v in variants]
+    groups = group_identical(alone)
+    labels = [v.label for v in variants]
+    return Comparison(frame.image, variants, groups, difference_rows(alone, labels, groups), tile)
+
+
+def default_out(lesson_name: str) -> Path:
+    return Path(f"compare_{lesson_name}.png")

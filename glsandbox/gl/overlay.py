@@ -1,0 +1,87 @@
+"""Draws a scene's overlays: one textured rectangle per image, blended on top.
+
+Run by :class:`~glsandbox.gl.executor.Executor` for the plan's ``overlay``
+passes. Each image becomes a texture (kept per overlay name and updated when
+its pixels change, so a label that changes every frame reuses one texture),
+and is copied texel for pixel by ``shaders/overlay.glsl`` with straight-alpha
+blending: ``rgb = a*src + (1-a)*dst``, while the frame's alpha becomes
+``a + (1-a)*dst_a`` so an opaque frame stays opaque.
+"""
+
+from __future__ import annotations
+
+import hashlib
+
+import moderngl
+import numpy as np
+
+from glsandbox.overlay import Overlay
+from glsandbox.plan import Pass
+from glsandbox.scene import Scene
+
+
+class OverlayDrawer:
+    """Textures and the attribute-less vertex array for overlay passes."""
+
+    def __init__(self, ctx: moderngl.Context) -> None:
+        self.ctx = ctx
+        self._textures: dict[str, tuple[str, moderngl.Texture]] = {}
+        self._vao: tuple[int, moderngl.VertexArray] | None = None
+
+    def _texture(self, overlay: Overlay) -> moderngl.Texture:
+        image = np.ascontiguousarray(overlay.image, dtype=np.uint8)
+        digest = hashlib.blake2b(image.tobytes(), digest_size=12).hexdigest() + str(image.shape)
+        entry = self._textures.get(overlay.name)
+        if entry is not None and entry[0] == digest:
+            return entry[1]
+        h, w = image.shape[:2]
+        if entry is not None and entry[1].size == (w, h):
+            texture = entry[1]
+            texture.write(image.tobytes(), alignment=1)
+        else:
+            if entry is not None:
+                entry[1].release()
+            texture = self.ctx.texture((w, h), 4, image.tobytes(), alignment=1)
+            texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        self._textures[overlay.name] = (digest, texture)
+        return texture
+
+    def _vertex_array(self, program: moderngl.Program) -> moderngl.VertexArray:
+        if self._vao is None or self._vao[0] != program.glo:  # programs are rebuilt by shader reloads
+            if self._vao is not None:
+                self._vao[1].release()
+            self._vao = (program.glo, self.ctx.vertex_array(program, []))
+        return self._vao[1]
+
+    def draw(self, scene: Scene, step: Pass, framebuffer: moderngl.Framebuffer, size: tuple[int, int],
+             program: moderngl.Program) -> None:
+        """Draw the overlays named by ``step`` into ``framebuffer`` (``size`` pixels)."""
+        region = (0, 0, *size) if step.viewport < 0 else scene.viewports[step.viewport].pixels(*size)
+        by_name = {o.name: o for o in scene.overlays}
+        vao = self._vertex_array(program)
+        self.ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
+        self.ctx.enable(moderngl.BLEND)
+        self.ctx.blend_func = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA,
+                               moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA)
+        framebuffer.scissor = region
+        try:
+            for draw in step.draws:
+                overlay = by_name[draw.node]
+                rect = overlay.placement(region)
+                self._texture(overlay).use(location=0)
+                program["u_image"].value = 0
+                program["u_origin"].value = rect[:2]
+                framebuffer.viewport = rect
+                vao.render(moderngl.TRIANGLE_STRIP, vertices=4)
+        finally:
+            framebuffer.scissor = None
+            self.ctx.disable(moderngl.BLEND)
+            self.ctx.blend_func = moderngl.DEFAULT_BLENDING
+
+    def release(self) -> None:
+        for _, texture in self._textures.values():
+            texture.release()
+        self._textures.clear()
+        if self._vao is not None:
+            self._vao[1].release()
+            self._vao = None

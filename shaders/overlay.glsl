@@ -1,0 +1,26 @@
+#version 330 core
+// Overlays (labels, the composed matrix, figures): an RGBA image copied onto
+// the frame texel for pixel. The executor sets the GL viewport to the image's
+// rectangle and the scissor to its region; the quad covers that viewport and
+// each fragment fetches exactly one texel, so text is never resampled.
+
+#if defined(VERTEX_SHADER)
+void main() {
+    // A triangle strip over the whole viewport from the vertex number alone:
+    // 0 -> (-1,-1), 1 -> (1,-1), 2 -> (-1,1), 3 -> (1,1).
+    vec2 corner = vec2(float(gl_VertexID & 1), float(gl_VertexID >> 1));
+    gl_Position = vec4(corner * 2.0 - 1.0, 0.0, 1.0);
+}
+
+#elif defined(FRAGMENT_SHADER)
+uniform sampler2D u_image;
+uniform ivec2 u_origin;  // the frame pixel of the image's bottom-left corner
+out vec4 frag_color;
+
+void main() {
+    ivec2 size = textureSize(u_image, 0);
+    ivec2 p = ivec2(gl_FragCoord.xy) - u_origin;
+    // Texture row 0 is the image's top row (images are stored top first).
+    frag_color = texelFetch(u_image, ivec2(p.x, size.y - 1 - p.y), 0);
+}
+#endif
