@@ -7,6 +7,7 @@ convention; shapes the course gives in DirectX form go through
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -39,6 +40,10 @@ class Mesh:
     mode: str = "triangles"
 
     def __post_init__(self) -> None:
+        # Meshes are shared, immutable data (renderers cache per mesh object).
+        for array in (self.positions, self.indices, self.normals, self.uvs, self.colors):
+            if isinstance(array, np.ndarray):
+                array.flags.writeable = False
         if self.mode not in MODES:
             raise SandboxError(f"mesh {self.name!r}: unknown mode {self.mode!r}; use one of {', '.join(MODES)}")
 
@@ -93,12 +98,14 @@ COURSE_CUBE_COLORS = np.array(
 )
 
 
+@functools.cache
 def cube() -> Mesh:
     """The course's indexed cube: 8 vertices, 36 indices, converted to OpenGL."""
     pos, idx = from_directx_mesh(COURSE_CUBE_VERTICES, COURSE_CUBE_INDICES)
     return Mesh("cube", pos, idx.astype(np.uint32), colors=COURSE_CUBE_COLORS.copy())
 
 
+@functools.cache
 def cube24() -> Mesh:
     """A cube with 24 vertices: per-face normals and uv (0..1 on every face).
 
@@ -131,28 +138,33 @@ def cube24() -> Mesh:
 _QUAD_CORNERS = np.array([(-0.5, -0.5, 0), (0.5, -0.5, 0), (-0.5, 0.5, 0), (0.5, 0.5, 0)], dtype=np.float64)
 
 
+@functools.cache
 def quad_strip() -> Mesh:
     """A unit quad as a 4-vertex triangle strip (TRIANGLESTRIP)."""
     return Mesh("quad_strip", _QUAD_CORNERS.copy(), mode="triangle_strip")
 
 
+@functools.cache
 def quad_list() -> Mesh:
     """The same quad as a 6-vertex triangle list (TRIANGLELIST): two corners repeat."""
     c = _QUAD_CORNERS
     return Mesh("quad_list", np.array([c[0], c[1], c[2], c[2], c[1], c[3]]))
 
 
+@functools.cache
 def quad_list_swapped() -> Mesh:
     """The list quad with its second triangle's winding swapped: a back face."""
     c = _QUAD_CORNERS
     return Mesh("quad_list_swapped", np.array([c[0], c[1], c[2], c[2], c[3], c[1]]))
 
 
+@functools.cache
 def triangle() -> Mesh:
     """The course's first triangle, counter-clockwise."""
     return Mesh("triangle", np.array([(-0.5, -0.5, 0.0), (0.5, -0.5, 0.0), (0.0, 0.5, 0.0)]))
 
 
+@functools.cache
 def plane(size: float = 1.0) -> Mesh:
     """A square in the xz plane, facing +y, with uv 0..1."""
     h = size / 2.0

@@ -10,10 +10,12 @@ buffers the plan lists.
 from __future__ import annotations
 
 from dataclasses import dataclass
+import weakref
 from typing import Any
 
 import numpy as np
 
+from glsandbox.geometry import Mesh
 from glsandbox.scene import Node, Scene
 
 
@@ -153,9 +155,20 @@ def lit_program_for(node: Node, lights: int) -> ProgramVariant:
     return ProgramVariant("phong", tuple(defines))
 
 
+_FLAT: weakref.WeakKeyDictionary[Mesh, bool] = weakref.WeakKeyDictionary()
+
+
 def _is_flat(node: Node) -> bool:
-    """Whether a mesh lies in one plane: then it cannot hide parts of itself."""
-    points = np.asarray(node.mesh.positions, dtype=np.float64)
+    """Whether a mesh lies in one plane: then it cannot hide parts of itself.
+    Meshes are immutable, so the answer is kept per mesh object."""
+    flat = _FLAT.get(node.mesh)
+    if flat is None:
+        flat = _FLAT[node.mesh] = _coplanar(node.mesh.positions)
+    return flat
+
+
+def _coplanar(positions: np.ndarray) -> bool:
+    points = np.asarray(positions, dtype=np.float64)
     spread = points - points.mean(axis=0)
     singular = np.linalg.svd(spread, compute_uv=False)
     return len(singular) < 3 or singular[2] <= 1e-9 * max(singular[0], 1e-300)
@@ -208,6 +221,7 @@ def plan(scene: Scene) -> Plan:
         programs=tuple(sorted(programs)),
         passes=tuple(passes),
     )
+
 
 # --- overlays (labels and figures over the frame) ----------------------------
 

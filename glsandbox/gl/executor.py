@@ -8,6 +8,7 @@ says and nothing more; choosing passes is :func:`glsandbox.plan.plan`'s job.
 from __future__ import annotations
 
 import hashlib
+import weakref
 from dataclasses import dataclass
 
 import moderngl
@@ -30,7 +31,19 @@ _ATTRIBUTES = (("positions", "in_position", 3), ("normals", "in_normal", 3),
                ("uvs", "in_uv", 2), ("colors", "in_color", 3))
 
 
+_MESH_KEYS: weakref.WeakKeyDictionary[Mesh, tuple[str, str]] = weakref.WeakKeyDictionary()
+
+
 def _mesh_key(mesh: Mesh) -> tuple[str, str]:
+    """Name and content digest: equal meshes share GPU buffers. Meshes are
+    immutable, so the digest is computed once per mesh object."""
+    key = _MESH_KEYS.get(mesh)
+    if key is None:
+        key = _MESH_KEYS[mesh] = _digest(mesh)
+    return key
+
+
+def _digest(mesh: Mesh) -> tuple[str, str]:
     digest = hashlib.blake2b(digest_size=12)
     for name, _, _ in _ATTRIBUTES:
         array = getattr(mesh, name)
