@@ -65,6 +65,7 @@ class HeadlessRenderer:
 
     def render_scene(self, scene: Scene, size: tuple[int, int]) -> Frame:
         start = _time.perf_counter()
+        self.host.make_current()
         frame_plan = plan(scene)
         target = self.target(size, frame_plan.buffers)
         self.executor.render(scene, target.framebuffer, size, frame_plan)
@@ -75,6 +76,7 @@ class HeadlessRenderer:
         return self.render_scene(with_samples(lesson.scene(), samples), size)
 
     def close(self) -> None:
+        self.host.make_current()  # deletes must reach this context's objects
         for target in self._targets.values():
             target.release()
         self._targets.clear()

@@ -99,3 +99,19 @@ def test_offscreen_targets_have_the_depth_and_stencil_bits_asked_for(gl) -> None
 def test_odd_sizes_render(gl, size) -> None:
     image = render(gl, "clear_and_swap", "split=off", size=size)
     assert image.shape == (size[1], size[0], 4)
+
+
+def test_a_second_renderer_in_the_process_leaves_the_first_intact(gl) -> None:
+    from glsandbox.app import HeadlessRenderer
+
+    lesson = find_lesson("indexed_cube")(time=0.5)
+    before = np.array(gl.render(lesson, (64, 64)).image)
+    if gl.host.backend != "egl":
+        pytest.skip("two contexts of one backend are checked on EGL; OSMesa and EGL must not be mixed")
+    other = HeadlessRenderer("egl")  # opening it makes it current
+    try:
+        np.testing.assert_array_equal(np.array(other.render(lesson, (64, 64)).image), before)
+        np.testing.assert_array_equal(np.array(gl.render(lesson, (64, 64)).image), before)
+    finally:
+        other.close()  # its deletes must not reach the first context's objects
+    np.testing.assert_array_equal(np.array(gl.render(lesson, (64, 64)).image), before)

@@ -31,11 +31,22 @@ class GLHost:
     get_proc: Callable[[str], int]
     window: Any = None  # the glfw window, for the window backend
     _on_release: Callable[[], None] | None = None
+    _make_current: Callable[[], None] | None = None
     raw: RawGL = field(init=False)
 
     def __post_init__(self) -> None:
         self.raw = RawGL(self.get_proc)
         self.raw.disable_dither()
+
+    def make_current(self) -> None:
+        """Make this context current on this thread.
+
+        Needed when a process holds several contexts: opening the second one
+        makes it current, and GL calls for the first would go to the wrong
+        context (or crash). Cheap enough to call once per frame.
+        """
+        if self._make_current is not None:
+            self._make_current()
 
     @property
     def renderer(self) -> str:
@@ -101,8 +112,10 @@ def _open_egl() -> GLHost:
             f"EGL backend unavailable ({reason}); install EGL with: apt-get install libegl1 libegl-mesa0 "
             "libgl1-mesa-dri"
         ) from None
-    loader = ctx.mglo._context  # glcontext's EGL loader; it resolves any GL entry point
-    return GLHost(ctx, "egl", loader.load)
+    loader = ctx.mglo._context  # glcontext's EGL context: it resolves any GL entry point
+    # Entering glcontext's context calls eglMakeCurrent (it also remembers the
+    # previous one, which we never restore: this context stays current).
+    return GLHost(ctx, "egl", loader.load, _make_current=loader.__enter__)
 
 
 def _open_osmesa() -> GLHost:
@@ -117,7 +130,8 @@ def _open_osmesa() -> GLHost:
         raise SandboxError(f"OSMesa backend unavailable: {' '.join(str(exc).split())}") from None
     if ctx.version_code < REQUIRED_GL:
         raise SandboxError(f"OSMesa gave OpenGL {ctx.version_code}, need {REQUIRED_GL}")
-    return GLHost(ctx, "osmesa", osmesa.load_opengl_function, _on_release=osmesa.release)
+    return GLHost(ctx, "osmesa", osmesa.load_opengl_function, _on_release=osmesa.release,
+                  _make_current=osmesa.make_current)
 
 
 def _open_window(size: tuple[int, int], title: str, samples: int) -> GLHost:
@@ -160,4 +174,5 @@ def _open_window(size: tuple[int, int], title: str, samples: int) -> GLHost:
     def get_proc(name: str) -> int:
         return glfw.get_proc_address(name) or 0
 
-    return GLHost(ctx, "window", get_proc, window=handle, _on_release=close)
+    return GLHost(ctx, "window", get_proc, window=handle, _on_release=close,
+                  _make_current=lambda: glfw.make_context_current(handle))

@@ -72,9 +72,14 @@ class OSMesaContext:
         self._lib = lib
         self._handle = handle
         self._buffer = (ctypes.c_ubyte * (4 * size[0] * size[1]))()
-        if not lib.OSMesaMakeCurrent(handle, self._buffer, GL_UNSIGNED_BYTE, size[0], size[1]):
+        self._size = size
+        if not self.make_current():
             lib.OSMesaDestroyContext(handle)
             raise SandboxError("OSMesa backend unavailable: OSMesaMakeCurrent failed")
+
+    def make_current(self) -> bool:
+        """Bind this context (and its small client buffer) to this thread."""
+        return bool(self._lib.OSMesaMakeCurrent(self._handle, self._buffer, GL_UNSIGNED_BYTE, *self._size))
 
     # moderngl's loader protocol
     def load_opengl_function(self, name: str) -> int:
