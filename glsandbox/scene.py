@@ -201,6 +201,10 @@ class Scene:
 # --- TOML scene files -------------------------------------------------------
 
 
+#: Lighting coefficients a scene file may set on a node (see :class:`Material`).
+_MATERIAL_NUMBERS = ("ambient", "diffuse", "specular", "shininess")
+
+
 class _Locator:
     """Finds the line of a key in a TOML text, for error messages.
 
@@ -303,7 +307,7 @@ class _SceneReader:
 
     def node(self, data: dict[str, Any], i: int) -> Node:
         allowed = {"name", "mesh", "order", "scale", "translate", "rotate", "color", "shading",
-                   "cull_back_faces", "viewports"}
+                   "cull_back_faces", "viewports", *_MATERIAL_NUMBERS, "normals", "texture", "filter", "wrap"}
         self.check_keys(data, allowed, "nodes", i)
         mesh_name = data.get("mesh")
         if not isinstance(mesh_name, str):
@@ -339,11 +343,40 @@ class _SceneReader:
             name=str(data.get("name", f"node{i}")),
             mesh=mesh,
             model=model,
-            material=Material(color=self.color(data, "color", "nodes", i, default=(1.0, 1.0, 1.0, 1.0)),  # type: ignore[arg-type]
-                              shading=shading),
+            material=self.material(data, i, shading),
             cull_back_faces=cull,
             viewports=tuple(views) if views is not None else None,
         )
+
+    def material(self, data: dict[str, Any], i: int, shading: str) -> Material:
+        """A node's material: colour, shading, the lighting coefficients, a texture."""
+        numbers = {}
+        for key in _MATERIAL_NUMBERS:
+            value = self.number(data, key, "nodes", i)
+            if value is not None:
+                numbers[key] = value
+        texture = None
+        if "texture" in data:
+            source = data["texture"]
+            if not isinstance(source, str):
+                raise self.fail("nodes", i, "texture", f"expected an image name or file path, got {source!r}")
+            if source not in BUILTIN_TEXTURES and not Path(source).is_absolute():
+                source = str(self.path.parent / source)  # relative to the scene file, not the shell
+            try:
+                texture = Texture(source, filter=str(data.get("filter", "mip_linear")),
+                                  wrap=str(data.get("wrap", "repeat")))
+            except SandboxError as exc:
+                bad = "filter" if "filter" in str(exc) else "wrap" if "wrap" in str(exc) else "texture"
+                raise self.fail("nodes", i, bad, str(exc)) from None
+        elif "filter" in data or "wrap" in data:
+            raise self.fail("nodes", i, "filter" if "filter" in data else "wrap", "needs texture = \"<image>\"")
+        try:
+            return Material(color=self.color(data, "color", "nodes", i, default=(1.0, 1.0, 1.0, 1.0)),  # type: ignore[arg-type]
+                            shading=shading, normals=str(data.get("normals", "correct")), texture=texture,
+                            **numbers)
+        except SandboxError as exc:
+            key = next((k for k in (*_MATERIAL_NUMBERS, "normals") if k in data and k in str(exc)), None)
+            raise self.fail("nodes", i, key, str(exc)) from None
 
     def viewport(self, data: dict[str, Any], i: int) -> Viewport:
         self.check_keys(data, {"rect", "clear_color", "label"}, "viewports", i)

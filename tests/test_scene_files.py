@@ -78,3 +78,58 @@ def test_scene_errors_name_file_and_line(tmp_path: Path, text: str, expected: st
 def test_missing_scene_file_is_named(tmp_path: Path) -> None:
     with pytest.raises(SandboxError, match="nothere.toml: scene file not found"):
         load_scene(tmp_path / "nothere.toml")
+
+
+LIT = """\
+[[lights]]
+position = [2, 4, 3]
+
+[[nodes]]
+mesh = "cube24"
+shading = "blinn_phong"
+ambient = 0.2
+specular = 0.0
+shininess = 8
+normals = "naive"
+texture = "images/wood.png"
+filter = "nearest"
+wrap = "clamp"
+"""
+
+
+def test_lit_textured_nodes_load_with_paths_relative_to_the_scene_file(tmp_path: Path) -> None:
+    node = load_scene(write(tmp_path, LIT)).nodes[0]
+    m = node.material
+    assert (m.shading, m.ambient, m.diffuse, m.specular, m.shininess, m.normals) == (
+        "blinn_phong", 0.2, 0.4, 0.0, 8.0, "naive")
+    assert m.texture is not None
+    assert (m.texture.source, m.texture.filter, m.texture.wrap) == (str(tmp_path / "images/wood.png"), "nearest",
+                                                                     "clamp")
+    plan_text = plan(load_scene(write(tmp_path, LIT))).describe()
+    assert "NUM_LIGHTS=1" in plan_text and "texture unit 0" in plan_text
+
+
+@pytest.mark.parametrize(
+    ("change", "expected"),
+    [
+        (("filter = \"nearest\"", "filter = \"bicubic\""), r"scene.toml:12: nodes\[0\].filter: unknown texture filter"),
+        (("wrap = \"clamp\"", "wrap = \"tile\""), r"scene.toml:13: nodes\[0\].wrap: unknown texture wrap"),
+        (("ambient = 0.2", "ambient = -1"), r"scene.toml:7: nodes\[0\].ambient: material ambient must be"),
+        (("normals = \"naive\"", "normals = \"bent\""), r"scene.toml:10: nodes\[0\].normals: unknown normals"),
+        (("texture = \"images/wood.png\"\n", ""), r"scene.toml:11: nodes\[0\].filter: needs texture"),
+    ],
+)
+def test_material_errors_name_the_line(tmp_path: Path, change: tuple[str, str], expected: str) -> None:
+    with pytest.raises(SandboxError, match=expected):
+        load_scene(write(tmp_path, LIT.replace(*change)))
+
+
+def test_a_lit_scene_file_renders_lit(tmp_path: Path, gl) -> None:
+    from glsandbox.lesson import scene_file_lesson
+
+    path = write(tmp_path, '[[lights]]\nposition = [0, 0, 5]\n\n[[nodes]]\nmesh = "cube24"\nshading = "phong"\n'
+                           'color = [1, 0, 0]\n\n[camera]\neye = [0, 0, 6]\n')
+    image = gl.render(scene_file_lesson(path)(), (64, 64)).image
+    # Facing the light head on: 0.1 ambient + 0.4 diffuse + specular on red, clamped.
+    r, g, b, _ = image[32, 32]
+    assert r > 150 and g < r and b < r
