@@ -26,6 +26,7 @@ from glsandbox.gl.target import OffscreenTarget
 from glsandbox.golden import save_png
 from glsandbox.lesson import Lesson
 from glsandbox.plan import Buffers, Plan, plan
+from glsandbox.raytrace.render import InteractiveResolution, trace_viewports
 from glsandbox.scene import Scene
 
 DEFAULT_SIZE = (640, 480)
@@ -66,6 +67,7 @@ class HeadlessRenderer:
     def render_scene(self, scene: Scene, size: tuple[int, int]) -> Frame:
         start = _time.perf_counter()
         self.host.make_current()
+        scene = trace_viewports(scene, size, self.host.ctx)  # renderer=ray viewports become traced images
         frame_plan = plan(scene)
         target = self.target(size, frame_plan.buffers)
         self.executor.render(scene, target.framebuffer, size, frame_plan)
@@ -143,6 +145,7 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
         host.release()
         raise SandboxError("no display for a window: set DISPLAY or run under Xvfb, or use --headless")
     executor = Executor(host)
+    motion = InteractiveResolution()  # ray-traced viewports: coarser while the camera moves
     state = {"lesson": lesson, "error": "", "shots": 0}
     start_time = lesson.time
     clock_start = glfw.get_time()
@@ -194,6 +197,7 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
             if width > 0 and height > 0:  # minimised windows have no framebuffer
                 # The window's own MSAA does the sampling; the camera keys' camera, once moved, replaces the scene's.
                 scene = camera_input.apply(with_samples(current.scene(), 0))
+                scene = trace_viewports(scene, (width, height), host.ctx, motion.resolution(scene))
                 executor.render(scene, host.ctx.screen, (width, height))
                 glfw.swap_buffers(host.window)
             frames += 1

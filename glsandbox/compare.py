@@ -162,7 +162,8 @@ def compose(variants: list[Variant], columns: int, size: tuple[int, int], labels
             x, y, w, h = vp.rect
             viewports.append(Viewport(rect=(tx + x * tw, ty + y * th, w * tw, h * th),
                                       clear_color=vp.clear_color if vp.clear_color is not None else scene.clear_color,
-                                      camera=vp.camera or scene.camera, label=vp.label))
+                                      camera=vp.camera or scene.camera, label=vp.label,
+                                      renderer=vp.renderer))
         mine = tuple(range(first, len(viewports)))
         for node in scene.nodes:
             views = mine if node.viewports is None else tuple(first + v for v in node.viewports)
@@ -182,6 +183,9 @@ def compose(variants: list[Variant], columns: int, size: tuple[int, int], labels
         name="compare",
         nodes=tuple(nodes),
         camera=variants[0].scene.camera,
+        # Lights are per scene, not per viewport: the first variant's light the
+        # whole frame (the figures below render each variant alone, with its own).
+        lights=variants[0].scene.lights,
         clear_color=variants[0].scene.clear_color,
         viewports=tuple(viewports),
         samples=max(v.scene.samples for v in variants),

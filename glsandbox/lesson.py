@@ -13,11 +13,12 @@ import importlib
 import math
 import pkgutil
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, ClassVar
 
 from glsandbox.errors import SandboxError
+from glsandbox.scene import RENDERERS
 from glsandbox.scene import Scene, load_scene
 
 
@@ -74,6 +75,12 @@ class Param:
 #: Every lesson has ``time``: the moment to render, in seconds.
 TIME = Param("time", 0.0, "the moment to render, in seconds (animated lessons move with it)", minimum=0.0)
 
+#: Every lesson has ``renderer``: the rasterizer, or the ray tracer on the same
+#: Scene (``ray``: the GLSL engine, ``ray_numpy``: the float64 reference), so
+#: ``glsandbox compare LESSON --vary renderer=raster,ray`` shows both.
+RENDERER = Param("renderer", "raster", "who draws the 3D content: the rasterizer or the ray tracer "
+                 "(the same Scene)", choices=RENDERERS)
+
 
 class Lesson:
     """Base class. Subclasses set the class attributes and implement :meth:`build`."""
@@ -97,7 +104,7 @@ class Lesson:
 
     @classmethod
     def all_params(cls) -> tuple[Param, ...]:
-        return (TIME, *cls.params)
+        return (TIME, RENDERER, *cls.params)
 
     @classmethod
     def from_settings(cls, settings: Iterable[str]) -> Lesson:
@@ -123,8 +130,12 @@ class Lesson:
         return type(self)(**{**self.values, "time": time})
 
     def scene(self) -> Scene:
-        """The Scene for the current values."""
-        return self.build()
+        """The Scene for the current values (``renderer`` marks its viewports)."""
+        scene = self.build()
+        renderer = self.values.get("renderer", "raster")
+        if renderer != "raster":  # traced by glsandbox.raytrace.render.trace_viewports
+            scene = replace(scene, viewports=tuple(replace(vp, renderer=renderer) for vp in scene.viewports))
+        return scene
 
     def build(self) -> Scene:
         raise NotImplementedError

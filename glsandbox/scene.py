@@ -46,6 +46,9 @@ TEXTURE_FILTERS = ("nearest", "linear", "mip_nearest", "mip_linear", "anisotropi
 #: What happens to uv outside 0..1: ``REPEAT``, ``MIRRORED_REPEAT``, ``CLAMP_TO_EDGE``.
 TEXTURE_WRAPS = ("repeat", "mirrored", "clamp")
 
+#: Who renders a viewport: the rasterizer, the GLSL ray tracer, the numpy (float64) ray tracer.
+RENDERERS = ("raster", "ray", "ray_numpy")
+
 #: Images the project draws itself (:mod:`glsandbox.images`); any other
 #: texture source is an image file path.
 BUILTIN_TEXTURES = ("checker", "labels", "mip_levels")
@@ -128,8 +131,14 @@ class Material:
     shininess: float = 32.0
     normals: str = "correct"
     texture: Texture | None = None
+    #: Share of the colour that a mirror-like surface takes from the reflected
+    #: ray (course section "Yansıma vektörü"): ``(1-r)·local + r·reflected``.
+    #: Only the ray tracer follows reflection rays; the rasterizer ignores it.
+    reflectivity: float = 0.0
 
     def __post_init__(self) -> None:
+        if not (math.isfinite(self.reflectivity) and 0.0 <= self.reflectivity <= 1.0):
+            raise SandboxError(f"material reflectivity must lie in 0..1, got {self.reflectivity!r}")
         if self.shading not in SHADINGS:
             raise SandboxError(f"unknown shading {self.shading!r}; use one of {', '.join(SHADINGS)}")
         if self.normals not in NORMAL_MODES:
@@ -173,6 +182,14 @@ class Viewport:
     clear_color: Color | None = None
     camera: Camera | None = None
     label: str = ""
+    #: Who draws the viewport's 3D content: ``"raster"`` (the executor),
+    #: ``"ray"`` (the GLSL ray tracer) or ``"ray_numpy"`` (the float64 ray
+    #: tracer); see :func:`glsandbox.raytrace.render.trace_viewports`.
+    renderer: str = "raster"
+
+    def __post_init__(self) -> None:
+        if self.renderer not in RENDERERS:
+            raise SandboxError(f"unknown renderer {self.renderer!r}; use one of {', '.join(RENDERERS)}")
 
     def pixels(self, width: int, height: int) -> tuple[int, int, int, int]:
         """(x, y, w, h) in pixels; edges are rounded so tiles meet without gaps."""

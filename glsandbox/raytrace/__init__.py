@@ -13,7 +13,11 @@ one of these reproduces):
 - the nearest hit (``tDistances``/``min_indis``): :func:`nearest_hit`,
   :func:`first_hit` (a :class:`Hit` record), :func:`nearest_hit_many`;
 - Yansıma vektörü :func:`reflect`, Phong boyama modeli :func:`phong`;
-- Gölge testi: :func:`in_shadow` (and :func:`shadow_ray`).
+- Gölge testi: :func:`in_shadow` (and :func:`shadow_ray`);
+- the whole picture: :func:`render` traces a :class:`glsandbox.scene.Scene`,
+  the same one the rasterizer draws, with the float64 ``"numpy"`` engine or
+  the GLSL ``"gpu"`` engine (:mod:`glsandbox.raytrace.render`,
+  :mod:`glsandbox.raytrace.world`, :mod:`glsandbox.raytrace.gpu`).
 
 Conventions: right-handed, float64 throughout; ``t`` is in units of the ray's
 direction as given; misses are ``None`` (scalar) or ``inf`` (vectorized).
@@ -26,6 +30,7 @@ from glsandbox.raytrace.base import Shape
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.plane import Plane
 from glsandbox.raytrace.ray import Ray
+from glsandbox.raytrace.render import ENGINES, RenderStats, render
 from glsandbox.raytrace.shading import diffuse_factor, phong, reflect, specular_factor
 from glsandbox.raytrace.sphere import SPHERE_METHODS, Sphere
 from glsandbox.raytrace.trace import (
@@ -50,6 +55,7 @@ from glsandbox.raytrace.vec import cross, dot, length, normalize
 __all__ = [
     "AABB",
     "DEFAULT_METHOD",
+    "ENGINES",
     "INSIDE_TESTS",
     "POINT_IN_TRIANGLE",
     "SHADOW_EPSILON",
@@ -58,6 +64,7 @@ __all__ = [
     "Plane",
     "Ray",
     "RayTraceError",
+    "RenderStats",
     "Shape",
     "Sphere",
     "Triangle",
@@ -74,6 +81,7 @@ __all__ = [
     "normalize",
     "phong",
     "reflect",
+    "render",
     "shadow_ray",
     "specular_factor",
 ]

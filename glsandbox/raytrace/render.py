@@ -1,0 +1,456 @@
+"""``render(scene, size, engine=...)``: ray-trace the Scene the rasterizer draws.
+
+Two engines, one algorithm:
+
+- ``"numpy"``: the float64 reference, vectorized over pixels (this module);
+- ``"gpu"``: a GLSL fragment shader on a ModernGL context, float32
+  (:mod:`glsandbox.raytrace.gpu`, ``shaders/raytrace.glsl``).
+
+The algorithm, in the course's order (first half of the notes):
+
+1. **Primary rays** through the image plane (:func:`~glsandbox.raytrace.world.camera_rays`).
+2. **Nearest hit** (``tDistances``/``min_indis``): for each node, the AABB
+   slab test first (course "Hızlandırma: AABB"; ``aabb=False`` skips it),
+   then Möller–Trumbore against its triangles, or the exact sphere test.
+   **Backface culling** (course "Hızlandırma: backface culling"): a node the
+   rasterizer culls (``cull_back_faces``) is one-sided for *every* ray, as
+   ``det > 0`` in Möller–Trumbore; ``cull_backfaces=True``/``False``
+   overrides all nodes.
+3. **Shading**, the rasterizer's formula (``shaders/common/lighting.glsl``,
+   course "Lighting"), so the two renderers differ only where the raster
+   approximates: per light, ``min(ka·mesh + kd·max(N·L,0)·mesh·light +
+   ks·max(R·E,0)^n·light, 1)``, summed; ``R`` the light direction mirrored
+   about ``N`` (Blinn–Phong: ``N·H``). The course's first-half form with
+   ``ka + kd + ks = 1`` is :func:`glsandbox.raytrace.phong`; the exam scenes
+   use coefficients that sum to 1. Gouraud and naive normals are raster
+   approximations: the ray tracer always shades per pixel with the normal
+   matrix. ``solid`` and ``vertex_color`` surfaces are unlit (their colour,
+   barycentric-interpolated vertex colours). Textures are sampled bilinearly
+   in their base level at the barycentric uv ``t(u,v) = V0 + u(V1−V0) +
+   v(V2−V0)`` (no mipmaps: a ray has no footprint).
+4. **Shadow rays** (course "Gölge testi"): a light counts for a lit point only
+   if nothing lies between: the ray ``P' + s·(L − P')``, ``0 < s < 1``, hits
+   nothing (``s = 1`` is the light itself, so an occluder beyond it never
+   counts). ``P'`` is ``P`` moved off its surface by a relative offset
+   towards the light's side (:data:`SHADOW_OFFSET`, float32-safe, see
+   :mod:`glsandbox.raytrace.trace`). In shadow, only the ambient term stays.
+   A light's lamp (a node whose box holds it) casts no shadow for it.
+5. **Reflection** (course "Yansıma vektörü"): a surface with
+   ``material.reflectivity = r > 0`` shows ``(1 − r)·local + r·reflected``,
+   the reflected ray ``R = Rd − 2(Rd·N)N`` traced again, up to
+   ``max_depth`` bounces (at the last one the local colour stands in).
+   A ray that hits nothing shows the viewport's clear colour.
+
+Colours are clamped to 0..1 and rounded to 8 bits as GL does (``⌊255c + ½⌋``).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from glsandbox.raytrace.aabb import AABB
+from glsandbox.raytrace.errors import RayTraceError
+from glsandbox.raytrace.sphere import Sphere
+from glsandbox.raytrace.world import World, build_world, camera_rays
+from glsandbox.scene import Scene
+
+__all__ = ["ENGINES", "SHADOW_OFFSET", "InteractiveResolution", "RenderStats", "render", "render_viewport", "to_rgba8", "trace_viewports"]
+
+#: The two engines.
+ENGINES = ("numpy", "gpu")
+
+#: Relative offset of secondary-ray origins: ``SHADOW_OFFSET·max(1, max|P_i|)``
+#: along the normal. 2⁻¹⁶ is about 256 float32 ulps of the point's largest
+#: coordinate, so the GLSL engine uses the same value as the reference
+#: (:data:`glsandbox.raytrace.SHADOW_EPSILON`, 2⁻³², suits float64 only).
+SHADOW_OFFSET: float = 2.0**-16
+
+_UNIT_SPHERE = Sphere((0.0, 0.0, 0.0), 1.0)
+
+
+@dataclass
+class RenderStats:
+    """What one numpy render did: rays cast by kind, and its time."""
+
+    primary: int = 0
+    shadow: int = 0
+    reflection: int = 0
+    seconds: float = 0.0
+
+    @property
+    def rays(self) -> int:
+        return self.primary + self.shadow + self.reflection
+
+
+# --- the nearest hit over a World -------------------------------------------
+
+
+@dataclass
+class _Hits:
+    t: NDArray[np.float64]  # inf for a miss
+    node: NDArray[np.intp]  # -1 for a miss
+    tri: NDArray[np.intp]  # world triangle index (meshes), -1 otherwise
+
+
+def _nearest(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_max: float | NDArray[np.float64],
+             cull: bool | None, aabb: bool, light: int = -1) -> _Hits:
+    """Nearest hit with ``0 < t < t_max`` over every node (the course's ``min_indis`` loop).
+
+    ``light >= 0`` makes it a shadow query for that light: its lamp is skipped.
+    """
+    n = d.shape[0]
+    o = np.broadcast_to(o, d.shape)
+    best_t = np.broadcast_to(np.asarray(t_max, dtype=np.float64), (n,)).copy()
+    best_node = np.full(n, -1, dtype=np.intp)
+    best_tri = np.full(n, -1, dtype=np.intp)
+    for k, node in enumerate(world.nodes):
+        if light >= 0 and node.lamp_of >> light & 1:
+            continue
+        if aabb:
+            near, far = AABB(node.box_min, node.box_max).slabs(o, d)
+            idx = np.nonzero((near <= far) & (far > 0.0) & (near < best_t))[0]
+        else:
+            idx = np.arange(n)
+        if idx.size == 0:
+            continue
+        one_sided = node.cull if cull is None else cull
+        oi, di = o[idx], d[idx]
+        if node.kind == "sphere":
+            inv = node.inverse
+            oo = oi @ inv[:3, :3].T + inv[:3, 3]  # the ray in the unit sphere's own space
+            dd = di @ inv[:3, :3].T
+            t = _UNIT_SPHERE.intersect_many(oo, dd)
+            if one_sided:  # from inside, the sphere's front faces all face away
+                t = np.where(np.einsum("ij,ij->i", oo, oo) < 1.0, np.inf, t)
+            j = np.full(idx.size, -1, dtype=np.intp)
+        else:
+            batch = world.batches[k]
+            assert batch is not None
+            t, j = batch.nearest_many(oi, di, cull_backfaces=one_sided)
+            j = np.where(j >= 0, j + node.start, -1)
+        better = t < best_t[idx]
+        sel = idx[better]
+        best_t[sel] = t[better]
+        best_node[sel] = k
+        best_tri[sel] = j[better]
+    hit = best_node >= 0
+    return _Hits(np.where(hit, best_t, np.inf), best_node, best_tri)
+
+
+# --- surface attributes at the hits ------------------------------------------
+
+
+def _barycentric(world: World, tri: NDArray[np.intp], o: NDArray[np.float64],
+                 d: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Möller–Trumbore's ``(u, v)`` of each ray on its own triangle: ``P = V0 + u·e1 + v·e2``."""
+    v0 = world.v0[tri]
+    e1 = world.v1[tri] - v0
+    e2 = world.v2[tri] - v0
+    p = np.cross(d, e2)
+    det = np.einsum("ij,ij->i", e1, p)
+    det = np.where(det == 0.0, 1.0, det)
+    s = o - v0
+    q = np.cross(s, e1)
+    return np.einsum("ij,ij->i", s, p) / det, np.einsum("ij,ij->i", d, q) / det
+
+
+def _sample(image: NDArray[np.float64], wrap: int, uv: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Bilinear filtering of ``image`` (row 0 = v 0, as GL reads the uploaded image) at ``uv``."""
+    h, w = image.shape[:2]
+    x = uv[:, 0] * w - 0.5
+    y = uv[:, 1] * h - 0.5
+    x0 = np.floor(x)
+    y0 = np.floor(y)
+    fx = (x - x0)[:, None]
+    fy = (y - y0)[:, None]
+
+    def wrap_index(i: NDArray[np.float64], size: int) -> NDArray[np.intp]:
+        i = i.astype(np.intp)
+        if wrap == 0:  # repeat
+            return np.mod(i, size)
+        if wrap == 1:  # mirrored repeat: 0..size-1, size-1..0, ...
+            m = np.mod(i, 2 * size)
+            return np.where(m < size, m, 2 * size - 1 - m)
+        return np.clip(i, 0, size - 1)  # clamp to edge
+
+    xa, xb = wrap_index(x0, w), wrap_index(x0 + 1, w)
+    ya, yb = wrap_index(y0, h), wrap_index(y0 + 1, h)
+    top = image[ya, xa] * (1 - fx) + image[ya, xb] * fx
+    bottom = image[yb, xa] * (1 - fx) + image[yb, xb] * fx
+    return top * (1 - fy) + bottom * fy
+
+
+def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.float64]
+             ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """``(point, unit normal, base colour)`` for hit rays (all of ``hits`` must be hits)."""
+    n = d.shape[0]
+    o = np.broadcast_to(o, d.shape)
+    point = o + hits.t[:, None] * d
+    normal = np.zeros((n, 3))
+    base = np.zeros((n, 3))
+    uv = np.zeros((n, 2))
+    for k, node in enumerate(world.nodes):
+        sel = np.nonzero(hits.node == k)[0]
+        if sel.size == 0:
+            continue
+        if node.kind == "sphere":
+            inv = node.inverse
+            q = point[sel] @ inv[:3, :3].T + inv[:3, 3]  # the hit on the unit sphere
+            q /= np.linalg.norm(q, axis=1, keepdims=True)
+            normal[sel] = q @ node.normal_matrix.T
+            # geometry.sphere()'s uv: u = azimuth/2π from +z towards +x, v = polar angle/π from +y.
+            uv[sel, 0] = np.mod(np.arctan2(q[:, 0], q[:, 2]), 2 * np.pi) / (2 * np.pi)
+            uv[sel, 1] = np.arccos(np.clip(q[:, 1], -1.0, 1.0)) / np.pi
+            colors = np.ones((sel.size, 3))
+        else:
+            tri = hits.tri[sel]
+            u, v = _barycentric(world, tri, o[sel], d[sel])
+            w = np.stack([1.0 - u - v, u, v], axis=1)[:, :, None]  # weights of V0, V1, V2
+            normal[sel] = (world.normals[tri] * w).sum(axis=1)
+            uv[sel] = (world.uvs[tri] * w).sum(axis=1)
+            colors = (world.colors[tri] * w).sum(axis=1)
+        color = np.broadcast_to(node.color, (sel.size, 3)).copy()
+        if node.mode == 1:  # vertex colours, times the material colour (basic.glsl)
+            color *= colors
+        if node.texture >= 0:
+            image, wrap = world.textures[node.texture]
+            color *= _sample(image, wrap, uv[sel])[:, :3]
+        base[sel] = color
+    normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-300)
+    return point, normal, base
+
+
+def _offset(point: NDArray[np.float64], normal: NDArray[np.float64], side: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``point`` moved off its surface towards ``side`` by the relative :data:`SHADOW_OFFSET`."""
+    scale = SHADOW_OFFSET * np.maximum(1.0, np.abs(point).max(axis=1))
+    sign = np.where(np.einsum("ij,ij->i", normal, side) < 0.0, -1.0, 1.0)
+    return point + (scale * sign)[:, None] * normal
+
+
+def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.float64], shadows: bool,
+           cull: bool | None, aabb: bool, stats: RenderStats
+           ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Local colour of hit rays (the raster's per-light formula), plus point and normal for bounces."""
+    point, normal, base = _surface(world, hits, o, d)
+    color = base.copy()  # unlit surfaces keep their colour
+    lit = np.array([world.nodes[k].lit for k in hits.node], dtype=bool) if hits.node.size else np.zeros(0, bool)
+    if lit.any():
+        idx = np.nonzero(lit)[0]
+        nodes = [world.nodes[k] for k in hits.node[idx]]
+        ka = np.array([nd.ka for nd in nodes])[:, None]
+        kd = np.array([nd.kd for nd in nodes])[:, None]
+        ks = np.array([nd.ks for nd in nodes])[:, None]
+        shin = np.array([nd.shininess for nd in nodes])
+        blinn = np.array([nd.mode == 3 for nd in nodes])
+        p, nrm, mesh = point[idx], normal[idx], base[idx]
+        to_eye = -d[idx] / np.linalg.norm(d[idx], axis=1, keepdims=True)
+        total = np.zeros_like(mesh)
+        for index, (light, light_color) in enumerate(zip(world.light_positions, world.light_colors)):
+            to_light = light - p
+            to_light /= np.maximum(np.linalg.norm(to_light, axis=1, keepdims=True), 1e-300)
+            n_dot_l = np.einsum("ij,ij->i", nrm, to_light)
+            diffuse = np.maximum(n_dot_l, 0.0)[:, None] * mesh * light_color
+            reflected = -to_light + 2.0 * n_dot_l[:, None] * nrm  # fromLight − 2(fromLight·N)N
+            r_dot_e = np.einsum("ij,ij->i", to_eye, reflected)
+            halfway = to_light + to_eye
+            halfway /= np.maximum(np.linalg.norm(halfway, axis=1, keepdims=True), 1e-300)
+            n_dot_h = np.einsum("ij,ij->i", nrm, halfway)
+            cosine = np.maximum(np.where(blinn, n_dot_h, r_dot_e), 0.0)
+            highlight = np.where(n_dot_l > 0.0, cosine ** shin, 0.0)
+            specular = highlight[:, None] * light_color
+            visible = np.ones(idx.size)
+            if shadows:
+                start = _offset(p, nrm, light - p)
+                stats.shadow += idx.size
+                blocked = _nearest(world, start, light - start, 1.0, cull, aabb, index).node >= 0
+                visible = np.where(blocked, 0.0, 1.0)
+            total += np.minimum(ka * mesh + visible[:, None] * (kd * diffuse + ks * specular), 1.0)
+        color[idx] = total
+    return color, point, normal
+
+
+def _trace(world: World, o: NDArray[np.float64], d: NDArray[np.float64], max_depth: int, shadows: bool,
+           cull: bool | None, aabb: bool, stats: RenderStats) -> NDArray[np.float64]:
+    """Colour of each ray, reflections followed iteratively: ``(1−r)·local + r·reflected``."""
+    n = d.shape[0]
+    out = np.zeros((n, 3))
+    weight = np.ones(n)
+    alive = np.arange(n)
+    o = np.broadcast_to(o, d.shape)
+    for depth in range(max_depth + 1):
+        hits = _nearest(world, o, d, np.inf, cull, aabb)
+        miss = hits.node < 0
+        out[alive[miss]] += weight[miss, None] * world.background
+        hit = ~miss
+        if not hit.any():
+            break
+        sub = _Hits(hits.t[hit], hits.node[hit], hits.tri[hit])
+        local, point, normal = _shade(world, sub, o[hit], d[hit], shadows, cull, aabb, stats)
+        r = np.array([world.nodes[k].reflectivity for k in sub.node]) if depth < max_depth else np.zeros(sub.node.size)
+        w = weight[hit]
+        out[alive[hit]] += (w * (1.0 - r))[:, None] * local
+        bounce = r > 0.0
+        if not bounce.any():
+            break
+        dh = d[hit][bounce]
+        nh = normal[bounce]
+        reflected = dh - 2.0 * np.einsum("ij,ij->i", dh, nh)[:, None] * nh  # Yansıma vektörü
+        o = _offset(point[bounce], nh, -dh)
+        d = reflected
+        weight = (w * r)[bounce]
+        alive = alive[hit][bounce]
+        stats.reflection += alive.size
+    return out
+
+
+def to_rgba8(rgb: NDArray[np.float64]) -> NDArray[np.uint8]:
+    """Clamp to 0..1 and round to 8 bits as GL's unorm conversion does; alpha 255."""
+    c = np.floor(np.clip(rgb, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
+    alpha = np.full((*c.shape[:-1], 1), 255, dtype=np.uint8)
+    return np.concatenate([c, alpha], axis=-1)
+
+
+def render_viewport(scene: Scene, size: tuple[int, int], viewport: int = 0, *, max_depth: int = 2,
+                    shadows: bool = True, cull_backfaces: bool | None = None, aabb: bool = True,
+                    analytic_spheres: bool = True, stats: RenderStats | None = None) -> NDArray[np.float64]:
+    """One viewport with the numpy engine at ``size`` pixels: float rgb ``(H, W, 3)``, unclamped."""
+    width, height = size
+    vp = scene.viewports[viewport]
+    world = build_world(scene, viewport, analytic_spheres=analytic_spheres)
+    eye, dirs = camera_rays(vp.camera or scene.camera, width, height)
+    stats = stats if stats is not None else RenderStats()
+    stats.primary += dirs.shape[0]
+    rgb = _trace(world, eye, dirs, max_depth, shadows, cull_backfaces, aabb, stats)
+    return rgb.reshape(height, width, 3)
+
+
+def _check(size: tuple[int, int], engine: str, max_depth: int) -> None:
+    if engine not in ENGINES:
+        raise RayTraceError(f"unknown ray tracing engine {engine!r}; use one of {', '.join(ENGINES)}")
+    if len(size) != 2 or any(int(s) != s or s <= 0 or s > 16384 for s in size):
+        raise RayTraceError(f"image size must be two positive integers, got {size!r}")
+    if int(max_depth) != max_depth or not 0 <= max_depth <= 16:
+        raise RayTraceError(f"max_depth must be an integer in 0..16, got {max_depth!r}")
+
+
+def render(scene: Scene, size: tuple[int, int], engine: str = "numpy", *, ctx: object | None = None,
+           max_depth: int = 2, shadows: bool = True, cull_backfaces: bool | None = None, aabb: bool = True,
+           analytic_spheres: bool = True, stats: RenderStats | None = None) -> NDArray[np.uint8]:
+    """Ray-trace ``scene`` at ``size = (width, height)``: an ``(H, W, 4)`` uint8 image, top row first.
+
+    Every viewport is traced in its rectangle with its camera and clear
+    colour, as the rasterizer lays them out; overlays are not drawn (they
+    are the rasterizer's). ``engine="gpu"`` needs ``ctx``, a ModernGL
+    context (the GLSL engine renders on it). Options: ``max_depth``
+    reflection bounces, ``shadows``, ``cull_backfaces`` (None: per node, as
+    the rasterizer), ``aabb`` culling, ``analytic_spheres`` (see
+    :mod:`glsandbox.raytrace.world`). ``stats`` (numpy engine) counts the rays.
+    """
+    _check(size, engine, max_depth)
+    width, height = int(size[0]), int(size[1])
+    start = time.perf_counter()
+    frame = np.zeros((height, width, 4), dtype=np.uint8)
+    options = dict(max_depth=int(max_depth), shadows=shadows, cull_backfaces=cull_backfaces, aabb=aabb,
+                   analytic_spheres=analytic_spheres)
+    tracer: Callable[[int, tuple[int, int]], NDArray[np.uint8]]
+    if engine == "gpu":
+        if ctx is None:
+            raise RayTraceError("engine='gpu' needs a ModernGL context: render(..., ctx=renderer.host.ctx)")
+        from glsandbox.raytrace.gpu import gpu_tracer
+
+        gpu = gpu_tracer(ctx)
+        tracer = lambda index, rect: gpu.render_viewport(scene, rect, index, **options)  # noqa: E731
+    else:
+        tracer = lambda index, rect: to_rgba8(render_viewport(  # noqa: E731
+            scene, rect, index, stats=stats, **options))
+    for index, vp in enumerate(scene.viewports):
+        x, y, w, h = vp.pixels(width, height)
+        if w <= 0 or h <= 0:
+            continue
+        top = height - y - h  # viewports count from the bottom, images from the top
+        frame[top:top + h, x:x + w] = tracer(index, (w, h))
+    if stats is not None:
+        stats.seconds += time.perf_counter() - start
+    return frame
+
+
+# --- the raster-versus-ray hook ----------------------------------------------
+
+
+def trace_viewports(scene: Scene, size: tuple[int, int], ctx: object | None = None,
+                    resolution: float = 1.0) -> Scene:
+    """The hook that lets every lesson render with either renderer.
+
+    Viewports whose ``renderer`` is ``"ray"`` (GLSL engine on ``ctx``) or
+    ``"ray_numpy"`` are traced now; each becomes a plain viewport with no
+    nodes that shows its traced image as its first overlay (drawn texel for
+    pixel, so the rasterizer's own overlays still land on top). A scene with
+    only raster viewports comes back unchanged. The result is an ordinary
+    Scene for the raster executor. ``resolution`` < 1 traces that fraction
+    of the pixels in each direction and enlarges the image (nearest pixel):
+    the interactive window's coarse frames while the camera moves.
+    """
+    from glsandbox.overlay import Overlay
+
+    ray = {i for i, vp in enumerate(scene.viewports) if vp.renderer != "raster"}
+    if not ray:
+        return scene
+    width, height = size
+    images = []
+    for i in sorted(ray):
+        vp = scene.viewports[i]
+        w, h = vp.pixels(width, height)[2:]
+        if w <= 0 or h <= 0:
+            continue
+        single = replace(scene, viewports=(replace(vp, rect=(0.0, 0.0, 1.0, 1.0)),),
+                         nodes=tuple(replace(n, viewports=None) for n in scene.nodes
+                                     if n.viewports is None or i in n.viewports), overlays=())
+        engine = "gpu" if vp.renderer == "ray" and ctx is not None else "numpy"
+        if resolution < 1.0:
+            small = (max(1, math.ceil(w * resolution)), max(1, math.ceil(h * resolution)))
+            image = render(single, small, engine, ctx=ctx)
+            rows = np.minimum((np.arange(h) * small[1]) // h, small[1] - 1)
+            cols = np.minimum((np.arange(w) * small[0]) // w, small[0] - 1)
+            image = np.ascontiguousarray(image[rows][:, cols])
+        else:
+            image = render(single, (w, h), engine, ctx=ctx)
+        images.append(Overlay(f"raytrace/{i}", image, viewport=i, position=(0, 0)))
+    everywhere = tuple(range(len(scene.viewports)))
+    nodes = []
+    for node in scene.nodes:
+        shown = tuple(v for v in (node.viewports if node.viewports is not None else everywhere) if v not in ray)
+        if shown:
+            nodes.append(node if shown == node.viewports or (node.viewports is None and shown == everywhere)
+                         else replace(node, viewports=shown))
+    viewports = tuple(replace(vp, renderer="raster") for vp in scene.viewports)
+    return replace(scene, nodes=tuple(nodes), viewports=viewports, overlays=(*images, *scene.overlays))
+
+
+class InteractiveResolution:
+    """The interactive ray tracer's rule: coarse while the camera moves, full when still.
+
+    :meth:`resolution` is called once per window frame with the scene about
+    to be drawn; while its camera differs from the last frame's (or did
+    within ``settle`` seconds) it answers ``moving`` (a quarter of the
+    pixels each way by default: 16 times fewer rays), then 1.
+    """
+
+    def __init__(self, moving: float = 0.25, settle: float = 0.3) -> None:
+        self.moving = moving
+        self.settle = settle
+        self._last: object | None = None
+        self._moved_at = -math.inf
+
+    def resolution(self, scene: Scene, now: float | None = None) -> float:
+        now = time.perf_counter() if now is None else now
+        cameras = tuple(vp.camera or scene.camera for vp in scene.viewports)
+        if self._last is not None and cameras != self._last:
+            self._moved_at = now
+        self._last = cameras
+        return self.moving if now - self._moved_at < self.settle else 1.0

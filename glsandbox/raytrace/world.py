@@ -1,0 +1,293 @@
+"""From the rasterizer's Scene to what a ray tracer needs: world triangles and primary rays.
+
+Both engines (:mod:`glsandbox.raytrace.render`, numpy float64, and
+:mod:`glsandbox.raytrace.gpu`, GLSL float32) trace a :class:`World`, built
+once per viewport by :func:`build_world` from the *same*
+:class:`glsandbox.scene.Scene` the rasterizer draws:
+
+- every node's mesh is moved into world space by its model matrix, exactly
+  as the vertex shader's ``m_model`` does: positions by ``M``, normals by the
+  normal matrix ``(M³ˣ³)⁻ᵀ`` (course errata: never ``mul(Norm, world)``);
+  triangle strips become triangles with the strip's winding
+  (:meth:`glsandbox.geometry.Mesh.triangles`); line meshes have no surface
+  and are not traced;
+- a node whose mesh is :func:`glsandbox.geometry.sphere` (the unit UV sphere,
+  recognised by its name and by every vertex lying on the unit sphere) is
+  traced as the *exact* unit sphere under its model matrix (an ellipsoid in
+  general): the ray is taken into the sphere's own space with ``M⁻¹`` and
+  tested against ``|p| = 1`` (course section "Işın-Küre kesim testi"). An
+  affine map keeps ``t``: ``M⁻¹(O + t·d) = M⁻¹O + t·(M⁻¹d)``, so no
+  renormalising is needed. The rasterizer draws the tessellation; the
+  difference at the silhouette is one of the approximations the
+  raster-versus-ray comparison shows. ``analytic_spheres=False`` traces the
+  triangles instead;
+- each node gets a world axis-aligned bounding box, the course's
+  "Hızlandırma: AABB": a ray that misses the box skips every triangle inside.
+  A node whose box holds a light is that light's lamp (the lessons draw each
+  light as a small cube around it) and casts no shadow *for that light*;
+  otherwise every shadow ray would start inside or enter the lamp.
+
+Primary rays (course section "Bakış noktası, görüntü düzlemi GD(x,y)")
+---------------------------------------------------------------------
+The notes put the eye at the origin and the image plane at ``z = 10``; the
+pixel ``(x, y)`` of an 800x450 image goes to
+``GD(x, y) = (16x/799 − 8, 4.5 − 9y/449, 10)`` (:func:`course_image_plane`):
+the first and last pixel sit exactly on the plane's edges. The rasterizer
+samples pixel *centres* instead, so to render the same picture the engines
+use :func:`camera_rays`: pixel ``(i, j)`` (row ``j`` from the top) goes
+through ``x_ndc = 2(i + ½)/W − 1``, ``y_ndc = 1 − 2(j + ½)/H`` on a plane one
+unit in front of the eye, ``tan(fov/2)`` high and ``aspect`` times that wide,
+turned into world space by the camera's basis. The direction is *not*
+normalised: its component along the view axis is 1, so the ``t`` of a hit is
+its depth, the raster's view-space ``z`` (near and far are not clipped: every
+lesson's scene lies well inside them).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from glsandbox import transforms
+from glsandbox.geometry import Mesh
+from glsandbox.images import builtin_levels, load_image
+from glsandbox.raytrace.errors import RayTraceError
+from glsandbox.raytrace.triangle import TriangleBatch
+from glsandbox.scene import Camera, Scene
+
+__all__ = [
+    "MODES",
+    "NodeInfo",
+    "World",
+    "build_world",
+    "camera_rays",
+    "course_image_plane",
+    "wrap_code",
+]
+
+#: How a node's surface is coloured, as the engines number it.
+MODES = {"solid": 0, "vertex_color": 1, "phong": 2, "gouraud": 2, "blinn_phong": 3}
+#: Texture wrap modes as the engines number them.
+WRAPS = {"repeat": 0, "mirrored": 1, "clamp": 2}
+
+
+def wrap_code(name: str) -> int:
+    return WRAPS[name]
+
+
+@dataclass
+class NodeInfo:
+    """One traced node: its shape, its box, its material (already numbered for the engines)."""
+
+    name: str
+    kind: str  # "mesh" or "sphere" (the unit sphere under ``model``)
+    start: int  # first triangle in the world arrays
+    count: int  # number of triangles
+    box_min: NDArray[np.float64]
+    box_max: NDArray[np.float64]
+    cull: bool
+    has_normals: bool
+    has_colors: bool
+    color: NDArray[np.float64]  # rgb
+    mode: int  # MODES value
+    ka: float
+    kd: float
+    ks: float
+    shininess: float
+    reflectivity: float
+    texture: int  # index into World.textures, -1 for none
+    model: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
+    inverse: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
+    normal_matrix: NDArray[np.float64] = field(default_factory=lambda: np.eye(3))
+    #: Bit ``i`` set: light ``i`` lies inside this node's box, so the node is
+    #: that light's lamp (the lessons draw each light as a small cube around
+    #: it) and casts no shadow for it.
+    lamp_of: int = 0
+
+    @property
+    def lit(self) -> bool:
+        return self.mode >= 2
+
+
+@dataclass
+class World:
+    """Everything the engines trace in one viewport, in world space (float64).
+
+    Triangle ``k`` is ``v0[k], v1[k], v2[k]`` with per-vertex ``normals[k]``
+    (the face normal three times when the mesh has none), ``uvs[k]`` and
+    ``colors[k]``; it belongs to node ``tri_node[k]``.
+    """
+
+    nodes: list[NodeInfo]
+    v0: NDArray[np.float64]
+    v1: NDArray[np.float64]
+    v2: NDArray[np.float64]
+    normals: NDArray[np.float64]  # (M, 3, 3)
+    uvs: NDArray[np.float64]  # (M, 3, 2)
+    colors: NDArray[np.float64]  # (M, 3, 3)
+    tri_node: NDArray[np.intp]
+    light_positions: NDArray[np.float64]  # (L, 3)
+    light_colors: NDArray[np.float64]  # (L, 3)
+    background: NDArray[np.float64]  # rgb of the viewport's clear colour
+    textures: list[tuple[NDArray[np.float64], int]]  # (image (H, W, 4) in 0..1, wrap code)
+    batches: list[TriangleBatch | None] = field(default_factory=list)
+
+    @property
+    def triangle_count(self) -> int:
+        return int(self.v0.shape[0])
+
+
+def is_unit_sphere(mesh: Mesh) -> bool:
+    """Whether ``mesh`` is :func:`glsandbox.geometry.sphere`: named so, every vertex on ``|p| = 1``."""
+    if mesh.name != "sphere" or mesh.mode != "triangles":
+        return False
+    radii = np.linalg.norm(np.asarray(mesh.positions, dtype=np.float64), axis=1)
+    return bool(np.all(np.abs(radii - 1.0) < 1e-9))
+
+
+def _texture_image(source: str) -> NDArray[np.float64]:
+    """The base level of a texture as float rgba in 0..1 (the ray tracer samples level 0 only)."""
+    from glsandbox.scene import BUILTIN_TEXTURES
+
+    level = builtin_levels(source)[0] if source in BUILTIN_TEXTURES else load_image(source)
+    return np.asarray(level, dtype=np.float64) / 255.0
+
+
+def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = True) -> World:
+    """The :class:`World` of ``scene`` as seen in viewport ``viewport``.
+
+    Nodes restricted to other viewports are left out; the background is the
+    viewport's clear colour (or the scene's).
+    """
+    if not 0 <= viewport < len(scene.viewports):
+        raise RayTraceError(f"viewport {viewport} does not exist ({len(scene.viewports)} defined)")
+    vp = scene.viewports[viewport]
+    clear = vp.clear_color if vp.clear_color is not None else scene.clear_color
+    nodes: list[NodeInfo] = []
+    v0s, v1s, v2s, ns, uvs, cols, owners = [], [], [], [], [], [], []
+    textures: list[tuple[NDArray[np.float64], int]] = []
+    texture_index: dict[tuple[str, str], int] = {}
+    batches: list[TriangleBatch | None] = []
+    start = 0
+    for node in scene.nodes:
+        if node.viewports is not None and viewport not in node.viewports:
+            continue
+        mesh = node.mesh
+        if mesh.mode in ("lines", "line_strip"):
+            continue  # a path has no surface to hit
+        model = np.asarray(node.model, dtype=np.float64)
+        material = node.material
+        tex = -1
+        if material.texture is not None:
+            key = (material.texture.source, material.texture.wrap)
+            if key not in texture_index:
+                texture_index[key] = len(textures)
+                textures.append((_texture_image(material.texture.source), WRAPS[material.texture.wrap]))
+            tex = texture_index[key]
+        common = dict(
+            name=node.name, cull=bool(node.cull_back_faces),
+            color=np.asarray(material.color[:3], dtype=np.float64), mode=MODES[material.shading],
+            ka=float(material.ambient), kd=float(material.diffuse), ks=float(material.specular),
+            shininess=float(material.shininess), reflectivity=float(getattr(material, "reflectivity", 0.0)),
+            texture=tex, model=model,
+        )
+        if analytic_spheres and is_unit_sphere(mesh):
+            corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=np.float64)
+            world_corners = transforms.transform_points(model, corners)
+            nodes.append(NodeInfo(kind="sphere", start=start, count=0, box_min=world_corners.min(axis=0),
+                                  box_max=world_corners.max(axis=0), has_normals=True, has_colors=False,
+                                  inverse=np.linalg.inv(model), normal_matrix=transforms.normal_matrix(model),
+                                  **common))
+            batches.append(None)
+            continue
+        order = mesh.indices if mesh.indices is not None else np.arange(mesh.vertex_count)
+        if mesh.mode == "triangles":
+            tri = np.asarray(order, dtype=np.intp).reshape(-1, 3)
+        else:  # a strip: triangle k is (k, k+1, k+2), odd ones swapped to keep the winding
+            tri = np.array([(order[k + 1], order[k], order[k + 2]) if k % 2 else (order[k], order[k + 1], order[k + 2])
+                            for k in range(len(order) - 2)], dtype=np.intp).reshape(-1, 3)
+        if len(tri) == 0:
+            continue
+        world = transforms.transform_points(model, np.asarray(mesh.positions, dtype=np.float64))
+        a, b, c = world[tri[:, 0]], world[tri[:, 1]], world[tri[:, 2]]
+        if mesh.normals is not None:
+            n_world = np.asarray(mesh.normals, dtype=np.float64) @ transforms.normal_matrix(model).T
+            n_world /= np.maximum(np.linalg.norm(n_world, axis=1, keepdims=True), 1e-300)
+            n = n_world[tri]
+        else:  # flat: the face normal, counter-clockwise front (OpenGL's rule)
+            face = np.cross(b - a, c - a)
+            face /= np.maximum(np.linalg.norm(face, axis=1, keepdims=True), 1e-300)
+            n = np.repeat(face[:, None, :], 3, axis=1)
+        uv = np.asarray(mesh.uvs, dtype=np.float64)[tri] if mesh.uvs is not None else np.zeros((len(tri), 3, 2))
+        col = np.asarray(mesh.colors, dtype=np.float64)[tri] if mesh.colors is not None else np.ones((len(tri), 3, 3))
+        v0s.append(a), v1s.append(b), v2s.append(c), ns.append(n), uvs.append(uv), cols.append(col)
+        owners.append(np.full(len(tri), len(nodes), dtype=np.intp))
+        nodes.append(NodeInfo(kind="mesh", start=start, count=len(tri), box_min=world.min(axis=0),
+                              box_max=world.max(axis=0), has_normals=mesh.normals is not None,
+                              has_colors=mesh.colors is not None, **common))
+        batches.append(TriangleBatch(a, b, c))
+        start += len(tri)
+    lights = scene.lights
+    for info in nodes:
+        for i, light in enumerate(lights):
+            if np.all(info.box_min <= light.position) and np.all(np.asarray(light.position) <= info.box_max):
+                info.lamp_of |= 1 << i
+
+    def stack(parts: list[NDArray[np.float64]], shape: tuple[int, ...]) -> NDArray[np.float64]:
+        return np.concatenate(parts) if parts else np.zeros((0, *shape))
+
+    return World(
+        nodes=nodes, v0=stack(v0s, (3,)), v1=stack(v1s, (3,)), v2=stack(v2s, (3,)), normals=stack(ns, (3, 3)),
+        uvs=stack(uvs, (3, 2)), colors=stack(cols, (3, 3)),
+        tri_node=np.concatenate(owners) if owners else np.zeros(0, dtype=np.intp),
+        light_positions=np.array([l.position for l in lights], dtype=np.float64).reshape(-1, 3),
+        light_colors=np.array([l.color for l in lights], dtype=np.float64).reshape(-1, 3),
+        background=np.asarray(clear[:3], dtype=np.float64), textures=textures, batches=batches,
+    )
+
+
+def camera_basis(camera: Camera, aspect: float) -> tuple[NDArray[np.float64], NDArray[np.float64], float, float]:
+    """``(eye, basis, half_width, half_height)``: the image plane one unit in front of the eye.
+
+    ``basis`` is the 3x3 rotation from view space to world space (the inverse
+    of the view matrix's rotation): its columns are the camera's right, up
+    and backward axes in world coordinates.
+    """
+    view = camera.view()
+    inverse = np.linalg.inv(np.asarray(view, dtype=np.float64))
+    half_h = math.tan(math.radians(camera.fov_y) / 2.0)
+    return inverse[:3, 3].copy(), inverse[:3, :3].copy(), half_h * aspect, half_h
+
+
+def camera_rays(camera: Camera, width: int, height: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Primary rays through pixel centres: ``(eye (3,), directions (H·W, 3))``, row 0 at the top.
+
+    ``t`` along a direction is the depth in front of the eye (see the module docstring).
+    """
+    if width <= 0 or height <= 0:
+        raise RayTraceError(f"image size must be positive, got {width}x{height}")
+    eye, basis, half_w, half_h = camera_basis(camera, width / height)
+    x = (2.0 * (np.arange(width) + 0.5) / width - 1.0) * half_w
+    y = (1.0 - 2.0 * (np.arange(height) + 0.5) / height) * half_h
+    xs, ys = np.meshgrid(x, y)
+    d_view = np.stack([xs, ys, -np.ones_like(xs)], axis=-1).reshape(-1, 3)
+    return eye, d_view @ basis.T
+
+
+def course_image_plane(x: NDArray[np.float64] | float, y: NDArray[np.float64] | float, width: int = 800,
+                       height: int = 450, half_width: float = 8.0, half_height: float = 4.5,
+                       distance: float = 10.0) -> NDArray[np.float64]:
+    """The notes' ``GD(x, y)``: pixel ``(x, y)`` to its point on the image plane (DirectX, looking +z).
+
+    ``GD(x, y) = (2·8·x/(W−1) − 8, 4.5 − 2·4.5·y/(H−1), 10)``; for 800x450 that is
+    ``(16x/799 − 8, 4.5 − 9y/449, 10)``: pixel (0, 0) is the top-left corner
+    ``(−8, 4.5, 10)`` and (799, 449) the bottom-right ``(8, −4.5, 10)``.
+    """
+    xs = np.asarray(x, dtype=np.float64)
+    ys = np.asarray(y, dtype=np.float64)
+    px = 2.0 * half_width * xs / (width - 1) - half_width
+    py = half_height - 2.0 * half_height * ys / (height - 1)
+    return np.stack(np.broadcast_arrays(px, py, np.full_like(px + py, distance)), axis=-1)

@@ -1,0 +1,315 @@
+#version 330 core
+// The ray tracer as one fragment shader (glsandbox.raytrace.gpu): one
+// fragment = one pixel = one primary ray, with its shadow rays and
+// reflection bounces. The same algorithm as the float64 numpy engine
+// (glsandbox/raytrace/render.py, read its docstring for the course sections),
+// in float32. A fragment shader, not a compute shader: on llvmpipe it
+// measured about 5x faster for this.
+//
+// Data (uploaded per frame by glsandbox/raytrace/gpu.py), RGBA32F textures
+// read with texelFetch as flat arrays of vec4 records:
+//   u_tris   TRI_RECORDS per triangle: v0 | e1 | e2 | n0,uv0.x | n1,uv0.y |
+//            n2,uv1.x | c0,uv1.y | c1,uv2.x | c2,uv2.y   (world space)
+//   u_nodes  NODE_RECORDS per node: box min,kind | box max,cull |
+//            start,count,has_normals,has_colors | colour,mode | ka,kd,ks,n |
+//            reflectivity,texture,lamp bits | inverse model (3 rows) |
+//            normal matrix (3 rows)
+// Variants: NUM_LIGHTS (the light loop), NUM_TEXTURES (0..4 samplers).
+
+#define TEX_WIDTH 1024
+#define TRI_RECORDS 9
+#define NODE_RECORDS 12
+#define INF 1e30
+
+#if defined(VERTEX_SHADER)
+void main() {
+    // A strip over the whole viewport: 0 -> (-1,-1), 1 -> (1,-1), 2 -> (-1,1), 3 -> (1,1).
+    vec2 corner = vec2(float(gl_VertexID & 1), float(gl_VertexID >> 1));
+    gl_Position = vec4(corner * 2.0 - 1.0, 0.0, 1.0);
+}
+
+#elif defined(FRAGMENT_SHADER)
+uniform sampler2D u_tris;
+uniform sampler2D u_nodes;
+uniform int u_node_count;
+uniform vec2 u_size;        // the image in pixels
+uniform vec3 u_eye;         // camera position (world)
+uniform mat3 u_basis;       // view space -> world (right, up, back)
+uniform vec2 u_half;        // image plane half-size at distance 1: tan(fov/2)*aspect, tan(fov/2)
+uniform vec3 u_background;  // the viewport's clear colour
+uniform int u_max_depth;    // reflection bounces
+uniform bool u_shadows;
+uniform int u_cull;         // -1: per node (as the rasterizer), 0: never, 1: always
+uniform bool u_aabb;
+uniform float u_offset;     // relative offset of secondary-ray origins (SHADOW_OFFSET)
+#if NUM_LIGHTS > 0
+uniform vec3 u_light_pos[NUM_LIGHTS];
+uniform vec3 u_light_color[NUM_LIGHTS];
+#endif
+#if NUM_TEXTURES > 0
+uniform sampler2D u_tex0;
+uniform int u_wrap[NUM_TEXTURES];
+#endif
+#if NUM_TEXTURES > 1
+uniform sampler2D u_tex1;
+#endif
+#if NUM_TEXTURES > 2
+uniform sampler2D u_tex2;
+#endif
+#if NUM_TEXTURES > 3
+uniform sampler2D u_tex3;
+#endif
+out vec4 frag_color;
+
+vec4 record(sampler2D s, int i) { return texelFetch(s, ivec2(i % TEX_WIDTH, i / TEX_WIDTH), 0); }
+vec4 node_rec(int k, int r) { return record(u_nodes, k * NODE_RECORDS + r); }
+vec4 tri_rec(int k, int r) { return record(u_tris, k * TRI_RECORDS + r); }
+
+// Hızlandırma: AABB. The slab test: the ray is inside the box between the
+// largest entry and the smallest exit; skip the node unless that interval
+// is non-empty, ends after 0 and starts before the best hit so far.
+bool slab(vec3 o, vec3 inv_d, vec3 lo, vec3 hi, float best) {
+    vec3 ta = (lo - o) * inv_d;
+    vec3 tb = (hi - o) * inv_d;
+    vec3 tn = min(ta, tb);
+    vec3 tf = max(ta, tb);
+    float near = max(max(tn.x, tn.y), tn.z);
+    float far = min(min(tf.x, tf.y), tf.z);
+    return near <= far && far > 0.0 && near < best;
+}
+
+// Möller–Trumbore: O + t d = V0 + u e1 + v e2 by Cramer's rule.
+// det = e1·(d×e2) = −N·d is positive for a front face: backface culling
+// keeps only det > 0 (course "Hızlandırma: backface culling").
+float triangle_t(int k, vec3 o, vec3 d, bool cull) {
+    vec3 v0 = tri_rec(k, 0).xyz;
+    vec3 e1 = tri_rec(k, 1).xyz;
+    vec3 e2 = tri_rec(k, 2).xyz;
+    vec3 p = cross(d, e2);
+    float det = dot(e1, p);
+    if (cull ? det <= 0.0 : det == 0.0) return INF;
+    float inv_det = 1.0 / det;
+    vec3 s = o - v0;
+    float u = dot(s, p) * inv_det;
+    if (u < 0.0 || u > 1.0) return INF;
+    vec3 q = cross(s, e1);
+    float v = dot(d, q) * inv_det;
+    if (v < 0.0 || u + v > 1.0) return INF;
+    float t = dot(e2, q) * inv_det;
+    return t > 0.0 ? t : INF;
+}
+
+// Işın-Küre kesim testi in the unit sphere's own space, the numerically
+// stable form (Ray Tracing Gems ch. 7): discriminant from the vector
+// h = l − (b/a)d, roots q/a and c/q without cancellation.
+float sphere_t(vec3 o, vec3 d, bool cull) {
+    if (cull && dot(o, o) < 1.0) return INF;  // from inside, every front face faces away
+    vec3 l = -o;
+    float a = dot(d, d);
+    float b = dot(l, d);
+    vec3 h = l - (b / a) * d;
+    float disc = a * (1.0 - dot(h, h));
+    if (disc < 0.0) return INF;
+    float q = b + (b >= 0.0 ? sqrt(disc) : -sqrt(disc));
+    if (q == 0.0) return INF;
+    float l_len = length(l);
+    float c = (l_len - 1.0) * (l_len + 1.0);
+    float t1 = q / a;
+    float t0 = c / q;
+    float near = min(t0, t1);
+    float far = max(t0, t1);
+    return near > 0.0 ? near : (far > 0.0 ? far : INF);
+}
+
+vec3 to_object(int k, vec3 p, float w) {
+    vec4 h = vec4(p, w);
+    return vec3(dot(node_rec(k, 6), h), dot(node_rec(k, 7), h), dot(node_rec(k, 8), h));
+}
+
+// The nearest hit with 0 < t < t_max (tDistances / min_indis). light >= 0:
+// a shadow query for that light, whose lamp is skipped.
+float nearest(vec3 o, vec3 d, float t_max, int light, out int hit_node, out int hit_tri) {
+    float best = t_max;
+    hit_node = -1;
+    hit_tri = -1;
+    vec3 inv_d = 1.0 / d;
+    for (int k = 0; k < u_node_count; ++k) {
+        vec4 r0 = node_rec(k, 0);
+        vec4 r1 = node_rec(k, 1);
+        if (light >= 0 && ((int(node_rec(k, 5).z) >> light) & 1) != 0) continue;
+        if (u_aabb && !slab(o, inv_d, r0.xyz, r1.xyz, best)) continue;
+        bool cull = u_cull < 0 ? r1.w > 0.5 : u_cull == 1;
+        if (r0.w > 0.5) {
+            float t = sphere_t(to_object(k, o, 1.0), to_object(k, d, 0.0), cull);
+            if (t < best) { best = t; hit_node = k; hit_tri = -1; }
+        } else {
+            vec4 r2 = node_rec(k, 2);
+            int start = int(r2.x);
+            int stop = start + int(r2.y);
+            for (int j = start; j < stop; ++j) {
+                float t = triangle_t(j, o, d, cull);
+                if (t < best) { best = t; hit_node = k; hit_tri = j; }
+            }
+        }
+    }
+    return best;
+}
+
+#if NUM_TEXTURES > 0
+int wrap_index(int i, int size, int mode) {
+    if (mode == 0) return i - size * int(floor(float(i) / float(size)));  // repeat
+    if (mode == 1) {  // mirrored repeat
+        int m = i - 2 * size * int(floor(float(i) / float(2 * size)));
+        return m < size ? m : 2 * size - 1 - m;
+    }
+    return clamp(i, 0, size - 1);  // clamp to edge
+}
+
+vec4 fetch_texel(int slot, ivec2 ij) {
+#if NUM_TEXTURES > 1
+    if (slot == 1) return texelFetch(u_tex1, ij, 0);
+#endif
+#if NUM_TEXTURES > 2
+    if (slot == 2) return texelFetch(u_tex2, ij, 0);
+#endif
+#if NUM_TEXTURES > 3
+    if (slot == 3) return texelFetch(u_tex3, ij, 0);
+#endif
+    return texelFetch(u_tex0, ij, 0);
+}
+
+ivec2 texture_size(int slot) {
+#if NUM_TEXTURES > 1
+    if (slot == 1) return textureSize(u_tex1, 0);
+#endif
+#if NUM_TEXTURES > 2
+    if (slot == 2) return textureSize(u_tex2, 0);
+#endif
+#if NUM_TEXTURES > 3
+    if (slot == 3) return textureSize(u_tex3, 0);
+#endif
+    return textureSize(u_tex0, 0);
+}
+
+// Bilinear in the base level, the wrap mode done by hand (as the numpy engine).
+vec3 sample_texture(int slot, vec2 uv) {
+    ivec2 size = texture_size(slot);
+    int mode = u_wrap[slot];
+    vec2 xy = uv * vec2(size) - 0.5;
+    vec2 base = floor(xy);
+    vec2 f = xy - base;
+    int x0 = int(base.x), y0 = int(base.y);
+    int xa = wrap_index(x0, size.x, mode), xb = wrap_index(x0 + 1, size.x, mode);
+    int ya = wrap_index(y0, size.y, mode), yb = wrap_index(y0 + 1, size.y, mode);
+    vec3 top = mix(fetch_texel(slot, ivec2(xa, ya)).rgb, fetch_texel(slot, ivec2(xb, ya)).rgb, f.x);
+    vec3 bottom = mix(fetch_texel(slot, ivec2(xa, yb)).rgb, fetch_texel(slot, ivec2(xb, yb)).rgb, f.x);
+    return mix(top, bottom, f.y);
+}
+#endif
+
+// Point, unit normal and base colour of a hit.
+void surface(int k, int j, float t, vec3 o, vec3 d, out vec3 p, out vec3 n, out vec3 base) {
+    p = o + t * d;
+    vec2 uv = vec2(0.0);
+    vec3 colors = vec3(1.0);
+    if (node_rec(k, 0).w > 0.5) {
+        vec3 q = normalize(to_object(k, p, 1.0));  // the hit on the unit sphere
+        n = vec3(dot(node_rec(k, 9).xyz, q), dot(node_rec(k, 10).xyz, q), dot(node_rec(k, 11).xyz, q));
+        const float PI = 3.14159265358979;
+        float phi = atan(q.x, q.z);
+        uv = vec2((phi < 0.0 ? phi + 2.0 * PI : phi) / (2.0 * PI), acos(clamp(q.y, -1.0, 1.0)) / PI);
+    } else {
+        // Barycentric (u, v) of the hit: t(u,v) = V0 + u(V1−V0) + v(V2−V0).
+        vec3 v0 = tri_rec(j, 0).xyz, e1 = tri_rec(j, 1).xyz, e2 = tri_rec(j, 2).xyz;
+        vec3 pp = cross(d, e2);
+        float det = dot(e1, pp);
+        vec3 s = o - v0;
+        float u = dot(s, pp) / det;
+        float v = dot(d, cross(s, e1)) / det;
+        vec3 w = vec3(1.0 - u - v, u, v);
+        vec4 a = tri_rec(j, 3), b = tri_rec(j, 4), c = tri_rec(j, 5);
+        vec4 ca = tri_rec(j, 6), cb = tri_rec(j, 7), cc = tri_rec(j, 8);
+        n = w.x * a.xyz + w.y * b.xyz + w.z * c.xyz;
+        uv = w.x * vec2(a.w, b.w) + w.y * vec2(c.w, ca.w) + w.z * vec2(cb.w, cc.w);
+        colors = w.x * ca.xyz + w.y * cb.xyz + w.z * cc.xyz;
+    }
+    n = normalize(n);
+    vec4 m = node_rec(k, 3);
+    base = m.rgb;
+    if (int(m.w) == 1) base *= colors;  // vertex colours
+#if NUM_TEXTURES > 0
+    int slot = int(node_rec(k, 5).y);
+    if (slot >= 0) base *= sample_texture(slot, uv);
+#endif
+}
+
+// Secondary rays start off the surface, on the side of `towards`.
+vec3 offset_point(vec3 p, vec3 n, vec3 towards) {
+    float scale = u_offset * max(1.0, max(max(abs(p.x), abs(p.y)), abs(p.z)));
+    return p + (dot(n, towards) < 0.0 ? -scale : scale) * n;
+}
+
+// The rasterizer's per-light Phong (common/lighting.glsl), with shadow rays.
+vec3 shade(int k, vec3 p, vec3 n, vec3 mesh, vec3 d) {
+    int mode = int(node_rec(k, 3).w);
+    if (mode < 2) return mesh;  // solid, vertex colours: unlit
+    vec3 color = vec3(0.0);
+#if NUM_LIGHTS > 0
+    vec4 coef = node_rec(k, 4);
+    vec3 to_eye = -normalize(d);
+    for (int i = 0; i < NUM_LIGHTS; ++i) {
+        vec3 to_light = normalize(u_light_pos[i] - p);
+        float n_dot_l = dot(n, to_light);
+        vec3 diffuse = max(n_dot_l, 0.0) * mesh * u_light_color[i];
+        float highlight = 0.0;
+        if (n_dot_l > 0.0) {
+            float cosine;
+            if (mode == 3) {
+                cosine = dot(n, normalize(to_light + to_eye));
+            } else {
+                vec3 reflected = -to_light + 2.0 * n_dot_l * n;
+                cosine = dot(to_eye, reflected);
+            }
+            highlight = pow(max(cosine, 0.0), coef.w);
+        }
+        vec3 specular = highlight * u_light_color[i];
+        float visible = 1.0;
+        if (u_shadows) {
+            vec3 start = offset_point(p, n, u_light_pos[i] - p);
+            int occluder, tri;
+            nearest(start, u_light_pos[i] - start, 1.0, i, occluder, tri);
+            if (occluder >= 0) visible = 0.0;
+        }
+        color += min(coef.x * mesh + visible * (coef.y * diffuse + coef.z * specular), vec3(1.0));
+    }
+#endif
+    return color;
+}
+
+void main() {
+    vec2 ndc = 2.0 * gl_FragCoord.xy / u_size - 1.0;  // pixel centres, as the rasterizer samples
+    vec3 o = u_eye;
+    vec3 d = u_basis * vec3(ndc * u_half, -1.0);
+    vec3 color = vec3(0.0);
+    float weight = 1.0;
+    for (int depth = 0; depth <= u_max_depth; ++depth) {
+        int k, j;
+        float t = nearest(o, d, INF, -1, k, j);
+        if (k < 0) {
+            color += weight * u_background;
+            break;
+        }
+        vec3 p, n, base;
+        surface(k, j, t, o, d, p, n, base);
+        vec3 local = shade(k, p, n, base, d);
+        float r = depth < u_max_depth ? node_rec(k, 5).x : 0.0;
+        color += weight * (1.0 - r) * local;
+        if (r <= 0.0) break;
+        vec3 reflected = d - 2.0 * dot(d, n) * n;  // Yansıma vektörü
+        o = offset_point(p, n, -d);
+        d = reflected;
+        weight *= r;
+    }
+    frag_color = vec4(clamp(color, 0.0, 1.0), 1.0);
+}
+#endif
