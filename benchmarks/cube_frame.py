@@ -1,6 +1,7 @@
 """Benchmark: the indexed cube at 800x600, raw ModernGL versus glsandbox.
 
-Run: ``uv run python benchmarks/cube_frame.py [--frames N] [--rounds R]``
+Run: ``uv run python benchmarks/cube_frame.py [--frames N] [--rounds R]``;
+``glsandbox bench`` runs the same case (:func:`cases`) with every other benchmark.
 
 Both sides draw the same frame (clear, the course cube with its vertex
 colours, depth test and back-face culling, the course camera, a rotation that
@@ -15,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import statistics
+from dataclasses import replace
 import subprocess
 import sys
 import tempfile
@@ -81,18 +83,29 @@ class RawCube:
         return np.frombuffer(self.fbo.read(components=4, alignment=1), dtype=np.uint8)
 
 
-def measure(frame, frames: int, start: float) -> float:
-    """Seconds per frame over ``frames`` consecutive frames."""
-    t0 = time.perf_counter()
-    for k in range(frames):
-        frame(start + 0.01 * k)
-    return (time.perf_counter() - t0) / frames
-
-
 def cold_start(command: list[str]) -> float:
     t0 = time.perf_counter()
     subprocess.run(command, check=True, capture_output=True)
     return time.perf_counter() - t0
+
+
+def cases(env) -> list:
+    """The bench case: raw ModernGL vs glsandbox on the indexed cube (one context, alternating rounds)."""
+    from glsandbox.bench import Case, Side, same_pixels
+    from glsandbox.lesson import find_lesson
+
+    renderer = env.renderer
+    raw = RawCube(renderer.host.ctx)
+    lesson = find_lesson("indexed_cube")()
+
+    def ours(k: int) -> np.ndarray:
+        return renderer.render(lesson.at(0.3 + 0.01 * k), SIZE).image
+
+    def theirs(k: int) -> np.ndarray:
+        return raw.frame(0.3 + 0.01 * k).reshape(SIZE[1], SIZE[0], 4)[::-1]
+
+    return [Case("frame vs raw ModernGL", "indexed_cube", Side("raw ModernGL", theirs), Side("glsandbox", ours),
+                 repeat=100, goal=1.10, compare=same_pixels)]
 
 
 def main() -> int:
@@ -110,26 +123,16 @@ def main() -> int:
         Image.fromarray(pixels).save(args.raw_once)
         return 0
 
-    from glsandbox.app import HeadlessRenderer
-    from glsandbox.lesson import find_lesson
+    from glsandbox.bench import BenchEnv, measure
 
-    renderer = HeadlessRenderer("egl")
-    raw = RawCube(renderer.host.ctx)
-    lesson = find_lesson("indexed_cube")()
-
-    def ours(t: float) -> np.ndarray:
-        return renderer.render(lesson.at(t), SIZE).image
-
-    # Same picture first: the comparison is only fair if both draw the same frame.
-    same = np.array_equal(raw.frame(0.3).reshape(SIZE[1], SIZE[0], 4)[::-1], ours(0.3))
-    for fn in (raw.frame, ours):  # warm-up
-        measure(fn, 10, 0.0)
-    raw_times, our_times = [], []
-    for r in range(args.rounds):
-        raw_times.append(measure(raw.frame, args.frames, r))
-        our_times.append(measure(ours, args.frames, r))
+    env = BenchEnv()
+    (case,) = cases(env)
+    case = replace(case, repeat=args.frames)
+    (result,) = measure([case], args.rounds)
+    raw_times, our_times = result.baseline_s, result.subject_s
     raw_ms, our_ms = statistics.median(raw_times) * 1e3, statistics.median(our_times) * 1e3
-    renderer.close()
+    same = result.same == "identical"
+    env.close()
 
     with tempfile.TemporaryDirectory() as tmp:
         ours_cold = statistics.median(cold_start([sys.executable, "-m", "glsandbox.cli", "render", "indexed_cube",

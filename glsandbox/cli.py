@@ -186,6 +186,22 @@ pre {{ background: #eee; padding: 0.5em; }}
 """
 
 
+def cmd_tradeoffs(args: argparse.Namespace) -> int:
+    """``glsandbox tradeoffs``: accuracy knobs, timed and compared with a reference (:mod:`glsandbox.tradeoffs`)."""
+    from glsandbox.tradeoffs import run
+
+    run(args.out, quick=args.quick, backend=args.backend, runs=args.runs, only=args.knob)
+    print(f"wrote {args.out / 'report.md'}, {args.out / 'tradeoffs.csv'}, {args.out / 'tradeoffs.png'}")
+    return 0
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    """``glsandbox bench``: every benchmark in benchmarks/, one table of side-by-side ratios."""
+    from glsandbox.bench import run_all
+
+    return run_all(json_path=args.json, quick=args.quick, only=args.only)
+
+
 def build_parser() -> argparse.ArgumentParser:
     from glsandbox.app import add_render_options
 
@@ -218,6 +234,21 @@ def build_parser() -> argparse.ArgumentParser:
     add_render_options(p)
     p.add_argument("--out", type=Path, default=None, help="the PNG to write (default compare_LESSON.png)")
     p.set_defaults(func=cmd_compare)
+
+    p = sub.add_parser("tradeoffs", help="what accuracy costs in time: each knob timed and compared with a reference")
+    p.add_argument("--out", type=Path, default=Path("out/tradeoffs"), help="output folder (default out/tradeoffs)")
+    p.add_argument("--quick", action="store_true", help="a reduced set at a small size (for CI)")
+    p.add_argument("--runs", type=int, default=5, help="timed runs per setting (at least 5, default 5)")
+    p.add_argument("--knob", action="append", default=[], metavar="NAME", help="only this knob (repeatable)")
+    p.add_argument("--backend", default=None, help="GL backend (default: GLSANDBOX_BACKEND or auto)")
+    p.set_defaults(func=cmd_tradeoffs)
+
+    p = sub.add_parser("bench", help="run every benchmark in benchmarks/ and print one table of ratios")
+    p.add_argument("--json", type=Path, default=None, metavar="FILE", help="also write the figures as JSON")
+    p.add_argument("--quick", action="store_true", help="fewer frames and rounds (a smoke run)")
+    p.add_argument("--only", action="append", default=[], metavar="NAME",
+                   help="only benchmarks whose name contains NAME (repeatable)")
+    p.set_defaults(func=cmd_bench)
     return parser
 
 

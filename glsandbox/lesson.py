@@ -19,7 +19,7 @@ from typing import Any, ClassVar
 
 from glsandbox.errors import SandboxError
 from glsandbox.scene import RENDERERS
-from glsandbox.scene import Scene, load_scene
+from glsandbox.scene import EFFECTS, Scene, load_scene
 
 
 @dataclass(frozen=True)
@@ -75,6 +75,11 @@ class Param:
 #: Every lesson has ``time``: the moment to render, in seconds.
 TIME = Param("time", 0.0, "the moment to render, in seconds (animated lessons move with it)", minimum=0.0)
 
+#: Every lesson has ``effects``: ``needed`` plans only what the scene calls for,
+#: ``all`` forces every buffer and pass on (same picture; the bench's baseline).
+EFFECTS_PARAM = Param("effects", "needed", "plan only the effects the scene needs, or force all on "
+                      "(same picture, for the bench)", choices=EFFECTS)
+
 #: Every lesson has ``renderer``: the rasterizer, or the ray tracer on the same
 #: Scene (``ray``: the GLSL engine, ``ray_numpy``: the float64 reference), so
 #: ``glsandbox compare LESSON --vary renderer=raster,ray`` shows both.
@@ -104,7 +109,7 @@ class Lesson:
 
     @classmethod
     def all_params(cls) -> tuple[Param, ...]:
-        return (TIME, RENDERER, *cls.params)
+        return (TIME, RENDERER, EFFECTS_PARAM, *cls.params)
 
     @classmethod
     def from_settings(cls, settings: Iterable[str]) -> Lesson:
@@ -135,7 +140,8 @@ class Lesson:
         renderer = self.values.get("renderer", "raster")
         if renderer != "raster":  # traced by glsandbox.raytrace.render.trace_viewports
             scene = replace(scene, viewports=tuple(replace(vp, renderer=renderer) for vp in scene.viewports))
-        return scene
+        effects = self.values.get("effects", "needed")  # effects=all: the bench's everything-on plan
+        return scene if scene.effects == effects else replace(scene, effects=effects)
 
     def build(self) -> Scene:
         raise NotImplementedError

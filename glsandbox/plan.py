@@ -192,13 +192,19 @@ def plan(scene: Scene) -> Plan:
     Depth is allocated, cleared and tested only when something can hide
     something else (see :func:`_needs_depth`); MSAA only when asked for; the
     stencil only when a pass uses it (no pass in the foundation lessons does).
+    With ``scene.effects == "all"`` every buffer and test that leaves the
+    picture unchanged is forced on: the plan is a superset of the needed one.
     """
-    uses_depth = _needs_depth(scene)
+    # effects=all: the everything-on baseline. Depth and stencil are allocated
+    # and cleared in every viewport, and the depth test runs in every draw pass
+    # (unless the scene turned depth testing off, which would change the picture).
+    force = scene.effects == "all"
+    uses_depth = _needs_depth(scene) or (force and scene.depth_test)
     passes: list[Pass] = []
     programs: set[ProgramVariant] = set()
     for index, viewport in enumerate(scene.viewports):
         color = viewport.clear_color if viewport.clear_color is not None else scene.clear_color
-        passes.append(Pass("clear", index, clear_color=color, clear_depth=uses_depth))
+        passes.append(Pass("clear", index, clear_color=color, clear_depth=uses_depth, clear_stencil=force))
         draws = []
         for node in scene.nodes:
             if node.viewports is not None and index not in node.viewports:

@@ -49,6 +49,10 @@ TEXTURE_WRAPS = ("repeat", "mirrored", "clamp")
 #: Who renders a viewport: the rasterizer, the GLSL ray tracer, the numpy (float64) ray tracer.
 RENDERERS = ("raster", "ray", "ray_numpy")
 
+#: How much the plan turns on (``--set effects=...``, every lesson): only what
+#: the scene needs, or everything that does not change the picture.
+EFFECTS = ("needed", "all")
+
 #: Images the project draws itself (:mod:`glsandbox.images`); any other
 #: texture source is an image file path.
 BUILTIN_TEXTURES = ("checker", "labels", "mip_levels")
@@ -213,6 +217,10 @@ class Scene:
     depth_test: bool = True
     #: Labels and figures drawn over the frame (:mod:`glsandbox.overlay`).
     overlays: tuple[Overlay, ...] = ()
+    #: ``"needed"``: the plan lists only what the scene calls for; ``"all"``:
+    #: every buffer and pass state forced on (the everything-on baseline that
+    #: ``glsandbox bench`` measures on-demand planning against). See :data:`EFFECTS`.
+    effects: str = "needed"
 
 
 # --- TOML scene files -------------------------------------------------------

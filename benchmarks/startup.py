@@ -1,0 +1,32 @@
+"""Benchmark: cold start (process start to the first PNG) and the full ``tour``.
+
+Cold start: ``glsandbox render indexed_cube`` at 800x600 vs the raw ModernGL
+script path of ``cube_frame.py --raw-once`` (context, resources, one frame,
+one PNG). The tour renders every lesson in one process; it has no baseline,
+its time is printed on its own.
+"""
+
+from __future__ import annotations
+
+import sys
+import tempfile
+from pathlib import Path
+
+_TMP = tempfile.TemporaryDirectory(prefix="glsandbox-bench-")
+
+
+def cases(env) -> list:
+    from glsandbox.bench import Case, Side, run_process
+
+    tmp = Path(_TMP.name)
+    here = Path(__file__).resolve().parent
+    ours = [sys.executable, "-m", "glsandbox.cli", "render", "indexed_cube", "--size", "800x600",
+            "--backend", "egl", "--out", str(tmp / "ours.png")]
+    raw = [sys.executable, str(here / "cube_frame.py"), "--raw-once", str(tmp / "raw.png")]
+    tour = [sys.executable, "-m", "glsandbox.cli", "tour", "--backend", "egl", "--out", str(tmp / "tour")]
+    return [
+        Case("startup", "cold start to first PNG", Side("raw ModernGL script", run_process(raw)),
+             Side("glsandbox render", run_process(ours)), repeat=1, unit="s"),
+        Case("startup", "full tour (every lesson, 640x480)", None, Side("glsandbox tour", run_process(tour)),
+             repeat=1, unit="s"),
+    ]

@@ -1,0 +1,280 @@
+"""``glsandbox bench``: every benchmark in ``benchmarks/``, one table of ratios.
+
+A benchmark module in ``benchmarks/`` (any ``*.py`` not starting with ``_``)
+defines ``cases(env: BenchEnv) -> list[Case]``. A :class:`Case` pairs a
+*baseline* side with a *subject* side (e.g. raw ModernGL vs glsandbox, or the
+on-demand plan vs ``effects=all``). All cases run together in alternating
+rounds, in one process and on one GL context: every round times each
+case's two sides back to back, the order swapped every other round, so the
+noise of a shared machine hits both alike. The figure per case is the ratio
+of the two medians (subject / baseline). Speed goals are printed, never
+asserted (see DESIGN.md, "Benchmarks, not timed tests").
+
+The same harness drives ``python benchmarks/cube_frame.py`` on its own.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import statistics
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+import numpy as np
+
+from glsandbox.errors import SandboxError
+
+#: The frame size of the frame benchmarks (the course's 800x600 window).
+FRAME_SIZE = (800, 600)
+
+
+@dataclass(frozen=True)
+class Side:
+    """One side of a comparison: a label and a callable doing one unit of work.
+
+    ``run(k)`` does the k-th repetition (frames pass ``k`` on as an animation
+    step); what it returns is kept from the first call for the picture check.
+    """
+
+    label: str
+    run: Callable[[int], Any]
+
+
+@dataclass(frozen=True)
+class Case:
+    """Two sides measured side by side; the ratio is subject / baseline.
+
+    ``repeat`` is how many repetitions make one timed sample (many cheap
+    frames, one process start); ``unit`` is how the per-repetition time is
+    printed ("ms" or "s"); ``goal`` is the ratio aimed for (printed, never
+    asserted); ``compare`` decides whether the two sides show the same
+    picture from their first results (None: nothing to compare).
+    """
+
+    group: str
+    name: str
+    baseline: Side | None
+    subject: Side
+    repeat: int = 30
+    unit: str = "ms"
+    goal: float | None = None
+    note: str = ""
+    compare: Callable[[Any, Any], str] | None = None
+
+
+@dataclass
+class BenchEnv:
+    """What benchmark modules get: a shared headless renderer, the frame size and the mode."""
+
+    quick: bool = False
+    size: tuple[int, int] = FRAME_SIZE
+    root: Path = field(default_factory=lambda: Path.cwd())
+    _renderer: Any = None
+
+    @property
+    def renderer(self) -> Any:
+        """One :class:`~glsandbox.app.HeadlessRenderer` on EGL for every case (one context)."""
+        if self._renderer is None:
+            from glsandbox.app import HeadlessRenderer
+
+            self._renderer = HeadlessRenderer("egl")
+        return self._renderer
+
+    def close(self) -> None:
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+
+@dataclass
+class Result:
+    """The timings of one case: per-repetition seconds of each sample, both sides."""
+
+    case: Case
+    baseline_s: list[float]
+    subject_s: list[float]
+    same: str = ""
+
+    @property
+    def ratio(self) -> float | None:
+        if not self.baseline_s:
+            return None
+        return statistics.median(self.subject_s) / statistics.median(self.baseline_s)
+
+    def to_dict(self) -> dict[str, Any]:
+        c = self.case
+        scale = 1e3 if c.unit == "ms" else 1.0
+
+        def summary(samples: list[float]) -> dict[str, float] | None:
+            if not samples:
+                return None
+            return {"median": round(statistics.median(samples) * scale, 4),
+                    "min": round(min(samples) * scale, 4), "max": round(max(samples) * scale, 4)}
+
+        return {"group": c.group, "name": c.name, "unit": c.unit,
+                "baseline": c.baseline.label if c.baseline else None, "subject": c.subject.label,
+                "baseline_time": summary(self.baseline_s), "subject_time": summary(self.subject_s),
+                "ratio": None if self.ratio is None else round(self.ratio, 4), "goal": c.goal,
+                "goal_met": None if c.goal is None or self.ratio is None else self.ratio <= c.goal,
+                "same_picture": self.same or None, "note": c.note or None}
+
+
+# --- measuring ----------------------------------------------------------------
+
+
+def _sample(side: Side, repeat: int, start: int) -> float:
+    t0 = time.perf_counter()
+    for k in range(repeat):
+        side.run(start + k)
+    return (time.perf_counter() - t0) / repeat
+
+
+def measure(cases: Sequence[Case], rounds: int, log: Callable[[str], None] = lambda s: None) -> list[Result]:
+    """Alternating rounds over every case; the first call of each side is a warm-up and the picture check."""
+    results = []
+    for case in cases:
+        first_base = case.baseline.run(0) if case.baseline else None
+        first_subject = case.subject.run(0)
+        same = case.compare(first_base, first_subject) if case.compare and case.baseline else ""
+        results.append(Result(case, [], [], same))
+    for r in range(rounds):
+        log(f"bench: round {r + 1}/{rounds}")
+        for result in results:
+            case = result.case
+            sides = [(case.baseline, result.baseline_s), (case.subject, result.subject_s)]
+            if r % 2:
+                sides.reverse()
+            for side, samples in sides:
+                if side is not None:
+                    samples.append(_sample(side, case.repeat, r * case.repeat))
+    return results
+
+
+def same_pixels(a: Any, b: Any) -> str:
+    """``identical``, or how far two RGBA frames are apart (largest level difference, share of pixels)."""
+    a, b = np.asarray(a), np.asarray(b)
+    if a.shape != b.shape:
+        return f"NO (shapes {a.shape} vs {b.shape})"
+    if np.array_equal(a, b):
+        return "identical"
+    diff = np.abs(a.astype(np.int16) - b.astype(np.int16)).max(axis=-1)
+    return f"max {int(diff.max())} levels, {np.count_nonzero(diff) / diff.size:.2%} px"
+
+
+def run_process(command: list[str]) -> Callable[[int], None]:
+    """A side that starts a process and waits for it (cold start, tour)."""
+
+    def side(_: int) -> None:
+        proc = subprocess.run(command, capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise SandboxError(f"bench: {' '.join(command[:4])}... failed: "
+                               f"{(proc.stderr.strip().splitlines() or ['?'])[-1]}")
+
+    return side
+
+
+# --- discovery and the table ------------------------------------------------------
+
+
+def benchmarks_dir() -> Path:
+    """The ``benchmarks/`` folder of the source tree (next to the package), else of the working folder."""
+    for root in (Path(__file__).resolve().parent.parent, Path.cwd()):
+        if (root / "benchmarks").is_dir():
+            return root / "benchmarks"
+    raise SandboxError("no benchmarks/ folder: run glsandbox bench from a clone of the repository")
+
+
+def load_modules(folder: Path) -> list[ModuleType]:
+    """Import every benchmark module (``*.py`` not starting with ``_``) that defines ``cases``."""
+    if str(folder) not in sys.path:
+        sys.path.insert(0, str(folder))  # so modules can share helpers in _*.py
+    modules = []
+    for path in sorted(folder.glob("*.py")):
+        if path.name.startswith("_"):
+            continue
+        spec = importlib.util.spec_from_file_location(f"benchmarks_{path.stem}", path)
+        assert spec is not None and spec.loader is not None
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        if hasattr(module, "cases"):
+            modules.append(module)
+    return modules
+
+
+def format_table(results: Sequence[Result]) -> str:
+    """One table: every case, both medians with spread, the ratio, the goal and the picture check."""
+    header = ("benchmark", "baseline", "subject", "baseline", "subject", "ratio", "goal", "same picture")
+    rows = []
+    for res in results:
+        c = res.case
+        scale = 1e3 if c.unit == "ms" else 1.0
+
+        def cell(samples: list[float]) -> str:
+            if not samples:
+                return "-"
+            return (f"{statistics.median(samples) * scale:.3f} {c.unit} "
+                    f"({min(samples) * scale:.3f}-{max(samples) * scale:.3f})")
+
+        ratio = res.ratio
+        goal = "-" if c.goal is None or ratio is None else f"<={c.goal:.2f}x {'met' if ratio <= c.goal else 'NOT met'}"
+        rows.append((f"{c.group}: {c.name}", c.baseline.label if c.baseline else "-", c.subject.label,
+                     cell(res.baseline_s), cell(res.subject_s), "-" if ratio is None else f"{ratio:.2f}x",
+                     goal, res.same or "-"))
+    widths = [max(len(str(r[i])) for r in (header, *rows)) for i in range(len(header))]
+    lines = ["  ".join(str(v).ljust(w) for v, w in zip(header, widths)).rstrip(),
+             "  ".join("-" * w for w in widths)]
+    lines += ["  ".join(str(v).ljust(w) for v, w in zip(r, widths)).rstrip() for r in rows]
+    return "\n".join(lines)
+
+
+def run_all(json_path: Path | None = None, quick: bool = False, only: Sequence[str] = (),
+            rounds: int | None = None) -> int:
+    """Collect the cases of every benchmark module, measure them together, print one table."""
+    if json_path is not None and (json_path.is_dir() or not json_path.parent.is_dir()):
+        raise SandboxError(f"--json {json_path}: not a file in an existing folder")
+    folder = benchmarks_dir()
+    env = BenchEnv(quick=quick, root=folder.parent)
+    log = lambda text: print(text, file=sys.stderr, flush=True)  # noqa: E731
+    try:
+        cases: list[Case] = []
+        for module in load_modules(folder):
+            found = module.cases(env)
+            cases += [c for c in found if not only or any(o in f"{c.group}: {c.name}" for o in only)]
+            log(f"bench: {Path(module.__file__ or '').name}: {len(found)} cases")
+        if not cases:
+            raise SandboxError("no benchmark case matched")
+        groups = list(dict.fromkeys(c.group for c in cases))
+        cases.sort(key=lambda c: groups.index(c.group))  # stable: one group's rows together
+        rounds = rounds or (3 if quick else 7)
+        if quick:
+            cases = [_quick(c) for c in cases]
+        started = time.perf_counter()
+        results = measure(cases, rounds, log)
+        renderer = env._renderer.host.renderer if env._renderer is not None else "?"
+    finally:
+        env.close()
+    title = (f"glsandbox bench: {len(results)} cases, {rounds} alternating rounds, frames {env.size[0]}x"
+             f"{env.size[1]}, {renderer}; ratio = subject / baseline (medians), spread min-max")
+    print(title)
+    print(format_table(results))
+    if json_path is not None:
+        data = {"title": title, "renderer": renderer, "rounds": rounds, "quick": quick,
+                "seconds": round(time.perf_counter() - started, 2), "cases": [r.to_dict() for r in results]}
+        tmp = json_path.with_name(f".{json_path.name}.tmp")
+        tmp.write_text(json.dumps(data, indent=2) + "\n", encoding="utf-8")
+        tmp.replace(json_path)
+        print(f"wrote {json_path}")
+    return 0
+
+
+def _quick(case: Case) -> Case:
+    from dataclasses import replace
+
+    return replace(case, repeat=max(1, min(case.repeat, 5)))

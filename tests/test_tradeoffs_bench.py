@@ -1,0 +1,188 @@
+"""``glsandbox tradeoffs``, ``glsandbox bench`` and ``--set effects=all``.
+
+The two commands run in subprocesses (a second GL context must not be opened
+in the test process); their content is checked, never their timings.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from glsandbox.lesson import all_lessons
+from glsandbox.plan import plan
+from glsandbox.tradeoffs import CSV_COLUMNS, downsample
+
+REPO = Path(__file__).resolve().parent.parent
+
+
+def _run(*args: str, timeout: int = 240) -> subprocess.CompletedProcess:
+    env = {**os.environ, "GLSANDBOX_BACKEND": os.environ.get("GLSANDBOX_BACKEND", "egl")}
+    return subprocess.run([sys.executable, "-m", "glsandbox.cli", *args], cwd=REPO, capture_output=True,
+                          text=True, timeout=timeout, env=env)
+
+
+# --- supersampling -------------------------------------------------------------------
+
+
+def test_downsample_averages_each_block() -> None:
+    big = np.zeros((4, 6, 4), dtype=np.uint8)
+    big[:2, :2] = 255          # one full block
+    big[2:, 4:] = [100, 0, 0, 255]
+    big[2, 4] = [104, 0, 0, 255]  # (104 + 3*100) / 4 = 101
+    small = downsample(big, 2)
+    assert small.shape == (2, 3, 4) and small.dtype == np.uint8
+    assert small[0, 0].tolist() == [255, 255, 255, 255]
+    assert small[1, 2].tolist() == [101, 0, 0, 255]
+    assert small[0, 1].tolist() == [0, 0, 0, 0]
+    assert np.array_equal(downsample(big, 1), big)
+
+
+# --- effects=all ----------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("cls", all_lessons(), ids=lambda c: c.name)
+def test_effects_all_plan_is_a_superset(cls) -> None:
+    needed, forced = plan(cls().scene()), plan(cls(effects="all").scene())
+    assert forced.buffers.depth >= needed.buffers.depth and forced.buffers.stencil
+    assert forced.buffers.depth or not cls().scene().depth_test
+    assert forced.buffers.samples == needed.buffers.samples  # MSAA would change the picture
+    assert set(needed.programs) <= set(forced.programs)
+    assert len(forced.passes) >= len(needed.passes)
+    for step in needed.passes:  # every needed pass is there, with at least the same buffers and tests
+        twins = [p for p in forced.passes if (p.kind, p.viewport, p.draws) == (step.kind, step.viewport, step.draws)]
+        assert twins, step.describe()
+        twin = twins[0]
+        assert twin.clear_depth >= step.clear_depth and twin.clear_stencil >= step.clear_stencil
+        assert twin.depth_test >= step.depth_test
+    assert all(p.clear_stencil for p in forced.passes if p.kind == "clear")
+
+
+@pytest.mark.parametrize("cls", all_lessons(), ids=lambda c: c.name)
+def test_effects_all_renders_the_same_picture(gl, cls) -> None:
+    for time in (0.0, 0.7):
+        needed = gl.render(cls(time=time), (96, 72)).image.copy()
+        forced_frame = gl.render(cls(time=time, effects="all"), (96, 72))
+        assert forced_frame.plan.buffers.stencil
+        assert np.array_equal(needed, forced_frame.image), f"{cls.name} at time {time}"
+
+
+def test_effects_is_a_parameter_of_every_lesson() -> None:
+    proc = _run("plan", "indexed_cube", "--set", "effects=all")
+    assert proc.returncode == 0, proc.stderr
+    assert "stencil 8" in proc.stdout
+    proc = _run("plan", "indexed_cube", "--set", "effects=some")
+    assert proc.returncode == 2 and proc.stderr.startswith("error: --set effects=some: expected one of needed, all")
+
+
+# --- glsandbox tradeoffs --quick --------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def quick_report(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("tradeoffs")
+    proc = _run("tradeoffs", "--quick", "--out", str(out))
+    assert proc.returncode == 0, proc.stderr
+    assert "[1/" in proc.stderr and "timing run 5/5" in proc.stderr  # progress on stderr
+    return out
+
+
+def _rows(out: Path) -> list[dict[str, str]]:
+    with open(out / "tradeoffs.csv", newline="", encoding="utf-8") as handle:
+        return list(csv.DictReader(handle))
+
+
+def test_tradeoffs_writes_every_file(quick_report: Path) -> None:
+    for name in ("report.md", "tradeoffs.csv", "tradeoffs.png"):
+        assert (quick_report / name).is_file(), name
+    assert (quick_report / "tradeoffs.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    rows = _rows(quick_report)
+    assert tuple(rows[0].keys()) == CSV_COLUMNS
+    for row in rows:
+        assert (quick_report / row["error_map"]).is_file() and (quick_report / row["image"]).is_file()
+        assert int(row["runs"]) >= 5
+        assert 0 < float(row["time_min_ms"]) <= float(row["time_median_ms"]) <= float(row["time_max_ms"])
+
+
+def test_tradeoffs_report_has_a_table_per_knob(quick_report: Path) -> None:
+    report = (quick_report / "report.md").read_text(encoding="utf-8")
+    header = "| setting | time median (ms) | spread min-max (ms) | RMSE | PSNR (dB) | FLIP | error map |"
+    assert report.count(header) == 4
+    for title in ("## Anti-aliasing (`antialiasing`)", "## Lighting model (`lighting`)",
+                  "## Texture filtering (`texture_filter`)"):
+        assert title in report
+    assert "| SSAA 8x (reference) | " in report
+    assert "Reference: the float64 numpy ray tracer" in report  # lighting's reference
+    assert "## Ray tracer engine (`ray_engine`)" in report
+    rows = _rows(quick_report)
+    knobs = {row["knob"] for row in rows}
+    assert knobs == {"antialiasing", "lighting", "ray_engine", "texture_filter"}
+    for knob in knobs:  # one reference per knob, at zero error
+        refs = [r for r in rows if r["knob"] == knob and r["reference"] == "1"]
+        assert len(refs) == 1 and float(refs[0]["rmse"]) == 0.0 and refs[0]["psnr_db"] == "inf"
+        assert float(refs[0]["flip"]) == 0.0
+
+
+def test_tradeoffs_errors_fall_where_they_must(quick_report: Path) -> None:
+    rows = {(r["knob"], r["setting"]): r for r in _rows(quick_report)}
+
+    def err(knob: str, setting: str, metric: str = "rmse") -> float:
+        return float(rows[(knob, setting)][metric])
+
+    for metric in ("rmse", "flip"):
+        chain = [err("antialiasing", s, metric) for s in ("none", "SSAA 2x", "SSAA 4x")]
+        assert chain[0] > chain[1] > chain[2] > 0, (metric, chain)  # supersampling error shrinks with factor
+        assert err("antialiasing", "MSAA 4x", metric) < err("antialiasing", "none", metric)
+        assert err("texture_filter", "mipmapped (trilinear)", metric) < err("texture_filter", "nearest", metric)
+    assert err("texture_filter", "anisotropic 16x") < err("texture_filter", "mipmapped (trilinear)")
+    assert err("lighting", "per-pixel Phong") < err("lighting", "per-vertex (Gouraud)")
+    psnr = [float(rows[("antialiasing", s)]["psnr_db"]) for s in ("none", "SSAA 2x", "SSAA 4x")]
+    assert psnr[0] < psnr[1] < psnr[2]
+    report = (quick_report / "report.md").read_text(encoding="utf-8")
+    assert "DOES NOT HOLD" not in report and report.count("(RMSE): holds") == 2
+
+
+def test_tradeoffs_lists_what_is_not_measured_yet(quick_report: Path) -> None:
+    from glsandbox.tradeoffs import PENDING, all_knobs
+
+    report = (quick_report / "report.md").read_text(encoding="utf-8")
+    measured = {k.name for k in all_knobs()}
+    for name in PENDING:
+        assert (f"- `{name}`:" in report) == (name not in measured)
+
+
+def test_tradeoffs_bad_runs_is_one_line() -> None:
+    proc = _run("tradeoffs", "--quick", "--runs", "3", "--out", "/nonexistent/x")
+    assert proc.returncode == 2 and proc.stderr.strip() == "error: --runs 3: the timing needs at least 5 runs"
+
+
+# --- glsandbox bench -----------------------------------------------------------------------
+
+
+def test_bench_prints_one_table_and_writes_json(tmp_path: Path) -> None:
+    out = tmp_path / "bench.json"
+    proc = _run("bench", "--quick", "--only", "clear_and_swap", "--json", str(out))
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stdout.splitlines()
+    assert lines[0].startswith("glsandbox bench: 2 cases")
+    assert lines[1].split()[:3] == ["benchmark", "baseline", "subject"]
+    assert any(line.startswith("frame vs raw ModernGL: clear_and_swap") and "identical" in line for line in lines)
+    assert any(line.startswith("on-demand vs effects=all: clear_and_swap") and "identical" in line
+               for line in lines)
+    data = json.loads(out.read_text(encoding="utf-8"))
+    assert {c["group"] for c in data["cases"]} == {"frame vs raw ModernGL", "on-demand vs effects=all"}
+    for case in data["cases"]:
+        assert case["same_picture"] == "identical" and case["ratio"] > 0
+        assert case["baseline_time"]["min"] <= case["baseline_time"]["median"] <= case["baseline_time"]["max"]
+
+
+def test_bench_unknown_case_is_one_line() -> None:
+    proc = _run("bench", "--quick", "--only", "no_such_benchmark")
+    assert proc.returncode == 2 and proc.stderr.strip().endswith("error: no benchmark case matched")
