@@ -156,6 +156,12 @@ def compose(variants: list[Variant], columns: int, size: tuple[int, int], labels
     overlays: list[Overlay] = []
     for index, (variant, tile) in enumerate(zip(variants, tile_rects(len(variants), columns))):
         scene = variant.scene
+        if scene.mirror is not None or scene.shadow is not None or scene.depth_mode != "standard":
+            # A mirror, a shadow and the depth mode belong to a whole scene (its
+            # stencil bits and clip control), so they cannot share one frame with other tiles yet.
+            raise SandboxError(f"compare: {scene.name!r} ({variant.label}) uses a mirror, a planar shadow or "
+                               "reverse-Z depth, which cannot be composed into tiles; render each variant with "
+                               "glsandbox render --set ...")
         tx, ty, tw, th = tile
         first = len(viewports)
         for vp in scene.viewports:

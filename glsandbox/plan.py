@@ -15,6 +15,8 @@ from typing import Any
 
 import numpy as np
 
+from glsandbox.effects import shadow_casters
+from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh
 from glsandbox.scene import Node, Scene
 
@@ -41,11 +43,13 @@ class Buffers:
     depth: bool
     stencil: bool
     samples: int
+    #: A 32-bit float depth buffer (reverse-Z) instead of 24-bit integers.
+    float_depth: bool = False
 
     def describe(self) -> str:
         parts = ["colour RGBA8"]
         if self.depth:
-            parts.append("depth 24")
+            parts.append("depth 32F" if self.float_depth else "depth 24")
         if self.stencil:
             parts.append("stencil 8")
         parts.append(f"MSAA {self.samples}x" if self.samples > 1 else "no MSAA")
@@ -74,9 +78,16 @@ class Pass:
     draws: tuple[Draw, ...] = ()
     depth_test: bool = False
 
+    #: Effect passes (:data:`EFFECT_PASS_KINDS`): the stencil state as text,
+    #: and what else the pass does differently (see :func:`effect_passes`).
+    stencil: str = ""
+    detail: str = ""
+
     def describe(self) -> str:
         if self.kind == "overlay":
             return describe_overlay_pass(self)
+        if self.kind in EFFECT_PASS_KINDS:
+            return describe_effect_pass(self)
         if self.kind == "clear":
             what = []
             if self.clear_color is not None:
@@ -199,16 +210,19 @@ def plan(scene: Scene) -> Plan:
     # and cleared in every viewport, and the depth test runs in every draw pass
     # (unless the scene turned depth testing off, which would change the picture).
     force = scene.effects == "all"
-    uses_depth = _needs_depth(scene) or (force and scene.depth_test)
+    uses_depth = _needs_depth(scene) or (force and scene.depth_test) or _has_effects(scene)
     passes: list[Pass] = []
     programs: set[ProgramVariant] = set()
     for index, viewport in enumerate(scene.viewports):
         color = viewport.clear_color if viewport.clear_color is not None else scene.clear_color
-        passes.append(Pass("clear", index, clear_color=color, clear_depth=uses_depth, clear_stencil=force))
+        passes.append(Pass("clear", index, clear_color=color, clear_depth=uses_depth,
+                           clear_stencil=force or _needs_stencil(scene)))
         draws = []
         for node in scene.nodes:
             if node.viewports is not None and index not in node.viewports:
                 continue
+            if scene.mirror is not None and node.name == scene.mirror.node:
+                continue  # the mirror's glass is drawn by the mirror passes
             variant = program_for(node, len(scene.lights))
             programs.add(variant)
             texture = node.material.texture
@@ -216,6 +230,7 @@ def plan(scene: Scene) -> Plan:
                               texture=texture.describe() if texture is not None else None))
         if draws:
             passes.append(Pass("draw", index, draws=tuple(draws), depth_test=uses_depth))
+        passes.extend(effect_passes(scene, index, programs))
     overlay_steps = overlay_passes(scene)
     if overlay_steps:
         programs.add(OVERLAY_PROGRAM)
@@ -223,7 +238,8 @@ def plan(scene: Scene) -> Plan:
     samples = scene.samples if scene.samples > 1 else 0
     return Plan(
         scene=scene.name,
-        buffers=Buffers(depth=uses_depth, stencil=any(p.clear_stencil for p in passes), samples=samples),
+        buffers=Buffers(depth=uses_depth, stencil=any(p.clear_stencil for p in passes), samples=samples,
+                        float_depth=uses_depth and scene.depth_mode == "reverse_z"),
         programs=tuple(sorted(programs)),
         passes=tuple(passes),
     )
@@ -254,3 +270,109 @@ def overlay_passes(scene: Scene) -> list[Pass]:
 def describe_overlay_pass(step: Pass) -> str:
     where = "frame" if step.viewport < 0 else f"viewport {step.viewport}"
     return f"overlay {where} (blended, no depth test): " + ", ".join(d.node for d in step.draws)
+
+
+# --- effects: the stencil mirror and the planar shadow (course "The stencil Test") ---
+
+#: Pass kinds that only a scene with a mirror or a shadow receiver gets, in frame order.
+EFFECT_PASS_KINDS = ("mark_mirror", "reflection", "mirror_surface", "shadow")
+#: The stencil bit of the mirror's pixels, and the bit of pixels already shadowed.
+#: Separate bits (with write and compare masks) let both effects share one buffer.
+MIRROR_STENCIL_BIT = 0x1
+SHADOW_STENCIL_BIT = 0x2
+#: Shadows are drawn in one flat colour.
+SHADOW_PROGRAM = ProgramVariant("basic", (("SOLID_COLOR", ""),))
+
+
+def _has_effects(scene: Scene) -> bool:
+    return scene.mirror is not None or scene.shadow is not None
+
+
+def _needs_stencil(scene: Scene) -> bool:
+    """The stencil buffer exists only for a stencil mirror or a stencil shadow."""
+    return bool((scene.mirror is not None and scene.mirror.stencil)
+                or (scene.shadow is not None and scene.shadow.stencil))
+
+
+def _shown(node: Node, index: int) -> bool:
+    return node.viewports is None or index in node.viewports
+
+
+def effect_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> list[Pass]:
+    """The mirror's and the shadow's passes for viewport ``index``, after its draw pass.
+
+    Mirror (stencil): ``mark_mirror`` draws the glass into the stencil only
+    (colour and depth writes off, depth test on, so what stands in front of
+    the glass keeps its pixels unmarked; the course's ``MarkMirrorDSS``);
+    ``reflection`` draws the reflected nodes with R @ model where the stencil
+    holds the mirror bit (``DrawReflectionDSS``), with the front-face rule
+    flipped (det R = -1, ``CullClockwise``) and the lights reflected too;
+    ``mirror_surface`` blends the glass over it. Without the stencil the
+    reflection pass has no stencil test and leaks outside the glass.
+
+    Shadow: one ``shadow`` pass drawing the casters with the lifted shadow
+    matrix, blended, without depth writes and without culling (the flattened
+    cube's front and back faces both cover the shadow). With the stencil each
+    pixel is darkened once: test "shadow bit clear", then set it.
+    """
+    nodes = {node.name: node for node in scene.nodes}
+    passes: list[Pass] = []
+    mirror = scene.mirror
+    if mirror is not None and mirror.node in nodes and _shown(nodes[mirror.node], index):
+        glass = nodes[mirror.node]
+        glass_variant = program_for(glass, len(scene.lights))
+        programs.add(glass_variant)
+        glass_draw = Draw(glass.name, glass_variant.key, glass.cull_back_faces)
+        if mirror.stencil:
+            passes.append(Pass("mark_mirror", index, draws=(glass_draw,), depth_test=True,
+                               stencil=f"always, replace {MIRROR_STENCIL_BIT}"))
+        reflected = []
+        for name in mirror.reflected:
+            if name not in nodes:
+                raise SandboxError(f"mirror reflects {name!r}, which is not a node of the scene")
+            node = nodes[name]
+            if _shown(node, index):
+                variant = program_for(node, len(scene.lights))
+                programs.add(variant)
+                reflected.append(Draw(name, variant.key, node.cull_back_faces))
+        passes.append(Pass("reflection", index, draws=tuple(reflected), depth_test=True,
+                           stencil=f"equal {MIRROR_STENCIL_BIT}, keep" if mirror.stencil else "",
+                           detail="front faces clockwise, lights reflected"))
+        passes.append(Pass("mirror_surface", index, draws=(glass_draw,), depth_test=True, detail="blended"))
+    shadow = scene.shadow
+    if shadow is not None and shadow.receiver in nodes and _shown(nodes[shadow.receiver], index):
+        models = {name: (nodes[name].model, nodes[name].mesh.positions) for name in shadow.casters if name in nodes}
+        casting = shadow_casters(shadow, models)
+        how = [f"lift {shadow.lift:g}"]
+        if shadow.polygon_offset:
+            how.append("polygon offset")
+        how.append("blended, no depth writes")
+        culled = [f"{name} culled ({why})" for name, why in casting.culled]
+        if casting.reason:
+            culled.append(f"culled: {casting.reason}")
+        draws = tuple(Draw(name, SHADOW_PROGRAM.key, False) for name in casting.kept if _shown(nodes[name], index))
+        if draws:
+            programs.add(SHADOW_PROGRAM)
+        passes.append(Pass("shadow", index, draws=draws, depth_test=True,
+                           stencil=(f"equal 0 on bit {SHADOW_STENCIL_BIT}, set it" if shadow.stencil else ""),
+                           detail="; ".join([", ".join(how), *culled])))
+    return passes
+
+
+_EFFECT_TITLES = {"mark_mirror": "mark mirror", "reflection": "reflection", "mirror_surface": "mirror surface",
+                  "shadow": "shadow"}
+
+
+def describe_effect_pass(step: Pass) -> str:
+    what = ["depth test" if step.depth_test else "no depth test"]
+    if step.kind == "mark_mirror":
+        what.append("no colour or depth writes")
+    if step.stencil:
+        what.append(f"stencil {step.stencil}")
+    elif step.kind in ("reflection", "shadow"):
+        what.append("no stencil")
+    if step.detail:
+        what.append(step.detail)
+    items = "; ".join(f"{d.node} with {d.program}" + ("" if d.cull_back_faces else " (no culling)")
+                      for d in step.draws) or "nothing"
+    return f"{_EFFECT_TITLES[step.kind]} viewport {step.viewport} ({', '.join(what)}): {items}"

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from glsandbox import transforms
+from glsandbox.effects import DEPTH_MODES, Mirror, PlanarShadow
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh, builtin_mesh
 from glsandbox.overlay import Overlay
@@ -217,10 +218,20 @@ class Scene:
     depth_test: bool = True
     #: Labels and figures drawn over the frame (:mod:`glsandbox.overlay`).
     overlays: tuple[Overlay, ...] = ()
+    #: A planar mirror drawn through the stencil buffer (:mod:`glsandbox.effects`).
+    mirror: Mirror | None = None
+    #: A planar shadow projected onto a receiver (:mod:`glsandbox.effects`).
+    shadow: PlanarShadow | None = None
+    #: How depth is stored and compared: ``standard`` or ``reverse_z``.
+    depth_mode: str = "standard"
     #: ``"needed"``: the plan lists only what the scene calls for; ``"all"``:
     #: every buffer and pass state forced on (the everything-on baseline that
     #: ``glsandbox bench`` measures on-demand planning against). See :data:`EFFECTS`.
     effects: str = "needed"
+
+    def __post_init__(self) -> None:
+        if self.depth_mode not in DEPTH_MODES:
+            raise SandboxError(f"unknown depth mode {self.depth_mode!r}; use one of {', '.join(DEPTH_MODES)}")
 
 
 # --- TOML scene files -------------------------------------------------------

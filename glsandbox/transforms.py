@@ -259,3 +259,144 @@ def from_directx_mesh(positions: np.ndarray, indices: np.ndarray) -> tuple[np.nd
 def gl_bytes(m: np.ndarray) -> bytes:
     """Bytes for a GLSL ``mat3``/``mat4`` uniform: float32, column-major."""
     return np.ascontiguousarray(np.asarray(m, dtype=np.float32).T).tobytes()
+
+
+# --- planes, mirrors, planar shadows, reverse-Z (course section "The stencil Test") ---
+
+Plane = tuple[float, float, float, float]
+
+
+def normalize_plane(plane: Sequence[float]) -> np.ndarray:
+    """A plane ``a*x + b*y + c*z + d = 0`` scaled so that (a, b, c) has length 1.
+
+    The course's ``XMPlaneNormalize``: after it, ``n·p + d`` is the signed
+    distance of a point p from the plane, positive on the side n points to.
+    Dividing all four numbers by |n| keeps the same plane. A zero normal is no
+    plane and is refused.
+    """
+    arr = np.asarray(plane, dtype=np.float64).reshape(-1)
+    if arr.shape != (4,) or not np.all(np.isfinite(arr)):
+        raise SandboxError(f"a plane must be four finite numbers (a, b, c, d), got {plane!r}")
+    length = float(np.linalg.norm(arr[:3]))
+    if length < 1e-12:
+        raise SandboxError(f"plane {tuple(arr)} has a zero normal (a, b, c): it is not a plane")
+    return arr / length
+
+
+def from_directx_plane(plane: Sequence[float]) -> np.ndarray:
+    """A plane given in the course's left-handed coordinates, in OpenGL's.
+
+    With z mirrored, a point (x, y, z) becomes (x, y, -z); the plane
+    ``a x + b y + c z + d = 0`` therefore becomes ``a x + b y - c z + d = 0``:
+    the course's mirror plane (0, 0, 1, -6), z = 6, is OpenGL's z = -6.
+    """
+    a, b, c, d = np.asarray(plane, dtype=np.float64).reshape(4)
+    return np.array([a, b, -c, d])
+
+
+def reflection_matrix(plane: Sequence[float]) -> Matrix:
+    """The mirror image through a plane (the course's ``XMMatrixReflect``).
+
+    With the plane normalized to (n, d), a point p is at signed distance
+    ``s = n·p + d``; its image is ``p - 2 s n``. As a matrix (column vectors)::
+
+        R = | I - 2 n nᵀ   -2 d n |
+            |     0          1    |
+
+    R² = I (reflecting twice gives the point back) and det R = -1: a
+    reflection turns counter-clockwise triangles clockwise, so the reflected
+    pass must flip the front-face rule (the course's ``CullClockwise``).
+    """
+    p = normalize_plane(plane)
+    n, d = p[:3], p[3]
+    m = np.eye(4)
+    m[:3, :3] -= 2.0 * np.outer(n, n)
+    m[:3, 3] = -2.0 * d * n
+    return m
+
+
+#: Below this |P·L| (plane normalized, light direction unit length) a light is
+#: treated as parallel to the plane (directional) or lying in it (point).
+SHADOW_EPSILON = 1e-9
+
+
+def light_vector(light: Sequence[float]) -> np.ndarray:
+    """A homogeneous light (x, y, z, w): w = 1 a point light at (x, y, z),
+    w = 0 a directional light shining *from* direction (x, y, z) (the
+    course's ``toMainLight = -lightDir``). Directions are normalized."""
+    arr = np.asarray(light, dtype=np.float64).reshape(-1)
+    if arr.shape != (4,) or not np.all(np.isfinite(arr)) or arr[3] not in (0.0, 1.0):
+        raise SandboxError(f"a light must be (x, y, z, w) with w = 1 (point) or 0 (direction), got {light!r}")
+    if arr[3] == 0.0:
+        length = float(np.linalg.norm(arr[:3]))
+        if length < 1e-12:
+            raise SandboxError("a directional light needs a non-zero direction, got (0, 0, 0)")
+        arr = np.array([*(arr[:3] / length), 0.0])
+    return arr
+
+
+def light_height(plane: Sequence[float], light: Sequence[float]) -> float:
+    """``P·L`` for the normalized plane and light: a point light's signed
+    distance from the plane, or the cosine between a directional light and
+    the plane's normal. Positive: the light is on the side the normal faces."""
+    return float(normalize_plane(plane) @ light_vector(light))
+
+
+def shadow_matrix(plane: Sequence[float], light: Sequence[float]) -> Matrix:
+    """Flatten geometry onto a plane along the rays from a light (the course's ``XMMatrixShadow``).
+
+    With P the normalized plane and L the homogeneous light (w = 1 point, w = 0
+    direction), ``S = (P·L) I - L Pᵀ``. For a point X (w = 1)::
+
+        S X = (P·L) X - (P·X) L
+
+    a combination of X and L, so S X lies on the line through X and the light;
+    and ``P·(S X) = (P·L)(P·X) - (P·X)(P·L) = 0``, so it lies on the plane.
+    The homogeneous w of S X is ``P·L - P·X`` for a point light (the light's
+    height above the plane minus the vertex's) and ``P·L`` for a directional
+    one. w = 0 means the ray never meets the plane: a directional light
+    parallel to it (refused here), or a vertex at the light's height; w < 0, a
+    vertex above a point light, projects to the wrong side (the planner culls
+    such casters, see :func:`glsandbox.effects.shadow_casters`). A point light
+    lying in the plane gives a rank-1 matrix and is refused too.
+    """
+    p = normalize_plane(plane)
+    l = light_vector(light)
+    dot = float(p @ l)
+    if abs(dot) < SHADOW_EPSILON:
+        what = "parallel to" if l[3] == 0.0 else "in"
+        raise SandboxError(
+            f"light {tuple(float(v) for v in l)} lies {what} the shadow plane {tuple(float(v) for v in p)}: "
+            "no planar shadow exists (P·L = 0)")
+    return dot * np.eye(4) - np.outer(l, p)
+
+
+def offset_along_normal(plane: Sequence[float], distance: float) -> Matrix:
+    """A translation by ``distance`` along the plane's unit normal: the course's
+    ``shadowOffsetY = XMMatrixTranslation(0, 0.005, 0)`` for any plane."""
+    n = normalize_plane(plane)[:3]
+    return translate(*(float(distance) * n))
+
+
+#: Clip z' = (w - z) / 2: maps OpenGL's clip depth (near -1, far +1) to
+#: reverse-Z (near 1, far 0) in the 0..1 range that ``glClipControl(...,
+#: GL_ZERO_TO_ONE)`` keeps as is.
+_REVERSE_Z = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, -0.5, 0.5], [0.0, 0.0, 0.0, 1.0]])
+
+
+def reverse_z(projection: Matrix) -> Matrix:
+    """A projection remapped to reverse-Z: near plane at depth 1, far at 0.
+
+    Depth d = z_ndc after the perspective divide is ``A + B/z`` (z the view
+    distance): hyperbolic, so most of the 0..1 range is spent close to the
+    near plane. A 24-bit integer buffer has the same step 2^-24 everywhere,
+    which leaves few steps far away: with near 0.01 and far 100 two surfaces
+    0.005 apart fall on one step beyond a distance of about 29. A float buffer
+    has steps proportional to the value; mapping far to 0 puts the float's
+    fine steps where the hyperbola is flat, which nearly cancels out: the
+    relative depth precision becomes about uniform in distance. Needs
+    ``glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE)`` (else GL maps -1..1 to
+    0..1 and halves the precision again), a float depth buffer, clear depth 0
+    and the depth test ``GREATER``.
+    """
+    return _REVERSE_Z @ np.asarray(projection, dtype=np.float64)

@@ -17,11 +17,12 @@ import numpy as np
 from glsandbox import transforms
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh
+from glsandbox.gl import effects as gl_effects
 from glsandbox.gl.context import GLHost
 from glsandbox.gl.overlay import OverlayDrawer
 from glsandbox.gl.shaders import compile_program
 from glsandbox.gl.textures import TextureCache
-from glsandbox.plan import Draw, Pass, Plan, ProgramVariant, plan as make_plan
+from glsandbox.plan import EFFECT_PASS_KINDS, Draw, Pass, Plan, ProgramVariant, plan as make_plan
 from glsandbox.scene import Light, Material, Node, Scene
 
 _MODES = {"triangles": moderngl.TRIANGLES, "triangle_strip": moderngl.TRIANGLE_STRIP,
@@ -76,6 +77,7 @@ class Executor:
         self._overlays: OverlayDrawer | None = None  # made on the first overlay pass
         self._textures = TextureCache(host)
         self._lights: tuple[Light, ...] = ()  # the lights of the frame being drawn
+        self._clear_depth = 1.0  # 0 with reverse-Z (glsandbox.gl.effects)
 
     # --- resources ----------------------------------------------------------
 
@@ -137,7 +139,9 @@ class Executor:
             self.program(variant)
         nodes = {node.name: node for node in scene.nodes}
         self._lights = scene.lights
+        self._clear_depth = gl_effects.clear_depth_value(scene)
         framebuffer.use()
+        gl_effects.begin_depth_mode(self, scene)
         for step in frame_plan.passes:
             if step.kind == "overlay":
                 self._draw_overlays(scene, step, framebuffer, size)
@@ -149,11 +153,15 @@ class Executor:
             else:
                 camera = viewport.camera or scene.camera
                 aspect = rect[2] / rect[3] if rect[3] else 1.0
-                view, proj = camera.view(), camera.projection(aspect)
+                view, proj = camera.view(), gl_effects.projection_for(scene, camera.projection(aspect))
                 framebuffer.viewport = rect
                 self._set_depth(step.depth_test)
+                if step.kind in EFFECT_PASS_KINDS:  # the stencil mirror and the planar shadow
+                    gl_effects.run_effect_pass(self, scene, step, nodes, view, proj)
+                    continue
                 for draw in step.draws:
                     self._draw(nodes[draw.node], draw, view, proj)
+        gl_effects.end_depth_mode(self, scene)
         framebuffer.viewport = (0, 0, *size)
         self._set_depth(False)
         self.ctx.disable(moderngl.CULL_FACE)
@@ -162,7 +170,9 @@ class Executor:
     def _clear(self, framebuffer: moderngl.Framebuffer, step: Pass, rect: tuple[int, int, int, int]) -> None:
         r, g, b, a = step.clear_color or (0.0, 0.0, 0.0, 0.0)
         # moderngl scissors the clear to the viewport rectangle.
-        framebuffer.clear(r, g, b, a, depth=1.0, viewport=rect)
+        framebuffer.clear(r, g, b, a, depth=self._clear_depth, viewport=rect)
+        if step.clear_stencil:  # moderngl's clear leaves the stencil alone
+            self.host.raw.clear_stencil(rect)
 
     def _set_depth(self, on: bool) -> None:
         if on:
@@ -170,23 +180,27 @@ class Executor:
         else:
             self.ctx.disable(moderngl.DEPTH_TEST)
 
-    def _draw(self, node: Node, draw: Draw, view: np.ndarray, proj: np.ndarray) -> None:
+    def _draw(self, node: Node, draw: Draw, view: np.ndarray, proj: np.ndarray,
+              model: np.ndarray | None = None, front_face: str = "ccw") -> None:
+        """Draw one node. ``model`` replaces its model matrix and ``front_face``
+        the winding rule (a mirror's reflected pass: ``R @ model``, ``"cw"``)."""
         program = self._programs[draw.program][1]
         vao, gpu = self._vao(node.mesh, draw.program)
+        model = node.model if model is None else model
         if draw.cull_back_faces:
             self.ctx.enable(moderngl.CULL_FACE)
             self.ctx.cull_face = "back"
-            self.ctx.front_face = "ccw"
+            self.ctx.front_face = front_face
         else:
             self.ctx.disable(moderngl.CULL_FACE)
         uniforms = {
-            "m_model": transforms.gl_bytes(node.model),
+            "m_model": transforms.gl_bytes(model),
             "m_view": transforms.gl_bytes(view),
             "m_proj": transforms.gl_bytes(proj),
             "u_color": np.asarray(node.material.color, dtype="f4").tobytes(),
         }
         if "m_normal" in program:
-            uniforms["m_normal"] = transforms.gl_bytes(transforms.normal_matrix(node.model))
+            uniforms["m_normal"] = transforms.gl_bytes(transforms.normal_matrix(model))
         for name, data in uniforms.items():
             if name in program:
                 program[name].write(data)

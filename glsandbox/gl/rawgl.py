@@ -32,6 +32,29 @@ GL_DITHER = 0x0BD0
 GL_STENCIL_TEST = 0x0B90
 GL_TEXTURE_WRAP_S = 0x2802
 GL_TEXTURE_WRAP_T = 0x2803
+# Stencil, depth and clip state (the mirror and shadow passes, glsandbox.gl.effects).
+GL_DEPTH_COMPONENT32F = 0x8CAC
+GL_DEPTH32F_STENCIL8 = 0x8CAD
+GL_NEVER, GL_LESS, GL_EQUAL, GL_LEQUAL, GL_GREATER, GL_NOTEQUAL, GL_GEQUAL, GL_ALWAYS = range(0x0200, 0x0208)
+GL_KEEP = 0x1E00
+GL_REPLACE = 0x1E01
+GL_STENCIL_BUFFER_BIT = 0x0400
+GL_SCISSOR_TEST = 0x0C11
+GL_LOWER_LEFT = 0x8CA1
+GL_NEGATIVE_ONE_TO_ONE = 0x935E
+GL_ZERO_TO_ONE = 0x935F
+# Queries for the state snapshot (tests check every pass leaves it as found).
+STATE_INTEGERS = {
+    "stencil_func": 0x0B92, "stencil_value_mask": 0x0B93, "stencil_fail": 0x0B94,
+    "stencil_pass_depth_fail": 0x0B95, "stencil_pass_depth_pass": 0x0B96, "stencil_ref": 0x0B97,
+    "stencil_writemask": 0x0B98, "depth_func": 0x0B74, "depth_writemask": 0x0B72, "front_face": 0x0B46,
+    "cull_face_mode": 0x0B45, "clip_origin": 0x935C, "clip_depth_mode": 0x935D,
+    "blend_src_rgb": 0x80C9, "blend_dst_rgb": 0x80C8,
+}
+STATE_FLAGS = {"stencil_test": GL_STENCIL_TEST, "depth_test": 0x0B71, "cull_face": 0x0B44, "blend": 0x0BE2,
+               "polygon_offset_fill": 0x8037, "scissor_test": GL_SCISSOR_TEST}
+STATE_FLOATS = {"polygon_offset_factor": 0x8038, "polygon_offset_units": 0x2A00, "depth_clear_value": 0x0B73}
+GL_COLOR_WRITEMASK = 0x0C23
 
 _VOID = None
 _UINT = ctypes.c_uint
@@ -57,6 +80,13 @@ _SIGNATURES: dict[str, tuple] = {
     "glClearStencil": (_VOID, _INT),
     "glClear": (_VOID, _UINT),
     "glSamplerParameteri": (_VOID, _UINT, _UINT, _INT),
+    "glColorMask": (_VOID, ctypes.c_ubyte, ctypes.c_ubyte, ctypes.c_ubyte, ctypes.c_ubyte),
+    "glDepthMask": (_VOID, ctypes.c_ubyte),
+    "glClipControl": (_VOID, _UINT, _UINT),
+    "glClearDepth": (_VOID, ctypes.c_double),
+    "glScissor": (_VOID, _INT, _INT, _INT, _INT),
+    "glGetFloatv": (_VOID, _UINT, ctypes.POINTER(ctypes.c_float)),
+    "glReadPixels": (_VOID, _INT, _INT, _INT, _INT, _UINT, _UINT, ctypes.c_void_p),
 }
 
 
@@ -90,7 +120,7 @@ class RawGL:
         self.glDisable(GL_DITHER)
 
     def create_depth_framebuffer(self, color_renderbuffer: int, size: tuple[int, int], samples: int,
-                                 stencil: bool, depth: bool = True) -> tuple[int, int]:
+                                 stencil: bool, depth: bool = True, float_depth: bool = False) -> tuple[int, int]:
         """A framebuffer with moderngl's colour renderbuffer and our depth(-stencil) one.
 
         Returns ``(framebuffer, depth_renderbuffer)`` GL names (0 when there is no depth).
@@ -104,7 +134,10 @@ class RawGL:
         if depth or stencil:
             self.glGenRenderbuffers(1, ctypes.byref(rb))
             self.glBindRenderbuffer(GL_RENDERBUFFER, rb.value)
-            fmt = GL_DEPTH24_STENCIL8 if stencil else GL_DEPTH_COMPONENT24
+            if float_depth:  # reverse-Z wants a float depth buffer (glsandbox.transforms.reverse_z)
+                fmt = GL_DEPTH32F_STENCIL8 if stencil else GL_DEPTH_COMPONENT32F
+            else:
+                fmt = GL_DEPTH24_STENCIL8 if stencil else GL_DEPTH_COMPONENT24
             self.glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, fmt, size[0], size[1])
             attachment = GL_DEPTH_STENCIL_ATTACHMENT if stencil else GL_DEPTH_ATTACHMENT
             self.glFramebufferRenderbuffer(GL_FRAMEBUFFER, attachment, GL_RENDERBUFFER, rb.value)
@@ -138,6 +171,38 @@ class RawGL:
         ``GL_MIRRORED_REPEAT``)."""
         self.glSamplerParameteri(sampler, GL_TEXTURE_WRAP_S, mode)
         self.glSamplerParameteri(sampler, GL_TEXTURE_WRAP_T, mode)
+
+    def clear_stencil(self, rect: tuple[int, int, int, int], value: int = 0) -> None:
+        """Clear the stencil of the bound framebuffer inside ``rect`` to ``value``
+        (scissored, all bits writable for the clear; both restored after)."""
+        self.glEnable(GL_SCISSOR_TEST)
+        self.glScissor(*rect)
+        self.glStencilMask(0xFF)
+        self.glClearStencil(value)
+        self.glClear(GL_STENCIL_BUFFER_BIT)
+        self.glDisable(GL_SCISSOR_TEST)
+
+    def read_stencil(self, fbo: int, size: tuple[int, int]) -> bytes:
+        """The stencil values of a single-sample framebuffer, bottom row first."""
+        old = self.get_integer(GL_FRAMEBUFFER_BINDING)
+        self.glBindFramebuffer(GL_FRAMEBUFFER, fbo)
+        data = ctypes.create_string_buffer(size[0] * size[1])
+        self.glReadPixels(0, 0, size[0], size[1], 0x1901, 0x1401, data)  # GL_STENCIL_INDEX, GL_UNSIGNED_BYTE
+        self.glBindFramebuffer(GL_FRAMEBUFFER, old)
+        return data.raw
+
+    def state_snapshot(self) -> dict[str, object]:
+        """The pipeline state the effect passes change, read back from GL."""
+        state: dict[str, object] = {name: self.get_integer(pname) for name, pname in STATE_INTEGERS.items()}
+        state.update({name: bool(self.glIsEnabled(cap)) for name, cap in STATE_FLAGS.items()})
+        for name, pname in STATE_FLOATS.items():
+            value = ctypes.c_float(0.0)
+            self.glGetFloatv(pname, ctypes.byref(value))
+            state[name] = value.value
+        mask = (_INT * 4)()
+        self.glGetIntegerv(GL_COLOR_WRITEMASK, mask)
+        state["color_writemask"] = tuple(mask)
+        return state
 
     def delete_framebuffer(self, fbo: int, renderbuffer: int) -> None:
         if renderbuffer:

@@ -33,7 +33,8 @@ class OffscreenTarget:
         samples = buffers.samples
         self._color = ctx.renderbuffer(size, 4, samples=samples)
         self._fbo_name, self._depth_name = host.raw.create_depth_framebuffer(
-            self._color.glo, size, samples, stencil=buffers.stencil, depth=buffers.depth)
+            self._color.glo, size, samples, stencil=buffers.stencil, depth=buffers.depth,
+            float_depth=buffers.float_depth)
         self.framebuffer: moderngl.Framebuffer = ctx.detect_framebuffer(self._fbo_name)
         self._resolved: moderngl.Framebuffer | None = None
         if samples:

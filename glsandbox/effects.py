@@ -1,0 +1,147 @@
+"""Effects a scene may ask for: a planar mirror, a planar shadow, and the depth mode.
+
+Course section "The stencil Test": ``MarkMirrorDSS``, ``DrawReflectionDSS``,
+``XMMatrixReflect``, ``CullClockwise``, ``XMMatrixShadow`` and
+``shadowOffsetY``. These are plain data, like the rest of the Scene; the
+matrices come from :mod:`glsandbox.transforms`, the passes from
+:func:`glsandbox.plan.plan`, and the GL state from :mod:`glsandbox.gl.effects`.
+No GL here.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from glsandbox import transforms
+from glsandbox.errors import SandboxError
+
+Color = tuple[float, float, float, float]
+
+#: How depth is stored and compared. ``standard``: OpenGL's -1..1 clip depth
+#: into a 24-bit integer buffer, test LESS. ``reverse_z``: a 32-bit float
+#: buffer, ``glClipControl`` 0..1, near at 1 and far at 0, test GREATER (see
+#: :func:`glsandbox.transforms.reverse_z`).
+DEPTH_MODES = ("standard", "reverse_z")
+
+
+@dataclass(frozen=True)
+class Mirror:
+    """A planar mirror: the node that is the glass, its plane, and what it reflects.
+
+    ``stencil=True`` is the course's method: mark the glass's pixels in the
+    stencil buffer (``MarkMirrorDSS``: always pass, replace), then draw the
+    reflected nodes only where the stencil matches (``DrawReflectionDSS``:
+    equal, keep). ``stencil=False`` draws the reflection without the test, so
+    it leaks outside the glass. ``reflected`` names the nodes drawn mirrored
+    (the glass itself and the wall it sits in are not among them). The glass
+    node's colour alpha is how much of the glass shows over the reflection.
+    """
+
+    node: str
+    plane: tuple[float, float, float, float]
+    reflected: tuple[str, ...]
+    stencil: bool = True
+
+    def __post_init__(self) -> None:
+        # Normalized once here, so the plan and the executor see the same numbers.
+        object.__setattr__(self, "plane", tuple(float(v) for v in transforms.normalize_plane(self.plane)))
+        if self.node in self.reflected:
+            raise SandboxError(f"mirror node {self.node!r} cannot reflect itself")
+
+    def matrix(self) -> np.ndarray:
+        """The reflection matrix R (det -1, R² = I)."""
+        return transforms.reflection_matrix(self.plane)
+
+
+@dataclass(frozen=True)
+class PlanarShadow:
+    """Casters flattened onto a receiver's plane along the light's rays.
+
+    ``light`` is homogeneous: (x, y, z, 1) a point light, (x, y, z, 0) a
+    directional light shining from direction (x, y, z). ``lift`` is the
+    course's ``shadowOffsetY``: the shadow is moved this far off the plane,
+    along its normal, so it wins the depth test against the receiver.
+    ``polygon_offset`` pulls the shadow towards the camera in the depth test
+    instead (``glPolygonOffset``: by the depth slope and a few depth steps),
+    which holds at any distance. ``stencil=True`` darkens each pixel once
+    (stencil equal 0, then set); ``False`` blends every overlapping
+    triangle again (the ``double_blend`` mistake).
+    """
+
+    receiver: str
+    plane: tuple[float, float, float, float]
+    light: tuple[float, float, float, float]
+    casters: tuple[str, ...]
+    lift: float = 0.005
+    polygon_offset: bool = True
+    stencil: bool = True
+    color: Color = (0.0, 0.0, 0.0, 0.5)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "plane", tuple(float(v) for v in transforms.normalize_plane(self.plane)))
+        object.__setattr__(self, "light", tuple(float(v) for v in transforms.light_vector(self.light)))
+        if not math.isfinite(self.lift) or self.lift < 0.0:
+            raise SandboxError(f"shadow lift must be a finite number >= 0, got {self.lift!r}")
+        if any(not 0.0 <= c <= 1.0 for c in self.color) or len(self.color) != 4:
+            raise SandboxError(f"shadow colour must be four numbers in 0..1, got {self.color!r}")
+
+    @property
+    def height(self) -> float:
+        """``P·L``: the point light's height above the plane, or the cosine of
+        a directional light with the normal; <= 0 means the receiver is unlit."""
+        return float(np.dot(self.plane, self.light))
+
+    def matrix(self) -> np.ndarray:
+        """The lifted shadow matrix ``T(lift·n) @ S`` (see :func:`glsandbox.transforms.shadow_matrix`)."""
+        return transforms.offset_along_normal(self.plane, self.lift) @ transforms.shadow_matrix(self.plane, self.light)
+
+
+@dataclass(frozen=True)
+class ShadowCasting:
+    """Which casters cast a shadow, and why the others do not."""
+
+    kept: tuple[str, ...]
+    culled: tuple[tuple[str, str], ...] = field(default=())  # (node, reason)
+    reason: str = ""  # non-empty: the whole shadow is culled
+
+    @property
+    def empty(self) -> bool:
+        return not self.kept
+
+
+def shadow_casters(shadow: PlanarShadow, models: dict[str, tuple[np.ndarray, np.ndarray]]) -> ShadowCasting:
+    """Decide what the shadow pass may draw, so that it never draws garbage.
+
+    ``models`` maps each caster to (model matrix, mesh positions). Cases:
+
+    - a light lying in the plane or parallel to it: no shadow matrix exists;
+      refused by :func:`glsandbox.transforms.shadow_matrix` with a message;
+    - the light below the plane (``P·L < 0``): the receiver's upper side is
+      not lit, so nothing is shadowed there: the whole pass is culled;
+    - a point light and a caster with a vertex at or above the light's height
+      (``P·X >= P·L``): that vertex's ray never reaches the plane (w <= 0 in
+      :func:`glsandbox.transforms.shadow_matrix`) and its triangles would be
+      projected through infinity: that caster is culled, with the reason.
+    """
+    transforms.shadow_matrix(shadow.plane, shadow.light)  # refuses the degenerate lights
+    height = shadow.height
+    if height < 0.0:
+        return ShadowCasting((), reason=f"light is below the receiver plane (P·L = {height:.3g})")
+    plane = np.asarray(shadow.plane)
+    kept: list[str] = []
+    culled: list[tuple[str, str]] = []
+    for name in shadow.casters:
+        if name not in models:
+            raise SandboxError(f"shadow caster {name!r} is not a node of the scene")
+        model, positions = models[name]
+        if shadow.light[3] == 1.0:
+            world = transforms.transform_points(model, positions)
+            top = float(np.max(world @ plane[:3] + plane[3]))
+            if top >= height - transforms.SHADOW_EPSILON:
+                culled.append((name, f"a vertex is {top:.3g} above the plane, not below the point light at {height:.3g}"))
+                continue
+        kept.append(name)
+    return ShadowCasting(tuple(kept), tuple(culled))
