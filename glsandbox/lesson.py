@@ -98,10 +98,13 @@ class Lesson:
     #: Whether the picture changes with ``time`` (the window advances it).
     animated: ClassVar[bool] = False
     params: ClassVar[tuple[Param, ...]] = ()
+    #: Defaults of the shared parameters this lesson changes (the ray-tracing
+    #: lessons set ``{"renderer": "ray"}``).
+    defaults: ClassVar[dict[str, Any]] = {}
 
     def __init__(self, **values: Any) -> None:
         known = {p.name: p for p in self.all_params()}
-        self.values: dict[str, Any] = {p.name: p.default for p in known.values()}
+        self.values: dict[str, Any] = {p.name: self.defaults.get(p.name, p.default) for p in known.values()}
         for key, value in values.items():
             if key not in known:
                 raise SandboxError(unknown_param_message(self, key))

@@ -34,7 +34,7 @@ The algorithm, in the course's order (first half of the notes):
    counts). ``P'`` is ``P`` moved off its surface by a relative offset
    towards the light's side (:data:`SHADOW_OFFSET`, float32-safe, see
    :mod:`glsandbox.raytrace.trace`). In shadow, only the ambient term stays.
-   A light's lamp (a node whose box holds it) casts no shadow for it.
+   A light's lamp (an unlit node whose box holds it) casts no shadow for it.
 5. **Reflection** (course "Yansıma vektörü"): a surface with
    ``material.reflectivity = r > 0`` shows ``(1 − r)·local + r·reflected``,
    the reflected ray ``R = Rd − 2(Rd·N)N`` traced again, up to
@@ -81,6 +81,9 @@ class RenderStats:
     primary: int = 0
     shadow: int = 0
     reflection: int = 0
+    #: Ray-shape tests done (one per ray and triangle, or ray and sphere):
+    #: what backface and AABB culling save.
+    tests: int = 0
     seconds: float = 0.0
 
     @property
@@ -99,7 +102,7 @@ class _Hits:
 
 
 def _nearest(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_max: float | NDArray[np.float64],
-             cull: bool | None, aabb: bool, light: int = -1) -> _Hits:
+             cull: bool | None, aabb: bool, light: int = -1, stats: RenderStats | None = None) -> _Hits:
     """Nearest hit with ``0 < t < t_max`` over every node (the course's ``min_indis`` loop).
 
     ``light >= 0`` makes it a shadow query for that light: its lamp is skipped.
@@ -120,6 +123,8 @@ def _nearest(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_max
         if idx.size == 0:
             continue
         one_sided = node.cull if cull is None else cull
+        if stats is not None:
+            stats.tests += idx.size * max(node.count, 1)
         oi, di = o[idx], d[idx]
         if node.kind == "sphere":
             inv = node.inverse
@@ -268,7 +273,7 @@ def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.floa
             if shadows:
                 start = _offset(p, nrm, light - p)
                 stats.shadow += idx.size
-                blocked = _nearest(world, start, light - start, 1.0, cull, aabb, index).node >= 0
+                blocked = _nearest(world, start, light - start, 1.0, cull, aabb, index, stats).node >= 0
                 visible = np.where(blocked, 0.0, 1.0)
             total += np.minimum(ka * mesh + visible[:, None] * (kd * diffuse + ks * specular), 1.0)
         color[idx] = total
@@ -284,7 +289,7 @@ def _trace(world: World, o: NDArray[np.float64], d: NDArray[np.float64], max_dep
     alive = np.arange(n)
     o = np.broadcast_to(o, d.shape)
     for depth in range(max_depth + 1):
-        hits = _nearest(world, o, d, np.inf, cull, aabb)
+        hits = _nearest(world, o, d, np.inf, cull, aabb, stats=stats)
         miss = hits.node < 0
         out[alive[miss]] += weight[miss, None] * world.background
         hit = ~miss

@@ -23,9 +23,10 @@ once per viewport by :func:`build_world` from the *same*
   triangles instead;
 - each node gets a world axis-aligned bounding box, the course's
   "Hızlandırma: AABB": a ray that misses the box skips every triangle inside.
-  A node whose box holds a light is that light's lamp (the lessons draw each
-  light as a small cube around it) and casts no shadow *for that light*;
-  otherwise every shadow ray would start inside or enter the lamp.
+  An unlit node (``solid``/``vertex_color``) whose box holds a light is that
+  light's lamp (the lessons draw each light as a small cube around it) and
+  casts no shadow *for that light*; otherwise every shadow ray would enter
+  the lamp. Lit nodes always cast shadows.
 
 Primary rays (course section "Bakış noktası, görüntü düzlemi GD(x,y)")
 ---------------------------------------------------------------------
@@ -102,7 +103,7 @@ class NodeInfo:
     model: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
     inverse: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
     normal_matrix: NDArray[np.float64] = field(default_factory=lambda: np.eye(3))
-    #: Bit ``i`` set: light ``i`` lies inside this node's box, so the node is
+    #: Bit ``i`` set: light ``i`` lies inside this unlit node's box, so the node is
     #: that light's lamp (the lessons draw each light as a small cube around
     #: it) and casts no shadow for it.
     lamp_of: int = 0
@@ -233,7 +234,8 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
     lights = scene.lights
     for info in nodes:
         for i, light in enumerate(lights):
-            if np.all(info.box_min <= light.position) and np.all(np.asarray(light.position) <= info.box_max):
+            inside = np.all(info.box_min <= light.position) and np.all(np.asarray(light.position) <= info.box_max)
+            if inside and not info.lit:
                 info.lamp_of |= 1 << i
 
     def stack(parts: list[NDArray[np.float64]], shape: tuple[int, ...]) -> NDArray[np.float64]:

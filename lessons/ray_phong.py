@@ -1,0 +1,148 @@
+"""Ray tracing lesson 4: Phong with shadow rays and reflections; the two exam scenes.
+
+Course sections "Phong boyama modeli" (ka + kd + ks = 1), "Yansıma vektörü"
+(R = Rd - 2(Rd·N)N, followed to depth 2) and "Gölge testi" (a point is in
+shadow iff something lies at 0 < t < distance to the light). ``--set
+scene=...``:
+
+- ``demo``: spheres and a box on a half-mirror floor, two lights;
+- ``exam2013``: worked examples #8 and #9. The ray from the origin along
+  (0.96, 0.28, 0) hits the red sphere (C = (80,15,0), r = 10) at t = 75, the
+  point (72,21,0) with normal (-0.8,0.6,0); the reflected ray (0,1,0) hits
+  the blue sphere (C = (72,121,0), r = 35) at t = 65. Towards the light
+  L = (100,117,0) (distance 100, direction (0.28,0.96,0)) the blue sphere is
+  crossed at t = 75 < 100: the point is in shadow. The red sphere is a
+  mirror here so the reflection shows; the notes' typo of #9 (subtracting
+  the blue centre) is corrected;
+- ``exam2012``: worked example #10. From P = (0,-8,-5) towards L = (0,10,-29)
+  (distance 30, direction (0,0.6,-0.8)) the plane N = (0,-0.6,0.8), D = 39.2
+  is crossed at t = 40, *beyond* the light: P is lit. The notes conclude
+  "in shadow"; that is the erratum, and the picture shows the light
+  reaching the floor under the tilted plane.
+
+Course coordinates are DirectX's; they are mirrored to OpenGL's (z -> -z).
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+
+from glsandbox import geometry, transforms
+from glsandbox.app import lesson_main
+from glsandbox.lesson import Lesson, Param, register
+from glsandbox.overlay import Overlay, text_image
+from glsandbox.raytrace import Plane, Ray, Sphere, first_hit, in_shadow, reflect, shadow_ray
+from glsandbox.scene import Camera, Light, Material, Node, Scene
+
+#: The course's first-half Phong: ka + kd + ks = 1.
+KA, KD, KS = 0.2, 0.6, 0.2
+SCENES = ("demo", "exam2013", "exam2012")
+
+
+def fmt(v) -> str:
+    """A vector as the course writes it: (0, 0.6, -0.8)."""
+    return "(" + ", ".join(f"{round(float(x), 9) + 0.0:.6g}" for x in v) + ")"
+
+
+def dx(p: tuple[float, float, float]) -> tuple[float, float, float]:
+    """A course (DirectX) point in OpenGL coordinates."""
+    return tuple(float(v) for v in transforms.from_directx_point(p))  # type: ignore[return-value]
+
+
+def material(color: tuple[float, float, float], reflectivity: float = 0.0, shininess: float = 32.0) -> Material:
+    return Material(color=(*color, 1.0), shading="phong", ambient=KA, diffuse=KD, specular=KS,
+                    shininess=shininess, reflectivity=reflectivity)
+
+
+def sphere(name: str, center: tuple[float, float, float], radius: float, mat: Material) -> Node:
+    return Node(name, geometry.sphere(), transforms.translate(*center) @ transforms.scale(radius, radius, radius), mat)
+
+
+def lamp(index: int, position: tuple[float, float, float], size: float, color=(1.0, 1.0, 1.0)) -> Node:
+    """A light drawn as a small unlit cube around it (casts no shadow for its own light)."""
+    return Node(f"lamp{index}", geometry.cube(), transforms.translate(*position) @ transforms.scale(size, size, size),
+                Material(color=(*color, 1.0)))
+
+
+def demo_scene(name: str) -> Scene:
+    floor = Node("floor", geometry.plane(16.0), transforms.translate(0.0, -1.0, 0.0),
+                 material((0.55, 0.55, 0.6), reflectivity=0.35))
+    box = Node("box", geometry.cube24(), transforms.translate(1.8, -0.4, -1.2) @ transforms.rotate_y(0.5)
+               @ transforms.scale(0.6, 0.6, 0.6), material((0.9, 0.75, 0.2)))
+    lights = (Light((3.0, 4.0, 3.0)), Light((-4.0, 3.0, 1.0), (0.5, 0.5, 0.7)))
+    nodes = (floor, box,
+             sphere("mirror", (-0.6, 0.0, -0.5), 1.0, material((0.9, 0.9, 0.95), reflectivity=0.6)),
+             sphere("red", (0.9, -0.55, 1.2), 0.45, material((0.9, 0.15, 0.1))),
+             sphere("green", (-2.2, -0.6, 1.0), 0.4, material((0.2, 0.8, 0.3))),
+             *(lamp(i, l.position, 0.1, l.color) for i, l in enumerate(lights)))
+    camera = Camera(eye=(0.0, 1.6, 6.0), target=(0.0, -0.2, 0.0), fov_y=45.0)
+    return Scene(name, nodes=nodes, camera=camera, lights=lights, clear_color=(0.45, 0.6, 0.85, 1.0))
+
+
+def exam2013(name: str) -> tuple[Scene, list[str]]:
+    red, blue, light = Sphere(dx((80, 15, 0)), 10.0), Sphere(dx((72, 121, 0)), 35.0), dx((100, 117, 0))
+    ray = Ray((0.0, 0.0, 0.0), dx((0.96, 0.28, 0.0)))
+    hit = first_hit(ray, [red, blue])
+    assert hit is not None
+    bounce = Ray(hit.point, reflect(ray.direction, hit.normal))
+    t_blue = blue.intersect(bounce)
+    to_light, distance = shadow_ray(hit.point, light, hit.normal)
+    t_block = blue.intersect(to_light)
+    rows = ["2013 exam (#8, #9)",
+            f"red hit t = {hit.t:.6g} at {fmt(hit.point)}, N = {fmt(hit.normal)}",
+            f"reflected {fmt(bounce.direction)} hits blue at t = {t_blue:.6g}",
+            f"to light: distance {distance:.6g}, blue at t = {t_block:.6g} < {distance:.6g}: "
+            + ("in shadow" if in_shadow(hit.point, light, [red, blue], hit.normal) else "lit")]
+    nodes = (sphere("red", tuple(red.center), 10.0, material((0.9, 0.1, 0.1), reflectivity=0.5)),
+             sphere("blue", tuple(blue.center), 35.0, material((0.15, 0.25, 0.9))),
+             lamp(0, light, 2.0))
+    camera = Camera(eye=(70.0, 30.0, 170.0), target=(76.0, 55.0, 0.0), fov_y=55.0, far=1000.0)
+    return Scene(name, nodes=nodes, camera=camera, lights=(Light(light),), clear_color=(0.08, 0.08, 0.12, 1.0)), rows
+
+
+def exam2012(name: str) -> tuple[Scene, list[str]]:
+    light, point = dx((0, 10, -29)), dx((0, -8, -5))
+    normal = dx((0.0, -0.6, 0.8))
+    plane = Plane.through(normal, dx((0, 20, -34)))
+    to_light, distance = shadow_ray(point, light, (0.0, 1.0, 0.0))
+    t_plane = plane.intersect(Ray(point, to_light.direction))
+    rows = ["2012 exam (#10)",
+            f"P = (0,-8,-5) -> L = (0,10,-29): distance {distance:.6g}",
+            f"plane N = (0,-0.6,0.8), D = {-plane.d if plane.d < 0 else plane.d:.6g}: hit at t = {t_plane:.6g}",
+            f"t = {t_plane:.6g} > {distance:.6g}: beyond the light, P is LIT",
+            "(the notes' 'in shadow' is the erratum: rule is 0 < t < distance)"]
+    angle = math.atan2(normal[2], normal[1])  # R_x(angle) turns the plane's +y normal onto N
+    tilted = Node("tilted", geometry.plane(60.0),
+                  transforms.translate(*dx((0, 20, -34))) @ transforms.rotate_x(angle),
+                  material((0.7, 0.7, 0.75)), cull_back_faces=False)
+    floor = Node("floor", geometry.plane(80.0), transforms.translate(0.0, -8.0, 0.0), material((0.6, 0.55, 0.45)))
+    marker = sphere("P", point, 0.6, material((0.9, 0.2, 0.2)))
+    camera = Camera(eye=(30.0, 8.0, -20.0), target=(0.0, 0.0, 15.0), fov_y=60.0, far=500.0)
+    nodes = (floor, tilted, marker, lamp(0, light, 0.6))
+    return Scene(name, nodes=nodes, camera=camera, lights=(Light(light),), clear_color=(0.08, 0.08, 0.12, 1.0)), rows
+
+
+@register
+class RayPhong(Lesson):
+    name = "ray_phong"
+    title = "Phong, shadow rays and reflections; the 2013 and 2012 exam scenes"
+    course_section = "Phong boyama modeli; Yansıma vektörü; Gölge testi"
+    order = 140
+    defaults = {"renderer": "ray"}
+    params = (Param("scene", "demo", "which scene", choices=SCENES),)
+
+    def build(self) -> Scene:
+        which = self.values["scene"]
+        if which == "demo":
+            scene = demo_scene(self.name)
+            rows = [f"Phong ka={KA} kd={KD} ks={KS} (sum 1), shadows, reflections to depth 2"]
+        else:
+            scene, rows = (exam2013 if which == "exam2013" else exam2012)(self.name)
+        from dataclasses import replace
+
+        return replace(scene, overlays=(Overlay("figures", text_image(rows), None, (4, 4)),))
+
+
+if __name__ == "__main__":
+    sys.exit(lesson_main(RayPhong))
