@@ -100,6 +100,10 @@ def cmd_compare(args: argparse.Namespace) -> int:
         result = compare_variants(variants, columns, size, renderer)
     save_png(result.image, out)
     print(result.report())
+    if result.difference is not None:  # the first two distinct pictures, amplified
+        diff_out = out.with_name(f"{out.stem}-diff.png")
+        save_png(result.difference, diff_out)
+        print(f"wrote {diff_out} (difference of the first two distinct pictures, x4)")
     print(f"wrote {out} ({size[0]}x{size[1]}, {len(variants)} tiles)")
     return 0
 

@@ -64,6 +64,8 @@ class Comparison:
     groups: list[list[int]]  # indices of variants with identical pictures
     pairs: list[dict[str, object]]  # one row per pair of groups: a, b and the metrics
     tile_size: tuple[int, int]
+    #: With two or more distinct pictures: where the first two differ (see :func:`difference_image`).
+    difference: np.ndarray | None = None
 
     def report(self) -> str:
         """The text ``glsandbox compare`` prints: identical groups, then the difference table."""
@@ -238,7 +240,21 @@ def compare_variants(variants: list[Variant], columns: int, size: tuple[int, int
     alone = [renderer.render_scene(replace(v.scene, overlays=()), tile).image.copy() for v in variants]
     groups = group_identical(alone)
     labels = [v.label for v in variants]
-    return Comparison(frame.image, variants, groups, difference_rows(alone, labels, groups), tile)
+    difference = difference_image(alone[groups[0][0]], alone[groups[1][0]]) if len(groups) > 1 else None
+    return Comparison(frame.image, variants, groups, difference_rows(alone, labels, groups), tile, difference)
+
+
+#: How much :func:`difference_image` amplifies: a difference of 64 levels is white.
+DIFFERENCE_GAIN = 4
+
+
+def difference_image(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Where two pictures differ: the largest channel difference per pixel, times
+    :data:`DIFFERENCE_GAIN`, as grey on black (e.g. raster against ray: the
+    shadows, the silhouettes of tessellated spheres, per-vertex lighting)."""
+    d = np.abs(a[..., :3].astype(np.int16) - b[..., :3].astype(np.int16)).max(axis=2)
+    grey = np.clip(d * DIFFERENCE_GAIN, 0, 255).astype(np.uint8)
+    return np.dstack([grey, grey, grey, np.full_like(grey, 255)])
 
 
 def default_out(lesson_name: str) -> Path:

@@ -194,3 +194,6 @@ def test_compare_raster_against_ray(gl):
     share = float(result.pairs[0]["share"]) if result.pairs else 0.0
     assert share < 0.05
     assert math.isfinite(share)
+    phong = compare(find_lesson("phong"), ["renderer=raster,ray"], [], (192, 72), gl)
+    assert phong.difference is not None and phong.difference.shape == (72, 96, 4)
+    assert phong.difference[..., 0].max() > 100  # the shadows only the ray tracer casts
