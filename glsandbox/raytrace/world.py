@@ -57,7 +57,7 @@ from glsandbox.geometry import Mesh
 from glsandbox.images import builtin_levels, load_image
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.triangle import TriangleBatch
-from glsandbox.scene import Camera, Scene
+from glsandbox.scene import Camera, Node, Scene
 
 __all__ = [
     "MODES",
@@ -157,6 +157,19 @@ def _texture_image(source: str) -> NDArray[np.float64]:
     return np.asarray(level, dtype=np.float64) / 255.0
 
 
+def _reflectivity(scene: Scene, node: Node) -> float:
+    """The node's ``material.reflectivity``; for the glass of the scene's stencil
+    mirror (:class:`glsandbox.effects.Mirror`) at least ``1 - alpha``, the share
+    of the reflection the rasterizer blends under the glass. The ray tracer
+    reflects everything in front of the glass, not only the mirror's
+    ``reflected`` nodes: the answer the stencil approximation aims at."""
+    value = float(node.material.reflectivity)
+    mirror = getattr(scene, "mirror", None)
+    if mirror is not None and node.name == mirror.node:
+        value = max(value, 1.0 - float(node.material.color[3]))
+    return value
+
+
 def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = True) -> World:
     """The :class:`World` of ``scene`` as seen in viewport ``viewport``.
 
@@ -192,7 +205,7 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
             name=node.name, cull=bool(node.cull_back_faces),
             color=np.asarray(material.color[:3], dtype=np.float64), mode=MODES[material.shading],
             ka=float(material.ambient), kd=float(material.diffuse), ks=float(material.specular),
-            shininess=float(material.shininess), reflectivity=float(getattr(material, "reflectivity", 0.0)),
+            shininess=float(material.shininess), reflectivity=_reflectivity(scene, node),
             texture=tex, model=model,
         )
         if analytic_spheres and is_unit_sphere(mesh):

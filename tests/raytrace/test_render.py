@@ -197,3 +197,14 @@ def test_compare_raster_against_ray(gl):
     phong = compare(find_lesson("phong"), ["renderer=raster,ray"], [], (192, 72), gl)
     assert phong.difference is not None and phong.difference.shape == (72, 96, 4)
     assert phong.difference[..., 0].max() > 100  # the shadows only the ray tracer casts
+
+
+def test_stencil_mirror_glass_reflects_in_the_ray_tracer():
+    """The mirror lesson's glass (scene.mirror) reflects 1 - alpha of the light, as the raster blends it."""
+    scene = find_lesson("mirror")().scene()
+    if getattr(scene, "mirror", None) is None:
+        pytest.skip("the mirror lesson has no stencil mirror")
+    world = build_world(scene)
+    glass = next(n for n in world.nodes if n.name == scene.mirror.node)
+    alpha = next(n for n in scene.nodes if n.name == scene.mirror.node).material.color[3]
+    assert glass.reflectivity == pytest.approx(1.0 - alpha) and glass.reflectivity > 0
