@@ -7,6 +7,11 @@ of viewports. Each variant's viewports are squeezed into its tile, its nodes
 restricted to them, and each looks through its own camera, so every variant
 renders exactly as it would alone (at the tile's size).
 
+Variants that cannot share one frame (a stencil mirror, a planar shadow or
+reverse-Z depth own the whole frame; lights belong to a whole scene) are
+rendered one by one at their tile's size and placed in the frame instead
+(:func:`stitch`), so every tile is still what that variant renders alone.
+
 It then tells which variants give identical pictures and how far apart the
 others are. Those figures come from each variant rendered alone at the tile
 size *without its overlays* (labels and matrices differ by design; the 3D
@@ -158,12 +163,11 @@ def compose(variants: list[Variant], columns: int, size: tuple[int, int], labels
     overlays: list[Overlay] = []
     for index, (variant, tile) in enumerate(zip(variants, tile_rects(len(variants), columns))):
         scene = variant.scene
-        if scene.mirror is not None or scene.shadow is not None or scene.depth_mode != "standard":
-            # A mirror, a shadow and the depth mode belong to a whole scene (its
-            # stencil bits and clip control), so they cannot share one frame with other tiles yet.
-            raise SandboxError(f"compare: {scene.name!r} ({variant.label}) uses a mirror, a planar shadow or "
-                               "reverse-Z depth, which cannot be composed into tiles; render each variant with "
-                               "glsandbox render --set ...")
+        reason = whole_frame_reason(scene)
+        if reason is not None or scene.lights != variants[0].scene.lights:
+            # Callers check :func:`composable` first and stitch such variants instead.
+            raise SandboxError(f"compare: {scene.name!r} ({variant.label}) cannot share a frame with the other "
+                               f"tiles: {reason or 'its lights differ'}")
         tx, ty, tw, th = tile
         first = len(viewports)
         for vp in scene.viewports:
@@ -202,6 +206,63 @@ def compose(variants: list[Variant], columns: int, size: tuple[int, int], labels
     )
 
 
+def whole_frame_reason(scene: Scene) -> str | None:
+    """Why a scene cannot be one tile of a shared frame, or None.
+
+    A mirror and a planar shadow own the frame's stencil bits, reverse-Z
+    owns its depth convention (glClipControl): they belong to a whole frame.
+    """
+    if scene.mirror is not None:
+        return "it has a stencil mirror"
+    if scene.shadow is not None:
+        return "it has a planar shadow"
+    if scene.depth_mode != "standard":
+        return f"it uses {scene.depth_mode} depth"
+    return None
+
+
+def composable(variants: list[Variant]) -> str | None:
+    """None when every variant can be a viewport of one frame; else why not.
+
+    Besides whole-frame effects, lights are per scene, not per viewport: variants
+    with different lights (e.g. ``--vary lights=0,1,2``) cannot share one frame.
+    """
+    for variant in variants:
+        reason = whole_frame_reason(variant.scene)
+        if reason is not None:
+            return f"{variant.label}: {reason}"
+        if variant.scene.lights != variants[0].scene.lights:
+            return f"{variant.label}: its lights differ from {variants[0].label}'s"
+    return None
+
+
+def stitch(variants: list[Variant], columns: int, size: tuple[int, int], renderer,
+           labels: bool = True) -> np.ndarray:
+    """The frame made of tiles rendered one by one, each variant alone at its
+    tile's size, then placed where :func:`compose` would have put its viewport."""
+    frame = np.zeros((size[1], size[0], 4), dtype=np.uint8)
+    for variant, tile in zip(variants, tile_rects(len(variants), columns)):
+        x, y, w, h = Viewport(rect=tile).pixels(*size)
+        if w <= 0 or h <= 0:
+            continue
+        top = size[1] - y - h  # tile rects count from the bottom, image rows from the top
+        frame[top:top + h, x:x + w] = renderer.render_scene(variant.scene, (w, h)).image
+        if labels:
+            _paste(frame, text_image([variant.label], color=LABEL_COLOR), x + w - 3, top + h - 3)
+    return frame
+
+
+def _paste(frame: np.ndarray, image: np.ndarray, right: int, bottom: int) -> None:
+    """Alpha-blend ``image`` into ``frame`` with its bottom-right corner at (right, bottom)."""
+    h, w = image.shape[:2]
+    x0, y0 = max(right - w, 0), max(bottom - h, 0)
+    part = image[h - (bottom - y0):, w - (right - x0):].astype(np.float32)
+    region = frame[y0:bottom, x0:right]
+    alpha = part[..., 3:4] / 255.0
+    region[..., :3] = np.round(part[..., :3] * alpha + region[..., :3] * (1.0 - alpha)).astype(np.uint8)
+    region[..., 3] = 255
+
+
 def group_identical(images: list[np.ndarray]) -> list[list[int]]:
     """Indices grouped by exactly equal pixels, in first-seen order."""
     groups: list[list[int]] = []
@@ -236,12 +297,15 @@ def compare_variants(variants: list[Variant], columns: int, size: tuple[int, int
     """Render already built variants: the composed frame, then each alone for the figures."""
     rows = math.ceil(len(variants) / columns)
     tile = (max(1, size[0] // columns), max(1, size[1] // rows))
-    frame = renderer.render_scene(compose(variants, columns, size), size)
+    if composable(variants) is None:
+        image = renderer.render_scene(compose(variants, columns, size), size).image
+    else:
+        image = stitch(variants, columns, size, renderer)
     alone = [renderer.render_scene(replace(v.scene, overlays=()), tile).image.copy() for v in variants]
     groups = group_identical(alone)
     labels = [v.label for v in variants]
     difference = difference_image(alone[groups[0][0]], alone[groups[1][0]]) if len(groups) > 1 else None
-    return Comparison(frame.image, variants, groups, difference_rows(alone, labels, groups), tile, difference)
+    return Comparison(image, variants, groups, difference_rows(alone, labels, groups), tile, difference)
 
 
 #: How much :func:`difference_image` amplifies: a difference of 64 levels is white.

@@ -112,3 +112,23 @@ def test_cli_refuses_bad_values_with_exit_2_and_writes_nothing(tmp_path: Path, c
     err = capsys.readouterr().err
     assert err.startswith("error: ") and message in err and err.count("\n") == 1
     assert not out.exists()
+
+
+@pytest.mark.parametrize(("lesson", "vary"), [("mirror", "mirror=stencil,off,no_stencil"), ("phong", "lights=0,2")])
+def test_variants_that_cannot_share_a_frame_are_stitched_tile_by_tile(gl, lesson: str, vary: str) -> None:
+    # A mirror owns the frame's stencil; lights belong to a whole scene: such
+    # variants are rendered alone at the tile size and placed in the frame.
+    from glsandbox.compare import composable, tile_rects
+    from glsandbox.scene import Viewport
+
+    variants, columns = build_variants(find_lesson(lesson), [vary], [])
+    assert composable(variants) is not None
+    size = (300, 200)
+    result = compare_variants(variants, columns, size, gl)
+    assert len(result.groups) == len(variants)  # every value changes the picture
+    for variant, tile in zip(variants, tile_rects(len(variants), columns)):
+        x, y, w, h = Viewport(rect=tile).pixels(*size)
+        top = size[1] - y - h
+        alone = gl.render_scene(variant.scene, (w, h)).image
+        # Identical except where the tile's label is drawn (bottom-right corner).
+        np.testing.assert_array_equal(result.image[top:top + h // 2, x:x + w], alone[: h // 2])

@@ -190,11 +190,12 @@ def test_plans_without_effects_are_unchanged():
     assert "depth 24," in plan(MirrorLesson(depth="standard").scene()).buffers.describe() + ","
 
 
-def test_compare_refuses_effects_it_cannot_tile():
-    from glsandbox.compare import build_variants, compose
+def test_compare_cannot_compose_whole_frame_effects_so_it_stitches_them():
+    from glsandbox.compare import build_variants, composable, compose
 
     variants, columns = build_variants(MirrorLesson, ["shadow=on,off"], [])
-    with pytest.raises(SandboxError, match="cannot be composed into tiles"):
+    assert "stencil mirror" in composable(variants)
+    with pytest.raises(SandboxError, match="cannot share a frame"):
         compose(variants, columns, SIZE)
 
 
