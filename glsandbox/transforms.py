@@ -236,9 +236,15 @@ def from_directx_point(p: Sequence[float]) -> np.ndarray:
     return np.array([x, y, -z])
 
 
+#: ``F @ M @ F`` for the diagonal ``F = MIRROR_Z`` just flips the signs of
+#: row 2 and column 2 (their crossing twice, so it keeps its sign).
+_MIRROR_SIGNS = np.outer(np.diag(MIRROR_Z), np.diag(MIRROR_Z))
+
+
 def from_directx_matrix(m_row: np.ndarray) -> Matrix:
-    """A DirectX (row-vector, left-handed) 4x4 matrix in OpenGL form."""
-    return MIRROR_Z @ np.asarray(m_row, dtype=np.float64).T @ MIRROR_Z
+    """A DirectX (row-vector, left-handed) 4x4 matrix in OpenGL form:
+    ``MIRROR_Z @ m_row.T @ MIRROR_Z``, done as a sign flip."""
+    return np.asarray(m_row, dtype=np.float64).T * _MIRROR_SIGNS
 
 
 def from_directx_mesh(positions: np.ndarray, indices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

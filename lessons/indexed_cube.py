@@ -41,6 +41,11 @@ def cube_with_flipped_face(face: str) -> geometry.Mesh:
     return geometry.Mesh(f"cube_flip_{face}", mesh.positions, tri.reshape(-1), colors=mesh.colors)
 
 
+#: The course's camera: eye (0, 3, -10) in DirectX, looking at the origin,
+#: 45° field of view, near 0.01, far 100.
+COURSE_CAMERA = Camera(eye=tuple(transforms.from_directx_point((0.0, 3.0, -10.0))), fov_y=45.0, near=0.01, far=100.0)
+
+
 @register
 class IndexedCube(Lesson):
     name = "indexed_cube"
@@ -62,8 +67,7 @@ class IndexedCube(Lesson):
         model = transforms.from_directx_matrix(dx_rotation)
         node = Node("cube", cube_with_flipped_face(self.values["flip"]), model,
                     Material(shading="vertex_color"), cull_back_faces=bool(self.values["cull"]))
-        eye = tuple(transforms.from_directx_point((0.0, 3.0, -10.0)))
-        return Scene(self.name, nodes=(node,), camera=Camera(eye=eye, fov_y=45.0, near=0.01, far=100.0))
+        return Scene(self.name, nodes=(node,), camera=COURSE_CAMERA)
 
 
 if __name__ == "__main__":

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import hashlib
 import weakref
+from collections.abc import Collection
 from dataclasses import dataclass
 
 import moderngl
@@ -72,6 +73,7 @@ class Executor:
         self.host = host
         self.ctx = host.ctx
         self._programs: dict[str, tuple[ProgramVariant, moderngl.Program]] = {}
+        self._member_names: dict[str, frozenset[str]] = {}
         self._meshes: dict[tuple[str, str], _GpuMesh] = {}
         self._vaos: dict[tuple[tuple[str, str], str], moderngl.VertexArray] = {}
         self._overlays: OverlayDrawer | None = None  # made on the first overlay pass
@@ -98,6 +100,7 @@ class Executor:
             vao.release()
         self._vaos.clear()
         self._programs = fresh
+        self._member_names.clear()
 
     def _gpu_mesh(self, mesh: Mesh) -> tuple[tuple[str, str], _GpuMesh]:
         key = _mesh_key(mesh)
@@ -180,6 +183,15 @@ class Executor:
         else:
             self.ctx.disable(moderngl.DEPTH_TEST)
 
+    def _members(self, program_key: str) -> frozenset[str]:
+        """A program's uniform and attribute names. moderngl's Program has no
+        ``__contains__``, so ``name in program`` walks all its members each
+        time; the set is built once per program."""
+        names = self._member_names.get(program_key)
+        if names is None:
+            names = self._member_names[program_key] = frozenset(self._programs[program_key][1])
+        return names
+
     def _draw(self, node: Node, draw: Draw, view: np.ndarray, proj: np.ndarray,
               model: np.ndarray | None = None, front_face: str = "ccw") -> None:
         """Draw one node. ``model`` replaces its model matrix and ``front_face``
@@ -193,24 +205,25 @@ class Executor:
             self.ctx.front_face = front_face
         else:
             self.ctx.disable(moderngl.CULL_FACE)
+        members = self._members(draw.program)
         uniforms = {
             "m_model": transforms.gl_bytes(model),
             "m_view": transforms.gl_bytes(view),
             "m_proj": transforms.gl_bytes(proj),
             "u_color": np.asarray(node.material.color, dtype="f4").tobytes(),
         }
-        if "m_normal" in program:
+        if "m_normal" in members:
             uniforms["m_normal"] = transforms.gl_bytes(transforms.normal_matrix(model))
         for name, data in uniforms.items():
-            if name in program:
+            if name in members:
                 program[name].write(data)
         if node.material.lit:
-            write_light_uniforms(program, self._lights, view)
-            write_material_uniforms(program, node.material)
+            write_light_uniforms(program, self._lights, view, members)
+            write_material_uniforms(program, node.material, members)
         texture = node.material.texture
         if texture is not None:
             self._textures.bind(texture, 0)
-            if "u_texture" in program:
+            if "u_texture" in members:
                 program["u_texture"].value = 0
         vao.render(gpu.mode, vertices=gpu.count)
         if texture is not None:
@@ -240,6 +253,7 @@ class Executor:
         self._vaos.clear()
         self._meshes.clear()
         self._programs.clear()
+        self._member_names.clear()
 
 
 # --- lighting uniforms (course section "Lighting") --------------------------
@@ -252,25 +266,27 @@ def eye_position(view: np.ndarray) -> np.ndarray:
     return np.linalg.inv(np.asarray(view, dtype=np.float64))[:3, 3]
 
 
-def write_light_uniforms(program: moderngl.Program, lights: tuple[Light, ...], view: np.ndarray) -> None:
+def write_light_uniforms(program: moderngl.Program, lights: tuple[Light, ...], view: np.ndarray,
+                         members: Collection[str]) -> None:
     """The course's ``vLightPos[]``, ``vLightColor[]`` and ``vEyePos``, in world space.
 
     The shader's arrays are sized by its ``NUM_LIGHTS`` define, which the plan
-    set to ``len(lights)``; with no lights they do not exist.
+    set to ``len(lights)``; with no lights they do not exist. ``members`` are
+    the program's uniform names (see :meth:`Executor._members`).
     """
-    if "u_eye" in program:
+    if "u_eye" in members:
         program["u_eye"].write(eye_position(view).astype("f4").tobytes())
-    if lights and "u_light_pos" in program:
+    if lights and "u_light_pos" in members:
         program["u_light_pos"].write(np.array([l.position for l in lights], dtype="f4").tobytes())
-    if lights and "u_light_color" in program:
+    if lights and "u_light_color" in members:
         program["u_light_color"].write(np.array([l.color for l in lights], dtype="f4").tobytes())
 
 
-def write_material_uniforms(program: moderngl.Program, material: Material) -> None:
+def write_material_uniforms(program: moderngl.Program, material: Material, members: Collection[str]) -> None:
     """The coefficients of the course's ``0.1*mesh + 0.4*diffuse + 0.3*specular``
     and the exponent (32); a zero coefficient switches its term off."""
     values = {"u_ambient": material.ambient, "u_diffuse": material.diffuse,
               "u_specular": material.specular, "u_shininess": material.shininess}
     for name, value in values.items():
-        if name in program:  # a term the compiler removed has no uniform
+        if name in members:  # a term the compiler removed has no uniform
             program[name].value = float(value)
