@@ -67,6 +67,163 @@ def embree_primary(scene, size: tuple[int, int]) -> Callable[[], object] | None:
     return lambda: embree.run(origins, directions, output=1)
 
 
+# --- glsandbox bench: the ray tracer's engines against Embree, one table ------------
+
+#: The scenes ``glsandbox bench`` traces (``--quick``: the first only).
+BENCH_SCENES = ("phong", "ray_phong")
+#: Issue 6's goals as time ratios against Embree: gpu >= 1.0x Embree's ray rate, numpy >= 0.1x.
+GOALS = {"gpu": 1.0, "numpy": 10.0}
+EMBREE_MISSING = ("ray tracer vs Embree: skipped: embreex not installed "
+                  "(uv run --group bench glsandbox bench); rows show the gpu engine against the numpy engine")
+
+
+def embree_available() -> bool:
+    """Whether ``embreex`` (Embree's Python binding) can be imported."""
+    try:
+        from embreex import rtcore_scene  # noqa: F401
+        from embreex.mesh_construction import TriangleMesh  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+class EmbreeCaster:
+    """Embree casting the rays the engines cast for one scene: primary rays,
+    a shadow ray per light at every lit hit (``OCCLUDED`` queries, the
+    light's lamp left out as the engines do), and reflection bounces up to
+    ``max_depth`` where a material reflects. Closest hit and occlusion
+    only, no shading: an upper bound for the same ray work. Spheres are
+    their triangle mesh (Embree needs triangles)."""
+
+    def __init__(self, scene: object, size: tuple[int, int], shadows: bool, max_depth: int) -> None:
+        from embreex import rtcore_scene
+        from embreex.mesh_construction import TriangleMesh
+
+        world = build_world(scene, analytic_spheres=False)
+        triangles = np.stack([world.v0, world.v1, world.v2], axis=1).astype(np.float32)
+        self.scene = rtcore_scene.EmbreeScene()
+        TriangleMesh(self.scene, triangles)
+        self.shadow_scenes = []  # one per light, without that light's lamp
+        for index in range(len(world.light_positions) if shadows else 0):
+            keep = np.array([not world.nodes[k].lamp_of >> index & 1 for k in world.tri_node], dtype=bool)
+            occluders = rtcore_scene.EmbreeScene()
+            if keep.any():
+                TriangleMesh(occluders, np.ascontiguousarray(triangles[keep]))
+            self.shadow_scenes.append(occluders if keep.any() else None)
+        self.lights = world.light_positions.astype(np.float32)
+        self.tri_node = world.tri_node
+        self.lit = np.array([n.lit for n in world.nodes], dtype=bool)
+        self.reflectivity = np.array([n.reflectivity for n in world.nodes])
+        self.max_depth = max_depth
+        eye, dirs = camera_rays(scene.viewports[0].camera or scene.camera, *size)
+        self.origins = np.ascontiguousarray(np.broadcast_to(eye, dirs.shape), dtype=np.float32)
+        self.directions = np.ascontiguousarray(dirs, dtype=np.float32)
+
+    def cast(self) -> int:
+        """Cast every ray once; returns how many were cast."""
+        from glsandbox.raytrace.render import SHADOW_OFFSET
+
+        o, d, cast = self.origins, self.directions, 0
+        for depth in range(self.max_depth + 1):
+            hits = self.scene.run(o, d, output=1)
+            cast += d.shape[0]
+            hit = hits["primID"] >= 0
+            if not hit.any():
+                break
+            nodes = self.tri_node[hits["primID"][hit]]
+            dh = d[hit]
+            point = o[hit] + hits["tfar"][hit, None] * dh
+            normal = hits["Ng"][hit]
+            normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-30)
+            scale = (SHADOW_OFFSET * np.maximum(1.0, np.abs(point).max(axis=1)))[:, None]
+            lit = self.lit[nodes]
+            for light, occluders in zip(self.lights, self.shadow_scenes):
+                p, n = point[lit], normal[lit]
+                towards = light - p
+                side = np.where(np.einsum("ij,ij->i", n, towards) < 0.0, -1.0, 1.0)[:, None]
+                start = np.ascontiguousarray(p + scale[lit] * side * n, dtype=np.float32)
+                cast += start.shape[0]
+                if occluders is not None and start.shape[0]:
+                    occluders.run(start, np.ascontiguousarray(light - start, dtype=np.float32),
+                                  dists=np.ones(start.shape[0], dtype=np.float32), query="OCCLUDED")
+            bounce = self.reflectivity[nodes] > 0.0
+            if depth == self.max_depth or not bounce.any():
+                break
+            db, nb = dh[bounce], normal[bounce]
+            d = np.ascontiguousarray(db - 2.0 * np.einsum("ij,ij->i", db, nb)[:, None] * nb, dtype=np.float32)
+            side = np.where(np.einsum("ij,ij->i", nb, -db) < 0.0, -1.0, 1.0)[:, None]
+            o = np.ascontiguousarray(point[bounce] + scale[bounce] * side * nb, dtype=np.float32)
+        return cast
+
+
+def cases(env: object) -> list:
+    """``glsandbox bench`` cases: per scene and mode (primary; shadow+bounce: the
+    secondary rays), the numpy and gpu engines against Embree casting the same
+    rays, ratio = engine time / Embree time; without ``embreex``, the gpu
+    engine against the numpy engine, and a note saying Embree was skipped.
+    Everything is built on first use, so listing the cases costs nothing."""
+    from glsandbox.bench import Case, Side
+
+    size: tuple[int, int] = env.size  # type: ignore[attr-defined]
+    has_embree = embree_available()
+    if not has_embree:
+        env.note(EMBREE_MISSING)  # type: ignore[attr-defined]
+    counts: dict[tuple[str, str], int] = {}
+
+    def scene_of(name: str) -> object:
+        return find_lesson(name)(renderer="raster").scene()
+
+    def rays(name: str, mode: str) -> int:
+        """The engines' ray count (numpy's RenderStats; the gpu engine casts the same rays)."""
+        if (name, mode) not in counts:
+            stats = RenderStats()
+            render(scene_of(name), size, stats=stats, **MODES[mode])
+            counts[(name, mode)] = stats.rays
+        return counts[(name, mode)]
+
+    def engine(name: str, mode: str, kind: str) -> Side:
+        scene = scene_of(name)
+        options = MODES[mode]
+
+        def run(_: int) -> int:
+            if kind == "gpu":
+                render(scene, size, "gpu", ctx=env.renderer.host.ctx, **options)  # type: ignore[attr-defined]
+                return rays(name, mode)
+            stats = RenderStats()
+            render(scene, size, stats=stats, **options)
+            counts[(name, mode)] = stats.rays
+            return stats.rays
+
+        return Side("gpu engine (GLSL float32)" if kind == "gpu" else "numpy engine (float64)", run)
+
+    def embree(name: str, mode: str) -> Side:
+        caster: list[EmbreeCaster] = []
+
+        def run(_: int) -> int:
+            if not caster:
+                options = MODES[mode]
+                caster.append(EmbreeCaster(scene_of(name), size, options["shadows"], options["max_depth"]))
+            return caster[0].cast()
+
+        return Side("Embree (embreex)", run)
+
+    def same_rays(baseline: int, subject: int) -> str:
+        return f"{subject:,} rays each" if baseline == subject else f"rays: {subject:,}, Embree {baseline:,}"
+
+    found = []
+    for name in BENCH_SCENES[:1] if env.quick else BENCH_SCENES:  # type: ignore[attr-defined]
+        for mode in MODES:
+            if has_embree:
+                for kind in ("numpy", "gpu"):
+                    found.append(Case("ray tracer vs Embree", f"{name}, {mode}, {kind}", embree(name, mode),
+                                      engine(name, mode, kind), repeat=1, goal=GOALS[kind], compare=same_rays,
+                                      note="ratio = engine time / Embree time for the same rays"))
+            else:
+                found.append(Case("ray tracer engines", f"{name}, {mode}", engine(name, mode, "numpy"),
+                                  engine(name, mode, "gpu"), repeat=1, compare=same_rays))
+    return found
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--rounds", type=int, default=3)

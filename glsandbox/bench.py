@@ -76,7 +76,14 @@ class BenchEnv:
     quick: bool = False
     size: tuple[int, int] = FRAME_SIZE
     root: Path = field(default_factory=lambda: Path.cwd())
+    #: Lines printed under the table (and written to the JSON): what a module skipped and why.
+    notes: list[str] = field(default_factory=list)
     _renderer: Any = None
+
+    def note(self, text: str) -> None:
+        """Print ``text`` under the table, e.g. ``skipped: embreex not installed``."""
+        if text not in self.notes:
+            self.notes.append(text)
 
     @property
     def renderer(self) -> Any:
@@ -264,9 +271,12 @@ def run_all(json_path: Path | None = None, quick: bool = False, only: Sequence[s
              f"{env.size[1]}, {renderer}; ratio = subject / baseline (medians), spread min-max")
     print(title)
     print(format_table(results))
+    for text in env.notes:
+        print(text)
     if json_path is not None:
         data = {"title": title, "renderer": renderer, "rounds": rounds, "quick": quick,
-                "seconds": round(time.perf_counter() - started, 2), "cases": [r.to_dict() for r in results]}
+                "seconds": round(time.perf_counter() - started, 2), "cases": [r.to_dict() for r in results],
+                "notes": list(env.notes)}
         tmp = json_path.with_name(f".{json_path.name}.tmp")
         tmp.write_text(json.dumps(data, indent=2) + "\n", encoding="utf-8")
         tmp.replace(json_path)

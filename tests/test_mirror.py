@@ -17,7 +17,8 @@ from glsandbox import transforms
 from glsandbox.effects import Mirror, PlanarShadow, shadow_casters
 from glsandbox.errors import SandboxError
 from glsandbox.plan import plan
-from glsandbox.scene import Material, Scene
+from glsandbox.scene import Scene
+from glsandbox.zfighting import count_z_fighting, flat_receiver, shade_mask
 from lessons.mirror import MirrorLesson
 from lessons.phong import PhongLesson
 
@@ -244,39 +245,21 @@ def test_reflection_shows_inside_the_mirror_only(gl):
     assert leaked > 1000
 
 
-def unlit_floor(scene: Scene, drop: float = 0.0) -> Scene:
-    """The scene with a flat, unlit floor (0.8 grey), optionally lowered by ``drop``."""
-    nodes = tuple(replace(n, model=transforms.translate(0, -drop, 0) @ n.model,
-                          material=Material(color=(0.8, 0.8, 0.8, 1.0))) if n.name == "floor" else n
-                  for n in scene.nodes)
-    return replace(scene, nodes=nodes)
-
-
-def shade_mask(image: np.ndarray, level: int) -> np.ndarray:
-    return np.all(np.abs(image - level) <= 1, axis=-1)
-
-
 def test_stencil_darkens_each_shadow_pixel_once(gl):
     # Floor 204 (0.8); black at alpha 0.5 once: 102; twice: 51.
-    once = render(gl, unlit_floor(MirrorLesson(mirror="off").scene()))
-    twice = render(gl, unlit_floor(MirrorLesson(mirror="off", shadow="double_blend").scene()))
+    once = render(gl, flat_receiver(MirrorLesson(mirror="off").scene()))
+    twice = render(gl, flat_receiver(MirrorLesson(mirror="off", shadow="double_blend").scene()))
     assert shade_mask(once, 102).sum() > 500 and shade_mask(once, 51).sum() == 0
     assert shade_mask(twice, 51).sum() > 500
     assert np.array_equal(shade_mask(once, 102), shade_mask(twice, 51))
 
 
 def z_fighting_pixels(gl, **settings) -> tuple[int, int]:
-    """(shadow pixels, z-fighting pixels) for the lesson with an unlit floor.
-
-    The oracle is the same frame with the floor lowered by 0.25: the shadow
-    (projected onto the plane y = 0 whatever the floor node does) then floats
-    far above it and cannot fight, and its footprint is unchanged. Pixels
-    shadowed in the oracle but not in the frame lost the depth test to the floor.
-    """
-    scene = MirrorLesson(mirror="off", far=200.0, **settings).scene()
-    frame = shade_mask(render(gl, unlit_floor(scene)), 102)
-    oracle = shade_mask(render(gl, unlit_floor(scene, drop=0.25)), 102)
-    return int(oracle.sum()), int((oracle & ~frame).sum())
+    """(shadow pixels, z-fighting pixels) for the lesson with an unlit floor
+    (:func:`glsandbox.zfighting.count_z_fighting`: the oracle is the same frame
+    with the floor lowered by 0.25, where the shadow cannot fight)."""
+    counted = count_z_fighting(gl, MirrorLesson(mirror="off", far=200.0, **settings).scene(), SIZE)
+    return counted.shadow, counted.fighting
 
 
 FAR_VIEWS = {"room": dict(distance=10.5, fov=45.0), "30": dict(distance=30.0, fov=17.0),

@@ -114,7 +114,9 @@ def test_tradeoffs_writes_every_file(quick_report: Path) -> None:
 def test_tradeoffs_report_has_a_table_per_knob(quick_report: Path) -> None:
     report = (quick_report / "report.md").read_text(encoding="utf-8")
     header = "| setting | time median (ms) | spread min-max (ms) | RMSE | PSNR (dB) | FLIP | error map |"
-    assert report.count(header) == 4
+    assert report.count(header) == 5
+    assert report.count("| setting | time median (ms) | spread min-max (ms) | z-fighting px | share of shadow px | "
+                        "RMSE | PSNR (dB) | FLIP | error map |") == 1
     for title in ("## Anti-aliasing (`antialiasing`)", "## Lighting model (`lighting`)",
                   "## Texture filtering (`texture_filter`)"):
         assert title in report
@@ -123,7 +125,7 @@ def test_tradeoffs_report_has_a_table_per_knob(quick_report: Path) -> None:
     assert "## Ray tracer engine (`ray_engine`)" in report
     rows = _rows(quick_report)
     knobs = {row["knob"] for row in rows}
-    assert knobs == {"antialiasing", "lighting", "ray_engine", "texture_filter"}
+    assert knobs == {"antialiasing", "lighting", "ray_engine", "texture_filter", "depth", "shadows_mirror"}
     for knob in knobs:  # one reference per knob, at zero error
         refs = [r for r in rows if r["knob"] == knob and r["reference"] == "1"]
         assert len(refs) == 1 and float(refs[0]["rmse"]) == 0.0 and refs[0]["psnr_db"] == "inf"
@@ -149,6 +151,48 @@ def test_tradeoffs_errors_fall_where_they_must(quick_report: Path) -> None:
     assert "DOES NOT HOLD" not in report and report.count("(RMSE): holds") == 2
 
 
+def test_depth_knob_counts_z_fighting_pixels(quick_report: Path) -> None:
+    # Seen from 90 units (tests/test_mirror.py pins it): a 24-bit buffer with no polygon offset
+    # fights with or without the course's lift, and so does reverse-Z without any lift; each
+    # remedy alone (nearer plane, reverse-Z with the lift, polygon offset) has no fighting pixel.
+    rows = {r["setting"]: r for r in _rows(quick_report) if r["knob"] == "depth"}
+    reference = rows["default: reverse-Z float, lift 0.005, polygon offset"]
+    assert reference["reference"] == "1" and reference["count_px"] == "0"
+    shadow = int(reference["count_of_px"])
+    assert shadow > 50  # the shadow is in the frame
+    for label in ("standard 24-bit, lift 0, no offset", "standard 24-bit, lift 0.005, no offset",
+                  "reverse-Z float, lift 0, no offset"):
+        fighting = int(rows[label]["count_px"])
+        assert fighting > 0.15 * shadow, (label, fighting, shadow)
+        assert float(rows[label]["count_share"]) == pytest.approx(fighting / int(rows[label]["count_of_px"]))
+        assert float(rows[label]["rmse"]) > 0.0
+    for label in ("standard 24-bit, lift 0.005, near 0.1", "standard 24-bit, lift 0.005, polygon offset",
+                  "reverse-Z float, lift 0.005, no offset"):
+        assert rows[label]["count_px"] == "0", label
+    others = [r for r in _rows(quick_report) if r["knob"] != "depth"]
+    assert all(r["count_px"] == "" for r in others)  # only the depth knob counts pixels
+    report = (quick_report / "report.md").read_text(encoding="utf-8")
+    assert "## Depth precision (`depth`)" in report
+    fights = int(rows["standard 24-bit, lift 0, no offset"]["count_px"])
+    assert f"| standard 24-bit, lift 0, no offset | " in report and f" | {fights} | " in report
+    assert "| default: reverse-Z float, lift 0.005, polygon offset (reference) | " in report
+
+
+def test_shadows_mirror_knob_against_the_ray_tracer(quick_report: Path) -> None:
+    rows = {r["setting"]: r for r in _rows(quick_report) if r["knob"] == "shadows_mirror"}
+    reference = rows["ray tracer, numpy (float64)"]
+    assert reference["reference"] == "1" and float(reference["rmse"]) == 0.0 and reference["psnr_db"] == "inf"
+    raster = float(rows["raster: stencil mirror + planar shadow"]["rmse"])
+    assert 0.0 < raster < float(rows["raster: opaque glass, planar shadow"]["rmse"])  # the reflection is most of it
+    assert float(rows["raster: stencil mirror, no shadow"]["flip"]) > float(
+        rows["raster: stencil mirror + planar shadow"]["flip"])  # the planar shadow brings it closer
+    assert float(rows["ray tracer, gpu (GLSL, float32)"]["rmse"]) < 0.25 * raster  # float32 only
+    report = (quick_report / "report.md").read_text(encoding="utf-8")
+    assert "## Planar shadow and stencil mirror vs the ray tracer (`shadows_mirror`)" in report
+    assert "| ray tracer, numpy (float64) (reference) | " in report
+    assert "The two renderers model different things" in report  # the honest notes
+
+
 def test_tradeoffs_lists_what_is_not_measured_yet(quick_report: Path) -> None:
     from glsandbox.tradeoffs import PENDING, all_knobs
 
@@ -156,6 +200,8 @@ def test_tradeoffs_lists_what_is_not_measured_yet(quick_report: Path) -> None:
     measured = {k.name for k in all_knobs()}
     for name in PENDING:
         assert (f"- `{name}`:" in report) == (name not in measured)
+    assert "## Not measured yet" not in report  # every knob of the issue is measured now
+    assert {"depth", "shadows_mirror"} <= measured
 
 
 def test_tradeoffs_bad_runs_is_one_line() -> None:
@@ -186,3 +232,44 @@ def test_bench_prints_one_table_and_writes_json(tmp_path: Path) -> None:
 def test_bench_unknown_case_is_one_line() -> None:
     proc = _run("bench", "--quick", "--only", "no_such_benchmark")
     assert proc.returncode == 2 and proc.stderr.strip().endswith("error: no benchmark case matched")
+
+
+# --- the ray tracer's benchmark cases (benchmarks/raytrace.py) ------------------------------
+
+
+def _raytrace_module():
+    from glsandbox.bench import benchmarks_dir, load_modules
+
+    return next(m for m in load_modules(benchmarks_dir()) if m.__file__.endswith("raytrace.py"))
+
+
+def test_raytrace_cases_without_embree_say_so(gl, monkeypatch) -> None:
+    from glsandbox.bench import BenchEnv, measure
+
+    module = _raytrace_module()
+    monkeypatch.setattr(module, "embree_available", lambda: False)
+    env = BenchEnv(quick=True, size=(48, 36))
+    env._renderer = gl  # the session's context: never a second one in this process
+    found = module.cases(env)
+    assert env.notes == [module.EMBREE_MISSING] and "skipped: embreex not installed" in env.notes[0]
+    assert [c.group for c in found] == ["ray tracer engines"] * 2
+    assert [c.name for c in found] == ["phong, primary", "phong, shadow+bounce"]
+    results = measure(found, rounds=1)
+    for result in results:
+        assert result.ratio is not None and result.ratio > 0
+        assert result.same.endswith("rays each")
+    assert results[0].same == f"{48 * 36:,} rays each"  # primary: one ray per pixel
+
+
+def test_embree_casts_the_engines_rays() -> None:
+    pytest.importorskip("embreex")
+    module = _raytrace_module()
+    from glsandbox.lesson import find_lesson
+    from glsandbox.raytrace import RenderStats, render
+
+    scene = find_lesson("ray_phong")(renderer="raster").scene()
+    for mode, options in module.MODES.items():
+        stats = RenderStats()
+        render(scene, (40, 30), stats=stats, **options)
+        cast = module.EmbreeCaster(scene, (40, 30), options["shadows"], options["max_depth"]).cast()
+        assert abs(cast - stats.rays) <= 0.02 * stats.rays, mode  # spheres are meshes for Embree
