@@ -11,10 +11,22 @@
 //   u_tris   TRI_RECORDS per triangle: v0 | e1 | e2 | n0,uv0.x | n1,uv0.y |
 //            n2,uv1.x | c0,uv1.y | c1,uv2.x | c2,uv2.y   (world space)
 //   u_nodes  NODE_RECORDS per node: box min,kind | box max,cull |
-//            start,count,has_normals,has_colors | colour,mode | ka,kd,ks,n |
+//            start,count,scene order,0 | colour,mode | ka,kd,ks,n |
 //            reflectivity,texture,lamp bits | inverse model (3 rows) |
-//            normal matrix (3 rows)
-// Variants: NUM_LIGHTS (the light loop), NUM_TEXTURES (0..4 samplers).
+//            normal matrix (3 rows); mesh nodes first (u_mesh_count of
+//            them), then sphere nodes (u_sphere_count).
+// Variants: NUM_LIGHTS (the light loop), NUM_TEXTURES (0..4 samplers),
+// SHADOWS (shadow rays), REFLECT (reflection bounces), HAS_MESHES,
+// HAS_SPHERES.
+//
+// Why variants and two node loops: llvmpipe runs a fragment shader on 8
+// lanes with execution masks; an `if` whose lanes are all off still executes
+// (masked), and a loop runs its body at least once. Code a scene cannot
+// reach (shadow rays with shadows off, the sphere test in a scene without
+// spheres, the sphere test for a mesh node) is therefore compiled out or
+// kept out of the loops instead of branched around. Ties keep the course's
+// min_indis rule exactly: the first node in scene order, then the first
+// triangle, wins.
 
 #define TEX_WIDTH 1024
 #define TRI_RECORDS 9
@@ -31,14 +43,14 @@ void main() {
 #elif defined(FRAGMENT_SHADER)
 uniform sampler2D u_tris;
 uniform sampler2D u_nodes;
-uniform int u_node_count;
+uniform int u_mesh_count;    // mesh nodes: records 0 .. u_mesh_count-1
+uniform int u_sphere_count;  // sphere nodes: the next u_sphere_count records
 uniform vec2 u_size;        // the image in pixels
 uniform vec3 u_eye;         // camera position (world)
 uniform mat3 u_basis;       // view space -> world (right, up, back)
 uniform vec2 u_half;        // image plane half-size at distance 1: tan(fov/2)*aspect, tan(fov/2)
 uniform vec3 u_background;  // the viewport's clear colour
-uniform int u_max_depth;    // reflection bounces
-uniform bool u_shadows;
+uniform int u_max_depth;    // reflection bounces (REFLECT: > 0)
 uniform int u_cull;         // -1: per node (as the rasterizer), 0: never, 1: always
 uniform bool u_aabb;
 uniform float u_offset;     // relative offset of secondary-ray origins (SHADOW_OFFSET)
@@ -80,23 +92,22 @@ bool slab(vec3 o, vec3 inv_d, vec3 lo, vec3 hi, float best) {
 
 // Möller–Trumbore: O + t d = V0 + u e1 + v e2 by Cramer's rule.
 // det = e1·(d×e2) = −N·d is positive for a front face: backface culling
-// keeps only det > 0 (course "Hızlandırma: backface culling").
+// keeps only det > 0 (course "Hızlandırma: backface culling"). Branchless:
+// under llvmpipe's masks an early return saves nothing.
 float triangle_t(int k, vec3 o, vec3 d, bool cull) {
     vec3 v0 = tri_rec(k, 0).xyz;
     vec3 e1 = tri_rec(k, 1).xyz;
     vec3 e2 = tri_rec(k, 2).xyz;
     vec3 p = cross(d, e2);
     float det = dot(e1, p);
-    if (cull ? det <= 0.0 : det == 0.0) return INF;
     float inv_det = 1.0 / det;
     vec3 s = o - v0;
     float u = dot(s, p) * inv_det;
-    if (u < 0.0 || u > 1.0) return INF;
     vec3 q = cross(s, e1);
     float v = dot(d, q) * inv_det;
-    if (v < 0.0 || u + v > 1.0) return INF;
     float t = dot(e2, q) * inv_det;
-    return t > 0.0 ? t : INF;
+    bool ok = (cull ? det > 0.0 : det != 0.0) && u >= 0.0 && u <= 1.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0;
+    return ok ? t : INF;
 }
 
 // Işın-Küre kesim testi in the unit sphere's own space, the numerically
@@ -126,34 +137,82 @@ vec3 to_object(int k, vec3 p, float w) {
     return vec3(dot(node_rec(k, 6), h), dot(node_rec(k, 7), h), dot(node_rec(k, 8), h));
 }
 
-// The nearest hit with 0 < t < t_max (tDistances / min_indis). light >= 0:
-// a shadow query for that light, whose lamp is skipped.
-float nearest(vec3 o, vec3 d, float t_max, int light, out int hit_node, out int hit_tri) {
-    float best = t_max;
+bool node_cull(vec4 r1) { return u_cull < 0 ? r1.w > 0.5 : u_cull == 1; }
+
+// The nearest hit with t > 0 (tDistances / min_indis): mesh nodes, then
+// sphere nodes; an equal t goes to the node first in scene order (r2.z), and
+// within a node to the first triangle, as the course's loop over the scene.
+float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri) {
+    float best = INF;
+    float best_order = 1e9;
     hit_node = -1;
     hit_tri = -1;
     vec3 inv_d = 1.0 / d;
-    for (int k = 0; k < u_node_count; ++k) {
+#if HAS_MESHES
+    for (int k = 0; k < u_mesh_count; ++k) {
         vec4 r0 = node_rec(k, 0);
         vec4 r1 = node_rec(k, 1);
-        if (light >= 0 && ((int(node_rec(k, 5).z) >> light) & 1) != 0) continue;
         if (u_aabb && !slab(o, inv_d, r0.xyz, r1.xyz, best)) continue;
-        bool cull = u_cull < 0 ? r1.w > 0.5 : u_cull == 1;
-        if (r0.w > 0.5) {
-            float t = sphere_t(to_object(k, o, 1.0), to_object(k, d, 0.0), cull);
-            if (t < best) { best = t; hit_node = k; hit_tri = -1; }
-        } else {
-            vec4 r2 = node_rec(k, 2);
-            int start = int(r2.x);
-            int stop = start + int(r2.y);
-            for (int j = start; j < stop; ++j) {
-                float t = triangle_t(j, o, d, cull);
-                if (t < best) { best = t; hit_node = k; hit_tri = j; }
+        bool cull = node_cull(r1);
+        vec4 r2 = node_rec(k, 2);
+        int start = int(r2.x);
+        int stop = start + int(r2.y);
+        for (int j = start; j < stop; ++j) {
+            float t = triangle_t(j, o, d, cull);
+            if (t < best || (t == best && t < INF && r2.z < best_order)) {
+                best = t; best_order = r2.z; hit_node = k; hit_tri = j;
             }
         }
     }
+#endif
+#if HAS_SPHERES
+    for (int k = u_mesh_count; k < u_mesh_count + u_sphere_count; ++k) {
+        vec4 r0 = node_rec(k, 0);
+        vec4 r1 = node_rec(k, 1);
+        if (u_aabb && !slab(o, inv_d, r0.xyz, r1.xyz, best)) continue;
+        float t = sphere_t(to_object(k, o, 1.0), to_object(k, d, 0.0), node_cull(r1));
+        float order = node_rec(k, 2).z;
+        if (t < best || (t == best && t < INF && order < best_order)) {
+            best = t; best_order = order; hit_node = k; hit_tri = -1;
+        }
+    }
+#endif
     return best;
 }
+
+#if SHADOWS
+// The shadow query for light `light`: is anything hit with 0 < t < 1? Any
+// hit answers it, so the search stops at the first; the light's lamp is
+// skipped.
+bool occluded(vec3 o, vec3 d, int light) {
+    vec3 inv_d = 1.0 / d;
+#if HAS_MESHES
+    for (int k = 0; k < u_mesh_count; ++k) {
+        vec4 r0 = node_rec(k, 0);
+        vec4 r1 = node_rec(k, 1);
+        if (((int(node_rec(k, 5).z) >> light) & 1) != 0) continue;
+        if (u_aabb && !slab(o, inv_d, r0.xyz, r1.xyz, 1.0)) continue;
+        bool cull = node_cull(r1);
+        vec4 r2 = node_rec(k, 2);
+        int start = int(r2.x);
+        int stop = start + int(r2.y);
+        for (int j = start; j < stop; ++j) {
+            if (triangle_t(j, o, d, cull) < 1.0) return true;
+        }
+    }
+#endif
+#if HAS_SPHERES
+    for (int k = u_mesh_count; k < u_mesh_count + u_sphere_count; ++k) {
+        vec4 r0 = node_rec(k, 0);
+        vec4 r1 = node_rec(k, 1);
+        if (((int(node_rec(k, 5).z) >> light) & 1) != 0) continue;
+        if (u_aabb && !slab(o, inv_d, r0.xyz, r1.xyz, 1.0)) continue;
+        if (sphere_t(to_object(k, o, 1.0), to_object(k, d, 0.0), node_cull(r1)) < 1.0) return true;
+    }
+#endif
+    return false;
+}
+#endif
 
 #if NUM_TEXTURES > 0
 int wrap_index(int i, int size, int mode) {
@@ -212,13 +271,20 @@ void surface(int k, int j, float t, vec3 o, vec3 d, out vec3 p, out vec3 n, out 
     p = o + t * d;
     vec2 uv = vec2(0.0);
     vec3 colors = vec3(1.0);
-    if (node_rec(k, 0).w > 0.5) {
+#if HAS_SPHERES && HAS_MESHES
+    if (j < 0) {
+#endif
+#if HAS_SPHERES
         vec3 q = normalize(to_object(k, p, 1.0));  // the hit on the unit sphere
         n = vec3(dot(node_rec(k, 9).xyz, q), dot(node_rec(k, 10).xyz, q), dot(node_rec(k, 11).xyz, q));
         const float PI = 3.14159265358979;
         float phi = atan(q.x, q.z);
         uv = vec2((phi < 0.0 ? phi + 2.0 * PI : phi) / (2.0 * PI), acos(clamp(q.y, -1.0, 1.0)) / PI);
+#endif
+#if HAS_SPHERES && HAS_MESHES
     } else {
+#endif
+#if HAS_MESHES
         // Barycentric (u, v) of the hit: t(u,v) = V0 + u(V1−V0) + v(V2−V0).
         vec3 v0 = tri_rec(j, 0).xyz, e1 = tri_rec(j, 1).xyz, e2 = tri_rec(j, 2).xyz;
         vec3 pp = cross(d, e2);
@@ -232,7 +298,10 @@ void surface(int k, int j, float t, vec3 o, vec3 d, out vec3 p, out vec3 n, out 
         n = w.x * a.xyz + w.y * b.xyz + w.z * c.xyz;
         uv = w.x * vec2(a.w, b.w) + w.y * vec2(c.w, ca.w) + w.z * vec2(cb.w, cc.w);
         colors = w.x * ca.xyz + w.y * cb.xyz + w.z * cc.xyz;
+#endif
+#if HAS_SPHERES && HAS_MESHES
     }
+#endif
     n = normalize(n);
     vec4 m = node_rec(k, 3);
     base = m.rgb;
@@ -274,12 +343,10 @@ vec3 shade(int k, vec3 p, vec3 n, vec3 mesh, vec3 d) {
         }
         vec3 specular = highlight * u_light_color[i];
         float visible = 1.0;
-        if (u_shadows) {
-            vec3 start = offset_point(p, n, u_light_pos[i] - p);
-            int occluder, tri;
-            nearest(start, u_light_pos[i] - start, 1.0, i, occluder, tri);
-            if (occluder >= 0) visible = 0.0;
-        }
+#if SHADOWS
+        vec3 start = offset_point(p, n, u_light_pos[i] - p);
+        if (occluded(start, u_light_pos[i] - start, i)) visible = 0.0;
+#endif
         color += min(coef.x * mesh + visible * (coef.y * diffuse + coef.z * specular), vec3(1.0));
     }
 #endif
@@ -291,10 +358,11 @@ void main() {
     vec3 o = u_eye;
     vec3 d = u_basis * vec3(ndc * u_half, -1.0);
     vec3 color = vec3(0.0);
+#if REFLECT
     float weight = 1.0;
     for (int depth = 0; depth <= u_max_depth; ++depth) {
         int k, j;
-        float t = nearest(o, d, INF, -1, k, j);
+        float t = nearest(o, d, k, j);
         if (k < 0) {
             color += weight * u_background;
             break;
@@ -310,6 +378,17 @@ void main() {
         d = reflected;
         weight *= r;
     }
+#else
+    int k, j;
+    float t = nearest(o, d, k, j);
+    if (k < 0) {
+        color = u_background;
+    } else {
+        vec3 p, n, base;
+        surface(k, j, t, o, d, p, n, base);
+        color = shade(k, p, n, base, d);
+    }
+#endif
     frag_color = vec4(clamp(color, 0.0, 1.0), 1.0);
 }
 #endif
