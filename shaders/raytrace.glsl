@@ -318,6 +318,8 @@ vec3 offset_point(vec3 p, vec3 n, vec3 towards) {
     return p + (dot(n, towards) < 0.0 ? -scale : scale) * n;
 }
 
+#include "common/course_light.glsl"
+
 // The rasterizer's per-light Phong (common/lighting.glsl), with shadow rays.
 vec3 shade(int k, vec3 p, vec3 n, vec3 mesh, vec3 d) {
     int mode = int(node_rec(k, 3).w);
@@ -327,21 +329,9 @@ vec3 shade(int k, vec3 p, vec3 n, vec3 mesh, vec3 d) {
     vec4 coef = node_rec(k, 4);
     vec3 to_eye = -normalize(d);
     for (int i = 0; i < NUM_LIGHTS; ++i) {
-        vec3 to_light = normalize(u_light_pos[i] - p);
-        float n_dot_l = dot(n, to_light);
-        vec3 diffuse = max(n_dot_l, 0.0) * mesh * u_light_color[i];
-        float highlight = 0.0;
-        if (n_dot_l > 0.0) {
-            float cosine;
-            if (mode == 3) {
-                cosine = dot(n, normalize(to_light + to_eye));
-            } else {
-                vec3 reflected = -to_light + 2.0 * n_dot_l * n;
-                cosine = dot(to_eye, reflected);
-            }
-            highlight = pow(max(cosine, 0.0), coef.w);
-        }
-        vec3 specular = highlight * u_light_color[i];
+        vec3 diffuse, specular;
+        course_light(n, normalize(u_light_pos[i] - p), to_eye, mesh, u_light_color[i], coef.w, mode == 3,
+                     diffuse, specular);
         float visible = 1.0;
 #if SHADOWS
         vec3 start = offset_point(p, n, u_light_pos[i] - p);

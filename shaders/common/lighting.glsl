@@ -25,26 +25,21 @@ uniform vec3 u_light_pos[NUM_LIGHTS];    // vLightPos[]
 uniform vec3 u_light_color[NUM_LIGHTS];  // vLightColor[]
 #endif
 
+#include "common/course_light.glsl"
+
 vec3 shade(vec3 position, vec3 normal, vec3 mesh) {
     vec3 color = vec3(0.0);
 #if NUM_LIGHTS > 0
     vec3 to_eye = normalize(u_eye - position);
-    for (int i = 0; i < NUM_LIGHTS; ++i) {
-        vec3 to_light = normalize(u_light_pos[i] - position);
-        float n_dot_l = dot(normal, to_light);
-        vec3 diffuse = max(n_dot_l, 0.0) * mesh * u_light_color[i];
-        float highlight = 0.0;
-        if (n_dot_l > 0.0) {
 #ifdef BLINN
-            vec3 halfway = normalize(to_light + to_eye);
-            highlight = pow(max(dot(normal, halfway), 0.0), u_shininess);
+    const bool blinn = true;
 #else
-            vec3 from_light = -to_light;
-            vec3 reflected = from_light - 2.0 * dot(from_light, normal) * normal;
-            highlight = pow(max(dot(to_eye, reflected), 0.0), u_shininess);
+    const bool blinn = false;
 #endif
-        }
-        vec3 specular = highlight * u_light_color[i];
+    for (int i = 0; i < NUM_LIGHTS; ++i) {
+        vec3 diffuse, specular;
+        course_light(normal, normalize(u_light_pos[i] - position), to_eye, mesh, u_light_color[i], u_shininess,
+                     blinn, diffuse, specular);
         color += min(u_ambient * mesh + u_diffuse * diffuse + u_specular * specular, vec3(1.0));
     }
 #endif
