@@ -5,12 +5,7 @@
 // each fragment fetches exactly one texel, so text is never resampled.
 
 #if defined(VERTEX_SHADER)
-void main() {
-    // A triangle strip over the whole viewport from the vertex number alone:
-    // 0 -> (-1,-1), 1 -> (1,-1), 2 -> (-1,1), 3 -> (1,1).
-    vec2 corner = vec2(float(gl_VertexID & 1), float(gl_VertexID >> 1));
-    gl_Position = vec4(corner * 2.0 - 1.0, 0.0, 1.0);
-}
+#include "common/fullscreen_vertex.glsl"
 
 #elif defined(FRAGMENT_SHADER)
 uniform sampler2D u_image;
