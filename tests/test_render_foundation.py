@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import need
 
 from glsandbox.lesson import find_lesson
 from glsandbox.plan import Buffers
@@ -107,7 +108,8 @@ def test_a_second_renderer_in_the_process_leaves_the_first_intact(gl) -> None:
     lesson = find_lesson("indexed_cube")(time=0.5)
     before = np.array(gl.render(lesson, (64, 64)).image)
     if gl.host.backend != "egl":
-        pytest.skip("two contexts of one backend are checked on EGL; OSMesa and EGL must not be mixed")
+        need("EGL", f"the session renderer runs on {gl.host.backend}; two contexts of one backend "
+                    "are checked on EGL (OSMesa and EGL must not be mixed in one process)")
     other = HeadlessRenderer("egl")  # opening it makes it current
     try:
         np.testing.assert_array_equal(np.array(other.render(lesson, (64, 64)).image), before)
