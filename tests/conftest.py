@@ -123,8 +123,12 @@ def xvfb_display():
 
     if shutil.which("Xvfb") is None:
         need("Xvfb", "the Xvfb binary is not installed (apt-get install xvfb)")
+    # -noreset: by default Xvfb resets itself when its last client disconnects,
+    # and a window opened during that reset fails with "Failed to open display"
+    # (CI saw this between two window tests).
     read_fd, write_fd = os.pipe()
-    proc = subprocess.Popen(["Xvfb", "-displayfd", str(write_fd), "-screen", "0", "800x600x24", "-nolisten", "tcp"],
+    proc = subprocess.Popen(["Xvfb", "-displayfd", str(write_fd), "-screen", "0", "800x600x24", "-nolisten", "tcp",
+                             "-noreset"],
                             pass_fds=(write_fd,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     os.close(write_fd)
     with os.fdopen(read_fd) as pipe:

@@ -38,7 +38,8 @@ class LessonWindow:
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
             if self.proc.poll() is not None:
-                raise AssertionError(f"lesson exited early: {self.proc.stderr.read()}")
+                raise AssertionError(f"lesson exited early with code {self.proc.returncode}: "
+                                     f"{self.proc.stdout.read()} {self.proc.stderr.read()}")
             value = probe()
             if value:
                 return value
@@ -61,7 +62,12 @@ class LessonWindow:
         return np.asarray(ImageGrab.grab(xdisplay=self.display).convert("RGB"))
 
     def close(self) -> int:
-        self.key("Escape")
+        # Escape through XTEST to the focused window, not XSendEvent to our
+        # window: the lesson destroys its window on the press, the release
+        # sent to that window then fails, and xdotool leaves Escape held in
+        # the server, where autorepeat closes the next test's window.
+        self._xdotool("windowfocus", "--sync", self.window)
+        self._xdotool("key", "Escape")
         try:
             return self.proc.wait(timeout=20)
         finally:
