@@ -173,8 +173,13 @@ def plane(size: float = 1.0) -> Mesh:
                 np.tile([0.0, 1.0, 0.0], (4, 1)), np.array([(0, 1), (1, 1), (1, 0), (0, 0)], dtype=np.float64))
 
 
+@functools.cache
 def sphere(stacks: int = 24, slices: int = 48) -> Mesh:
     """A unit sphere (UV sphere) with outward normals and uv.
+
+    Built once per (stacks, slices), like the other built-in meshes: a lesson
+    rebuilding its scene every frame gets the same Mesh object back, so the
+    executor's upload (keyed per mesh object) is found instead of re-hashed.
 
     Vertex (i, j) sits at polar angle ``pi*i/stacks`` from +y and azimuth
     ``2*pi*j/slices``; on a unit sphere the normal equals the position. The
