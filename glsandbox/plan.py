@@ -9,7 +9,8 @@ buffers the plan lists.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+import functools
 import weakref
 from typing import Any
 
@@ -27,13 +28,12 @@ class ProgramVariant:
 
     shader: str
     defines: tuple[tuple[str, str], ...] = ()
+    #: ``shader[DEFINE,NAME=value]``: names the compiled program in plans and caches.
+    key: str = field(init=False, compare=False, repr=False)
 
-    @property
-    def key(self) -> str:
-        if not self.defines:
-            return self.shader
+    def __post_init__(self) -> None:
         flags = ",".join(name if value == "" else f"{name}={value}" for name, value in self.defines)
-        return f"{self.shader}[{flags}]"
+        object.__setattr__(self, "key", f"{self.shader}[{flags}]" if self.defines else self.shader)
 
 
 @dataclass(frozen=True)
@@ -136,14 +136,21 @@ def program_for(node: Node, lights: int = 0) -> ProgramVariant:
     """The shader variant a node needs: ``basic`` with its colour source, or
     ``phong`` (:func:`lit_program_for`) when its material is lit; ``TEXTURED``
     only when it has a texture. ``lights`` is the number of lights in the scene."""
-    if node.material.lit:
+    material = node.material
+    if material.lit:
         return lit_program_for(node, lights)
-    source = "VERTEX_COLOR" if node.material.shading == "vertex_color" else "SOLID_COLOR"
-    return ProgramVariant("basic", ((source, ""), *_texture_defines(node)))
+    return _basic_variant(material.shading == "vertex_color", material.texture is not None)
 
 
-def _texture_defines(node: Node) -> tuple[tuple[str, str], ...]:
-    return (("TEXTURED", ""),) if node.material.texture is not None else ()
+def _texture_defines(textured: bool) -> tuple[tuple[str, str], ...]:
+    return (("TEXTURED", ""),) if textured else ()
+
+
+# One ProgramVariant object per combination: planning runs every frame.
+@functools.cache
+def _basic_variant(vertex_color: bool, textured: bool) -> ProgramVariant:
+    source = "VERTEX_COLOR" if vertex_color else "SOLID_COLOR"
+    return ProgramVariant("basic", ((source, ""), *_texture_defines(textured)))
 
 
 def lit_program_for(node: Node, lights: int) -> ProgramVariant:
@@ -155,14 +162,19 @@ def lit_program_for(node: Node, lights: int) -> ProgramVariant:
     the course's ``mul(Input.Norm, world)`` instead of the normal matrix.
     """
     material = node.material
+    return _lit_variant(lights, material.shading, material.normals, material.texture is not None)
+
+
+@functools.cache
+def _lit_variant(lights: int, shading: str, normals: str, textured: bool) -> ProgramVariant:
     defines: list[tuple[str, str]] = [("NUM_LIGHTS", str(lights))]
-    if material.shading == "gouraud":
+    if shading == "gouraud":
         defines.append(("PER_VERTEX", ""))
-    if material.shading == "blinn_phong":
+    if shading == "blinn_phong":
         defines.append(("BLINN", ""))
-    if material.normals == "naive":
+    if normals == "naive":
         defines.append(("NAIVE_NORMALS", ""))
-    defines.extend(_texture_defines(node))
+    defines.extend(_texture_defines(textured))
     return ProgramVariant("phong", tuple(defines))
 
 

@@ -264,7 +264,7 @@ def from_directx_mesh(positions: np.ndarray, indices: np.ndarray) -> tuple[np.nd
 
 def gl_bytes(m: np.ndarray) -> bytes:
     """Bytes for a GLSL ``mat3``/``mat4`` uniform: float32, column-major."""
-    return np.ascontiguousarray(np.asarray(m, dtype=np.float32).T).tobytes()
+    return np.asarray(m, dtype=np.float32).tobytes(order="F")
 
 
 # --- planes, mirrors, planar shadows, reverse-Z (course section "The stencil Test") ---

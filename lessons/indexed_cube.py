@@ -17,6 +17,8 @@ too).
 
 from __future__ import annotations
 
+import functools
+import math
 import sys
 
 import numpy as np
@@ -30,6 +32,7 @@ from glsandbox.scene import Camera, Material, Node, Scene
 FACE_TRIANGLES = {"top": (0, 1), "front": (2, 3)}
 
 
+@functools.cache  # one Mesh per face: rebuilt scenes reuse its upload
 def cube_with_flipped_face(face: str) -> geometry.Mesh:
     """The course cube with one face's two triangles wound the other way."""
     mesh = geometry.cube()
@@ -44,6 +47,8 @@ def cube_with_flipped_face(face: str) -> geometry.Mesh:
 #: The course's camera: eye (0, 3, -10) in DirectX, looking at the origin,
 #: 45° field of view, near 0.01, far 100.
 COURSE_CAMERA = Camera(eye=tuple(transforms.from_directx_point((0.0, 3.0, -10.0))), fov_y=45.0, near=0.01, far=100.0)
+#: Tutorial 04's colours: each corner's own, interpolated across the faces.
+VERTEX_COLORS = Material(shading="vertex_color")
 
 
 @register
@@ -61,12 +66,12 @@ class IndexedCube(Lesson):
 
     def build(self) -> Scene:
         angle = float(self.values["speed"]) * self.time
+        c, s = math.cos(angle), math.sin(angle)
         # DirectX's XMMatrixRotationY(angle), converted by the z mirror.
-        dx_rotation = np.array([[np.cos(angle), 0, -np.sin(angle), 0], [0, 1, 0, 0],
-                                [np.sin(angle), 0, np.cos(angle), 0], [0, 0, 0, 1]])
+        dx_rotation = np.array([[c, 0.0, -s, 0.0], [0.0, 1.0, 0.0, 0.0], [s, 0.0, c, 0.0], [0.0, 0.0, 0.0, 1.0]])
         model = transforms.from_directx_matrix(dx_rotation)
-        node = Node("cube", cube_with_flipped_face(self.values["flip"]), model,
-                    Material(shading="vertex_color"), cull_back_faces=bool(self.values["cull"]))
+        node = Node("cube", cube_with_flipped_face(self.values["flip"]), model, VERTEX_COLORS,
+                    cull_back_faces=bool(self.values["cull"]))
         return Scene(self.name, nodes=(node,), camera=COURSE_CAMERA)
 
 

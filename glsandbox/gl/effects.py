@@ -26,7 +26,7 @@ from glsandbox.plan import MIRROR_STENCIL_BIT, SHADOW_STENCIL_BIT, Pass
 from glsandbox.scene import Light, Node, Scene
 
 if TYPE_CHECKING:
-    from glsandbox.gl.executor import Executor
+    from glsandbox.gl.executor import Executor, PassCamera
 
 GL_INVERT = 0x150A
 
@@ -63,12 +63,12 @@ def end_depth_mode(executor: Executor, scene: Scene) -> None:
 
 
 def run_effect_pass(executor: Executor, scene: Scene, step: Pass, nodes: dict[str, Node],
-                    view: np.ndarray, proj: np.ndarray) -> None:
+                    camera: PassCamera) -> None:
     """Run one ``mark_mirror``, ``reflection``, ``mirror_surface`` or ``shadow`` pass."""
     runners = {"mark_mirror": _mark_mirror, "reflection": _reflection,
                "mirror_surface": _mirror_surface, "shadow": _shadow}
     try:
-        runners[step.kind](executor, scene, step, nodes, view, proj)
+        runners[step.kind](executor, scene, step, nodes, camera)
     finally:
         restore_state(executor, scene)
 
@@ -92,7 +92,7 @@ def restore_state(executor: Executor, scene: Scene) -> None:
 
 
 def _mark_mirror(executor: Executor, scene: Scene, step: Pass, nodes: dict[str, Node],
-                 view: np.ndarray, proj: np.ndarray) -> None:
+                 camera: PassCamera) -> None:
     """``MarkMirrorDSS``: the glass's visible pixels get the mirror bit.
 
     The stencil test always passes; where the depth test passes too (nothing
@@ -107,7 +107,7 @@ def _mark_mirror(executor: Executor, scene: Scene, step: Pass, nodes: dict[str, 
     raw.glColorMask(0, 0, 0, 0)
     raw.glDepthMask(0)
     for draw in step.draws:
-        executor._draw(nodes[draw.node], draw, view, proj)
+        executor._draw(nodes[draw.node], draw, camera)
 
 
 def reflected_lights(lights: tuple[Light, ...], reflection: np.ndarray) -> tuple[Light, ...]:
@@ -119,7 +119,7 @@ def reflected_lights(lights: tuple[Light, ...], reflection: np.ndarray) -> tuple
 
 
 def _reflection(executor: Executor, scene: Scene, step: Pass, nodes: dict[str, Node],
-                view: np.ndarray, proj: np.ndarray) -> None:
+                camera: PassCamera) -> None:
     """``DrawReflectionDSS``: the reflected nodes, only where the mirror bit is set.
 
     Each node is drawn with ``R @ model``. R has determinant -1, so a triangle
@@ -139,21 +139,21 @@ def _reflection(executor: Executor, scene: Scene, step: Pass, nodes: dict[str, N
     executor._lights = reflected_lights(scene.lights, reflection)
     for draw in step.draws:
         node = nodes[draw.node]
-        executor._draw(node, draw, view, proj, model=reflection @ node.model, front_face="cw")
+        executor._draw(node, draw, camera, model=reflection @ node.model, front_face="cw")
 
 
 def _mirror_surface(executor: Executor, scene: Scene, step: Pass, nodes: dict[str, Node],
-                    view: np.ndarray, proj: np.ndarray) -> None:
+                    camera: PassCamera) -> None:
     """The glass over its reflection, blended by its colour's alpha."""
     ctx = executor.ctx
     ctx.enable(moderngl.BLEND)
     ctx.blend_func = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA)
     for draw in step.draws:
-        executor._draw(nodes[draw.node], draw, view, proj)
+        executor._draw(nodes[draw.node], draw, camera)
 
 
 def _shadow(executor: Executor, scene: Scene, step: Pass, nodes: dict[str, Node],
-            view: np.ndarray, proj: np.ndarray) -> None:
+            camera: PassCamera) -> None:
     """The casters flattened by the lifted shadow matrix, dark and blended.
 
     Depth test on (the shadow must hide behind what stands in front of the
@@ -181,13 +181,12 @@ def _shadow(executor: Executor, scene: Scene, step: Pass, nodes: dict[str, Node]
     ctx.disable(moderngl.CULL_FACE)
     flatten = shadow.matrix()
     color = np.asarray(shadow.color, dtype="f4").tobytes()
-    view_bytes, proj_bytes = transforms.gl_bytes(view), transforms.gl_bytes(proj)
     for draw in step.draws:
         node = nodes[draw.node]
         program = executor._programs[draw.program][1]
         vao, gpu = executor._vao(node.mesh, draw.program)
         program["m_model"].write(transforms.gl_bytes(flatten @ node.model))
-        program["m_view"].write(view_bytes)
-        program["m_proj"].write(proj_bytes)
+        program["m_view"].write(camera.view_bytes)
+        program["m_proj"].write(camera.proj_bytes)
         program["u_color"].write(color)
         vao.render(gpu.mode, vertices=gpu.count)

@@ -11,6 +11,7 @@ import hashlib
 import weakref
 from collections.abc import Collection
 from dataclasses import dataclass
+from functools import cached_property
 
 import moderngl
 import numpy as np
@@ -56,6 +57,39 @@ def _digest(mesh: Mesh) -> tuple[str, str]:
         digest.update(np.ascontiguousarray(mesh.indices).tobytes())
     digest.update(mesh.mode.encode())
     return mesh.name, digest.hexdigest()
+
+
+@dataclass(frozen=True)
+class PassCamera:
+    """A pass's view and projection, with what the draws need from them made
+    once per pass instead of once per draw: the uniform bytes and the eye."""
+
+    view: np.ndarray
+    proj: np.ndarray
+
+    @cached_property
+    def view_bytes(self) -> bytes:
+        return transforms.gl_bytes(self.view)
+
+    @cached_property
+    def proj_bytes(self) -> bytes:
+        return transforms.gl_bytes(self.proj)
+
+    @cached_property
+    def eye(self) -> np.ndarray:
+        return eye_position(self.view)
+
+
+#: Uniform bytes of material colours: a lesson rebuilding its scene each frame
+#: makes new Materials with the same few colours.
+_COLOR_BYTES: dict[tuple[float, ...], bytes] = {}
+
+
+def _color_bytes(color: tuple[float, ...]) -> bytes:
+    data = _COLOR_BYTES.get(color)
+    if data is None:
+        data = _COLOR_BYTES[color] = np.asarray(color, dtype="f4").tobytes()
+    return data
 
 
 @dataclass
@@ -156,14 +190,14 @@ class Executor:
             else:
                 camera = viewport.camera or scene.camera
                 aspect = rect[2] / rect[3] if rect[3] else 1.0
-                view, proj = camera.view(), gl_effects.projection_for(scene, camera.projection(aspect))
+                pass_camera = PassCamera(camera.view(), gl_effects.projection_for(scene, camera.projection(aspect)))
                 framebuffer.viewport = rect
                 self._set_depth(step.depth_test)
                 if step.kind in EFFECT_PASS_KINDS:  # the stencil mirror and the planar shadow
-                    gl_effects.run_effect_pass(self, scene, step, nodes, view, proj)
+                    gl_effects.run_effect_pass(self, scene, step, nodes, pass_camera)
                     continue
                 for draw in step.draws:
-                    self._draw(nodes[draw.node], draw, view, proj)
+                    self._draw(nodes[draw.node], draw, pass_camera)
         gl_effects.end_depth_mode(self, scene)
         framebuffer.viewport = (0, 0, *size)
         self._set_depth(False)
@@ -192,7 +226,7 @@ class Executor:
             names = self._member_names[program_key] = frozenset(self._programs[program_key][1])
         return names
 
-    def _draw(self, node: Node, draw: Draw, view: np.ndarray, proj: np.ndarray,
+    def _draw(self, node: Node, draw: Draw, camera: PassCamera,
               model: np.ndarray | None = None, front_face: str = "ccw") -> None:
         """Draw one node. ``model`` replaces its model matrix and ``front_face``
         the winding rule (a mirror's reflected pass: ``R @ model``, ``"cw"``)."""
@@ -208,9 +242,9 @@ class Executor:
         members = self._members(draw.program)
         uniforms = {
             "m_model": transforms.gl_bytes(model),
-            "m_view": transforms.gl_bytes(view),
-            "m_proj": transforms.gl_bytes(proj),
-            "u_color": np.asarray(node.material.color, dtype="f4").tobytes(),
+            "m_view": camera.view_bytes,
+            "m_proj": camera.proj_bytes,
+            "u_color": _color_bytes(node.material.color),
         }
         if "m_normal" in members:
             uniforms["m_normal"] = transforms.gl_bytes(transforms.normal_matrix(model))
@@ -218,7 +252,7 @@ class Executor:
             if name in members:
                 program[name].write(data)
         if node.material.lit:
-            write_light_uniforms(program, self._lights, view, members)
+            write_light_uniforms(program, self._lights, camera.eye, members)
             write_material_uniforms(program, node.material, members)
         texture = node.material.texture
         if texture is not None:
@@ -266,16 +300,17 @@ def eye_position(view: np.ndarray) -> np.ndarray:
     return np.linalg.inv(np.asarray(view, dtype=np.float64))[:3, 3]
 
 
-def write_light_uniforms(program: moderngl.Program, lights: tuple[Light, ...], view: np.ndarray,
+def write_light_uniforms(program: moderngl.Program, lights: tuple[Light, ...], eye: np.ndarray,
                          members: Collection[str]) -> None:
     """The course's ``vLightPos[]``, ``vLightColor[]`` and ``vEyePos``, in world space.
 
     The shader's arrays are sized by its ``NUM_LIGHTS`` define, which the plan
-    set to ``len(lights)``; with no lights they do not exist. ``members`` are
-    the program's uniform names (see :meth:`Executor._members`).
+    set to ``len(lights)``; with no lights they do not exist. ``eye`` is
+    :func:`eye_position` of the view; ``members`` are the program's uniform
+    names (see :meth:`Executor._members`).
     """
     if "u_eye" in members:
-        program["u_eye"].write(eye_position(view).astype("f4").tobytes())
+        program["u_eye"].write(eye.astype("f4").tobytes())
     if lights and "u_light_pos" in members:
         program["u_light_pos"].write(np.array([l.position for l in lights], dtype="f4").tobytes())
     if lights and "u_light_color" in members:
