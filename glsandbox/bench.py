@@ -252,8 +252,12 @@ def run_all(json_path: Path | None = None, quick: bool = False, only: Sequence[s
     try:
         cases: list[Case] = []
         for module in load_modules(folder):
+            noted = len(env.notes)
             found = module.cases(env)
-            cases += [c for c in found if not only or any(o in f"{c.group}: {c.name}" for o in only)]
+            matched = [c for c in found if not only or any(o in f"{c.group}: {c.name}" for o in only)]
+            if not matched:  # a module left out by --only: its notes (what it skipped) do not apply
+                del env.notes[noted:]
+            cases += matched
             log(f"bench: {Path(module.__file__ or '').name}: {len(found)} cases")
         if not cases:
             raise SandboxError("no benchmark case matched")
