@@ -11,7 +11,6 @@ import hashlib
 import weakref
 from collections.abc import Collection
 from dataclasses import dataclass
-from functools import cached_property
 
 import moderngl
 import numpy as np
@@ -59,25 +58,23 @@ def _digest(mesh: Mesh) -> tuple[str, str]:
     return mesh.name, digest.hexdigest()
 
 
-@dataclass(frozen=True)
 class PassCamera:
     """A pass's view and projection, with what the draws need from them made
-    once per pass instead of once per draw: the uniform bytes and the eye."""
+    once per pass instead of once per draw: the uniform bytes, and the eye
+    (only lit draws ask for it)."""
 
-    view: np.ndarray
-    proj: np.ndarray
+    __slots__ = ("view", "proj", "view_bytes", "proj_bytes", "_eye")
 
-    @cached_property
-    def view_bytes(self) -> bytes:
-        return transforms.gl_bytes(self.view)
+    def __init__(self, view: np.ndarray, proj: np.ndarray) -> None:
+        self.view, self.proj = view, proj
+        self.view_bytes, self.proj_bytes = transforms.gl_bytes(view), transforms.gl_bytes(proj)
+        self._eye: np.ndarray | None = None
 
-    @cached_property
-    def proj_bytes(self) -> bytes:
-        return transforms.gl_bytes(self.proj)
-
-    @cached_property
+    @property
     def eye(self) -> np.ndarray:
-        return eye_position(self.view)
+        if self._eye is None:
+            self._eye = eye_position(self.view)
+        return self._eye
 
 
 #: Uniform bytes of material colours: a lesson rebuilding its scene each frame
