@@ -203,9 +203,12 @@ def _needs_depth(scene: Scene) -> bool:
     if not scene.depth_test:
         return False
     for index in range(len(scene.viewports)):
-        shown = [n for n in scene.nodes if n.viewports is None or index in n.viewports]
-        if len(shown) > 1 or any(not _is_flat(n) for n in shown):
-            return True
+        shown = 0
+        for node in scene.nodes:
+            if node.viewports is None or index in node.viewports:
+                shown += 1
+                if shown > 1 or not _is_flat(node):
+                    return True
     return False
 
 
@@ -270,6 +273,8 @@ def overlay_passes(scene: Scene) -> list[Pass]:
     viewport is the region they are clipped to (-1: the whole frame). A scene
     without overlays gets no pass and no overlay program.
     """
+    if not scene.overlays:
+        return []
     regions: dict[int, list[Draw]] = {}
     for overlay in scene.overlays:
         region = -1 if overlay.viewport is None else overlay.viewport
@@ -327,6 +332,8 @@ def effect_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
     cube's front and back faces both cover the shadow). With the stencil each
     pixel is darkened once: test "shadow bit clear", then set it.
     """
+    if not _has_effects(scene):
+        return []
     nodes = {node.name: node for node in scene.nodes}
     passes: list[Pass] = []
     mirror = scene.mirror
