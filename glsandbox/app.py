@@ -1,8 +1,10 @@
 """Running lessons: headless renders, and the interactive window loop.
 
-Headless: :class:`HeadlessRenderer` keeps one context and renders any number
-of lessons into offscreen targets. Window: :func:`run_window` is the course's
-render loop (clear, draw, swap), with ESC to quit, F12 for a screenshot, R to
+Both draw through a :class:`FrameRenderer`: the plan's offscreen target, with
+exactly the depth, stencil and MSAA the plan lists. Headless:
+:class:`HeadlessRenderer` opens a context and reads the frames back. Window:
+:func:`run_window` is the course's render loop (clear, draw, swap), copying
+each frame onto the window, with ESC to quit, F12 for a screenshot, R to
 reload shaders, the frame rate in the title, and resizing.
 """
 
@@ -50,32 +52,42 @@ def with_samples(scene: Scene, samples: int) -> Scene:
     return replace(scene, samples=samples) if samples != scene.samples else scene
 
 
-class HeadlessRenderer:
-    """Renders lessons offscreen on one context, reusing programs and targets."""
+class FrameRenderer:
+    """Draws scenes into offscreen targets on one context, reusing programs and targets.
 
-    def __init__(self, backend: str | None = None) -> None:
-        self.host: GLHost = open_context(backend)
-        self.executor = Executor(self.host)
+    Every frame goes into a target made for its plan, so a frame has the
+    buffers its plan lists whether it ends up read back (headless) or copied
+    onto a window, whose own framebuffer has fixed ones (24-bit integer
+    depth, no float depth for reverse-Z).
+    """
+
+    #: Targets kept for reuse; a window being resized makes one per size.
+    KEEP_TARGETS = 8
+
+    def __init__(self, host: GLHost) -> None:
+        self.host = host
+        self.executor = Executor(host)
         self._targets: dict[tuple[tuple[int, int], Buffers], OffscreenTarget] = {}
 
     def target(self, size: tuple[int, int], buffers: Buffers) -> OffscreenTarget:
         key = (size, buffers)
-        if key not in self._targets:
-            self._targets[key] = OffscreenTarget(self.host, size, buffers)
-        return self._targets[key]
+        target = self._targets.get(key)
+        if target is None:
+            if len(self._targets) >= self.KEEP_TARGETS:  # drop the oldest
+                self._targets.pop(next(iter(self._targets))).release()
+            target = self._targets[key] = OffscreenTarget(self.host, size, buffers)
+        return target
 
-    def render_scene(self, scene: Scene, size: tuple[int, int]) -> Frame:
-        start = _time.perf_counter()
+    def draw(self, scene: Scene, size: tuple[int, int],
+             ray_resolution: float = 1.0) -> tuple[Plan, OffscreenTarget]:
+        """Draw one frame; returns its plan and the target holding it.
+        ``ray_resolution`` < 1 traces ray-traced viewports coarser (the window while moving)."""
         self.host.make_current()
-        scene = trace_viewports(scene, size, self.host.ctx)  # renderer=ray viewports become traced images
+        scene = trace_viewports(scene, size, self.host.ctx, ray_resolution)  # renderer=ray viewports: traced images
         frame_plan = plan(scene)
         target = self.target(size, frame_plan.buffers)
         self.executor.render(scene, target.framebuffer, size, frame_plan)
-        image = target.read()
-        return Frame(image, frame_plan, _time.perf_counter() - start)
-
-    def render(self, lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: int = 0) -> Frame:
-        return self.render_scene(with_samples(lesson.scene(), samples), size)
+        return frame_plan, target
 
     def close(self) -> None:
         self.host.make_current()  # deletes must reach this context's objects
@@ -83,6 +95,25 @@ class HeadlessRenderer:
             target.release()
         self._targets.clear()
         self.executor.release()
+
+
+class HeadlessRenderer(FrameRenderer):
+    """Renders lessons offscreen on a context of its own and reads the frames back."""
+
+    def __init__(self, backend: str | None = None) -> None:
+        super().__init__(open_context(backend))
+
+    def render_scene(self, scene: Scene, size: tuple[int, int]) -> Frame:
+        start = _time.perf_counter()
+        frame_plan, target = self.draw(scene, size)
+        image = target.read()
+        return Frame(image, frame_plan, _time.perf_counter() - start)
+
+    def render(self, lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: int = 0) -> Frame:
+        return self.render_scene(with_samples(lesson.scene(), samples), size)
+
+    def close(self) -> None:
+        super().close()
         self.host.release()
 
     def __enter__(self) -> HeadlessRenderer:
@@ -136,15 +167,20 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
     Keys: ESC quits; F12 writes ``screenshots/<lesson>-<n>.png``; R reloads the
     shaders from disk (a broken shader keeps the last good program and shows
     its error in the title and on stderr); other keys go to the lesson.
+
+    Each frame is drawn as headless draws it (a :class:`FrameRenderer`
+    target with the plan's buffers, ``samples`` MSAA resolved there) and
+    copied onto the window, so the window shows the headless pixels.
     """
     import glfw
 
     host = open_context(backend if backend not in (None, "auto") else "auto", window=True, size=size,
-                        title=f"glsandbox: {lesson.name}", samples=samples)
+                        title=f"glsandbox: {lesson.name}")
     if host.backend != "window":
         host.release()
         raise SandboxError("no display for a window: set DISPLAY or run under Xvfb, or use --headless")
-    executor = Executor(host)
+    renderer = FrameRenderer(host)
+    executor = renderer.executor
     motion = InteractiveResolution()  # ray-traced viewports: coarser while the camera moves
     state = {"lesson": lesson, "error": "", "shots": 0}
     start_time = lesson.time
@@ -195,10 +231,10 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
                 current.values["time"] = start_time + glfw.get_time() - clock_start
             width, height = glfw.get_framebuffer_size(host.window)
             if width > 0 and height > 0:  # minimised windows have no framebuffer
-                # The window's own MSAA does the sampling; the camera keys' camera, once moved, replaces the scene's.
-                scene = camera_input.apply(with_samples(current.scene(), 0))
-                scene = trace_viewports(scene, (width, height), host.ctx, motion.resolution(scene))
-                executor.render(scene, host.ctx.screen, (width, height))
+                # The camera keys' camera, once moved, replaces the scene's.
+                scene = camera_input.apply(with_samples(current.scene(), samples))
+                _, target = renderer.draw(scene, (width, height), motion.resolution(scene))
+                host.raw.blit_color(target.resolved().glo, host.ctx.screen.glo, (width, height))
                 glfw.swap_buffers(host.window)
             frames += 1
             fps_frames += 1
@@ -211,7 +247,7 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
             if max_frames is not None and frames >= max_frames:
                 break
     finally:
-        executor.release()
+        renderer.close()
         host.release()
 
 

@@ -127,6 +127,26 @@ def test_window_shows_the_lesson_saves_screenshots_resizes_and_quits(window_env:
     assert code == 0
 
 
+def test_window_has_the_buffers_the_plan_asks_for(window_env: str, tmp_path: Path, gl) -> None:
+    # Reverse-Z needs a float depth buffer, which a window's own framebuffer
+    # does not have (24-bit integers); far away without polygon offset the
+    # shadow would z-fight there. The window draws into the plan's target
+    # (here with MSAA, resolved there) and copies it over, so it shows
+    # exactly the headless frame.
+    settings = ["depth=reverse_z", "offset=off", "distance=90", "fov=5.7", "far=200", "speed=0"]
+    args = [a for s in settings for a in ("--set", s)]
+    win = LessonWindow(window_env, tmp_path, "lessons.mirror", "--size", "320x240", "--samples", "4", *args)
+    try:
+        win.wait_title(lambda t: "fps" in t)
+        win.key("F12")
+        shot = load_png(wait_for(tmp_path / "screenshots" / "mirror-1.png"))
+    finally:
+        code = win.close()
+    assert code == 0
+    headless = gl.render(find_lesson("mirror").from_settings(settings), (320, 240), samples=4).image
+    np.testing.assert_array_equal(shot[..., :3], headless[..., :3])
+
+
 def test_r_reloads_shaders_and_a_broken_one_keeps_the_last_good_program(window_env: str, tmp_path: Path) -> None:
     shaders = tmp_path / "shaders"
     shutil.copytree(REPO / "shaders", shaders)

@@ -15,7 +15,12 @@ from glsandbox.errors import SandboxError
 
 GL_FRAMEBUFFER = 0x8D40
 GL_RENDERBUFFER = 0x8D41
-GL_FRAMEBUFFER_BINDING = 0x8CA6
+GL_FRAMEBUFFER_BINDING = 0x8CA6  # also the draw framebuffer's binding
+GL_READ_FRAMEBUFFER = 0x8CA8
+GL_DRAW_FRAMEBUFFER = 0x8CA9
+GL_READ_FRAMEBUFFER_BINDING = 0x8CAA
+GL_COLOR_BUFFER_BIT = 0x4000
+GL_NEAREST = 0x2600
 GL_RENDERBUFFER_BINDING = 0x8CA7
 GL_COLOR_ATTACHMENT0 = 0x8CE0
 GL_DEPTH_ATTACHMENT = 0x8D00
@@ -87,6 +92,7 @@ _SIGNATURES: dict[str, tuple] = {
     "glScissor": (_VOID, _INT, _INT, _INT, _INT),
     "glGetFloatv": (_VOID, _UINT, ctypes.POINTER(ctypes.c_float)),
     "glReadPixels": (_VOID, _INT, _INT, _INT, _INT, _UINT, _UINT, ctypes.c_void_p),
+    "glBlitFramebuffer": (_VOID, _INT, _INT, _INT, _INT, _INT, _INT, _INT, _INT, _UINT, _UINT),
 }
 
 
@@ -181,6 +187,20 @@ class RawGL:
         self.glClearStencil(value)
         self.glClear(GL_STENCIL_BUFFER_BIT)
         self.glDisable(GL_SCISSOR_TEST)
+
+    def blit_color(self, source: int, destination: int, size: tuple[int, int]) -> None:
+        """Copy the colour of framebuffer ``source`` onto ``destination`` (0: the
+        window), pixel for pixel. Colour only: moderngl's ``copy_framebuffer``
+        copies depth too, which fails (GL_INVALID_OPERATION, nothing copied)
+        when the depth formats differ, as a float-depth target's and a
+        window's 24-bit one do."""
+        old_read, old_draw = self.get_integer(GL_READ_FRAMEBUFFER_BINDING), self.get_integer(GL_FRAMEBUFFER_BINDING)
+        self.glBindFramebuffer(GL_READ_FRAMEBUFFER, source)
+        self.glBindFramebuffer(GL_DRAW_FRAMEBUFFER, destination)
+        width, height = size
+        self.glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST)
+        self.glBindFramebuffer(GL_READ_FRAMEBUFFER, old_read)
+        self.glBindFramebuffer(GL_DRAW_FRAMEBUFFER, old_draw)
 
     def read_stencil(self, fbo: int, size: tuple[int, int]) -> bytes:
         """The stencil values of a single-sample framebuffer, bottom row first."""

@@ -44,6 +44,13 @@ class OffscreenTarget:
         """(depth bits, stencil bits) actually allocated."""
         return self.host.raw.attachment_bits(self._fbo_name)
 
+    def resolved(self) -> moderngl.Framebuffer:
+        """The single-sample framebuffer holding the frame (MSAA resolved into it first)."""
+        if self._resolved is None:
+            return self.framebuffer
+        self.host.ctx.copy_framebuffer(self._resolved, self.framebuffer)
+        return self._resolved
+
     def read(self) -> np.ndarray:
         """The frame as an (H, W, 4) uint8 RGBA array, top row first.
 
@@ -51,11 +58,7 @@ class OffscreenTarget:
         negative stride: copying a fresh 800x600 frame costs more than drawing
         it (page faults on new memory), so nothing is copied here.
         """
-        source = self.framebuffer
-        if self._resolved is not None:
-            self.host.ctx.copy_framebuffer(self._resolved, self.framebuffer)
-            source = self._resolved
-        data = source.read(components=4, alignment=1)
+        data = self.resolved().read(components=4, alignment=1)
         return np.frombuffer(data, dtype=np.uint8).reshape(self.size[1], self.size[0], 4)[::-1]
 
     def release(self) -> None:
