@@ -305,6 +305,28 @@ class _SceneReader:
             raise self.fail(table, index, key, f"expected a list of {want} finite numbers, got {value!r}")
         return tuple(float(v) for v in value)
 
+    def flag(self, data: dict[str, Any], key: str, table: str, index: int = 0, default: bool = True) -> bool:
+        value = data.get(key, default)
+        if not isinstance(value, bool):
+            raise self.fail(table, index, key, f"expected true or false, got {value!r}")
+        return value
+
+    def names(self, data: dict[str, Any], key: str, table: str, known: set[str]) -> tuple[str, ...]:
+        """A list of node names, each one a node of the file."""
+        value = data.get(key)
+        if not (isinstance(value, list) and all(isinstance(v, str) for v in value)):
+            raise self.fail(table, 0, key, f"expected a list of node names, got {value!r}")
+        for name in value:
+            if name not in known:
+                raise self.fail(table, 0, key, f"no node is named {name!r} (nodes: {', '.join(sorted(known))})")
+        return tuple(value)
+
+    def node_name(self, data: dict[str, Any], key: str, table: str, known: set[str]) -> str:
+        value = data.get(key)
+        if not isinstance(value, str):
+            raise self.fail(table, 0, key if key in data else None, f"needs {key} = \"<node name>\"")
+        return self.names({key: [value]}, key, table, known)[0]
+
     def number(self, data: dict[str, Any], key: str, table: str, index: int = 0,
                default: float | None = None) -> float | None:
         if key not in data:
@@ -369,9 +391,7 @@ class _SceneReader:
             raise self.fail("nodes", i, "shading", f"unknown shading {shading!r}; use one of {', '.join(SHADINGS)}")
         if shading == "vertex_color" and mesh.colors is None:
             raise self.fail("nodes", i, "shading", f"mesh {mesh_name!r} has no vertex colours")
-        cull = data.get("cull_back_faces", True)
-        if not isinstance(cull, bool):
-            raise self.fail("nodes", i, "cull_back_faces", f"expected true or false, got {cull!r}")
+        cull = self.flag(data, "cull_back_faces", "nodes", i)
         views = data.get("viewports")
         if views is not None and not (isinstance(views, list) and all(isinstance(v, int) for v in views)):
             raise self.fail("nodes", i, "viewports", f"expected a list of viewport indices, got {views!r}")
@@ -432,9 +452,51 @@ class _SceneReader:
         col = self.numbers(data, "color", (3,), "lights", i, default=(1.0, 1.0, 1.0))
         return Light(position=pos, color=col)  # type: ignore[arg-type]
 
+    def mirror(self, data: dict[str, Any], known: set[str]) -> Mirror:
+        """``[mirror]``: the glass node, its plane (a, b, c, d with ax + by + cz + d = 0), what it reflects."""
+        self.check_keys(data, {"node", "plane", "reflected", "stencil"}, "mirror")
+        node = self.node_name(data, "node", "mirror", known)
+        plane = self.numbers(data, "plane", (4,), "mirror")
+        if plane is None:
+            raise self.fail("mirror", 0, None, "needs plane = [a, b, c, d] (the glass's plane ax + by + cz + d = 0)")
+        reflected = self.names(data, "reflected", "mirror", known)
+        try:
+            return Mirror(node, plane, reflected, stencil=self.flag(data, "stencil", "mirror"))  # type: ignore[arg-type]
+        except SandboxError as exc:
+            raise self.fail("mirror", 0, "reflected" if "reflect" in str(exc) else "plane", str(exc)) from None
+
+    def shadow(self, data: dict[str, Any], known: set[str]) -> PlanarShadow:
+        """``[shadow]``: casters flattened onto the receiver's plane along the light."""
+        self.check_keys(data, {"receiver", "plane", "light", "casters", "lift", "polygon_offset", "stencil", "color"},
+                        "shadow")
+        receiver = self.node_name(data, "receiver", "shadow", known)
+        plane = self.numbers(data, "plane", (4,), "shadow")
+        light = self.numbers(data, "light", (4,), "shadow")
+        for key, value, what in (("plane", plane, "[a, b, c, d]"), ("light", light, "[x, y, z, 1] (point) or "
+                                                                               "[x, y, z, 0] (directional)")):
+            if value is None:
+                raise self.fail("shadow", 0, None, f"needs {key} = {what}")
+        casters = self.names(data, "casters", "shadow", known)
+        try:
+            shadow = PlanarShadow(receiver, plane, light, casters,  # type: ignore[arg-type]
+                                  lift=self.number(data, "lift", "shadow", default=0.005),  # type: ignore[arg-type]
+                                  polygon_offset=self.flag(data, "polygon_offset", "shadow"),
+                                  stencil=self.flag(data, "stencil", "shadow"),
+                                  color=self.numbers(data, "color", (4,), "shadow",  # type: ignore[arg-type]
+                                                     default=(0.0, 0.0, 0.0, 0.5)))
+        except SandboxError as exc:
+            key = next((k for k in ("lift", "color", "light", "plane") if k in str(exc)), None)
+            raise self.fail("shadow", 0, key, str(exc)) from None
+        try:  # a light in the plane or parallel to it has no shadow matrix
+            transforms.shadow_matrix(shadow.plane, shadow.light)
+        except SandboxError as exc:
+            raise self.fail("shadow", 0, "light", str(exc)) from None
+        return shadow
+
     def scene(self, data: dict[str, Any]) -> Scene:
-        self.check_keys(data, {"name", "clear_color", "camera", "nodes", "lights", "viewports", "depth_test"}, "")
-        tables = {"camera": dict, "nodes": list, "lights": list, "viewports": list}
+        self.check_keys(data, {"name", "clear_color", "camera", "nodes", "lights", "viewports", "depth_test",
+                               "depth_mode", "mirror", "shadow"}, "")
+        tables = {"camera": dict, "nodes": list, "lights": list, "viewports": list, "mirror": dict, "shadow": dict}
         for key, kind in tables.items():
             if key in data and not isinstance(data[key], kind):
                 shape = f"[{key}]" if kind is dict else f"[[{key}]]"
@@ -445,9 +507,13 @@ class _SceneReader:
             for v in n.viewports or ():
                 if not 0 <= v < len(viewports):
                     raise self.fail("nodes", i, "viewports", f"viewport {v} does not exist ({len(viewports)} defined)")
-        depth = data.get("depth_test", True)
-        if not isinstance(depth, bool):
-            raise self.fail("", 0, "depth_test", f"expected true or false, got {depth!r}")
+        depth = self.flag(data, "depth_test", "")
+        depth_mode = data.get("depth_mode", "standard")
+        if depth_mode not in DEPTH_MODES:
+            raise self.fail("", 0, "depth_mode", f"unknown depth mode {depth_mode!r}; use one of {', '.join(DEPTH_MODES)}")
+        known = {n.name for n in nodes}
+        if len(known) < len(nodes) and ("mirror" in data or "shadow" in data):
+            raise self.fail("", 0, None, "node names must differ when a mirror or shadow names them")
         return Scene(
             name=str(data.get("name", self.path.stem)),
             nodes=nodes,
@@ -456,6 +522,9 @@ class _SceneReader:
             clear_color=self.color(data, "clear_color", "", default=COURSE_BLUE),  # type: ignore[arg-type]
             viewports=viewports,
             depth_test=depth,
+            mirror=self.mirror(data["mirror"], known) if "mirror" in data else None,
+            shadow=self.shadow(data["shadow"], known) if "shadow" in data else None,
+            depth_mode=depth_mode,
         )
 
 

@@ -133,3 +133,80 @@ def test_a_lit_scene_file_renders_lit(tmp_path: Path, gl) -> None:
     # Facing the light head on: 0.1 ambient + 0.4 diffuse + specular on red, clamped.
     r, g, b, _ = image[32, 32]
     assert r > 150 and g < r and b < r
+
+
+# --- the mirror and the shadow in a scene file ([mirror], [shadow], depth_mode) ---
+
+ROOM = (Path(__file__).resolve().parent.parent / "examples" / "mirror_room.toml").read_text()
+
+
+def without_table(text: str, table: str) -> str:
+    """The file with one ``[table]`` (its header up to the next blank line or the end) removed."""
+    start = text.index(f"[{table}]")
+    end = text.find("\n\n", start)
+    return text[:start] + (text[end:] if end >= 0 else "")
+
+
+def test_the_example_room_loads_its_mirror_shadow_and_depth_mode(tmp_path: Path) -> None:
+    scene = load_scene(write(tmp_path, ROOM))
+    assert scene.depth_mode == "reverse_z"
+    assert scene.mirror is not None and scene.shadow is not None
+    assert (scene.mirror.node, scene.mirror.reflected, scene.mirror.stencil) == ("glass", ("box", "floor"), True)
+    assert scene.mirror.plane == (0.0, 0.0, 1.0, 4.0)
+    assert (scene.shadow.receiver, scene.shadow.casters, scene.shadow.light) == ("floor", ("box",), (-2, 5, 2, 1))
+    assert (scene.shadow.lift, scene.shadow.polygon_offset, scene.shadow.stencil) == (0.005, True, True)
+    frame_plan = plan(scene)
+    assert [p.kind for p in frame_plan.passes] == ["clear", "draw", "mark_mirror", "reflection", "mirror_surface",
+                                                   "shadow"]
+    assert frame_plan.buffers.stencil and frame_plan.buffers.float_depth
+    # Without the two tables the plan has neither their passes nor the stencil.
+    plain = plan(load_scene(write(tmp_path, without_table(without_table(ROOM, "mirror"), "shadow"))))
+    assert [p.kind for p in plain.passes] == ["clear", "draw"] and not plain.buffers.stencil
+
+
+def test_the_example_room_shows_its_reflection_and_shadow(tmp_path: Path, gl) -> None:
+    from glsandbox.lesson import scene_file_lesson
+
+    def render(text: str, name: str) -> np.ndarray:
+        path = tmp_path / f"{name}.toml"
+        path.write_text(text)
+        return gl.render(scene_file_lesson(path)(), (160, 120)).image[..., :3].astype(int)
+
+    room = render(ROOM, "room")
+    no_mirror = render(without_table(ROOM, "mirror"), "no_mirror")
+    no_shadow = render(without_table(ROOM, "shadow"), "no_shadow")
+    # The mirror changes only the glass (the reflected box and floor appear in it) ...
+    changed = np.any(room != no_mirror, axis=-1)
+    assert changed.sum() > 300
+    rows, cols = np.nonzero(changed)
+    assert rows.min() > 15 and rows.max() < 55 and cols.min() > 80 and cols.max() < 120  # the glass, top middle
+    # ... and the shadow only darkens the floor beside the box.
+    darker = np.all(room <= no_shadow, axis=-1) & np.any(room < no_shadow, axis=-1)
+    assert darker.sum() > 50 and np.array_equal(darker, np.any(room != no_shadow, axis=-1))
+
+
+def line_of(text: str, fragment: str) -> int:
+    return next(i for i, line in enumerate(text.splitlines(), start=1) if fragment in line)
+
+
+@pytest.mark.parametrize(
+    ("change", "expected"),
+    [
+        (('reflected = ["box", "floor"]', 'reflected = ["box", "ghost"]'),
+         r"mirror.reflected: no node is named 'ghost'"),
+        (('reflected = ["box", "floor"]', 'reflected = ["box", "glass"]'), r"mirror.reflected: .*cannot reflect itself"),
+        (('node = "glass"', 'node = 3'), r"mirror.node: needs node"),
+        (('plane = [0, 0, 1, 4] ', 'tilt = 1 '), r"mirror.tilt: unknown key"),
+        (('light = [-2, 5, 2, 1]', 'light = [1, 0, 0, 0]'), r"shadow.light: .*parallel"),
+        (('casters = ["box"]', 'casters = "box"'), r"shadow.casters: expected a list of node names"),
+        (('depth_mode = "reverse_z"', 'depth_mode = "inverse"'), r"depth_mode: unknown depth mode 'inverse'"),
+    ],
+)
+def test_mirror_and_shadow_errors_name_the_line(tmp_path: Path, change: tuple[str, str], expected: str) -> None:
+    old, new = change
+    assert old in ROOM
+    text = ROOM.replace(old, new)
+    key_line = line_of(text, new.split("=")[0].strip() + " =")
+    with pytest.raises(SandboxError, match=rf"scene.toml:{key_line}: {expected}") as info:
+        load_scene(write(tmp_path, text))
+    assert "\n" not in str(info.value)
