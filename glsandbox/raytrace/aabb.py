@@ -35,12 +35,20 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from glsandbox.raytrace.base import broadcast_rays, finite_positive_or_none
+from glsandbox.raytrace.base import broadcast_rays, finite_positive_or_none, shared_origin
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.ray import Ray
 from glsandbox.raytrace.vec import Vec3, as_vec3
 
-__all__ = ["AABB"]
+__all__ = ["AABB", "reciprocals"]
+
+
+def reciprocals(directions: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``1/d`` of ``(N, 3)`` directions as a ``(3, N)`` array, one contiguous row an axis
+    (what :meth:`AABB.slabs_reciprocal` takes). Deliberately ``1/(+0) = +inf``
+    and ``1/(−0) = −inf``, without a warning."""
+    with np.errstate(divide="ignore"):
+        return 1.0 / np.ascontiguousarray(np.asarray(directions, dtype=np.float64).T)
 
 
 class AABB:
@@ -99,17 +107,33 @@ class AABB:
         Empty when ``t_near > t_far``. See the module docstring for ±0 and NaN.
         """
         o, d = broadcast_rays(origins, directions)
-        with np.errstate(divide="ignore"):
-            inv = 1.0 / d  # deliberate: 1/(+0) = +inf, 1/(−0) = −inf
-        with np.errstate(invalid="ignore"):
-            ta = (self.min - o) * inv  # 0·inf = NaN when O lies on the min plane
-            tb = (self.max - o) * inv
-        negative = np.signbit(d)  # true for −0.0 too
-        near = np.where(negative, tb, ta)
-        far = np.where(negative, ta, tb)
-        near = np.where(np.isnan(near), -np.inf, near)  # on the plane: the slab never starts
-        far = np.where(np.isnan(far), np.inf, far)  # ...and never ends
-        return near.max(axis=1), far.min(axis=1)
+        return self.slabs_reciprocal(shared_origin(o), reciprocals(d))
+
+    def slabs_reciprocal(self, origin: Vec3, inverse: NDArray[np.float64]
+                         ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """:meth:`slabs` with the directions' reciprocals already formed: ``inverse``
+        is :func:`reciprocals` of the ``(N, 3)`` directions, ``(3, N)``, one row an
+        axis; ``origin`` is ``(N, 3)``, or ``(3,)`` for one origin shared by all.
+
+        A renderer tests every ray against many boxes, so it forms ``1/d`` once.
+        Per axis, the entry is the smaller of ``t_a, t_b`` and the exit the larger:
+        for ``d_i > 0`` that is ``t_a`` then ``t_b``, for ``d_i < 0`` (or ``−0.0``,
+        whose reciprocal is ``−inf``) the other way round, the same pair the sign
+        bit picks. ``np.minimum``/``np.maximum`` keep a NaN (the origin on a slab
+        plane with ``d_i = ±0``); ``np.fmax``/``np.fmin`` then skip it, so that
+        slab neither starts nor ends, as the module docstring says.
+        """
+        origin = np.asarray(origin, dtype=np.float64)
+        near = np.full(inverse.shape[1], -np.inf)
+        far = np.full(inverse.shape[1], np.inf)
+        with np.errstate(invalid="ignore"):  # 0·inf = NaN when O lies on a slab plane
+            for axis in range(3):
+                o = origin[..., axis]
+                ta = (self.min[axis] - o) * inverse[axis]
+                tb = (self.max[axis] - o) * inverse[axis]
+                np.fmax(near, np.minimum(ta, tb), out=near)
+                np.fmin(far, np.maximum(ta, tb, out=tb), out=far)
+        return near, far
 
     def intersect_many(self, origins: ArrayLike, directions: ArrayLike) -> NDArray[np.float64]:
         """The slab test for ``N`` rays: a ``(N,)`` array of ``t``, ``inf`` for a miss."""

@@ -25,7 +25,7 @@ from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.ray import Ray
 from glsandbox.raytrace.vec import Vec3, as_vec3_batch
 
-__all__ = ["Shape", "broadcast_rays", "finite_positive_or_none"]
+__all__ = ["Shape", "broadcast_rays", "finite_positive_or_none", "shared_origin"]
 
 
 @runtime_checkable
@@ -62,6 +62,19 @@ def broadcast_rays(origins: ArrayLike, directions: ArrayLike) -> tuple[Vec3, Vec
         else:
             raise RayTraceError(f"origins and directions must have the same length, got {o.shape[0]} and {d.shape[0]}")
     return o, d
+
+
+def shared_origin(origins: Vec3) -> Vec3:
+    """``(3,)`` when every row of ``(N, 3)`` ``origins`` is one origin, else ``origins``.
+
+    :func:`broadcast_rays` turns a single origin (the eye of all primary rays)
+    into a stride-0 view; the kernels recognise it here and form what depends
+    on the origin alone (``O − C``, ``O − V0``...) once instead of per ray:
+    the same numbers, computed fewer times.
+    """
+    if origins.ndim == 2 and origins.shape[0] > 0 and origins.strides[0] == 0:
+        return origins[0]
+    return origins
 
 
 def finite_positive_or_none(t: NDArray[np.float64] | float) -> float | None:

@@ -52,7 +52,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from glsandbox.raytrace.base import broadcast_rays, finite_positive_or_none
+from glsandbox.raytrace.base import broadcast_rays, finite_positive_or_none, shared_origin
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.ray import Ray
 from glsandbox.raytrace.vec import Vec3, as_vec3, dot, length, normalize
@@ -121,7 +121,7 @@ class Sphere:
         """The stable test for ``N`` rays: a ``(N,)`` array of ``t``, ``inf`` for a miss."""
         o, d = broadcast_rays(origins, directions)
         r = self.radius
-        l = self.center - o  # noqa: E741 (the course's l)
+        l = self.center - shared_origin(o)  # noqa: E741 (the course's l; one (3,) vector for a shared origin)
         a = dot(d, d)
         b = dot(l, d)  # a·s in the course's terms (s = b/a along a non-unit d)
         ok = a > 0.0

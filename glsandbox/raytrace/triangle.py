@@ -70,7 +70,7 @@ from fractions import Fraction
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from glsandbox.raytrace.base import broadcast_rays, finite_positive_or_none
+from glsandbox.raytrace.base import broadcast_rays, finite_positive_or_none, shared_origin
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.ray import Ray
 from glsandbox.raytrace.vec import Vec3, as_vec3, as_vec3_batch, cross, dot, length
@@ -507,11 +507,17 @@ def moller_trumbore_many(
     c = as_vec3_batch(v2, "v2")
     if not (a.shape == b.shape == c.shape):
         raise RayTraceError(f"v0, v1, v2 must have the same shape, got {a.shape}, {b.shape}, {c.shape}")
+    return _moller_trumbore_kernel(o, d, a, *_triangle_terms(a, b, c), cull_backfaces)
+
+
+def _triangle_terms(a: Vec3, b: Vec3, c: Vec3
+                    ) -> tuple[Vec3, Vec3, NDArray[np.float64], NDArray[np.bool_]]:
+    """Möller-Trumbore's per-triangle terms of ``(M, 3)`` corners: the edges ``e1, e2``,
+    ``|e1 × e2|`` and whether the triangle is not degenerate (``(M,)`` each)."""
     e1 = b - a
     e2 = c - a
-    n_len = length(cross(e1, e2))  # (M,)
-    ok_tri = n_len > DEGENERATE_SIN * length(e1) * length(e2)
-    return _moller_trumbore_kernel(o, d, a, e1, e2, n_len, ok_tri, cull_backfaces)
+    n_len = length(cross(e1, e2))
+    return e1, e2, n_len, n_len > DEGENERATE_SIN * length(e1) * length(e2)
 
 
 def _moller_trumbore_kernel(
@@ -524,21 +530,46 @@ def _moller_trumbore_kernel(
     ok_tri: NDArray[np.bool_],
     cull_backfaces: bool,
 ) -> NDArray[np.float64]:
-    """The arithmetic of :func:`moller_trumbore_many` on validated ``(N, 3)``/``(M, 3)`` arrays."""
-    o3 = o[:, None, :]  # (N, 1, 3) against (M, 3) -> (N, M)
-    d3 = d[:, None, :]
-    p = cross(d3, e2)
-    det = dot(e1, p)
+    """The arithmetic of :func:`moller_trumbore_many` on validated ``(N, 3)``/``(M, 3)`` arrays.
+
+    Every ``(N, M)`` quantity is kept as three component arrays (``p_x, p_y,
+    p_z``...), never as an ``(N, M, 3)`` stack, with the products summed in
+    the order :func:`~glsandbox.raytrace.vec.dot` and
+    :func:`~glsandbox.raytrace.vec.cross` use: the same numbers, bit for bit.
+
+    Rays that share one origin (the eye, for every primary ray of Bakış
+    noktası; ``o`` is then a stride-0 broadcast of it or a ``(3,)`` vector)
+    make ``s = O − V0`` and ``q = s × e1`` depend on the triangle alone: they
+    are formed once per triangle, ``(M, 3)``, instead of once per ray and
+    triangle. Only ``p = d × e2`` and the three dot products with the ray's
+    direction are left per pair.
+    """
+    o = shared_origin(o)
+    d = np.asarray(d, dtype=np.float64)
+    dx, dy, dz = d[:, 0, None], d[:, 1, None], d[:, 2, None]  # (N, 1) against (M,) -> (N, M)
+    px, py, pz = _cross_parts(dx, dy, dz, e2[:, 0], e2[:, 1], e2[:, 2])  # p = d × e2
+    det = e1[:, 0] * px + e1[:, 1] * py + e1[:, 2] * pz  # e1·p = −N·d
     threshold = PARALLEL_EPS * length(d)[:, None] * n_len[None, :]
     ok = (det > threshold) if cull_backfaces else (np.abs(det) > threshold)
     ok &= ok_tri[None, :]
-    s = o3 - a
-    q = cross(s, e1)
-    u = _divide(dot(s, p), det, ok)
-    v = _divide(dot(d3, q), det, ok)
-    t = _divide(dot(e2, q), det, ok)
+    if o.ndim == 1:  # one origin: s and q per triangle, (M,)
+        s = o - a
+        sx, sy, sz = s[:, 0], s[:, 1], s[:, 2]
+    else:  # an origin per ray: (N, M)
+        sx, sy, sz = (o[:, i, None] - a[:, i] for i in range(3))
+    qx, qy, qz = _cross_parts(sx, sy, sz, e1[:, 0], e1[:, 1], e1[:, 2])  # q = s × e1
+    u = _divide(sx * px + sy * py + sz * pz, det, ok)  # s·p / det
+    v = _divide(dx * qx + dy * qy + dz * qz, det, ok)  # d·q / det
+    t = _divide(e2[:, 0] * qx + e2[:, 1] * qy + e2[:, 2] * qz, det, ok)  # e2·q / det
     hit = ok & (u >= 0.0) & (v >= 0.0) & (u + v <= 1.0) & (t > 0.0)
     return np.where(hit, t, np.inf)
+
+
+def _cross_parts(ax: NDArray[np.float64], ay: NDArray[np.float64], az: NDArray[np.float64], bx: NDArray[np.float64],
+                 by: NDArray[np.float64], bz: NDArray[np.float64]
+                 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """The components of ``a × b`` (:func:`~glsandbox.raytrace.vec.cross`'s formula), unstacked."""
+    return ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
 
 
 def _divide(num: NDArray[np.float64], den: NDArray[np.float64], where: NDArray[np.bool_]) -> NDArray[np.float64]:
@@ -554,7 +585,7 @@ class TriangleBatch:
     :class:`Triangle` objects (:meth:`from_triangles`).
     """
 
-    __slots__ = ("v0", "v1", "v2")
+    __slots__ = ("v0", "v1", "v2", "_e1", "_e2", "_n_len", "_ok")
 
     v0: NDArray[np.float64]
     v1: NDArray[np.float64]
@@ -568,6 +599,8 @@ class TriangleBatch:
             raise RayTraceError("v0, v1, v2 must have the same shape (M, 3)")
         if not (np.all(np.isfinite(self.v0)) and np.all(np.isfinite(self.v1)) and np.all(np.isfinite(self.v2))):
             raise RayTraceError("triangle vertices must be finite")
+        # Möller-Trumbore's per-triangle terms, formed once for every ray cast at the batch.
+        self._e1, self._e2, self._n_len, self._ok = _triangle_terms(self.v0, self.v1, self.v2)
 
     @classmethod
     def from_indexed(cls, vertices: ArrayLike, indices: ArrayLike) -> TriangleBatch:
@@ -603,29 +636,37 @@ class TriangleBatch:
         origins: ArrayLike,
         directions: ArrayLike,
         cull_backfaces: bool = False,
-        chunk_elements: int = 1 << 20,
+        chunk_elements: int = 1 << 13,
     ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
         """Nearest hit per ray: ``(t, index)``, ``t = inf`` and ``index = −1`` for a miss.
 
-        Triangles are processed in chunks so at most about ``chunk_elements``
-        ray-triangle pairs are in memory at once. Ties go to the lower index
-        (the course's ``min_indis`` loop keeps the first minimum).
+        Rays and triangles are processed in blocks of at most about
+        ``chunk_elements`` ray-triangle pairs: blocks of rays against every
+        triangle while the triangles are few (the default keeps a block's
+        dozen ``(rays, M)`` temporaries in a core's cache, far faster than
+        streaming ``(N, M)`` arrays through memory), blocks of triangles too
+        when they are many. Ties go to the lower index (the course's
+        ``min_indis`` loop keeps the first minimum).
         """
         o, d = broadcast_rays(origins, directions)
-        n_rays = o.shape[0]
+        n_rays = d.shape[0]
         best_t = np.full(n_rays, np.inf)
         best_i = np.full(n_rays, -1, dtype=np.intp)
-        step = max(1, int(chunk_elements) // max(1, n_rays))
-        for start in range(0, len(self), step):
-            stop = min(len(self), start + step)
-            t = moller_trumbore_many(
-                o, d, self.v0[start:stop], self.v1[start:stop], self.v2[start:stop], cull_backfaces=cull_backfaces
-            )
-            j = np.argmin(t, axis=1)
-            tj = t[np.arange(n_rays), j]
-            better = tj < best_t
-            best_t = np.where(better, tj, best_t)
-            best_i = np.where(better, j + start, best_i)
+        chunk = max(1, int(chunk_elements))
+        m = len(self)
+        ray_step = max(min(n_rays, 64), min(n_rays, chunk // max(1, m)), 1)
+        tri_step = max(1, chunk // ray_step)
+        for first in range(0, m, tri_step):
+            tris = slice(first, min(m, first + tri_step))
+            for lo in range(0, n_rays, ray_step):
+                rays = slice(lo, min(n_rays, lo + ray_step))
+                t = _moller_trumbore_kernel(o[rays], d[rays], self.v0[tris], self._e1[tris], self._e2[tris],
+                                            self._n_len[tris], self._ok[tris], cull_backfaces)
+                j = np.argmin(t, axis=1)  # the first minimum: the lowest index on a tie
+                tj = t[np.arange(t.shape[0]), j]
+                better = tj < best_t[rays]  # strictly: an earlier block keeps a tie
+                best_t[rays] = np.where(better, tj, best_t[rays])
+                best_i[rays] = np.where(better, j + first, best_i[rays])
         return best_t, best_i
 
     def __repr__(self) -> str:
