@@ -26,17 +26,9 @@ from pathlib import Path
 import moderngl
 import numpy as np
 
-SIZE = (800, 600)
+from _raw import VERTEX_COLOR_FS, VERTEX_COLOR_VS
 
-RAW_VERTEX = """#version 330 core
-uniform mat4 m_model; uniform mat4 m_view; uniform mat4 m_proj;
-in vec3 in_position; in vec3 in_color; out vec3 v_color;
-void main() { gl_Position = m_proj * m_view * m_model * vec4(in_position, 1.0); v_color = in_color; }
-"""
-RAW_FRAGMENT = """#version 330 core
-in vec3 v_color; out vec4 frag_color;
-void main() { frag_color = vec4(v_color, 1.0); }
-"""
+SIZE = (800, 600)
 
 
 class RawCube:
@@ -51,7 +43,7 @@ class RawCube:
                           dtype="f4")
         indices = np.array([3, 1, 0, 2, 1, 3, 0, 5, 4, 1, 5, 0, 3, 4, 7, 0, 4, 3, 1, 6, 5, 2, 6, 1, 2, 7, 6, 3, 7, 2,
                             6, 4, 5, 7, 4, 6], dtype="u4").reshape(-1, 3)[:, [0, 2, 1]].copy()
-        self.program = ctx.program(vertex_shader=RAW_VERTEX, fragment_shader=RAW_FRAGMENT)
+        self.program = ctx.program(vertex_shader=VERTEX_COLOR_VS, fragment_shader=VERTEX_COLOR_FS)
         self.vao = ctx.vertex_array(self.program, [(ctx.buffer(positions.tobytes()), "3f", "in_position"),
                                                    (ctx.buffer(colors.tobytes()), "3f", "in_color")],
                                     index_buffer=ctx.buffer(indices.tobytes()))

@@ -1,13 +1,20 @@
 """Benchmark: each lesson's frame through glsandbox vs a hand-written raw-ModernGL frame.
 
-Run with every other benchmark by ``glsandbox bench`` (the indexed cube's
-case lives in ``cube_frame.py``). Each raw class draws the lesson's default
-frame at 800x600 with plain ModernGL calls: its own shaders (the same
-formulas as ``shaders/``), matrices by hand (``_raw.py``), state set
-directly. Mesh and image data come from glsandbox.geometry / glsandbox.images
-(arrays, uploaded once; not per-frame work). The table's last column says
-whether both draw the same picture. Goal (issue 7): glsandbox <= 1.10x raw.
-``transform_order`` has no raw baseline yet (its trail and overlays).
+Run with every other benchmark by ``glsandbox bench``. Every raster lesson
+has a raw class here (the indexed cube's case lives in ``cube_frame.py``).
+Each draws the lesson's default frame at 800x600 with plain ModernGL calls:
+its own shaders (the same formulas as ``shaders/``), matrices by hand
+(``_raw.py``), state set directly, and the few GL calls moderngl lacks
+(stencil, write masks, clip control) through ctypes (``_raw.gl_calls``).
+Mesh and image data come from glsandbox.geometry / glsandbox.images, and the
+numbers of a scene (sizes, colours, camera) from the lesson module: arrays and
+constants, read and uploaded once, not per-frame work. Where a lesson's
+picture needs more than GL every frame (the transform-order lesson's matrix
+panel is text whose numbers change), the raw side does that work too, with its
+own code; what never changes (a constant text panel) is made once, like a mesh.
+The table's last column says whether both draw the same picture; the tests
+(``tests/test_tradeoffs_bench.py``) check each pixel for pixel at 160x120.
+Goal (issue 7): glsandbox <= 1.10x raw.
 """
 
 from __future__ import annotations
@@ -17,7 +24,10 @@ import math
 import moderngl
 import numpy as np
 
-from _raw import framebuffer, gl, look_at, perspective, read, rotate_y, scale, translate
+from _raw import (GL_ALWAYS, GL_EQUAL, GL_INVERT, GL_KEEP, GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE, GL_REPLACE,
+                  GL_STENCIL_BUFFER_BIT, GL_STENCIL_TEST, GL_ZERO_TO_ONE, VERTEX_COLOR_FS, VERTEX_COLOR_VS,
+                  depth_stencil_framebuffer, framebuffer, gl, gl_calls, look_at, perspective, read, reverse_z, rotate_x,
+                  rotate_y, rotate_z, scale, translate)
 
 SOLID_VS = """#version 330 core
 uniform mat4 m_model; uniform mat4 m_view; uniform mat4 m_proj;
@@ -46,13 +56,14 @@ void main() {
     v_world = world.xyz; v_normal = normalize(m_normal * in_normal);
 }
 """
-PHONG_FS = """#version 330 core
-uniform vec4 u_color; uniform vec3 u_eye; uniform vec3 u_light_pos[2]; uniform vec3 u_light_color[2];
+# Prefixed with "#version 330 core" and "#define LIGHTS n" by phong_fs(n).
+PHONG_FS_BODY = """
+uniform vec4 u_color; uniform vec3 u_eye; uniform vec3 u_light_pos[LIGHTS]; uniform vec3 u_light_color[LIGHTS];
 in vec3 v_world; in vec3 v_normal; out vec4 frag_color;
 void main() {
     vec3 n = normalize(v_normal), mesh = u_color.rgb, color = vec3(0.0);
     vec3 to_eye = normalize(u_eye - v_world);
-    for (int i = 0; i < 2; ++i) {
+    for (int i = 0; i < LIGHTS; ++i) {
         vec3 l = normalize(u_light_pos[i] - v_world);
         float nl = dot(n, l);
         float s = 0.0;
@@ -65,13 +76,34 @@ void main() {
 """
 
 
+def phong_fs(lights: int) -> str:
+    """The per-pixel Phong fragment shader with its light loop sized to ``lights``."""
+    return f"#version 330 core\n#define LIGHTS {lights}\n{PHONG_FS_BODY}"
+
+
+# An image copied onto the frame texel for pixel: the viewport is the image's rectangle, the quad
+# covers it (corners from the vertex number), each fragment fetches its texel (row 0: the top row).
+IMAGE_VS = """#version 330 core
+void main() { gl_Position = vec4(vec2(gl_VertexID % 2, gl_VertexID / 2) * 2.0 - 1.0, 0.0, 1.0); }
+"""
+IMAGE_FS = """#version 330 core
+uniform sampler2D u_image; uniform ivec2 u_origin; out vec4 frag_color;
+void main() {
+    ivec2 p = ivec2(gl_FragCoord.xy) - u_origin;
+    frag_color = texelFetch(u_image, ivec2(p.x, textureSize(u_image, 0).y - 1 - p.y), 0);
+}
+"""
+
+
 def _vao(ctx: moderngl.Context, program: moderngl.Program, mesh, with_normals: bool = False,
-         with_uv: bool = False) -> moderngl.VertexArray:
+         with_uv: bool = False, with_colors: bool = False) -> moderngl.VertexArray:
     content = [(ctx.buffer(np.asarray(mesh.positions, "f4").tobytes()), "3f", "in_position")]
     if with_normals:
         content.append((ctx.buffer(np.asarray(mesh.normals, "f4").tobytes()), "3f", "in_normal"))
     if with_uv:
         content.append((ctx.buffer(np.asarray(mesh.uvs, "f4").tobytes()), "2f", "in_uv"))
+    if with_colors:
+        content.append((ctx.buffer(np.asarray(mesh.colors, "f4").tobytes()), "3f", "in_color"))
     index = ctx.buffer(np.asarray(mesh.indices, "u4").tobytes()) if mesh.indices is not None else None
     return ctx.vertex_array(program, content, index_buffer=index)
 
@@ -121,6 +153,7 @@ class RawTriangle:
             p["u_color"].value = (1.0, 0.55, 0.1, 1.0)
             vao.render(mode)
         self.fbo.viewport = (0, 0, *self.size)
+        ctx.disable(moderngl.CULL_FACE)
         return read(self.fbo, self.size)
 
 
@@ -131,7 +164,7 @@ class RawPhong:
         from glsandbox import geometry
 
         self.ctx, self.size, self.fbo = ctx, size, framebuffer(ctx, size)
-        self.lit = ctx.program(vertex_shader=PHONG_VS, fragment_shader=PHONG_FS)
+        self.lit = ctx.program(vertex_shader=PHONG_VS, fragment_shader=phong_fs(2))
         self.solid = ctx.program(vertex_shader=SOLID_VS, fragment_shader=SOLID_FS)
         self.ground = _vao(ctx, self.lit, geometry.plane(12.0), with_normals=True)
         self.sphere = _vao(ctx, self.lit, geometry.sphere(), with_normals=True)
@@ -213,7 +246,296 @@ class RawTexture:
         return read(self.fbo, self.size)
 
 
-RAW_BASELINES = {"clear_and_swap": RawClear, "triangle": RawTriangle, "phong": RawPhong, "texture": RawTexture}
+class RawTransformOrder:
+    """transform_order (order STR, overlay on): the centre cube spinning, the second cube under
+    R @ T @ S orbiting the origin, the trail of its top corner, and two text panels on top.
+
+    Per frame, as any program showing this picture must: the trail's 64 points (numpy, all at
+    once) written into one buffer, and the matrix panel, whose numbers change every frame, drawn
+    with Pillow (the lesson's font and layout: 3 px padding, 2 px between lines, the matrix's
+    columns right-aligned 8 px apart, white on black at alpha 150) and uploaded. The figures
+    panel never changes: it is made once by the lesson's own function (data, like the meshes).
+    """
+
+    def __init__(self, ctx: moderngl.Context, size: tuple[int, int]) -> None:
+        from PIL import Image, ImageDraw, ImageFont
+
+        from glsandbox import geometry
+        from lessons import transform_order as lesson
+
+        defaults = {p.name: p.default for p in lesson.TransformOrder.params}
+        assert defaults["order"] == "STR" and defaults["view"] == "single" and defaults["overlay"]
+        self.speed, self.spin, self.span = defaults["speed"], defaults["spin"], defaults["trail"]
+        self.ctx, self.size, self.fbo = ctx, size, framebuffer(ctx, size)
+        self.colored = ctx.program(vertex_shader=VERTEX_COLOR_VS, fragment_shader=VERTEX_COLOR_FS)
+        self.solid = ctx.program(vertex_shader=SOLID_VS, fragment_shader=SOLID_FS)
+        self.image = ctx.program(vertex_shader=IMAGE_VS, fragment_shader=IMAGE_FS)
+        self.cube = _vao(ctx, self.colored, geometry.cube(), with_colors=True)
+        self.samples = lesson.TRAIL_SAMPLES
+        self.trail_buffer = ctx.buffer(reserve=self.samples * 12)
+        self.trail = ctx.vertex_array(self.solid, [(self.trail_buffer, "3f", "in_position")])
+        self.quad = ctx.vertex_array(self.image, [])
+        camera = lesson.CAMERA
+        self.view = gl(look_at(camera.eye, camera.target, camera.up))
+        self.proj = gl(perspective(camera.fov_y, size[0] / size[1], camera.near, camera.far))
+        self.ts = translate(*lesson.OFFSET) @ scale(*lesson.SCALE)  # S, then T
+        self.corner = (self.ts @ (*lesson.TRAIL_POINT, 1.0))[:3]  # the trail's point after S and T
+        self.trail_color = lesson.TRAIL_COLOR
+        # The matrix panel's font, measure and fixed lines.
+        self.font = ImageFont.load_default()
+        measure = ImageDraw.Draw(Image.new("RGBA", (1, 1))).textlength
+        self.width = lambda text: math.ceil(measure(text, font=self.font))
+        ascent, descent = self.font.getmetrics()
+        self.step = ascent + descent + 2
+        self.lines = ("mScale * mTranslate * mRotate", "M = R @ T @ S =",
+                      f"orbits the origin, radius {np.linalg.norm(lesson.OFFSET):.1f}")
+        self.lines_width = max(self.width(text) for text in self.lines)
+        self.panel_height = 8 * self.step - 2 + 6  # 8 rows; the width changes with the numbers
+        self.panel: moderngl.Texture | None = None
+        figures = np.ascontiguousarray(lesson.figures_panel())
+        self.figures = self._texture(figures.shape[1], figures.shape[0], figures.tobytes())
+        self.figures_at = (4, 3)  # the lesson's (4, -4): its last row the 4th from the bottom
+
+    def _texture(self, width: int, height: int, data: bytes) -> moderngl.Texture:
+        texture = self.ctx.texture((width, height), 4, data, alignment=1)
+        texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        return texture
+
+    def _matrix_panel(self, angle: float, model: np.ndarray) -> tuple[int, bytes]:
+        """The panel's width and RGBA bytes (top row first): order, products, the matrix, the motion."""
+        from PIL import Image, ImageDraw
+
+        cells = [["0.00" if text == "-0.00" else text for text in (f"{v:.2f}" for v in row)] for row in model]
+        columns = [max(self.width(row[c]) for row in cells) for c in range(4)]
+        header = f"STR: scale, translate, rotate (R {math.degrees(angle):.0f} deg)"
+        width = max(self.width(header), self.lines_width, sum(columns) + 3 * 8) + 6
+        panel = Image.new("RGBA", (width, self.panel_height), (0, 0, 0, 150))
+        draw = ImageDraw.Draw(panel)
+        white = (255, 255, 255, 255)
+        for row, text in zip((0, 1, 2, 7), (header, *self.lines)):
+            draw.text((3, 3 + row * self.step), text, font=self.font, fill=white)
+        for row, numbers in enumerate(cells, start=3):
+            x = 3
+            for column, text in zip(columns, numbers):
+                draw.text((x + column - self.width(text), 3 + row * self.step), text, font=self.font, fill=white)
+                x += column + 8
+        return width, panel.tobytes()
+
+    def frame(self, k: int) -> np.ndarray:
+        t = 0.01 * k
+        angle = self.speed * t
+        ctx, colored, solid = self.ctx, self.colored, self.solid
+        second = rotate_y(-angle) @ self.ts  # the course's XMMatrixRotationY(angle) is rotate_y(-angle) here
+        turns = -np.linspace(angle - self.span, angle, self.samples)
+        c, s = np.cos(turns), np.sin(turns)
+        x, y, z = self.corner
+        self.trail_buffer.write(np.stack([c * x + s * z, np.full_like(c, y), c * z - s * x], 1).astype("f4"))
+        width, pixels = self._matrix_panel(angle, second)
+        if self.panel is None or self.panel.size != (width, self.panel_height):
+            if self.panel is not None:
+                self.panel.release()
+            self.panel = self._texture(width, self.panel_height, pixels)
+        else:
+            self.panel.write(pixels, alignment=1)
+
+        self.fbo.use()
+        self.fbo.clear(0.0, 0.125, 0.6, 1.0, depth=1.0)
+        ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
+        colored["m_view"].write(self.view)
+        colored["m_proj"].write(self.proj)
+        for model in (rotate_y(-self.spin * t), second):
+            colored["m_model"].write(gl(model))
+            self.cube.render(moderngl.TRIANGLES)
+        ctx.disable(moderngl.CULL_FACE)
+        solid["m_model"].write(gl(np.eye(4)))
+        solid["m_view"].write(self.view)
+        solid["m_proj"].write(self.proj)
+        solid["u_color"].value = self.trail_color
+        self.trail.render(moderngl.LINE_STRIP)
+        # The panels: straight alpha over the frame, and the frame's alpha stays opaque.
+        ctx.disable(moderngl.DEPTH_TEST)
+        ctx.enable(moderngl.BLEND)
+        ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA, moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA
+        top_left = (4, self.size[1] - 4 - self.panel_height)  # the lesson's (4, 4) from the top left
+        for texture, origin in ((self.panel, top_left), (self.figures, self.figures_at)):
+            texture.use(0)
+            self.image["u_origin"].value = origin
+            self.fbo.viewport = (*origin, *texture.size)
+            self.quad.render(moderngl.TRIANGLE_STRIP, vertices=4)
+        self.fbo.viewport = (0, 0, *self.size)
+        ctx.disable(moderngl.BLEND)
+        ctx.blend_func = moderngl.DEFAULT_BLENDING
+        return read(self.fbo, self.size)
+
+
+def _lit_draw(vao: moderngl.VertexArray, model: np.ndarray, color: tuple) -> tuple:
+    """A lit draw's vertex array, model matrix, normal matrix ((M^-1)^T, column-major) and colour."""
+    return vao, gl(model), np.linalg.inv(model[:3, :3]).astype("f4").tobytes(), color
+
+
+class RawMirror:
+    """mirror (stencil mirror, stencil shadow, point light, reverse-Z, polygon offset): the room, the
+    glass marked in the stencil, the reflection where it is marked, the glass blended, the cube's
+    planar shadow darkening each pixel once.
+
+    moderngl has no stencil, write-mask or clip-control calls and no depth-stencil renderbuffer:
+    those go through ctypes from the context's own loader (``_raw.gl_calls``, not glsandbox's
+    rawgl), the rest is moderngl. Every state changed is put back at the end of the frame (the
+    bench shares one context with glsandbox). The room's dimensions, the camera's and light's
+    numbers are read from the lesson module once (data); R, the shadow matrix and the reverse-Z
+    projection are written out here. Matrices of what does not move are made once.
+    """
+
+    def __init__(self, ctx: moderngl.Context, size: tuple[int, int]) -> None:
+        from glsandbox import geometry
+        from lessons import mirror as lesson
+
+        v = {p.name: p.default for p in lesson.MirrorLesson.params}
+        assert (v["mirror"], v["shadow"], v["light"], v["depth"], v["offset"]) == \
+            ("stencil", "on", "point", "reverse_z", True)
+        self.ctx, self.size, self.gl = ctx, size, gl_calls(ctx)
+        self.fbo = depth_stencil_framebuffer(ctx, self.gl, size)
+        self.lit = ctx.program(vertex_shader=PHONG_VS, fragment_shader=phong_fs(1))
+        self.solid = ctx.program(vertex_shader=SOLID_VS, fragment_shader=SOLID_FS)
+        plane, cube24 = geometry.plane(1.0), geometry.cube24()
+        lit_plane, self.lit_cube = (_vao(ctx, self.lit, m, with_normals=True) for m in (plane, cube24))
+        self.glass, self.shadow_cube = _vao(ctx, self.solid, plane), _vao(ctx, self.solid, cube24)
+        light_cube = _vao(ctx, self.solid, geometry.cube())
+
+        # The room: a floor, the left wall, the back wall as four pieces round the glass's hole.
+        half, back, front, high = lesson.HALF_WIDTH, lesson.BACK, lesson.FRONT, lesson.WALL_HEIGHT
+        glass_half, glass_low, glass_high = lesson.GLASS_HALF, lesson.GLASS_BOTTOM, lesson.GLASS_TOP
+        middle, deep, side = (front + back) / 2, front - back, half - glass_half
+        to_z, to_x = rotate_x(math.radians(90.0)), rotate_z(math.radians(-90.0))  # the plane (+y) facing +z, +x
+
+        def back_piece(width: float, height: float, x: float, y: float) -> np.ndarray:
+            return translate(x, y, back) @ to_z @ scale(width, 1.0, height)
+
+        floor = translate(0.0, 0.0, middle) @ scale(2 * half, 1.0, deep)
+        wall_left = translate(-half, high / 2, middle) @ to_x @ scale(high, 1.0, deep)
+        wall = (0.6, 0.55, 0.7, 1.0)
+        room = [(floor, (0.75, 0.72, 0.65, 1.0)), (wall_left, (0.45, 0.6, 0.5, 1.0)),
+                (back_piece(side, high, -(glass_half + side / 2), high / 2), wall),
+                (back_piece(side, high, glass_half + side / 2, high / 2), wall),
+                (back_piece(2 * glass_half, glass_low, 0.0, glass_low / 2), wall),
+                (back_piece(2 * glass_half, high - glass_high, 0.0, (glass_high + high) / 2), wall)]
+        self.glass_model = gl(back_piece(2 * glass_half, glass_high - glass_low, 0.0, (glass_low + glass_high) / 2))
+        self.glass_color = lesson.GLASS_COLOR
+
+        # R: the reflection through the glass's plane n·p + d = 0 (|n| = 1): p - 2 (n·p + d) n.
+        mirror = np.asarray(lesson.MIRROR_PLANE, dtype=np.float64)
+        mirror /= np.linalg.norm(mirror[:3])
+        self.reflect = np.eye(4)
+        self.reflect[:3, :3] -= 2.0 * np.outer(mirror[:3], mirror[:3])
+        self.reflect[:3, 3] = -2.0 * mirror[3] * mirror[:3]
+        # The shadow: S = (P·L) I - L Pᵀ flattens onto the floor P along the rays from the point L,
+        # then lifted by ``lift`` along the floor's normal.
+        light = np.array([v["lx"], v["ly"], v["lz"], 1.0])
+        floor_plane = np.asarray(lesson.FLOOR_PLANE, dtype=np.float64)
+        floor_plane /= np.linalg.norm(floor_plane[:3])
+        self.flatten = translate(*(v["lift"] * floor_plane[:3])) @ (
+            float(floor_plane @ light) * np.eye(4) - np.outer(light, floor_plane))
+        self.shadow_color = lesson.SHADOW_COLOR
+        self.lights = tuple(np.asarray(p[:3], "f4").tobytes() for p in (light, self.reflect @ light))
+
+        # The draws that do not move, their matrices made once: seen and reflected.
+        light_model = translate(*light[:3]) @ scale(*(lesson.LIGHT_CUBE_SCALE,) * 3)
+        self.room = [_lit_draw(lit_plane, model, color) for model, color in room]
+        self.reflected_room = [_lit_draw(lit_plane, self.reflect @ model, color) for model, color in room[:2]]
+        self.light_draws = [(light_cube, gl(m)) for m in (light_model, self.reflect @ light_model)]
+        self.cube_color = (1.0, 0.5, 0.15, 1.0)
+        self.cube_at, self.cube_half, self.speed = lesson.CUBE_CENTRE, lesson.CUBE_HALF, v["speed"]
+
+        direction = np.asarray(lesson.EYE_DIRECTION) / np.linalg.norm(lesson.EYE_DIRECTION)
+        eye = np.asarray(lesson.TARGET) + v["distance"] * direction
+        view = gl(look_at(eye, lesson.TARGET))
+        proj = gl(reverse_z(perspective(v["fov"], size[0] / size[1], v["near"], v["far"])))
+        for program in (self.lit, self.solid):  # the camera never moves: set once
+            program["m_view"].write(view)
+            program["m_proj"].write(proj)
+        self.lit["u_eye"].write(eye.astype("f4").tobytes())
+        self.lit["u_light_color"].write(np.ones(3, "f4").tobytes())
+
+    def _lit(self, draws: list) -> None:
+        lit = self.lit
+        for vao, model, normal, color in draws:
+            lit["m_model"].write(model)
+            lit["m_normal"].write(normal)
+            lit["u_color"].value = color
+            vao.render(moderngl.TRIANGLES)
+
+    def _stencil(self, write_mask: int, test: int, ref: int, compare_mask: int, on_pass: int) -> None:
+        """Which bits a pass writes, its test (``ref & compare_mask`` against the buffer's), and what
+        a fragment passing stencil and depth does to the written bits (failing ones keep them)."""
+        self.gl.StencilMask(write_mask)
+        self.gl.StencilFunc(test, ref, compare_mask)
+        self.gl.StencilOp(GL_KEEP, GL_KEEP, on_pass)
+
+    def _solid(self, vao: moderngl.VertexArray, model: bytes, color: tuple) -> None:
+        self.solid["m_model"].write(model)
+        self.solid["u_color"].value = color
+        vao.render(moderngl.TRIANGLES)
+
+    def frame(self, k: int) -> np.ndarray:
+        t = 0.01 * k
+        ctx, raw, lit = self.ctx, self.gl, self.lit
+        h = self.cube_half
+        cube = translate(*self.cube_at) @ rotate_y(0.5 + self.speed * t) @ scale(h, h, h)
+        seen, mirrored = (_lit_draw(self.lit_cube, m, self.cube_color) for m in (cube, self.reflect @ cube))
+
+        self.fbo.use()
+        raw.ClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE)  # reverse-Z: depth 0..1 as is, near 1, far 0
+        ctx.depth_func = ">"
+        self.fbo.clear(0.08, 0.08, 0.12, 1.0, depth=0.0)
+        raw.ClearStencil(0)
+        raw.Clear(GL_STENCIL_BUFFER_BIT)
+        ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
+        lit["u_light_pos"].write(self.lights[0])
+        self._lit([*self.room, seen])
+        self._solid(*self.light_draws[0], (1.0, 1.0, 0.85, 1.0))
+        # Mark the glass's visible pixels with stencil bit 1; no colour or depth writes.
+        raw.Enable(GL_STENCIL_TEST)
+        self._stencil(1, GL_ALWAYS, 1, 0xFF, GL_REPLACE)
+        raw.ColorMask(0, 0, 0, 0)
+        raw.DepthMask(0)
+        self._solid(self.glass, self.glass_model, self.glass_color)
+        # The reflection where bit 1 is set: R @ model, the light through R, clockwise fronts (det R = -1).
+        self._stencil(0, GL_EQUAL, 1, 1, GL_KEEP)
+        raw.ColorMask(1, 1, 1, 1)
+        raw.DepthMask(1)
+        ctx.front_face = "cw"
+        lit["u_light_pos"].write(self.lights[1])
+        self._lit([*self.reflected_room, mirrored])
+        self._solid(*self.light_draws[1], (1.0, 1.0, 0.85, 1.0))
+        # The glass blended over its reflection.
+        raw.Disable(GL_STENCIL_TEST)
+        ctx.front_face = "ccw"
+        ctx.enable(moderngl.BLEND)
+        ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
+        self._solid(self.glass, self.glass_model, self.glass_color)
+        # The shadow: darken a pixel only while its bit 2 is clear, then set it; no depth writes,
+        # no culling, pulled towards the camera by polygon offset (+1, +1: nearer is larger here).
+        raw.Enable(GL_STENCIL_TEST)
+        self._stencil(2, GL_EQUAL, 0, 2, GL_INVERT)
+        raw.DepthMask(0)
+        ctx.polygon_offset = (1.0, 1.0)
+        ctx.disable(moderngl.CULL_FACE)
+        self._solid(self.shadow_cube, gl(self.flatten @ cube), self.shadow_color)
+        # OpenGL's defaults again.
+        raw.Disable(GL_STENCIL_TEST)
+        self._stencil(0xFF, GL_ALWAYS, 0, 0xFF, GL_KEEP)
+        raw.DepthMask(1)
+        ctx.polygon_offset = (0.0, 0.0)
+        ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
+        ctx.blend_func = moderngl.DEFAULT_BLENDING
+        ctx.depth_func = "<"
+        raw.ClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE)
+        raw.ClearDepth(1.0)
+        return read(self.fbo, self.size)
+
+
+RAW_BASELINES = {"clear_and_swap": RawClear, "triangle": RawTriangle, "phong": RawPhong, "texture": RawTexture,
+                 "transform_order": RawTransformOrder, "mirror": RawMirror}
 
 
 def cases(env) -> list:

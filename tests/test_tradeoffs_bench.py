@@ -235,13 +235,49 @@ def test_bench_unknown_case_is_one_line() -> None:
     assert proc.returncode == 2 and proc.stderr.strip().endswith("error: no benchmark case matched")
 
 
+# --- the raw-ModernGL baselines (benchmarks/lesson_frames.py) --------------------------------
+
+RAW_BASELINE_LESSONS = ("clear_and_swap", "triangle", "phong", "texture", "transform_order", "mirror")
+
+
+def test_every_raw_baseline_is_checked_here() -> None:
+    assert tuple(_benchmark_module("lesson_frames.py").RAW_BASELINES) == RAW_BASELINE_LESSONS
+
+
+@pytest.mark.parametrize("name", RAW_BASELINE_LESSONS)
+def test_raw_baseline_draws_the_lessons_picture(gl, name: str) -> None:
+    """The bench's "same picture" column, at a small size: the hand-written frame equals
+    glsandbox's pixel for pixel at the lesson's defaults, at several moments, and leaves the
+    shared context's state as it found it (the bench alternates the two on one context)."""
+    from glsandbox.lesson import find_lesson
+
+    def state() -> dict[str, object]:
+        # moderngl's Framebuffer.use() sets the depth write mask from the framebuffer (off for a
+        # colour-only one) and every frame starts with one, glsandbox's too: that one is not compared.
+        return {key: value for key, value in gl.host.raw.state_snapshot().items() if key != "depth_writemask"}
+
+    size = (160, 120)
+    raw = _benchmark_module("lesson_frames.py").RAW_BASELINES[name](gl.host.ctx, size)
+    lesson = find_lesson(name)()
+    for k in (0, 37, 150):
+        expected = gl.render(lesson.at(0.01 * k), size).image.copy()
+        before = state()
+        drawn = np.array(raw.frame(k))
+        assert state() == before, f"{name}: the raw frame left GL state changed"
+        assert np.array_equal(drawn, expected), f"{name} at time {0.01 * k}"
+
+
 # --- the ray tracer's benchmark cases (benchmarks/raytrace.py) ------------------------------
 
 
-def _raytrace_module():
+def _benchmark_module(file_name: str):
     from glsandbox.bench import benchmarks_dir, load_modules
 
-    return next(m for m in load_modules(benchmarks_dir()) if m.__file__.endswith("raytrace.py"))
+    return next(m for m in load_modules(benchmarks_dir()) if m.__file__.endswith(file_name))
+
+
+def _raytrace_module():
+    return _benchmark_module("raytrace.py")
 
 
 def test_raytrace_cases_without_embree_say_so(gl, monkeypatch) -> None:
