@@ -39,6 +39,7 @@ reverse-Z plus polygon offset, holds at every distance the room is seen from.
 
 from __future__ import annotations
 
+import functools
 import math
 import sys
 
@@ -100,6 +101,37 @@ def back_wall_pieces() -> list[tuple[str, np.ndarray]]:
     ]
 
 
+def _lit(rgb: tuple[float, float, float]) -> Material:
+    return Material(color=(*rgb, 1.0), shading="phong")
+
+
+@functools.cache  # the room never moves: built once, its matrices read-only
+def room_nodes() -> tuple[Node, ...]:
+    """The floor, the left wall, the back wall around the glass's hole, and the glass."""
+    depth_z = FRONT - BACK
+    nodes = (
+        Node("floor", geometry.plane(1.0),
+             transforms.translate(0.0, 0.0, (FRONT + BACK) / 2) @ transforms.scale(2 * HALF_WIDTH, 1.0, depth_z),
+             _lit((0.75, 0.72, 0.65))),
+        Node("wall_left", geometry.plane(1.0), quad(depth_z, WALL_HEIGHT, (-HALF_WIDTH, WALL_HEIGHT / 2,
+                                                                        (FRONT + BACK) / 2), "+x"),
+             _lit((0.45, 0.6, 0.5))),
+        *(Node(name, geometry.plane(1.0), model, _lit((0.6, 0.55, 0.7))) for name, model in back_wall_pieces()),
+        Node("glass", geometry.plane(1.0),
+             quad(2 * GLASS_HALF, GLASS_TOP - GLASS_BOTTOM, (0.0, (GLASS_BOTTOM + GLASS_TOP) / 2, BACK), "+z"),
+             Material(color=GLASS_COLOR, shading="solid")),
+    )
+    for node in nodes:
+        node.model.setflags(write=False)
+    return nodes
+
+
+@functools.cache
+def glass_mirror(reflected: tuple[str, ...], stencil: bool) -> Mirror:
+    """The mirror in the back wall's hole, reflecting ``reflected``."""
+    return Mirror("glass", MIRROR_PLANE, reflected, stencil=stencil)
+
+
 @register
 class MirrorLesson(Lesson):
     name = "mirror"
@@ -138,28 +170,17 @@ class MirrorLesson(Lesson):
         v = self.values
         if not float(v["near"]) < float(v["far"]):
             raise SandboxError(f"--set near={v['near']}: must be less than far={v['far']}")
-        lit = lambda rgb: Material(color=(*rgb, 1.0), shading="phong")  # noqa: E731
         light = transforms.light_vector(self.light_vector())
         if light[3] == 1.0:
             shading_light = Light(tuple(float(c) for c in light[:3]))
         else:  # a directional light: a point so far away that its rays are parallel in the room
             shading_light = Light(tuple(float(c) for c in FAR_LIGHT * light[:3]))
-        depth_z = FRONT - BACK
         nodes = [
-            Node("floor", geometry.plane(1.0),
-                 transforms.translate(0.0, 0.0, (FRONT + BACK) / 2) @ transforms.scale(2 * HALF_WIDTH, 1.0, depth_z),
-                 lit((0.75, 0.72, 0.65))),
-            Node("wall_left", geometry.plane(1.0), quad(depth_z, WALL_HEIGHT, (-HALF_WIDTH, WALL_HEIGHT / 2,
-                                                                            (FRONT + BACK) / 2), "+x"),
-                 lit((0.45, 0.6, 0.5))),
-            *(Node(name, geometry.plane(1.0), model, lit((0.6, 0.55, 0.7))) for name, model in back_wall_pieces()),
-            Node("glass", geometry.plane(1.0),
-                 quad(2 * GLASS_HALF, GLASS_TOP - GLASS_BOTTOM, (0.0, (GLASS_BOTTOM + GLASS_TOP) / 2, BACK), "+z"),
-                 Material(color=GLASS_COLOR, shading="solid")),
+            *room_nodes(),
             Node("cube", geometry.cube24(),
                  transforms.translate(*CUBE_CENTRE) @ transforms.rotate_y(0.5 + float(v["speed"]) * self.time)
                  @ transforms.scale(CUBE_HALF, CUBE_HALF, CUBE_HALF),
-                 lit((1.0, 0.5, 0.15))),
+                 _lit((1.0, 0.5, 0.15))),
         ]
         reflected = ["floor", "wall_left", "cube"]
         if light[3] == 1.0:
@@ -169,7 +190,7 @@ class MirrorLesson(Lesson):
             reflected.append("light")
         mirror = None
         if v["mirror"] != "off":
-            mirror = Mirror("glass", MIRROR_PLANE, tuple(reflected), stencil=v["mirror"] == "stencil")
+            mirror = glass_mirror(tuple(reflected), v["mirror"] == "stencil")
         shadow = None
         if v["shadow"] != "off":
             shadow = PlanarShadow("floor", FLOOR_PLANE, self.light_vector(), ("cube",), lift=float(v["lift"]),

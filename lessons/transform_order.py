@@ -35,6 +35,7 @@ order and Tab switches to the split view of all six (``--set view=split``).
 
 from __future__ import annotations
 
+import functools
 import math
 import sys
 from dataclasses import dataclass
@@ -92,6 +93,16 @@ def second_cube_model(order: str, angle: float) -> np.ndarray:
                               R=rotation(angle))
 
 
+def second_cube_models(order: str, angles: np.ndarray) -> np.ndarray:
+    """:func:`second_cube_model` for many angles at once, an (N, 4, 4) stack:
+    ``compose`` multiplies with ``@``, which broadcasts S and T over the stack of R."""
+    c, s = np.cos(-angles), np.sin(-angles)  # rotation(a) is rotate_y(-a)
+    rotations = np.zeros((len(angles), 4, 4))
+    rotations[:, 0, 0], rotations[:, 0, 2], rotations[:, 2, 0], rotations[:, 2, 2] = c, s, -s, c
+    rotations[:, 1, 1] = rotations[:, 3, 3] = 1.0
+    return transforms.compose(order, S=transforms.scale(*SCALE), T=transforms.translate(*OFFSET), R=rotations)
+
+
 def order_classes(angle: float) -> list[list[str]]:
     """The six orders grouped by identical model matrices (exact float64 equality)."""
     groups: list[list[str]] = []
@@ -144,19 +155,25 @@ def matrix_panel(order: str, angle: float) -> np.ndarray:
     return text_image(rows)
 
 
+@functools.cache  # constant: drawn once, shared read-only by every frame
 def figures_panel() -> np.ndarray:
     """The notes' camera constants and what they do (course section "W A S D, Z X")."""
-    return text_image([
+    return _read_only(text_image([
         f"notes' 0.9666/0.259: r 10 -> {course_camera.course_drift(24):.2f} (24 turns),",
         f"{course_camera.course_drift(1000):.2f} (1000); rotateRight det {course_camera.course_right_determinant():.4f}",
-    ])
+    ]))
+
+
+def _read_only(image: np.ndarray) -> np.ndarray:
+    image.setflags(write=False)
+    return image
 
 
 def trail_mesh(order: str, angle: float, span: float) -> geometry.Mesh:
     """The top corner's path while R went from ``angle - span`` to ``angle``, as a line strip."""
-    points = [transforms.transform_points(second_cube_model(order, a), TRAIL_POINT[None])[0]
-              for a in np.linspace(angle - span, angle, TRAIL_SAMPLES)]
-    return geometry.Mesh(f"trail_{order}", np.array(points), mode="line_strip")
+    models = second_cube_models(order, np.linspace(angle - span, angle, TRAIL_SAMPLES))
+    corner = models @ np.append(TRAIL_POINT, 1.0)  # (N, 4): the corner under each model
+    return geometry.Mesh(f"trail_{order}", corner[:, :3] / corner[:, 3:], mode="line_strip")
 
 
 @register

@@ -170,3 +170,26 @@ def test_golden_orders(gl, golden, order: str) -> None:
 def test_golden_split_view(gl, golden) -> None:
     lesson = TransformOrder.from_settings(["view=split", "time=1"])
     golden(gl.render(lesson, SIZE).image, "transform_order/split")
+
+
+def test_the_trail_is_the_top_corner_under_each_recent_model() -> None:
+    from lessons.transform_order import TRAIL_POINT, trail_mesh
+
+    for order in transforms.ORDERS:
+        trail = trail_mesh(order, 1.3, 2.0).positions
+        assert trail.shape == (64, 3)
+        for k in (0, 21, 63):  # sample k sits at angle 1.3 - 2 + 2k/63
+            model = second_cube_model(order, 1.3 - 2.0 + 2.0 * k / 63)
+            np.testing.assert_allclose(trail[k], (model @ np.append(TRAIL_POINT, 1.0))[:3], atol=1e-12)
+
+
+def test_a_new_trail_every_frame_does_not_pile_up_on_the_gpu(gl, monkeypatch) -> None:
+    # Each frame's trail is a new mesh; past MESH_LIMIT the least recently drawn are released.
+    monkeypatch.setattr(gl.executor, "MESH_LIMIT", 6)
+    lesson = TransformOrder(overlay=True)
+    first = gl.render(lesson.at(0.0), (96, 72)).image.copy()
+    for k in range(1, 20):
+        gl.render(lesson.at(0.1 * k), (96, 72))
+        assert gl.executor.mesh_count <= 6
+    # The released meshes come back when drawn again: the first frame is unchanged.
+    np.testing.assert_array_equal(gl.render(lesson.at(0.0), (96, 72)).image, first)

@@ -7,6 +7,7 @@ says and nothing more; choosing passes is :func:`glsandbox.plan.plan`'s job.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import weakref
 from collections.abc import Collection
@@ -89,6 +90,13 @@ def _color_bytes(color: tuple[float, ...]) -> bytes:
     return data
 
 
+@functools.lru_cache(maxsize=1024)
+def _normal_matrix_bytes(model: bytes) -> bytes:
+    """The normal matrix's uniform bytes for a float64 model matrix given as
+    bytes: models that do not move (walls, floors) skip the inverse each frame."""
+    return transforms.gl_bytes(transforms.normal_matrix(np.frombuffer(model).reshape(4, 4)))
+
+
 @dataclass
 class _GpuMesh:
     buffers: dict[str, moderngl.Buffer]
@@ -100,12 +108,20 @@ class _GpuMesh:
 class Executor:
     """Runs plans on one context, keeping programs and meshes between frames."""
 
+    #: Uploaded meshes kept between frames. A lesson that makes a new mesh
+    #: every frame (transform_order's trail) would otherwise fill GPU memory
+    #: in a long-running window: past this many, the least recently drawn
+    #: are released (never one the current frame draws).
+    MESH_LIMIT = 256
+
     def __init__(self, host: GLHost) -> None:
         self.host = host
         self.ctx = host.ctx
         self._programs: dict[str, tuple[ProgramVariant, moderngl.Program]] = {}
         self._member_names: dict[str, frozenset[str]] = {}
         self._meshes: dict[tuple[str, str], _GpuMesh] = {}
+        self._mesh_last_frame: dict[tuple[str, str], int] = {}
+        self._frame = 0
         self._vaos: dict[tuple[tuple[str, str], str], moderngl.VertexArray] = {}
         self._overlays: OverlayDrawer | None = None  # made on the first overlay pass
         self._textures = TextureCache(host)
@@ -146,7 +162,29 @@ class Executor:
                 index = self.ctx.buffer(np.asarray(mesh.indices, dtype="u4").tobytes())
             gpu = _GpuMesh(buffers, index, _MODES[mesh.mode], mesh.element_count)
             self._meshes[key] = gpu
+        self._mesh_last_frame[key] = self._frame
         return key, gpu
+
+    @property
+    def mesh_count(self) -> int:
+        """How many meshes are uploaded now."""
+        return len(self._meshes)
+
+    def _release_stale_meshes(self) -> None:
+        """Keep at most :attr:`MESH_LIMIT` meshes, dropping the least recently drawn."""
+        excess = len(self._meshes) - self.MESH_LIMIT
+        if excess <= 0:
+            return
+        stale = sorted((frame, key) for key, frame in self._mesh_last_frame.items() if frame < self._frame)
+        for _, key in stale[:excess]:
+            gpu = self._meshes.pop(key)
+            del self._mesh_last_frame[key]
+            for vao_key in [k for k in self._vaos if k[0] == key]:
+                self._vaos.pop(vao_key).release()
+            for buffer in gpu.buffers.values():
+                buffer.release()
+            if gpu.index is not None:
+                gpu.index.release()
 
     def _vao(self, mesh: Mesh, program_key: str) -> tuple[moderngl.VertexArray, _GpuMesh]:
         key, gpu = self._gpu_mesh(mesh)
@@ -169,6 +207,7 @@ class Executor:
                frame_plan: Plan | None = None) -> Plan:
         """Draw one frame of ``scene`` into ``framebuffer`` (``size`` pixels)."""
         frame_plan = frame_plan or make_plan(scene)
+        self._frame += 1
         for variant in frame_plan.programs:
             self.program(variant)
         nodes = {node.name: node for node in scene.nodes}
@@ -199,6 +238,7 @@ class Executor:
         framebuffer.viewport = (0, 0, *size)
         self._set_depth(False)
         self.ctx.disable(moderngl.CULL_FACE)
+        self._release_stale_meshes()
         return frame_plan
 
     def _clear(self, framebuffer: moderngl.Framebuffer, step: Pass, rect: tuple[int, int, int, int]) -> None:
@@ -244,7 +284,7 @@ class Executor:
             "u_color": _color_bytes(node.material.color),
         }
         if "m_normal" in members:
-            uniforms["m_normal"] = transforms.gl_bytes(transforms.normal_matrix(model))
+            uniforms["m_normal"] = _normal_matrix_bytes(np.asarray(model, dtype=np.float64).tobytes())
         for name, data in uniforms.items():
             if name in members:
                 program[name].write(data)
@@ -283,6 +323,7 @@ class Executor:
         self._textures.release()
         self._vaos.clear()
         self._meshes.clear()
+        self._mesh_last_frame.clear()
         self._programs.clear()
         self._member_names.clear()
 

@@ -25,14 +25,18 @@ class OverlayDrawer:
 
     def __init__(self, ctx: moderngl.Context) -> None:
         self.ctx = ctx
-        self._textures: dict[str, tuple[str, moderngl.Texture]] = {}
+        # name -> (content digest, texture, the image last uploaded)
+        self._textures: dict[str, tuple[str, moderngl.Texture, np.ndarray]] = {}
         self._vao: tuple[int, moderngl.VertexArray] | None = None
 
     def _texture(self, overlay: Overlay) -> moderngl.Texture:
+        entry = self._textures.get(overlay.name)
+        if entry is not None and entry[2] is overlay.image and not overlay.image.flags.writeable:
+            return entry[1]  # the same read-only array as last time (a panel made once): nothing to hash
         image = np.ascontiguousarray(overlay.image, dtype=np.uint8)
         digest = hashlib.blake2b(image.tobytes(), digest_size=12).hexdigest() + str(image.shape)
-        entry = self._textures.get(overlay.name)
         if entry is not None and entry[0] == digest:
+            self._textures[overlay.name] = (digest, entry[1], overlay.image)
             return entry[1]
         h, w = image.shape[:2]
         if entry is not None and entry[1].size == (w, h):
@@ -43,7 +47,7 @@ class OverlayDrawer:
                 entry[1].release()
             texture = self.ctx.texture((w, h), 4, image.tobytes(), alignment=1)
             texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        self._textures[overlay.name] = (digest, texture)
+        self._textures[overlay.name] = (digest, texture, overlay.image)
         return texture
 
     def _vertex_array(self, program: moderngl.Program) -> moderngl.VertexArray:
@@ -79,7 +83,7 @@ class OverlayDrawer:
             self.ctx.blend_func = moderngl.DEFAULT_BLENDING
 
     def release(self) -> None:
-        for _, texture in self._textures.values():
+        for _, texture, _ in self._textures.values():
             texture.release()
         self._textures.clear()
         if self._vao is not None:
