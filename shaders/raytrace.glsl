@@ -6,27 +6,35 @@
 // in float32. A fragment shader, not a compute shader: on llvmpipe it
 // measured about 5x faster for this.
 //
-// Data (uploaded per frame by glsandbox/raytrace/gpu.py), RGBA32F textures
-// read with texelFetch as flat arrays of vec4 records:
-//   u_tris   TRI_RECORDS per triangle: v0 | e1 | e2 | n0,uv0.x | n1,uv0.y |
-//            n2,uv1.x | c0,uv1.y | c1,uv2.x | c2,uv2.y   (world space)
-//   u_nodes  NODE_RECORDS per node: box min,kind | box max,cull |
-//            start,count,scene order,0 | colour,mode | ka,kd,ks,n |
-//            reflectivity,texture,lamp bits | inverse model (3 rows) |
-//            normal matrix (3 rows); mesh nodes first (u_mesh_count of
-//            them), then sphere nodes (u_sphere_count).
+// Data (uploaded by glsandbox/raytrace/gpu.py), flat arrays of vec4 records:
+//   triangles  TRI_RECORDS per triangle: v0 | e1 | e2 | n0,uv0.x | n1,uv0.y |
+//              n2,uv1.x | c0,uv1.y | c1,uv2.x | c2,uv2.y   (world space)
+//   nodes      NODE_RECORDS per node: box min,kind | box max,cull |
+//              start,count,scene order,0 | colour,mode | ka,kd,ks,n |
+//              reflectivity,texture,lamp bits | inverse model (3 rows) |
+//              normal matrix (3 rows); mesh nodes first (u_mesh_count of
+//              them), then sphere nodes (u_sphere_count).
+// Small scenes keep them in a uniform block (SceneData: u_node, u_tri),
+// larger ones in RGBA32F textures read with texelFetch (u_nodes, u_tris).
+//
 // Variants: NUM_LIGHTS (the light loop), NUM_TEXTURES (0..4 samplers),
 // SHADOWS (shadow rays), REFLECT (reflection bounces), HAS_MESHES,
-// HAS_SPHERES.
+// HAS_SPHERES, VERTEX_COLORS (a node uses them); SCENE_NODES (the scene's
+// node list, see nearest()) with NODE_COUNT, and TRIS_IN_BLOCK with
+// TRI_COUNT (the triangles fit the uniform block).
 //
-// Why variants and two node loops: llvmpipe runs a fragment shader on 8
-// lanes with execution masks; an `if` whose lanes are all off still executes
-// (masked), and a loop runs its body at least once. Code a scene cannot
-// reach (shadow rays with shadows off, the sphere test in a scene without
-// spheres, the sphere test for a mesh node) is therefore compiled out or
-// kept out of the loops instead of branched around. Ties keep the course's
-// min_indis rule exactly: the first node in scene order, then the first
-// triangle, wins.
+// Why variants: llvmpipe runs a fragment shader on 8 lanes (pixels) at
+// once with execution masks. An `if` whose lanes are all off still executes
+// (masked); only a loop can skip work, and only iterations after the first:
+// it runs while any lane is still in it. So code a scene cannot reach
+// (shadow rays with shadows off, the sphere test in a scene without
+// spheres, vertex colours nobody uses) is compiled out instead of branched
+// around, and the AABB test decides how many iterations a node's triangle
+// loop runs. Data read with an index the compiler can see is constant (a
+// node's records in an unrolled node list) is one load for all 8 lanes; an
+// index that varies per lane is 8 loads, and texelFetch costs more again.
+// Ties keep the course's min_indis rule exactly: the first node in scene
+// order, then the first triangle, wins.
 
 #define TEX_WIDTH 1024
 #define TRI_RECORDS 9
@@ -37,8 +45,6 @@
 #include "common/fullscreen_vertex.glsl"
 
 #elif defined(FRAGMENT_SHADER)
-uniform sampler2D u_tris;
-uniform sampler2D u_nodes;
 uniform int u_mesh_count;    // mesh nodes: records 0 .. u_mesh_count-1
 uniform int u_sphere_count;  // sphere nodes: the next u_sphere_count records
 uniform vec2 u_size;        // the image in pixels
@@ -69,9 +75,27 @@ uniform sampler2D u_tex3;
 #endif
 out vec4 frag_color;
 
+#if defined(SCENE_NODES)
+layout(std140) uniform SceneData {
+    vec4 u_node[NODE_COUNT * NODE_RECORDS];
+#if TRIS_IN_BLOCK
+    vec4 u_tri[TRI_COUNT * TRI_RECORDS];
+#endif
+};
+vec4 node_rec(int k, int r) { return u_node[k * NODE_RECORDS + r]; }
+#endif
+
 vec4 record(sampler2D s, int i) { return texelFetch(s, ivec2(i % TEX_WIDTH, i / TEX_WIDTH), 0); }
+#if !defined(SCENE_NODES)
+uniform sampler2D u_nodes;
 vec4 node_rec(int k, int r) { return record(u_nodes, k * NODE_RECORDS + r); }
+#endif
+#if TRIS_IN_BLOCK
+vec4 tri_rec(int k, int r) { return u_tri[k * TRI_RECORDS + r]; }
+#else
+uniform sampler2D u_tris;
 vec4 tri_rec(int k, int r) { return record(u_tris, k * TRI_RECORDS + r); }
+#endif
 
 // Hızlandırma: AABB. The slab test: the ray is inside the box between the
 // largest entry and the smallest exit; skip the node unless that interval
@@ -86,11 +110,13 @@ bool slab(vec3 o, vec3 inv_d, vec3 lo, vec3 hi, float best) {
     return near <= far && far > 0.0 && near < best;
 }
 
-// Möller–Trumbore: O + t d = V0 + u e1 + v e2 by Cramer's rule.
-// det = e1·(d×e2) = −N·d is positive for a front face: backface culling
-// keeps only det > 0 (course "Hızlandırma: backface culling"). Branchless:
-// under llvmpipe's masks an early return saves nothing.
-float triangle_t(int k, vec3 o, vec3 d, bool cull) {
+// Möller–Trumbore: O + t d = V0 + u e1 + v e2 by Cramer's rule; `uv` gets
+// the hit's barycentric (u, v), which the shading needs (so it is not
+// solved again there). det = e1·(d×e2) = −N·d is positive for a front
+// face: backface culling keeps only det > 0 (course "Hızlandırma: backface
+// culling"). Branchless: under llvmpipe's masks an early return saves
+// nothing.
+float triangle_t(int k, vec3 o, vec3 d, bool cull, out vec2 uv) {
     vec3 v0 = tri_rec(k, 0).xyz;
     vec3 e1 = tri_rec(k, 1).xyz;
     vec3 e2 = tri_rec(k, 2).xyz;
@@ -102,6 +128,7 @@ float triangle_t(int k, vec3 o, vec3 d, bool cull) {
     vec3 q = cross(s, e1);
     float v = dot(d, q) * inv_det;
     float t = dot(e2, q) * inv_det;
+    uv = vec2(u, v);
     bool ok = (cull ? det > 0.0 : det != 0.0) && u >= 0.0 && u <= 1.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0;
     return ok ? t : INF;
 }
@@ -135,15 +162,48 @@ vec3 to_object(int k, vec3 p, float w) {
 
 bool node_cull(vec4 r1) { return u_cull < 0 ? r1.w > 0.5 : u_cull == 1; }
 
-// The nearest hit with t > 0 (tDistances / min_indis): mesh nodes, then
-// sphere nodes; an equal t goes to the node first in scene order (r2.z), and
-// within a node to the first triangle, as the course's loop over the scene.
-float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri) {
+// How many of a mesh node's triangles a ray tests: all of them, or none
+// when the ray misses the node's box (or meets it only beyond `best`).
+// Lanes with 0 leave the triangle loop at once, and when all 8 lanes of a
+// block miss, the loop ends after one masked pass instead of `count`.
+int box_count(int k, vec3 o, vec3 inv_d, float best, int count) {
+    return !u_aabb || slab(o, inv_d, node_rec(k, 0).xyz, node_rec(k, 1).xyz, best) ? count : 0;
+}
+
+// The nearest hit with t > 0 (tDistances / min_indis): its t, node `k`,
+// triangle `j` (-1 for a sphere) and barycentric `uv` (meshes).
+float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv) {
     float best = INF;
-    float best_order = 1e9;
     hit_node = -1;
     hit_tri = -1;
+    hit_uv = vec2(0.0);
     vec3 inv_d = 1.0 / d;
+    vec2 uv;
+#if defined(SCENE_NODES)
+    // The node list unrolled, in scene order: SCENE_NODES is a sequence of
+    // MESH(k, start, count, cull, lamps) and SPHERE(k, cull, lamps) with
+    // the record slot, triangles, one-sidedness and lamp bits as literals,
+    // so every node record is read at a constant index, and a strict `<`
+    // gives ties to the earlier node and triangle (min_indis).
+#define MESH(k, start, count, cull, lamps) { \
+        int stop = start + box_count(k, o, inv_d, best, count); \
+        for (int j = start; j < stop; ++j) { \
+            float t = triangle_t(j, o, d, cull != 0, uv); \
+            if (t < best) { best = t; hit_node = k; hit_tri = j; hit_uv = uv; } \
+        } \
+    }
+#define SPHERE(k, cull, lamps) { \
+        float t = sphere_t(to_object(k, o, 1.0), to_object(k, d, 0.0), cull != 0); \
+        if (t < best) { best = t; hit_node = k; hit_tri = -1; } \
+    }
+    SCENE_NODES
+#undef MESH
+#undef SPHERE
+#else
+    // Any number of nodes: mesh nodes, then sphere nodes, in two loops over
+    // the records; an equal t goes to the node first in scene order (r2.z),
+    // and within a node to the first triangle.
+    float best_order = 1e9;
 #if HAS_MESHES
     for (int k = 0; k < u_mesh_count; ++k) {
         vec4 r0 = node_rec(k, 0);
@@ -154,9 +214,9 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri) {
         int start = int(r2.x);
         int stop = start + int(r2.y);
         for (int j = start; j < stop; ++j) {
-            float t = triangle_t(j, o, d, cull);
+            float t = triangle_t(j, o, d, cull, uv);
             if (t < best || (t == best && t < INF && r2.z < best_order)) {
-                best = t; best_order = r2.z; hit_node = k; hit_tri = j;
+                best = t; best_order = r2.z; hit_node = k; hit_tri = j; hit_uv = uv;
             }
         }
     }
@@ -173,15 +233,33 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri) {
         }
     }
 #endif
+#endif
     return best;
 }
 
 #if SHADOWS
 // The shadow query for light `light`: is anything hit with 0 < t < 1? Any
-// hit answers it, so the search stops at the first; the light's lamp is
-// skipped.
+// hit answers it, so a lane stops testing at its first; the light's lamp
+// is skipped.
 bool occluded(vec3 o, vec3 d, int light) {
     vec3 inv_d = 1.0 / d;
+    vec2 uv;
+#if defined(SCENE_NODES)
+    bool hit = false;
+    // A lamp is known per node and the light loop is unrolled: the lamp
+    // test folds away at compile time.
+#define MESH(k, start, count, cull, lamps) if (((lamps >> light) & 1) == 0) { \
+        int stop = start + box_count(k, o, inv_d, 1.0, count); \
+        for (int j = start; j < stop && !hit; ++j) hit = triangle_t(j, o, d, cull != 0, uv) < 1.0; \
+    }
+#define SPHERE(k, cull, lamps) if (((lamps >> light) & 1) == 0) { \
+        hit = hit || sphere_t(to_object(k, o, 1.0), to_object(k, d, 0.0), cull != 0) < 1.0; \
+    }
+    SCENE_NODES
+#undef MESH
+#undef SPHERE
+    return hit;
+#else
 #if HAS_MESHES
     for (int k = 0; k < u_mesh_count; ++k) {
         vec4 r0 = node_rec(k, 0);
@@ -193,7 +271,7 @@ bool occluded(vec3 o, vec3 d, int light) {
         int start = int(r2.x);
         int stop = start + int(r2.y);
         for (int j = start; j < stop; ++j) {
-            if (triangle_t(j, o, d, cull) < 1.0) return true;
+            if (triangle_t(j, o, d, cull, uv) < 1.0) return true;
         }
     }
 #endif
@@ -207,6 +285,7 @@ bool occluded(vec3 o, vec3 d, int light) {
     }
 #endif
     return false;
+#endif
 }
 #endif
 
@@ -262,8 +341,9 @@ vec3 sample_texture(int slot, vec2 uv) {
 }
 #endif
 
-// Point, unit normal and base colour of a hit.
-void surface(int k, int j, float t, vec3 o, vec3 d, out vec3 p, out vec3 n, out vec3 base) {
+// Point, unit normal and base colour of a hit; `bary` is the (u, v) the
+// triangle test found.
+void surface(int k, int j, float t, vec2 bary, vec3 o, vec3 d, out vec3 p, out vec3 n, out vec3 base) {
     p = o + t * d;
     vec2 uv = vec2(0.0);
     vec3 colors = vec3(1.0);
@@ -281,19 +361,15 @@ void surface(int k, int j, float t, vec3 o, vec3 d, out vec3 p, out vec3 n, out 
     } else {
 #endif
 #if HAS_MESHES
-        // Barycentric (u, v) of the hit: t(u,v) = V0 + u(V1−V0) + v(V2−V0).
-        vec3 v0 = tri_rec(j, 0).xyz, e1 = tri_rec(j, 1).xyz, e2 = tri_rec(j, 2).xyz;
-        vec3 pp = cross(d, e2);
-        float det = dot(e1, pp);
-        vec3 s = o - v0;
-        float u = dot(s, pp) / det;
-        float v = dot(d, cross(s, e1)) / det;
-        vec3 w = vec3(1.0 - u - v, u, v);
+        // Barycentric weights of the hit: t(u,v) = V0 + u(V1−V0) + v(V2−V0).
+        vec3 w = vec3(1.0 - bary.x - bary.y, bary.x, bary.y);
         vec4 a = tri_rec(j, 3), b = tri_rec(j, 4), c = tri_rec(j, 5);
-        vec4 ca = tri_rec(j, 6), cb = tri_rec(j, 7), cc = tri_rec(j, 8);
         n = w.x * a.xyz + w.y * b.xyz + w.z * c.xyz;
+#if VERTEX_COLORS || NUM_TEXTURES > 0
+        vec4 ca = tri_rec(j, 6), cb = tri_rec(j, 7), cc = tri_rec(j, 8);
         uv = w.x * vec2(a.w, b.w) + w.y * vec2(c.w, ca.w) + w.z * vec2(cb.w, cc.w);
         colors = w.x * ca.xyz + w.y * cb.xyz + w.z * cc.xyz;
+#endif
 #endif
 #if HAS_SPHERES && HAS_MESHES
     }
@@ -301,7 +377,9 @@ void surface(int k, int j, float t, vec3 o, vec3 d, out vec3 p, out vec3 n, out 
     n = normalize(n);
     vec4 m = node_rec(k, 3);
     base = m.rgb;
+#if VERTEX_COLORS
     if (int(m.w) == 1) base *= colors;  // vertex colours
+#endif
 #if NUM_TEXTURES > 0
     int slot = int(node_rec(k, 5).y);
     if (slot >= 0) base *= sample_texture(slot, uv);
@@ -348,13 +426,14 @@ void main() {
     float weight = 1.0;
     for (int depth = 0; depth <= u_max_depth; ++depth) {
         int k, j;
-        float t = nearest(o, d, k, j);
+        vec2 bary;
+        float t = nearest(o, d, k, j, bary);
         if (k < 0) {
             color += weight * u_background;
             break;
         }
         vec3 p, n, base;
-        surface(k, j, t, o, d, p, n, base);
+        surface(k, j, t, bary, o, d, p, n, base);
         vec3 local = shade(k, p, n, base, d);
         float r = depth < u_max_depth ? node_rec(k, 5).x : 0.0;
         color += weight * (1.0 - r) * local;
@@ -366,12 +445,13 @@ void main() {
     }
 #else
     int k, j;
-    float t = nearest(o, d, k, j);
+    vec2 bary;
+    float t = nearest(o, d, k, j, bary);
     if (k < 0) {
         color = u_background;
     } else {
         vec3 p, n, base;
-        surface(k, j, t, o, d, p, n, base);
+        surface(k, j, t, bary, o, d, p, n, base);
         color = shade(k, p, n, base, d);
     }
 #endif
