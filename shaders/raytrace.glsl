@@ -14,14 +14,15 @@
 //              reflectivity,texture,lamp bits | inverse model (3 rows) |
 //              normal matrix (3 rows); mesh nodes first (u_mesh_count of
 //              them), then sphere nodes (u_sphere_count).
-// Small scenes keep them in a uniform block (SceneData: u_node, u_tri),
-// larger ones in RGBA32F textures read with texelFetch (u_nodes, u_tris).
+// A small scene has them in a uniform block (SceneData: u_node, u_tri), a
+// larger one in RGBA32F textures read with texelFetch (u_nodes, u_tris).
 //
 // Variants: NUM_LIGHTS (the light loop), NUM_TEXTURES (0..4 samplers),
-// SHADOWS (shadow rays), REFLECT (reflection bounces), HAS_MESHES,
-// HAS_SPHERES, VERTEX_COLORS (a node uses them); SCENE_NODES (the scene's
-// node list, see nearest()) with NODE_COUNT, and TRIS_IN_BLOCK with
-// TRI_COUNT (the triangles fit the uniform block).
+// SHADOWS (shadow rays), REFLECT (reflection bounces: some node reflects
+// and max_depth > 0), HAS_MESHES, HAS_SPHERES, VERTEX_COLORS (a node uses
+// them); SCENE_NODES (the scene's node list, see nearest()) with
+// NODE_COUNT and TRI_COUNT for a small scene, whose records are in the
+// uniform block.
 //
 // Why variants: llvmpipe runs a fragment shader on 8 lanes (pixels) at
 // once with execution masks. An `if` whose lanes are all off still executes
@@ -78,22 +79,15 @@ out vec4 frag_color;
 #if defined(SCENE_NODES)
 layout(std140) uniform SceneData {
     vec4 u_node[NODE_COUNT * NODE_RECORDS];
-#if TRIS_IN_BLOCK
     vec4 u_tri[TRI_COUNT * TRI_RECORDS];
-#endif
 };
 vec4 node_rec(int k, int r) { return u_node[k * NODE_RECORDS + r]; }
-#endif
-
-vec4 record(sampler2D s, int i) { return texelFetch(s, ivec2(i % TEX_WIDTH, i / TEX_WIDTH), 0); }
-#if !defined(SCENE_NODES)
-uniform sampler2D u_nodes;
-vec4 node_rec(int k, int r) { return record(u_nodes, k * NODE_RECORDS + r); }
-#endif
-#if TRIS_IN_BLOCK
 vec4 tri_rec(int k, int r) { return u_tri[k * TRI_RECORDS + r]; }
 #else
 uniform sampler2D u_tris;
+uniform sampler2D u_nodes;
+vec4 record(sampler2D s, int i) { return texelFetch(s, ivec2(i % TEX_WIDTH, i / TEX_WIDTH), 0); }
+vec4 node_rec(int k, int r) { return record(u_nodes, k * NODE_RECORDS + r); }
 vec4 tri_rec(int k, int r) { return record(u_tris, k * TRI_RECORDS + r); }
 #endif
 
@@ -162,12 +156,16 @@ vec3 to_object(int k, vec3 p, float w) {
 
 bool node_cull(vec4 r1) { return u_cull < 0 ? r1.w > 0.5 : u_cull == 1; }
 
-// How many of a mesh node's triangles a ray tests: all of them, or none
+// How many of mesh node k's triangles a ray tests: all of them, or none
 // when the ray misses the node's box (or meets it only beyond `best`).
 // Lanes with 0 leave the triangle loop at once, and when all 8 lanes of a
-// block miss, the loop ends after one masked pass instead of `count`.
-int box_count(int k, vec3 o, vec3 inv_d, float best, int count) {
-    return !u_aabb || slab(o, inv_d, node_rec(k, 0).xyz, node_rec(k, 1).xyz, best) ? count : 0;
+// block miss, the loop ends after one masked pass instead of one per
+// triangle. The count is read from the node's record, not written into the
+// source: with a known bound Mesa unrolls the loop into a test per
+// triangle, each behind its own exit (measured on 8 and 16 mesh nodes:
+// slower, and 1.5 to 1.7 times the compile time).
+int box_count(int k, vec3 o, vec3 inv_d, float best) {
+    return !u_aabb || slab(o, inv_d, node_rec(k, 0).xyz, node_rec(k, 1).xyz, best) ? int(node_rec(k, 2).y) : 0;
 }
 
 // The nearest hit with t > 0 (tDistances / min_indis): its t, node `k`,
@@ -181,22 +179,29 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
     vec2 uv;
 #if defined(SCENE_NODES)
     // The node list unrolled, in scene order: SCENE_NODES is a sequence of
-    // MESH(k, start, count, cull, lamps) and SPHERE(k, cull, lamps) with
-    // the record slot, triangles, one-sidedness and lamp bits as literals,
-    // so every node record is read at a constant index, and a strict `<`
-    // gives ties to the earlier node and triangle (min_indis).
-#define MESH(k, start, count, cull, lamps) { \
-        int stop = start + box_count(k, o, inv_d, best, count); \
+    // MESH(k, start, cull, lamps) (a loop over the node's triangles from
+    // `start`), TRI(k, j, cull, lamps) (one triangle of a node too small to
+    // be worth a loop, gpu.UNROLL_TRIS) and SPHERE(k, cull, lamps), with the
+    // record slot, triangles, one-sidedness and lamp bits as literals, so
+    // node records are read at constant indices, and a strict `<` gives
+    // ties to the earlier node and triangle (min_indis).
+#define MESH(k, start, cull, lamps) { \
+        int stop = start + box_count(k, o, inv_d, best); \
         for (int j = start; j < stop; ++j) { \
             float t = triangle_t(j, o, d, cull != 0, uv); \
             if (t < best) { best = t; hit_node = k; hit_tri = j; hit_uv = uv; } \
         } \
+    }
+#define TRI(k, j, cull, lamps) { \
+        float t = triangle_t(j, o, d, cull != 0, uv); \
+        if (t < best) { best = t; hit_node = k; hit_tri = j; hit_uv = uv; } \
     }
 #define SPHERE(k, cull, lamps) { \
         float t = sphere_t(to_object(k, o, 1.0), to_object(k, d, 0.0), cull != 0); \
         if (t < best) { best = t; hit_node = k; hit_tri = -1; } \
     }
     SCENE_NODES
+#undef TRI
 #undef MESH
 #undef SPHERE
 #else
@@ -246,16 +251,20 @@ bool occluded(vec3 o, vec3 d, int light) {
     vec2 uv;
 #if defined(SCENE_NODES)
     bool hit = false;
-    // A lamp is known per node and the light loop is unrolled: the lamp
-    // test folds away at compile time.
-#define MESH(k, start, count, cull, lamps) if (((lamps >> light) & 1) == 0) { \
-        int stop = start + box_count(k, o, inv_d, 1.0, count); \
+    // The lamp bits are literals: the lamp test is one comparison per node,
+    // none where the compiler unrolls the light loop.
+#define MESH(k, start, cull, lamps) if (((lamps >> light) & 1) == 0) { \
+        int stop = start + box_count(k, o, inv_d, 1.0); \
         for (int j = start; j < stop && !hit; ++j) hit = triangle_t(j, o, d, cull != 0, uv) < 1.0; \
+    }
+#define TRI(k, j, cull, lamps) if (((lamps >> light) & 1) == 0) { \
+        hit = hit || triangle_t(j, o, d, cull != 0, uv) < 1.0; \
     }
 #define SPHERE(k, cull, lamps) if (((lamps >> light) & 1) == 0) { \
         hit = hit || sphere_t(to_object(k, o, 1.0), to_object(k, d, 0.0), cull != 0) < 1.0; \
     }
     SCENE_NODES
+#undef TRI
 #undef MESH
 #undef SPHERE
     return hit;

@@ -5,32 +5,36 @@ fragment, with shadow rays and reflection bounces, the same algorithm as the
 float64 numpy engine (:mod:`glsandbox.raytrace.render`) in float32. The
 :class:`~glsandbox.raytrace.world.World` (world-space triangles, nodes, their
 boxes and materials) is packed into flat arrays of ``vec4`` records: in one
-uniform buffer when the scene is small (every lesson scene but
-``ray_acceleration``'s 2,018 triangles, whose triangles go to an RGBA32F
-texture read with ``texelFetch``); the materials' images become RGBA8
-textures sampled by hand (bilinear, base level, the wrap mode done in the
-shader) exactly as the numpy engine does.
+uniform buffer for a small scene (every lesson scene but
+``ray_acceleration``'s 2,018 triangles), else in two RGBA32F textures read
+with ``texelFetch``; the materials' images become RGBA8 textures sampled by
+hand (bilinear, base level, the wrap mode done in the shader) exactly as
+the numpy engine does.
 
 A fragment shader rather than a compute shader: on llvmpipe the same ray
 cast measured about 10 Mrays/s against 1.9 (DESIGN.md, measured facts).
 
 Speed (``benchmarks/raytrace.py``): llvmpipe runs 8 pixels at once under
-execution masks, so skipped code still costs unless a whole loop can end.
-The program is specialised per scene and options: shadow rays, reflections,
-meshes, spheres and vertex colours are compiled in only when they can
-happen, and for scenes of up to :data:`UNROLL_NODES` nodes the node loop is
-unrolled from the scene's own node list (``SCENE_NODES``: each node's
-triangle range, one-sidedness and lamp bits as literals), which reads node
-records at constant indices (one load for 8 pixels, not 8) and lets the
-AABB test end a node's triangle loop for a block of pixels that all miss
-its box. Shadow rays stop at their first hit; the shading reuses the
-triangle test's barycentrics. The uploaded scene is kept between renders: a
-render of the same scene (the same node objects, lights and viewport)
-reuses it and only moves the camera. Measured on the ``phong`` and
-``ray_phong`` scenes at 800x600 (llvmpipe, 2 cores): 2.2 to 2.5 times
-faster than the texture-and-loop version before it, with the same pixels
-(elsewhere at most 1 level apart: the barycentrics are multiplied by
-``1/det`` instead of divided by ``det``).
+execution masks, so skipped code still costs unless a whole loop can end,
+and a value read at an index that varies per pixel costs 8 loads. The
+program is therefore specialised per scene and options: shadow rays,
+reflection bounces (only where a node reflects), meshes, spheres and vertex
+colours are compiled in only when they can happen, and a small scene's
+program has its node list unrolled from the scene itself (``SCENE_NODES``:
+each node's triangle range, one-sidedness and lamp bits as literals), so
+node records are read at constant indices, the AABB test sets how many
+iterations a node's triangle loop runs (a block of pixels that all miss
+the box leaves after one), and nodes of one or two triangles are tested
+without a loop. Shadow rays stop at their first hit; the shading reuses
+the triangle test's barycentrics. The uploaded scene is kept between
+renders: a render of the same scene (the same node objects, lights and
+viewport) reuses it and only moves the camera. Measured at 800x600
+(llvmpipe, 2 cores) against the texture-and-loop version before: the
+``phong`` and ``ray_phong`` scenes 2.6 to 2.9 times faster with the same
+pixels, the other lessons 2.1 to 2.6 times (textures within 1 level),
+``ray_acceleration`` (the texture path) unchanged. The price is compile
+time: a lesson's first render (compiling its program variant, Mesa's shader
+cache off) took 0.4 to 0.9 s, against 0.2 to 0.35 s before.
 
 Float32 differs from float64 in the last bits of ``t`` and of the shading;
 the image agrees with the numpy engine's to within a couple of 8-bit levels
@@ -60,11 +64,21 @@ TRI_RECORDS = 9
 NODE_RECORDS = 12
 #: Samplers the shader declares at most.
 MAX_TEXTURES = 4
-#: Scenes with at most this many nodes get a program with the node loop
-#: unrolled (``SCENE_NODES`` in ``shaders/raytrace.glsl``).
-UNROLL_NODES = 64
-#: vec4 records the uniform block may hold: 64 KiB, OpenGL's guaranteed
-#: minimum of GL_MAX_UNIFORM_BLOCK_SIZE is 16 KiB but llvmpipe gives 64.
+#: Scenes with at most this many nodes, of which at most UNROLL_LOOPS have
+#: more than UNROLL_TRIS triangles, get a program with the node list
+#: unrolled (``SCENE_NODES`` in ``shaders/raytrace.glsl``). The bounds keep
+#: Mesa's compile time (no shader cache) within about 2 s: it grows
+#: exponentially with the number of triangle loops outside the bounce loop
+#: (8 cubes 0.7 s, 12 cubes 3 s, 16 cubes 82 s), linearly otherwise; 16
+#: nodes of which 8 loop measured 0.9 to 2.2 s.
+UNROLL_NODES = 16
+UNROLL_LOOPS = 8
+#: Mesh nodes of at most this many triangles are tested without a loop
+#: (a loop iteration measured about twice the cost of the same test unrolled).
+UNROLL_TRIS = 2
+#: vec4 records the uniform block may hold at most: 64 KiB, what llvmpipe
+#: allows (about 450 triangles); less where the context's
+#: GL_MAX_UNIFORM_BLOCK_SIZE is smaller (OpenGL guarantees 16 KiB).
 BLOCK_RECORDS = 4096
 
 _TRACERS: dict[int, tuple[moderngl.Context, GpuTracer]] = {}
@@ -77,6 +91,11 @@ def gpu_tracer(ctx: moderngl.Context) -> GpuTracer:
         entry = (ctx, GpuTracer(ctx))
         _TRACERS[id(ctx)] = entry
     return entry[1]
+
+
+def _at_least_one(rows: NDArray[np.float32]) -> NDArray[np.float32]:
+    """``rows``, or one record of zeros for an empty array (a GLSL array has at least one element)."""
+    return rows if rows.shape[0] else np.zeros((1, 4), dtype=np.float32)
 
 
 def _records(rows: NDArray[np.float32]) -> tuple[tuple[int, int], bytes]:
@@ -155,35 +174,30 @@ def _same_key(a: tuple[object, ...] | None, b: tuple[object, ...]) -> bool:
 class _Uploaded:
     """One scene's World on the context: its records and images, kept between renders.
 
-    Where the scene is small enough the records go to one uniform buffer
-    (the shader's ``SceneData`` block) instead of textures: node records
-    when there are at most :data:`UNROLL_NODES` nodes (the shader then
-    unrolls its node loop, :meth:`scene_nodes`), triangle records too when
-    everything fits :data:`BLOCK_RECORDS`. Textures hold the rest.
+    A small scene (at most :data:`UNROLL_NODES` nodes, records within
+    :data:`BLOCK_RECORDS`) has its node and triangle records in one uniform
+    buffer, the shader's ``SceneData`` block, and gets a program with its
+    node list unrolled (:meth:`scene_nodes`); a larger one has them in two
+    RGBA32F textures and the shader's general loops.
     """
 
-    def __init__(self, ctx: moderngl.Context, world: World, key: tuple[object, ...]) -> None:
+    def __init__(self, ctx: moderngl.Context, world: World, key: tuple[object, ...], block_records: int) -> None:
         self.key = key
         self.world = world
         self.tris = pack_triangles(world)
         self.nodes = pack_nodes(world)
         self.mesh_count = sum(1 for node in world.nodes if node.kind != "sphere")
         self.sphere_count = len(world.nodes) - self.mesh_count
-        #: The node loop is unrolled (node records in the block).
-        self.unrolled = len(world.nodes) <= UNROLL_NODES
-        #: The triangle records are in the block as well.
-        self.tris_in_block = self.unrolled and self.tris.shape[0] + self.nodes.shape[0] <= BLOCK_RECORDS
+        loops = sum(1 for node in world.nodes if node.kind != "sphere" and node.count > UNROLL_TRIS)
+        self.unrolled = (len(world.nodes) <= UNROLL_NODES and loops <= UNROLL_LOOPS
+                         and max(1, self.tris.shape[0]) + max(1, self.nodes.shape[0]) <= block_records)
         self.block: moderngl.Buffer | None = None
-        if self.unrolled:
-            rows = [self.nodes if len(world.nodes) else np.zeros((NODE_RECORDS, 4), dtype=np.float32)]
-            if self.tris_in_block:
-                rows.append(self.tris if world.triangle_count else np.zeros((TRI_RECORDS, 4), dtype=np.float32))
-            self.block = ctx.buffer(np.concatenate(rows).tobytes())
         #: Samplers by uniform name, in texture unit order.
         self.textures: dict[str, moderngl.Texture] = {}
-        records = {"u_tris": None if self.tris_in_block else self.tris, "u_nodes": None if self.unrolled else self.nodes}
-        for name, rows in records.items():
-            if rows is not None:
+        if self.unrolled:
+            self.block = ctx.buffer(np.concatenate([_at_least_one(self.nodes), _at_least_one(self.tris)]).tobytes())
+        else:
+            for name, rows in (("u_tris", self.tris), ("u_nodes", self.nodes)):
                 tex_size, data = _records(rows)
                 texture = ctx.texture(tex_size, 4, data, dtype="f4")
                 texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
@@ -199,9 +213,8 @@ class _Uploaded:
         """The program variant's scene-shaped defines (see ``shaders/raytrace.glsl``)."""
         found = [("VERTEX_COLORS", str(int(any(node.mode == MODES["vertex_color"] for node in self.world.nodes))))]
         if self.unrolled:
-            found += [("SCENE_NODES", self.scene_nodes(cull)), ("NODE_COUNT", str(max(1, len(self.world.nodes))))]
-        if self.tris_in_block:
-            found += [("TRIS_IN_BLOCK", "1"), ("TRI_COUNT", str(max(1, self.world.triangle_count)))]
+            found += [("SCENE_NODES", self.scene_nodes(cull)), ("NODE_COUNT", str(max(1, len(self.world.nodes)))),
+                      ("TRI_COUNT", str(max(1, self.world.triangle_count)))]
         return tuple(found)
 
     def scene_nodes(self, cull: bool | None) -> str:
@@ -214,8 +227,10 @@ class _Uploaded:
             one_sided = int(node.cull if cull is None else cull)
             if node.kind == "sphere":
                 parts.append(f"SPHERE({slots[k]},{one_sided},{node.lamp_of})")
+            elif node.count <= UNROLL_TRIS:
+                parts += [f"TRI({slots[k]},{j},{one_sided},{node.lamp_of})" for j in range(node.start, node.start + node.count)]
             else:
-                parts.append(f"MESH({slots[k]},{node.start},{node.count},{one_sided},{node.lamp_of})")
+                parts.append(f"MESH({slots[k]},{node.start},{one_sided},{node.lamp_of})")
         return " ".join(parts)
 
     def same_data(self, world: World) -> bool:
@@ -252,6 +267,8 @@ class GpuTracer:
         self._vaos: dict[tuple[tuple[str, str], ...], moderngl.VertexArray] = {}
         self._targets: dict[tuple[int, int], tuple[moderngl.Texture, moderngl.Framebuffer]] = {}
         self._scenes: list[_Uploaded] = []
+        #: vec4 records a uniform block holds on this context (at most BLOCK_RECORDS).
+        self.block_records = min(BLOCK_RECORDS, int(ctx.info.get("GL_MAX_UNIFORM_BLOCK_SIZE", 16384)) // 16)
         #: Uploads made and reused (what the benchmark's cold and warm figures show).
         self.uploads = 0
         self.reuses = 0
@@ -301,7 +318,7 @@ class GpuTracer:
                 self._scenes.insert(0, self._scenes.pop(i))
                 self.reuses += 1
                 return entry
-        entry = _Uploaded(self.ctx, world, key)
+        entry = _Uploaded(self.ctx, world, key, self.block_records)
         self.uploads += 1
         self._scenes.insert(0, entry)
         while len(self._scenes) > self.KEEP_SCENES:
@@ -324,7 +341,9 @@ class GpuTracer:
         vp = scene.viewports[viewport]
         eye, basis, half_w, half_h = camera_basis(vp.camera or scene.camera, width / height)
         lights = world.light_positions.shape[0]
-        program, vao = self._program(lights, len(world.textures), shadows=bool(shadows), reflect=max_depth > 0,
+        # The bounce loop only where some node reflects.
+        reflect = max_depth > 0 and any(node.reflectivity > 0.0 for node in world.nodes)
+        program, vao = self._program(lights, len(world.textures), shadows=bool(shadows), reflect=reflect,
                                      meshes=uploaded.mesh_count > 0, spheres=uploaded.sphere_count > 0,
                                      scene=uploaded.defines(cull_backfaces))
         from glsandbox.raytrace.render import SHADOW_OFFSET
