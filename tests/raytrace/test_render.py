@@ -175,6 +175,47 @@ def test_gpu_engine_options_match(gl):
         assert (diff > LEVELS).mean() <= MAX_BAD_SHARE, options
 
 
+def render_both_ways(gl, monkeypatch, scene: Scene) -> tuple[np.ndarray, np.ndarray]:
+    """The gpu engine's image with the unrolled program (the scene is small) and
+    with the general one (UNROLL_NODES = 0: no scene counts as small)."""
+    from glsandbox.raytrace import gpu as gpu_engine
+
+    tracer = gpu_engine.gpu_tracer(gl.host.ctx)
+    tracer.forget_scenes()  # each way uploads the scene afresh
+    unrolled = render(scene, SIZE, "gpu", ctx=gl.host.ctx)
+    assert tracer._scenes[0].unrolled
+    tracer.forget_scenes()
+    with monkeypatch.context() as patch:
+        patch.setattr(gpu_engine, "UNROLL_NODES", 0)
+        general = render(scene, SIZE, "gpu", ctx=gl.host.ctx)
+        assert not tracer._scenes[0].unrolled
+    tracer.forget_scenes()
+    return unrolled, general
+
+
+def test_gpu_unrolled_and_general_programs_agree(gl, monkeypatch):
+    """Small scenes get a program with their node list unrolled; larger ones the
+    general loop over textures. Both trace the same picture."""
+    for name in ("ray_phong", "phong"):
+        scene = find_lesson(name)().scene()
+        unrolled, general = render_both_ways(gl, monkeypatch, scene)
+        diff = np.abs(unrolled.astype(int) - general.astype(int)).max(axis=2)
+        assert diff.max() <= 1, name
+
+
+def test_coincident_nodes_show_the_first_node_in_both_engines(gl, monkeypatch):
+    """Two quads in one place: the course's tie rule keeps the first node hit, in
+    numpy (float64), in the gpu's unrolled program and in its general one."""
+    quad = transforms.rotate_x(math.radians(90.0)) @ transforms.scale(4.0, 1.0, 4.0)  # facing +z
+    red, green = Material(color=(1.0, 0.0, 0.0, 1.0)), Material(color=(0.0, 1.0, 0.0, 1.0))
+    scene = Scene("tie", nodes=(Node("first", geometry.plane(1.0), quad, red),
+                                Node("second", geometry.plane(1.0), quad, green)),
+                  camera=Camera(eye=(0.3, 0.2, 5.0)), clear_color=(0.0, 0.0, 0.0, 1.0))
+    for image in (render(scene, SIZE, "numpy"), *render_both_ways(gl, monkeypatch, scene)):
+        centre = image[SIZE[1] // 2 - 10:SIZE[1] // 2 + 10, SIZE[0] // 2 - 10:SIZE[0] // 2 + 10]
+        assert (centre[..., 0] == 255).all() and (centre[..., 1] == 0).all()  # red, the first node
+
+
 def test_lesson_renders_with_either_renderer(gl):
     """The hook: renderer=ray draws the traced image through the raster executor, texel for pixel."""
     cls = find_lesson("phong")
