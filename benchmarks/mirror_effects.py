@@ -23,7 +23,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from glsandbox.app import HeadlessRenderer, parse_size  # noqa: E402
+from glsandbox.cli import parse_size
+from glsandbox.frame import HeadlessRenderer  # noqa: E402
 from glsandbox.plan import plan  # noqa: E402
 from lessons.mirror import MirrorLesson  # noqa: E402
 

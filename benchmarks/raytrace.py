@@ -37,7 +37,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from glsandbox.app import HeadlessRenderer, parse_size
+from glsandbox.cli import parse_size
+from glsandbox.frame import HeadlessRenderer
 from glsandbox.lesson import find_lesson
 from glsandbox.raytrace import RenderStats, render
 from glsandbox.raytrace.gpu import gpu_tracer

@@ -87,9 +87,9 @@ class BenchEnv:
 
     @property
     def renderer(self) -> Any:
-        """One :class:`~glsandbox.app.HeadlessRenderer` on EGL for every case (one context)."""
+        """One :class:`~glsandbox.frame.HeadlessRenderer` on EGL for every case (one context)."""
         if self._renderer is None:
-            from glsandbox.app import HeadlessRenderer
+            from glsandbox.frame import HeadlessRenderer
 
             self._renderer = HeadlessRenderer("egl")
         return self._renderer

@@ -1,8 +1,10 @@
-"""The ``glsandbox`` command.
+"""The ``glsandbox`` command, and ``python -m lessons.<module>``.
 
-``list``, ``run LESSON``, ``render LESSON --out FILE.png``, ``tour [--out DIR]``
-and ``plan LESSON``, where LESSON is a lesson name or a scene ``.toml`` file.
-User errors print ``error: <one line>`` and exit with status 2.
+``list``, ``run LESSON``, ``render LESSON --out FILE.png``, ``tour [--out DIR]``,
+``plan LESSON``, ``compare``, ``tradeoffs`` and ``bench``, where LESSON is a
+lesson name or a scene ``.toml`` file. :func:`lesson_main` is the entry point
+of a lesson module (a window, or ``--headless --out FILE.png``). User errors
+print ``error: <one line>`` and exit with status 2.
 """
 
 from __future__ import annotations
@@ -10,13 +12,22 @@ from __future__ import annotations
 import argparse
 import html
 import json
+import os
 import sys
 import time
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
+
 from glsandbox.errors import SandboxError
+from glsandbox.files import save_png, write_text
+from glsandbox.frame import DEFAULT_SIZE, Frame, HeadlessRenderer, with_samples
+from glsandbox.gl.context import BACKENDS
+from glsandbox.lesson import Lesson, all_lessons, find_lesson
+from glsandbox.plan import plan
+from glsandbox.window import run_window
 
 EXIT_USAGE = 2
 
@@ -33,21 +44,71 @@ def run_guarded(body: Callable[[], int]) -> int:
         return 130
 
 
-def _lesson(args: argparse.Namespace):  # -> Lesson
-    from glsandbox.lesson import find_lesson
+# --- shared by the commands ------------------------------------------------
 
+
+def check_writable(path: Path) -> None:
+    """Refuse an output path we cannot write, before any work is done."""
+    parent = path.parent if str(path.parent) else Path(".")
+    if path.is_dir():
+        raise SandboxError(f"--out {path}: is a folder, expected a .png file name")
+    if path.suffix.lower() != ".png":
+        raise SandboxError(f"--out {path}: the output must be a .png file")
+    if not parent.is_dir():
+        raise SandboxError(f"--out {path}: folder {parent} does not exist")
+    if not os.access(parent, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
+        raise SandboxError(f"--out {path}: not writable")
+
+
+def render_to_file(lesson: Lesson, out: Path, size: tuple[int, int], samples: int = 0,
+                   backend: str | None = None) -> Frame:
+    """Render one lesson headless and write it as a PNG (atomically)."""
+    check_writable(out)
+    with HeadlessRenderer(backend) as renderer:
+        frame = renderer.render(lesson, size, samples)
+    write_png(frame.image, out)
+    return frame
+
+
+def write_png(image: np.ndarray, out: Path) -> None:
+    """Write a PNG atomically; an OS failure becomes a one-line error naming the file."""
+    try:
+        save_png(image, out)
+    except OSError as exc:
+        raise SandboxError(f"--out {out}: cannot write ({exc.strerror or exc})") from None
+
+
+def parse_size(text: str) -> tuple[int, int]:
+    """``WxH`` -> (W, H), refusing anything else with the value named."""
+    w, sep, h = text.lower().partition("x")
+    try:
+        size = (int(w), int(h))
+    except ValueError:
+        size = (0, 0)
+    if not sep or size[0] <= 0 or size[1] <= 0 or max(size) > 16384:
+        raise SandboxError(f"--size {text!r}: expected WIDTHxHEIGHT with positive integers, e.g. 640x480")
+    return size
+
+
+def add_render_options(parser: argparse.ArgumentParser) -> None:
+    """The options shared by every command that renders."""
+    parser.add_argument("--size", default=None, help="frame size WxH (default 640x480)")
+    parser.add_argument("--samples", type=int, default=0, help="MSAA samples (0: none)")
+    parser.add_argument("--backend", default=None, help=f"one of {', '.join(BACKENDS)} "
+                        "(default: GLSANDBOX_BACKEND or auto)")
+    parser.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
+                        help="a lesson parameter (repeatable); every lesson has time=SECONDS")
+
+
+def _lesson(args: argparse.Namespace) -> Lesson:
     return find_lesson(args.lesson).from_settings(args.settings)
 
 
 def _size(args: argparse.Namespace) -> tuple[int, int]:
-    from glsandbox.app import DEFAULT_SIZE, parse_size
-
     return parse_size(args.size) if args.size else DEFAULT_SIZE
 
 
 def cmd_list(args: argparse.Namespace) -> int:
-    from glsandbox.lesson import all_lessons
-
     for cls in all_lessons():
         print(f"{cls.name:<18} {cls.title}  [{cls.course_section}]")
         if args.verbose:
@@ -57,17 +118,12 @@ def cmd_list(args: argparse.Namespace) -> int:
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
-    from glsandbox.app import with_samples
-    from glsandbox.plan import plan
-
     lesson = _lesson(args)
     print(plan(with_samples(lesson.scene(), args.samples)).describe())
     return 0
 
 
 def cmd_render(args: argparse.Namespace) -> int:
-    from glsandbox.app import render_to_file
-
     lesson = _lesson(args)
     size = _size(args)
     frame = render_to_file(lesson, args.out, size, args.samples, args.backend)
@@ -76,18 +132,13 @@ def cmd_render(args: argparse.Namespace) -> int:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from glsandbox.app import run_window
-
     run_window(_lesson(args), _size(args), args.samples, args.backend)
     return 0
 
 
 def cmd_compare(args: argparse.Namespace) -> int:
     """``glsandbox compare``: tiles side by side, then which are identical and how far apart."""
-    from glsandbox.app import HeadlessRenderer, check_writable, with_samples
     from glsandbox.compare import build_variants, compare_variants, default_out
-    from glsandbox.golden import save_png
-    from glsandbox.lesson import find_lesson
 
     lesson_cls = find_lesson(args.lesson)
     out: Path = args.out or default_out(lesson_cls.name)
@@ -109,9 +160,6 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
 
 def cmd_tour(args: argparse.Namespace) -> int:
-    from glsandbox.app import HeadlessRenderer, write_png
-    from glsandbox.lesson import all_lessons
-
     out: Path = args.out
     try:
         out.mkdir(parents=True, exist_ok=True)
@@ -144,8 +192,8 @@ def cmd_tour(args: argparse.Namespace) -> int:
         backend = renderer.host.backend
     summary = {"size": list(size), "samples": args.samples, "backend": backend, "renderer": renderer_name,
                "seconds": round(time.perf_counter() - started, 3), "lessons": results}
-    _write_text(out / "tour.json", json.dumps(summary, indent=2) + "\n")
-    _write_text(out / "index.html", _gallery(summary))
+    write_text(out / "tour.json", json.dumps(summary, indent=2) + "\n")
+    write_text(out / "index.html", _gallery(summary))
     failed = [r["lesson"] for r in results if not r["ok"]]
     print(f"tour: {len(results) - len(failed)} of {len(results)} rendered; gallery {out / 'index.html'}",
           file=sys.stderr)
@@ -153,13 +201,6 @@ def cmd_tour(args: argparse.Namespace) -> int:
         print(f"tour: failed: {', '.join(failed)}", file=sys.stderr)
         return 1
     return 0
-
-
-def _write_text(path: Path, text: str) -> None:
-    """Write via a temporary file, so a reader never sees half a file."""
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)
 
 
 def _gallery(summary: dict) -> str:
@@ -207,8 +248,6 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from glsandbox.app import add_render_options
-
     parser = argparse.ArgumentParser(prog="glsandbox", description="A graphics course as runnable ModernGL lessons.")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
@@ -259,6 +298,29 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     return run_guarded(lambda: args.func(args))
+
+
+def lesson_main(lesson_cls: type[Lesson], argv: list[str] | None = None) -> int:
+    """Entry point of a lesson module: a window, or ``--headless --out FILE.png``."""
+    parser = argparse.ArgumentParser(prog=f"python -m lessons.{lesson_cls.name}",
+                                     description=f"{lesson_cls.title} ({lesson_cls.course_section})")
+    add_render_options(parser)
+    parser.add_argument("--headless", action="store_true", help="render offscreen instead of opening a window")
+    parser.add_argument("--out", type=Path, default=None, help="with --headless: the PNG to write")
+    args = parser.parse_args(argv)
+
+    def body() -> int:
+        lesson = lesson_cls.from_settings(args.settings)
+        size = parse_size(args.size) if args.size else DEFAULT_SIZE
+        if args.headless:
+            out = args.out or Path(f"{lesson_cls.name}.png")
+            frame = render_to_file(lesson, out, size, args.samples, args.backend)
+            print(f"wrote {out} ({size[0]}x{size[1]}, {frame.seconds * 1000:.1f} ms)")
+        else:
+            run_window(lesson, size, args.samples, args.backend)
+        return 0
+
+    return run_guarded(body)
 
 
 if __name__ == "__main__":

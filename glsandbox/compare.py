@@ -287,7 +287,7 @@ def difference_rows(images: list[np.ndarray], labels: list[str], groups: list[li
 
 
 def compare(lesson_cls: type[Lesson], varies: list[str], settings: list[str], size: tuple[int, int],
-            renderer) -> Comparison:  # renderer: glsandbox.app.HeadlessRenderer
+            renderer) -> Comparison:  # renderer: glsandbox.frame.HeadlessRenderer
     """Render the composed frame and compare the variants (see the module doc)."""
     variants, columns = build_variants(lesson_cls, varies, settings)
     return compare_variants(variants, columns, size, renderer)

@@ -35,17 +35,16 @@ from __future__ import annotations
 
 import math
 import os
-import tempfile
 import warnings
 from dataclasses import dataclass, replace
 from pathlib import Path, PurePath
 
 import numpy as np
 import numpy.typing as npt
-from PIL import Image
 
 from glsandbox import metrics
 from glsandbox.errors import SandboxError
+from glsandbox.files import load_png, save_png
 
 __all__ = [
     "Comparison",
@@ -306,58 +305,6 @@ def compare_images(
 # --------------------------------------------------------------------------
 # PNG input / output
 # --------------------------------------------------------------------------
-
-
-def load_png(path: str | os.PathLike[str]) -> np.ndarray:
-    """Read a PNG file as a uint8 RGBA array of shape (H, W, 4).
-
-    Greyscale, palette and RGB files are converted to RGBA (opaque alpha).
-
-    Raises:
-        FileNotFoundError: the file does not exist.
-        PIL.UnidentifiedImageError: the file is not a PNG.
-    """
-    with Image.open(path, formats=["PNG"]) as im:
-        return np.array(im.convert("RGBA"), dtype=np.uint8)
-
-
-def save_png(image: npt.ArrayLike, path: str | os.PathLike[str]) -> Path:
-    """Write a uint8 image, (H, W), (H, W, 1), (H, W, 3) or (H, W, 4), as a PNG.
-
-    The write is atomic: the PNG is written to a temporary file in the target
-    folder, flushed to disk and moved over ``path`` with :func:`os.replace`,
-    so readers see either the old file or the complete new one and nothing
-    half-written is left behind on an error. Parent folders are created.
-
-    Returns:
-        The path written.
-    """
-    arr = np.asarray(image)
-    if arr.dtype != np.uint8:
-        raise TypeError(f"cannot save dtype {arr.dtype} as PNG; expected uint8")
-    if arr.ndim == 3 and arr.shape[2] == 1:
-        arr = arr[:, :, 0]
-    if not (arr.ndim == 2 or (arr.ndim == 3 and arr.shape[2] in (3, 4))):
-        raise ValueError(f"cannot save shape {arr.shape} as PNG; expected (H, W[, 1|3|4])")
-    im = Image.fromarray(np.ascontiguousarray(arr))  # uint8: L, RGB or RGBA by shape
-
-    target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp_name = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as f:
-            im.save(f, format="PNG")
-            f.flush()
-            os.fsync(f.fileno())
-        os.chmod(tmp_name, 0o644)  # mkstemp makes 0600; goldens are ordinary files
-        os.replace(tmp_name, target)
-    except BaseException:
-        try:
-            os.unlink(tmp_name)
-        except FileNotFoundError:
-            pass
-        raise
-    return target
 
 
 # --------------------------------------------------------------------------

@@ -2,7 +2,7 @@
 
 A lesson turns its parameter values (always including ``time``) into a
 :class:`~glsandbox.scene.Scene`. Rendering, windows and the CLI are elsewhere
-(:mod:`glsandbox.app`, :mod:`glsandbox.cli`); a lesson is only data and maths,
+(:mod:`glsandbox.frame`, :mod:`glsandbox.window`, :mod:`glsandbox.cli`); a lesson is only data and maths,
 so it renders the same moment exactly, headless or in a window.
 """
 
@@ -147,7 +147,7 @@ class Lesson:
         """The Scene for the current values (``renderer`` marks its viewports)."""
         scene = self.build()
         renderer = self.values.get("renderer", "raster")
-        if renderer != "raster":  # traced by glsandbox.raytrace.render.trace_viewports
+        if renderer != "raster":  # traced by glsandbox.frame.trace_viewports
             scene = replace(scene, viewports=tuple(replace(vp, renderer=renderer) for vp in scene.viewports))
         effects = self.values.get("effects", "needed")  # effects=all: the bench's everything-on plan
         return scene if scene.effects == effects else replace(scene, effects=effects)

@@ -205,7 +205,7 @@ def _needs_depth(scene: Scene) -> bool:
     for index in range(len(scene.viewports)):
         shown = 0
         for node in scene.nodes:
-            if node.viewports is None or index in node.viewports:
+            if node.shown_in(index):
                 shown += 1
                 if shown > 1 or not _is_flat(node):
                     return True
@@ -234,7 +234,7 @@ def plan(scene: Scene) -> Plan:
                            clear_stencil=force or _needs_stencil(scene)))
         draws = []
         for node in scene.nodes:
-            if node.viewports is not None and index not in node.viewports:
+            if not node.shown_in(index):
                 continue
             if scene.mirror is not None and node.name == scene.mirror.node:
                 continue  # the mirror's glass is drawn by the mirror passes
@@ -311,10 +311,6 @@ def _needs_stencil(scene: Scene) -> bool:
                 or (scene.shadow is not None and scene.shadow.stencil))
 
 
-def _shown(node: Node, index: int) -> bool:
-    return node.viewports is None or index in node.viewports
-
-
 def effect_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> list[Pass]:
     """The mirror's and the shadow's passes for viewport ``index``, after its draw pass.
 
@@ -337,7 +333,7 @@ def effect_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
     nodes = {node.name: node for node in scene.nodes}
     passes: list[Pass] = []
     mirror = scene.mirror
-    if mirror is not None and mirror.node in nodes and _shown(nodes[mirror.node], index):
+    if mirror is not None and mirror.node in nodes and nodes[mirror.node].shown_in(index):
         glass = nodes[mirror.node]
         glass_variant = program_for(glass, len(scene.lights))
         programs.add(glass_variant)
@@ -350,7 +346,7 @@ def effect_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
             if name not in nodes:
                 raise SandboxError(f"mirror reflects {name!r}, which is not a node of the scene")
             node = nodes[name]
-            if _shown(node, index):
+            if node.shown_in(index):
                 variant = program_for(node, len(scene.lights))
                 programs.add(variant)
                 reflected.append(Draw(name, variant.key, node.cull_back_faces))
@@ -359,7 +355,7 @@ def effect_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
                            detail="front faces clockwise, lights reflected"))
         passes.append(Pass("mirror_surface", index, draws=(glass_draw,), depth_test=True, detail="blended"))
     shadow = scene.shadow
-    if shadow is not None and shadow.receiver in nodes and _shown(nodes[shadow.receiver], index):
+    if shadow is not None and shadow.receiver in nodes and nodes[shadow.receiver].shown_in(index):
         models = {name: (nodes[name].model, nodes[name].mesh.positions) for name in shadow.casters if name in nodes}
         casting = shadow_casters(shadow, models)
         how = [f"lift {shadow.lift:g}"]
@@ -369,7 +365,7 @@ def effect_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
         culled = [f"{name} culled ({why})" for name, why in casting.culled]
         if casting.reason:
             culled.append(f"culled: {casting.reason}")
-        draws = tuple(Draw(name, SHADOW_PROGRAM.key, False) for name in casting.kept if _shown(nodes[name], index))
+        draws = tuple(Draw(name, SHADOW_PROGRAM.key, False) for name in casting.kept if nodes[name].shown_in(index))
         if draws:
             programs.add(SHADOW_PROGRAM)
         passes.append(Pass("shadow", index, draws=draws, depth_test=True,

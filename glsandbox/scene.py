@@ -174,6 +174,10 @@ class Node:
     cull_back_faces: bool = True
     viewports: tuple[int, ...] | None = None
 
+    def shown_in(self, viewport: int) -> bool:
+        """Whether the node is drawn in viewport ``viewport`` (by index)."""
+        return self.viewports is None or viewport in self.viewports
+
 
 @dataclass(frozen=True)
 class Viewport:
@@ -189,7 +193,7 @@ class Viewport:
     label: str = ""
     #: Who draws the viewport's 3D content: ``"raster"`` (the executor),
     #: ``"ray"`` (the GLSL ray tracer) or ``"ray_numpy"`` (the float64 ray
-    #: tracer); see :func:`glsandbox.raytrace.render.trace_viewports`.
+    #: tracer); see :func:`glsandbox.frame.trace_viewports`.
     renderer: str = "raster"
 
     def __post_init__(self) -> None:

@@ -67,7 +67,7 @@ def downsample(image: np.ndarray, factor: int) -> np.ndarray:
 def render_supersampled(renderer: Any, scene: Scene, size: tuple[int, int], factor: int) -> np.ndarray:
     """Supersampling: render ``scene`` at ``factor`` times the width and
     height, then :func:`downsample` to ``size``. ``renderer`` is a
-    :class:`~glsandbox.app.HeadlessRenderer`. Returns (H, W, 4) ``uint8``."""
+    :class:`~glsandbox.frame.HeadlessRenderer`. Returns (H, W, 4) ``uint8``."""
     if factor < 1:
         raise SandboxError(f"supersampling factor must be 1 or more, got {factor}")
     big = (size[0] * factor, size[1] * factor)
@@ -87,9 +87,9 @@ class Bench:
 
     @property
     def renderer(self) -> Any:
-        """The shared :class:`~glsandbox.app.HeadlessRenderer`."""
+        """The shared :class:`~glsandbox.frame.HeadlessRenderer`."""
         if self._renderer is None:
-            from glsandbox.app import HeadlessRenderer
+            from glsandbox.frame import HeadlessRenderer
 
             self._renderer = HeadlessRenderer(self.backend)
         return self._renderer
@@ -458,7 +458,7 @@ def _slug(text: str) -> str:
 def measure_knob(knob: Knob, bench: Bench, out: Path, quick: bool, runs: int = RUNS,
                  log: Callable[[str], None] = lambda s: None) -> KnobResult:
     """Render every setting and the reference, time them in interleaved runs, compare with the reference."""
-    from glsandbox.golden import save_png
+    from glsandbox.files import save_png
 
     settings = [*knob.chosen(quick), knob.reference]
     pictures = []

@@ -75,7 +75,7 @@ def shade_mask(image: np.ndarray, level: int, tolerance: int = 1) -> np.ndarray:
 
 
 def count_z_fighting(renderer: Any, scene: Scene, size: tuple[int, int]) -> ZFighting:
-    """Render ``scene`` and its oracle with ``renderer`` (a :class:`~glsandbox.app.HeadlessRenderer`)
+    """Render ``scene`` and its oracle with ``renderer`` (a :class:`~glsandbox.frame.HeadlessRenderer`)
     at ``size`` and count the z-fighting pixels of its planar shadow (see the module docstring)."""
     level = shadow_level(scene)
     frame = shade_mask(renderer.render_scene(flat_receiver(scene), size).image, level)

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import sys
 
-from glsandbox.app import lesson_main
+from glsandbox.cli import lesson_main
 from glsandbox.lesson import Lesson, Param, register
 from glsandbox.scene import COURSE_BLUE, Scene, Viewport
 

@@ -24,7 +24,7 @@ import sys
 import numpy as np
 
 from glsandbox import geometry, transforms
-from glsandbox.app import lesson_main
+from glsandbox.cli import lesson_main
 from glsandbox.lesson import Lesson, Param, register
 from glsandbox.scene import Camera, Material, Node, Scene
 

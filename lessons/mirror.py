@@ -46,7 +46,7 @@ import sys
 import numpy as np
 
 from glsandbox import geometry, transforms
-from glsandbox.app import lesson_main
+from glsandbox.cli import lesson_main
 from glsandbox.effects import DEPTH_MODES, Mirror, PlanarShadow
 from glsandbox.errors import SandboxError
 from glsandbox.lesson import Lesson, Param, register

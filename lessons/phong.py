@@ -28,7 +28,7 @@ import math
 import sys
 
 from glsandbox import geometry, transforms
-from glsandbox.app import lesson_main
+from glsandbox.cli import lesson_main
 from glsandbox.lesson import Lesson, Param, register
 from glsandbox.scene import LIT_SHADINGS, NORMAL_MODES, Camera, Light, Material, Node, Scene
 

@@ -25,7 +25,7 @@ import time
 from dataclasses import replace
 
 from glsandbox import geometry, transforms
-from glsandbox.app import lesson_main
+from glsandbox.cli import lesson_main
 from glsandbox.lesson import Lesson, Param, register
 from glsandbox.overlay import Overlay, text_image
 from glsandbox.raytrace import RenderStats, render

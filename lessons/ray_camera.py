@@ -19,7 +19,7 @@ from __future__ import annotations
 import sys
 
 from glsandbox import geometry, transforms
-from glsandbox.app import lesson_main
+from glsandbox.cli import lesson_main
 from glsandbox.lesson import Lesson, register
 from glsandbox.overlay import Overlay, text_image
 from glsandbox.raytrace.world import course_image_plane

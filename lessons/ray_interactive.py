@@ -7,7 +7,7 @@ camera keys of every lesson work (W/S move, A/D turn 15°, Z/X up and down,
 arrows and mouse drag orbit, wheel zooms); while the camera moves the frame
 is traced at a quarter of the resolution each way (16 times fewer rays),
 and at full resolution as soon as it is still
-(:class:`glsandbox.raytrace.render.InteractiveResolution`).
+(:class:`glsandbox.frame.InteractiveResolution`).
 ``--set renderer=raster`` shows the rasterizer's version of the same scene.
 """
 
@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import sys
 
-from glsandbox.app import lesson_main
+from glsandbox.cli import lesson_main
 from glsandbox.lesson import Lesson, register
 from glsandbox.scene import Scene
 from lessons.ray_phong import demo_scene

@@ -29,7 +29,7 @@ import math
 import sys
 
 from glsandbox import geometry, transforms
-from glsandbox.app import lesson_main
+from glsandbox.cli import lesson_main
 from glsandbox.lesson import Lesson, Param, register
 from glsandbox.overlay import Overlay, text_image
 from glsandbox.raytrace import Plane, Ray, Sphere, first_hit, in_shadow, reflect, shadow_ray

@@ -19,7 +19,7 @@ import sys
 import numpy as np
 
 from glsandbox import geometry, transforms
-from glsandbox.app import lesson_main
+from glsandbox.cli import lesson_main
 from glsandbox.lesson import Lesson, register
 from glsandbox.overlay import Overlay, text_image
 from glsandbox.raytrace import Ray, Sphere, nearest_hit

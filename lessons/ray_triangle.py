@@ -22,7 +22,7 @@ import time
 import numpy as np
 
 from glsandbox import transforms
-from glsandbox.app import lesson_main
+from glsandbox.cli import lesson_main
 from glsandbox.geometry import Mesh
 from glsandbox.lesson import Lesson, Param, register
 from glsandbox.overlay import Overlay, text_image

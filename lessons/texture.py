@@ -27,7 +27,7 @@ import sys
 from dataclasses import replace
 
 from glsandbox import geometry, transforms
-from glsandbox.app import lesson_main
+from glsandbox.cli import lesson_main
 from glsandbox.lesson import Lesson, Param, register
 from glsandbox.scene import TEXTURE_FILTERS, TEXTURE_WRAPS, Camera, Material, Node, Scene, Texture
 

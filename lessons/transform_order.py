@@ -44,7 +44,7 @@ import numpy as np
 
 from glsandbox import camera as course_camera
 from glsandbox import geometry, transforms
-from glsandbox.app import lesson_main
+from glsandbox.cli import lesson_main
 from glsandbox.errors import SandboxError
 from glsandbox.lesson import Lesson, Param, register
 from glsandbox.overlay import Overlay, text_image

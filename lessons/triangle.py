@@ -14,7 +14,7 @@ from __future__ import annotations
 import sys
 
 from glsandbox import geometry
-from glsandbox.app import lesson_main
+from glsandbox.cli import lesson_main
 from glsandbox.lesson import Lesson, Param, register
 from glsandbox.scene import Camera, Material, Node, Scene, Viewport
 

@@ -86,7 +86,7 @@ def need(resource: str, reason: str) -> None:
 @pytest.fixture(scope="session")
 def gl_renderer():
     """A headless renderer on the default backend (EGL, else OSMesa), shared by the session."""
-    from glsandbox.app import HeadlessRenderer
+    from glsandbox.frame import HeadlessRenderer
     from glsandbox.errors import SandboxError
 
     try:
@@ -99,7 +99,7 @@ def gl_renderer():
 
 @pytest.fixture
 def gl(gl_renderer):
-    """The shared :class:`~glsandbox.app.HeadlessRenderer` (``gl.render(lesson, size)``)."""
+    """The shared :class:`~glsandbox.frame.HeadlessRenderer` (``gl.render(lesson, size)``)."""
     return gl_renderer
 
 

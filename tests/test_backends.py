@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from conftest import backend_available, need
 
-from glsandbox.golden import load_png
+from glsandbox.files import load_png
 from glsandbox.lesson import all_lessons
 
 LESSONS = [cls.name for cls in all_lessons()]

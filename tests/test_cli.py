@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from glsandbox.golden import load_png
+from glsandbox.files import load_png
 
 REPO = Path(__file__).resolve().parent.parent
 

@@ -14,7 +14,7 @@ from conftest import need
 from glsandbox.cli import main
 from glsandbox.compare import build_variants, compare_variants, compose, parse_vary, tile_rects
 from glsandbox.errors import SandboxError
-from glsandbox.golden import load_png
+from glsandbox.files import load_png
 from glsandbox.lesson import find_lesson
 from glsandbox.plan import plan
 

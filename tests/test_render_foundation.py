@@ -103,7 +103,7 @@ def test_odd_sizes_render(gl, size) -> None:
 
 
 def test_a_second_renderer_in_the_process_leaves_the_first_intact(gl) -> None:
-    from glsandbox.app import HeadlessRenderer
+    from glsandbox.frame import HeadlessRenderer
 
     lesson = find_lesson("indexed_cube")(time=0.5)
     before = np.array(gl.render(lesson, (64, 64)).image)

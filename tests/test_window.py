@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 from conftest import need
 
-from glsandbox.golden import compare_images, load_png
+from glsandbox.files import load_png
+from glsandbox.golden import compare_images
 from glsandbox.lesson import find_lesson
 
 REPO = Path(__file__).resolve().parent.parent

@@ -312,7 +312,7 @@ class GpuTracer:
         if len(world.textures) > MAX_TEXTURES:
             raise RayTraceError(f"the gpu engine samples at most {MAX_TEXTURES} textures per viewport, "
                                 f"scene {scene.name!r} has {len(world.textures)}")
-        for i, entry in enumerate(self._scenes):  # new objects, same data (trace_viewports rebuilds nodes)
+        for i, entry in enumerate(self._scenes):  # new objects, same data (glsandbox.frame.trace_viewports rebuilds nodes)
             if entry.same_data(world):
                 entry.key = key
                 self._scenes.insert(0, self._scenes.pop(i))

@@ -61,7 +61,7 @@ from glsandbox.raytrace.vec import length
 from glsandbox.raytrace.world import World, build_world, camera_rays
 from glsandbox.scene import Scene
 
-__all__ = ["ENGINES", "SHADOW_OFFSET", "InteractiveResolution", "RenderStats", "render", "render_viewport", "to_rgba8", "trace_viewports"]
+__all__ = ["ENGINES", "SHADOW_OFFSET", "RenderStats", "render", "render_viewport", "to_rgba8"]
 
 #: The two engines.
 ENGINES = ("numpy", "gpu")
@@ -412,79 +412,3 @@ def render(scene: Scene, size: tuple[int, int], engine: str = "numpy", *, ctx: o
     if stats is not None:
         stats.seconds += time.perf_counter() - start
     return frame
-
-
-# --- the raster-versus-ray hook ----------------------------------------------
-
-
-def trace_viewports(scene: Scene, size: tuple[int, int], ctx: object | None = None,
-                    resolution: float = 1.0) -> Scene:
-    """The hook that lets every lesson render with either renderer.
-
-    Viewports whose ``renderer`` is ``"ray"`` (GLSL engine on ``ctx``) or
-    ``"ray_numpy"`` are traced now; each becomes a plain viewport with no
-    nodes that shows its traced image as its first overlay (drawn texel for
-    pixel, so the rasterizer's own overlays still land on top). A scene with
-    only raster viewports comes back unchanged. The result is an ordinary
-    Scene for the raster executor. ``resolution`` < 1 traces that fraction
-    of the pixels in each direction and enlarges the image (nearest pixel):
-    the interactive window's coarse frames while the camera moves.
-    """
-    from glsandbox.overlay import Overlay
-
-    ray = {i for i, vp in enumerate(scene.viewports) if vp.renderer != "raster"}
-    if not ray:
-        return scene
-    width, height = size
-    images = []
-    for i in sorted(ray):
-        vp = scene.viewports[i]
-        w, h = vp.pixels(width, height)[2:]
-        if w <= 0 or h <= 0:
-            continue
-        single = replace(scene, viewports=(replace(vp, rect=(0.0, 0.0, 1.0, 1.0)),),
-                         nodes=tuple(replace(n, viewports=None) for n in scene.nodes
-                                     if n.viewports is None or i in n.viewports), overlays=())
-        engine = "gpu" if vp.renderer == "ray" and ctx is not None else "numpy"
-        if resolution < 1.0:
-            small = (max(1, math.ceil(w * resolution)), max(1, math.ceil(h * resolution)))
-            image = render(single, small, engine, ctx=ctx)
-            rows = np.minimum((np.arange(h) * small[1]) // h, small[1] - 1)
-            cols = np.minimum((np.arange(w) * small[0]) // w, small[0] - 1)
-            image = np.ascontiguousarray(image[rows][:, cols])
-        else:
-            image = render(single, (w, h), engine, ctx=ctx)
-        images.append(Overlay(f"raytrace/{i}", image, viewport=i, position=(0, 0)))
-    everywhere = tuple(range(len(scene.viewports)))
-    nodes = []
-    for node in scene.nodes:
-        shown = tuple(v for v in (node.viewports if node.viewports is not None else everywhere) if v not in ray)
-        if shown:
-            nodes.append(node if shown == node.viewports or (node.viewports is None and shown == everywhere)
-                         else replace(node, viewports=shown))
-    viewports = tuple(replace(vp, renderer="raster") for vp in scene.viewports)
-    return replace(scene, nodes=tuple(nodes), viewports=viewports, overlays=(*images, *scene.overlays))
-
-
-class InteractiveResolution:
-    """The interactive ray tracer's rule: coarse while the camera moves, full when still.
-
-    :meth:`resolution` is called once per window frame with the scene about
-    to be drawn; while its camera differs from the last frame's (or did
-    within ``settle`` seconds) it answers ``moving`` (a quarter of the
-    pixels each way by default: 16 times fewer rays), then 1.
-    """
-
-    def __init__(self, moving: float = 0.25, settle: float = 0.3) -> None:
-        self.moving = moving
-        self.settle = settle
-        self._last: object | None = None
-        self._moved_at = -math.inf
-
-    def resolution(self, scene: Scene, now: float | None = None) -> float:
-        now = time.perf_counter() if now is None else now
-        cameras = tuple(vp.camera or scene.camera for vp in scene.viewports)
-        if self._last is not None and cameras != self._last:
-            self._moved_at = now
-        self._last = cameras
-        return self.moving if now - self._moved_at < self.settle else 1.0

@@ -221,7 +221,7 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
     batches: list[TriangleBatch | None] = []
     start = 0
     for node in scene.nodes:
-        if node.viewports is not None and viewport not in node.viewports:
+        if not node.shown_in(viewport):
             continue
         mesh = node.mesh
         if mesh.mode in ("lines", "line_strip"):

@@ -17,7 +17,8 @@ from glsandbox import geometry, transforms
 from glsandbox.errors import SandboxError
 from glsandbox.lesson import all_lessons, find_lesson
 from glsandbox.raytrace import Sphere
-from glsandbox.raytrace.render import InteractiveResolution, RenderStats, render, trace_viewports
+from glsandbox.frame import InteractiveResolution, trace_viewports
+from glsandbox.raytrace.render import RenderStats, render
 from glsandbox.raytrace.world import build_world, camera_rays, course_image_plane
 from glsandbox.scene import Camera, Light, Material, Node, Scene, Viewport
 

@@ -1,0 +1,94 @@
+"""Reading and writing files: PNG images and text, written atomically.
+
+Every file glsandbox writes (rendered PNGs, goldens, the tour's JSON and
+gallery, reports, plots) goes through :func:`atomic_write`: the bytes go to a
+temporary file in the target folder under a unique name, are flushed to disk
+and then moved over the target with :func:`os.replace`. A reader sees the old
+file or the complete new one, never half of one; two writers of the same name
+never share a temporary file; on any error the temporary file is removed.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+from typing import BinaryIO
+
+import numpy as np
+import numpy.typing as npt
+from PIL import Image
+
+__all__ = ["atomic_write", "load_png", "png_bytes", "save_png", "write_text"]
+
+
+def atomic_write(path: str | os.PathLike[str], data: bytes | Callable[[BinaryIO], object]) -> Path:
+    """Write ``data`` (bytes, or a function writing to a binary file) to ``path`` atomically.
+
+    Parent folders are created. The temporary name is ``.<name>.<random>.tmp``
+    beside the target (unique per call, made by :func:`tempfile.mkstemp`).
+    OS errors propagate as :class:`OSError`; nothing is left behind.
+    """
+    target = Path(path)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp_name = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            if callable(data):
+                data(f)
+            else:
+                f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        os.chmod(tmp_name, 0o644)  # mkstemp makes 0600; outputs are ordinary files
+        os.replace(tmp_name, target)
+    except BaseException:
+        try:
+            os.unlink(tmp_name)
+        except FileNotFoundError:
+            pass
+        raise
+    return target
+
+
+def write_text(path: str | os.PathLike[str], text: str) -> Path:
+    """Write UTF-8 text atomically (see :func:`atomic_write`)."""
+    return atomic_write(path, text.encode("utf-8"))
+
+
+def _png_image(image: npt.ArrayLike) -> Image.Image:
+    arr = np.asarray(image)
+    if arr.dtype != np.uint8:
+        raise TypeError(f"cannot save dtype {arr.dtype} as PNG; expected uint8")
+    if arr.ndim == 3 and arr.shape[2] == 1:
+        arr = arr[:, :, 0]
+    if not (arr.ndim == 2 or (arr.ndim == 3 and arr.shape[2] in (3, 4))):
+        raise ValueError(f"cannot save shape {arr.shape} as PNG; expected (H, W[, 1|3|4])")
+    return Image.fromarray(np.ascontiguousarray(arr))  # uint8: L, RGB or RGBA by shape
+
+
+def png_bytes(image: npt.ArrayLike) -> bytes:
+    """A uint8 image, (H, W), (H, W, 1), (H, W, 3) or (H, W, 4), encoded as PNG."""
+    buffer = io.BytesIO()
+    _png_image(image).save(buffer, format="PNG")
+    return buffer.getvalue()
+
+
+def save_png(image: npt.ArrayLike, path: str | os.PathLike[str]) -> Path:
+    """Write a uint8 image as a PNG, atomically (:func:`atomic_write`). Returns the path."""
+    return atomic_write(path, png_bytes(image))
+
+
+def load_png(path: str | os.PathLike[str]) -> np.ndarray:
+    """Read a PNG file as a uint8 RGBA array of shape (H, W, 4).
+
+    Greyscale, palette and RGB files are converted to RGBA (opaque alpha).
+
+    Raises:
+        FileNotFoundError: the file does not exist.
+        PIL.UnidentifiedImageError: the file is not a PNG.
+    """
+    with Image.open(path, formats=["PNG"]) as im:
+        return np.array(im.convert("RGBA"), dtype=np.uint8)

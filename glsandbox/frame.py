@@ -1,0 +1,229 @@
+"""One frame from a Scene: the rasterizer and the ray tracer composed.
+
+Every frame, headless or in a window, goes through :class:`FrameRenderer`:
+
+1. viewports the lesson asked to ray-trace (``renderer=ray`` or
+   ``ray_numpy``) are traced first (:func:`trace_viewports`); each becomes a
+   plain viewport showing its traced image, so overlays and split screens
+   keep working. A frame with only raster viewports never enters
+   :mod:`glsandbox.raytrace`;
+2. :func:`glsandbox.plan.plan` lists the passes the scene needs;
+3. the raster executor draws them into an offscreen target with exactly the
+   depth, stencil and MSAA the plan lists.
+
+:class:`HeadlessRenderer` opens a context of its own and reads frames back;
+the window (:mod:`glsandbox.window`) copies the target onto the screen.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from glsandbox.errors import SandboxError
+from glsandbox.gl.context import GLHost, open_context
+from glsandbox.gl.executor import Executor
+from glsandbox.gl.target import OffscreenTarget
+from glsandbox.lesson import Lesson
+from glsandbox.overlay import Overlay
+from glsandbox.plan import Buffers, Plan, plan
+from glsandbox.scene import Scene
+
+__all__ = ["DEFAULT_SIZE", "Frame", "FrameRenderer", "HeadlessRenderer", "InteractiveResolution",
+           "LazyRenderer", "trace_viewports", "with_samples"]
+
+#: The frame size when none is given (``--size``).
+DEFAULT_SIZE = (640, 480)
+
+
+@dataclass
+class Frame:
+    """One rendered frame: the pixels, the plan that made them, and its cost."""
+
+    image: np.ndarray  # (H, W, 4) uint8, top row first
+    plan: Plan
+    seconds: float
+
+
+def with_samples(scene: Scene, samples: int) -> Scene:
+    """The scene with the requested MSAA sample count (0 or 1: none)."""
+    if samples < 0:
+        raise SandboxError(f"--samples {samples}: must be 0 or more")
+    return replace(scene, samples=samples) if samples != scene.samples else scene
+
+
+# --- the raster-versus-ray hook ----------------------------------------------
+
+
+def trace_viewports(scene: Scene, size: tuple[int, int], ctx: object | None = None,
+                    resolution: float = 1.0) -> Scene:
+    """The hook that lets every lesson render with either renderer.
+
+    Viewports whose ``renderer`` is ``"ray"`` (GLSL engine on ``ctx``) or
+    ``"ray_numpy"`` are traced now; each becomes a plain viewport with no
+    nodes that shows its traced image as its first overlay (drawn texel for
+    pixel, so the rasterizer's own overlays still land on top). A scene with
+    only raster viewports comes back unchanged, without importing the ray
+    tracer. The result is an ordinary Scene for the raster executor.
+    ``resolution`` < 1 traces that fraction of the pixels in each direction
+    and enlarges the image (nearest pixel): the interactive window's coarse
+    frames while the camera moves.
+    """
+    ray = {i for i, vp in enumerate(scene.viewports) if vp.renderer != "raster"}
+    if not ray:
+        return scene
+    from glsandbox.raytrace.render import render  # only frames that trace pay for the import
+
+    width, height = size
+    images = []
+    for i in sorted(ray):
+        vp = scene.viewports[i]
+        w, h = vp.pixels(width, height)[2:]
+        if w <= 0 or h <= 0:
+            continue
+        single = replace(scene, viewports=(replace(vp, rect=(0.0, 0.0, 1.0, 1.0)),),
+                         nodes=tuple(replace(n, viewports=None) for n in scene.nodes if n.shown_in(i)),
+                         overlays=())
+        engine = "gpu" if vp.renderer == "ray" and ctx is not None else "numpy"
+        if resolution < 1.0:
+            small = (max(1, math.ceil(w * resolution)), max(1, math.ceil(h * resolution)))
+            image = render(single, small, engine, ctx=ctx)
+            rows = np.minimum((np.arange(h) * small[1]) // h, small[1] - 1)
+            cols = np.minimum((np.arange(w) * small[0]) // w, small[0] - 1)
+            image = np.ascontiguousarray(image[rows][:, cols])
+        else:
+            image = render(single, (w, h), engine, ctx=ctx)
+        images.append(Overlay(f"raytrace/{i}", image, viewport=i, position=(0, 0)))
+    everywhere = tuple(range(len(scene.viewports)))
+    nodes = []
+    for node in scene.nodes:
+        shown = tuple(v for v in (node.viewports if node.viewports is not None else everywhere) if v not in ray)
+        if shown:
+            nodes.append(node if shown == node.viewports or (node.viewports is None and shown == everywhere)
+                         else replace(node, viewports=shown))
+    viewports = tuple(replace(vp, renderer="raster") for vp in scene.viewports)
+    return replace(scene, nodes=tuple(nodes), viewports=viewports, overlays=(*images, *scene.overlays))
+
+
+class InteractiveResolution:
+    """The interactive ray tracer's rule: coarse while the camera moves, full when still.
+
+    :meth:`resolution` is called once per window frame with the scene about
+    to be drawn; while its camera differs from the last frame's (or did
+    within ``settle`` seconds) it answers ``moving`` (a quarter of the
+    pixels each way by default: 16 times fewer rays), then 1.
+    """
+
+    def __init__(self, moving: float = 0.25, settle: float = 0.3) -> None:
+        self.moving = moving
+        self.settle = settle
+        self._last: object | None = None
+        self._moved_at = -math.inf
+
+    def resolution(self, scene: Scene, now: float | None = None) -> float:
+        now = time.perf_counter() if now is None else now
+        cameras = tuple(vp.camera or scene.camera for vp in scene.viewports)
+        if self._last is not None and cameras != self._last:
+            self._moved_at = now
+        self._last = cameras
+        return self.moving if now - self._moved_at < self.settle else 1.0
+
+
+# --- renderers ---------------------------------------------------------------
+
+
+class FrameRenderer:
+    """Draws scenes into offscreen targets on one context, reusing programs and targets.
+
+    Every frame goes into a target made for its plan, so a frame has the
+    buffers its plan lists whether it ends up read back (headless) or copied
+    onto a window, whose own framebuffer has fixed ones (24-bit integer
+    depth, no float depth for reverse-Z).
+    """
+
+    #: Targets kept for reuse; a window being resized makes one per size.
+    KEEP_TARGETS = 8
+
+    def __init__(self, host: GLHost) -> None:
+        self.host = host
+        self.executor = Executor(host)
+        self._targets: dict[tuple[tuple[int, int], Buffers], OffscreenTarget] = {}
+
+    def target(self, size: tuple[int, int], buffers: Buffers) -> OffscreenTarget:
+        key = (size, buffers)
+        target = self._targets.get(key)
+        if target is None:
+            if len(self._targets) >= self.KEEP_TARGETS:  # drop the oldest
+                self._targets.pop(next(iter(self._targets))).release()
+            target = self._targets[key] = OffscreenTarget(self.host, size, buffers)
+        return target
+
+    def draw(self, scene: Scene, size: tuple[int, int],
+             ray_resolution: float = 1.0) -> tuple[Plan, OffscreenTarget]:
+        """Draw one frame; returns its plan and the target holding it.
+        ``ray_resolution`` < 1 traces ray-traced viewports coarser (the window while moving)."""
+        self.host.make_current()
+        scene = trace_viewports(scene, size, self.host.ctx, ray_resolution)
+        frame_plan = plan(scene)
+        target = self.target(size, frame_plan.buffers)
+        self.executor.render(scene, target.framebuffer, size, frame_plan)
+        return frame_plan, target
+
+    def close(self) -> None:
+        self.host.make_current()  # deletes must reach this context's objects
+        for target in self._targets.values():
+            target.release()
+        self._targets.clear()
+        self.executor.release()
+
+
+class HeadlessRenderer(FrameRenderer):
+    """Renders lessons offscreen on a context of its own and reads the frames back."""
+
+    def __init__(self, backend: str | None = None) -> None:
+        super().__init__(open_context(backend))
+
+    def render_scene(self, scene: Scene, size: tuple[int, int]) -> Frame:
+        start = time.perf_counter()
+        frame_plan, target = self.draw(scene, size)
+        image = target.read()
+        return Frame(image, frame_plan, time.perf_counter() - start)
+
+    def render(self, lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: int = 0) -> Frame:
+        return self.render_scene(with_samples(lesson.scene(), samples), size)
+
+    def close(self) -> None:
+        super().close()
+        self.host.release()
+
+    def __enter__(self) -> HeadlessRenderer:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+class LazyRenderer:
+    """A :class:`HeadlessRenderer` opened on first use and shared until :meth:`close`.
+
+    The measuring tools (``glsandbox bench``, ``glsandbox tradeoffs``) hold
+    one: a run whose cases all skip never opens a context.
+    """
+
+    def __init__(self, backend: str | None = None) -> None:
+        self.backend = backend
+        self._renderer: HeadlessRenderer | None = None
+
+    @property
+    def renderer(self) -> HeadlessRenderer:
+        if self._renderer is None:
+            self._renderer = HeadlessRenderer(self.backend)
+        return self._renderer
+
+    def close(self) -> None:
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
