@@ -32,7 +32,7 @@ import numpy as np
 
 from glsandbox import metrics
 from glsandbox.errors import SandboxError
-from glsandbox.lesson import Lesson, Param, unknown_param_message
+from glsandbox.lesson import Lesson, Param
 from glsandbox.overlay import Overlay, text_image
 from glsandbox.scene import Node, Scene, Viewport
 
@@ -94,22 +94,12 @@ class Comparison:
 
 def parse_vary(lesson_cls: type[Lesson], text: str) -> Vary:
     """Parse ``key=v1,v2,...`` against the lesson's parameters; every value is validated."""
-    key, sep, rest = text.partition("=")
-    key = key.strip()
-    if not sep or not key:
-        raise SandboxError(f"--vary {text!r}: expected key=value1,value2,...")
-    params = {p.name: p for p in lesson_cls.all_params()}
-    if key not in params:
-        raise SandboxError(unknown_param_message(lesson_cls, key).replace("--set", "--vary", 1))
+    param, rest = lesson_cls.setting(text, "--vary", "key=value1,value2,...")
     texts = tuple(t.strip() for t in rest.split(","))
-    if not texts or any(t == "" for t in texts):
+    if any(t == "" for t in texts):
         raise SandboxError(f"--vary {text!r}: empty value; give values separated by commas")
-    try:
-        values = tuple(params[key].parse(t) for t in texts)
-    except SandboxError as exc:  # Param.parse names the value as --set; here it came from --vary
-        message = str(exc)
-        raise SandboxError("--vary " + message[len("--set "):] if message.startswith("--set ") else message) from None
-    return Vary(params[key], texts, values)
+    values = tuple(param.parse(t, "--vary") for t in texts)
+    return Vary(param, texts, values)
 
 
 def build_variants(lesson_cls: type[Lesson], varies: list[str], settings: list[str]) -> tuple[list[Variant], int]:

@@ -13,7 +13,7 @@ import difflib
 import importlib
 import math
 import pkgutil
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, ClassVar
@@ -33,14 +33,22 @@ class Param:
     choices: tuple[str, ...] | None = None
     minimum: float | None = None
     maximum: float | None = None
+    #: A parser of its own for text values (e.g. :func:`glsandbox.transforms.parse_order`);
+    #: its :class:`SandboxError` is reported with the parameter and value.
+    convert: Callable[[str], Any] | None = None
 
     @property
     def kind(self) -> type:
         return type(self.default)
 
-    def parse(self, text: str) -> Any:
-        """Turn ``--set`` text into a value, or raise naming the value."""
-        where = f"--set {self.name}={text}"
+    def parse(self, text: str, flag: str = "--set") -> Any:
+        """Turn ``--set`` text into a value, or raise naming the value (and ``flag``)."""
+        where = f"{flag} {self.name}={text}"
+        if self.convert is not None:
+            try:
+                return self.convert(text)
+            except SandboxError as exc:
+                raise SandboxError(f"{where}: {exc}") from None
         if self.choices is not None:
             if text not in self.choices:
                 raise SandboxError(f"{where}: expected one of {', '.join(self.choices)}")
@@ -116,18 +124,24 @@ class Lesson:
         return (TIME, RENDERER, EFFECTS_PARAM, *cls.params)
 
     @classmethod
+    def setting(cls, item: str, flag: str = "--set", expected: str = "key=value") -> tuple[Param, str]:
+        """Split ``key=text`` (a ``--set`` or ``--vary`` argument) into the parameter and its text."""
+        key, sep, text = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise SandboxError(f"{flag} {item!r}: expected {expected}")
+        known = {p.name: p for p in cls.all_params()}
+        if key not in known:
+            raise SandboxError(unknown_param_message(cls, key, flag))
+        return known[key], text.strip()
+
+    @classmethod
     def from_settings(cls, settings: Iterable[str]) -> Lesson:
         """Build from ``key=value`` strings (the CLI's ``--set``)."""
-        known = {p.name: p for p in cls.all_params()}
         values: dict[str, Any] = {}
         for item in settings:
-            key, sep, text = item.partition("=")
-            key = key.strip()
-            if not sep or not key:
-                raise SandboxError(f"--set {item!r}: expected key=value")
-            if key not in known:
-                raise SandboxError(unknown_param_message(cls, key))
-            values[key] = known[key].parse(text.strip())
+            param, text = cls.setting(item)
+            values[param.name] = param.parse(text)
         return cls(**values)
 
     @property
@@ -160,11 +174,11 @@ class Lesson:
         return False
 
 
-def unknown_param_message(lesson: type[Lesson] | Lesson, key: str) -> str:
+def unknown_param_message(lesson: type[Lesson] | Lesson, key: str, flag: str = "--set") -> str:
     names = [p.name for p in lesson.all_params()]
     close = difflib.get_close_matches(key, names, n=1)
     hint = f"; did you mean {close[0]!r}?" if close else ""
-    return f"--set {key}: {lesson.name} has no parameter {key!r}{hint} (parameters: {', '.join(names)})"
+    return f"{flag} {key}: {lesson.name} has no parameter {key!r}{hint} (parameters: {', '.join(names)})"
 
 
 class SceneFileLesson(Lesson):

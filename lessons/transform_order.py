@@ -38,14 +38,12 @@ from __future__ import annotations
 import functools
 import math
 import sys
-from dataclasses import dataclass
 
 import numpy as np
 
 from glsandbox import camera as course_camera
 from glsandbox import geometry, transforms
 from glsandbox.cli import lesson_main
-from glsandbox.errors import SandboxError
 from glsandbox.lesson import Lesson, Param, register
 from glsandbox.overlay import Overlay, text_image
 from glsandbox.scene import Camera, Material, Node, Scene, Viewport
@@ -66,17 +64,6 @@ CAMERA = Camera(eye=(0.0, 7.0, 12.0), target=(0.0, 1.2, 0.0), up=(0.0, 1.0, 0.0)
 SPLIT_CAMERA = Camera(eye=(0.0, 8.0, 14.0), target=(0.0, 0.5, 0.0), up=(0.0, 1.0, 0.0), fov_y=60.0)
 #: The split view's layout: three columns, two rows, orders in ORDERS order.
 SPLIT_COLUMNS, SPLIT_ROWS = 3, 2
-
-
-@dataclass(frozen=True)
-class OrderParam(Param):
-    """The ``order`` parameter: any permutation of S, T, R, in either case."""
-
-    def parse(self, text: str) -> str:
-        try:
-            return transforms.parse_order(text)
-        except SandboxError as exc:
-            raise SandboxError(f"--set {self.name}={text}: {exc}") from None
 
 
 def rotation(angle: float) -> np.ndarray:
@@ -184,8 +171,8 @@ class TransformOrder(Lesson):
     order = 35
     animated = True
     params = (
-        OrderParam("order", "STR", "the order S, T, R act on the second cube (STR = mScale*mTranslate*mRotate)",
-                   choices=transforms.ORDERS),
+        Param("order", "STR", "the order S, T, R act on the second cube (STR = mScale*mTranslate*mRotate)",
+              choices=transforms.ORDERS, convert=transforms.parse_order),
         Param("speed", 1.0, "R's angle grows by this many radians per second"),
         Param("spin", 1.0, "the centre cube's spin in radians per second"),
         Param("overlay", True, "the label, matrix, figures and trail (off: pictures compare pixel for pixel)"),
