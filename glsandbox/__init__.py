@@ -1,12 +1,63 @@
 """glsandbox: a graphics course as runnable, tested ModernGL lessons.
 
-The public pieces are a :class:`~glsandbox.scene.Scene` (plain data), its
-:func:`~glsandbox.plan.plan` (only the passes the scene needs), and renderers
-that run a plan: the raster executor in :mod:`glsandbox.gl` and, for the
-course's first half, the ray tracer in :mod:`glsandbox.raytrace`.
+This package's namespace is the public face: everything a lesson or a user
+script needs to describe a scene and run it. A Scene is plain data; the
+rasterizer plans and draws it (:func:`glsandbox.plan.plan`, :mod:`glsandbox.gl`),
+and the ray tracer (:mod:`glsandbox.raytrace`) traces the same Scene::
+
+    import glsandbox
+    from glsandbox import Lesson, Node, Scene, geometry, register
+
+    @register
+    class OneCube(Lesson):
+        name = "one_cube"
+        def build(self) -> Scene:
+            return Scene(self.name, nodes=(Node("cube", geometry.cube()),))
+
+    if __name__ == "__main__":
+        raise SystemExit(glsandbox.run(OneCube))   # a window, or --headless --out cube.png
+
+The layers below (the README's "How it works" table) import downwards only;
+:func:`run` is the one door up to the command line, opened when called.
 """
 
+from glsandbox import camera, geometry, transforms
+from glsandbox.effects import DEPTH_MODES, Mirror, PlanarShadow
 from glsandbox.errors import SandboxError
+from glsandbox.geometry import Mesh
+from glsandbox.lesson import Lesson, Param, register
+from glsandbox.overlay import Overlay, text_image
+from glsandbox.scene import (
+    COURSE_BLUE,
+    LIT_SHADINGS,
+    NORMAL_MODES,
+    TEXTURE_FILTERS,
+    TEXTURE_WRAPS,
+    Camera,
+    Light,
+    Material,
+    Node,
+    Scene,
+    Texture,
+    Viewport,
+)
 
 __version__ = "0.1.0"
-__all__ = ["SandboxError", "__version__"]
+__all__ = [
+    "COURSE_BLUE", "DEPTH_MODES", "LIT_SHADINGS", "NORMAL_MODES", "TEXTURE_FILTERS", "TEXTURE_WRAPS",
+    "Camera", "Lesson", "Light", "Material", "Mesh", "Mirror", "Node", "Overlay", "Param", "PlanarShadow",
+    "SandboxError", "Scene", "Texture", "Viewport",
+    "__version__", "camera", "geometry", "register", "run", "text_image", "transforms",
+]
+
+
+def run(lesson_cls: type[Lesson], argv: list[str] | None = None) -> int:
+    """Run a lesson class from the command line: a window, or ``--headless --out FILE.png``.
+
+    ``argv`` defaults to ``sys.argv[1:]``; the return value is the exit
+    status (0, or 2 with one ``error:`` line for a mistake). The command
+    line (:mod:`glsandbox.cli`) is imported only now.
+    """
+    from glsandbox.cli import lesson_main
+
+    return lesson_main(lesson_cls, argv)

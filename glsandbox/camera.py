@@ -31,6 +31,7 @@ a positive yaw turns left (a right-handed rotation about +y takes -z towards
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
@@ -77,6 +78,7 @@ def course_rotate_right(p: Sequence[float], camera: Sequence[float] = (0.0, 0.0,
     return q + np.asarray(camera, dtype=np.float64)
 
 
+@functools.cache  # a pure function of two numbers, shown on every frame of some lessons
 def course_drift(turns: int, radius: float = 10.0) -> float:
     """Distance from the camera of a point ``radius`` away after ``turns``
     presses of the notes' rotateLeft, applied one after another as the notes do.

@@ -222,10 +222,22 @@ def all_lessons() -> list[type[Lesson]]:
 
 
 def find_lesson(name_or_path: str) -> type[Lesson]:
-    """A lesson by name, or a scene ``.toml`` file; suggest the closest name."""
+    """A lesson by name, or a scene ``.toml`` file; suggest the closest name.
+
+    A built-in lesson lives in the module of its name (``lessons/<name>.py``),
+    so that module alone is imported; other names look through every lesson.
+    """
     path = Path(name_or_path)
     if name_or_path.endswith(".toml") or path.is_file():
         return scene_file_lesson(path)
+    if name_or_path.isidentifier() and not name_or_path.startswith("_"):
+        try:
+            importlib.import_module(f"lessons.{name_or_path}")
+        except ModuleNotFoundError as exc:
+            if exc.name != f"lessons.{name_or_path}":
+                raise
+        if name_or_path in _REGISTRY:
+            return _REGISTRY[name_or_path]
     lessons_by_name = {cls.name: cls for cls in all_lessons()}
     if name_or_path in lessons_by_name:
         return lessons_by_name[name_or_path]

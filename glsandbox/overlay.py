@@ -45,6 +45,10 @@ class Overlay:
         if image.dtype != np.uint8 or image.ndim != 3 or image.shape[2] != 4 or 0 in image.shape:
             raise SandboxError(f"overlay {self.name!r}: expected a non-empty (H, W, 4) uint8 image, "
                                f"got {image.dtype} {image.shape}")
+        # The overlay keeps the image read-only: the GL side may then skip
+        # re-hashing the same array object from one frame to the next.
+        image.setflags(write=False)
+        object.__setattr__(self, "image", image)
 
     def placement(self, region: tuple[int, int, int, int]) -> tuple[int, int, int, int]:
         """Where the image lands, as a GL rectangle (x, y from the bottom left, w, h) in pixels."""
@@ -63,12 +67,21 @@ def _font() -> ImageFont.ImageFont | ImageFont.FreeTypeFont:
 
 def text_image(rows: Sequence[str | Sequence[str]], *, color: RGBA = TEXT_COLOR, panel: RGBA = PANEL_COLOR,
                padding: int = 3, line_gap: int = 2, column_gap: int = 8) -> np.ndarray:
-    """Rows of text on a panel, as an RGBA array for an :class:`Overlay`.
+    """Rows of text on a panel, as a read-only RGBA array for an :class:`Overlay`.
 
     A row is a string, or a sequence of cells: cells of all such rows are
     right-aligned in shared columns (used for matrices, whose numbers would
-    not line up in a proportional font).
+    not line up in a proportional font). The same rows give back the same
+    array (recently drawn panels are kept), so a lesson may rebuild its
+    overlays every frame and pay for the text once.
     """
+    key = tuple(row if isinstance(row, str) else tuple(row) for row in rows)
+    return _text_image(key, color, panel, padding, line_gap, column_gap)
+
+
+@lru_cache(maxsize=128)
+def _text_image(rows: tuple[str | tuple[str, ...], ...], color: RGBA, panel: RGBA,
+                padding: int, line_gap: int, column_gap: int) -> np.ndarray:
     font = _font()
     draw_probe = ImageDraw.Draw(Image.new("RGBA", (1, 1)))
 
@@ -96,4 +109,6 @@ def text_image(rows: Sequence[str | Sequence[str]], *, color: RGBA = TEXT_COLOR,
                 draw.text((x + col_w[c] - width(cell), y), cell, font=font, fill=color)
                 x += col_w[c] + column_gap
         y += line_h + line_gap
-    return np.asarray(image, dtype=np.uint8).copy()
+    pixels = np.asarray(image, dtype=np.uint8).copy()
+    pixels.setflags(write=False)
+    return pixels

@@ -98,6 +98,17 @@ def rotate_y(angle: float) -> Matrix:
     return np.array([[c, 0, s, 0], [0, 1, 0, 0], [-s, 0, c, 0], [0, 0, 0, 1]], dtype=np.float64)
 
 
+def rotate_y_stack(angles: np.ndarray) -> np.ndarray:
+    """:func:`rotate_y` for many angles at once: an (N, 4, 4) stack, which ``@``
+    broadcasts against single matrices (a whole animation path in one product)."""
+    angles = np.asarray(angles, dtype=np.float64)
+    c, s = np.cos(angles), np.sin(angles)
+    stack = np.zeros((len(angles), 4, 4))
+    stack[:, 0, 0], stack[:, 0, 2], stack[:, 2, 0], stack[:, 2, 2] = c, s, -s, c
+    stack[:, 1, 1] = stack[:, 3, 3] = 1.0
+    return stack
+
+
 def rotate_z(angle: float) -> Matrix:
     """Right-handed rotation about +z by ``angle`` radians (x turns towards y)."""
     c, s = math.cos(angle), math.sin(angle)

@@ -12,9 +12,9 @@ from __future__ import annotations
 
 import sys
 
-from glsandbox.cli import lesson_main
-from glsandbox.lesson import Lesson, Param, register
-from glsandbox.scene import COURSE_BLUE, Scene, Viewport
+import glsandbox
+from glsandbox import COURSE_BLUE, Lesson, Param, Scene, Viewport, register
+
 
 #: Player two's colour: the course's blue with red and blue swapped.
 PLAYER_TWO = (0.6, 0.125, 0.0, 1.0)
@@ -37,4 +37,4 @@ class ClearAndSwap(Lesson):
 
 
 if __name__ == "__main__":
-    sys.exit(lesson_main(ClearAndSwap))
+    sys.exit(glsandbox.run(ClearAndSwap))

@@ -17,23 +17,20 @@ too).
 
 from __future__ import annotations
 
-import functools
 import math
 import sys
 
 import numpy as np
 
-from glsandbox import geometry, transforms
-from glsandbox.cli import lesson_main
-from glsandbox.lesson import Lesson, Param, register
-from glsandbox.scene import Camera, Material, Node, Scene
+import glsandbox
+from glsandbox import Camera, Lesson, Material, Node, Param, Scene, geometry, register, transforms
+
 
 #: Which two of the 12 triangles make each face, in the course's index order.
 FACE_TRIANGLES = {"top": (0, 1), "front": (2, 3)}
 
 
-@functools.cache  # one Mesh per face: rebuilt scenes reuse its upload
-def cube_with_flipped_face(face: str) -> geometry.Mesh:
+def cube_with_flipped_face(face: str) -> glsandbox.Mesh:
     """The course cube with one face's two triangles wound the other way."""
     mesh = geometry.cube()
     if face == "none":
@@ -41,7 +38,11 @@ def cube_with_flipped_face(face: str) -> geometry.Mesh:
     tri = mesh.indices.reshape(-1, 3).copy()
     for k in FACE_TRIANGLES[face]:
         tri[k] = tri[k][[0, 2, 1]]
-    return geometry.Mesh(f"cube_flip_{face}", mesh.positions, tri.reshape(-1), colors=mesh.colors)
+    return glsandbox.Mesh(f"cube_flip_{face}", mesh.positions, tri.reshape(-1), colors=mesh.colors)
+
+
+#: The three cubes of ``--set flip=...``: the course's, and one with a face turned away.
+CUBES = {face: cube_with_flipped_face(face) for face in ("none", "front", "top")}
 
 
 #: The course's camera: eye (0, 3, -10) in DirectX, looking at the origin,
@@ -60,7 +61,7 @@ class IndexedCube(Lesson):
     animated = True
     params = (
         Param("speed", 1.0, "turn rate in radians per second (XMMatrixRotationY(t))"),
-        Param("flip", "none", "swap the winding of one face's triangles", choices=("none", "front", "top")),
+        Param("flip", "none", "swap the winding of one face's triangles", choices=tuple(CUBES)),
         Param("cull", True, "back-face culling"),
     )
 
@@ -70,10 +71,10 @@ class IndexedCube(Lesson):
         # DirectX's XMMatrixRotationY(angle), converted by the z mirror.
         dx_rotation = np.array([[c, 0.0, -s, 0.0], [0.0, 1.0, 0.0, 0.0], [s, 0.0, c, 0.0], [0.0, 0.0, 0.0, 1.0]])
         model = transforms.from_directx_matrix(dx_rotation)
-        node = Node("cube", cube_with_flipped_face(self.values["flip"]), model, VERTEX_COLORS,
+        node = Node("cube", CUBES[self.values["flip"]], model, VERTEX_COLORS,
                     cull_back_faces=bool(self.values["cull"]))
         return Scene(self.name, nodes=(node,), camera=COURSE_CAMERA)
 
 
 if __name__ == "__main__":
-    sys.exit(lesson_main(IndexedCube))
+    sys.exit(glsandbox.run(IndexedCube))

@@ -39,18 +39,29 @@ reverse-Z plus polygon offset, holds at every distance the room is seen from.
 
 from __future__ import annotations
 
-import functools
 import math
 import sys
 
 import numpy as np
 
-from glsandbox import geometry, transforms
-from glsandbox.cli import lesson_main
-from glsandbox.effects import DEPTH_MODES, Mirror, PlanarShadow
-from glsandbox.errors import SandboxError
-from glsandbox.lesson import Lesson, Param, register
-from glsandbox.scene import Camera, Light, Material, Node, Scene
+import glsandbox
+from glsandbox import (
+    DEPTH_MODES,
+    Camera,
+    Lesson,
+    Light,
+    Material,
+    Mirror,
+    Node,
+    Param,
+    PlanarShadow,
+    SandboxError,
+    Scene,
+    geometry,
+    register,
+    transforms,
+)
+
 
 #: The room (OpenGL coordinates, y up): floor y = 0, back wall z = BACK, left wall x = -HALF_WIDTH.
 HALF_WIDTH = 5.0
@@ -105,7 +116,6 @@ def _lit(rgb: tuple[float, float, float]) -> Material:
     return Material(color=(*rgb, 1.0), shading="phong")
 
 
-@functools.cache  # the room never moves: built once, its matrices read-only
 def room_nodes() -> tuple[Node, ...]:
     """The floor, the left wall, the back wall around the glass's hole, and the glass."""
     depth_z = FRONT - BACK
@@ -121,12 +131,13 @@ def room_nodes() -> tuple[Node, ...]:
              quad(2 * GLASS_HALF, GLASS_TOP - GLASS_BOTTOM, (0.0, (GLASS_BOTTOM + GLASS_TOP) / 2, BACK), "+z"),
              Material(color=GLASS_COLOR, shading="solid")),
     )
-    for node in nodes:
-        node.model.setflags(write=False)
     return nodes
 
 
-@functools.cache
+#: The room does not move: built once.
+ROOM = room_nodes()
+
+
 def glass_mirror(reflected: tuple[str, ...], stencil: bool) -> Mirror:
     """The mirror in the back wall's hole, reflecting ``reflected``."""
     return Mirror("glass", MIRROR_PLANE, reflected, stencil=stencil)
@@ -176,7 +187,7 @@ class MirrorLesson(Lesson):
         else:  # a directional light: a point so far away that its rays are parallel in the room
             shading_light = Light(tuple(float(c) for c in FAR_LIGHT * light[:3]))
         nodes = [
-            *room_nodes(),
+            *ROOM,
             Node("cube", geometry.cube24(),
                  transforms.translate(*CUBE_CENTRE) @ transforms.rotate_y(0.5 + float(v["speed"]) * self.time)
                  @ transforms.scale(CUBE_HALF, CUBE_HALF, CUBE_HALF),
@@ -215,4 +226,4 @@ class MirrorLesson(Lesson):
 
 
 if __name__ == "__main__":
-    sys.exit(lesson_main(MirrorLesson))
+    sys.exit(glsandbox.run(MirrorLesson))

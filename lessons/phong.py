@@ -27,10 +27,22 @@ from __future__ import annotations
 import math
 import sys
 
-from glsandbox import geometry, transforms
-from glsandbox.cli import lesson_main
-from glsandbox.lesson import Lesson, Param, register
-from glsandbox.scene import LIT_SHADINGS, NORMAL_MODES, Camera, Light, Material, Node, Scene
+import glsandbox
+from glsandbox import (
+    LIT_SHADINGS,
+    NORMAL_MODES,
+    Camera,
+    Lesson,
+    Light,
+    Material,
+    Node,
+    Param,
+    Scene,
+    geometry,
+    register,
+    transforms,
+)
+
 
 #: The course's light colours: vLightColor[2] = {(1,1,1,1), (1,1,0,1)}.
 LIGHT_COLORS = ((1.0, 1.0, 1.0), (1.0, 1.0, 0.0))
@@ -119,4 +131,4 @@ class PhongLesson(Lesson):
 
 
 if __name__ == "__main__":
-    sys.exit(lesson_main(PhongLesson))
+    sys.exit(glsandbox.run(PhongLesson))

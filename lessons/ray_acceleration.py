@@ -24,12 +24,22 @@ import sys
 import time
 from dataclasses import replace
 
-from glsandbox import geometry, transforms
-from glsandbox.cli import lesson_main
-from glsandbox.lesson import Lesson, Param, register
-from glsandbox.overlay import Overlay, text_image
+import glsandbox
+from glsandbox import (
+    Camera,
+    Lesson,
+    Light,
+    Material,
+    Node,
+    Overlay,
+    Param,
+    Scene,
+    geometry,
+    register,
+    text_image,
+    transforms,
+)
 from glsandbox.raytrace import RenderStats, render
-from glsandbox.scene import Camera, Light, Material, Node, Scene
 
 #: Measured at this size, so the lesson stays quick.
 MEASURE_SIZE = (64, 48)
@@ -84,4 +94,4 @@ class RayAcceleration(Lesson):
 
 
 if __name__ == "__main__":
-    sys.exit(lesson_main(RayAcceleration))
+    sys.exit(glsandbox.run(RayAcceleration))

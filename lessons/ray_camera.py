@@ -18,12 +18,21 @@ from __future__ import annotations
 
 import sys
 
-from glsandbox import geometry, transforms
-from glsandbox.cli import lesson_main
-from glsandbox.lesson import Lesson, register
-from glsandbox.overlay import Overlay, text_image
-from glsandbox.raytrace.world import course_image_plane
-from glsandbox.scene import Camera, Light, Material, Node, Scene
+import glsandbox
+from glsandbox import (
+    Camera,
+    Lesson,
+    Light,
+    Material,
+    Node,
+    Overlay,
+    Scene,
+    geometry,
+    register,
+    text_image,
+    transforms,
+)
+from glsandbox.raytrace import course_image_plane
 
 #: The course's image plane: 16 x 9 units at distance 10, so the vertical field of view is 2·atan(4.5/10).
 FOV_Y = 48.46554491945989
@@ -67,4 +76,4 @@ class RayCamera(Lesson):
 
 
 if __name__ == "__main__":
-    sys.exit(lesson_main(RayCamera))
+    sys.exit(glsandbox.run(RayCamera))

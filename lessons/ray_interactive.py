@@ -15,10 +15,9 @@ from __future__ import annotations
 
 import sys
 
-from glsandbox.cli import lesson_main
-from glsandbox.lesson import Lesson, register
-from glsandbox.scene import Scene
-from lessons.ray_phong import demo_scene
+import glsandbox
+from glsandbox import Lesson, Scene, register
+from lessons._scenes import demo_scene
 
 
 @register
@@ -34,4 +33,4 @@ class RayInteractive(Lesson):
 
 
 if __name__ == "__main__":
-    sys.exit(lesson_main(RayInteractive))
+    sys.exit(glsandbox.run(RayInteractive))

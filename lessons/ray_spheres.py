@@ -18,12 +18,21 @@ import sys
 
 import numpy as np
 
-from glsandbox import geometry, transforms
-from glsandbox.cli import lesson_main
-from glsandbox.lesson import Lesson, register
-from glsandbox.overlay import Overlay, text_image
+import glsandbox
+from glsandbox import (
+    Camera,
+    Lesson,
+    Light,
+    Material,
+    Node,
+    Overlay,
+    Scene,
+    geometry,
+    register,
+    text_image,
+    transforms,
+)
 from glsandbox.raytrace import Ray, Sphere, nearest_hit
-from glsandbox.scene import Camera, Light, Material, Node, Scene
 
 #: (name, centre in course coordinates, radius, colour)
 SPHERES = (
@@ -80,4 +89,4 @@ class RaySpheres(Lesson):
 
 
 if __name__ == "__main__":
-    sys.exit(lesson_main(RaySpheres))
+    sys.exit(glsandbox.run(RaySpheres))

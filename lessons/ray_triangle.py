@@ -21,13 +21,21 @@ import time
 
 import numpy as np
 
-from glsandbox import transforms
-from glsandbox.cli import lesson_main
-from glsandbox.geometry import Mesh
-from glsandbox.lesson import Lesson, Param, register
-from glsandbox.overlay import Overlay, text_image
+import glsandbox
+from glsandbox import (
+    Camera,
+    Lesson,
+    Material,
+    Mesh,
+    Node,
+    Overlay,
+    Param,
+    Scene,
+    register,
+    text_image,
+    transforms,
+)
 from glsandbox.raytrace import INSIDE_TESTS, Plane, Ray, Triangle
-from glsandbox.scene import Camera, Material, Node, Scene
 
 V0, V1, V2 = (30.0, -40.0, 60.0), (60.0, -120.0, 0.0), (0.0, -120.0, 0.0)
 GRID = (80, 60)
@@ -95,4 +103,4 @@ class RayTriangle(Lesson):
 
 
 if __name__ == "__main__":
-    sys.exit(lesson_main(RayTriangle))
+    sys.exit(glsandbox.run(RayTriangle))

@@ -26,10 +26,22 @@ import math
 import sys
 from dataclasses import replace
 
-from glsandbox import geometry, transforms
-from glsandbox.cli import lesson_main
-from glsandbox.lesson import Lesson, Param, register
-from glsandbox.scene import TEXTURE_FILTERS, TEXTURE_WRAPS, Camera, Material, Node, Scene, Texture
+import glsandbox
+from glsandbox import (
+    TEXTURE_FILTERS,
+    TEXTURE_WRAPS,
+    Camera,
+    Lesson,
+    Material,
+    Node,
+    Param,
+    Scene,
+    Texture,
+    geometry,
+    register,
+    transforms,
+)
+
 
 GROUND_SIZE = 60.0
 GROUND_Y = -1.0
@@ -85,4 +97,4 @@ def course_uv_table() -> dict[str, list[tuple[tuple[float, float, float], tuple[
 
 
 if __name__ == "__main__":
-    sys.exit(lesson_main(TextureLesson))
+    sys.exit(glsandbox.run(TextureLesson))

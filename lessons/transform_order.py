@@ -35,18 +35,15 @@ order and Tab switches to the split view of all six (``--set view=split``).
 
 from __future__ import annotations
 
-import functools
 import math
 import sys
 
 import numpy as np
 
+import glsandbox
+from glsandbox import Camera, Lesson, Material, Node, Overlay, Param, Scene, Viewport, register, text_image
 from glsandbox import camera as course_camera
 from glsandbox import geometry, transforms
-from glsandbox.cli import lesson_main
-from glsandbox.lesson import Lesson, Param, register
-from glsandbox.overlay import Overlay, text_image
-from glsandbox.scene import Camera, Material, Node, Scene, Viewport
 
 #: The course's second cube: S, T, and the rotation axis of R.
 SCALE = (0.3, 1.0, 0.3)
@@ -83,11 +80,8 @@ def second_cube_model(order: str, angle: float) -> np.ndarray:
 def second_cube_models(order: str, angles: np.ndarray) -> np.ndarray:
     """:func:`second_cube_model` for many angles at once, an (N, 4, 4) stack:
     ``compose`` multiplies with ``@``, which broadcasts S and T over the stack of R."""
-    c, s = np.cos(-angles), np.sin(-angles)  # rotation(a) is rotate_y(-a)
-    rotations = np.zeros((len(angles), 4, 4))
-    rotations[:, 0, 0], rotations[:, 0, 2], rotations[:, 2, 0], rotations[:, 2, 2] = c, s, -s, c
-    rotations[:, 1, 1] = rotations[:, 3, 3] = 1.0
-    return transforms.compose(order, S=transforms.scale(*SCALE), T=transforms.translate(*OFFSET), R=rotations)
+    return transforms.compose(order, S=transforms.scale(*SCALE), T=transforms.translate(*OFFSET),
+                              R=transforms.rotate_y_stack(-np.asarray(angles)))  # rotation(a) is rotate_y(-a)
 
 
 def order_classes(angle: float) -> list[list[str]]:
@@ -142,18 +136,12 @@ def matrix_panel(order: str, angle: float) -> np.ndarray:
     return text_image(rows)
 
 
-@functools.cache  # constant: drawn once, shared read-only by every frame
 def figures_panel() -> np.ndarray:
     """The notes' camera constants and what they do (course section "W A S D, Z X")."""
-    return _read_only(text_image([
+    return text_image([
         f"notes' 0.9666/0.259: r 10 -> {course_camera.course_drift(24):.2f} (24 turns),",
         f"{course_camera.course_drift(1000):.2f} (1000); rotateRight det {course_camera.course_right_determinant():.4f}",
-    ]))
-
-
-def _read_only(image: np.ndarray) -> np.ndarray:
-    image.setflags(write=False)
-    return image
+    ])
 
 
 def trail_mesh(order: str, angle: float, span: float) -> geometry.Mesh:
@@ -236,4 +224,4 @@ class TransformOrder(Lesson):
 
 
 if __name__ == "__main__":
-    sys.exit(lesson_main(TransformOrder))
+    sys.exit(glsandbox.run(TransformOrder))

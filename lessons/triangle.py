@@ -13,10 +13,9 @@ from __future__ import annotations
 
 import sys
 
-from glsandbox import geometry
-from glsandbox.cli import lesson_main
-from glsandbox.lesson import Lesson, Param, register
-from glsandbox.scene import Camera, Material, Node, Scene, Viewport
+import glsandbox
+from glsandbox import Camera, Lesson, Material, Node, Param, Scene, Viewport, geometry, register
+
 
 ORANGE = (1.0, 0.55, 0.1, 1.0)
 #: Looking straight at the quad from +z, so it fills the middle of the view.
@@ -55,4 +54,4 @@ class Triangle(Lesson):
 
 
 if __name__ == "__main__":
-    sys.exit(lesson_main(Triangle))
+    sys.exit(glsandbox.run(Triangle))

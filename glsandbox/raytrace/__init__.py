@@ -51,6 +51,7 @@ from glsandbox.raytrace.triangle import (
     moller_trumbore_many,
 )
 from glsandbox.raytrace.vec import cross, dot, length, normalize
+from glsandbox.raytrace.world import camera_rays, course_image_plane
 
 __all__ = [
     "AABB",
@@ -69,6 +70,8 @@ __all__ = [
     "Sphere",
     "Triangle",
     "TriangleBatch",
+    "camera_rays",
+    "course_image_plane",
     "cross",
     "diffuse_factor",
     "dot",

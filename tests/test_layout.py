@@ -1,0 +1,186 @@
+"""The package's layers: imports point down only, with no loop, and lessons use the public face.
+
+Every import is read from the source (top-level, inside functions and under
+``TYPE_CHECKING`` alike), so an import hidden in a function cannot hide a loop.
+The table is the README's "How it works" table.
+"""
+
+from __future__ import annotations
+
+import ast
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+#: Lowest first. A module may import its own layer and the ones above it in this list.
+LAYERS: list[tuple[str, tuple[str, ...]]] = [
+    ("core", ("glsandbox.errors", "glsandbox.transforms", "glsandbox.geometry", "glsandbox.files")),
+    ("scene data", ("glsandbox.scene", "glsandbox.planar", "glsandbox.effects", "glsandbox.images",
+                    "glsandbox.overlay", "glsandbox.meshfile")),
+    ("scene logic", ("glsandbox.scene_file", "glsandbox.plan", "glsandbox.camera", "glsandbox.lesson")),
+    ("renderers", ("glsandbox.gl", "glsandbox.raytrace")),
+    ("one frame", ("glsandbox.frame",)),
+    ("window and measuring", ("glsandbox.window", "glsandbox.measure")),
+    ("command line", ("glsandbox.cli",)),
+]
+
+#: The two doors up, each opened only when called: lesson discovery
+#: (``glsandbox.lesson`` imports the ``lessons`` package) and ``glsandbox.run``
+#: (the public face imports the command line).
+ALLOWED_UP = {("glsandbox.lesson", "lessons"), ("glsandbox", "glsandbox.cli")}
+
+
+def module_name(path: Path) -> str:
+    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts.pop()
+    return ".".join(parts)
+
+
+def is_module(name: str) -> bool:
+    base = ROOT.joinpath(*name.split("."))
+    return base.with_suffix(".py").is_file() or (base / "__init__.py").is_file()
+
+
+def imports_of(path: Path) -> set[str]:
+    """Every glsandbox/lessons module ``path`` imports, resolved to module names."""
+    found: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            found.update(a.name for a in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            for alias in node.names:  # `from glsandbox import geometry` imports a module
+                sub = f"{node.module}.{alias.name}"
+                found.add(sub if is_module(sub) else node.module)
+    return {n for n in found if n.split(".")[0] in ("glsandbox", "lessons")}
+
+
+def layer_of(name: str) -> int | None:
+    for index, (_, prefixes) in enumerate(LAYERS):
+        if any(name == p or name.startswith(p + ".") for p in prefixes):
+            return index
+    return None
+
+
+def graph() -> dict[str, set[str]]:
+    files = [*ROOT.glob("glsandbox/**/*.py"), *ROOT.glob("lessons/*.py")]
+    return {module_name(f): imports_of(f) for f in files}
+
+
+def test_every_package_module_has_a_layer():
+    unplaced = [m for m in graph() if m.startswith("glsandbox.") and layer_of(m) is None]
+    assert not unplaced, f"modules missing from the layer table (README and LAYERS): {unplaced}"
+
+
+def test_imports_point_down_only():
+    upward = []
+    for module, targets in graph().items():
+        if not module.startswith("glsandbox"):
+            continue
+        for target in targets:
+            if (module, target) in ALLOWED_UP or target == module:
+                continue
+            if target == "glsandbox" and module != "glsandbox":
+                upward.append(f"{module} -> the public face (import the module that defines the name)")
+                continue
+            here, there = layer_of(module), layer_of(target)
+            if module == "glsandbox" or there is None:
+                continue
+            if here is None or there > here or target.startswith("lessons"):
+                upward.append(f"{module} ({LAYERS[here][0] if here is not None else '?'}) -> "
+                              f"{target} ({LAYERS[there][0]})")
+    assert not upward, "imports pointing up:\n" + "\n".join(sorted(upward))
+
+
+def test_the_rasterizer_never_imports_the_ray_tracer():
+    offenders = [f"{m} -> {t}" for m, ts in graph().items() if m.startswith("glsandbox.gl")
+                 for t in ts if t.startswith("glsandbox.raytrace")]
+    assert not offenders
+
+
+def test_no_import_loop():
+    full = graph()
+    edges = {m: {t for t in ts if t in full} for m, ts in full.items()}
+    edges.pop("glsandbox", None)  # the public face re-exports; nothing inside imports it (tested above)
+    for targets in edges.values():
+        targets.discard("glsandbox")
+    state: dict[str, int] = {}
+    stack: list[str] = []
+    loops: list[list[str]] = []
+
+    def visit(node: str) -> None:
+        state[node] = 1
+        stack.append(node)
+        for nxt in sorted(edges.get(node, ())):
+            if state.get(nxt) == 1:
+                loops.append(stack[stack.index(nxt):] + [nxt])
+            elif nxt not in state:
+                visit(nxt)
+        stack.pop()
+        state[node] = 2
+
+    for node in sorted(edges):
+        if node not in state:
+            visit(node)
+    assert not loops, "import loops: " + "; ".join(" -> ".join(loop) for loop in loops)
+
+
+def written_imports(path: Path) -> set[str]:
+    """The module names as written: ``from glsandbox import geometry`` is ``glsandbox``."""
+    found: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            found.update(a.name for a in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            found.add(node.module)
+    return {n for n in found if n.split(".")[0] in ("glsandbox", "lessons")}
+
+
+def test_lessons_use_only_the_public_face():
+    allowed = {"glsandbox", "glsandbox.raytrace"}
+    reaching = {}
+    for path in ROOT.glob("lessons/*.py"):
+        bad = sorted(t for t in written_imports(path) - allowed if not t.startswith("lessons._"))
+        if bad:
+            reaching[path.name] = bad
+    assert not reaching, f"lessons reaching past glsandbox and glsandbox.raytrace: {reaching}"
+
+
+def test_public_face_has_what_a_lesson_needs():
+    import glsandbox
+
+    for name in ("Scene", "Node", "Material", "Camera", "Light", "Viewport", "Texture", "Mirror",
+                 "PlanarShadow", "Overlay", "Lesson", "Param", "register", "geometry", "transforms", "run"):
+        assert hasattr(glsandbox, name), name
+    assert set(glsandbox.__all__) <= set(dir(glsandbox))
+
+
+def test_a_raster_frame_never_loads_the_ray_tracer_and_import_glsandbox_loads_no_gl():
+    script = textwrap.dedent("""
+        import sys
+        import glsandbox
+        assert not any(m.startswith(("moderngl", "glsandbox.gl", "glsandbox.cli")) for m in sys.modules), \\
+            sorted(m for m in sys.modules if m.startswith("glsandbox"))
+        from glsandbox import Node, Scene, geometry
+        from glsandbox.frame import HeadlessRenderer
+        try:
+            renderer = HeadlessRenderer()
+        except glsandbox.SandboxError as exc:
+            print("no-gl", exc)
+            raise SystemExit(0)
+        with renderer:
+            renderer.render_scene(Scene("cube", nodes=(Node("cube", geometry.cube()),)), (32, 32))
+        loaded = sorted(m for m in sys.modules if m.startswith("glsandbox.raytrace"))
+        assert not loaded, loaded
+        print("ok")
+    """)
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=ROOT)
+    assert result.returncode == 0, result.stderr
+    if result.stdout.startswith("no-gl"):
+        from conftest import need
+
+        need("a GL backend", result.stdout)
+    assert result.stdout.strip() == "ok"
