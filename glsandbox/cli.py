@@ -16,6 +16,7 @@ import os
 import sys
 import time
 from collections.abc import Callable
+from typing import NoReturn
 from dataclasses import replace
 from pathlib import Path
 
@@ -27,21 +28,42 @@ from glsandbox.frame import DEFAULT_SIZE, Frame, HeadlessRenderer, with_samples
 from glsandbox.gl.context import BACKENDS
 from glsandbox.lesson import Lesson, all_lessons, find_lesson
 from glsandbox.plan import plan
+from glsandbox.scene import Scene
 from glsandbox.window import run_window
 
 EXIT_USAGE = 2
+#: What a Unix tool exits with when its reader went away (128 + SIGPIPE).
+EXIT_BROKEN_PIPE = 141
+
+
+class ArgumentParser(argparse.ArgumentParser):
+    """argparse with the project's error contract: one ``error:`` line, exit 2 (no usage dump)."""
+
+    def error(self, message: str) -> NoReturn:
+        print(f"error: {self.prog}: {message} (see {self.prog} --help)", file=sys.stderr)
+        raise SystemExit(EXIT_USAGE)
 
 
 def run_guarded(body: Callable[[], int]) -> int:
-    """Run a command body; a :class:`SandboxError` becomes ``error: ...``, exit 2."""
+    """Run a command body; a :class:`SandboxError` becomes ``error: ...``, exit 2.
+
+    A reader that stops early (``glsandbox plan LESSON | head -3``) ends the
+    command quietly, as it ends any Unix tool.
+    """
     try:
-        return body()
+        status = body()
+        sys.stdout.flush()  # a closed pipe shows here, inside the guard, not at interpreter exit
+        return status
     except SandboxError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return EXIT_USAGE
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:
+        # Python would flush stdout again at exit and complain: point it at /dev/null.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_BROKEN_PIPE
 
 
 # --- shared by the commands ------------------------------------------------
@@ -149,11 +171,11 @@ def cmd_compare(args: argparse.Namespace) -> int:
     variants = [replace(v, scene=with_samples(v.scene, args.samples)) for v in variants]
     with HeadlessRenderer(args.backend) as renderer:
         result = compare_variants(variants, columns, size, renderer)
-    save_png(result.image, out)
+    write_png(result.image, out)
     print(result.report())
     if result.difference is not None:  # the first two distinct pictures, amplified
         diff_out = out.with_name(f"{out.stem}-diff.png")
-        save_png(result.difference, diff_out)
+        write_png(result.difference, diff_out)
         print(f"wrote {diff_out} (difference of the first two distinct pictures, x4)")
     print(f"wrote {out} ({size[0]}x{size[1]}, {len(variants)} tiles)")
     return 0
@@ -161,14 +183,17 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
 def cmd_tour(args: argparse.Namespace) -> int:
     out: Path = args.out
+    if args.settings:  # refused before the output folder exists
+        raise SandboxError("--set is per lesson; use glsandbox render LESSON --set ... instead of tour")
+    size = _size(args)
+    with_samples(Scene("samples"), args.samples)  # a bad --samples fails now, not once per lesson
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise SandboxError(f"--out {out}: cannot create folder ({exc.strerror})") from None
-    size = _size(args)
+    if not os.access(out, os.W_OK | os.X_OK):
+        raise SandboxError(f"--out {out}: folder is not writable")
     lessons = all_lessons()
-    if args.settings:
-        raise SandboxError("--set is per lesson; use glsandbox render LESSON --set ... instead of tour")
     results = []
     started = time.perf_counter()
     with HeadlessRenderer(args.backend) as renderer:
@@ -192,8 +217,11 @@ def cmd_tour(args: argparse.Namespace) -> int:
         backend = renderer.host.backend
     summary = {"size": list(size), "samples": args.samples, "backend": backend, "renderer": renderer_name,
                "seconds": round(time.perf_counter() - started, 3), "lessons": results}
-    write_text(out / "tour.json", json.dumps(summary, indent=2) + "\n")
-    write_text(out / "index.html", _gallery(summary))
+    for name, text in (("tour.json", json.dumps(summary, indent=2) + "\n"), ("index.html", _gallery(summary))):
+        try:
+            write_text(out / name, text)
+        except OSError as exc:
+            raise SandboxError(f"--out {out / name}: cannot write ({exc.strerror or exc})") from None
     failed = [r["lesson"] for r in results if not r["ok"]]
     print(f"tour: {len(results) - len(failed)} of {len(results)} rendered; gallery {out / 'index.html'}",
           file=sys.stderr)
@@ -248,7 +276,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="glsandbox", description="A graphics course as runnable ModernGL lessons.")
+    parser = ArgumentParser(prog="glsandbox", description="A graphics course as runnable ModernGL lessons.")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     p = sub.add_parser("list", help="list the lessons")
@@ -302,7 +330,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def lesson_main(lesson_cls: type[Lesson], argv: list[str] | None = None) -> int:
     """Entry point of a lesson module: a window, or ``--headless --out FILE.png``."""
-    parser = argparse.ArgumentParser(prog=f"python -m lessons.{lesson_cls.name}",
+    parser = ArgumentParser(prog=f"python -m lessons.{lesson_cls.name}",
                                      description=f"{lesson_cls.title} ({lesson_cls.course_section})")
     add_render_options(parser)
     parser.add_argument("--headless", action="store_true", help="render offscreen instead of opening a window")

@@ -13,6 +13,7 @@ from __future__ import annotations
 import io
 import os
 import tempfile
+import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import BinaryIO
@@ -24,16 +25,52 @@ from PIL import Image
 __all__ = ["atomic_write", "load_png", "png_bytes", "save_png", "write_text"]
 
 
+#: A file name may have 255 bytes; ``mkstemp`` adds 8 random characters and the suffix.
+_NAME_MAX = 255
+_TMP_SUFFIX = ".tmp"
+#: A temporary file this old was left by a writer that was killed (``kill -9``,
+#: power loss); the next write of the same name removes it.
+STALE_SECONDS = 600.0
+
+
+def _tmp_prefix(name: str) -> str:
+    """``.<name>.``, cut so that the temporary name fits where ``name`` fits."""
+    room = _NAME_MAX - len(".") - len(".") - 8 - len(_TMP_SUFFIX)
+    encoded = name.encode("utf-8")[:room].decode("utf-8", errors="ignore")
+    return f".{encoded}."
+
+
+def _remove_stale(folder: Path, prefix: str) -> None:
+    """Delete this name's temporary files that no live writer can own any more."""
+    cutoff = time.time() - STALE_SECONDS
+    try:
+        entries = list(os.scandir(folder))
+    except OSError:
+        return
+    for entry in entries:
+        if entry.name.startswith(prefix) and entry.name.endswith(_TMP_SUFFIX) \
+                and len(entry.name) == len(prefix) + 8 + len(_TMP_SUFFIX):
+            try:
+                if entry.stat(follow_symlinks=False).st_mtime < cutoff:
+                    os.unlink(entry.path)
+            except OSError:
+                pass
+
+
 def atomic_write(path: str | os.PathLike[str], data: bytes | Callable[[BinaryIO], object]) -> Path:
     """Write ``data`` (bytes, or a function writing to a binary file) to ``path`` atomically.
 
     Parent folders are created. The temporary name is ``.<name>.<random>.tmp``
-    beside the target (unique per call, made by :func:`tempfile.mkstemp`).
-    OS errors propagate as :class:`OSError`; nothing is left behind.
+    beside the target (unique per call, made by :func:`tempfile.mkstemp`, and
+    cut to fit when the name is long); temporary files of the same name older
+    than :data:`STALE_SECONDS` (left by a killed writer) are removed. OS errors
+    propagate as :class:`OSError`; nothing is left behind.
     """
     target = Path(path)
     target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp_name = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
+    prefix = _tmp_prefix(target.name)
+    _remove_stale(target.parent, prefix)
+    fd, tmp_name = tempfile.mkstemp(dir=target.parent, prefix=prefix, suffix=_TMP_SUFFIX)
     try:
         with os.fdopen(fd, "wb") as f:
             if callable(data):

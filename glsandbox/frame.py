@@ -49,9 +49,9 @@ class Frame:
 
 
 def with_samples(scene: Scene, samples: int) -> Scene:
-    """The scene with the requested MSAA sample count (0 or 1: none)."""
-    if samples < 0:
-        raise SandboxError(f"--samples {samples}: must be 0 or more")
+    """The scene with the requested MSAA sample count (0 or 1: none; else a power of two)."""
+    if samples < 0 or (samples > 1 and samples & (samples - 1)):
+        raise SandboxError(f"--samples {samples}: MSAA takes 0 (off) or a power of two (2, 4, 8, ...)")
     return replace(scene, samples=samples) if samples != scene.samples else scene
 
 

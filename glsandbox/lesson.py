@@ -23,6 +23,10 @@ from glsandbox.scene import RENDERERS
 from glsandbox.scene import EFFECTS, Scene, load_scene
 
 
+#: The largest magnitude a number parameter takes unless it says otherwise.
+NUMBER_LIMIT = 1e6
+
+
 @dataclass(frozen=True)
 class Param:
     """A lesson parameter, settable with ``--set name=value``."""
@@ -68,10 +72,14 @@ class Param:
                 raise SandboxError(f"{where}: expected {noun}") from None
             if not math.isfinite(value):
                 raise SandboxError(f"{where}: expected a finite number")
-            if self.minimum is not None and value < self.minimum:
-                raise SandboxError(f"{where}: must be at least {self.minimum:g}")
-            if self.maximum is not None and value > self.maximum:
-                raise SandboxError(f"{where}: must be at most {self.maximum:g}")
+            # Values enter the maths here: bounded, so products (time x speed, a
+            # camera distance, a far plane) stay finite and meaningful.
+            low = -NUMBER_LIMIT if self.minimum is None else self.minimum
+            high = NUMBER_LIMIT if self.maximum is None else self.maximum
+            if value < low:
+                raise SandboxError(f"{where}: must be at least {low:g}")
+            if value > high:
+                raise SandboxError(f"{where}: must be at most {high:g}")
             return value
         return text
 

@@ -1,0 +1,84 @@
+"""Hostile input at the command line: one ``error:`` line and exit 2, or a clean stop; never a
+traceback, never a half-written file or an empty folder left behind (issue 12)."""
+
+from __future__ import annotations
+
+import errno
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from glsandbox import cli
+from test_cli import REPO, assert_user_error, glsandbox
+
+
+@pytest.mark.parametrize("args, fragment", [
+    (["render", "indexed_cube", "--samples", "3"], "--samples 3"),
+    (["render", "indexed_cube", "--samples", "-1"], "--samples -1"),
+    (["render", "indexed_cube", "--set", "time=1e308", "--set", "speed=10"], "time=1e308"),
+    (["render", "mirror", "--set", "far=1e308"], "far=1e308"),
+    (["render", "mirror", "--set", "distance=1e300"], "distance=1e300"),
+    (["render", "mirror", "--set", "lx=1e308", "--set", "light=directional"], "lx=1e308"),
+    (["compare", "phong", "--vary", "speed=1e308,1", "--set", "time=2"], "speed=1e308"),
+])
+def test_out_of_range_numbers_are_refused_where_they_enter(tmp_path: Path, args: list[str], fragment: str) -> None:
+    out = tmp_path / "x.png"
+    assert_user_error(glsandbox(*args, "--out", str(out)), fragment)
+    assert not out.exists()
+
+
+def test_a_bad_sample_count_stops_a_tour_before_it_starts(tmp_path: Path) -> None:
+    out = tmp_path / "tour"
+    assert_user_error(glsandbox("tour", "--samples", "3", "--out", str(out)), "--samples 3")
+    assert not out.exists()
+
+
+def test_argparse_mistakes_are_one_line() -> None:
+    for args in (["render"], ["render", "indexed_cube"], ["nosuchcommand"], ["render", "x", "--samples", "many"]):
+        assert_user_error(glsandbox(*args), "see glsandbox")
+
+
+def test_a_lesson_module_reports_argparse_mistakes_in_one_line() -> None:
+    proc = subprocess.run([sys.executable, "-m", "lessons.indexed_cube", "--no-such-flag"], capture_output=True,
+                          text=True, cwd=REPO, timeout=60)
+    assert_user_error(proc, "--no-such-flag")
+
+
+def test_tour_with_set_leaves_no_empty_folder(tmp_path: Path) -> None:
+    out = tmp_path / "tour"
+    assert_user_error(glsandbox("tour", "--set", "x=1", "--out", str(out)), "--set")
+    assert not out.exists()
+
+
+def test_tour_into_a_read_only_folder_is_refused_up_front(tmp_path: Path, monkeypatch, capsys) -> None:
+    # Root (as in CI) may write anywhere, so the folder is made unwritable as
+    # the access check sees it.
+    out = tmp_path / "locked"
+    out.mkdir()
+    real_access = os.access
+    monkeypatch.setattr(cli.os, "access", lambda p, mode: False if Path(p) == out else real_access(p, mode))
+    assert cli.main(["tour", "--out", str(out)]) == 2
+    assert capsys.readouterr().err.strip() == f"error: --out {out}: folder is not writable"
+    assert list(out.iterdir()) == []
+
+
+def test_a_full_disk_is_one_error_line_and_no_partial_file(tmp_path: Path, monkeypatch, capsys, gl) -> None:
+    def full(image, path):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(cli, "save_png", full)
+    out = tmp_path / "cube.png"
+    assert cli.main(["render", "indexed_cube", "--size", "32x32", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"error: --out {out}: cannot write (No space left on device)"]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_reader_that_stops_early_ends_the_command_quietly() -> None:
+    # `true` reads nothing and exits at once: every write of the command meets a closed pipe.
+    command = f"{sys.executable} -m glsandbox.cli plan mirror | true"
+    proc = subprocess.run(["bash", "-c", command], capture_output=True, text=True, cwd=REPO, timeout=60)
+    assert proc.stderr == "", proc.stderr
