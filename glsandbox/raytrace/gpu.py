@@ -52,6 +52,7 @@ from numpy.typing import NDArray
 
 from glsandbox.gl.shaders import compile_program
 from glsandbox.plan import ProgramVariant
+from glsandbox.raytrace.constants import SHADOW_OFFSET
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.world import MODES, World, build_world, camera_basis
 from glsandbox.scene import Scene
@@ -346,8 +347,6 @@ class GpuTracer:
         program, vao = self._program(lights, len(world.textures), shadows=bool(shadows), reflect=reflect,
                                      meshes=uploaded.mesh_count > 0, spheres=uploaded.sphere_count > 0,
                                      scene=uploaded.defines(cull_backfaces))
-        from glsandbox.raytrace.render import SHADOW_OFFSET
-
         if uploaded.block is not None:
             program["SceneData"].binding = 0
             uploaded.block.bind_to_uniform_block(0)

@@ -32,7 +32,8 @@ The algorithm, in the course's order (first half of the notes):
    if nothing lies between: the ray ``P' + s·(L − P')``, ``0 < s < 1``, hits
    nothing (``s = 1`` is the light itself, so an occluder beyond it never
    counts). ``P'`` is ``P`` moved off its surface by a relative offset
-   towards the light's side (:data:`SHADOW_OFFSET`, float32-safe, see
+   towards the light's side
+   (:data:`~glsandbox.raytrace.constants.SHADOW_OFFSET`, float32-safe, see
    :mod:`glsandbox.raytrace.trace`). In shadow, only the ambient term stays.
    A light's lamp (an unlit node whose box holds it) casts no shadow for it.
 5. **Reflection** (course "Yansıma vektörü"): a surface with
@@ -55,22 +56,17 @@ import numpy as np
 from numpy.typing import NDArray
 
 from glsandbox.raytrace.aabb import AABB, reciprocals
+from glsandbox.raytrace.constants import SHADOW_OFFSET
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.sphere import Sphere
 from glsandbox.raytrace.vec import length
 from glsandbox.raytrace.world import World, build_world, camera_rays
 from glsandbox.scene import Scene
 
-__all__ = ["ENGINES", "SHADOW_OFFSET", "RenderStats", "render", "render_viewport", "to_rgba8"]
+__all__ = ["ENGINES", "RenderStats", "render", "render_viewport", "to_rgba8"]
 
 #: The two engines.
 ENGINES = ("numpy", "gpu")
-
-#: Relative offset of secondary-ray origins: ``SHADOW_OFFSET·max(1, max|P_i|)``
-#: along the normal. 2⁻¹⁶ is about 256 float32 ulps of the point's largest
-#: coordinate, so the GLSL engine uses the same value as the reference
-#: (:data:`glsandbox.raytrace.SHADOW_EPSILON`, 2⁻³², suits float64 only).
-SHADOW_OFFSET: float = 2.0**-16
 
 #: Primary rays are traced this many at a time, each block through every step
 #: (nearest hit, shading, shadow rays, bounces) before the next. Every ray's
