@@ -2,7 +2,7 @@
 
 One full-viewport quad; ``shaders/raytrace.glsl`` traces one primary ray per
 fragment, with shadow rays and reflection bounces, the same algorithm as the
-float64 numpy engine (:mod:`glsandbox.raytrace.render`) in float32. The
+float64 numpy engine (:mod:`glsandbox.raytrace.numpy_engine`) in float32. The
 :class:`~glsandbox.raytrace.world.World` (world-space triangles, nodes, their
 boxes and materials) is packed into flat arrays of ``vec4`` records: in one
 uniform buffer for a small scene (every lesson scene but

@@ -1,6 +1,6 @@
 """From the rasterizer's Scene to what a ray tracer needs: world triangles and primary rays.
 
-Both engines (:mod:`glsandbox.raytrace.render`, numpy float64, and
+Both engines (:mod:`glsandbox.raytrace.numpy_engine`, numpy float64, and
 :mod:`glsandbox.raytrace.gpu`, GLSL float32) trace a :class:`World`, built
 once per viewport by :func:`build_world` from the *same*
 :class:`glsandbox.scene.Scene` the rasterizer draws:
