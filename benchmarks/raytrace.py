@@ -41,6 +41,7 @@ from glsandbox.cli import parse_size
 from glsandbox.frame import HeadlessRenderer
 from glsandbox.lesson import find_lesson
 from glsandbox.raytrace import RenderStats, render
+from glsandbox.raytrace.constants import SHADOW_OFFSET
 from glsandbox.raytrace.gpu import gpu_tracer
 from glsandbox.raytrace.world import build_world, camera_rays
 
@@ -128,8 +129,6 @@ class EmbreeCaster:
 
     def cast(self) -> int:
         """Cast every ray once; returns how many were cast."""
-        from glsandbox.raytrace.render import SHADOW_OFFSET
-
         o, d, cast = self.origins, self.directions, 0
         for depth in range(self.max_depth + 1):
             hits = self.scene.run(o, d, output=1)

@@ -2,8 +2,8 @@
 // The ray tracer as one fragment shader (glsandbox.raytrace.gpu): one
 // fragment = one pixel = one primary ray, with its shadow rays and
 // reflection bounces. The same algorithm as the float64 numpy engine
-// (glsandbox/raytrace/render.py, read its docstring for the course sections),
-// in float32. A fragment shader, not a compute shader: on llvmpipe it
+// (glsandbox/raytrace/numpy_engine.py; render.py's docstring gives the course
+// sections), in float32. A fragment shader, not a compute shader: on llvmpipe it
 // measured about 5x faster for this.
 //
 // Data (uploaded by glsandbox/raytrace/gpu.py), flat arrays of vec4 records:

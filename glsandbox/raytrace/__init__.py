@@ -1,9 +1,11 @@
-"""The course's first half: a ray tracer from scratch, in numpy float64.
+"""The course's first half: a ray tracer from scratch, in numpy float64 (and in GLSL, float32).
 
-Public API, in the course's words (see COURSE.md for the worked examples every
-one of these reproduces):
+Public API, in the course's words (``tests/raytrace/test_raytrace_worked_examples.py``
+checks that these reproduce every worked example of the notes):
 
 - Vektörel işlemler: :func:`normalize`, :func:`dot`, :func:`cross`, :func:`length`;
+- Bakış noktası, görüntü düzlemi GD(x,y): :func:`course_image_plane`, the
+  notes' pixel-to-image-plane mapping;
 - the ray ``R = R0 + t·Rd``: :class:`Ray`;
 - shapes, each with ``intersect(ray) -> t | None`` (nearest ``t > 0``),
   ``normal_at(point)`` and vectorized ``intersect_many(origins, directions)``:
@@ -16,8 +18,15 @@ one of these reproduces):
 - Gölge testi: :func:`in_shadow` (and :func:`shadow_ray`);
 - the whole picture: :func:`render` traces a :class:`glsandbox.scene.Scene`,
   the same one the rasterizer draws, with the float64 ``"numpy"`` engine or
-  the GLSL ``"gpu"`` engine (:mod:`glsandbox.raytrace.render`,
-  :mod:`glsandbox.raytrace.world`, :mod:`glsandbox.raytrace.gpu`).
+  the GLSL ``"gpu"`` engine (one of :data:`ENGINES`); :class:`RenderStats`
+  counts what a numpy render did.
+
+The modules, each importing only those above it: ``errors``, ``vec``, ``ray``,
+``base``, then the shapes (``plane``, ``triangle``, ``sphere``, ``aabb``) and
+what uses them (``trace``, ``shading``); ``constants`` (the numbers both
+engines share); ``world`` (a Scene as the engines trace it, and the primary
+rays); the engines, ``numpy_engine`` and ``gpu`` (GLSL, ``shaders/raytrace.glsl``);
+``render``, the front door that picks one.
 
 Conventions: right-handed, float64 throughout; ``t`` is in units of the ray's
 direction as given; misses are ``None`` (scalar) or ``inf`` (vectorized).

@@ -1,6 +1,6 @@
 """The ray tracer's error type.
 
-DESIGN.md asks for one user-facing error type (:class:`glsandbox.errors.SandboxError`);
+glsandbox has one user-facing error type (:class:`glsandbox.errors.SandboxError`);
 numpy-style code expects :class:`ValueError` for bad arguments. ``RayTraceError``
 is both, so ``except SandboxError`` (the CLI) and ``except ValueError`` (library
 users, tests) catch it alike.

@@ -1,40 +1,75 @@
 """The GLSL ray tracing engine: ``render(scene, size, engine="gpu", ctx=...)``.
 
-One full-viewport quad; ``shaders/raytrace.glsl`` traces one primary ray per
-fragment, with shadow rays and reflection bounces, the same algorithm as the
-float64 numpy engine (:mod:`glsandbox.raytrace.render`) in float32. The
-:class:`~glsandbox.raytrace.world.World` (world-space triangles, nodes, their
-boxes and materials) is packed into flat arrays of ``vec4`` records: in one
-uniform buffer for a small scene (every lesson scene but
-``ray_acceleration``'s 2,018 triangles), else in two RGBA32F textures read
-with ``texelFetch``; the materials' images become RGBA8 textures sampled by
-hand (bilinear, base level, the wrap mode done in the shader) exactly as
-the numpy engine does.
+``shaders/raytrace.glsl`` is a fragment shader drawn over one full-viewport
+quad: one fragment is one pixel and one primary ray, with its shadow rays
+and reflection bounces. It runs the algorithm of
+:mod:`glsandbox.raytrace.render`, the one the float64 numpy engine
+(:mod:`glsandbox.raytrace.numpy_engine`) runs, in float32. A fragment shader
+rather than a compute shader: on llvmpipe the same ray cast measured about
+10 Mrays/s against 1.9.
 
-A fragment shader rather than a compute shader: on llvmpipe the same ray
-cast measured about 10 Mrays/s against 1.9 (DESIGN.md, measured facts).
+The scene on the context
+------------------------
+:func:`~glsandbox.raytrace.world.build_world` gives the
+:class:`~glsandbox.raytrace.world.World` (world-space triangles; nodes with
+their boxes and materials); :func:`pack_triangles` and :func:`pack_nodes`
+flatten it into ``vec4`` records, :data:`TRI_RECORDS` per triangle and
+:data:`NODE_RECORDS` per node, mesh nodes first (the layout is in the
+shader). A small scene (see the program variants below) has its records in
+one uniform block, the shader's ``SceneData``; a larger one in two RGBA32F
+textures :data:`TEX_WIDTH` wide, read with ``texelFetch``. The materials'
+images become RGBA8 textures (at most :data:`MAX_TEXTURES` a viewport)
+sampled by hand, bilinear in the base level with the wrap mode done in the
+shader, exactly as the numpy engine samples them. Uploads are kept (the
+last :attr:`GpuTracer.KEEP_SCENES`): a render of the same node objects,
+lights and viewport, or of new objects that pack to the same records, only
+moves the camera.
 
-Speed (``benchmarks/raytrace.py``): llvmpipe runs 8 pixels at once under
-execution masks, so skipped code still costs unless a whole loop can end,
-and a value read at an index that varies per pixel costs 8 loads. The
-program is therefore specialised per scene and options: shadow rays,
-reflection bounces (only where a node reflects), meshes, spheres and vertex
-colours are compiled in only when they can happen, and a small scene's
-program has its node list unrolled from the scene itself (``SCENE_NODES``:
-each node's triangle range, one-sidedness and lamp bits as literals), so
-node records are read at constant indices, the AABB test sets how many
-iterations a node's triangle loop runs (a block of pixels that all miss
-the box leaves after one), and nodes of one or two triangles are tested
-without a loop. Shadow rays stop at their first hit; the shading reuses
-the triangle test's barycentrics. The uploaded scene is kept between
-renders: a render of the same scene (the same node objects, lights and
-viewport) reuses it and only moves the camera. Measured at 800x600
-(llvmpipe, 2 cores) against the texture-and-loop version before: the
-``phong`` and ``ray_phong`` scenes 2.6 to 2.9 times faster with the same
-pixels, the other lessons 2.1 to 2.6 times (textures within 1 level),
-``ray_acceleration`` (the texture path) unchanged. The price is compile
-time: a lesson's first render (compiling its program variant, Mesa's shader
-cache off) took 0.4 to 0.9 s, against 0.2 to 0.35 s before.
+Program variants
+----------------
+One program per set of defines, compiled on first use and kept (the last
+:attr:`GpuTracer.KEEP_PROGRAMS`). llvmpipe runs 8 pixels at once under
+execution masks: a branch no pixel takes still costs, only a loop can end
+early, and a record read at an index that varies per pixel costs 8 loads.
+So what a scene cannot reach is compiled out rather than branched around:
+``NUM_LIGHTS`` and ``NUM_TEXTURES`` size the light loop and the samplers;
+``SHADOWS`` (shadow rays), ``REFLECT`` (the bounce loop: some node reflects
+and ``max_depth > 0``), ``HAS_MESHES``, ``HAS_SPHERES`` and
+``VERTEX_COLORS`` switch code on.
+
+A small scene, at most :data:`UNROLL_NODES` nodes of which at most
+:data:`UNROLL_LOOPS` have more than :data:`UNROLL_TRIS` triangles, its
+records within the uniform block (:data:`BLOCK_RECORDS`, or less where the
+context's ``GL_MAX_UNIFORM_BLOCK_SIZE`` is smaller), also gets its node list
+unrolled into the program: ``SCENE_NODES`` (:meth:`_Uploaded.scene_nodes`,
+with ``NODE_COUNT`` and ``TRI_COUNT``) lists every node in scene order as
+``MESH`` (a loop over its triangles that runs as many times as the node's
+AABB test allows: none when the ray misses the box), ``TRI`` (each triangle
+of a node of at most :data:`UNROLL_TRIS`, tested without a loop) or
+``SPHERE``, with its record slot, triangle range, one-sidedness and lamp
+bits as literals, so its records are read at constant indices. Any larger
+scene gets the general program: a loop over the node records and, inside
+it, over each node's triangles. Unrolling is paid in compile time (Mesa's
+shader cache is off): it grows exponentially with the number of triangle
+loops, which the bounds keep near a second; a lesson's first render, which
+compiles its variant, takes 0.4 to 0.9 s. In both programs shadow rays stop
+at their first hit, and the shading reuses the triangle test's barycentrics.
+
+llvmpipe's loop limit
+---------------------
+llvmpipe ends a shader invocation's loops after 65,535 iterations, all
+loops counted together (Mesa gallivm's ``LP_MAX_TGSI_LOOP_ITERATIONS``),
+silently. This engine does **not** check it. Every triangle a ray tests in
+a loop is an iteration, for the primary ray, each shadow ray and each
+bounce (in the general program every node record too), and a pixel that
+runs past the limit keeps whatever it had found: one node of about 65,000
+triangles that the primary ray's box test lets in is enough, and fewer
+when shadow rays and bounces enter it too. The lesson scenes stay far
+below it: the largest, ``ray_acceleration`` (2,018 triangles, the general
+program, one light), runs at most about 4,100 iterations a pixel. A
+traversal that visits only the nodes and triangles a ray's boxes let in (a
+BVH) makes the count grow with what a ray passes near rather than with the
+scene's size; that is still no bound.
 
 Float32 differs from float64 in the last bits of ``t`` and of the shading;
 the image agrees with the numpy engine's to within a couple of 8-bit levels
@@ -52,6 +87,7 @@ from numpy.typing import NDArray
 
 from glsandbox.gl.shaders import compile_program
 from glsandbox.plan import ProgramVariant
+from glsandbox.raytrace.constants import SHADOW_OFFSET
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.world import MODES, World, build_world, camera_basis
 from glsandbox.scene import Scene
@@ -346,8 +382,6 @@ class GpuTracer:
         program, vao = self._program(lights, len(world.textures), shadows=bool(shadows), reflect=reflect,
                                      meshes=uploaded.mesh_count > 0, spheres=uploaded.sphere_count > 0,
                                      scene=uploaded.defines(cull_backfaces))
-        from glsandbox.raytrace.render import SHADOW_OFFSET
-
         if uploaded.block is not None:
             program["SceneData"].binding = 0
             uploaded.block.bind_to_uniform_block(0)

@@ -1,10 +1,18 @@
 """``render(scene, size, engine=...)``: ray-trace the Scene the rasterizer draws.
 
-Two engines, one algorithm:
+This module is the front door: it checks the options, traces each viewport
+with the engine asked for and lays the tiles out in one image. Two engines,
+one algorithm:
 
-- ``"numpy"``: the float64 reference, vectorized over pixels (this module);
+- ``"numpy"``: the float64 reference, vectorized over rays
+  (:mod:`glsandbox.raytrace.numpy_engine`);
 - ``"gpu"``: a GLSL fragment shader on a ModernGL context, float32
   (:mod:`glsandbox.raytrace.gpu`, ``shaders/raytrace.glsl``).
+
+Each offers ``render_viewport(scene, size, viewport, **options)``, an
+``(H, W, 4)`` uint8 image of one viewport. Both trace a
+:class:`~glsandbox.raytrace.world.World` (:mod:`glsandbox.raytrace.world`)
+and read the numbers they share from :mod:`glsandbox.raytrace.constants`.
 
 The algorithm, in the course's order (first half of the notes):
 
@@ -32,7 +40,8 @@ The algorithm, in the course's order (first half of the notes):
    if nothing lies between: the ray ``P' + s·(L − P')``, ``0 < s < 1``, hits
    nothing (``s = 1`` is the light itself, so an occluder beyond it never
    counts). ``P'`` is ``P`` moved off its surface by a relative offset
-   towards the light's side (:data:`SHADOW_OFFSET`, float32-safe, see
+   towards the light's side
+   (:data:`~glsandbox.raytrace.constants.SHADOW_OFFSET`, float32-safe, see
    :mod:`glsandbox.raytrace.trace`). In shadow, only the ambient term stays.
    A light's lamp (an unlit node whose box holds it) casts no shadow for it.
 5. **Reflection** (course "Yansıma vektörü"): a surface with
@@ -46,322 +55,22 @@ Colours are clamped to 0..1 and rounded to 8 bits as GL does (``⌊255c + ½⌋`
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from functools import partial
 
 import numpy as np
 from numpy.typing import NDArray
 
-from glsandbox.raytrace.aabb import AABB, reciprocals
+from glsandbox.raytrace import numpy_engine
 from glsandbox.raytrace.errors import RayTraceError
-from glsandbox.raytrace.sphere import Sphere
-from glsandbox.raytrace.vec import length
-from glsandbox.raytrace.world import World, build_world, camera_rays
+from glsandbox.raytrace.numpy_engine import RenderStats
 from glsandbox.scene import Scene
 
-__all__ = ["ENGINES", "SHADOW_OFFSET", "RenderStats", "render", "render_viewport", "to_rgba8"]
+__all__ = ["ENGINES", "RenderStats", "render"]
 
 #: The two engines.
 ENGINES = ("numpy", "gpu")
-
-#: Relative offset of secondary-ray origins: ``SHADOW_OFFSET·max(1, max|P_i|)``
-#: along the normal. 2⁻¹⁶ is about 256 float32 ulps of the point's largest
-#: coordinate, so the GLSL engine uses the same value as the reference
-#: (:data:`glsandbox.raytrace.SHADOW_EPSILON`, 2⁻³², suits float64 only).
-SHADOW_OFFSET: float = 2.0**-16
-
-#: Primary rays are traced this many at a time, each block through every step
-#: (nearest hit, shading, shadow rays, bounces) before the next. Every ray's
-#: colour depends on that ray alone, so the blocks give the same pixels as one
-#: pass over the image; but a block's temporaries (a few dozen arrays of
-#: ``RAY_BLOCK`` numbers or 3-vectors) stay in a core's cache, where a
-#: whole-image pass streams every ``(W·H, 3)`` temporary through memory and
-#: pays the page faults of allocating it: about twice as fast at 800x600.
-RAY_BLOCK: int = 1 << 14
-
-_UNIT_SPHERE = Sphere((0.0, 0.0, 0.0), 1.0)
-
-
-@dataclass
-class RenderStats:
-    """What one numpy render did: rays cast by kind, and its time."""
-
-    primary: int = 0
-    shadow: int = 0
-    reflection: int = 0
-    #: Ray-shape tests done (one per ray and triangle, or ray and sphere):
-    #: what backface and AABB culling save.
-    tests: int = 0
-    seconds: float = 0.0
-
-    @property
-    def rays(self) -> int:
-        return self.primary + self.shadow + self.reflection
-
-
-# --- the nearest hit over a World -------------------------------------------
-
-
-@dataclass
-class _Hits:
-    t: NDArray[np.float64]  # inf for a miss
-    node: NDArray[np.intp]  # -1 for a miss
-    tri: NDArray[np.intp]  # world triangle index (meshes), -1 otherwise
-
-
-def _rows(o: NDArray[np.float64], rays: NDArray[np.intp] | NDArray[np.bool_]) -> NDArray[np.float64]:
-    """The origins of the rays ``rays`` picks: ``o`` itself when it is the one ``(3,)``
-    origin every ray shares (primary rays start at the eye), else those rows."""
-    return o if o.ndim == 1 else o[rays]
-
-
-def _nearest(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_max: float | NDArray[np.float64],
-             cull: bool | None, aabb: bool, light: int = -1, stats: RenderStats | None = None) -> _Hits:
-    """Nearest hit with ``0 < t < t_max`` over every node (the course's ``min_indis`` loop).
-
-    ``o`` is ``(N, 3)``, or ``(3,)`` for rays that share one origin (the eye):
-    the kernels then form the origin's terms once (see
-    :func:`~glsandbox.raytrace.base.shared_origin`). ``light >= 0`` makes it a
-    shadow query for that light: its lamp is skipped.
-    """
-    n = d.shape[0]
-    best_t = np.broadcast_to(np.asarray(t_max, dtype=np.float64), (n,)).copy()
-    best_node = np.full(n, -1, dtype=np.intp)
-    best_tri = np.full(n, -1, dtype=np.intp)
-    inverse = reciprocals(d) if aabb else None  # 1/d once for every node's slab test
-    for k, node in enumerate(world.nodes):
-        if light >= 0 and node.lamp_of >> light & 1:
-            continue
-        if inverse is not None:
-            near, far = AABB(node.box_min, node.box_max).slabs_reciprocal(o, inverse)
-            idx = np.nonzero((near <= far) & (far > 0.0) & (near < best_t))[0]
-        else:
-            idx = np.arange(n)
-        if idx.size == 0:
-            continue
-        one_sided = node.cull if cull is None else cull
-        if stats is not None:
-            stats.tests += idx.size * max(node.count, 1)
-        oi, di = _rows(o, idx), d[idx]
-        if node.kind == "sphere":
-            inv = node.inverse
-            oo = oi @ inv[:3, :3].T + inv[:3, 3]  # the ray in the unit sphere's own space
-            dd = di @ inv[:3, :3].T
-            t = _UNIT_SPHERE.intersect_many(oo, dd)
-            if one_sided:  # from inside, the sphere's front faces all face away
-                t = np.where(np.einsum("...j,...j->...", oo, oo) < 1.0, np.inf, t)
-            j = np.full(idx.size, -1, dtype=np.intp)
-        else:
-            batch = world.batches[k]
-            assert batch is not None
-            t, j = batch.nearest_many(oi, di, cull_backfaces=one_sided)
-            j = np.where(j >= 0, j + node.start, -1)
-        better = t < best_t[idx]
-        sel = idx[better]
-        best_t[sel] = t[better]
-        best_node[sel] = k
-        best_tri[sel] = j[better]
-    hit = best_node >= 0
-    return _Hits(np.where(hit, best_t, np.inf), best_node, best_tri)
-
-
-# --- surface attributes at the hits ------------------------------------------
-
-
-def _barycentric(world: World, tri: NDArray[np.intp], o: NDArray[np.float64],
-                 d: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Möller–Trumbore's ``(u, v)`` of each ray on its own triangle: ``P = V0 + u·e1 + v·e2``."""
-    v0 = world.v0[tri]
-    e1 = world.v1[tri] - v0
-    e2 = world.v2[tri] - v0
-    p = np.cross(d, e2)
-    det = np.einsum("ij,ij->i", e1, p)
-    det = np.where(det == 0.0, 1.0, det)
-    s = o - v0
-    q = np.cross(s, e1)
-    return np.einsum("ij,ij->i", s, p) / det, np.einsum("ij,ij->i", d, q) / det
-
-
-def _sample(image: NDArray[np.float64], wrap: int, uv: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Bilinear filtering of ``image`` (row 0 = v 0, as GL reads the uploaded image) at ``uv``."""
-    h, w = image.shape[:2]
-    x = uv[:, 0] * w - 0.5
-    y = uv[:, 1] * h - 0.5
-    x0 = np.floor(x)
-    y0 = np.floor(y)
-    fx = (x - x0)[:, None]
-    fy = (y - y0)[:, None]
-
-    def wrap_index(i: NDArray[np.float64], size: int) -> NDArray[np.intp]:
-        i = i.astype(np.intp)
-        if wrap == 0:  # repeat
-            return np.mod(i, size)
-        if wrap == 1:  # mirrored repeat: 0..size-1, size-1..0, ...
-            m = np.mod(i, 2 * size)
-            return np.where(m < size, m, 2 * size - 1 - m)
-        return np.clip(i, 0, size - 1)  # clamp to edge
-
-    xa, xb = wrap_index(x0, w), wrap_index(x0 + 1, w)
-    ya, yb = wrap_index(y0, h), wrap_index(y0 + 1, h)
-    top = image[ya, xa] * (1 - fx) + image[ya, xb] * fx
-    bottom = image[yb, xa] * (1 - fx) + image[yb, xb] * fx
-    return top * (1 - fy) + bottom * fy
-
-
-def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.float64]
-             ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """``(point, unit normal, base colour)`` for hit rays (all of ``hits`` must be hits)."""
-    n = d.shape[0]
-    point = o + hits.t[:, None] * d
-    normal = np.zeros((n, 3))
-    base = np.zeros((n, 3))
-    uv = np.zeros((n, 2))
-    for k, node in enumerate(world.nodes):
-        sel = np.nonzero(hits.node == k)[0]
-        if sel.size == 0:
-            continue
-        if node.kind == "sphere":
-            inv = node.inverse
-            q = point[sel] @ inv[:3, :3].T + inv[:3, 3]  # the hit on the unit sphere
-            q /= length(q)[:, None]
-            normal[sel] = q @ node.normal_matrix.T
-            # geometry.sphere()'s uv: u = azimuth/2π from +z towards +x, v = polar angle/π from +y.
-            uv[sel, 0] = np.mod(np.arctan2(q[:, 0], q[:, 2]), 2 * np.pi) / (2 * np.pi)
-            uv[sel, 1] = np.arccos(np.clip(q[:, 1], -1.0, 1.0)) / np.pi
-            colors = np.ones((sel.size, 3)) if node.mode == 1 else None
-        else:
-            tri = hits.tri[sel]
-            u, v = _barycentric(world, tri, _rows(o, sel), d[sel])
-            w = (1.0 - u - v)[:, None], u[:, None], v[:, None]  # weights of V0, V1, V2
-            normal[sel] = _interpolate(world.normals[tri], w)
-            uv[sel] = _interpolate(world.uvs[tri], w)
-            colors = _interpolate(world.colors[tri], w) if node.mode == 1 else None
-        color = np.broadcast_to(node.color, (sel.size, 3)).copy()
-        if colors is not None:  # vertex colours, times the material colour (basic.glsl)
-            color *= colors
-        if node.texture >= 0:
-            image, wrap = world.textures[node.texture]
-            color *= _sample(image, wrap, uv[sel])[:, :3]
-        base[sel] = color
-    normal /= np.maximum(length(normal), 1e-300)[:, None]
-    return point, normal, base
-
-
-def _interpolate(values: NDArray[np.float64], w: tuple[NDArray[np.float64], ...]) -> NDArray[np.float64]:
-    """``w0·values[:, 0] + w1·values[:, 1] + w2·values[:, 2]``: per-vertex values (``(N, 3, k)``)
-    at the barycentric weights ``w`` (three ``(N, 1)``), summed in that order."""
-    return values[:, 0] * w[0] + values[:, 1] * w[1] + values[:, 2] * w[2]
-
-
-def _offset(point: NDArray[np.float64], normal: NDArray[np.float64], side: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``point`` moved off its surface towards ``side`` by the relative :data:`SHADOW_OFFSET`."""
-    scale = SHADOW_OFFSET * np.maximum(1.0, np.abs(point).max(axis=1))
-    sign = np.where(np.einsum("ij,ij->i", normal, side) < 0.0, -1.0, 1.0)
-    return point + (scale * sign)[:, None] * normal
-
-
-def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.float64], shadows: bool,
-           cull: bool | None, aabb: bool, stats: RenderStats
-           ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """Local colour of hit rays (the raster's per-light formula), plus point and normal for bounces."""
-    point, normal, base = _surface(world, hits, o, d)
-    color = base.copy()  # unlit surfaces keep their colour
-    table = world.materials
-    lit = table.lit[hits.node]
-    if lit.any():
-        idx = np.nonzero(lit)[0]
-        nodes = hits.node[idx]
-        ka = table.ka[nodes][:, None]
-        kd = table.kd[nodes][:, None]
-        ks = table.ks[nodes][:, None]
-        shin = table.shininess[nodes]
-        blinn = table.blinn[nodes]
-        p, nrm, mesh = point[idx], normal[idx], base[idx]
-        to_eye = -d[idx] / length(d[idx])[:, None]
-        total = np.zeros_like(mesh)
-        for index, (light, light_color) in enumerate(zip(world.light_positions, world.light_colors)):
-            to_light = light - p
-            to_light /= np.maximum(length(to_light), 1e-300)[:, None]
-            n_dot_l = np.einsum("ij,ij->i", nrm, to_light)
-            diffuse = np.maximum(n_dot_l, 0.0)[:, None] * mesh * light_color
-            reflected = -to_light + 2.0 * n_dot_l[:, None] * nrm  # fromLight − 2(fromLight·N)N
-            r_dot_e = np.einsum("ij,ij->i", to_eye, reflected)
-            cosine = r_dot_e
-            if blinn.any():  # Blinn-Phong: N·H, H the unit halfway vector
-                halfway = to_light + to_eye
-                halfway /= np.maximum(length(halfway), 1e-300)[:, None]
-                cosine = np.where(blinn, np.einsum("ij,ij->i", nrm, halfway), r_dot_e)
-            cosine = np.maximum(cosine, 0.0)
-            highlight = np.where(n_dot_l > 0.0, cosine ** shin, 0.0)
-            specular = highlight[:, None] * light_color
-            lighting = kd * diffuse + ks * specular
-            if shadows:
-                start = _offset(p, nrm, light - p)
-                stats.shadow += idx.size
-                blocked = _nearest(world, start, light - start, 1.0, cull, aabb, index, stats).node >= 0
-                lighting *= np.where(blocked, 0.0, 1.0)[:, None]  # in shadow only the ambient term stays
-            total += np.minimum(ka * mesh + lighting, 1.0)
-        color[idx] = total
-    return color, point, normal
-
-
-def _trace(world: World, o: NDArray[np.float64], d: NDArray[np.float64], max_depth: int, shadows: bool,
-           cull: bool | None, aabb: bool, stats: RenderStats) -> NDArray[np.float64]:
-    """Colour of each ray, reflections followed iteratively: ``(1−r)·local + r·reflected``."""
-    n = d.shape[0]
-    out = np.zeros((n, 3))
-    weight = np.ones(n)
-    alive = np.arange(n)
-    for depth in range(max_depth + 1):
-        hits = _nearest(world, o, d, np.inf, cull, aabb, stats=stats)
-        miss = hits.node < 0
-        out[alive[miss]] += weight[miss, None] * world.background
-        hit = ~miss
-        if not hit.any():
-            break
-        sub = _Hits(hits.t[hit], hits.node[hit], hits.tri[hit])
-        local, point, normal = _shade(world, sub, _rows(o, hit), d[hit], shadows, cull, aabb, stats)
-        r = world.materials.reflectivity[sub.node] if depth < max_depth else np.zeros(sub.node.size)
-        w = weight[hit]
-        out[alive[hit]] += (w * (1.0 - r))[:, None] * local
-        bounce = r > 0.0
-        if not bounce.any():
-            break
-        dh = d[hit][bounce]
-        nh = normal[bounce]
-        reflected = dh - 2.0 * np.einsum("ij,ij->i", dh, nh)[:, None] * nh  # Yansıma vektörü
-        o = _offset(point[bounce], nh, -dh)
-        d = reflected
-        weight = (w * r)[bounce]
-        alive = alive[hit][bounce]
-        stats.reflection += alive.size
-    return out
-
-
-def to_rgba8(rgb: NDArray[np.float64]) -> NDArray[np.uint8]:
-    """Clamp to 0..1 and round to 8 bits as GL's unorm conversion does; alpha 255."""
-    c = np.floor(np.clip(rgb, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
-    alpha = np.full((*c.shape[:-1], 1), 255, dtype=np.uint8)
-    return np.concatenate([c, alpha], axis=-1)
-
-
-def render_viewport(scene: Scene, size: tuple[int, int], viewport: int = 0, *, max_depth: int = 2,
-                    shadows: bool = True, cull_backfaces: bool | None = None, aabb: bool = True,
-                    analytic_spheres: bool = True, stats: RenderStats | None = None) -> NDArray[np.float64]:
-    """One viewport with the numpy engine at ``size`` pixels: float rgb ``(H, W, 3)``, unclamped."""
-    width, height = size
-    vp = scene.viewports[viewport]
-    world = build_world(scene, viewport, analytic_spheres=analytic_spheres)
-    eye, dirs = camera_rays(vp.camera or scene.camera, width, height)
-    stats = stats if stats is not None else RenderStats()
-    stats.primary += dirs.shape[0]
-    rgb = np.empty((dirs.shape[0], 3))
-    for lo in range(0, dirs.shape[0], RAY_BLOCK):
-        rays = slice(lo, lo + RAY_BLOCK)
-        rgb[rays] = _trace(world, eye, dirs[rays], max_depth, shadows, cull_backfaces, aabb, stats)
-    return rgb.reshape(height, width, 3)
 
 
 def _check(size: tuple[int, int], engine: str, max_depth: int) -> None:
@@ -392,23 +101,23 @@ def render(scene: Scene, size: tuple[int, int], engine: str = "numpy", *, ctx: o
     frame = np.zeros((height, width, 4), dtype=np.uint8)
     options = dict(max_depth=int(max_depth), shadows=shadows, cull_backfaces=cull_backfaces, aabb=aabb,
                    analytic_spheres=analytic_spheres)
-    tracer: Callable[[int, tuple[int, int]], NDArray[np.uint8]]
+    # tracer(size, viewport): one viewport's image, from either engine.
+    tracer: Callable[[tuple[int, int], int], NDArray[np.uint8]]
     if engine == "gpu":
         if ctx is None:
             raise RayTraceError("engine='gpu' needs a ModernGL context: render(..., ctx=renderer.host.ctx)")
+        # Imported here, not at the top: a numpy render never loads moderngl or the shaders.
         from glsandbox.raytrace.gpu import gpu_tracer
 
-        gpu = gpu_tracer(ctx)
-        tracer = lambda index, rect: gpu.render_viewport(scene, rect, index, **options)  # noqa: E731
+        tracer = partial(gpu_tracer(ctx).render_viewport, scene, **options)
     else:
-        tracer = lambda index, rect: to_rgba8(render_viewport(  # noqa: E731
-            scene, rect, index, stats=stats, **options))
+        tracer = partial(numpy_engine.render_viewport, scene, stats=stats, **options)
     for index, vp in enumerate(scene.viewports):
         x, y, w, h = vp.pixels(width, height)
         if w <= 0 or h <= 0:
             continue
         top = height - y - h  # viewports count from the bottom, images from the top
-        frame[top:top + h, x:x + w] = tracer(index, (w, h))
+        frame[top:top + h, x:x + w] = tracer((w, h), index)
     if stats is not None:
         stats.seconds += time.perf_counter() - start
     return frame

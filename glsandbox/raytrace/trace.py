@@ -16,7 +16,7 @@ ray from ``P`` towards the light ``L`` hits an occluder at ``0 < t < |L − P|``
 (with a unit direction, so ``t`` is a distance). An occluder *beyond* the light
 does not count.
 
-Erratum (COURSE.md, worked example #10, the 2012 exam): the notes find the
+Erratum (Gölge testi, worked example #10, the 2012 exam): the notes find the
 plane at ``t = 40`` with the light at distance 30 and conclude "t_light < t,
 so it is in shadow". The plane is crossed beyond the light, so nothing blocks
 it: ``P`` is **lit**. The notes' own 2013 answer (#9: blue sphere at

@@ -10,7 +10,7 @@ batched call then round identically, bit for bit. The vectorized intersection
 kernels rely on that (one ray through :meth:`Sphere.intersect` gives exactly the
 same ``t`` as the same ray inside :meth:`Sphere.intersect_many`).
 
-Worked example #1 (COURSE.md): ``R1 = (30, -80, -60)``, ``R2 = (-30, -80, -60)``;
+Worked example #1: ``R1 = (30, -80, -60)``, ``R2 = (-30, -80, -60)``;
 ``cross(R1, R2) = (0, 3600, -4800)``, ``length = 6000``,
 ``normalize = (0, 0.6, -0.8)``.
 """

@@ -1,6 +1,6 @@
 """From the rasterizer's Scene to what a ray tracer needs: world triangles and primary rays.
 
-Both engines (:mod:`glsandbox.raytrace.render`, numpy float64, and
+Both engines (:mod:`glsandbox.raytrace.numpy_engine`, numpy float64, and
 :mod:`glsandbox.raytrace.gpu`, GLSL float32) trace a :class:`World`, built
 once per viewport by :func:`build_world` from the *same*
 :class:`glsandbox.scene.Scene` the rasterizer draws:
@@ -58,7 +58,7 @@ from glsandbox.geometry import Mesh
 from glsandbox.images import builtin_levels, load_image
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.triangle import TriangleBatch
-from glsandbox.scene import Camera, Node, Scene
+from glsandbox.scene import BUILTIN_TEXTURES, Camera, Node, Scene
 
 __all__ = [
     "MODES",
@@ -68,7 +68,6 @@ __all__ = [
     "build_world",
     "camera_rays",
     "course_image_plane",
-    "wrap_code",
 ]
 
 #: How a node's surface is coloured, as the engines number it.
@@ -77,23 +76,17 @@ MODES = {"solid": 0, "vertex_color": 1, "phong": 2, "gouraud": 2, "blinn_phong":
 WRAPS = {"repeat": 0, "mirrored": 1, "clamp": 2}
 
 
-def wrap_code(name: str) -> int:
-    return WRAPS[name]
-
-
 @dataclass
 class NodeInfo:
     """One traced node: its shape, its box, its material (already numbered for the engines)."""
 
     name: str
-    kind: str  # "mesh" or "sphere" (the unit sphere under ``model``)
+    kind: str  # "mesh" or "sphere" (the unit sphere under the node's model matrix)
     start: int  # first triangle in the world arrays
     count: int  # number of triangles
     box_min: NDArray[np.float64]
     box_max: NDArray[np.float64]
     cull: bool
-    has_normals: bool
-    has_colors: bool
     color: NDArray[np.float64]  # rgb
     mode: int  # MODES value
     ka: float
@@ -102,7 +95,8 @@ class NodeInfo:
     shininess: float
     reflectivity: float
     texture: int  # index into World.textures, -1 for none
-    model: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
+    #: A sphere's model matrix inverted (world to the unit sphere's space) and its
+    #: normal matrix; identities for a mesh, whose triangles are in world space.
     inverse: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
     normal_matrix: NDArray[np.float64] = field(default_factory=lambda: np.eye(3))
     #: Bit ``i`` set: light ``i`` lies inside this unlit node's box, so the node is
@@ -185,8 +179,6 @@ def is_unit_sphere(mesh: Mesh) -> bool:
 
 def _texture_image(source: str) -> NDArray[np.float64]:
     """The base level of a texture as float rgba in 0..1 (the ray tracer samples level 0 only)."""
-    from glsandbox.scene import BUILTIN_TEXTURES
-
     level = builtin_levels(source)[0] if source in BUILTIN_TEXTURES else load_image(source)
     return np.asarray(level, dtype=np.float64) / 255.0
 
@@ -240,15 +232,14 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
             color=np.asarray(material.color[:3], dtype=np.float64), mode=MODES[material.shading],
             ka=float(material.ambient), kd=float(material.diffuse), ks=float(material.specular),
             shininess=float(material.shininess), reflectivity=_reflectivity(scene, node),
-            texture=tex, model=model,
+            texture=tex,
         )
         if analytic_spheres and is_unit_sphere(mesh):
             corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=np.float64)
             world_corners = transforms.transform_points(model, corners)
             nodes.append(NodeInfo(kind="sphere", start=start, count=0, box_min=world_corners.min(axis=0),
-                                  box_max=world_corners.max(axis=0), has_normals=True, has_colors=False,
-                                  inverse=np.linalg.inv(model), normal_matrix=transforms.normal_matrix(model),
-                                  **common))
+                                  box_max=world_corners.max(axis=0), inverse=np.linalg.inv(model),
+                                  normal_matrix=transforms.normal_matrix(model), **common))
             batches.append(None)
             continue
         order = mesh.indices if mesh.indices is not None else np.arange(mesh.vertex_count)
@@ -274,8 +265,7 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
         v0s.append(a), v1s.append(b), v2s.append(c), ns.append(n), uvs.append(uv), cols.append(col)
         owners.append(np.full(len(tri), len(nodes), dtype=np.intp))
         nodes.append(NodeInfo(kind="mesh", start=start, count=len(tri), box_min=world.min(axis=0),
-                              box_max=world.max(axis=0), has_normals=mesh.normals is not None,
-                              has_colors=mesh.colors is not None, **common))
+                              box_max=world.max(axis=0), **common))
         batches.append(TriangleBatch(a, b, c))
         start += len(tri)
     lights = scene.lights

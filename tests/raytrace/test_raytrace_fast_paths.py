@@ -8,17 +8,14 @@ None of that may change a single bit of ``t`` or of a pixel.
 
 from __future__ import annotations
 
-import importlib
-
 import numpy as np
 import pytest
 
 from glsandbox.lesson import find_lesson
 from glsandbox.raytrace import AABB, Sphere, TriangleBatch, moller_trumbore_many, render
+from glsandbox.raytrace import numpy_engine as render_module
 from glsandbox.raytrace.base import shared_origin
 from glsandbox.raytrace.world import build_world, camera_basis, camera_rays
-
-render_module = importlib.import_module("glsandbox.raytrace.render")  # the package's ``render`` is the function
 
 RNG = np.random.default_rng(7)
 EYE = np.array([0.3, 1.7, 6.2])

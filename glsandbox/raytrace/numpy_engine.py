@@ -1,0 +1,381 @@
+"""The numpy engine: the float64 reference ray tracer, vectorized over rays.
+
+:func:`render_viewport` traces one viewport of a Scene (the front door,
+:func:`glsandbox.raytrace.render`, lays the viewports out). It follows the
+algorithm of :mod:`glsandbox.raytrace.render` step by step, on whole batches
+of rays at once:
+
+- :func:`_nearest`: the nearest hit (``tDistances``/``min_indis``) of each
+  ray over the :class:`~glsandbox.raytrace.world.World`'s nodes;
+- :func:`_occluded`: the shadow query (Gölge testi), whether anything but the
+  light's lamp lies at ``0 < s < 1`` along each shadow ray;
+- :func:`_surface`: point, normal and base colour at the hits (barycentric
+  normals, uv and vertex colours; textures sampled bilinearly by hand);
+- :func:`_shade`: the rasterizer's per-light Phong with a shadow ray per light;
+- :func:`_trace`: reflections followed iteratively, ``(1 − r)·local + r·reflected``.
+
+Primary rays are traced :data:`RAY_BLOCK` at a time, each block through every
+step before the next.
+
+Where an acceleration structure plugs in
+----------------------------------------
+:func:`_nearest` and :func:`_occluded` are the only places that look for hits,
+and both go through :func:`_scan_nodes`: every node in scene order, its
+world box first (course "Hızlandırma: AABB"), then :func:`_hit_node` on the
+rays that enter it. A BVH over the nodes replaces :func:`_scan_nodes`
+(keeping ``_Hits`` and the tie rule: an equal ``t`` goes to the earlier
+node, then the earlier triangle); a BVH over one mesh's triangles replaces
+the brute-force ``world.batches[k].nearest_many`` call in :func:`_hit_node`,
+built by :func:`~glsandbox.raytrace.world.build_world` next to the node's
+:class:`~glsandbox.raytrace.triangle.TriangleBatch`. Today :func:`_occluded`
+is the nearest-hit scan cut at ``t = 1``, so the ray-shape tests it counts in
+:class:`RenderStats` are those of that scan (the ``ray_acceleration`` lesson
+shows them); an any-hit traversal may stop at a ray's first hit, and
+changes those counts.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from glsandbox.raytrace.aabb import AABB, reciprocals
+from glsandbox.raytrace.constants import SHADOW_OFFSET
+from glsandbox.raytrace.sphere import Sphere
+from glsandbox.raytrace.vec import length
+from glsandbox.raytrace.world import World, build_world, camera_rays
+from glsandbox.scene import Scene
+
+__all__ = ["RAY_BLOCK", "RenderStats", "render_viewport", "to_rgba8"]
+
+#: Primary rays are traced this many at a time, each block through every step
+#: (nearest hit, shading, shadow rays, bounces) before the next. Every ray's
+#: colour depends on that ray alone, so the blocks give the same pixels as one
+#: pass over the image; but a block's temporaries (a few dozen arrays of
+#: ``RAY_BLOCK`` numbers or 3-vectors) stay in a core's cache, where a
+#: whole-image pass streams every ``(W·H, 3)`` temporary through memory and
+#: pays the page faults of allocating it: about twice as fast at 800x600.
+RAY_BLOCK: int = 1 << 14
+
+_UNIT_SPHERE = Sphere((0.0, 0.0, 0.0), 1.0)
+
+
+@dataclass
+class RenderStats:
+    """What one numpy render did: rays cast by kind, and its time."""
+
+    primary: int = 0
+    shadow: int = 0
+    reflection: int = 0
+    #: Ray-shape tests done (one per ray and triangle, or ray and sphere):
+    #: what backface and AABB culling save.
+    tests: int = 0
+    seconds: float = 0.0
+
+    @property
+    def rays(self) -> int:
+        return self.primary + self.shadow + self.reflection
+
+
+# --- finding hits: the nearest hit, and the shadow query ------------------------
+
+
+@dataclass
+class _Hits:
+    t: NDArray[np.float64]  # inf for a miss
+    node: NDArray[np.intp]  # -1 for a miss
+    tri: NDArray[np.intp]  # world triangle index (meshes), -1 otherwise
+
+
+def _rows(o: NDArray[np.float64], rays: NDArray[np.intp] | NDArray[np.bool_]) -> NDArray[np.float64]:
+    """The origins of the rays ``rays`` picks: ``o`` itself when it is the one ``(3,)``
+    origin every ray shares (primary rays start at the eye), else those rows."""
+    return o if o.ndim == 1 else o[rays]
+
+
+def _nearest(world: World, o: NDArray[np.float64], d: NDArray[np.float64], cull: bool | None, aabb: bool,
+             stats: RenderStats | None = None) -> _Hits:
+    """Nearest hit with ``t > 0`` of each ray over every node (the course's ``min_indis`` loop).
+
+    ``o`` is ``(N, 3)``, or ``(3,)`` for rays that share one origin (the eye):
+    the kernels then form the origin's terms once (see
+    :func:`~glsandbox.raytrace.base.shared_origin`). ``cull`` is the render's
+    ``cull_backfaces`` (None: each node's own), ``aabb`` whether boxes are
+    tested first.
+    """
+    return _scan_nodes(world, o, d, np.inf, cull, aabb, -1, stats)
+
+
+def _occluded(world: World, o: NDArray[np.float64], d: NDArray[np.float64], light: int, cull: bool | None,
+              aabb: bool, stats: RenderStats | None = None) -> NDArray[np.bool_]:
+    """Gölge testi for shadow rays towards light ``light``: whether each ray ``o + s·d``
+    hits something at ``0 < s < 1`` (``d`` reaches the light at ``s = 1``, so an
+    occluder beyond the light never counts). The light's lamp is skipped."""
+    return _scan_nodes(world, o, d, 1.0, cull, aabb, light, stats).node >= 0
+
+
+def _scan_nodes(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_max: float, cull: bool | None,
+                aabb: bool, light: int, stats: RenderStats | None) -> _Hits:
+    """Nearest hit with ``0 < t < t_max``, every node in scene order; ``light >= 0`` skips that light's lamp.
+
+    Each node's box (its slab test, ``1/d`` formed once for all nodes) picks the
+    rays that enter it before the best hit so far; only those are tested
+    against the node. A strict ``<`` keeps ties with the earlier node.
+    """
+    n = d.shape[0]
+    best_t = np.broadcast_to(np.asarray(t_max, dtype=np.float64), (n,)).copy()
+    best_node = np.full(n, -1, dtype=np.intp)
+    best_tri = np.full(n, -1, dtype=np.intp)
+    inverse = reciprocals(d) if aabb else None  # 1/d once for every node's slab test
+    for k, node in enumerate(world.nodes):
+        if light >= 0 and node.lamp_of >> light & 1:
+            continue
+        if inverse is not None:
+            near, far = AABB(node.box_min, node.box_max).slabs_reciprocal(o, inverse)
+            idx = np.nonzero((near <= far) & (far > 0.0) & (near < best_t))[0]
+        else:
+            idx = np.arange(n)
+        if idx.size == 0:
+            continue
+        if stats is not None:
+            stats.tests += idx.size * max(node.count, 1)
+        t, j = _hit_node(world, k, _rows(o, idx), d[idx], node.cull if cull is None else cull)
+        better = t < best_t[idx]
+        sel = idx[better]
+        best_t[sel] = t[better]
+        best_node[sel] = k
+        best_tri[sel] = j[better]
+    hit = best_node >= 0
+    return _Hits(np.where(hit, best_t, np.inf), best_node, best_tri)
+
+
+def _hit_node(world: World, k: int, o: NDArray[np.float64], d: NDArray[np.float64], one_sided: bool
+              ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
+    """Rays against node ``k`` alone: ``(t, world triangle index)``, ``(inf, −1)`` for a miss
+    and ``−1`` for a sphere's hits.
+
+    A sphere node is the unit sphere under its model matrix: the ray is taken
+    into the sphere's own space (Işın-Küre kesim testi there; ``t`` is kept by
+    the affine map). A mesh node's triangles are tested with Möller–Trumbore
+    (:meth:`~glsandbox.raytrace.triangle.TriangleBatch.nearest_many`), the lowest
+    index winning a tie. ``one_sided``: backface culling (course "Hızlandırma:
+    backface culling").
+    """
+    node = world.nodes[k]
+    if node.kind == "sphere":
+        inv = node.inverse
+        oo = o @ inv[:3, :3].T + inv[:3, 3]  # the ray in the unit sphere's own space
+        dd = d @ inv[:3, :3].T
+        t = _UNIT_SPHERE.intersect_many(oo, dd)
+        if one_sided:  # from inside, the sphere's front faces all face away
+            t = np.where(np.einsum("...j,...j->...", oo, oo) < 1.0, np.inf, t)
+        return t, np.full(d.shape[0], -1, dtype=np.intp)
+    batch = world.batches[k]
+    assert batch is not None
+    t, j = batch.nearest_many(o, d, cull_backfaces=one_sided)
+    return t, np.where(j >= 0, j + node.start, -1)
+
+
+# --- surface attributes at the hits --------------------------------------------
+
+
+def _barycentric(world: World, tri: NDArray[np.intp], o: NDArray[np.float64],
+                 d: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Möller–Trumbore's ``(u, v)`` of each ray on its own triangle: ``P = V0 + u·e1 + v·e2``."""
+    v0 = world.v0[tri]
+    e1 = world.v1[tri] - v0
+    e2 = world.v2[tri] - v0
+    p = np.cross(d, e2)
+    det = np.einsum("ij,ij->i", e1, p)
+    det = np.where(det == 0.0, 1.0, det)
+    s = o - v0
+    q = np.cross(s, e1)
+    return np.einsum("ij,ij->i", s, p) / det, np.einsum("ij,ij->i", d, q) / det
+
+
+def _sample(image: NDArray[np.float64], wrap: int, uv: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Bilinear filtering of ``image`` (row 0 = v 0, as GL reads the uploaded image) at ``uv``."""
+    h, w = image.shape[:2]
+    x = uv[:, 0] * w - 0.5
+    y = uv[:, 1] * h - 0.5
+    x0 = np.floor(x)
+    y0 = np.floor(y)
+    fx = (x - x0)[:, None]
+    fy = (y - y0)[:, None]
+
+    def wrap_index(i: NDArray[np.float64], size: int) -> NDArray[np.intp]:
+        i = i.astype(np.intp)
+        if wrap == 0:  # repeat
+            return np.mod(i, size)
+        if wrap == 1:  # mirrored repeat: 0..size-1, size-1..0, ...
+            m = np.mod(i, 2 * size)
+            return np.where(m < size, m, 2 * size - 1 - m)
+        return np.clip(i, 0, size - 1)  # clamp to edge
+
+    xa, xb = wrap_index(x0, w), wrap_index(x0 + 1, w)
+    ya, yb = wrap_index(y0, h), wrap_index(y0 + 1, h)
+    top = image[ya, xa] * (1 - fx) + image[ya, xb] * fx
+    bottom = image[yb, xa] * (1 - fx) + image[yb, xb] * fx
+    return top * (1 - fy) + bottom * fy
+
+
+def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.float64]
+             ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """``(point, unit normal, base colour)`` for hit rays (all of ``hits`` must be hits)."""
+    n = d.shape[0]
+    point = o + hits.t[:, None] * d
+    normal = np.zeros((n, 3))
+    base = np.zeros((n, 3))
+    uv = np.zeros((n, 2))
+    for k, node in enumerate(world.nodes):
+        sel = np.nonzero(hits.node == k)[0]
+        if sel.size == 0:
+            continue
+        if node.kind == "sphere":
+            inv = node.inverse
+            q = point[sel] @ inv[:3, :3].T + inv[:3, 3]  # the hit on the unit sphere
+            q /= length(q)[:, None]
+            normal[sel] = q @ node.normal_matrix.T
+            # geometry.sphere()'s uv: u = azimuth/2π from +z towards +x, v = polar angle/π from +y.
+            uv[sel, 0] = np.mod(np.arctan2(q[:, 0], q[:, 2]), 2 * np.pi) / (2 * np.pi)
+            uv[sel, 1] = np.arccos(np.clip(q[:, 1], -1.0, 1.0)) / np.pi
+            colors = np.ones((sel.size, 3)) if node.mode == 1 else None
+        else:
+            tri = hits.tri[sel]
+            u, v = _barycentric(world, tri, _rows(o, sel), d[sel])
+            w = (1.0 - u - v)[:, None], u[:, None], v[:, None]  # weights of V0, V1, V2
+            normal[sel] = _interpolate(world.normals[tri], w)
+            uv[sel] = _interpolate(world.uvs[tri], w)
+            colors = _interpolate(world.colors[tri], w) if node.mode == 1 else None
+        color = np.broadcast_to(node.color, (sel.size, 3)).copy()
+        if colors is not None:  # vertex colours, times the material colour (basic.glsl)
+            color *= colors
+        if node.texture >= 0:
+            image, wrap = world.textures[node.texture]
+            color *= _sample(image, wrap, uv[sel])[:, :3]
+        base[sel] = color
+    normal /= np.maximum(length(normal), 1e-300)[:, None]
+    return point, normal, base
+
+
+def _interpolate(values: NDArray[np.float64], w: tuple[NDArray[np.float64], ...]) -> NDArray[np.float64]:
+    """``w0·values[:, 0] + w1·values[:, 1] + w2·values[:, 2]``: per-vertex values (``(N, 3, k)``)
+    at the barycentric weights ``w`` (three ``(N, 1)``), summed in that order."""
+    return values[:, 0] * w[0] + values[:, 1] * w[1] + values[:, 2] * w[2]
+
+
+def _offset(point: NDArray[np.float64], normal: NDArray[np.float64], side: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``point`` moved off its surface towards ``side`` by the relative :data:`SHADOW_OFFSET`."""
+    scale = SHADOW_OFFSET * np.maximum(1.0, np.abs(point).max(axis=1))
+    sign = np.where(np.einsum("ij,ij->i", normal, side) < 0.0, -1.0, 1.0)
+    return point + (scale * sign)[:, None] * normal
+
+
+# --- shading and bounces -------------------------------------------------------
+
+
+def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.float64], shadows: bool,
+           cull: bool | None, aabb: bool, stats: RenderStats
+           ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Local colour of hit rays (the raster's per-light formula), plus point and normal for bounces."""
+    point, normal, base = _surface(world, hits, o, d)
+    color = base.copy()  # unlit surfaces keep their colour
+    table = world.materials
+    lit = table.lit[hits.node]
+    if lit.any():
+        idx = np.nonzero(lit)[0]
+        nodes = hits.node[idx]
+        ka = table.ka[nodes][:, None]
+        kd = table.kd[nodes][:, None]
+        ks = table.ks[nodes][:, None]
+        shin = table.shininess[nodes]
+        blinn = table.blinn[nodes]
+        p, nrm, mesh = point[idx], normal[idx], base[idx]
+        to_eye = -d[idx] / length(d[idx])[:, None]
+        total = np.zeros_like(mesh)
+        for index, (light, light_color) in enumerate(zip(world.light_positions, world.light_colors)):
+            to_light = light - p
+            to_light /= np.maximum(length(to_light), 1e-300)[:, None]
+            n_dot_l = np.einsum("ij,ij->i", nrm, to_light)
+            diffuse = np.maximum(n_dot_l, 0.0)[:, None] * mesh * light_color
+            reflected = -to_light + 2.0 * n_dot_l[:, None] * nrm  # fromLight − 2(fromLight·N)N
+            r_dot_e = np.einsum("ij,ij->i", to_eye, reflected)
+            cosine = r_dot_e
+            if blinn.any():  # Blinn-Phong: N·H, H the unit halfway vector
+                halfway = to_light + to_eye
+                halfway /= np.maximum(length(halfway), 1e-300)[:, None]
+                cosine = np.where(blinn, np.einsum("ij,ij->i", nrm, halfway), r_dot_e)
+            cosine = np.maximum(cosine, 0.0)
+            highlight = np.where(n_dot_l > 0.0, cosine ** shin, 0.0)
+            specular = highlight[:, None] * light_color
+            lighting = kd * diffuse + ks * specular
+            if shadows:
+                start = _offset(p, nrm, light - p)
+                stats.shadow += idx.size
+                blocked = _occluded(world, start, light - start, index, cull, aabb, stats)
+                lighting *= np.where(blocked, 0.0, 1.0)[:, None]  # in shadow only the ambient term stays
+            total += np.minimum(ka * mesh + lighting, 1.0)
+        color[idx] = total
+    return color, point, normal
+
+
+def _trace(world: World, o: NDArray[np.float64], d: NDArray[np.float64], max_depth: int, shadows: bool,
+           cull: bool | None, aabb: bool, stats: RenderStats) -> NDArray[np.float64]:
+    """Colour of each ray, reflections followed iteratively: ``(1−r)·local + r·reflected``."""
+    n = d.shape[0]
+    out = np.zeros((n, 3))
+    weight = np.ones(n)
+    alive = np.arange(n)
+    for depth in range(max_depth + 1):
+        hits = _nearest(world, o, d, cull, aabb, stats)
+        miss = hits.node < 0
+        out[alive[miss]] += weight[miss, None] * world.background
+        hit = ~miss
+        if not hit.any():
+            break
+        sub = _Hits(hits.t[hit], hits.node[hit], hits.tri[hit])
+        local, point, normal = _shade(world, sub, _rows(o, hit), d[hit], shadows, cull, aabb, stats)
+        r = world.materials.reflectivity[sub.node] if depth < max_depth else np.zeros(sub.node.size)
+        w = weight[hit]
+        out[alive[hit]] += (w * (1.0 - r))[:, None] * local
+        bounce = r > 0.0
+        if not bounce.any():
+            break
+        dh = d[hit][bounce]
+        nh = normal[bounce]
+        reflected = dh - 2.0 * np.einsum("ij,ij->i", dh, nh)[:, None] * nh  # Yansıma vektörü
+        o = _offset(point[bounce], nh, -dh)
+        d = reflected
+        weight = (w * r)[bounce]
+        alive = alive[hit][bounce]
+        stats.reflection += alive.size
+    return out
+
+
+def to_rgba8(rgb: NDArray[np.float64]) -> NDArray[np.uint8]:
+    """Clamp to 0..1 and round to 8 bits as GL's unorm conversion does; alpha 255."""
+    c = np.floor(np.clip(rgb, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
+    alpha = np.full((*c.shape[:-1], 1), 255, dtype=np.uint8)
+    return np.concatenate([c, alpha], axis=-1)
+
+
+def render_viewport(scene: Scene, size: tuple[int, int], viewport: int = 0, *, max_depth: int = 2,
+                    shadows: bool = True, cull_backfaces: bool | None = None, aabb: bool = True,
+                    analytic_spheres: bool = True, stats: RenderStats | None = None) -> NDArray[np.uint8]:
+    """Trace one viewport at ``size``: ``(H, W, 4)`` uint8, top row first (see :func:`to_rgba8`).
+
+    The options are :func:`glsandbox.raytrace.render`'s; ``stats`` counts the rays cast.
+    """
+    width, height = size
+    vp = scene.viewports[viewport]
+    world = build_world(scene, viewport, analytic_spheres=analytic_spheres)
+    eye, dirs = camera_rays(vp.camera or scene.camera, width, height)
+    stats = stats if stats is not None else RenderStats()
+    stats.primary += dirs.shape[0]
+    rgb = np.empty((dirs.shape[0], 3))
+    for lo in range(0, dirs.shape[0], RAY_BLOCK):
+        rays = slice(lo, lo + RAY_BLOCK)
+        rgb[rays] = _trace(world, eye, dirs[rays], max_depth, shadows, cull_backfaces, aabb, stats)
+    return to_rgba8(rgb.reshape(height, width, 3))
