@@ -11,7 +11,7 @@ from __future__ import annotations
 
 
 def cases(env) -> list:
-    from glsandbox.bench import Case, Side, same_pixels
+    from glsandbox.measure.bench import Case, Side, same_pixels
     from glsandbox.lesson import all_lessons
 
     renderer, size = env.renderer, env.size

@@ -42,7 +42,7 @@ CONFIGS: dict[str, dict[str, object]] = {
 def cases(env) -> list:
     """For ``glsandbox bench`` (when present): each effect configuration timed
     against the room with no effect, in its alternating rounds."""
-    from glsandbox.bench import Case, Side
+    from glsandbox.measure.bench import Case, Side
 
     renderer, size = env.renderer, env.size
 

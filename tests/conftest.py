@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from glsandbox.golden import Comparison, check_golden
+from glsandbox.measure.golden import Comparison, check_golden
 
 REPO_ROOT = Path(__file__).resolve().parent.parent  # the folder with pyproject.toml
 
@@ -51,7 +51,7 @@ def golden(request: pytest.FixtureRequest) -> GoldenCheck:
     """``golden(image, name, **tolerances)``: check ``image`` against tests/goldens/<name>.png.
 
     ``tolerances`` are ``threshold`` and ``max_bad_share`` (see
-    :func:`glsandbox.golden.compare_images`). ``name`` may contain ``/`` to
+    :func:`glsandbox.measure.golden.compare_images`). ``name`` may contain ``/`` to
     group goldens in folders.
     """
     update = bool(request.config.getoption(UPDATE_GOLDENS))

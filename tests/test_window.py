@@ -14,7 +14,7 @@ import pytest
 from conftest import need
 
 from glsandbox.files import load_png
-from glsandbox.golden import compare_images
+from glsandbox.measure.golden import compare_images
 from glsandbox.lesson import find_lesson
 
 REPO = Path(__file__).resolve().parent.parent

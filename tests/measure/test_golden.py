@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from glsandbox.golden import (
+from glsandbox.measure.golden import (
     Comparison,
     GoldenUpdated,
     GoldenUpdateRefused,
@@ -177,7 +177,7 @@ def test_comparison_is_frozen() -> None:
 @pytest.mark.parametrize("channels", [4, 3])
 @pytest.mark.parametrize("threshold", [0, 2, 40])
 def test_sparse_and_dense_neighbourhood_searches_agree(channels: int, threshold: int) -> None:
-    from glsandbox.golden import _bad_mask
+    from glsandbox.measure.golden import _bad_mask
 
     rng = np.random.default_rng(threshold + channels)
     expected = rng.integers(0, 4, (64, 48, channels), dtype=np.uint8) * np.uint8(60)
@@ -426,11 +426,11 @@ def test_golden_fixture_uses_the_goldens_folder(
 
 
 def test_update_goldens_option_is_a_usage_error_on_ci() -> None:
-    root = Path(__file__).resolve().parent.parent
+    root = Path(__file__).resolve().parents[2]
     env = {**os.environ, "CI": "1"}
     proc = subprocess.run(
         [sys.executable, "-m", "pytest", "--update-goldens", "--collect-only", "-q",
-         "-p", "no:cacheprovider", "tests/test_metrics.py"],
+         "-p", "no:cacheprovider", "tests/measure/test_metrics.py"],
         cwd=root, env=env, capture_output=True, text=True, timeout=60,
     )
     assert proc.returncode == pytest.ExitCode.USAGE_ERROR, proc.stdout + proc.stderr

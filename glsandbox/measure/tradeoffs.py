@@ -35,7 +35,7 @@ from typing import Any
 
 import numpy as np
 
-from glsandbox import metrics
+from glsandbox.measure import metrics
 from glsandbox.errors import SandboxError
 from glsandbox.scene import Scene
 
@@ -313,7 +313,7 @@ def _register_depth() -> None:
 
     def setting(label: str, note: str = "", **values: Any) -> Setting:
         def count(b: Bench) -> PixelCount:
-            from glsandbox.zfighting import count_z_fighting
+            from glsandbox.measure.zfighting import count_z_fighting
 
             found = count_z_fighting(b.renderer, scene(**values), b.size)
             return PixelCount(found.fighting, found.shadow)
@@ -342,7 +342,7 @@ def _register_depth() -> None:
         count_label="z-fighting px",
         count_of="shadow px",
         notes=(
-            "z-fighting px: shadow pixels the floor wins in the depth test (glsandbox.zfighting: the frame "
+            "z-fighting px: shadow pixels the floor wins in the depth test (glsandbox.measure.zfighting: the frame "
             "drawn with a flat unlit floor against an oracle whose floor is lowered 0.25, where the shadow "
             "cannot fight). RMSE, PSNR and FLIP compare the lit frame with the reference's lit frame.",
             "Depth d = A + B/z has slope near/z²: with near 0.01 a 24-bit buffer (step 2^-24) cannot tell "

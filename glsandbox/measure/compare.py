@@ -15,7 +15,7 @@ rendered one by one at their tile's size and placed in the frame instead
 It then tells which variants give identical pictures and how far apart the
 others are. Those figures come from each variant rendered alone at the tile
 size *without its overlays* (labels and matrices differ by design; the 3D
-picture is what is compared), using :mod:`glsandbox.metrics`.
+picture is what is compared), using :mod:`glsandbox.measure.metrics`.
 
 Every value is parsed by its parameter and every scene is built before
 anything renders, so a bad value is refused with nothing written.
@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from glsandbox import metrics
+from glsandbox.measure import metrics
 from glsandbox.errors import SandboxError
 from glsandbox.lesson import Lesson, Param
 from glsandbox.overlay import Overlay, text_image

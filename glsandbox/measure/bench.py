@@ -191,8 +191,8 @@ def run_process(command: list[str]) -> Callable[[int], None]:
 
 
 def benchmarks_dir() -> Path:
-    """The ``benchmarks/`` folder of the source tree (next to the package), else of the working folder."""
-    for root in (Path(__file__).resolve().parent.parent, Path.cwd()):
+    """The ``benchmarks/`` folder of the source tree (next to the ``glsandbox`` package), else of the working folder."""
+    for root in (Path(__file__).resolve().parents[2], Path.cwd()):
         if (root / "benchmarks").is_dir():
             return root / "benchmarks"
     raise SandboxError("no benchmarks/ folder: run glsandbox bench from a clone of the repository")

@@ -18,9 +18,9 @@ import pytest
 
 from glsandbox.lesson import all_lessons
 from glsandbox.plan import plan
-from glsandbox.tradeoffs import CSV_COLUMNS, downsample
+from glsandbox.measure.tradeoffs import CSV_COLUMNS, downsample
 
-REPO = Path(__file__).resolve().parent.parent
+REPO = Path(__file__).resolve().parents[2]
 
 
 def _run(*args: str, timeout: int = 240) -> subprocess.CompletedProcess:
@@ -194,7 +194,7 @@ def test_shadows_mirror_knob_against_the_ray_tracer(quick_report: Path) -> None:
 
 
 def test_tradeoffs_lists_what_is_not_measured_yet(quick_report: Path) -> None:
-    from glsandbox.tradeoffs import PENDING, all_knobs
+    from glsandbox.measure.tradeoffs import PENDING, all_knobs
 
     report = (quick_report / "report.md").read_text(encoding="utf-8")
     measured = {k.name for k in all_knobs()}
@@ -271,7 +271,7 @@ def test_raw_baseline_draws_the_lessons_picture(gl, name: str) -> None:
 
 
 def _benchmark_module(file_name: str):
-    from glsandbox.bench import benchmarks_dir, load_modules
+    from glsandbox.measure.bench import benchmarks_dir, load_modules
 
     return next(m for m in load_modules(benchmarks_dir()) if m.__file__.endswith(file_name))
 
@@ -281,7 +281,7 @@ def _raytrace_module():
 
 
 def test_raytrace_cases_without_embree_say_so(gl, monkeypatch) -> None:
-    from glsandbox.bench import BenchEnv, measure
+    from glsandbox.measure.bench import BenchEnv, measure
 
     module = _raytrace_module()
     monkeypatch.setattr(module, "embree_available", lambda: False)

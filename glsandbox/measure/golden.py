@@ -42,7 +42,7 @@ from pathlib import Path, PurePath
 import numpy as np
 import numpy.typing as npt
 
-from glsandbox import metrics
+from glsandbox.measure import metrics
 from glsandbox.errors import SandboxError
 from glsandbox.files import load_png, save_png
 
