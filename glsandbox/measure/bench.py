@@ -8,7 +8,8 @@ rounds, in one process and on one GL context: every round times each
 case's two sides back to back, the order swapped every other round, so the
 noise of a shared machine hits both alike. The figure per case is the ratio
 of the two medians (subject / baseline). Speed goals are printed, never
-asserted (see DESIGN.md, "Benchmarks, not timed tests").
+asserted: no test depends on a timing, which a busy machine would fail
+(README, "Benchmarks").
 
 The same harness drives ``python benchmarks/cube_frame.py`` on its own.
 """

@@ -61,7 +61,7 @@ class Variant:
 
 
 @dataclass
-class Comparison:
+class CompareResult:
     """The composed frame and the figures that compare the variants."""
 
     image: np.ndarray  # (H, W, 4) uint8, top row first
@@ -277,13 +277,13 @@ def difference_rows(images: list[np.ndarray], labels: list[str], groups: list[li
 
 
 def compare(lesson_cls: type[Lesson], varies: list[str], settings: list[str], size: tuple[int, int],
-            renderer) -> Comparison:  # renderer: glsandbox.frame.HeadlessRenderer
+            renderer) -> CompareResult:  # renderer: glsandbox.frame.HeadlessRenderer
     """Render the composed frame and compare the variants (see the module doc)."""
     variants, columns = build_variants(lesson_cls, varies, settings)
     return compare_variants(variants, columns, size, renderer)
 
 
-def compare_variants(variants: list[Variant], columns: int, size: tuple[int, int], renderer) -> Comparison:
+def compare_variants(variants: list[Variant], columns: int, size: tuple[int, int], renderer) -> CompareResult:
     """Render already built variants: the composed frame, then each alone for the figures."""
     rows = math.ceil(len(variants) / columns)
     tile = (max(1, size[0] // columns), max(1, size[1] // rows))
@@ -295,7 +295,7 @@ def compare_variants(variants: list[Variant], columns: int, size: tuple[int, int
     groups = group_identical(alone)
     labels = [v.label for v in variants]
     difference = difference_image(alone[groups[0][0]], alone[groups[1][0]]) if len(groups) > 1 else None
-    return Comparison(image, variants, groups, difference_rows(alone, labels, groups), tile, difference)
+    return CompareResult(image, variants, groups, difference_rows(alone, labels, groups), tile, difference)
 
 
 #: How much :func:`difference_image` amplifies: a difference of 64 levels is white.

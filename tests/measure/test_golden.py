@@ -11,14 +11,13 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from glsandbox.files import load_png, save_png
 from glsandbox.measure.golden import (
-    Comparison,
     GoldenUpdated,
     GoldenUpdateRefused,
+    ImageMatch,
     check_golden,
     compare_images,
-    load_png,
-    save_png,
     write_artifacts,
 )
 
@@ -318,7 +317,7 @@ def test_passing_golden(tmp_path: Path) -> None:
     golden = tmp_path / "cube.png"
     save_png(scene(), golden)
     cmp = check_golden(scene(101, 80), golden, update=False, results_dir=tmp_path / "results")
-    assert isinstance(cmp, Comparison)
+    assert isinstance(cmp, ImageMatch)
     assert cmp.passed and not cmp.updated
     assert not (tmp_path / "results").exists()
 
