@@ -83,8 +83,8 @@ def cold_start(command: list[str]) -> float:
 
 def cases(env) -> list:
     """The bench case: raw ModernGL vs glsandbox on the indexed cube (one context, alternating rounds)."""
-    from glsandbox.measure.bench import Case, Side, same_pixels
     from glsandbox.lesson import find_lesson
+    from glsandbox.measure.bench import Case, Side, same_pixels
 
     renderer = env.renderer
     raw = RawCube(renderer.host.ctx)

@@ -16,9 +16,9 @@ import pytest
 from glsandbox import transforms
 from glsandbox.effects import Mirror, PlanarShadow, shadow_casters
 from glsandbox.errors import SandboxError
+from glsandbox.measure.zfighting import count_z_fighting, flat_receiver, shade_mask
 from glsandbox.plan import plan
 from glsandbox.scene import Scene
-from glsandbox.measure.zfighting import count_z_fighting, flat_receiver, shade_mask
 from lessons.mirror import MirrorLesson
 from lessons.phong import PhongLesson
 

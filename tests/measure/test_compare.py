@@ -12,10 +12,10 @@ from conftest import REPO_ROOT as REPO
 from conftest import need
 
 from glsandbox.cli import main
-from glsandbox.measure.compare import build_variants, compare_variants, compose, parse_vary, tile_rects
 from glsandbox.errors import SandboxError
 from glsandbox.files import load_png
 from glsandbox.lesson import find_lesson
+from glsandbox.measure.compare import build_variants, compare_variants, compose, parse_vary, tile_rects
 from glsandbox.plan import plan
 
 ORDERS = "order=STR,SRT,RST,RTS,TSR,TRS"

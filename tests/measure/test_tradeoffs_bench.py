@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 
 from glsandbox.lesson import all_lessons
-from glsandbox.plan import plan
 from glsandbox.measure.tradeoffs import CSV_COLUMNS, downsample
+from glsandbox.plan import plan
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -286,7 +286,7 @@ def test_raytrace_cases_without_embree_say_so(gl, monkeypatch) -> None:
     module = _raytrace_module()
     monkeypatch.setattr(module, "embree_available", lambda: False)
     env = BenchEnv(quick=True, size=(48, 36))
-    env._renderer = gl  # the session's context: never a second one in this process
+    monkeypatch.setattr(env.gl, "_renderer", gl)  # the session's context: never a second one in this process
     found = module.cases(env)
     assert env.notes == [module.EMBREE_MISSING] and "skipped: embreex not installed" in env.notes[0]
     assert [c.group for c in found] == ["ray tracer engines"] * 2
