@@ -17,7 +17,8 @@ import numpy as np
 import pytest
 
 from glsandbox.lesson import all_lessons
-from glsandbox.measure.tradeoffs import CSV_COLUMNS, downsample
+from glsandbox.measure.render_context import downsample
+from glsandbox.measure.tradeoffs_report import CSV_COLUMNS
 from glsandbox.plan import plan
 
 REPO = Path(__file__).resolve().parents[2]
@@ -194,14 +195,42 @@ def test_shadows_mirror_knob_against_the_ray_tracer(quick_report: Path) -> None:
 
 
 def test_tradeoffs_lists_what_is_not_measured_yet(quick_report: Path) -> None:
-    from glsandbox.measure.tradeoffs import PENDING, all_knobs
+    from glsandbox.measure.knob import all_knobs
 
     report = (quick_report / "report.md").read_text(encoding="utf-8")
     measured = {k.name for k in all_knobs()}
-    for name in PENDING:
-        assert (f"- `{name}`:" in report) == (name not in measured)
     assert "## Not measured yet" not in report  # every knob of the issue is measured now
     assert {"depth", "shadows_mirror"} <= measured
+
+
+def test_a_knob_that_cannot_run_is_listed_as_not_measured_yet(tmp_path: Path) -> None:
+    from glsandbox.measure.tradeoffs_report import write_report
+
+    info = {"renderer": "llvmpipe", "backend": "egl", "size": "128x96", "runs": "5", "quick": "yes"}
+    write_report([], info, tmp_path / "report.md", {"embree": "embreex is not installed"})
+    report = (tmp_path / "report.md").read_text(encoding="utf-8")
+    assert "## Not measured yet\n\n- `embree`: embreex is not installed\n" in report
+
+
+@pytest.mark.parametrize("missing", ["flip_evaluator", "matplotlib"])
+def test_tradeoffs_without_the_measure_extra_is_one_line(tmp_path: Path, monkeypatch, capsys, missing: str) -> None:
+    from glsandbox.cli import main
+
+    monkeypatch.setitem(sys.modules, missing, None)  # as if not installed: importing it raises ImportError
+    out = tmp_path / "tradeoffs"
+    assert main(["tradeoffs", "--quick", "--out", str(out)]) == 2
+    assert capsys.readouterr().err == ("error: glsandbox tradeoffs needs flip-evaluator and matplotlib (the "
+                                       "'measure' extra): uv run --extra measure glsandbox tradeoffs\n")
+    assert not out.exists()  # refused before anything was written
+
+
+def test_the_measure_extra_is_imported_only_by_tradeoffs_at_work() -> None:
+    code = ("import sys, glsandbox.cli, glsandbox.measure.tradeoffs, glsandbox.measure.bench, "
+            "glsandbox.measure.compare, glsandbox.measure.golden; from glsandbox.measure.knob import all_knobs; "
+            "all_knobs(); print(sorted(m for m in ('flip_evaluator', 'matplotlib') if m in sys.modules))")
+    proc = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == "[]"
 
 
 def test_tradeoffs_bad_runs_is_one_line() -> None:
