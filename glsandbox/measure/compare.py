@@ -30,9 +30,9 @@ from pathlib import Path
 
 import numpy as np
 
-from glsandbox.measure import metrics
 from glsandbox.errors import SandboxError
 from glsandbox.lesson import Lesson, Param
+from glsandbox.measure import metrics
 from glsandbox.overlay import Overlay, text_image
 from glsandbox.scene import Node, Scene, Viewport
 

@@ -42,9 +42,9 @@ from pathlib import Path, PurePath
 import numpy as np
 import numpy.typing as npt
 
-from glsandbox.measure import metrics
-from glsandbox.errors import SandboxError
 from glsandbox import files
+from glsandbox.errors import SandboxError
+from glsandbox.measure import metrics
 
 __all__ = [
     "GoldenUpdateRefused",
