@@ -83,8 +83,8 @@ def cold_start(command: list[str]) -> float:
 
 def cases(env) -> list:
     """The bench case: raw ModernGL vs glsandbox on the indexed cube (one context, alternating rounds)."""
-    from glsandbox.bench import Case, Side, same_pixels
     from glsandbox.lesson import find_lesson
+    from glsandbox.measure.bench import Case, Side, same_pixels
 
     renderer = env.renderer
     raw = RawCube(renderer.host.ctx)
@@ -115,7 +115,7 @@ def main() -> int:
         Image.fromarray(pixels).save(args.raw_once)
         return 0
 
-    from glsandbox.bench import BenchEnv, measure
+    from glsandbox.measure.bench import BenchEnv, measure
 
     env = BenchEnv()
     (case,) = cases(env)

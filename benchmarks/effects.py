@@ -11,8 +11,8 @@ from __future__ import annotations
 
 
 def cases(env) -> list:
-    from glsandbox.bench import Case, Side, same_pixels
     from glsandbox.lesson import all_lessons
+    from glsandbox.measure.bench import Case, Side, same_pixels
 
     renderer, size = env.renderer, env.size
     found = []

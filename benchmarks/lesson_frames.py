@@ -540,8 +540,8 @@ RAW_BASELINES = {"clear_and_swap": RawClear, "triangle": RawTriangle, "phong": R
 
 def cases(env) -> list:
     """One case per lesson with a raw baseline: the lesson's default frame, animated by ``time``."""
-    from glsandbox.bench import Case, Side, same_pixels
     from glsandbox.lesson import find_lesson
+    from glsandbox.measure.bench import Case, Side, same_pixels
 
     renderer, size = env.renderer, env.size
     found = []

@@ -10,7 +10,8 @@ instead of reverse-Z. Each round renders every configuration for
 ``--frames`` frames (moving the cube, reading the pixels back), in turn, on
 one context, so machine noise hits all alike; the figure is the median over
 rounds of the per-frame time, and its ratio to the no-effect frame.
-No assertion: the numbers are for reading (see DESIGN.md, "Benchmarks").
+No assertion: the numbers are for reading; speed goals are never asserted
+(README, "Benchmarks").
 """
 
 from __future__ import annotations
@@ -42,7 +43,7 @@ CONFIGS: dict[str, dict[str, object]] = {
 def cases(env) -> list:
     """For ``glsandbox bench`` (when present): each effect configuration timed
     against the room with no effect, in its alternating rounds."""
-    from glsandbox.bench import Case, Side
+    from glsandbox.measure.bench import Case, Side
 
     renderer, size = env.renderer, env.size
 

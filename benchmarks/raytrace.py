@@ -168,7 +168,7 @@ def cases(env: object) -> list:
     rays, ratio = engine time / Embree time; without ``embreex``, the gpu
     engine against the numpy engine, and a note saying Embree was skipped.
     Everything is built on first use, so listing the cases costs nothing."""
-    from glsandbox.bench import Case, Side
+    from glsandbox.measure.bench import Case, Side
 
     size: tuple[int, int] = env.size  # type: ignore[attr-defined]
     has_embree = embree_available()

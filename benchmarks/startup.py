@@ -16,7 +16,7 @@ _TMP = tempfile.TemporaryDirectory(prefix="glsandbox-bench-")
 
 
 def cases(env) -> list:
-    from glsandbox.bench import Case, Side, run_process
+    from glsandbox.measure.bench import Case, Side, run_process
 
     tmp = Path(_TMP.name)
     here = Path(__file__).resolve().parent

@@ -160,7 +160,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 def cmd_compare(args: argparse.Namespace) -> int:
     """``glsandbox compare``: tiles side by side, then which are identical and how far apart."""
-    from glsandbox.compare import build_variants, compare_variants, default_out
+    from glsandbox.measure.compare import build_variants, compare_variants, default_out
 
     lesson_cls = find_lesson(args.lesson)
     out: Path = args.out or default_out(lesson_cls.name)
@@ -260,8 +260,8 @@ pre {{ background: #eee; padding: 0.5em; }}
 
 
 def cmd_tradeoffs(args: argparse.Namespace) -> int:
-    """``glsandbox tradeoffs``: accuracy knobs, timed and compared with a reference (:mod:`glsandbox.tradeoffs`)."""
-    from glsandbox.tradeoffs import run
+    """``glsandbox tradeoffs``: accuracy knobs, timed and compared with a reference (:mod:`glsandbox.measure.tradeoffs`)."""
+    from glsandbox.measure.tradeoffs import run
 
     run(args.out, quick=args.quick, backend=args.backend, runs=args.runs, only=args.knob)
     print(f"wrote {args.out / 'report.md'}, {args.out / 'tradeoffs.csv'}, {args.out / 'tradeoffs.png'}")
@@ -270,7 +270,7 @@ def cmd_tradeoffs(args: argparse.Namespace) -> int:
 
 def cmd_bench(args: argparse.Namespace) -> int:
     """``glsandbox bench``: every benchmark in benchmarks/, one table of side-by-side ratios."""
-    from glsandbox.bench import run_all
+    from glsandbox.measure.bench import run_all
 
     return run_all(json_path=args.json, quick=args.quick, only=args.only)
 

@@ -10,14 +10,15 @@ from typing import Any
 import numpy as np
 import pytest
 
-from glsandbox.golden import Comparison, check_golden
+from glsandbox.measure.golden import ImageMatch, check_golden
 
 REPO_ROOT = Path(__file__).resolve().parent.parent  # the folder with pyproject.toml
 
 
 # --- golden images ---------------------------------------------------------
-# See DESIGN.md, "Golden images". Goldens live in tests/goldens/<name>.png,
-# failure artefacts go to the ignored test-results/ folder.
+# The rule is glsandbox.measure.golden's (README, "Tests and golden images").
+# Goldens live in tests/goldens/<name>.png, failure artefacts go to the
+# ignored test-results/ folder.
 
 GOLDENS_DIR = REPO_ROOT / "tests" / "goldens"
 RESULTS_DIR = REPO_ROOT / "test-results"
@@ -43,7 +44,7 @@ def pytest_configure(config: pytest.Config) -> None:
         )
 
 
-GoldenCheck = Callable[..., Comparison]
+GoldenCheck = Callable[..., ImageMatch]
 
 
 @pytest.fixture
@@ -51,12 +52,12 @@ def golden(request: pytest.FixtureRequest) -> GoldenCheck:
     """``golden(image, name, **tolerances)``: check ``image`` against tests/goldens/<name>.png.
 
     ``tolerances`` are ``threshold`` and ``max_bad_share`` (see
-    :func:`glsandbox.golden.compare_images`). ``name`` may contain ``/`` to
+    :func:`glsandbox.measure.golden.compare_images`). ``name`` may contain ``/`` to
     group goldens in folders.
     """
     update = bool(request.config.getoption(UPDATE_GOLDENS))
 
-    def check(image: np.ndarray, name: str, **tolerances: Any) -> Comparison:
+    def check(image: np.ndarray, name: str, **tolerances: Any) -> ImageMatch:
         return check_golden(
             image,
             GOLDENS_DIR / f"{name}.png",

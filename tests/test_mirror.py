@@ -16,9 +16,9 @@ import pytest
 from glsandbox import transforms
 from glsandbox.effects import Mirror, PlanarShadow, shadow_casters
 from glsandbox.errors import SandboxError
+from glsandbox.measure.zfighting import count_z_fighting, flat_receiver, shade_mask
 from glsandbox.plan import plan
 from glsandbox.scene import Scene
-from glsandbox.zfighting import count_z_fighting, flat_receiver, shade_mask
 from lessons.mirror import MirrorLesson
 from lessons.phong import PhongLesson
 
@@ -192,7 +192,7 @@ def test_plans_without_effects_are_unchanged():
 
 
 def test_compare_cannot_compose_whole_frame_effects_so_it_stitches_them():
-    from glsandbox.compare import build_variants, composable, compose
+    from glsandbox.measure.compare import build_variants, composable, compose
 
     variants, columns = build_variants(MirrorLesson, ["shadow=on,off"], [])
     assert "stencil mirror" in composable(variants)
@@ -256,7 +256,7 @@ def test_stencil_darkens_each_shadow_pixel_once(gl):
 
 def z_fighting_pixels(gl, **settings) -> tuple[int, int]:
     """(shadow pixels, z-fighting pixels) for the lesson with an unlit floor
-    (:func:`glsandbox.zfighting.count_z_fighting`: the oracle is the same frame
+    (:func:`glsandbox.measure.zfighting.count_z_fighting`: the oracle is the same frame
     with the floor lowered by 0.25, where the shadow cannot fight)."""
     counted = count_z_fighting(gl, MirrorLesson(mirror="off", far=200.0, **settings).scene(), SIZE)
     return counted.shadow, counted.fighting

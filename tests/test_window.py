@@ -14,8 +14,8 @@ import pytest
 from conftest import need
 
 from glsandbox.files import load_png
-from glsandbox.golden import compare_images
 from glsandbox.lesson import find_lesson
+from glsandbox.measure.golden import compare_images
 
 REPO = Path(__file__).resolve().parent.parent
 COURSE_BLUE = (0, 32, 153)

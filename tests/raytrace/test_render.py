@@ -227,7 +227,7 @@ def test_lesson_renders_with_either_renderer(gl):
 
 
 def test_compare_raster_against_ray(gl):
-    from glsandbox.compare import compare
+    from glsandbox.measure.compare import compare
 
     result = compare(find_lesson("indexed_cube"), ["renderer=raster,ray"], [], (192, 72), gl)
     assert [v.label for v in result.variants] == ["renderer=raster", "renderer=ray"]

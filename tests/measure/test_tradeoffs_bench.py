@@ -17,10 +17,11 @@ import numpy as np
 import pytest
 
 from glsandbox.lesson import all_lessons
+from glsandbox.measure.render_context import downsample
+from glsandbox.measure.tradeoffs_report import CSV_COLUMNS
 from glsandbox.plan import plan
-from glsandbox.tradeoffs import CSV_COLUMNS, downsample
 
-REPO = Path(__file__).resolve().parent.parent
+REPO = Path(__file__).resolve().parents[2]
 
 
 def _run(*args: str, timeout: int = 240) -> subprocess.CompletedProcess:
@@ -194,14 +195,42 @@ def test_shadows_mirror_knob_against_the_ray_tracer(quick_report: Path) -> None:
 
 
 def test_tradeoffs_lists_what_is_not_measured_yet(quick_report: Path) -> None:
-    from glsandbox.tradeoffs import PENDING, all_knobs
+    from glsandbox.measure.knob import all_knobs
 
     report = (quick_report / "report.md").read_text(encoding="utf-8")
     measured = {k.name for k in all_knobs()}
-    for name in PENDING:
-        assert (f"- `{name}`:" in report) == (name not in measured)
     assert "## Not measured yet" not in report  # every knob of the issue is measured now
     assert {"depth", "shadows_mirror"} <= measured
+
+
+def test_a_knob_that_cannot_run_is_listed_as_not_measured_yet(tmp_path: Path) -> None:
+    from glsandbox.measure.tradeoffs_report import write_report
+
+    info = {"renderer": "llvmpipe", "backend": "egl", "size": "128x96", "runs": "5", "quick": "yes"}
+    write_report([], info, tmp_path / "report.md", {"embree": "embreex is not installed"})
+    report = (tmp_path / "report.md").read_text(encoding="utf-8")
+    assert "## Not measured yet\n\n- `embree`: embreex is not installed\n" in report
+
+
+@pytest.mark.parametrize("missing", ["flip_evaluator", "matplotlib"])
+def test_tradeoffs_without_the_measure_extra_is_one_line(tmp_path: Path, monkeypatch, capsys, missing: str) -> None:
+    from glsandbox.cli import main
+
+    monkeypatch.setitem(sys.modules, missing, None)  # as if not installed: importing it raises ImportError
+    out = tmp_path / "tradeoffs"
+    assert main(["tradeoffs", "--quick", "--out", str(out)]) == 2
+    assert capsys.readouterr().err == ("error: glsandbox tradeoffs needs flip-evaluator and matplotlib (the "
+                                       "'measure' extra): uv run --extra measure glsandbox tradeoffs\n")
+    assert not out.exists()  # refused before anything was written
+
+
+def test_the_measure_extra_is_imported_only_by_tradeoffs_at_work() -> None:
+    code = ("import sys, glsandbox.cli, glsandbox.measure.tradeoffs, glsandbox.measure.bench, "
+            "glsandbox.measure.compare, glsandbox.measure.golden; from glsandbox.measure.knob import all_knobs; "
+            "all_knobs(); print(sorted(m for m in ('flip_evaluator', 'matplotlib') if m in sys.modules))")
+    proc = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == "[]"
 
 
 def test_tradeoffs_bad_runs_is_one_line() -> None:
@@ -271,7 +300,7 @@ def test_raw_baseline_draws_the_lessons_picture(gl, name: str) -> None:
 
 
 def _benchmark_module(file_name: str):
-    from glsandbox.bench import benchmarks_dir, load_modules
+    from glsandbox.measure.bench import benchmarks_dir, load_modules
 
     return next(m for m in load_modules(benchmarks_dir()) if m.__file__.endswith(file_name))
 
@@ -281,12 +310,12 @@ def _raytrace_module():
 
 
 def test_raytrace_cases_without_embree_say_so(gl, monkeypatch) -> None:
-    from glsandbox.bench import BenchEnv, measure
+    from glsandbox.measure.bench import BenchEnv, measure
 
     module = _raytrace_module()
     monkeypatch.setattr(module, "embree_available", lambda: False)
     env = BenchEnv(quick=True, size=(48, 36))
-    env._renderer = gl  # the session's context: never a second one in this process
+    monkeypatch.setattr(env.gl, "_renderer", gl)  # the session's context: never a second one in this process
     found = module.cases(env)
     assert env.notes == [module.EMBREE_MISSING] and "skipped: embreex not installed" in env.notes[0]
     assert [c.group for c in found] == ["ray tracer engines"] * 2

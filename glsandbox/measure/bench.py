@@ -8,7 +8,8 @@ rounds, in one process and on one GL context: every round times each
 case's two sides back to back, the order swapped every other round, so the
 noise of a shared machine hits both alike. The figure per case is the ratio
 of the two medians (subject / baseline). Speed goals are printed, never
-asserted (see DESIGN.md, "Benchmarks, not timed tests").
+asserted: no test depends on a timing, which a busy machine would fail
+(README, "Benchmarks").
 
 The same harness drives ``python benchmarks/cube_frame.py`` on its own.
 """
@@ -30,6 +31,8 @@ from typing import Any
 import numpy as np
 
 from glsandbox.errors import SandboxError
+from glsandbox.files import write_text
+from glsandbox.frame import HeadlessRenderer, LazyRenderer
 
 #: The frame size of the frame benchmarks (the course's 800x600 window).
 FRAME_SIZE = (800, 600)
@@ -78,7 +81,9 @@ class BenchEnv:
     root: Path = field(default_factory=lambda: Path.cwd())
     #: Lines printed under the table (and written to the JSON): what a module skipped and why.
     notes: list[str] = field(default_factory=list)
-    _renderer: Any = None
+    #: The one EGL context every case draws on, opened by the first case that asks for it.
+    gl: LazyRenderer = field(default_factory=lambda: LazyRenderer("egl"))
+    _opened: bool = field(default=False, repr=False)
 
     def note(self, text: str) -> None:
         """Print ``text`` under the table, e.g. ``skipped: embreex not installed``."""
@@ -86,18 +91,17 @@ class BenchEnv:
             self.notes.append(text)
 
     @property
-    def renderer(self) -> Any:
+    def renderer(self) -> HeadlessRenderer:
         """One :class:`~glsandbox.frame.HeadlessRenderer` on EGL for every case (one context)."""
-        if self._renderer is None:
-            from glsandbox.frame import HeadlessRenderer
+        self._opened = True
+        return self.gl.renderer
 
-            self._renderer = HeadlessRenderer("egl")
-        return self._renderer
+    def renderer_name(self) -> str:
+        """The GL renderer the cases ran on; ``?`` when none of them opened it."""
+        return str(self.renderer.host.renderer) if self._opened else "?"
 
     def close(self) -> None:
-        if self._renderer is not None:
-            self._renderer.close()
-            self._renderer = None
+        self.gl.close()
 
 
 @dataclass
@@ -191,8 +195,8 @@ def run_process(command: list[str]) -> Callable[[int], None]:
 
 
 def benchmarks_dir() -> Path:
-    """The ``benchmarks/`` folder of the source tree (next to the package), else of the working folder."""
-    for root in (Path(__file__).resolve().parent.parent, Path.cwd()):
+    """The ``benchmarks/`` folder of the source tree (next to the ``glsandbox`` package), else of the working folder."""
+    for root in (Path(__file__).resolve().parents[2], Path.cwd()):
         if (root / "benchmarks").is_dir():
             return root / "benchmarks"
     raise SandboxError("no benchmarks/ folder: run glsandbox bench from a clone of the repository")
@@ -268,7 +272,7 @@ def run_all(json_path: Path | None = None, quick: bool = False, only: Sequence[s
             cases = [_quick(c) for c in cases]
         started = time.perf_counter()
         results = measure(cases, rounds, log)
-        renderer = env._renderer.host.renderer if env._renderer is not None else "?"
+        renderer = env.renderer_name()
     finally:
         env.close()
     title = (f"glsandbox bench: {len(results)} cases, {rounds} alternating rounds, frames {env.size[0]}x"
@@ -281,9 +285,7 @@ def run_all(json_path: Path | None = None, quick: bool = False, only: Sequence[s
         data = {"title": title, "renderer": renderer, "rounds": rounds, "quick": quick,
                 "seconds": round(time.perf_counter() - started, 2), "cases": [r.to_dict() for r in results],
                 "notes": list(env.notes)}
-        tmp = json_path.with_name(f".{json_path.name}.tmp")
-        tmp.write_text(json.dumps(data, indent=2) + "\n", encoding="utf-8")
-        tmp.replace(json_path)
+        write_text(json_path, json.dumps(data, indent=2) + "\n")
         print(f"wrote {json_path}")
     return 0
 

@@ -12,10 +12,10 @@ from conftest import REPO_ROOT as REPO
 from conftest import need
 
 from glsandbox.cli import main
-from glsandbox.compare import build_variants, compare_variants, compose, parse_vary, tile_rects
 from glsandbox.errors import SandboxError
 from glsandbox.files import load_png
 from glsandbox.lesson import find_lesson
+from glsandbox.measure.compare import build_variants, compare_variants, compose, parse_vary, tile_rects
 from glsandbox.plan import plan
 
 ORDERS = "order=STR,SRT,RST,RTS,TSR,TRS"
@@ -118,7 +118,7 @@ def test_cli_refuses_bad_values_with_exit_2_and_writes_nothing(tmp_path: Path, c
 def test_variants_that_cannot_share_a_frame_are_stitched_tile_by_tile(gl, lesson: str, vary: str) -> None:
     # A mirror owns the frame's stencil; lights belong to a whole scene: such
     # variants are rendered alone at the tile size and placed in the frame.
-    from glsandbox.compare import composable, tile_rects
+    from glsandbox.measure.compare import composable, tile_rects
     from glsandbox.scene import Viewport
 
     variants, columns = build_variants(find_lesson(lesson), [vary], [])

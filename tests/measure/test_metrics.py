@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from glsandbox.metrics import max_abs_diff, mismatch_share, psnr, rmse
+from glsandbox.measure.metrics import max_abs_diff, mismatch_share, psnr, rmse
 
 
 def grey(level: int, shape: tuple[int, ...] = (8, 8, 4)) -> np.ndarray:

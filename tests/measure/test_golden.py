@@ -11,14 +11,13 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from glsandbox.golden import (
-    Comparison,
+from glsandbox.files import load_png, save_png
+from glsandbox.measure.golden import (
     GoldenUpdated,
     GoldenUpdateRefused,
+    ImageMatch,
     check_golden,
     compare_images,
-    load_png,
-    save_png,
     write_artifacts,
 )
 
@@ -177,7 +176,7 @@ def test_comparison_is_frozen() -> None:
 @pytest.mark.parametrize("channels", [4, 3])
 @pytest.mark.parametrize("threshold", [0, 2, 40])
 def test_sparse_and_dense_neighbourhood_searches_agree(channels: int, threshold: int) -> None:
-    from glsandbox.golden import _bad_mask
+    from glsandbox.measure.golden import _bad_mask
 
     rng = np.random.default_rng(threshold + channels)
     expected = rng.integers(0, 4, (64, 48, channels), dtype=np.uint8) * np.uint8(60)
@@ -318,7 +317,7 @@ def test_passing_golden(tmp_path: Path) -> None:
     golden = tmp_path / "cube.png"
     save_png(scene(), golden)
     cmp = check_golden(scene(101, 80), golden, update=False, results_dir=tmp_path / "results")
-    assert isinstance(cmp, Comparison)
+    assert isinstance(cmp, ImageMatch)
     assert cmp.passed and not cmp.updated
     assert not (tmp_path / "results").exists()
 
@@ -426,11 +425,11 @@ def test_golden_fixture_uses_the_goldens_folder(
 
 
 def test_update_goldens_option_is_a_usage_error_on_ci() -> None:
-    root = Path(__file__).resolve().parent.parent
+    root = Path(__file__).resolve().parents[2]
     env = {**os.environ, "CI": "1"}
     proc = subprocess.run(
         [sys.executable, "-m", "pytest", "--update-goldens", "--collect-only", "-q",
-         "-p", "no:cacheprovider", "tests/test_metrics.py"],
+         "-p", "no:cacheprovider", "tests/measure/test_metrics.py"],
         cwd=root, env=env, capture_output=True, text=True, timeout=60,
     )
     assert proc.returncode == pytest.ExitCode.USAGE_ERROR, proc.stdout + proc.stderr

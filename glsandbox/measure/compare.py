@@ -15,7 +15,7 @@ rendered one by one at their tile's size and placed in the frame instead
 It then tells which variants give identical pictures and how far apart the
 others are. Those figures come from each variant rendered alone at the tile
 size *without its overlays* (labels and matrices differ by design; the 3D
-picture is what is compared), using :mod:`glsandbox.metrics`.
+picture is what is compared), using :mod:`glsandbox.measure.metrics`.
 
 Every value is parsed by its parameter and every scene is built before
 anything renders, so a bad value is refused with nothing written.
@@ -30,9 +30,9 @@ from pathlib import Path
 
 import numpy as np
 
-from glsandbox import metrics
 from glsandbox.errors import SandboxError
 from glsandbox.lesson import Lesson, Param
+from glsandbox.measure import metrics
 from glsandbox.overlay import Overlay, text_image
 from glsandbox.scene import Node, Scene, Viewport
 
@@ -61,7 +61,7 @@ class Variant:
 
 
 @dataclass
-class Comparison:
+class CompareResult:
     """The composed frame and the figures that compare the variants."""
 
     image: np.ndarray  # (H, W, 4) uint8, top row first
@@ -277,13 +277,13 @@ def difference_rows(images: list[np.ndarray], labels: list[str], groups: list[li
 
 
 def compare(lesson_cls: type[Lesson], varies: list[str], settings: list[str], size: tuple[int, int],
-            renderer) -> Comparison:  # renderer: glsandbox.frame.HeadlessRenderer
+            renderer) -> CompareResult:  # renderer: glsandbox.frame.HeadlessRenderer
     """Render the composed frame and compare the variants (see the module doc)."""
     variants, columns = build_variants(lesson_cls, varies, settings)
     return compare_variants(variants, columns, size, renderer)
 
 
-def compare_variants(variants: list[Variant], columns: int, size: tuple[int, int], renderer) -> Comparison:
+def compare_variants(variants: list[Variant], columns: int, size: tuple[int, int], renderer) -> CompareResult:
     """Render already built variants: the composed frame, then each alone for the figures."""
     rows = math.ceil(len(variants) / columns)
     tile = (max(1, size[0] // columns), max(1, size[1] // rows))
@@ -295,7 +295,7 @@ def compare_variants(variants: list[Variant], columns: int, size: tuple[int, int
     groups = group_identical(alone)
     labels = [v.label for v in variants]
     difference = difference_image(alone[groups[0][0]], alone[groups[1][0]]) if len(groups) > 1 else None
-    return Comparison(image, variants, groups, difference_rows(alone, labels, groups), tile, difference)
+    return CompareResult(image, variants, groups, difference_rows(alone, labels, groups), tile, difference)
 
 
 #: How much :func:`difference_image` amplifies: a difference of 64 levels is white.

@@ -1,6 +1,6 @@
-"""Golden image comparison, diff artefacts and atomic PNG input/output.
+"""Golden image comparison and diff artefacts.
 
-The rule (see DESIGN.md, "Golden images"):
+The rule the tests use against ``tests/goldens/`` (README, "Tests and golden images"):
 
 * Exact match passes.
 * Otherwise a pixel is *bad* when its largest channel difference exceeds
@@ -42,18 +42,16 @@ from pathlib import Path, PurePath
 import numpy as np
 import numpy.typing as npt
 
-from glsandbox import metrics
+from glsandbox import files
 from glsandbox.errors import SandboxError
-from glsandbox.files import load_png, save_png
+from glsandbox.measure import metrics
 
 __all__ = [
-    "Comparison",
     "GoldenUpdateRefused",
     "GoldenUpdated",
+    "ImageMatch",
     "check_golden",
     "compare_images",
-    "load_png",
-    "save_png",
     "write_artifacts",
 ]
 
@@ -87,7 +85,7 @@ class GoldenUpdated(UserWarning):
 
 
 @dataclass(frozen=True)
-class Comparison:
+class ImageMatch:
     """Outcome of comparing an actual image against an expected (golden) one.
 
     Attributes:
@@ -233,7 +231,7 @@ def compare_images(
     *,
     threshold: int = DEFAULT_THRESHOLD,
     max_bad_share: float = DEFAULT_MAX_BAD_SHARE,
-) -> Comparison:
+) -> ImageMatch:
     """Compare two uint8 RGBA images of shape (H, W, 4) with the golden rule.
 
     Args:
@@ -244,7 +242,7 @@ def compare_images(
             the comparison fails when ``bad_share > max_bad_share``.
 
     Returns:
-        A :class:`Comparison`. Different shapes give ``passed=False`` with a
+        A :class:`ImageMatch`. Different shapes give ``passed=False`` with a
         summary naming both shapes.
 
     Raises:
@@ -266,7 +264,7 @@ def compare_images(
     total = int(e.shape[0] * e.shape[1])
 
     if a.shape != e.shape:
-        return Comparison(
+        return ImageMatch(
             passed=False,
             identical=False,
             bad_pixels=total,
@@ -277,7 +275,7 @@ def compare_images(
             **common,
         )
     if np.array_equal(a, e):
-        return Comparison(
+        return ImageMatch(
             passed=True,
             identical=True,
             bad_pixels=0,
@@ -290,7 +288,7 @@ def compare_images(
 
     bad = int(np.count_nonzero(_bad_mask(a, e, int(threshold))))
     share = bad / total if total else 0.0
-    return Comparison(
+    return ImageMatch(
         passed=share <= max_bad_share,
         identical=False,
         bad_pixels=bad,
@@ -300,11 +298,6 @@ def compare_images(
         rmse=metrics.rmse(a, e),
         **common,
     )
-
-
-# --------------------------------------------------------------------------
-# PNG input / output
-# --------------------------------------------------------------------------
 
 
 # --------------------------------------------------------------------------
@@ -393,9 +386,9 @@ def write_artifacts(
         "expected": base / f"{name}-expected.png",
         "diff": base / f"{name}-diff.png",
     }
-    save_png(a, paths["actual"])
-    save_png(e, paths["expected"])
-    save_png(_diff_image(a, e, threshold), paths["diff"])
+    files.save_png(a, paths["actual"])
+    files.save_png(e, paths["expected"])
+    files.save_png(_diff_image(a, e, threshold), paths["diff"])
     return paths
 
 
@@ -405,7 +398,7 @@ def write_artifacts(
 
 
 def _write_golden(image: np.ndarray, path: Path, why: str) -> None:
-    save_png(image, path)
+    files.save_png(image, path)
     warnings.warn(GoldenUpdated(f"wrote golden {path} ({why})"), stacklevel=3)
 
 
@@ -418,7 +411,7 @@ def check_golden(
     threshold: int = DEFAULT_THRESHOLD,
     max_bad_share: float = DEFAULT_MAX_BAD_SHARE,
     name: str | None = None,
-) -> Comparison:
+) -> ImageMatch:
     """Check a rendered RGBA image against the golden PNG at ``golden_path``.
 
     Behaviour:
@@ -464,7 +457,7 @@ def check_golden(
         raise AssertionError(f"missing golden {golden}; {UPDATE_HINT}")
 
     try:
-        expected = load_png(golden)
+        expected = files.load_png(golden)
     except OSError as exc:  # includes PIL.UnidentifiedImageError
         if update:
             _write_golden(img, golden, f"was unreadable: {exc}")

@@ -1,0 +1,17 @@
+"""The measuring wing: tools that judge pictures and time frames; nothing here is needed to render one.
+
+- :mod:`~glsandbox.measure.metrics`: RMSE, PSNR, largest difference, share of differing pixels;
+- :mod:`~glsandbox.measure.golden`: the golden-image rule of the tests, and its diff pictures;
+- :mod:`~glsandbox.measure.compare`: ``glsandbox compare``, one lesson's variants side by side;
+- :mod:`~glsandbox.measure.zfighting`: counting the z-fighting pixels of a planar shadow;
+- :mod:`~glsandbox.measure.bench`: ``glsandbox bench``, every ``benchmarks/*.py`` in one table of ratios;
+- ``glsandbox tradeoffs``, what accuracy costs in time: :mod:`~glsandbox.measure.knob` (the knob
+  type and registry), :mod:`~glsandbox.measure.knobs` (the built-in knobs, one module each),
+  :mod:`~glsandbox.measure.render_context` (rendering a setting, supersampling),
+  :mod:`~glsandbox.measure.tradeoffs` (timing and comparing, :func:`~glsandbox.measure.tradeoffs.run`),
+  :mod:`~glsandbox.measure.tradeoffs_report` (CSV, Markdown, plot) and
+  :mod:`~glsandbox.measure.extra` (its optional dependencies, the ``measure`` extra).
+
+The wing uses the rest of glsandbox; the rest uses it only from the commands
+of :mod:`glsandbox.cli`, imported when the command runs.
+"""

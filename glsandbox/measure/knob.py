@@ -1,0 +1,122 @@
+"""Accuracy knobs: what ``glsandbox tradeoffs`` measures, and their registry.
+
+A :class:`Knob` is data: the scene it looks at, its :class:`Setting` values,
+the reference they are compared with, and what the report says about them.
+A setting is a label and a function from a
+:class:`~glsandbox.measure.render_context.RenderContext` (the GL renderer and
+the frame size) to an RGBA ``uint8`` picture, so a rasterised setting and a
+ray-traced reference plug in the same way.
+
+The built-in knobs are the modules of :mod:`glsandbox.measure.knobs`, one
+knob each, found the way lessons are: every module of that package not
+starting with ``_`` is imported and registers its knob with
+:func:`register_knob`. :func:`all_knobs` lists them by ``order``.
+"""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from glsandbox.scene import Scene
+
+if TYPE_CHECKING:
+    from glsandbox.measure.render_context import RenderContext
+
+__all__ = ["Knob", "PixelCount", "Setting", "all_knobs", "lesson_scene", "register_knob"]
+
+
+@dataclass(frozen=True)
+class PixelCount:
+    """An error counted in pixels: ``pixels`` bad ones out of ``of`` that matter
+    (for the depth knob: z-fighting pixels out of the shadow's pixels)."""
+
+    pixels: int
+    of: int
+
+    @property
+    def share(self) -> float:
+        """``pixels / of`` (0 when ``of`` is 0)."""
+        return self.pixels / self.of if self.of else 0.0
+
+
+@dataclass(frozen=True)
+class Setting:
+    """One value of a knob: a label and how to render the knob's scene with it.
+
+    ``count`` (knobs with a ``count_label``) counts the setting's bad pixels,
+    the knob's own error measure; it is computed once, outside the timing.
+    """
+
+    label: str
+    render: Callable[[RenderContext], np.ndarray]
+    note: str = ""
+    count: Callable[[RenderContext], PixelCount] | None = None
+
+
+@dataclass(frozen=True)
+class Knob:
+    """An accuracy knob: settings, the reference they are measured against, and checks.
+
+    ``monotone`` lists setting labels whose error must not grow along the
+    list (checked in the report and by the tests); ``quick`` the labels kept
+    by ``--quick``; ``unavailable`` returns why the knob cannot be measured
+    here (None: it can), and such a knob is listed in the report under "Not
+    measured yet". ``count_label`` names an error counted in pixels by
+    each setting's ``count`` (e.g. "z-fighting px"), reported before RMSE,
+    PSNR and FLIP and plotted instead of FLIP; ``notes`` are printed under
+    the knob's table (what the reference models differently, say).
+    ``order`` places the knob in the run and the report (the built-in ones
+    use 10 to 60; ties keep registration order).
+    """
+
+    name: str
+    title: str
+    scene: str
+    settings: tuple[Setting, ...]
+    reference: Setting
+    reference_note: str
+    quick: tuple[str, ...] = ()
+    monotone: tuple[str, ...] = ()
+    unavailable: Callable[[], str | None] = field(default=lambda: None)
+    count_label: str = ""
+    count_of: str = ""
+    notes: tuple[str, ...] = ()
+    order: int = 100
+
+    def chosen(self, quick: bool) -> tuple[Setting, ...]:
+        """The settings a run measures: all of them, or with ``quick`` the ``quick`` ones."""
+        if not quick or not self.quick:
+            return self.settings
+        return tuple(s for s in self.settings if s.label in self.quick)
+
+
+_KNOBS: dict[str, Knob] = {}
+
+
+def register_knob(knob: Knob) -> Knob:
+    """Add (or replace) a knob by its name."""
+    _KNOBS[knob.name] = knob
+    return knob
+
+
+def all_knobs() -> list[Knob]:
+    """Every knob: the modules of :mod:`glsandbox.measure.knobs` imported, then all by ``order``."""
+    from glsandbox.measure import knobs
+
+    for module in pkgutil.iter_modules(knobs.__path__):
+        if not module.name.startswith("_"):
+            importlib.import_module(f"{knobs.__name__}.{module.name}")
+    return sorted(_KNOBS.values(), key=lambda k: k.order)
+
+
+def lesson_scene(name: str, **values: Any) -> Scene:
+    """The scene of lesson ``name`` at the given parameter values (what a knob usually renders)."""
+    from glsandbox.lesson import find_lesson
+
+    return find_lesson(name)(**values).scene()
