@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import importlib
 import pkgutil
+import statistics
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -28,7 +29,7 @@ from glsandbox.scene import Scene
 if TYPE_CHECKING:
     from glsandbox.measure.render_context import RenderContext
 
-__all__ = ["Knob", "PixelCount", "Setting", "all_knobs", "lesson_scene", "register_knob"]
+__all__ = ["Knob", "KnobResult", "PixelCount", "Row", "Setting", "all_knobs", "lesson_scene", "register_knob"]
 
 
 @dataclass(frozen=True)
@@ -120,3 +121,49 @@ def lesson_scene(name: str, **values: Any) -> Scene:
     from glsandbox.lesson import find_lesson
 
     return find_lesson(name)(**values).scene()
+
+
+# --- what measuring a knob gives (glsandbox.measure.tradeoffs) --------------------
+
+
+@dataclass
+class Row:
+    """The figures of one setting."""
+
+    knob: str
+    setting: str
+    reference: bool
+    times_ms: list[float]
+    rmse: float
+    psnr: float
+    flip: float
+    image: str = ""
+    error_map: str = ""
+    count: PixelCount | None = None
+
+    @property
+    def median_ms(self) -> float:
+        return statistics.median(self.times_ms)
+
+    @property
+    def spread_ms(self) -> tuple[float, float]:
+        return min(self.times_ms), max(self.times_ms)
+
+
+@dataclass
+class KnobResult:
+    """One knob measured: a :class:`Row` per setting, the reference last."""
+
+    knob: Knob
+    rows: list[Row]
+
+    def row(self, label: str) -> Row:
+        return next(r for r in self.rows if r.setting == label)
+
+    def monotone_ok(self) -> bool | None:
+        """Whether errors do not grow along ``knob.monotone`` (None: nothing to check)."""
+        labels = [label for label in self.knob.monotone if any(r.setting == label for r in self.rows)]
+        if len(labels) < 2:
+            return None
+        errors = [self.row(label).rmse for label in labels]
+        return all(later <= earlier for earlier, later in zip(errors, errors[1:]))

@@ -18,11 +18,9 @@ and listed in the report under "Not measured yet".
 
 from __future__ import annotations
 
-import statistics
 import sys
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -30,7 +28,7 @@ import numpy as np
 from glsandbox.errors import SandboxError
 from glsandbox.files import save_png
 from glsandbox.measure import extra, metrics
-from glsandbox.measure.knob import Knob, PixelCount, all_knobs
+from glsandbox.measure.knob import Knob, KnobResult, Row, all_knobs
 from glsandbox.measure.render_context import RenderContext
 from glsandbox.measure.tradeoffs_report import write_csv, write_plot, write_report
 
@@ -41,49 +39,6 @@ RUNS = 5
 #: Frame size of the full report, and of ``--quick``.
 FULL_SIZE = (320, 240)
 QUICK_SIZE = (128, 96)
-
-
-@dataclass
-class Row:
-    """The figures of one setting."""
-
-    knob: str
-    setting: str
-    reference: bool
-    times_ms: list[float]
-    rmse: float
-    psnr: float
-    flip: float
-    image: str = ""
-    error_map: str = ""
-    count: PixelCount | None = None
-
-    @property
-    def median_ms(self) -> float:
-        return statistics.median(self.times_ms)
-
-    @property
-    def spread_ms(self) -> tuple[float, float]:
-        return min(self.times_ms), max(self.times_ms)
-
-
-@dataclass
-class KnobResult:
-    """One knob measured: a :class:`Row` per setting, the reference last."""
-
-    knob: Knob
-    rows: list[Row]
-
-    def row(self, label: str) -> Row:
-        return next(r for r in self.rows if r.setting == label)
-
-    def monotone_ok(self) -> bool | None:
-        """Whether errors do not grow along ``knob.monotone`` (None: nothing to check)."""
-        labels = [label for label in self.knob.monotone if any(r.setting == label for r in self.rows)]
-        if len(labels) < 2:
-            return None
-        errors = [self.row(label).rmse for label in labels]
-        return all(later <= earlier for earlier, later in zip(errors, errors[1:]))
 
 
 def flip_error(reference: np.ndarray, test: np.ndarray) -> tuple[float, np.ndarray]:

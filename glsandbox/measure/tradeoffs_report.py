@@ -16,13 +16,11 @@ import io
 import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from glsandbox.files import atomic_write, write_text
 from glsandbox.measure import extra
+from glsandbox.measure.knob import KnobResult
 
-if TYPE_CHECKING:
-    from glsandbox.measure.tradeoffs import KnobResult
 
 __all__ = ["CSV_COLUMNS", "write_csv", "write_plot", "write_report"]
 
