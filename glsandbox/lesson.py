@@ -20,7 +20,8 @@ from typing import Any, ClassVar
 
 from glsandbox.errors import SandboxError
 from glsandbox.scene import RENDERERS
-from glsandbox.scene import EFFECTS, Scene, load_scene
+from glsandbox.scene import EFFECTS, Scene
+from glsandbox.scene_file import load_scene
 
 
 @dataclass(frozen=True)
