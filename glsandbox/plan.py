@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from glsandbox.effects import shadow_casters
+from glsandbox.planar import shadow_casters
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh
 from glsandbox.scene import Node, Scene
@@ -78,16 +78,16 @@ class Pass:
     draws: tuple[Draw, ...] = ()
     depth_test: bool = False
 
-    #: Effect passes (:data:`EFFECT_PASS_KINDS`): the stencil state as text,
-    #: and what else the pass does differently (see :func:`effect_passes`).
+    #: Planar passes (:data:`PLANAR_PASS_KINDS`): the stencil state as text,
+    #: and what else the pass does differently (see :func:`planar_passes`).
     stencil: str = ""
     detail: str = ""
 
     def describe(self) -> str:
         if self.kind == "overlay":
             return describe_overlay_pass(self)
-        if self.kind in EFFECT_PASS_KINDS:
-            return describe_effect_pass(self)
+        if self.kind in PLANAR_PASS_KINDS:
+            return describe_planar_pass(self)
         if self.kind == "clear":
             what = []
             if self.clear_color is not None:
@@ -225,7 +225,7 @@ def plan(scene: Scene) -> Plan:
     # and cleared in every viewport, and the depth test runs in every draw pass
     # (unless the scene turned depth testing off, which would change the picture).
     force = scene.effects == "all"
-    uses_depth = _needs_depth(scene) or (force and scene.depth_test) or _has_effects(scene)
+    uses_depth = _needs_depth(scene) or (force and scene.depth_test) or _has_planar_effects(scene)
     passes: list[Pass] = []
     programs: set[ProgramVariant] = set()
     for index, viewport in enumerate(scene.viewports):
@@ -245,7 +245,7 @@ def plan(scene: Scene) -> Plan:
                               texture=texture.describe() if texture is not None else None))
         if draws:
             passes.append(Pass("draw", index, draws=tuple(draws), depth_test=uses_depth))
-        passes.extend(effect_passes(scene, index, programs))
+        passes.extend(planar_passes(scene, index, programs))
     overlay_steps = overlay_passes(scene)
     if overlay_steps:
         programs.add(OVERLAY_PROGRAM)
@@ -289,10 +289,10 @@ def describe_overlay_pass(step: Pass) -> str:
     return f"overlay {where} (blended, no depth test): " + ", ".join(d.node for d in step.draws)
 
 
-# --- effects: the stencil mirror and the planar shadow (course "The stencil Test") ---
+# --- planar effects: the stencil mirror and the planar shadow (course "The stencil Test") ---
 
 #: Pass kinds that only a scene with a mirror or a shadow receiver gets, in frame order.
-EFFECT_PASS_KINDS = ("mark_mirror", "reflection", "mirror_surface", "shadow")
+PLANAR_PASS_KINDS = ("mark_mirror", "reflection", "mirror_surface", "shadow")
 #: The stencil bit of the mirror's pixels, and the bit of pixels already shadowed.
 #: Separate bits (with write and compare masks) let both effects share one buffer.
 MIRROR_STENCIL_BIT = 0x1
@@ -301,7 +301,7 @@ SHADOW_STENCIL_BIT = 0x2
 SHADOW_PROGRAM = ProgramVariant("basic", (("SOLID_COLOR", ""),))
 
 
-def _has_effects(scene: Scene) -> bool:
+def _has_planar_effects(scene: Scene) -> bool:
     return scene.mirror is not None or scene.shadow is not None
 
 
@@ -311,7 +311,7 @@ def _needs_stencil(scene: Scene) -> bool:
                 or (scene.shadow is not None and scene.shadow.stencil))
 
 
-def effect_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> list[Pass]:
+def planar_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> list[Pass]:
     """The mirror's and the shadow's passes for viewport ``index``, after its draw pass.
 
     Mirror (stencil): ``mark_mirror`` draws the glass into the stencil only
@@ -328,7 +328,7 @@ def effect_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
     cube's front and back faces both cover the shadow). With the stencil each
     pixel is darkened once: test "shadow bit clear", then set it.
     """
-    if not _has_effects(scene):
+    if not _has_planar_effects(scene):
         return []
     nodes = {node.name: node for node in scene.nodes}
     passes: list[Pass] = []
@@ -374,11 +374,11 @@ def effect_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
     return passes
 
 
-_EFFECT_TITLES = {"mark_mirror": "mark mirror", "reflection": "reflection", "mirror_surface": "mirror surface",
+_PLANAR_TITLES = {"mark_mirror": "mark mirror", "reflection": "reflection", "mirror_surface": "mirror surface",
                   "shadow": "shadow"}
 
 
-def describe_effect_pass(step: Pass) -> str:
+def describe_planar_pass(step: Pass) -> str:
     what = ["depth test" if step.depth_test else "no depth test"]
     if step.kind == "mark_mirror":
         what.append("no colour or depth writes")
@@ -390,4 +390,4 @@ def describe_effect_pass(step: Pass) -> str:
         what.append(step.detail)
     items = "; ".join(f"{d.node} with {d.program}" + ("" if d.cull_back_faces else " (no culling)")
                       for d in step.draws) or "nothing"
-    return f"{_EFFECT_TITLES[step.kind]} viewport {step.viewport} ({', '.join(what)}): {items}"
+    return f"{_PLANAR_TITLES[step.kind]} viewport {step.viewport} ({', '.join(what)}): {items}"

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from glsandbox import transforms
-from glsandbox.effects import DEPTH_MODES, Mirror, PlanarShadow
+from glsandbox.planar import Mirror, PlanarShadow
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh
 from glsandbox.overlay import Overlay
@@ -49,6 +49,13 @@ RENDERERS = ("raster", "ray", "ray_numpy")
 #: How much the plan turns on (``--set effects=...``, every lesson): only what
 #: the scene needs, or everything that does not change the picture.
 EFFECTS = ("needed", "all")
+
+#: How depth is stored and compared. ``standard``: OpenGL's -1..1 clip depth
+#: into a 24-bit integer buffer, test LESS. ``reverse_z``: a 32-bit float
+#: buffer, ``glClipControl`` 0..1, near at 1 and far at 0, test GREATER (see
+#: :func:`glsandbox.transforms.reverse_z`).
+DEPTH_MODES = ("standard", "reverse_z")
+
 
 #: Images the project draws itself (:mod:`glsandbox.images`); any other
 #: texture source is an image file path.
@@ -218,11 +225,11 @@ class Scene:
     depth_test: bool = True
     #: Labels and figures drawn over the frame (:mod:`glsandbox.overlay`).
     overlays: tuple[Overlay, ...] = ()
-    #: A planar mirror drawn through the stencil buffer (:mod:`glsandbox.effects`).
+    #: A planar mirror drawn through the stencil buffer (:mod:`glsandbox.planar`).
     mirror: Mirror | None = None
-    #: A planar shadow projected onto a receiver (:mod:`glsandbox.effects`).
+    #: A planar shadow projected onto a receiver (:mod:`glsandbox.planar`).
     shadow: PlanarShadow | None = None
-    #: How depth is stored and compared: ``standard`` or ``reverse_z``.
+    #: How depth is stored and compared (:data:`DEPTH_MODES`).
     depth_mode: str = "standard"
     #: ``"needed"``: the plan lists only what the scene calls for; ``"all"``:
     #: every buffer and pass state forced on (the everything-on baseline that

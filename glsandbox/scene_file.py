@@ -17,11 +17,11 @@ from pathlib import Path
 from typing import Any
 
 from glsandbox import transforms
-from glsandbox.effects import DEPTH_MODES, Mirror, PlanarShadow
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import builtin_mesh
-from glsandbox.scene import (BUILTIN_TEXTURES, COURSE_BLUE, SHADINGS, Camera, Color, Light, Material, Node,
-                             Scene, Texture, Viewport)
+from glsandbox.planar import Mirror, PlanarShadow
+from glsandbox.scene import (BUILTIN_TEXTURES, COURSE_BLUE, DEPTH_MODES, SHADINGS, Camera, Color, Light, Material,
+                             Node, Scene, Texture, Viewport)
 
 #: Lighting coefficients a scene file may set on a node (see :class:`~glsandbox.scene.Material`).
 _MATERIAL_NUMBERS = ("ambient", "diffuse", "specular", "shininess")

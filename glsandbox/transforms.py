@@ -363,7 +363,7 @@ def shadow_matrix(plane: Sequence[float], light: Sequence[float]) -> Matrix:
     one. w = 0 means the ray never meets the plane: a directional light
     parallel to it (refused here), or a vertex at the light's height; w < 0, a
     vertex above a point light, projects to the wrong side (the planner culls
-    such casters, see :func:`glsandbox.effects.shadow_casters`). A point light
+    such casters, see :func:`glsandbox.planar.shadow_casters`). A point light
     lying in the plane gives a rank-1 matrix and is refused too.
     """
     p = normalize_plane(plane)

@@ -47,10 +47,10 @@ import numpy as np
 
 from glsandbox import geometry, transforms
 from glsandbox.cli import lesson_main
-from glsandbox.effects import DEPTH_MODES, Mirror, PlanarShadow
 from glsandbox.errors import SandboxError
 from glsandbox.lesson import Lesson, Param, register
-from glsandbox.scene import Camera, Light, Material, Node, Scene
+from glsandbox.planar import Mirror, PlanarShadow
+from glsandbox.scene import DEPTH_MODES, Camera, Light, Material, Node, Scene
 
 #: The room (OpenGL coordinates, y up): floor y = 0, back wall z = BACK, left wall x = -HALF_WIDTH.
 HALF_WIDTH = 5.0

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from glsandbox import transforms
-from glsandbox.effects import Mirror, PlanarShadow, shadow_casters
+from glsandbox.planar import Mirror, PlanarShadow, shadow_casters
 from glsandbox.errors import SandboxError
 from glsandbox.plan import plan
 from glsandbox.scene import Scene

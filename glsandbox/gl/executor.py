@@ -19,12 +19,12 @@ import numpy as np
 from glsandbox import transforms
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh
-from glsandbox.gl import effects as gl_effects
+from glsandbox.gl import depth as gl_depth, planar as gl_planar
 from glsandbox.gl.context import GLHost
 from glsandbox.gl.overlay import OverlayDrawer
 from glsandbox.gl.shaders import compile_program
 from glsandbox.gl.textures import TextureCache
-from glsandbox.plan import EFFECT_PASS_KINDS, Draw, Pass, Plan, ProgramVariant, plan as make_plan
+from glsandbox.plan import PLANAR_PASS_KINDS, Draw, Pass, Plan, ProgramVariant, plan as make_plan
 from glsandbox.scene import Light, Material, Node, Scene
 
 _MODES = {"triangles": moderngl.TRIANGLES, "triangle_strip": moderngl.TRIANGLE_STRIP,
@@ -126,7 +126,7 @@ class Executor:
         self._overlays: OverlayDrawer | None = None  # made on the first overlay pass
         self._textures = TextureCache(host)
         self._lights: tuple[Light, ...] = ()  # the lights of the frame being drawn
-        self._clear_depth = 1.0  # 0 with reverse-Z (glsandbox.gl.effects)
+        self._clear_depth = 1.0  # 0 with reverse-Z (glsandbox.gl.depth)
 
     # --- resources ----------------------------------------------------------
 
@@ -212,9 +212,9 @@ class Executor:
             self.program(variant)
         nodes = {node.name: node for node in scene.nodes}
         self._lights = scene.lights
-        self._clear_depth = gl_effects.clear_depth_value(scene)
+        self._clear_depth = gl_depth.clear_depth_value(scene)
         framebuffer.use()
-        gl_effects.begin_depth_mode(self, scene)
+        gl_depth.begin_depth_mode(self.ctx, self.host.raw, scene)
         for step in frame_plan.passes:
             if step.kind == "overlay":
                 self._draw_overlays(scene, step, framebuffer, size)
@@ -226,15 +226,15 @@ class Executor:
             else:
                 camera = viewport.camera or scene.camera
                 aspect = rect[2] / rect[3] if rect[3] else 1.0
-                pass_camera = PassCamera(camera.view(), gl_effects.projection_for(scene, camera.projection(aspect)))
+                pass_camera = PassCamera(camera.view(), gl_depth.projection_for(scene, camera.projection(aspect)))
                 framebuffer.viewport = rect
                 self._set_depth(step.depth_test)
-                if step.kind in EFFECT_PASS_KINDS:  # the stencil mirror and the planar shadow
-                    gl_effects.run_effect_pass(self, scene, step, nodes, pass_camera)
+                if step.kind in PLANAR_PASS_KINDS:  # the stencil mirror and the planar shadow
+                    gl_planar.run_planar_pass(self, scene, step, nodes, pass_camera)
                     continue
                 for draw in step.draws:
                     self._draw(nodes[draw.node], draw, pass_camera)
-        gl_effects.end_depth_mode(self, scene)
+        gl_depth.end_depth_mode(self.ctx, self.host.raw, scene)
         framebuffer.viewport = (0, 0, *size)
         self._set_depth(False)
         self.ctx.disable(moderngl.CULL_FACE)

@@ -1,11 +1,11 @@
-"""GL state for the effect passes: the stencil mirror, the planar shadow, reverse-Z.
+"""GL state for the planar passes: the stencil mirror and the planar shadow.
 
 Course section "The stencil Test". Direct3D 11 bundles this state into
 objects (``MarkMirrorDSS``, ``DrawReflectionDSS``, ``CullClockwiseRS``) set
 per draw; OpenGL keeps it as loose global switches, so every pass here sets
 what it needs and :func:`restore_state` puts back the defaults the other
 passes assume, whatever happened (``finally``). The raw calls moderngl lacks
-(stencil, colour and depth write masks, ``glClipControl``) go through
+(stencil, colour and depth write masks) go through
 :mod:`glsandbox.gl.rawgl`.
 
 Stencil bits (:data:`glsandbox.plan.MIRROR_STENCIL_BIT`, ``SHADOW_STENCIL_BIT``):
@@ -31,38 +31,10 @@ if TYPE_CHECKING:
 GL_INVERT = 0x150A
 
 
-# --- depth mode (per frame) ----------------------------------------------------
-
-
-def clear_depth_value(scene: Scene) -> float:
-    """What "far" is in the depth buffer: 1 normally, 0 with reverse-Z."""
-    return 0.0 if scene.depth_mode == "reverse_z" else 1.0
-
-
-def projection_for(scene: Scene, projection: np.ndarray) -> np.ndarray:
-    """The camera's projection, remapped for reverse-Z when the scene asks for it."""
-    return transforms.reverse_z(projection) if scene.depth_mode == "reverse_z" else projection
-
-
-def begin_depth_mode(executor: Executor, scene: Scene) -> None:
-    """Reverse-Z: clip depth 0..1 kept as is (``glClipControl``), test GREATER."""
-    if scene.depth_mode == "reverse_z":
-        executor.host.raw.glClipControl(rawgl.GL_LOWER_LEFT, rawgl.GL_ZERO_TO_ONE)
-        executor.ctx.depth_func = ">"
-
-
-def end_depth_mode(executor: Executor, scene: Scene) -> None:
-    """Back to OpenGL's defaults: clip depth -1..1, test LESS, clear depth 1."""
-    if scene.depth_mode == "reverse_z":
-        executor.host.raw.glClipControl(rawgl.GL_LOWER_LEFT, rawgl.GL_NEGATIVE_ONE_TO_ONE)
-        executor.host.raw.glClearDepth(1.0)
-        executor.ctx.depth_func = "<"
-
-
 # --- the passes ------------------------------------------------------------------
 
 
-def run_effect_pass(executor: Executor, scene: Scene, step: Pass, nodes: dict[str, Node],
+def run_planar_pass(executor: Executor, scene: Scene, step: Pass, nodes: dict[str, Node],
                     camera: PassCamera) -> None:
     """Run one ``mark_mirror``, ``reflection``, ``mirror_surface`` or ``shadow`` pass."""
     runners = {"mark_mirror": _mark_mirror, "reflection": _reflection,
