@@ -218,13 +218,13 @@ def plan(scene: Scene) -> Plan:
     Depth is allocated, cleared and tested only when something can hide
     something else (see :func:`_needs_depth`); MSAA only when asked for; the
     stencil only when a pass uses it (no pass in the foundation lessons does).
-    With ``scene.effects == "all"`` every buffer and test that leaves the
+    With ``scene.plan_mode == "all"`` every buffer and test that leaves the
     picture unchanged is forced on: the plan is a superset of the needed one.
     """
-    # effects=all: the everything-on baseline. Depth and stencil are allocated
+    # plan_mode "all": the everything-on baseline. Depth and stencil are allocated
     # and cleared in every viewport, and the depth test runs in every draw pass
     # (unless the scene turned depth testing off, which would change the picture).
-    force = scene.effects == "all"
+    force = scene.plan_mode == "all"
     uses_depth = _needs_depth(scene) or (force and scene.depth_test) or _has_planar_effects(scene)
     passes: list[Pass] = []
     programs: set[ProgramVariant] = set()

@@ -46,9 +46,10 @@ TEXTURE_WRAPS = ("repeat", "mirrored", "clamp")
 #: Who renders a viewport: the rasterizer, the GLSL ray tracer, the numpy (float64) ray tracer.
 RENDERERS = ("raster", "ray", "ray_numpy")
 
-#: How much the plan turns on (``--set effects=...``, every lesson): only what
-#: the scene needs, or everything that does not change the picture.
-EFFECTS = ("needed", "all")
+#: How much the plan turns on (:attr:`Scene.plan_mode`; every lesson's
+#: ``--set effects=...``): only what the scene needs, or everything that does
+#: not change the picture.
+PLAN_MODES = ("needed", "all")
 
 #: How depth is stored and compared. ``standard``: OpenGL's -1..1 clip depth
 #: into a 24-bit integer buffer, test LESS. ``reverse_z``: a 32-bit float
@@ -233,8 +234,8 @@ class Scene:
     depth_mode: str = "standard"
     #: ``"needed"``: the plan lists only what the scene calls for; ``"all"``:
     #: every buffer and pass state forced on (the everything-on baseline that
-    #: ``glsandbox bench`` measures on-demand planning against). See :data:`EFFECTS`.
-    effects: str = "needed"
+    #: ``glsandbox bench`` measures on-demand planning against). See :data:`PLAN_MODES`.
+    plan_mode: str = "needed"
 
     def __post_init__(self) -> None:
         if self.depth_mode not in DEPTH_MODES:
