@@ -15,41 +15,49 @@ masks, so one 8-bit buffer serves both without a clear in between.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import Any, Protocol
 
 import moderngl
 import numpy as np
 
 from glsandbox import transforms
 from glsandbox.gl import rawgl
-from glsandbox.plan import MIRROR_STENCIL_BIT, SHADOW_STENCIL_BIT, Pass
-from glsandbox.scene import Light, Node, Scene
+from glsandbox.plan import MIRROR_STENCIL_BIT, SHADOW_STENCIL_BIT, Draw, Pass
+from glsandbox.scene import Light, Material, Node, Scene
 
-if TYPE_CHECKING:
-    from glsandbox.gl.executor import Executor, PassCamera
 
-GL_INVERT = 0x150A
+class NodeDrawer(Protocol):
+    """What the planar passes need from the executor that runs them
+    (:class:`glsandbox.gl.executor.Executor`, which imports this module, so
+    this one never imports it): the context, the raw GL calls moderngl lacks,
+    and one node drawn with the pass's overrides (see
+    :meth:`~glsandbox.gl.executor.Executor.draw_node`). ``camera`` is the
+    executor's pass camera, handed back to it unread."""
+
+    ctx: moderngl.Context
+    raw: rawgl.RawGL
+
+    def draw_node(self, node: Node, draw: Draw, camera: Any, *, model: np.ndarray | None = None,
+                  front_face: str = "ccw", lights: tuple[Light, ...] | None = None,
+                  material: Material | None = None) -> None: ...
 
 
 # --- the passes ------------------------------------------------------------------
 
 
-def run_planar_pass(executor: Executor, scene: Scene, step: Pass, nodes: dict[str, Node],
-                    camera: PassCamera) -> None:
+def run_planar_pass(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, Node], camera: Any) -> None:
     """Run one ``mark_mirror``, ``reflection``, ``mirror_surface`` or ``shadow`` pass."""
     runners = {"mark_mirror": _mark_mirror, "reflection": _reflection,
                "mirror_surface": _mirror_surface, "shadow": _shadow}
     try:
-        runners[step.kind](executor, scene, step, nodes, camera)
+        runners[step.kind](drawer, scene, step, nodes, camera)
     finally:
-        restore_state(executor, scene)
+        restore_state(drawer.ctx, drawer.raw)
 
 
-def restore_state(executor: Executor, scene: Scene) -> None:
+def restore_state(ctx: moderngl.Context, raw: rawgl.RawGL) -> None:
     """The state every other pass assumes: no stencil test, all write masks on,
-    no blending, no polygon offset, counter-clockwise front faces, the
-    scene's own lights."""
-    raw, ctx = executor.host.raw, executor.ctx
+    no blending, no polygon offset, counter-clockwise front faces."""
     raw.glDisable(rawgl.GL_STENCIL_TEST)
     raw.glStencilMask(0xFF)
     raw.glStencilFunc(rawgl.GL_ALWAYS, 0, 0xFF)
@@ -60,18 +68,16 @@ def restore_state(executor: Executor, scene: Scene) -> None:
     ctx.blend_func = moderngl.DEFAULT_BLENDING
     ctx.polygon_offset = (0.0, 0.0)
     ctx.front_face = "ccw"
-    executor._lights = scene.lights
 
 
-def _mark_mirror(executor: Executor, scene: Scene, step: Pass, nodes: dict[str, Node],
-                 camera: PassCamera) -> None:
+def _mark_mirror(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, Node], camera: Any) -> None:
     """``MarkMirrorDSS``: the glass's visible pixels get the mirror bit.
 
     The stencil test always passes; where the depth test passes too (nothing
     in front of the glass) the bit is replaced by 1. Colour and depth writes
     are off: this pass changes nothing but the stencil.
     """
-    raw = executor.host.raw
+    raw = drawer.raw
     raw.glEnable(rawgl.GL_STENCIL_TEST)
     raw.glStencilMask(MIRROR_STENCIL_BIT)
     raw.glStencilFunc(rawgl.GL_ALWAYS, MIRROR_STENCIL_BIT, 0xFF)
@@ -79,7 +85,7 @@ def _mark_mirror(executor: Executor, scene: Scene, step: Pass, nodes: dict[str, 
     raw.glColorMask(0, 0, 0, 0)
     raw.glDepthMask(0)
     for draw in step.draws:
-        executor._draw(nodes[draw.node], draw, camera)
+        drawer.draw_node(nodes[draw.node], draw, camera)
 
 
 def reflected_lights(lights: tuple[Light, ...], reflection: np.ndarray) -> tuple[Light, ...]:
@@ -90,8 +96,7 @@ def reflected_lights(lights: tuple[Light, ...], reflection: np.ndarray) -> tuple
                  for l in lights)
 
 
-def _reflection(executor: Executor, scene: Scene, step: Pass, nodes: dict[str, Node],
-                camera: PassCamera) -> None:
+def _reflection(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, Node], camera: Any) -> None:
     """``DrawReflectionDSS``: the reflected nodes, only where the mirror bit is set.
 
     Each node is drawn with ``R @ model``. R has determinant -1, so a triangle
@@ -101,31 +106,29 @@ def _reflection(executor: Executor, scene: Scene, step: Pass, nodes: dict[str, N
     outside the glass.
     """
     assert scene.mirror is not None
-    raw = executor.host.raw
+    raw = drawer.raw
     if step.stencil:
         raw.glEnable(rawgl.GL_STENCIL_TEST)
         raw.glStencilMask(0x00)  # read only
         raw.glStencilFunc(rawgl.GL_EQUAL, MIRROR_STENCIL_BIT, MIRROR_STENCIL_BIT)
         raw.glStencilOp(rawgl.GL_KEEP, rawgl.GL_KEEP, rawgl.GL_KEEP)
     reflection = scene.mirror.matrix()
-    executor._lights = reflected_lights(scene.lights, reflection)
+    lights = reflected_lights(scene.lights, reflection)
     for draw in step.draws:
         node = nodes[draw.node]
-        executor._draw(node, draw, camera, model=reflection @ node.model, front_face="cw")
+        drawer.draw_node(node, draw, camera, model=reflection @ node.model, front_face="cw", lights=lights)
 
 
-def _mirror_surface(executor: Executor, scene: Scene, step: Pass, nodes: dict[str, Node],
-                    camera: PassCamera) -> None:
+def _mirror_surface(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, Node], camera: Any) -> None:
     """The glass over its reflection, blended by its colour's alpha."""
-    ctx = executor.ctx
+    ctx = drawer.ctx
     ctx.enable(moderngl.BLEND)
     ctx.blend_func = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA)
     for draw in step.draws:
-        executor._draw(nodes[draw.node], draw, camera)
+        drawer.draw_node(nodes[draw.node], draw, camera)
 
 
-def _shadow(executor: Executor, scene: Scene, step: Pass, nodes: dict[str, Node],
-            camera: PassCamera) -> None:
+def _shadow(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, Node], camera: Any) -> None:
     """The casters flattened by the lifted shadow matrix, dark and blended.
 
     Depth test on (the shadow must hide behind what stands in front of the
@@ -138,27 +141,20 @@ def _shadow(executor: Executor, scene: Scene, step: Pass, nodes: dict[str, Node]
     """
     shadow = scene.shadow
     assert shadow is not None
-    raw, ctx = executor.host.raw, executor.ctx
+    raw, ctx = drawer.raw, drawer.ctx
     if step.stencil:
         raw.glEnable(rawgl.GL_STENCIL_TEST)
         raw.glStencilMask(SHADOW_STENCIL_BIT)
         raw.glStencilFunc(rawgl.GL_EQUAL, 0, SHADOW_STENCIL_BIT)
-        raw.glStencilOp(rawgl.GL_KEEP, rawgl.GL_KEEP, GL_INVERT)
+        raw.glStencilOp(rawgl.GL_KEEP, rawgl.GL_KEEP, rawgl.GL_INVERT)
     raw.glDepthMask(0)
     ctx.enable(moderngl.BLEND)
     ctx.blend_func = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA)
     if shadow.polygon_offset:
         sign = 1.0 if scene.depth_mode == "reverse_z" else -1.0
         ctx.polygon_offset = (sign, sign)
-    ctx.disable(moderngl.CULL_FACE)
     flatten = shadow.matrix()
-    color = np.asarray(shadow.color, dtype="f4").tobytes()
-    for draw in step.draws:
+    flat = Material(color=shadow.color)  # one colour, unlit, untextured
+    for draw in step.draws:  # drawn without culling, as the plan says
         node = nodes[draw.node]
-        program = executor._programs[draw.program][1]
-        vao, gpu = executor._vao(node.mesh, draw.program)
-        program["m_model"].write(transforms.gl_bytes(flatten @ node.model))
-        program["m_view"].write(camera.view_bytes)
-        program["m_proj"].write(camera.proj_bytes)
-        program["u_color"].write(color)
-        vao.render(gpu.mode, vertices=gpu.count)
+        drawer.draw_node(node, draw, camera, model=flatten @ node.model, material=flat)
