@@ -66,6 +66,59 @@ class Draw:
     texture: str | None = None  # what texture unit 0 holds, only for textured nodes
 
 
+#: Stencil comparisons a pass may use (``glStencilFunc``).
+STENCIL_TESTS = ("always", "equal")
+#: What a fragment that passes the stencil and depth tests does to the
+#: written bits (``glStencilOp``'s third operation).
+STENCIL_OPS = ("keep", "replace", "invert")
+
+
+@dataclass(frozen=True)
+class StencilState:
+    """The stencil state of one pass: Direct3D's depth-stencil state (the
+    course's ``MarkMirrorDSS``, ``DrawReflectionDSS``), which OpenGL sets
+    with ``glStencilFunc``, ``glStencilMask`` and ``glStencilOp``.
+
+    A fragment passes when ``stencil & mask`` compares by ``test`` with
+    ``ref & mask`` (``always``: every fragment passes). Where it passes both
+    the stencil and the depth test, ``on_pass`` updates the bits of
+    ``write_mask``: ``keep`` leaves them, ``replace`` writes ``ref``'s,
+    ``invert`` flips them. A fragment that fails either test leaves the
+    stencil as it was.
+    """
+
+    test: str
+    ref: int
+    mask: int = 0xFF  # the compare mask
+    write_mask: int = 0x00
+    on_pass: str = "keep"
+
+    def __post_init__(self) -> None:
+        if self.test not in STENCIL_TESTS:
+            raise SandboxError(f"unknown stencil test {self.test!r}; use one of {', '.join(STENCIL_TESTS)}")
+        if self.on_pass not in STENCIL_OPS:
+            raise SandboxError(f"unknown stencil operation {self.on_pass!r}; use one of {', '.join(STENCIL_OPS)}")
+        for name in ("ref", "mask", "write_mask"):
+            if not 0 <= getattr(self, name) <= 0xFF:
+                raise SandboxError(f"stencil {name} must lie in 0..255 (an 8-bit buffer), got {getattr(self, name)!r}")
+
+    def describe(self) -> str:
+        """``always, replace 1``; ``equal 1, keep``; ``equal 0 on bit 2, set it``."""
+        test = self.test
+        if self.test != "always":
+            test += f" {self.ref}" + ("" if self.mask in (0xFF, self.ref) else f" on bit {self.mask}")
+        if self.on_pass == "replace":
+            update = f"replace {self.ref & self.write_mask}"
+        elif self.on_pass == "invert":
+            # Under "equal" with those bits 0 in ref, a flip can only set them.
+            clear_before = (self.test == "equal" and self.write_mask != 0
+                            and self.write_mask & self.mask == self.write_mask and self.ref & self.write_mask == 0)
+            update = "set it" if clear_before else f"invert bits {self.write_mask}"
+        else:
+            update = "keep"
+        return f"{test}, {update}"
+
+
 @dataclass(frozen=True)
 class Pass:
     """One step of the frame, restricted to one viewport."""
@@ -78,9 +131,10 @@ class Pass:
     draws: tuple[Draw, ...] = ()
     depth_test: bool = False
 
-    #: Planar passes (:data:`PLANAR_PASS_KINDS`): the stencil state as text,
-    #: and what else the pass does differently (see :func:`planar_passes`).
-    stencil: str = ""
+    #: Planar passes (:data:`PLANAR_PASS_KINDS`): the stencil state (None: no
+    #: stencil test), and what else the pass does differently, as text (see
+    #: :func:`planar_passes`).
+    stencil: StencilState | None = None
     detail: str = ""
 
     def describe(self) -> str:
@@ -297,6 +351,14 @@ PLANAR_PASS_KINDS = ("mark_mirror", "reflection", "mirror_surface", "shadow")
 #: Separate bits (with write and compare masks) let both effects share one buffer.
 MIRROR_STENCIL_BIT = 0x1
 SHADOW_STENCIL_BIT = 0x2
+#: ``MarkMirrorDSS``: every fragment of the glass that passes the depth test
+#: sets the mirror bit.
+MARK_MIRROR_STENCIL = StencilState("always", MIRROR_STENCIL_BIT, write_mask=MIRROR_STENCIL_BIT, on_pass="replace")
+#: ``DrawReflectionDSS``: only where the mirror bit is set; the stencil is read, not written.
+REFLECTION_STENCIL = StencilState("equal", MIRROR_STENCIL_BIT, mask=MIRROR_STENCIL_BIT)
+#: A pixel is darkened only while its shadow bit is clear, and the bit is then set
+#: (flipped from 0), so overlapping shadow triangles darken it once.
+SHADOW_STENCIL = StencilState("equal", 0, mask=SHADOW_STENCIL_BIT, write_mask=SHADOW_STENCIL_BIT, on_pass="invert")
 #: Shadows are drawn in one flat colour.
 SHADOW_PROGRAM = ProgramVariant("basic", (("SOLID_COLOR", ""),))
 
@@ -340,7 +402,7 @@ def planar_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
         glass_draw = Draw(glass.name, glass_variant.key, glass.cull_back_faces)
         if mirror.stencil:
             passes.append(Pass("mark_mirror", index, draws=(glass_draw,), depth_test=True,
-                               stencil=f"always, replace {MIRROR_STENCIL_BIT}"))
+                               stencil=MARK_MIRROR_STENCIL))
         reflected = []
         for name in mirror.reflected:
             if name not in nodes:
@@ -351,7 +413,7 @@ def planar_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
                 programs.add(variant)
                 reflected.append(Draw(name, variant.key, node.cull_back_faces))
         passes.append(Pass("reflection", index, draws=tuple(reflected), depth_test=True,
-                           stencil=f"equal {MIRROR_STENCIL_BIT}, keep" if mirror.stencil else "",
+                           stencil=REFLECTION_STENCIL if mirror.stencil else None,
                            detail="front faces clockwise, lights reflected"))
         passes.append(Pass("mirror_surface", index, draws=(glass_draw,), depth_test=True, detail="blended"))
     shadow = scene.shadow
@@ -369,7 +431,7 @@ def planar_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
         if draws:
             programs.add(SHADOW_PROGRAM)
         passes.append(Pass("shadow", index, draws=draws, depth_test=True,
-                           stencil=(f"equal 0 on bit {SHADOW_STENCIL_BIT}, set it" if shadow.stencil else ""),
+                           stencil=SHADOW_STENCIL if shadow.stencil else None,
                            detail="; ".join([", ".join(how), *culled])))
     return passes
 
@@ -382,8 +444,8 @@ def describe_planar_pass(step: Pass) -> str:
     what = ["depth test" if step.depth_test else "no depth test"]
     if step.kind == "mark_mirror":
         what.append("no colour or depth writes")
-    if step.stencil:
-        what.append(f"stencil {step.stencil}")
+    if step.stencil is not None:
+        what.append(f"stencil {step.stencil.describe()}")
     elif step.kind in ("reflection", "shadow"):
         what.append("no stencil")
     if step.detail:

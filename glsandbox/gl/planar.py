@@ -8,8 +8,9 @@ passes assume, whatever happened (``finally``). The raw calls moderngl lacks
 (stencil, colour and depth write masks) go through
 :mod:`glsandbox.gl.rawgl`.
 
-Stencil bits (:data:`glsandbox.plan.MIRROR_STENCIL_BIT`, ``SHADOW_STENCIL_BIT``):
-the mirror marks bit 0, the shadow bit 1, each with its own write and compare
+The stencil state of each pass is the plan's
+(:class:`glsandbox.plan.StencilState`, set by :func:`set_stencil`): the
+mirror marks bit 0, the shadow bit 1, each with its own write and compare
 masks, so one 8-bit buffer serves both without a clear in between.
 """
 
@@ -22,7 +23,7 @@ import numpy as np
 
 from glsandbox import transforms
 from glsandbox.gl import rawgl
-from glsandbox.plan import MIRROR_STENCIL_BIT, SHADOW_STENCIL_BIT, Draw, Pass
+from glsandbox.plan import Draw, Pass, StencilState
 from glsandbox.scene import Light, Material, Node, Scene
 
 
@@ -40,6 +41,22 @@ class NodeDrawer(Protocol):
     def draw_node(self, node: Node, draw: Draw, camera: Any, *, model: np.ndarray | None = None,
                   front_face: str = "ccw", lights: tuple[Light, ...] | None = None,
                   material: Material | None = None) -> None: ...
+
+
+# --- stencil state ---------------------------------------------------------------
+
+_STENCIL_TESTS = {"always": rawgl.GL_ALWAYS, "equal": rawgl.GL_EQUAL}
+_STENCIL_OPS = {"keep": rawgl.GL_KEEP, "replace": rawgl.GL_REPLACE, "invert": rawgl.GL_INVERT}
+
+
+def set_stencil(raw: rawgl.RawGL, stencil: StencilState) -> None:
+    """Turn the stencil test on with a pass's state: its write mask, its test
+    (function, reference, compare mask), and what a fragment passing both the
+    stencil and the depth test does; one failing either keeps the stencil."""
+    raw.glEnable(rawgl.GL_STENCIL_TEST)
+    raw.glStencilMask(stencil.write_mask)
+    raw.glStencilFunc(_STENCIL_TESTS[stencil.test], stencil.ref, stencil.mask)
+    raw.glStencilOp(rawgl.GL_KEEP, rawgl.GL_KEEP, _STENCIL_OPS[stencil.on_pass])  # stencil fail, depth fail, both pass
 
 
 # --- the passes ------------------------------------------------------------------
@@ -74,14 +91,13 @@ def _mark_mirror(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, 
     """``MarkMirrorDSS``: the glass's visible pixels get the mirror bit.
 
     The stencil test always passes; where the depth test passes too (nothing
-    in front of the glass) the bit is replaced by 1. Colour and depth writes
+    in front of the glass) the bit is replaced by 1 (the plan's
+    :data:`~glsandbox.plan.MARK_MIRROR_STENCIL`). Colour and depth writes
     are off: this pass changes nothing but the stencil.
     """
+    assert step.stencil is not None
     raw = drawer.raw
-    raw.glEnable(rawgl.GL_STENCIL_TEST)
-    raw.glStencilMask(MIRROR_STENCIL_BIT)
-    raw.glStencilFunc(rawgl.GL_ALWAYS, MIRROR_STENCIL_BIT, 0xFF)
-    raw.glStencilOp(rawgl.GL_KEEP, rawgl.GL_KEEP, rawgl.GL_REPLACE)  # stencil fail, depth fail, both pass
+    set_stencil(raw, step.stencil)
     raw.glColorMask(0, 0, 0, 0)
     raw.glDepthMask(0)
     for draw in step.draws:
@@ -106,12 +122,8 @@ def _reflection(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, N
     outside the glass.
     """
     assert scene.mirror is not None
-    raw = drawer.raw
-    if step.stencil:
-        raw.glEnable(rawgl.GL_STENCIL_TEST)
-        raw.glStencilMask(0x00)  # read only
-        raw.glStencilFunc(rawgl.GL_EQUAL, MIRROR_STENCIL_BIT, MIRROR_STENCIL_BIT)
-        raw.glStencilOp(rawgl.GL_KEEP, rawgl.GL_KEEP, rawgl.GL_KEEP)
+    if step.stencil is not None:  # read only: write mask 0
+        set_stencil(drawer.raw, step.stencil)
     reflection = scene.mirror.matrix()
     lights = reflected_lights(scene.lights, reflection)
     for draw in step.draws:
@@ -142,11 +154,8 @@ def _shadow(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, Node]
     shadow = scene.shadow
     assert shadow is not None
     raw, ctx = drawer.raw, drawer.ctx
-    if step.stencil:
-        raw.glEnable(rawgl.GL_STENCIL_TEST)
-        raw.glStencilMask(SHADOW_STENCIL_BIT)
-        raw.glStencilFunc(rawgl.GL_EQUAL, 0, SHADOW_STENCIL_BIT)
-        raw.glStencilOp(rawgl.GL_KEEP, rawgl.GL_KEEP, rawgl.GL_INVERT)
+    if step.stencil is not None:
+        set_stencil(raw, step.stencil)
     raw.glDepthMask(0)
     ctx.enable(moderngl.BLEND)
     ctx.blend_func = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA)
