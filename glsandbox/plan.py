@@ -271,7 +271,7 @@ def plan(scene: Scene) -> Plan:
 
     Depth is allocated, cleared and tested only when something can hide
     something else (see :func:`_needs_depth`); MSAA only when asked for; the
-    stencil only when a pass uses it (no pass in the foundation lessons does).
+    stencil only when a pass uses it (a stencil mirror or shadow, :func:`planar_passes`).
     With ``scene.plan_mode == "all"`` every buffer and test that leaves the
     picture unchanged is forced on: the plan is a superset of the needed one.
     """

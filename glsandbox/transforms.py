@@ -1,7 +1,7 @@
 """Matrices: model transforms by order string, camera, projection, conversions.
 
-Conventions (pinned by ``tests/test_transforms.py``)
-----------------------------------------------------
+Conventions
+-----------
 
 =====================  ==========================  ===============================
                        the course (DirectX 11)     glsandbox (OpenGL)
@@ -138,7 +138,8 @@ def normal_matrix(model: Matrix) -> np.ndarray:
     Normals are covectors: under a non-uniform scale ``diag(a, b, c)`` a
     tangent stretches by (a, b, c) but the normal must shrink by (1/a, 1/b,
     1/c) to stay perpendicular. The course's ``mul(Input.Norm, world)`` is
-    only right for rotations and uniform scales (see COURSE.md errata).
+    only right for rotations and uniform scales: under any other scale its
+    normals lean off the surface (the ``phong`` lesson's ``normals=naive``).
     """
     block = np.asarray(model, dtype=np.float64)[:3, :3]
     if abs(np.linalg.det(block)) < 1e-300:
@@ -339,13 +340,6 @@ def light_vector(light: Sequence[float]) -> np.ndarray:
             raise SandboxError("a directional light needs a non-zero direction, got (0, 0, 0)")
         arr = np.array([*(arr[:3] / length), 0.0])
     return arr
-
-
-def light_height(plane: Sequence[float], light: Sequence[float]) -> float:
-    """``P·L`` for the normalized plane and light: a point light's signed
-    distance from the plane, or the cosine between a directional light and
-    the plane's normal. Positive: the light is on the side the normal faces."""
-    return float(normalize_plane(plane) @ light_vector(light))
 
 
 def shadow_matrix(plane: Sequence[float], light: Sequence[float]) -> Matrix:
