@@ -240,3 +240,5 @@ class Scene:
     def __post_init__(self) -> None:
         if self.depth_mode not in DEPTH_MODES:
             raise SandboxError(f"unknown depth mode {self.depth_mode!r}; use one of {', '.join(DEPTH_MODES)}")
+        if self.plan_mode not in PLAN_MODES:
+            raise SandboxError(f"unknown plan mode {self.plan_mode!r}; use one of {', '.join(PLAN_MODES)}")
