@@ -22,13 +22,14 @@ The layers below (the README's "How it works" table) import downwards only;
 """
 
 from glsandbox import camera, geometry, transforms
-from glsandbox.effects import DEPTH_MODES, Mirror, PlanarShadow
+from glsandbox.planar import Mirror, PlanarShadow
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh
 from glsandbox.lesson import Lesson, Param, register
 from glsandbox.overlay import Overlay, text_image
 from glsandbox.scene import (
     COURSE_BLUE,
+    DEPTH_MODES,
     LIT_SHADINGS,
     NORMAL_MODES,
     TEXTURE_FILTERS,

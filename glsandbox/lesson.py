@@ -20,7 +20,8 @@ from typing import Any, ClassVar
 
 from glsandbox.errors import SandboxError
 from glsandbox.scene import RENDERERS
-from glsandbox.scene import EFFECTS, Scene, load_scene
+from glsandbox.scene import PLAN_MODES, Scene
+from glsandbox.scene_file import load_scene
 
 
 #: The largest magnitude a number parameter takes unless it says otherwise.
@@ -95,7 +96,7 @@ TIME = Param("time", 0.0, "the moment to render, in seconds (animated lessons mo
 #: Every lesson has ``effects``: ``needed`` plans only what the scene calls for,
 #: ``all`` forces every buffer and pass on (same picture; the bench's baseline).
 EFFECTS_PARAM = Param("effects", "needed", "plan only the effects the scene needs, or force all on "
-                      "(same picture, for the bench)", choices=EFFECTS)
+                      "(same picture, for the bench)", choices=PLAN_MODES)
 
 #: Every lesson has ``renderer``: the rasterizer, or the ray tracer on the same
 #: Scene (``ray``: the GLSL engine, ``ray_numpy``: the float64 reference), so
@@ -171,8 +172,8 @@ class Lesson:
         renderer = self.values.get("renderer", "raster")
         if renderer != "raster":  # traced by glsandbox.frame.trace_viewports
             scene = replace(scene, viewports=tuple(replace(vp, renderer=renderer) for vp in scene.viewports))
-        effects = self.values.get("effects", "needed")  # effects=all: the bench's everything-on plan
-        return scene if scene.effects == effects else replace(scene, effects=effects)
+        plan_mode = self.values.get("effects", "needed")  # effects=all: the bench's everything-on plan
+        return scene if scene.plan_mode == plan_mode else replace(scene, plan_mode=plan_mode)
 
     def build(self) -> Scene:
         raise NotImplementedError

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from glsandbox.effects import shadow_casters
+from glsandbox.planar import shadow_casters
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh
 from glsandbox.scene import Node, Scene
@@ -66,6 +66,59 @@ class Draw:
     texture: str | None = None  # what texture unit 0 holds, only for textured nodes
 
 
+#: Stencil comparisons a pass may use (``glStencilFunc``).
+STENCIL_TESTS = ("always", "equal")
+#: What a fragment that passes the stencil and depth tests does to the
+#: written bits (``glStencilOp``'s third operation).
+STENCIL_OPS = ("keep", "replace", "invert")
+
+
+@dataclass(frozen=True)
+class StencilState:
+    """The stencil state of one pass: Direct3D's depth-stencil state (the
+    course's ``MarkMirrorDSS``, ``DrawReflectionDSS``), which OpenGL sets
+    with ``glStencilFunc``, ``glStencilMask`` and ``glStencilOp``.
+
+    A fragment passes when ``stencil & mask`` compares by ``test`` with
+    ``ref & mask`` (``always``: every fragment passes). Where it passes both
+    the stencil and the depth test, ``on_pass`` updates the bits of
+    ``write_mask``: ``keep`` leaves them, ``replace`` writes ``ref``'s,
+    ``invert`` flips them. A fragment that fails either test leaves the
+    stencil as it was.
+    """
+
+    test: str
+    ref: int
+    mask: int = 0xFF  # the compare mask
+    write_mask: int = 0x00
+    on_pass: str = "keep"
+
+    def __post_init__(self) -> None:
+        if self.test not in STENCIL_TESTS:
+            raise SandboxError(f"unknown stencil test {self.test!r}; use one of {', '.join(STENCIL_TESTS)}")
+        if self.on_pass not in STENCIL_OPS:
+            raise SandboxError(f"unknown stencil operation {self.on_pass!r}; use one of {', '.join(STENCIL_OPS)}")
+        for name in ("ref", "mask", "write_mask"):
+            if not 0 <= getattr(self, name) <= 0xFF:
+                raise SandboxError(f"stencil {name} must lie in 0..255 (an 8-bit buffer), got {getattr(self, name)!r}")
+
+    def describe(self) -> str:
+        """``always, replace 1``; ``equal 1, keep``; ``equal 0 on bit 2, set it``."""
+        test = self.test
+        if self.test != "always":
+            test += f" {self.ref}" + ("" if self.mask in (0xFF, self.ref) else f" on bit {self.mask}")
+        if self.on_pass == "replace":
+            update = f"replace {self.ref & self.write_mask}"
+        elif self.on_pass == "invert":
+            # Under "equal" with those bits 0 in ref, a flip can only set them.
+            clear_before = (self.test == "equal" and self.write_mask != 0
+                            and self.write_mask & self.mask == self.write_mask and self.ref & self.write_mask == 0)
+            update = "set it" if clear_before else f"invert bits {self.write_mask}"
+        else:
+            update = "keep"
+        return f"{test}, {update}"
+
+
 @dataclass(frozen=True)
 class Pass:
     """One step of the frame, restricted to one viewport."""
@@ -78,16 +131,17 @@ class Pass:
     draws: tuple[Draw, ...] = ()
     depth_test: bool = False
 
-    #: Effect passes (:data:`EFFECT_PASS_KINDS`): the stencil state as text,
-    #: and what else the pass does differently (see :func:`effect_passes`).
-    stencil: str = ""
+    #: Planar passes (:data:`PLANAR_PASS_KINDS`): the stencil state (None: no
+    #: stencil test), and what else the pass does differently, as text (see
+    #: :func:`planar_passes`).
+    stencil: StencilState | None = None
     detail: str = ""
 
     def describe(self) -> str:
         if self.kind == "overlay":
             return describe_overlay_pass(self)
-        if self.kind in EFFECT_PASS_KINDS:
-            return describe_effect_pass(self)
+        if self.kind in PLANAR_PASS_KINDS:
+            return describe_planar_pass(self)
         if self.kind == "clear":
             what = []
             if self.clear_color is not None:
@@ -217,15 +271,15 @@ def plan(scene: Scene) -> Plan:
 
     Depth is allocated, cleared and tested only when something can hide
     something else (see :func:`_needs_depth`); MSAA only when asked for; the
-    stencil only when a pass uses it (no pass in the foundation lessons does).
-    With ``scene.effects == "all"`` every buffer and test that leaves the
+    stencil only when a pass uses it (a stencil mirror or shadow, :func:`planar_passes`).
+    With ``scene.plan_mode == "all"`` every buffer and test that leaves the
     picture unchanged is forced on: the plan is a superset of the needed one.
     """
-    # effects=all: the everything-on baseline. Depth and stencil are allocated
+    # plan_mode "all": the everything-on baseline. Depth and stencil are allocated
     # and cleared in every viewport, and the depth test runs in every draw pass
     # (unless the scene turned depth testing off, which would change the picture).
-    force = scene.effects == "all"
-    uses_depth = _needs_depth(scene) or (force and scene.depth_test) or _has_effects(scene)
+    force = scene.plan_mode == "all"
+    uses_depth = _needs_depth(scene) or (force and scene.depth_test) or _has_planar_effects(scene)
     passes: list[Pass] = []
     programs: set[ProgramVariant] = set()
     for index, viewport in enumerate(scene.viewports):
@@ -245,7 +299,7 @@ def plan(scene: Scene) -> Plan:
                               texture=texture.describe() if texture is not None else None))
         if draws:
             passes.append(Pass("draw", index, draws=tuple(draws), depth_test=uses_depth))
-        passes.extend(effect_passes(scene, index, programs))
+        passes.extend(planar_passes(scene, index, programs))
     overlay_steps = overlay_passes(scene)
     if overlay_steps:
         programs.add(OVERLAY_PROGRAM)
@@ -289,19 +343,27 @@ def describe_overlay_pass(step: Pass) -> str:
     return f"overlay {where} (blended, no depth test): " + ", ".join(d.node for d in step.draws)
 
 
-# --- effects: the stencil mirror and the planar shadow (course "The stencil Test") ---
+# --- planar effects: the stencil mirror and the planar shadow (course "The stencil Test") ---
 
 #: Pass kinds that only a scene with a mirror or a shadow receiver gets, in frame order.
-EFFECT_PASS_KINDS = ("mark_mirror", "reflection", "mirror_surface", "shadow")
+PLANAR_PASS_KINDS = ("mark_mirror", "reflection", "mirror_surface", "shadow")
 #: The stencil bit of the mirror's pixels, and the bit of pixels already shadowed.
 #: Separate bits (with write and compare masks) let both effects share one buffer.
 MIRROR_STENCIL_BIT = 0x1
 SHADOW_STENCIL_BIT = 0x2
+#: ``MarkMirrorDSS``: every fragment of the glass that passes the depth test
+#: sets the mirror bit.
+MARK_MIRROR_STENCIL = StencilState("always", MIRROR_STENCIL_BIT, write_mask=MIRROR_STENCIL_BIT, on_pass="replace")
+#: ``DrawReflectionDSS``: only where the mirror bit is set; the stencil is read, not written.
+REFLECTION_STENCIL = StencilState("equal", MIRROR_STENCIL_BIT, mask=MIRROR_STENCIL_BIT)
+#: A pixel is darkened only while its shadow bit is clear, and the bit is then set
+#: (flipped from 0), so overlapping shadow triangles darken it once.
+SHADOW_STENCIL = StencilState("equal", 0, mask=SHADOW_STENCIL_BIT, write_mask=SHADOW_STENCIL_BIT, on_pass="invert")
 #: Shadows are drawn in one flat colour.
 SHADOW_PROGRAM = ProgramVariant("basic", (("SOLID_COLOR", ""),))
 
 
-def _has_effects(scene: Scene) -> bool:
+def _has_planar_effects(scene: Scene) -> bool:
     return scene.mirror is not None or scene.shadow is not None
 
 
@@ -311,7 +373,7 @@ def _needs_stencil(scene: Scene) -> bool:
                 or (scene.shadow is not None and scene.shadow.stencil))
 
 
-def effect_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> list[Pass]:
+def planar_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> list[Pass]:
     """The mirror's and the shadow's passes for viewport ``index``, after its draw pass.
 
     Mirror (stencil): ``mark_mirror`` draws the glass into the stencil only
@@ -328,7 +390,7 @@ def effect_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
     cube's front and back faces both cover the shadow). With the stencil each
     pixel is darkened once: test "shadow bit clear", then set it.
     """
-    if not _has_effects(scene):
+    if not _has_planar_effects(scene):
         return []
     nodes = {node.name: node for node in scene.nodes}
     passes: list[Pass] = []
@@ -340,7 +402,7 @@ def effect_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
         glass_draw = Draw(glass.name, glass_variant.key, glass.cull_back_faces)
         if mirror.stencil:
             passes.append(Pass("mark_mirror", index, draws=(glass_draw,), depth_test=True,
-                               stencil=f"always, replace {MIRROR_STENCIL_BIT}"))
+                               stencil=MARK_MIRROR_STENCIL))
         reflected = []
         for name in mirror.reflected:
             if name not in nodes:
@@ -351,7 +413,7 @@ def effect_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
                 programs.add(variant)
                 reflected.append(Draw(name, variant.key, node.cull_back_faces))
         passes.append(Pass("reflection", index, draws=tuple(reflected), depth_test=True,
-                           stencil=f"equal {MIRROR_STENCIL_BIT}, keep" if mirror.stencil else "",
+                           stencil=REFLECTION_STENCIL if mirror.stencil else None,
                            detail="front faces clockwise, lights reflected"))
         passes.append(Pass("mirror_surface", index, draws=(glass_draw,), depth_test=True, detail="blended"))
     shadow = scene.shadow
@@ -369,25 +431,25 @@ def effect_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
         if draws:
             programs.add(SHADOW_PROGRAM)
         passes.append(Pass("shadow", index, draws=draws, depth_test=True,
-                           stencil=(f"equal 0 on bit {SHADOW_STENCIL_BIT}, set it" if shadow.stencil else ""),
+                           stencil=SHADOW_STENCIL if shadow.stencil else None,
                            detail="; ".join([", ".join(how), *culled])))
     return passes
 
 
-_EFFECT_TITLES = {"mark_mirror": "mark mirror", "reflection": "reflection", "mirror_surface": "mirror surface",
+_PLANAR_TITLES = {"mark_mirror": "mark mirror", "reflection": "reflection", "mirror_surface": "mirror surface",
                   "shadow": "shadow"}
 
 
-def describe_effect_pass(step: Pass) -> str:
+def describe_planar_pass(step: Pass) -> str:
     what = ["depth test" if step.depth_test else "no depth test"]
     if step.kind == "mark_mirror":
         what.append("no colour or depth writes")
-    if step.stencil:
-        what.append(f"stencil {step.stencil}")
+    if step.stencil is not None:
+        what.append(f"stencil {step.stencil.describe()}")
     elif step.kind in ("reflection", "shadow"):
         what.append("no stencil")
     if step.detail:
         what.append(step.detail)
     items = "; ".join(f"{d.node} with {d.program}" + ("" if d.cull_back_faces else " (no culling)")
                       for d in step.draws) or "nothing"
-    return f"{_EFFECT_TITLES[step.kind]} viewport {step.viewport} ({', '.join(what)}): {items}"
+    return f"{_PLANAR_TITLES[step.kind]} viewport {step.viewport} ({', '.join(what)}): {items}"

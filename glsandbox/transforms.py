@@ -1,7 +1,7 @@
 """Matrices: model transforms by order string, camera, projection, conversions.
 
-Conventions (pinned by ``tests/test_transforms.py``)
-----------------------------------------------------
+Conventions
+-----------
 
 =====================  ==========================  ===============================
                        the course (DirectX 11)     glsandbox (OpenGL)
@@ -149,7 +149,8 @@ def normal_matrix(model: Matrix) -> np.ndarray:
     Normals are covectors: under a non-uniform scale ``diag(a, b, c)`` a
     tangent stretches by (a, b, c) but the normal must shrink by (1/a, 1/b,
     1/c) to stay perpendicular. The course's ``mul(Input.Norm, world)`` is
-    only right for rotations and uniform scales (see COURSE.md errata).
+    only right for rotations and uniform scales: under any other scale its
+    normals lean off the surface (the ``phong`` lesson's ``normals=naive``).
     """
     block = np.asarray(model, dtype=np.float64)[:3, :3]
     if abs(np.linalg.det(block)) < 1e-300:
@@ -352,13 +353,6 @@ def light_vector(light: Sequence[float]) -> np.ndarray:
     return arr
 
 
-def light_height(plane: Sequence[float], light: Sequence[float]) -> float:
-    """``P·L`` for the normalized plane and light: a point light's signed
-    distance from the plane, or the cosine between a directional light and
-    the plane's normal. Positive: the light is on the side the normal faces."""
-    return float(normalize_plane(plane) @ light_vector(light))
-
-
 def shadow_matrix(plane: Sequence[float], light: Sequence[float]) -> Matrix:
     """Flatten geometry onto a plane along the rays from a light (the course's ``XMMatrixShadow``).
 
@@ -374,7 +368,7 @@ def shadow_matrix(plane: Sequence[float], light: Sequence[float]) -> Matrix:
     one. w = 0 means the ray never meets the plane: a directional light
     parallel to it (refused here), or a vertex at the light's height; w < 0, a
     vertex above a point light, projects to the wrong side (the planner culls
-    such casters, see :func:`glsandbox.effects.shadow_casters`). A point light
+    such casters, see :func:`glsandbox.planar.shadow_casters`). A point light
     lying in the plane gives a rank-1 matrix and is refused too.
     """
     p = normalize_plane(plane)

@@ -13,8 +13,8 @@ normals go through the normal matrix, the inverse transpose of the model
 matrix's 3x3: under a scale (a, b, c) a normal must shrink by (1/a, 1/b,
 1/c) to stay perpendicular to the stretched surface. ``--set normals=naive``
 uses the course's ``mul(Input.Norm, world)`` instead; the normals then lean
-towards the long axis and the shading slides across the surface (see the
-errata in COURSE.md).
+towards the long axis and the shading slides across the surface (the
+notes' own vertex shader has this mistake; the lesson shows why it is one).
 
 Parameters switch the variants: ``shading`` per-pixel Phong, per-vertex
 Gouraud, Blinn-Phong; ``ambient``, ``diffuse``, ``specular`` switch a term

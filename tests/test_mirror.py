@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 
 from glsandbox import transforms
-from glsandbox.effects import Mirror, PlanarShadow, shadow_casters
 from glsandbox.errors import SandboxError
 from glsandbox.measure.zfighting import count_z_fighting, flat_receiver, shade_mask
 from glsandbox.plan import plan
+from glsandbox.planar import Mirror, PlanarShadow, shadow_casters
 from glsandbox.scene import Scene
 from lessons.mirror import MirrorLesson
 from lessons.phong import PhongLesson
@@ -189,6 +189,37 @@ def test_plans_without_effects_are_unchanged():
     assert not p.buffers.stencil and not p.buffers.float_depth
     assert [s.kind for s in p.passes] == ["clear", "draw"]
     assert "depth 24," in plan(MirrorLesson(depth="standard").scene()).buffers.describe() + ","
+
+
+def test_planar_passes_carry_their_stencil_state_as_structure():
+    # The executor sets exactly these numbers (glsandbox.gl.planar.set_stencil).
+    from glsandbox.plan import StencilState
+
+    stencils = {s.kind: s.stencil for s in plan(MirrorLesson().scene()).passes}
+    assert stencils["mark_mirror"] == StencilState("always", 1, 0xFF, write_mask=1, on_pass="replace")
+    assert stencils["reflection"] == StencilState("equal", 1, 1, write_mask=0, on_pass="keep")
+    assert stencils["shadow"] == StencilState("equal", 0, 2, write_mask=2, on_pass="invert")
+    assert stencils["mirror_surface"] is None and stencils["draw"] is None
+    leaky = {s.kind: s.stencil for s in plan(MirrorLesson(mirror="no_stencil", shadow="double_blend").scene()).passes}
+    assert leaky["reflection"] is None and leaky["shadow"] is None
+    with pytest.raises(SandboxError, match="stencil test 'less'"):
+        StencilState("less", 0)
+
+
+def test_gl_planar_does_not_import_the_executor():
+    # The executor imports the planar passes; they reach it only through the
+    # NodeDrawer protocol, so no import (not even for typing) goes back.
+    import ast
+    from pathlib import Path
+
+    import glsandbox.gl.planar
+
+    tree = ast.parse(Path(glsandbox.gl.planar.__file__).read_text(encoding="utf-8"))
+    imported = {alias.name for node in ast.walk(tree) if isinstance(node, ast.Import) for alias in node.names}
+    imported |= {f"{node.module}.{alias.name}" if node.module else alias.name
+                 for node in ast.walk(tree) if isinstance(node, ast.ImportFrom) for alias in node.names}
+    imported |= {node.module for node in ast.walk(tree) if isinstance(node, ast.ImportFrom) and node.module}
+    assert not any("executor" in name for name in imported), sorted(imported)
 
 
 def test_compare_cannot_compose_whole_frame_effects_so_it_stitches_them():

@@ -9,7 +9,7 @@ import pytest
 
 from glsandbox.errors import SandboxError
 from glsandbox.plan import plan
-from glsandbox.scene import load_scene
+from glsandbox.scene_file import load_scene
 
 GOOD = """\
 name = "two boxes"

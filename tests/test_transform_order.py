@@ -56,7 +56,7 @@ def test_translate_then_rotate_orbits_and_rotate_then_translate_spins_in_place()
 
 
 def test_pyrr_multiplication_applies_the_right_operand_first() -> None:
-    # The trap DESIGN.md names: pyrr matrices are row-vector form, and a * b
+    # A known trap: pyrr matrices are row-vector form, and a * b
     # means "apply b, then a" (it computes b @ a in row-vector terms).
     t = pyrr.Matrix44.from_translation([4.0, 0.0, 0.0])
     s = pyrr.Matrix44.from_scale([0.3, 1.0, 0.3])

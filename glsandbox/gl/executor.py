@@ -19,12 +19,12 @@ import numpy as np
 from glsandbox import transforms
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh
-from glsandbox.gl import effects as gl_effects
+from glsandbox.gl import depth as gl_depth, planar as gl_planar
 from glsandbox.gl.context import GLHost
 from glsandbox.gl.overlay import OverlayDrawer
 from glsandbox.gl.shaders import compile_program
 from glsandbox.gl.textures import TextureCache
-from glsandbox.plan import EFFECT_PASS_KINDS, Draw, Pass, Plan, ProgramVariant, plan as make_plan
+from glsandbox.plan import PLANAR_PASS_KINDS, Draw, Pass, Plan, ProgramVariant, plan as make_plan
 from glsandbox.scene import Light, Material, Node, Scene
 
 _MODES = {"triangles": moderngl.TRIANGLES, "triangle_strip": moderngl.TRIANGLE_STRIP,
@@ -117,6 +117,7 @@ class Executor:
     def __init__(self, host: GLHost) -> None:
         self.host = host
         self.ctx = host.ctx
+        self.raw = host.raw  # the GL calls moderngl lacks (stencil, write masks, clip control)
         self._programs: dict[str, tuple[ProgramVariant, moderngl.Program]] = {}
         self._member_names: dict[str, frozenset[str]] = {}
         self._meshes: dict[tuple[str, str], _GpuMesh] = {}
@@ -125,8 +126,8 @@ class Executor:
         self._vaos: dict[tuple[tuple[str, str], str], moderngl.VertexArray] = {}
         self._overlays: OverlayDrawer | None = None  # made on the first overlay pass
         self._textures = TextureCache(host)
-        self._lights: tuple[Light, ...] = ()  # the lights of the frame being drawn
-        self._clear_depth = 1.0  # 0 with reverse-Z (glsandbox.gl.effects)
+        self._lights: tuple[Light, ...] = ()  # the lights of the frame being drawn (draw_node's default)
+        self._clear_depth = 1.0  # 0 with reverse-Z (glsandbox.gl.depth)
 
     # --- resources ----------------------------------------------------------
 
@@ -212,9 +213,9 @@ class Executor:
             self.program(variant)
         nodes = {node.name: node for node in scene.nodes}
         self._lights = scene.lights
-        self._clear_depth = gl_effects.clear_depth_value(scene)
+        self._clear_depth = gl_depth.clear_depth_value(scene)
         framebuffer.use()
-        gl_effects.begin_depth_mode(self, scene)
+        gl_depth.begin_depth_mode(self.ctx, self.raw, scene)
         for step in frame_plan.passes:
             if step.kind == "overlay":
                 self._draw_overlays(scene, step, framebuffer, size)
@@ -226,15 +227,15 @@ class Executor:
             else:
                 camera = viewport.camera or scene.camera
                 aspect = rect[2] / rect[3] if rect[3] else 1.0
-                pass_camera = PassCamera(camera.view(), gl_effects.projection_for(scene, camera.projection(aspect)))
+                pass_camera = PassCamera(camera.view(), gl_depth.projection_for(scene, camera.projection(aspect)))
                 framebuffer.viewport = rect
                 self._set_depth(step.depth_test)
-                if step.kind in EFFECT_PASS_KINDS:  # the stencil mirror and the planar shadow
-                    gl_effects.run_effect_pass(self, scene, step, nodes, pass_camera)
+                if step.kind in PLANAR_PASS_KINDS:  # the stencil mirror and the planar shadow
+                    gl_planar.run_planar_pass(self, scene, step, nodes, pass_camera)
                     continue
                 for draw in step.draws:
-                    self._draw(nodes[draw.node], draw, pass_camera)
-        gl_effects.end_depth_mode(self, scene)
+                    self.draw_node(nodes[draw.node], draw, pass_camera)
+        gl_depth.end_depth_mode(self.ctx, self.raw, scene)
         framebuffer.viewport = (0, 0, *size)
         self._set_depth(False)
         self.ctx.disable(moderngl.CULL_FACE)
@@ -246,7 +247,7 @@ class Executor:
         # moderngl scissors the clear to the viewport rectangle.
         framebuffer.clear(r, g, b, a, depth=self._clear_depth, viewport=rect)
         if step.clear_stencil:  # moderngl's clear leaves the stencil alone
-            self.host.raw.clear_stencil(rect)
+            self.raw.clear_stencil(rect)
 
     def _set_depth(self, on: bool) -> None:
         if on:
@@ -263,13 +264,23 @@ class Executor:
             names = self._member_names[program_key] = frozenset(self._programs[program_key][1])
         return names
 
-    def _draw(self, node: Node, draw: Draw, camera: PassCamera,
-              model: np.ndarray | None = None, front_face: str = "ccw") -> None:
-        """Draw one node. ``model`` replaces its model matrix and ``front_face``
-        the winding rule (a mirror's reflected pass: ``R @ model``, ``"cw"``)."""
+    def draw_node(self, node: Node, draw: Draw, camera: PassCamera, *, model: np.ndarray | None = None,
+                  front_face: str = "ccw", lights: tuple[Light, ...] | None = None,
+                  material: Material | None = None) -> None:
+        """Draw one node of the frame being rendered with ``draw``'s program,
+        culling as ``draw`` says, seen through ``camera`` (the pass's).
+
+        The planar passes (:mod:`glsandbox.gl.planar`) override what they
+        change: ``model`` replaces the node's model matrix, ``front_face`` the
+        winding rule of front faces, ``lights`` the frame's lights and
+        ``material`` the node's (a mirror's reflection: ``R @ model``,
+        ``"cw"``, the reflected lights; a planar shadow: the flattening
+        matrix and one flat colour).
+        """
         program = self._programs[draw.program][1]
         vao, gpu = self._vao(node.mesh, draw.program)
         model = node.model if model is None else model
+        material = node.material if material is None else material
         if draw.cull_back_faces:
             self.ctx.enable(moderngl.CULL_FACE)
             self.ctx.cull_face = "back"
@@ -281,17 +292,17 @@ class Executor:
             "m_model": transforms.gl_bytes(model),
             "m_view": camera.view_bytes,
             "m_proj": camera.proj_bytes,
-            "u_color": _color_bytes(node.material.color),
+            "u_color": _color_bytes(material.color),
         }
         if "m_normal" in members:
             uniforms["m_normal"] = _normal_matrix_bytes(np.asarray(model, dtype=np.float64).tobytes())
         for name, data in uniforms.items():
             if name in members:
                 program[name].write(data)
-        if node.material.lit:
-            write_light_uniforms(program, self._lights, camera.eye, members)
-            write_material_uniforms(program, node.material, members)
-        texture = node.material.texture
+        if material.lit:
+            write_light_uniforms(program, self._lights if lights is None else lights, camera.eye, members)
+            write_material_uniforms(program, material, members)
+        texture = material.texture
         if texture is not None:
             self._textures.bind(texture, 0)
             if "u_texture" in members:

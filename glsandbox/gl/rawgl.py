@@ -37,12 +37,13 @@ GL_DITHER = 0x0BD0
 GL_STENCIL_TEST = 0x0B90
 GL_TEXTURE_WRAP_S = 0x2802
 GL_TEXTURE_WRAP_T = 0x2803
-# Stencil, depth and clip state (the mirror and shadow passes, glsandbox.gl.effects).
+# Stencil, depth and clip state (the mirror and shadow passes, glsandbox.gl.planar; reverse-Z, glsandbox.gl.depth).
 GL_DEPTH_COMPONENT32F = 0x8CAC
 GL_DEPTH32F_STENCIL8 = 0x8CAD
 GL_NEVER, GL_LESS, GL_EQUAL, GL_LEQUAL, GL_GREATER, GL_NOTEQUAL, GL_GEQUAL, GL_ALWAYS = range(0x0200, 0x0208)
 GL_KEEP = 0x1E00
 GL_REPLACE = 0x1E01
+GL_INVERT = 0x150A
 GL_STENCIL_BUFFER_BIT = 0x0400
 GL_SCISSOR_TEST = 0x0C11
 GL_LOWER_LEFT = 0x8CA1

@@ -185,7 +185,7 @@ def _texture_image(source: str) -> NDArray[np.float64]:
 
 def _reflectivity(scene: Scene, node: Node) -> float:
     """The node's ``material.reflectivity``; for the glass of the scene's stencil
-    mirror (:class:`glsandbox.effects.Mirror`) at least ``1 - alpha``, the share
+    mirror (:class:`glsandbox.planar.Mirror`) at least ``1 - alpha``, the share
     of the reflection the rasterizer blends under the glass. The ray tracer
     reflects everything in front of the glass, not only the mirror's
     ``reflected`` nodes: the answer the stencil approximation aims at."""

@@ -1,4 +1,4 @@
-"""COURSE.md worked examples #1-#10, through the public API, to 1e-9 (float64)."""
+"""The course notes' worked examples #1-#10, through the public API, to 1e-9 (float64)."""
 
 from __future__ import annotations
 
@@ -193,7 +193,7 @@ RED_HIT = (72, 21, 0)
 
 def test_09_direction_to_light_is_from_the_red_hit_point_not_the_blue_centre() -> None:
     # The notes subtract (72, 121, 0) (the blue centre) but their (28, 96, 0)
-    # is L − (72, 21, 0): the red hit point. COURSE.md errata, "#9 typo".
+    # is L − (72, 21, 0): the red hit point (a typo in the notes).
     to_light = np.subtract(LIGHT_2013, RED_HIT)
     close(to_light, (28, 96, 0))
     close(length(to_light), 100)

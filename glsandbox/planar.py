@@ -1,10 +1,10 @@
-"""Effects a scene may ask for: a planar mirror, a planar shadow, and the depth mode.
+"""Planar effects a scene may ask for: a planar mirror and a planar shadow.
 
 Course section "The stencil Test": ``MarkMirrorDSS``, ``DrawReflectionDSS``,
 ``XMMatrixReflect``, ``CullClockwise``, ``XMMatrixShadow`` and
 ``shadowOffsetY``. These are plain data, like the rest of the Scene; the
 matrices come from :mod:`glsandbox.transforms`, the passes from
-:func:`glsandbox.plan.plan`, and the GL state from :mod:`glsandbox.gl.effects`.
+:func:`glsandbox.plan.plan`, and the GL state from :mod:`glsandbox.gl.planar`.
 No GL here.
 """
 
@@ -19,13 +19,6 @@ from glsandbox import transforms
 from glsandbox.errors import SandboxError
 
 Color = tuple[float, float, float, float]
-
-#: How depth is stored and compared. ``standard``: OpenGL's -1..1 clip depth
-#: into a 24-bit integer buffer, test LESS. ``reverse_z``: a 32-bit float
-#: buffer, ``glClipControl`` 0..1, near at 1 and far at 0, test GREATER (see
-#: :func:`glsandbox.transforms.reverse_z`).
-DEPTH_MODES = ("standard", "reverse_z")
-
 
 @dataclass(frozen=True)
 class Mirror:

@@ -1,0 +1,169 @@
+"""GL state for the planar passes: the stencil mirror and the planar shadow.
+
+Course section "The stencil Test". Direct3D 11 bundles this state into
+objects (``MarkMirrorDSS``, ``DrawReflectionDSS``, ``CullClockwiseRS``) set
+per draw; OpenGL keeps it as loose global switches, so every pass here sets
+what it needs and :func:`restore_state` puts back the defaults the other
+passes assume, whatever happened (``finally``). The raw calls moderngl lacks
+(stencil, colour and depth write masks) go through
+:mod:`glsandbox.gl.rawgl`.
+
+The stencil state of each pass is the plan's
+(:class:`glsandbox.plan.StencilState`, set by :func:`set_stencil`): the
+mirror marks bit 0, the shadow bit 1, each with its own write and compare
+masks, so one 8-bit buffer serves both without a clear in between.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Protocol
+
+import moderngl
+import numpy as np
+
+from glsandbox import transforms
+from glsandbox.gl import rawgl
+from glsandbox.plan import Draw, Pass, StencilState
+from glsandbox.scene import Light, Material, Node, Scene
+
+
+class NodeDrawer(Protocol):
+    """What the planar passes need from the executor that runs them
+    (:class:`glsandbox.gl.executor.Executor`, which imports this module, so
+    this one never imports it): the context, the raw GL calls moderngl lacks,
+    and one node drawn with the pass's overrides (see
+    :meth:`~glsandbox.gl.executor.Executor.draw_node`). ``camera`` is the
+    executor's pass camera, handed back to it unread."""
+
+    ctx: moderngl.Context
+    raw: rawgl.RawGL
+
+    def draw_node(self, node: Node, draw: Draw, camera: Any, *, model: np.ndarray | None = None,
+                  front_face: str = "ccw", lights: tuple[Light, ...] | None = None,
+                  material: Material | None = None) -> None: ...
+
+
+# --- stencil state ---------------------------------------------------------------
+
+_STENCIL_TESTS = {"always": rawgl.GL_ALWAYS, "equal": rawgl.GL_EQUAL}
+_STENCIL_OPS = {"keep": rawgl.GL_KEEP, "replace": rawgl.GL_REPLACE, "invert": rawgl.GL_INVERT}
+
+
+def set_stencil(raw: rawgl.RawGL, stencil: StencilState) -> None:
+    """Turn the stencil test on with a pass's state: its write mask, its test
+    (function, reference, compare mask), and what a fragment passing both the
+    stencil and the depth test does; one failing either keeps the stencil."""
+    raw.glEnable(rawgl.GL_STENCIL_TEST)
+    raw.glStencilMask(stencil.write_mask)
+    raw.glStencilFunc(_STENCIL_TESTS[stencil.test], stencil.ref, stencil.mask)
+    raw.glStencilOp(rawgl.GL_KEEP, rawgl.GL_KEEP, _STENCIL_OPS[stencil.on_pass])  # stencil fail, depth fail, both pass
+
+
+# --- the passes ------------------------------------------------------------------
+
+
+def run_planar_pass(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, Node], camera: Any) -> None:
+    """Run one ``mark_mirror``, ``reflection``, ``mirror_surface`` or ``shadow`` pass."""
+    runners = {"mark_mirror": _mark_mirror, "reflection": _reflection,
+               "mirror_surface": _mirror_surface, "shadow": _shadow}
+    try:
+        runners[step.kind](drawer, scene, step, nodes, camera)
+    finally:
+        restore_state(drawer.ctx, drawer.raw)
+
+
+def restore_state(ctx: moderngl.Context, raw: rawgl.RawGL) -> None:
+    """The state every other pass assumes: no stencil test, all write masks on,
+    no blending, no polygon offset, counter-clockwise front faces."""
+    raw.glDisable(rawgl.GL_STENCIL_TEST)
+    raw.glStencilMask(0xFF)
+    raw.glStencilFunc(rawgl.GL_ALWAYS, 0, 0xFF)
+    raw.glStencilOp(rawgl.GL_KEEP, rawgl.GL_KEEP, rawgl.GL_KEEP)
+    raw.glColorMask(1, 1, 1, 1)
+    raw.glDepthMask(1)
+    ctx.disable(moderngl.BLEND)
+    ctx.blend_func = moderngl.DEFAULT_BLENDING
+    ctx.polygon_offset = (0.0, 0.0)
+    ctx.front_face = "ccw"
+
+
+def _mark_mirror(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, Node], camera: Any) -> None:
+    """``MarkMirrorDSS``: the glass's visible pixels get the mirror bit.
+
+    The stencil test always passes; where the depth test passes too (nothing
+    in front of the glass) the bit is replaced by 1 (the plan's
+    :data:`~glsandbox.plan.MARK_MIRROR_STENCIL`). Colour and depth writes
+    are off: this pass changes nothing but the stencil.
+    """
+    assert step.stencil is not None
+    raw = drawer.raw
+    set_stencil(raw, step.stencil)
+    raw.glColorMask(0, 0, 0, 0)
+    raw.glDepthMask(0)
+    for draw in step.draws:
+        drawer.draw_node(nodes[draw.node], draw, camera)
+
+
+def reflected_lights(lights: tuple[Light, ...], reflection: np.ndarray) -> tuple[Light, ...]:
+    """The lights seen in the mirror: each position through R. Shading the
+    reflected point R·p with normal R·n and lights R·L for the real eye gives
+    the colour of p seen from the reflected eye, which is what a mirror shows."""
+    return tuple(Light(tuple(float(v) for v in transforms.transform_points(reflection, [l.position])[0]), l.color)
+                 for l in lights)
+
+
+def _reflection(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, Node], camera: Any) -> None:
+    """``DrawReflectionDSS``: the reflected nodes, only where the mirror bit is set.
+
+    Each node is drawn with ``R @ model``. R has determinant -1, so a triangle
+    that was counter-clockwise on screen is now clockwise: the front-face rule
+    flips (the course's ``CullClockwise``) so the same faces are culled.
+    Without the stencil (``mirror=no_stencil``) nothing stops the reflection
+    outside the glass.
+    """
+    assert scene.mirror is not None
+    if step.stencil is not None:  # read only: write mask 0
+        set_stencil(drawer.raw, step.stencil)
+    reflection = scene.mirror.matrix()
+    lights = reflected_lights(scene.lights, reflection)
+    for draw in step.draws:
+        node = nodes[draw.node]
+        drawer.draw_node(node, draw, camera, model=reflection @ node.model, front_face="cw", lights=lights)
+
+
+def _mirror_surface(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, Node], camera: Any) -> None:
+    """The glass over its reflection, blended by its colour's alpha."""
+    ctx = drawer.ctx
+    ctx.enable(moderngl.BLEND)
+    ctx.blend_func = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA)
+    for draw in step.draws:
+        drawer.draw_node(nodes[draw.node], draw, camera)
+
+
+def _shadow(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, Node], camera: Any) -> None:
+    """The casters flattened by the lifted shadow matrix, dark and blended.
+
+    Depth test on (the shadow must hide behind what stands in front of the
+    floor), depth writes off. ``polygon_offset`` pulls the shadow towards the
+    camera by ``factor * depth slope + units * smallest depth step``: -1, -1
+    in standard depth, +1, +1 in reverse-Z where nearer means larger.
+    With the stencil, a pixel is darkened only while its shadow bit is 0,
+    and the bit is then set (``GL_INVERT`` under write mask 2), so the
+    flattened cube's overlapping front and back faces darken it once.
+    """
+    shadow = scene.shadow
+    assert shadow is not None
+    raw, ctx = drawer.raw, drawer.ctx
+    if step.stencil is not None:
+        set_stencil(raw, step.stencil)
+    raw.glDepthMask(0)
+    ctx.enable(moderngl.BLEND)
+    ctx.blend_func = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA)
+    if shadow.polygon_offset:
+        sign = 1.0 if scene.depth_mode == "reverse_z" else -1.0
+        ctx.polygon_offset = (sign, sign)
+    flatten = shadow.matrix()
+    flat = Material(color=shadow.color)  # one colour, unlit, untextured
+    for draw in step.draws:  # drawn without culling, as the plan says
+        node = nodes[draw.node]
+        drawer.draw_node(node, draw, camera, model=flatten @ node.model, material=flat)
