@@ -213,9 +213,15 @@ class LazyRenderer:
     one: a run whose cases all skip never opens a context.
     """
 
-    def __init__(self, backend: str | None = None) -> None:
+    def __init__(self, backend: str | None = None, renderer: HeadlessRenderer | None = None) -> None:
         self.backend = backend
-        self._renderer: HeadlessRenderer | None = None
+        self._renderer = renderer  # given: an open renderer to share (it is closed by its owner)
+        self._owned = renderer is None
+
+    @property
+    def opened(self) -> bool:
+        """Whether a renderer is open (given, or opened by a use)."""
+        return self._renderer is not None
 
     @property
     def renderer(self) -> HeadlessRenderer:
@@ -224,6 +230,6 @@ class LazyRenderer:
         return self._renderer
 
     def close(self) -> None:
-        if self._renderer is not None:
+        if self._renderer is not None and self._owned:
             self._renderer.close()
-            self._renderer = None
+        self._renderer = None

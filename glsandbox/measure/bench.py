@@ -83,7 +83,6 @@ class BenchEnv:
     notes: list[str] = field(default_factory=list)
     #: The one EGL context every case draws on, opened by the first case that asks for it.
     gl: LazyRenderer = field(default_factory=lambda: LazyRenderer("egl"))
-    _opened: bool = field(default=False, repr=False)
 
     def note(self, text: str) -> None:
         """Print ``text`` under the table, e.g. ``skipped: embreex not installed``."""
@@ -93,12 +92,11 @@ class BenchEnv:
     @property
     def renderer(self) -> HeadlessRenderer:
         """One :class:`~glsandbox.frame.HeadlessRenderer` on EGL for every case (one context)."""
-        self._opened = True
         return self.gl.renderer
 
     def renderer_name(self) -> str:
         """The GL renderer the cases ran on; ``?`` when none of them opened it."""
-        return str(self.renderer.host.renderer) if self._opened else "?"
+        return str(self.renderer.host.renderer) if self.gl.opened else "?"
 
     def close(self) -> None:
         self.gl.close()

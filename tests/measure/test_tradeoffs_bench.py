@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from glsandbox.frame import LazyRenderer
 from glsandbox.lesson import all_lessons
 from glsandbox.measure.render_context import downsample
 from glsandbox.measure.tradeoffs_report import CSV_COLUMNS
@@ -315,7 +316,7 @@ def test_raytrace_cases_without_embree_say_so(gl, monkeypatch) -> None:
     module = _raytrace_module()
     monkeypatch.setattr(module, "embree_available", lambda: False)
     env = BenchEnv(quick=True, size=(48, 36))
-    monkeypatch.setattr(env.gl, "_renderer", gl)  # the session's context: never a second one in this process
+    env.gl = LazyRenderer(renderer=gl)  # the session's context: never a second one in this process
     found = module.cases(env)
     assert env.notes == [module.EMBREE_MISSING] and "skipped: embreex not installed" in env.notes[0]
     assert [c.group for c in found] == ["ray tracer engines"] * 2
