@@ -45,17 +45,24 @@ def is_module(name: str) -> bool:
     return base.with_suffix(".py").is_file() or (base / "__init__.py").is_file()
 
 
-def imports_of(path: Path) -> set[str]:
-    """Every glsandbox/lessons module ``path`` imports, resolved to module names."""
-    found: set[str] = set()
+def import_statements(path: Path) -> list[tuple[str, list[str]]]:
+    """(module as written, names imported from it) for every import in ``path``, nested ones too."""
+    found: list[tuple[str, list[str]]] = []
     for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
         if isinstance(node, ast.Import):
-            found.update(a.name for a in node.names)
+            found.extend((a.name, []) for a in node.names)
         elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
-            for alias in node.names:  # `from glsandbox import geometry` imports a module
-                sub = f"{node.module}.{alias.name}"
-                found.add(sub if is_module(sub) else node.module)
-    return {n for n in found if n.split(".")[0] in ("glsandbox", "lessons")}
+            found.append((node.module, [a.name for a in node.names]))
+    return [(module, names) for module, names in found if module.split(".")[0] in ("glsandbox", "lessons")]
+
+
+def imports_of(path: Path) -> set[str]:
+    """Every glsandbox/lessons module ``path`` imports, resolved to module names
+    (``from glsandbox import geometry`` imports the module ``glsandbox.geometry``)."""
+    resolved: set[str] = set()
+    for module, names in import_statements(path):
+        resolved.update({f"{module}.{n}" if is_module(f"{module}.{n}") else module for n in names} or {module})
+    return resolved
 
 
 def layer_of(name: str) -> int | None:
@@ -128,22 +135,11 @@ def test_no_import_loop():
     assert not loops, "import loops: " + "; ".join(" -> ".join(loop) for loop in loops)
 
 
-def written_imports(path: Path) -> set[str]:
-    """The module names as written: ``from glsandbox import geometry`` is ``glsandbox``."""
-    found: set[str] = set()
-    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
-        if isinstance(node, ast.Import):
-            found.update(a.name for a in node.names)
-        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
-            found.add(node.module)
-    return {n for n in found if n.split(".")[0] in ("glsandbox", "lessons")}
-
-
 def test_lessons_use_only_the_public_face():
     allowed = {"glsandbox", "glsandbox.raytrace"}
     reaching = {}
     for path in ROOT.glob("lessons/*.py"):
-        bad = sorted(t for t in written_imports(path) - allowed if not t.startswith("lessons._"))
+        bad = sorted(t for t in {module for module, _ in import_statements(path)} - allowed if not t.startswith("lessons._"))
         if bad:
             reaching[path.name] = bad
     assert not reaching, f"lessons reaching past glsandbox and glsandbox.raytrace: {reaching}"
