@@ -82,9 +82,22 @@ def gl(m: np.ndarray) -> bytes:
     return np.asarray(m, dtype="f4").T.tobytes()
 
 
+#: Frames are opaque, as glsandbox's (its ``glsandbox.gl.target.FRAME_COLOR_MASK``): the colour is
+#: cleared to alpha 1 once, when the framebuffer is made, and never gets alpha writes after that.
+COLOR_MASK = (True, True, True, False)
+
+
+def opaque(fbo: moderngl.Framebuffer) -> moderngl.Framebuffer:
+    """The framebuffer with alpha 1 everywhere and alpha writes off from now on (moderngl applies its
+    ``color_mask`` at every ``use()`` and ``clear()``): translucent draws leave the frame opaque."""
+    fbo.clear(0.0, 0.0, 0.0, 1.0)
+    fbo.color_mask = COLOR_MASK
+    return fbo
+
+
 def framebuffer(ctx: moderngl.Context, size: tuple[int, int], depth: bool = True) -> moderngl.Framebuffer:
-    return ctx.framebuffer(color_attachments=[ctx.renderbuffer(size, 4)],
-                           depth_attachment=ctx.depth_renderbuffer(size) if depth else None)
+    return opaque(ctx.framebuffer(color_attachments=[ctx.renderbuffer(size, 4)],
+                                  depth_attachment=ctx.depth_renderbuffer(size) if depth else None))
 
 
 def read(fbo: moderngl.Framebuffer, size: tuple[int, int]) -> np.ndarray:
@@ -147,4 +160,4 @@ def depth_stencil_framebuffer(ctx: moderngl.Context, gl: SimpleNamespace,
         raise RuntimeError(f"depth-stencil framebuffer {size} is incomplete")
     fbo = ctx.detect_framebuffer(framebuffer.value)
     fbo.extra = color  # keep the colour renderbuffer with the framebuffer
-    return fbo
+    return opaque(fbo)

@@ -26,7 +26,7 @@ from pathlib import Path
 import moderngl
 import numpy as np
 
-from _raw import VERTEX_COLOR_FS, VERTEX_COLOR_VS
+from _raw import VERTEX_COLOR_FS, VERTEX_COLOR_VS, opaque
 
 SIZE = (800, 600)
 
@@ -47,8 +47,8 @@ class RawCube:
         self.vao = ctx.vertex_array(self.program, [(ctx.buffer(positions.tobytes()), "3f", "in_position"),
                                                    (ctx.buffer(colors.tobytes()), "3f", "in_color")],
                                     index_buffer=ctx.buffer(indices.tobytes()))
-        self.fbo = ctx.framebuffer(color_attachments=[ctx.renderbuffer(SIZE, 4)],
-                                   depth_attachment=ctx.depth_renderbuffer(SIZE))
+        self.fbo = opaque(ctx.framebuffer(color_attachments=[ctx.renderbuffer(SIZE, 4)],
+                                          depth_attachment=ctx.depth_renderbuffer(SIZE)))  # as glsandbox's frames
         f = 1 / np.tan(np.radians(22.5))
         near, far, aspect = 0.01, 100.0, SIZE[0] / SIZE[1]
         proj = np.array([[f / aspect, 0, 0, 0], [0, f, 0, 0],

@@ -24,8 +24,8 @@ import math
 import moderngl
 import numpy as np
 
-from _raw import (GL_ALWAYS, GL_EQUAL, GL_INVERT, GL_KEEP, GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE, GL_REPLACE,
-                  GL_STENCIL_BUFFER_BIT, GL_STENCIL_TEST, GL_ZERO_TO_ONE, VERTEX_COLOR_FS, VERTEX_COLOR_VS,
+from _raw import (COLOR_MASK, GL_ALWAYS, GL_EQUAL, GL_INVERT, GL_KEEP, GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE,
+                  GL_REPLACE, GL_STENCIL_BUFFER_BIT, GL_STENCIL_TEST, GL_ZERO_TO_ONE, VERTEX_COLOR_FS, VERTEX_COLOR_VS,
                   depth_stencil_framebuffer, framebuffer, gl, gl_calls, look_at, perspective, read, reverse_z, rotate_x,
                   rotate_y, rotate_z, scale, translate)
 
@@ -352,10 +352,10 @@ class RawTransformOrder:
         solid["m_proj"].write(self.proj)
         solid["u_color"].value = self.trail_color
         self.trail.render(moderngl.LINE_STRIP)
-        # The panels: straight alpha over the frame, and the frame's alpha stays opaque.
+        # The panels: straight alpha over the frame (whose alpha is not written: it stays opaque).
         ctx.disable(moderngl.DEPTH_TEST)
         ctx.enable(moderngl.BLEND)
-        ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA, moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA
+        ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
         top_left = (4, self.size[1] - 4 - self.panel_height)  # the lesson's (4, 4) from the top left
         for texture, origin in ((self.panel, top_left), (self.figures, self.figures_at)):
             texture.use(0)
@@ -500,8 +500,9 @@ class RawMirror:
         raw.DepthMask(0)
         self._solid(self.glass, self.glass_model, self.glass_color)
         # The reflection where bit 1 is set: R @ model, the light through R, clockwise fronts (det R = -1).
+        # Colour writes back on but alpha (the frame stays opaque under the blended glass and shadow).
         self._stencil(0, GL_EQUAL, 1, 1, GL_KEEP)
-        raw.ColorMask(1, 1, 1, 1)
+        raw.ColorMask(*COLOR_MASK)
         raw.DepthMask(1)
         ctx.front_face = "cw"
         lit["u_light_pos"].write(self.lights[1])

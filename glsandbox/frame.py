@@ -43,7 +43,7 @@ DEFAULT_SIZE = (640, 480)
 class Frame:
     """One rendered frame: the pixels, the plan that made them, and its cost."""
 
-    image: np.ndarray  # (H, W, 4) uint8, top row first
+    image: np.ndarray  # (H, W, 4) uint8, top row first, alpha 255 (glsandbox.gl.target)
     plan: Plan
     seconds: float
 

@@ -73,8 +73,12 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
             path = screenshot_dir / f"{lesson.name}-{state['shots']}.png"
             width, height = glfw.get_framebuffer_size(host.window)
             data = host.ctx.screen.read(viewport=(0, 0, width, height), components=4, alignment=1)
-            image = np.frombuffer(data, dtype=np.uint8).reshape(height, width, 4)[::-1]
-            save_png(np.ascontiguousarray(image), path)
+            image = np.ascontiguousarray(np.frombuffer(data, dtype=np.uint8).reshape(height, width, 4)[::-1])
+            # What the screen shows: the window is opaque whatever its framebuffer's alpha
+            # holds (the frame copied there has alpha 1, glsandbox.gl.target, but a driver
+            # whose blit honours the colour mask would leave the window's own alpha).
+            image[..., 3] = 255
+            save_png(image, path)
             print(f"screenshot: {path}", file=sys.stderr, flush=True)
         elif key == glfw.KEY_R:
             try:

@@ -145,7 +145,8 @@ def test_window_has_the_buffers_the_plan_asks_for(window_env: str, tmp_path: Pat
         code = win.close()
     assert code == 0
     headless = gl.render(find_lesson("mirror").from_settings(settings), (320, 240), samples=4).image
-    np.testing.assert_array_equal(shot[..., :3], headless[..., :3])
+    np.testing.assert_array_equal(shot, headless)  # alpha too: both opaque (issue 12)
+    assert (shot[..., 3] == 255).all()
 
 
 def test_r_reloads_shaders_and_a_broken_one_keeps_the_last_good_program(window_env: str, tmp_path: Path) -> None:

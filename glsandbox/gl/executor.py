@@ -243,9 +243,12 @@ class Executor:
         return frame_plan
 
     def _clear(self, framebuffer: moderngl.Framebuffer, step: Pass, rect: tuple[int, int, int, int]) -> None:
-        r, g, b, a = step.clear_color or (0.0, 0.0, 0.0, 0.0)
-        # moderngl scissors the clear to the viewport rectangle.
-        framebuffer.clear(r, g, b, a, depth=self._clear_depth, viewport=rect)
+        r, g, b, _ = step.clear_color or (0.0, 0.0, 0.0, 0.0)
+        # moderngl scissors the clear to the viewport rectangle. Frames are opaque
+        # whatever the clear colour's alpha: a target's alpha is 1 and its mask keeps
+        # this clear off it (glsandbox.gl.target.FRAME_COLOR_MASK); a framebuffer
+        # without that mask still gets an opaque clear.
+        framebuffer.clear(r, g, b, 1.0, depth=self._clear_depth, viewport=rect)
         if step.clear_stencil:  # moderngl's clear leaves the stencil alone
             self.raw.clear_stencil(rect)
 

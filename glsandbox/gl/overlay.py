@@ -4,8 +4,8 @@ Run by :class:`~glsandbox.gl.executor.Executor` for the plan's ``overlay``
 passes. Each image becomes a texture (kept per overlay name and updated when
 its pixels change, so a label that changes every frame reuses one texture),
 and is copied texel for pixel by ``shaders/overlay.glsl`` with straight-alpha
-blending: ``rgb = a*src + (1-a)*dst``, while the frame's alpha becomes
-``a + (1-a)*dst_a`` so an opaque frame stays opaque.
+blending: ``rgb = a*src + (1-a)*dst``. The frame's alpha is not written
+(:data:`glsandbox.gl.target.FRAME_COLOR_MASK`), so the frame stays opaque.
 """
 
 from __future__ import annotations
@@ -65,8 +65,7 @@ class OverlayDrawer:
         vao = self._vertex_array(program)
         self.ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
         self.ctx.enable(moderngl.BLEND)
-        self.ctx.blend_func = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA,
-                               moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA)
+        self.ctx.blend_func = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA)
         framebuffer.scissor = region
         try:
             for draw in step.draws:

@@ -23,6 +23,7 @@ import numpy as np
 
 from glsandbox import transforms
 from glsandbox.gl import rawgl
+from glsandbox.gl.target import FRAME_COLOR_MASK
 from glsandbox.plan import Draw, Pass, StencilState
 from glsandbox.scene import Light, Material, Node, Scene
 
@@ -73,13 +74,15 @@ def run_planar_pass(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[st
 
 
 def restore_state(ctx: moderngl.Context, raw: rawgl.RawGL) -> None:
-    """The state every other pass assumes: no stencil test, all write masks on,
-    no blending, no polygon offset, counter-clockwise front faces."""
+    """The state every other pass assumes: no stencil test, stencil and depth
+    writes on, colour writes on but alpha (the frame's rule,
+    :data:`~glsandbox.gl.target.FRAME_COLOR_MASK`: frames stay opaque), no
+    blending, no polygon offset, counter-clockwise front faces."""
     raw.glDisable(rawgl.GL_STENCIL_TEST)
     raw.glStencilMask(0xFF)
     raw.glStencilFunc(rawgl.GL_ALWAYS, 0, 0xFF)
     raw.glStencilOp(rawgl.GL_KEEP, rawgl.GL_KEEP, rawgl.GL_KEEP)
-    raw.glColorMask(1, 1, 1, 1)
+    raw.glColorMask(*FRAME_COLOR_MASK)
     raw.glDepthMask(1)
     ctx.disable(moderngl.BLEND)
     ctx.blend_func = moderngl.DEFAULT_BLENDING
@@ -132,7 +135,8 @@ def _reflection(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, N
 
 
 def _mirror_surface(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, Node], camera: Any) -> None:
-    """The glass over its reflection, blended by its colour's alpha."""
+    """The glass over its reflection, blended by its colour's alpha (the
+    frame's own alpha is neither read nor written: it stays 1)."""
     ctx = drawer.ctx
     ctx.enable(moderngl.BLEND)
     ctx.blend_func = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA)

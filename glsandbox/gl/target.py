@@ -4,6 +4,10 @@ A target is a framebuffer object whose colour is a moderngl renderbuffer and
 whose depth (24 bits) or packed depth-stencil (24 + 8 bits) attachment comes
 from :mod:`glsandbox.gl.rawgl`. With MSAA the frame is resolved into a
 single-sample framebuffer before it is read back.
+
+Frames are opaque (issue 12): a target's alpha is 1 everywhere, as the
+window shows the frame, so PNGs, goldens and the gallery keep what the
+screen shows. The rule lives here, in :data:`FRAME_COLOR_MASK`.
 """
 
 from __future__ import annotations
@@ -14,6 +18,16 @@ import numpy as np
 from glsandbox.errors import SandboxError
 from glsandbox.gl.context import GLHost
 from glsandbox.plan import Buffers
+
+#: The colour write mask every frame is drawn with: red, green and blue, never
+#: alpha. A target's colour is cleared to alpha 1 once, when it is made, and its
+#: framebuffer carries this mask (moderngl applies a framebuffer's ``color_mask``
+#: at every ``use()`` and ``clear()``), so the per-viewport clears and every pass
+#: leave the 1 alone: frames are opaque at no cost per frame. Blending reads the
+#: source's alpha only (``SRC_ALPHA, ONE_MINUS_SRC_ALPHA``), never the frame's.
+#: A pass that sets the mask itself puts this one back
+#: (:func:`glsandbox.gl.planar.restore_state`).
+FRAME_COLOR_MASK = (True, True, True, False)
 
 
 class OffscreenTarget:
@@ -39,6 +53,9 @@ class OffscreenTarget:
         self._resolved: moderngl.Framebuffer | None = None
         if samples:
             self._resolved = ctx.framebuffer(color_attachments=[ctx.renderbuffer(size, 4)])
+            self._resolved.clear(0.0, 0.0, 0.0, 1.0)  # the resolve copies alpha 1 here, or keeps this 1
+        self.framebuffer.clear(0.0, 0.0, 0.0, 1.0)  # every sample; the last write to alpha
+        self.framebuffer.color_mask = FRAME_COLOR_MASK
 
     def bits(self) -> tuple[int, int]:
         """(depth bits, stencil bits) actually allocated."""
@@ -52,7 +69,7 @@ class OffscreenTarget:
         return self._resolved
 
     def read(self) -> np.ndarray:
-        """The frame as an (H, W, 4) uint8 RGBA array, top row first.
+        """The frame as an (H, W, 4) uint8 RGBA array, top row first, alpha 255.
 
         The array is a read-only view of the bytes GL returned, flipped by a
         negative stride: copying a fresh 800x600 frame costs more than drawing
