@@ -82,3 +82,26 @@ def test_a_reader_that_stops_early_ends_the_command_quietly() -> None:
     command = f"{sys.executable} -m glsandbox.cli plan mirror | true"
     proc = subprocess.run(["bash", "-c", command], capture_output=True, text=True, cwd=REPO, timeout=60)
     assert proc.stderr == "", proc.stderr
+
+
+def test_tradeoffs_into_an_unwritable_folder_or_a_full_disk_is_one_line(tmp_path: Path, monkeypatch,
+                                                                        capsys, gl) -> None:
+    from glsandbox.measure import tradeoffs
+
+    out = tmp_path / "locked"
+    out.mkdir()
+    real_access = os.access
+    monkeypatch.setattr(tradeoffs.os, "access", lambda p, mode: False if Path(p) == out else real_access(p, mode))
+    assert cli.main(["tradeoffs", "--quick", "--knob", "depth", "--out", str(out)]) == 2
+    assert capsys.readouterr().err.strip().splitlines()[-1] == f"error: --out {out}: folder is not writable"
+    monkeypatch.undo()
+
+    def full(*args, **kwargs):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(tradeoffs, "save_png", full)
+    full_out = tmp_path / "full"
+    assert cli.main(["tradeoffs", "--quick", "--knob", "depth", "--out", str(full_out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1] == f"error: --out {full_out}: cannot write (No space left on device)"
+    assert not [line for line in err if line.startswith("Traceback")]

@@ -23,7 +23,7 @@ import subprocess
 import sys
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import ModuleType
 from typing import Any
@@ -253,6 +253,7 @@ def run_all(json_path: Path | None = None, quick: bool = False, only: Sequence[s
     log = lambda text: print(text, file=sys.stderr, flush=True)  # noqa: E731
     try:
         cases: list[Case] = []
+        found_lines = []
         for module in load_modules(folder):
             noted = len(env.notes)
             found = module.cases(env)
@@ -260,9 +261,11 @@ def run_all(json_path: Path | None = None, quick: bool = False, only: Sequence[s
             if not matched:  # a module left out by --only: its notes (what it skipped) do not apply
                 del env.notes[noted:]
             cases += matched
-            log(f"bench: {Path(module.__file__ or '').name}: {len(found)} cases")
-        if not cases:
-            raise SandboxError("no benchmark case matched")
+            found_lines.append(f"bench: {Path(module.__file__ or '').name}: {len(matched)} of {len(found)} cases")
+        if not cases:  # said before any progress line: a mistake is one line
+            raise SandboxError(f"--only {' '.join(only)}: no benchmark case matched (see glsandbox bench)")
+        for line in found_lines:
+            log(line)
         groups = list(dict.fromkeys(c.group for c in cases))
         cases.sort(key=lambda c: groups.index(c.group))  # stable: one group's rows together
         rounds = rounds or (3 if quick else 7)
@@ -289,6 +292,4 @@ def run_all(json_path: Path | None = None, quick: bool = False, only: Sequence[s
 
 
 def _quick(case: Case) -> Case:
-    from dataclasses import replace
-
     return replace(case, repeat=max(1, min(case.repeat, 5)))

@@ -18,6 +18,7 @@ and listed in the report under "Not measured yet".
 
 from __future__ import annotations
 
+import os
 import sys
 import time
 from collections.abc import Callable, Sequence
@@ -108,6 +109,8 @@ def run(out: Path, quick: bool = False, backend: str | None = None, runs: int = 
             folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise SandboxError(f"--out {out}: cannot create folder ({exc.strerror})") from None
+    if not os.access(out, os.W_OK | os.X_OK):
+        raise SandboxError(f"--out {out}: folder is not writable")
     size = QUICK_SIZE if quick else FULL_SIZE
     context = RenderContext(size, backend)
     results = []
@@ -120,14 +123,20 @@ def run(out: Path, quick: bool = False, backend: str | None = None, runs: int = 
                 skipped[knob.name] = reason
                 continue
             say(f"[{number}/{len(knobs)}] {knob.name}: {len(knob.chosen(quick))} settings + reference")
-            results.append(measure_knob(knob, context, out, quick, runs, lambda text: say(text)))
+            try:
+                results.append(measure_knob(knob, context, out, quick, runs, lambda text: say(text)))
+            except OSError as exc:  # its images could not be written
+                raise SandboxError(f"--out {out}: cannot write ({exc.strerror or exc})") from None
         host = context.renderer.host
         info = {"renderer": str(host.renderer), "backend": str(host.backend), "size": f"{size[0]}x{size[1]}",
                 "runs": str(runs), "quick": "yes" if quick else "no"}
     finally:
         context.close()
-    write_csv(results, size, out / "tradeoffs.csv")
-    write_report(results, info, out / "report.md", skipped)
-    write_plot(results, out / "tradeoffs.png")
+    try:  # a full disk or a folder made read-only meanwhile: one line, no half-written file
+        write_csv(results, size, out / "tradeoffs.csv")
+        write_report(results, info, out / "report.md", skipped)
+        write_plot(results, out / "tradeoffs.png")
+    except OSError as exc:
+        raise SandboxError(f"--out {out}: cannot write ({exc.strerror or exc})") from None
     say(f"tradeoffs: {len(results)} knobs -> {out / 'report.md'}, {out / 'tradeoffs.csv'}, {out / 'tradeoffs.png'}")
     return results

@@ -262,7 +262,9 @@ def test_bench_prints_one_table_and_writes_json(tmp_path: Path) -> None:
 
 def test_bench_unknown_case_is_one_line() -> None:
     proc = _run("bench", "--quick", "--only", "no_such_benchmark")
-    assert proc.returncode == 2 and proc.stderr.strip().endswith("error: no benchmark case matched")
+    assert proc.returncode == 2
+    assert proc.stderr.strip().splitlines() == [
+        "error: --only no_such_benchmark: no benchmark case matched (see glsandbox bench)"]  # no progress first
 
 
 # --- the raw-ModernGL baselines (benchmarks/lesson_frames.py) --------------------------------
