@@ -49,11 +49,10 @@ def write(path: Path, text: str) -> Path:
 
 
 def quadrant_image() -> Image.Image:
-    """2x2 pixels: red top-left, green top-right, blue bottom-left, yellow bottom-right."""
-    image = Image.new("RGB", (2, 2))
-    for xy, rgb in (((0, 0), (255, 0, 0)), ((1, 0), (0, 255, 0)), ((0, 1), (0, 0, 255)), ((1, 1), (255, 255, 0))):
-        image.putpixel(xy, rgb)
-    return image
+    """Red top-left, green top-right, blue bottom-left, yellow bottom-right: 16x16 pixels, so that
+    bilinear sampling (the ray tracer's) reads pure colours inside each quadrant."""
+    quadrants = np.array([[(255, 0, 0), (0, 255, 0)], [(0, 0, 255), (255, 255, 0)]], dtype=np.uint8)
+    return Image.fromarray(np.repeat(np.repeat(quadrants, 8, axis=0), 8, axis=1))
 
 
 def textured_quad_glb(path: Path) -> Path:
