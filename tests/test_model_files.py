@@ -1,6 +1,6 @@
 """Model files in scene files and at the command line: ``mesh = "path/to/model.obj"``, every bad file
 end to end (exit 2, one ``error:`` line naming the scene file's line and the model file, no output), the
-dropped-face count in ``glsandbox plan``, rendering with both renderers."""
+dropped-face count in ``glsandbox plan``, rendering with both renderers, and the ``model`` lesson."""
 
 from __future__ import annotations
 
@@ -195,3 +195,66 @@ def test_a_model_scene_renders_and_compares_raster_with_ray(tmp_path: Path, gl) 
     row = next(line for line in proc.stdout.splitlines() if line.strip().startswith("renderer=raster"))
     share = float(re.search(r"([\d.]+)%", row).group(1))
     assert share < 5.0, row
+
+
+# --- the lesson ----------------------------------------------------------------------
+
+
+def test_the_model_lesson_shows_both_renderers_side_by_side(gl) -> None:
+    from lessons.model import GENERATED, ModelLesson, bvh_figures
+
+    frame = gl.render(ModelLesson(), (160, 120))
+    image = frame.image.astype(int)
+    left, right = image[:, :80], image[:, 80:]
+    for half in (left, right):  # the stone in the middle of each half, lit, against the dark sky above
+        assert half[60, 40, :3].sum() > half[30, 5, :3].sum() + 60
+    assert bvh_figures(GENERATED["rock"]()) == "BVH: not built"  # the hook, until the BVH lands: no number
+
+
+def test_the_model_lesson_loads_a_file_and_refuses_a_missing_one(tmp_path: Path) -> None:
+    (tmp_path / "cube.obj").write_text(CUBE_OBJ)
+    out = tmp_path / "cube.png"
+    proc = glsandbox("render", "model", "--set", f"mesh={tmp_path / 'cube.obj'}", "--set", "fit=off",
+                     "--set", "view=raster", "--out", str(out), "--size", "64x48")
+    assert proc.returncode == 0, proc.stderr
+    assert load_png(out).shape == (48, 64, 4)
+    proc = glsandbox("render", "model", "--set", f"mesh={tmp_path / 'nope.obj'}", "--out", str(out))
+    assert_user_error(proc, f"--set mesh={tmp_path / 'nope.obj'}: model file {tmp_path / 'nope.obj'} not found")
+
+
+def test_the_model_lesson_counts_the_triangles_it_shows() -> None:
+    from lessons.model import GENERATED, ModelLesson, triangle_count
+
+    assert {name: triangle_count(make()) for name, make in GENERATED.items()} == {
+        "rock": 320, "rock_fine": 1280, "terrain": 512}
+    scene = ModelLesson(view="raster").scene()
+    assert [vp.renderer for vp in scene.viewports] == ["raster"]
+    assert [vp.renderer for vp in ModelLesson().scene().viewports] == ["raster", "ray"]
+
+
+def test_model_lesson_golden_raster_view(gl, golden) -> None:
+    """The raster side only: the ray side will change when the BVH lands."""
+    from lessons.model import ModelLesson
+
+    golden(gl.render(ModelLesson(view="raster"), (256, 256)).image, "model/raster")
+
+
+def test_model_lesson_plan_is_pinned() -> None:
+    from glsandbox.plan import plan
+    from lessons.model import ModelLesson
+
+    draw = "floor with phong[NUM_LIGHTS=2]; model with phong[NUM_LIGHTS=2]"
+    assert plan(ModelLesson().scene()).describe() == "\n".join([
+        "plan for model",
+        "buffers: colour RGBA8, depth 24, no MSAA",
+        "programs:",
+        "  overlay",
+        "  phong[NUM_LIGHTS=2]",
+        "passes:",
+        "  1. clear viewport 0: colour (0.12, 0.14, 0.2, 1) + depth",
+        f"  2. draw viewport 0 (depth test): {draw}",
+        "  3. clear viewport 1: colour (0.12, 0.14, 0.2, 1) + depth",
+        f"  4. draw viewport 1 (depth test): {draw}",
+        "  5. overlay viewport 0 (blended, no depth test): label0",
+        "  6. overlay viewport 1 (blended, no depth test): label1",
+    ])
