@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -92,6 +93,23 @@ class Light:
     color: tuple[float, float, float] = (1.0, 1.0, 1.0)
 
 
+#: Digests of in-memory texture images by array identity (the arrays are read-only), so that
+#: a Texture made again from the same image (``dataclasses.replace`` of its sampler, a scene
+#: file read every frame) does not hash its pixels again.
+_IMAGE_DIGESTS: dict[int, tuple[weakref.ref[np.ndarray], str]] = {}
+
+
+def _image_digest(image: np.ndarray) -> str:
+    key = id(image)
+    entry = _IMAGE_DIGESTS.get(key)
+    if entry is not None and entry[0]() is image:
+        return entry[1]
+    shape = np.asarray(image.shape, dtype=np.int64).tobytes()
+    digest = hashlib.blake2b(shape + image.tobytes(), digest_size=12).hexdigest()
+    _IMAGE_DIGESTS[key] = (weakref.ref(image, lambda _: _IMAGE_DIGESTS.pop(key, None)), digest)
+    return digest
+
+
 @dataclass(frozen=True)
 class Texture:
     """An image on a surface and the sampler that reads it.
@@ -121,8 +139,7 @@ class Texture:
                                    f"got {image.dtype} {image.shape}")
             image.setflags(write=False)
             object.__setattr__(self, "image", image)
-            shape = np.asarray(image.shape, dtype=np.int64).tobytes()
-            object.__setattr__(self, "digest", hashlib.blake2b(shape + image.tobytes(), digest_size=12).hexdigest())
+            object.__setattr__(self, "digest", _image_digest(image))
         if self.filter not in TEXTURE_FILTERS:
             raise SandboxError(f"unknown texture filter {self.filter!r}; use one of {', '.join(TEXTURE_FILTERS)}")
         if self.wrap not in TEXTURE_WRAPS:
