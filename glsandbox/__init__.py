@@ -17,15 +17,20 @@ and the ray tracer (:mod:`glsandbox.raytrace`) traces the same Scene::
     if __name__ == "__main__":
         raise SystemExit(glsandbox.run(OneCube))   # a window, or --headless --out cube.png
 
+A model file is one call: ``Node("bunny", glsandbox.load_mesh("bunny.obj", fit=True))``;
+:func:`load_model` gives its texture and colour too (:mod:`glsandbox.meshfile`),
+and :mod:`glsandbox.meshgen` makes models without a file.
+
 The layers below (the README's "How it works" table) import downwards only;
 :func:`run` is the one door up to the command line, opened when called.
 """
 
-from glsandbox import camera, geometry, transforms
+from glsandbox import camera, geometry, meshgen, transforms
 from glsandbox.planar import Mirror, PlanarShadow
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh
 from glsandbox.lesson import Lesson, Param, register
+from glsandbox.meshfile import Model, fit_mesh, load_mesh, load_model
 from glsandbox.overlay import Overlay, text_image
 from glsandbox.scene import (
     COURSE_BLUE,
@@ -46,9 +51,10 @@ from glsandbox.scene import (
 __version__ = "0.1.0"
 __all__ = [
     "COURSE_BLUE", "DEPTH_MODES", "LIT_SHADINGS", "NORMAL_MODES", "TEXTURE_FILTERS", "TEXTURE_WRAPS",
-    "Camera", "Lesson", "Light", "Material", "Mesh", "Mirror", "Node", "Overlay", "Param", "PlanarShadow",
+    "Camera", "Lesson", "Light", "Material", "Mesh", "Mirror", "Model", "Node", "Overlay", "Param", "PlanarShadow",
     "SandboxError", "Scene", "Texture", "Viewport",
-    "__version__", "camera", "geometry", "register", "run", "text_image", "transforms",
+    "__version__", "camera", "fit_mesh", "geometry", "load_mesh", "load_model", "meshgen", "register", "run",
+    "text_image", "transforms",
 ]
 
 

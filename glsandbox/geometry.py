@@ -8,12 +8,14 @@ convention; shapes the course gives in DirectX form go through
 from __future__ import annotations
 
 import functools
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from glsandbox.errors import SandboxError
+from glsandbox.meshnormals import face_normals
 from glsandbox.transforms import from_directx_mesh
 
 #: Primitive topologies a mesh can use (the course's D3D11_PRIMITIVE_TOPOLOGY_*).
@@ -28,7 +30,9 @@ class Mesh:
     ``positions`` is (N, 3); ``normals`` (N, 3), ``uvs`` (N, 2) and ``colors``
     (N, 3) are optional;
     ``indices`` is a flat array, three per triangle for ``"triangles"``.
-    ``name`` identifies the mesh (GPU buffers are cached by it).
+    ``name`` identifies the mesh (GPU buffers are cached by it). ``notes``
+    says where a loaded mesh came from and what loading did to it (dropped
+    faces, how its normals were made): ``glsandbox plan`` prints them.
     """
 
     name: str
@@ -38,6 +42,7 @@ class Mesh:
     uvs: np.ndarray | None = None
     colors: np.ndarray | None = None
     mode: str = "triangles"
+    notes: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         # Meshes are shared, immutable data (renderers cache per mesh object).
@@ -56,23 +61,58 @@ class Mesh:
         """Vertices drawn: the index count, or the vertex count when not indexed."""
         return len(self.indices) if self.indices is not None else len(self.positions)
 
-    def triangles(self) -> np.ndarray:
-        """The triangles as (T, 3, 3) positions, whatever the topology.
+    def triangle_indices(self) -> np.ndarray:
+        """The triangles as (T, 3) vertex indices, whatever the topology (none for lines).
 
         A strip's triangle k uses vertices (k, k+1, k+2), with every odd
         triangle's first two swapped so all keep the strip's winding.
         """
         if self.mode in ("lines", "line_strip"):
-            return np.zeros((0, 3, 3))
+            return np.zeros((0, 3), dtype=np.intp)
         order = self.indices if self.indices is not None else np.arange(self.vertex_count)
         if self.mode == "triangles":
-            tri = np.asarray(order).reshape(-1, 3)
-        else:
-            tri = np.array([
-                (order[k + 1], order[k], order[k + 2]) if k % 2 else (order[k], order[k + 1], order[k + 2])
-                for k in range(len(order) - 2)
-            ])
-        return self.positions[tri]
+            return np.asarray(order, dtype=np.intp).reshape(-1, 3)
+        return np.array([
+            (order[k + 1], order[k], order[k + 2]) if k % 2 else (order[k], order[k + 1], order[k + 2])
+            for k in range(len(order) - 2)
+        ], dtype=np.intp).reshape(-1, 3)
+
+    def triangles(self) -> np.ndarray:
+        """The triangles as (T, 3, 3) positions, whatever the topology (see :meth:`triangle_indices`)."""
+        if self.mode in ("lines", "line_strip"):
+            return np.zeros((0, 3, 3))
+        return self.positions[self.triangle_indices()]
+
+
+_FACE_NORMALS: weakref.WeakKeyDictionary[Mesh, Mesh] = weakref.WeakKeyDictionary()
+
+
+def with_face_normals(mesh: Mesh) -> Mesh:
+    """``mesh`` for lit shading when it has no normals: flat shading, as the ray tracer shades it.
+
+    A vertex shared by faces that point different ways cannot carry one
+    normal for all of them (the course's 8-vertex cube), so the triangles are
+    un-indexed: each gets its own three vertices carrying its face normal
+    ``(V1 − V0) × (V2 − V0)``, normalised (:func:`glsandbox.meshnormals.face_normals`;
+    zero for a zero-area triangle, which covers no pixel). Uvs and colours
+    follow their corners. A mesh that has normals, or no triangles, comes back
+    as it is. Meshes are immutable, so the result is made once per mesh object.
+    """
+    if mesh.normals is not None or mesh.mode in ("lines", "line_strip"):
+        return mesh
+    flat = _FACE_NORMALS.get(mesh)
+    if flat is None:
+        tri = mesh.triangle_indices()
+        positions = np.asarray(mesh.positions, dtype=np.float64)
+        corners = tri.reshape(-1)
+        normals = np.repeat(face_normals(positions, tri), 3, axis=0)
+
+        def per_corner(array: np.ndarray | None) -> np.ndarray | None:
+            return None if array is None else np.asarray(array)[corners]
+
+        flat = _FACE_NORMALS[mesh] = Mesh(f"{mesh.name}/face_normals", positions[corners], None, normals,
+                                          per_corner(mesh.uvs), per_corner(mesh.colors), notes=mesh.notes)
+    return flat
 
 
 # --- the course's indexed cube (DirectX SDK Tutorial 04) --------------------

@@ -20,7 +20,7 @@ import numpy as np
 from PIL import Image, ImageDraw, ImageFont, UnidentifiedImageError
 
 from glsandbox.errors import SandboxError
-from glsandbox.scene import BUILTIN_TEXTURES
+from glsandbox.scene import BUILTIN_TEXTURES, Texture
 
 #: The colours of the four quadrants of the ``labels`` image, by the uv
 #: corner they hold: (0,0) top-left red, (1,0) top-right green, (0,1)
@@ -104,6 +104,17 @@ def builtin_levels(name: str) -> list[np.ndarray]:
         return mip_levels()
     raise SandboxError(f"unknown built-in texture {name!r}; use one of {', '.join(BUILTIN_TEXTURES)} "
                        "or an image file path")
+
+
+def texture_levels(texture: Texture, max_size: int | None = None) -> list[np.ndarray]:
+    """The mip levels of a texture, whatever its source: the image it carries
+    in memory, a built-in image, or an image file (read with :func:`load_image`;
+    ``max_size`` as there). Both renderers read textures through this."""
+    if texture.image is not None:
+        return [texture.image]
+    if not texture.is_file:
+        return builtin_levels(texture.source)
+    return [load_image(texture.source, max_size)]
 
 
 def load_image(path: str | Path, max_size: int | None = None) -> np.ndarray:

@@ -167,6 +167,10 @@ class Plan:
     buffers: Buffers
     programs: tuple[ProgramVariant, ...]
     passes: tuple[Pass, ...]
+    #: ``node: notes`` for each node whose mesh was loaded from a file (its
+    #: :attr:`~glsandbox.geometry.Mesh.notes`: triangles, degenerate faces
+    #: dropped, where the normals came from); empty for built-in meshes.
+    meshes: tuple[str, ...] = ()
 
     def describe(self) -> str:
         """A readable listing, as ``glsandbox plan`` prints it."""
@@ -174,16 +178,22 @@ class Plan:
         lines += [f"  {p.key}" for p in self.programs] or ["  (none)"]
         lines.append("passes:")
         lines += [f"  {i}. {p.describe()}" for i, p in enumerate(self.passes, start=1)]
+        if self.meshes:
+            lines.append("meshes:")
+            lines += [f"  {line}" for line in self.meshes]
         return "\n".join(lines)
 
     def to_dict(self) -> dict[str, Any]:
-        return {
+        result = {
             "scene": self.scene,
             "buffers": {"depth": self.buffers.depth, "stencil": self.buffers.stencil,
                         "samples": self.buffers.samples},
             "programs": [p.key for p in self.programs],
             "passes": [p.describe() for p in self.passes],
         }
+        if self.meshes:
+            result["meshes"] = list(self.meshes)
+        return result
 
 
 def program_for(node: Node, lights: int = 0) -> ProgramVariant:
@@ -311,6 +321,7 @@ def plan(scene: Scene) -> Plan:
                         float_depth=uses_depth and scene.depth_mode == "reverse_z"),
         programs=tuple(sorted(programs)),
         passes=tuple(passes),
+        meshes=tuple(f"{node.name}: {', '.join(node.mesh.notes)}" for node in scene.nodes if node.mesh.notes),
     )
 
 

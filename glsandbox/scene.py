@@ -7,7 +7,9 @@ down -z); see :mod:`glsandbox.transforms` for the course's DirectX form.
 
 from __future__ import annotations
 
+import hashlib
 import math
+import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -91,6 +93,23 @@ class Light:
     color: tuple[float, float, float] = (1.0, 1.0, 1.0)
 
 
+#: Digests of in-memory texture images by array identity (the arrays are read-only), so that
+#: a Texture made again from the same image (``dataclasses.replace`` of its sampler, a scene
+#: file read every frame) does not hash its pixels again.
+_IMAGE_DIGESTS: dict[int, tuple[weakref.ref[np.ndarray], str]] = {}
+
+
+def _image_digest(image: np.ndarray) -> str:
+    key = id(image)
+    entry = _IMAGE_DIGESTS.get(key)
+    if entry is not None and entry[0]() is image:
+        return entry[1]
+    shape = np.asarray(image.shape, dtype=np.int64).tobytes()
+    digest = hashlib.blake2b(shape + image.tobytes(), digest_size=12).hexdigest()
+    _IMAGE_DIGESTS[key] = (weakref.ref(image, lambda _: _IMAGE_DIGESTS.pop(key, None)), digest)
+    return digest
+
+
 @dataclass(frozen=True)
 class Texture:
     """An image on a surface and the sampler that reads it.
@@ -98,13 +117,29 @@ class Texture:
     ``source`` is a built-in image name (:data:`BUILTIN_TEXTURES`) or an image
     file path; ``filter`` and ``wrap`` are the sampler state, data like the
     rest of the scene, so one lesson can be rendered with each of them.
+
+    ``image``, when given, is the picture itself, in memory: an ``(H, W, 4)``
+    uint8 RGBA array, row 0 at the top (a model file's base colour texture,
+    :mod:`glsandbox.meshfile`). ``source`` then only names it (in plans and
+    errors); textures are told apart by ``digest``, a hash of the pixels,
+    made once here (the array is made read-only).
     """
 
     source: str = "checker"
     filter: str = "mip_linear"
     wrap: str = "repeat"
+    image: np.ndarray | None = field(default=None, compare=False, repr=False)
+    digest: str = field(init=False, default="", repr=False)
 
     def __post_init__(self) -> None:
+        if self.image is not None:
+            image = np.ascontiguousarray(self.image)
+            if image.dtype != np.uint8 or image.ndim != 3 or image.shape[2] != 4 or 0 in image.shape:
+                raise SandboxError(f"texture {self.source!r}: expected a non-empty (H, W, 4) uint8 image, "
+                                   f"got {image.dtype} {image.shape}")
+            image.setflags(write=False)
+            object.__setattr__(self, "image", image)
+            object.__setattr__(self, "digest", _image_digest(image))
         if self.filter not in TEXTURE_FILTERS:
             raise SandboxError(f"unknown texture filter {self.filter!r}; use one of {', '.join(TEXTURE_FILTERS)}")
         if self.wrap not in TEXTURE_WRAPS:
@@ -114,8 +149,8 @@ class Texture:
 
     @property
     def is_file(self) -> bool:
-        """Whether ``source`` names an image file rather than a built-in image."""
-        return self.source not in BUILTIN_TEXTURES
+        """Whether ``source`` names an image file (not a built-in image, nor one in memory)."""
+        return self.image is None and self.source not in BUILTIN_TEXTURES
 
     def describe(self) -> str:
         return f"{self.source} ({self.filter}, {self.wrap})"

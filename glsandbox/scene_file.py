@@ -13,18 +13,23 @@ from __future__ import annotations
 import math
 import re
 import tomllib
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from glsandbox import transforms
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import builtin_mesh
+from glsandbox.meshfile import CREASE_ANGLE, NORMALS as MESH_NORMALS, Model, is_model_path, load_model
 from glsandbox.planar import Mirror, PlanarShadow
 from glsandbox.scene import (BUILTIN_TEXTURES, COURSE_BLUE, DEPTH_MODES, SHADINGS, Camera, Color, Light, Material,
                              Node, Scene, Texture, Viewport)
 
 #: Lighting coefficients a scene file may set on a node (see :class:`~glsandbox.scene.Material`).
 _MATERIAL_NUMBERS = ("ambient", "diffuse", "specular", "shininess")
+
+#: Keys only a node whose mesh is a model file takes (:mod:`glsandbox.meshfile`).
+_MODEL_FILE_KEYS = ("fit", "mesh_normals", "crease_angle")
 
 
 class _Locator:
@@ -151,13 +156,15 @@ class _SceneReader:
 
     def node(self, data: dict[str, Any], i: int) -> Node:
         allowed = {"name", "mesh", "order", "scale", "translate", "rotate", "color", "shading",
-                   "cull_back_faces", "viewports", *_MATERIAL_NUMBERS, "normals", "texture", "filter", "wrap"}
+                   "cull_back_faces", "viewports", *_MATERIAL_NUMBERS, "normals", "texture", "filter", "wrap",
+                   *_MODEL_FILE_KEYS}
         self.check_keys(data, allowed, "nodes", i)
         mesh_name = data.get("mesh")
         if not isinstance(mesh_name, str):
             raise self.fail("nodes", i, "mesh" if "mesh" in data else None, "every node needs mesh = \"<name>\"")
+        loaded = self.model_file(data, i, mesh_name)
         try:
-            mesh = builtin_mesh(mesh_name)
+            mesh = loaded.mesh if loaded is not None else builtin_mesh(mesh_name)
         except SandboxError as exc:
             raise self.fail("nodes", i, "mesh", str(exc)) from None
         order = data.get("order", "STR")
@@ -185,10 +192,56 @@ class _SceneReader:
             name=str(data.get("name", f"node{i}")),
             mesh=mesh,
             model=model,
-            material=self.material(data, i, shading),
+            material=self.material(data, i, shading) if loaded is None else self.model_material(data, i, shading,
+                                                                                                 loaded),
             cull_back_faces=cull,
             viewports=tuple(views) if views is not None else None,
         )
+
+    def model_file(self, data: dict[str, Any], i: int, mesh_name: str) -> Model | None:
+        """A node's model file (``mesh = "path/to/model.obj"``, relative to the scene file),
+        loaded with its ``fit``, ``mesh_normals`` and ``crease_angle``; None for a built-in mesh."""
+        if not is_model_path(mesh_name):
+            for key in _MODEL_FILE_KEYS:
+                if key in data:
+                    raise self.fail("nodes", i, key, f"only for a mesh loaded from a file; {mesh_name!r} is built in")
+            return None
+        fit = self.flag(data, "fit", "nodes", i, default=False)
+        normals = data.get("mesh_normals", "auto")
+        if normals not in MESH_NORMALS:
+            raise self.fail("nodes", i, "mesh_normals", f"unknown mesh normals {normals!r}; "
+                                                        f"use one of {', '.join(MESH_NORMALS)}")
+        crease = self.number(data, "crease_angle", "nodes", i, default=CREASE_ANGLE)
+        assert crease is not None
+        if not 0.0 <= crease <= 180.0:
+            raise self.fail("nodes", i, "crease_angle", f"expected degrees in 0..180, got {crease:g}")
+        path = Path(mesh_name)
+        if not path.is_absolute():
+            path = self.path.parent / path  # relative to the scene file, not the shell
+        try:
+            return load_model(path, fit=fit, normals=normals, crease_angle=crease)
+        except SandboxError as exc:
+            key = "mesh_normals" if "normals = " in str(exc) else "mesh"
+            raise self.fail("nodes", i, key, str(exc)) from None
+
+    def model_material(self, data: dict[str, Any], i: int, shading: str, model: Model) -> Material:
+        """:meth:`material` for a model file's node: the file's base colour texture and
+        colour unless the node gives its own (``filter`` and ``wrap`` apply to the file's texture)."""
+        own = model.texture is None or "texture" in data
+        material = self.material(data if own else {k: v for k, v in data.items() if k not in ("filter", "wrap")},
+                                 i, shading)
+        if not own:
+            try:
+                texture = replace(model.texture, filter=str(data.get("filter", "mip_linear")),  # type: ignore[arg-type]
+                                  wrap=str(data.get("wrap", "repeat")))
+            except SandboxError as exc:
+                raise self.fail("nodes", i, "filter" if "filter" in str(exc) else "wrap", str(exc)) from None
+            material = replace(material, texture=texture)
+        if model.color is not None and "color" not in data:
+            material = replace(material, color=model.color)
+        if material.texture is not None and model.mesh.uvs is None:
+            raise self.fail("nodes", i, "texture", f"{model.path.name} has no texture coordinates to map it with")
+        return material
 
     def material(self, data: dict[str, Any], i: int, shading: str) -> Material:
         """A node's material: colour, shading, the lighting coefficients, a texture."""

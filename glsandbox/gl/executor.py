@@ -18,7 +18,7 @@ import numpy as np
 
 from glsandbox import transforms
 from glsandbox.errors import SandboxError
-from glsandbox.geometry import Mesh
+from glsandbox.geometry import Mesh, with_face_normals
 from glsandbox.gl import depth as gl_depth, planar as gl_planar
 from glsandbox.gl.context import GLHost
 from glsandbox.gl.overlay import OverlayDrawer
@@ -281,7 +281,14 @@ class Executor:
         matrix and one flat colour).
         """
         program = self._programs[draw.program][1]
-        vao, gpu = self._vao(node.mesh, draw.program)
+        members = self._members(draw.program)
+        mesh = node.mesh
+        if mesh.normals is None and "in_normal" in members:
+            # A lit draw of a mesh without normals (the course's 8-vertex cube, a
+            # file without them) is shaded flat, one face normal per triangle: what
+            # the ray tracer does with such a mesh (geometry.with_face_normals).
+            mesh = with_face_normals(mesh)
+        vao, gpu = self._vao(mesh, draw.program)
         model = node.model if model is None else model
         material = node.material if material is None else material
         if draw.cull_back_faces:
@@ -290,7 +297,6 @@ class Executor:
             self.ctx.front_face = front_face
         else:
             self.ctx.disable(moderngl.CULL_FACE)
-        members = self._members(draw.program)
         uniforms = {
             "m_model": transforms.gl_bytes(model),
             "m_view": camera.view_bytes,

@@ -20,7 +20,7 @@ import numpy as np
 
 from glsandbox.errors import SandboxError
 from glsandbox.gl.context import GLHost
-from glsandbox.images import builtin_levels, load_image
+from glsandbox.images import texture_levels
 from glsandbox.scene import Texture
 
 #: (min filter, mag filter) per :data:`glsandbox.scene.TEXTURE_FILTERS` name.
@@ -56,6 +56,8 @@ class TextureCache:
         return int(self.ctx.info["GL_MAX_TEXTURE_SIZE"])
 
     def _key(self, spec: Texture) -> tuple:
+        if spec.image is not None:
+            return ("image", spec.digest)
         if not spec.is_file:
             return ("builtin", spec.source)
         path = Path(spec.source)
@@ -73,11 +75,7 @@ class TextureCache:
         key = self._key(spec)
         texture = self._textures.get(key)
         if texture is None:
-            if spec.is_file:
-                levels = [load_image(spec.source, self.max_size)]
-            else:
-                levels = builtin_levels(spec.source)
-            texture = self._upload(levels, spec.source)
+            texture = self._upload(texture_levels(spec, self.max_size), spec.source)
             self._textures[key] = texture
         return texture
 

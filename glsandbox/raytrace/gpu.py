@@ -389,8 +389,8 @@ class GpuTracer:
             texture.use(unit)
             if name in program:
                 program[name].value = unit
-        if world.textures:
-            program["u_wrap"].value = [wrap for _, wrap in world.textures]
+        if world.textures:  # as bytes: moderngl wants a bare int for a one-element array (one texture)
+            program["u_wrap"].write(np.array([wrap for _, wrap in world.textures], dtype="i4").tobytes())
         values = {
             "u_mesh_count": uploaded.mesh_count, "u_sphere_count": uploaded.sphere_count,
             "u_size": (float(width), float(height)),

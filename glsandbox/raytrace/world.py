@@ -55,10 +55,10 @@ from numpy.typing import NDArray
 
 from glsandbox import transforms
 from glsandbox.geometry import Mesh
-from glsandbox.images import builtin_levels, load_image
+from glsandbox.images import texture_levels
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.triangle import TriangleBatch
-from glsandbox.scene import BUILTIN_TEXTURES, Camera, Node, Scene
+from glsandbox.scene import Camera, Node, Scene, Texture
 
 __all__ = [
     "MODES",
@@ -177,10 +177,9 @@ def is_unit_sphere(mesh: Mesh) -> bool:
     return bool(np.all(np.abs(radii - 1.0) < 1e-9))
 
 
-def _texture_image(source: str) -> NDArray[np.float64]:
+def _texture_image(texture: Texture) -> NDArray[np.float64]:
     """The base level of a texture as float rgba in 0..1 (the ray tracer samples level 0 only)."""
-    level = builtin_levels(source)[0] if source in BUILTIN_TEXTURES else load_image(source)
-    return np.asarray(level, dtype=np.float64) / 255.0
+    return np.asarray(texture_levels(texture)[0], dtype=np.float64) / 255.0
 
 
 def _reflectivity(scene: Scene, node: Node) -> float:
@@ -209,7 +208,7 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
     nodes: list[NodeInfo] = []
     v0s, v1s, v2s, ns, uvs, cols, owners = [], [], [], [], [], [], []
     textures: list[tuple[NDArray[np.float64], int]] = []
-    texture_index: dict[tuple[str, str], int] = {}
+    texture_index: dict[tuple[str, str, str], int] = {}
     batches: list[TriangleBatch | None] = []
     start = 0
     for node in scene.nodes:
@@ -222,10 +221,10 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
         material = node.material
         tex = -1
         if material.texture is not None:
-            key = (material.texture.source, material.texture.wrap)
+            key = (material.texture.source, material.texture.digest, material.texture.wrap)
             if key not in texture_index:
                 texture_index[key] = len(textures)
-                textures.append((_texture_image(material.texture.source), WRAPS[material.texture.wrap]))
+                textures.append((_texture_image(material.texture), WRAPS[material.texture.wrap]))
             tex = texture_index[key]
         common = dict(
             name=node.name, cull=bool(node.cull_back_faces),

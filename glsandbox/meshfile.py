@@ -1,0 +1,508 @@
+"""Model files: triangle meshes from OBJ, PLY, STL, OFF and glTF/GLB, read by trimesh.
+
+:func:`load_model` reads a file into a :class:`Model`: a
+:class:`~glsandbox.geometry.Mesh` (positions, normals, uvs and vertex colours
+where the file has them), the base colour texture of a glTF material (or of
+an OBJ's ``map_Kd``) as an in-memory :class:`~glsandbox.scene.Texture`, and
+what loading did. :func:`load_mesh` is the mesh alone. No format is parsed
+here: trimesh reads them (``process=False``: the file's vertices and faces as
+written, nothing merged); this module turns what it read into the course's
+conventions and checks it.
+
+- **Positions** as written; a glTF's node transforms are applied (its parts
+  become one mesh); a mirroring transform gets its triangles' winding swapped
+  so fronts stay counter-clockwise.
+- **Normals** (``normals=``): ``"auto"`` takes the file's vertex normals when
+  it has usable ones (OBJ ``vn``, PLY ``nx ny nz``, glTF ``NORMAL``) and
+  otherwise makes them with the crease angle (:mod:`glsandbox.meshnormals`,
+  30° by default: a cube keeps its edges, a scanned surface looks smooth);
+  ``"file"`` insists on the file's; ``"crease"``, ``"smooth"`` and ``"flat"``
+  always compute them that way. STL's per-facet normals are not vertex
+  normals: STL, like OFF, gets computed ones.
+- **Uvs**: trimesh gives them with v up (OpenGL's origin at the image's
+  bottom-left, glTF's flipped on reading); the course's textures have v
+  down, row 0 at the top (:mod:`glsandbox.images`), so v becomes ``1 − v``.
+- **Degenerate faces** (zero area: a repeated vertex index, coincident or
+  collinear corners) are dropped, not fatal, and counted: the count is in
+  :attr:`Model.dropped_faces` and in the mesh's ``notes``, which
+  ``glsandbox plan`` prints for the node.
+- ``fit=True`` centres the model's bounding box on the origin and scales it
+  uniformly so its longest side spans -1..1: the box of the built-in cube and
+  sphere, so a model can replace ``mesh = "cube"`` at the same size.
+
+Every problem with the file is one :class:`SandboxError` line naming it: not
+found, a folder, a FIFO or device (checked with ``stat`` before anything opens
+it, so nothing blocks), empty, unreadable, an unknown extension, data trimesh
+cannot read (garbage, truncated), no faces, vertices that are NaN or infinite,
+face indices out of range. Loads are cached by (resolved path, modification
+time, size, options): loading a file again returns the same :class:`Model`
+(and the same Mesh object, whose GPU buffers the executor keeps), until the
+file changes. trimesh's log messages and warnings are kept off stderr.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import logging
+import math
+import os
+import stat
+import warnings
+from collections import OrderedDict
+from collections.abc import Iterator
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from glsandbox.errors import SandboxError
+from glsandbox.geometry import Mesh
+from glsandbox.meshnormals import corner_normals, unique_vertices
+from glsandbox.scene import Material, Texture
+
+__all__ = ["CREASE_ANGLE", "FORMATS", "NORMALS", "Model", "fit_mesh", "is_model_path", "load_mesh", "load_model"]
+
+#: File extensions (lower case) and the trimesh file type each is read as.
+FORMATS: dict[str, str] = {".obj": "obj", ".ply": "ply", ".stl": "stl", ".off": "off", ".gltf": "gltf",
+                           ".glb": "glb"}
+
+#: How normals are made (module docstring): from the file when it has them, else crease; only
+#: the file's; or always computed (:data:`glsandbox.meshnormals.MODES`).
+NORMALS = ("auto", "file", "crease", "smooth", "flat")
+
+#: The default crease angle in degrees: faces meeting at a sharper angle keep a hard edge.
+CREASE_ANGLE = 30.0
+
+#: A face whose doubled area is at most this share of its longest edge squared is degenerate
+#: (the sine of its largest angle is that small): zero area up to rounding.
+DEGENERATE_SHARE = 1e-12
+
+#: How many loaded models are kept (least recently used dropped first).
+CACHE_SIZE = 16
+
+
+@dataclass(frozen=True, eq=False)
+class Model:
+    """A model file, loaded: its mesh, its base colour texture and colour, and what loading did.
+
+    ``texture`` is the material's base colour image where the file has one
+    (glTF ``baseColorTexture``, OBJ ``map_Kd``), in memory, with the default
+    sampler (replace ``filter``/``wrap`` with :func:`dataclasses.replace`);
+    ``color`` is a glTF material's ``baseColorFactor`` (rgba, 0..1), which
+    multiplies the texture as the course's textured shaders do. Put both on
+    a node with :meth:`material`.
+    """
+
+    path: Path
+    mesh: Mesh
+    texture: Texture | None
+    color: tuple[float, float, float, float] | None
+    #: Triangles kept, and degenerate ones dropped on loading.
+    triangles: int
+    dropped_faces: int
+    #: Where the normals came from: ``"file"``, ``"crease 30°"``, ``"smooth"`` or ``"flat"``.
+    normals: str
+
+    def material(self, **fields: Any) -> Material:
+        """A :class:`~glsandbox.scene.Material` with this model's texture and colour
+        (white when it has none), other fields as given (``shading="phong"``, ...)."""
+        fields.setdefault("color", self.color or (1.0, 1.0, 1.0, 1.0))
+        fields.setdefault("texture", self.texture)
+        return Material(**fields)
+
+
+def is_model_path(name: str) -> bool:
+    """Whether a scene file's ``mesh = "..."`` names a file rather than a built-in mesh:
+    built-in names have neither a folder part nor a file extension."""
+    return "/" in name or "\\" in name or Path(name).suffix != ""
+
+
+def load_mesh(path: str | os.PathLike[str], *, fit: bool = False, normals: str = "auto",
+              crease_angle: float = CREASE_ANGLE) -> Mesh:
+    """The mesh of a model file (:func:`load_model`'s ``.mesh``)."""
+    return load_model(path, fit=fit, normals=normals, crease_angle=crease_angle).mesh
+
+
+def load_model(path: str | os.PathLike[str], *, fit: bool = False, normals: str = "auto",
+               crease_angle: float = CREASE_ANGLE) -> Model:
+    """Read a model file (OBJ, PLY, STL, OFF, glTF or GLB) into a :class:`Model`.
+
+    ``fit``: centre it and scale it into the box -1..1; ``normals``: one of
+    :data:`NORMALS`; ``crease_angle``: in degrees, 0..180, for crease normals.
+    Every problem is one :class:`SandboxError` line naming the file (module
+    docstring). Cached by path, modification time, size and options.
+    """
+    if normals not in NORMALS:
+        raise SandboxError(f"unknown normals {normals!r} for a model file; use one of {', '.join(NORMALS)}")
+    if isinstance(crease_angle, bool) or not isinstance(crease_angle, (int, float)) \
+            or not (math.isfinite(crease_angle) and 0.0 <= crease_angle <= 180.0):
+        raise SandboxError(f"crease angle must be a number of degrees in 0..180, got {crease_angle!r}")
+    p = Path(path)
+    info = _regular_file(p)
+    file_type = FORMATS.get(p.suffix.lower())
+    if file_type is None:
+        known = ", ".join(FORMATS)
+        what = f"extension {p.suffix!r}" if p.suffix else "no extension"
+        raise SandboxError(f"model file {p}: unknown format ({what}); use one of {known}")
+    key = (str(p.resolve()), info.st_mtime_ns, info.st_size, bool(fit), normals, float(crease_angle))
+    model = _CACHE.get(key)
+    if model is not None:
+        _CACHE.move_to_end(key)
+        return model
+    data = _read(p)
+    parts = _parts(p, _trimesh_scene(p, data, file_type))
+    model = _model(p, file_type, parts, bool(fit), normals, float(crease_angle))
+    _CACHE[key] = model
+    while len(_CACHE) > CACHE_SIZE:
+        _CACHE.popitem(last=False)
+    return model
+
+
+def fit_mesh(mesh: Mesh) -> Mesh:
+    """``mesh`` centred on the origin and scaled uniformly so its bounding box's
+    longest side spans -1..1 (normals unchanged: a uniform scale keeps their directions)."""
+    positions = np.asarray(mesh.positions, dtype=np.float64)
+    if positions.size == 0:
+        return mesh
+    low, high = positions.min(axis=0), positions.max(axis=0)
+    extent = float((high - low).max())
+    if not (math.isfinite(extent) and extent > 0.0):
+        raise SandboxError(f"mesh {mesh.name!r} has no extent to fit (all its vertices are one point)")
+    centre = (low + high) / 2.0
+    return replace(mesh, positions=(positions - centre) * (2.0 / extent))
+
+
+_CACHE: OrderedDict[tuple[Any, ...], Model] = OrderedDict()
+
+
+# --- the file -------------------------------------------------------------
+
+
+def _regular_file(p: Path) -> os.stat_result:
+    """``stat`` the path and refuse anything that is not a regular, non-empty file, before opening it
+    (opening a FIFO for reading would wait for a writer forever)."""
+    try:
+        info = os.stat(p)
+    except FileNotFoundError:
+        raise SandboxError(f"model file {p} not found") from None
+    except PermissionError:
+        raise SandboxError(f"model file {p} is not readable (permission denied)") from None
+    except OSError as exc:
+        raise SandboxError(f"model file {p} cannot be read ({exc.strerror or exc})") from None
+    mode = info.st_mode
+    if stat.S_ISDIR(mode):
+        raise SandboxError(f"model file {p} is a folder, expected a model file")
+    if not stat.S_ISREG(mode):
+        kind = ("a FIFO (named pipe)" if stat.S_ISFIFO(mode) else "a socket" if stat.S_ISSOCK(mode)
+                else "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode) else "not a regular file")
+        raise SandboxError(f"model file {p} is {kind}, expected a regular file")
+    if info.st_size == 0:
+        raise SandboxError(f"model file {p} is empty")
+    return info
+
+
+def _read(p: Path) -> bytes:
+    try:
+        with open(p, "rb") as f:
+            return f.read()
+    except PermissionError:
+        raise SandboxError(f"model file {p} is not readable (permission denied)") from None
+    except OSError as exc:
+        raise SandboxError(f"model file {p} cannot be read ({exc.strerror or exc})") from None
+
+
+@contextlib.contextmanager
+def _quiet() -> Iterator[None]:
+    """trimesh's log records and warnings kept off stderr (its loggers are all under ``trimesh``)."""
+    logger = logging.getLogger("trimesh")
+    level = logger.level
+    logger.setLevel(logging.CRITICAL + 1)
+    try:
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore")
+            yield
+    finally:
+        logger.setLevel(level)
+
+
+def _reason(exc: BaseException) -> str:
+    """A short, one-line reason from a reader's exception."""
+    if isinstance(exc, ImportError):  # trimesh reached for an optional package: the data was not what it expected
+        return "unrecognised data"
+    if isinstance(exc, IndexError):
+        return f"a face index is out of range ({' '.join(str(exc).split())})"
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    return text if len(text) <= 160 else text[:157] + "..."
+
+
+def _trimesh_scene(p: Path, data: bytes, file_type: str) -> Any:
+    """The file as a ``trimesh.Scene`` (every format becomes one), read from ``data``."""
+    with _quiet():
+        import trimesh  # only a model load pays for the import
+        from trimesh.resolvers import FilePathResolver
+
+        class RegularFiles(FilePathResolver):  # a .gltf's buffers and images: also never a FIFO
+            def get(self, name: str) -> bytes:
+                target = Path(self.parent) / name.strip()
+                if target.exists() and not target.is_file():
+                    raise ValueError(f"{name!r} is not a regular file")
+                return super().get(name)
+
+        try:
+            resolver = RegularFiles(str(p))
+            loader = getattr(trimesh, "load_scene", None)
+            if loader is not None:
+                return loader(io.BytesIO(data), file_type=file_type, resolver=resolver, process=False)
+            return trimesh.load(io.BytesIO(data), file_type=file_type, resolver=resolver, process=False,
+                                force="scene")
+        except SandboxError:
+            raise
+        except (Exception, RecursionError) as exc:  # anything a reader raises on bad data
+            raise SandboxError(f"model file {p}: not a readable {file_type.upper()} file: {_reason(exc)}") from None
+
+
+@dataclass
+class _Part:
+    """One mesh of the file, in the model's space (a glTF node's transform applied)."""
+
+    positions: NDArray[np.float64]
+    faces: NDArray[np.int64]
+    normals: NDArray[np.float64] | None
+    uvs: NDArray[np.float64] | None
+    colors: NDArray[np.float64] | None  # per vertex (N, 3), or per corner (F, 3, 3) from face colours
+    image: NDArray[np.uint8] | None
+    color: tuple[float, float, float, float] | None
+
+
+def _parts(p: Path, scene: Any) -> list[_Part]:
+    """Every triangle mesh the scene places, with its transform applied."""
+    import trimesh
+
+    parts = []
+    with _quiet():
+        try:
+            for node in scene.graph.nodes_geometry:
+                transform, name = scene.graph[node]
+                geometry = scene.geometry.get(name)
+                if isinstance(geometry, trimesh.Trimesh):
+                    parts.append(_part(geometry, np.asarray(transform, dtype=np.float64)))
+        except SandboxError:
+            raise
+        except Exception as exc:
+            raise SandboxError(f"model file {p}: not a readable model: {_reason(exc)}") from None
+    return parts
+
+
+def _part(mesh: Any, transform: NDArray[np.float64]) -> _Part:
+    positions = np.array(mesh.vertices, dtype=np.float64).reshape(-1, 3)
+    faces = np.array(mesh.faces, dtype=np.int64).reshape(-1, 3)
+    normals = _file_normals(mesh, positions.shape[0])
+    linear = transform[:3, :3]
+    if not np.array_equal(transform, np.eye(4)):
+        positions = positions @ linear.T + transform[:3, 3]
+        if normals is not None:
+            with np.errstate(all="ignore"):
+                normals = normals @ np.linalg.inv(linear)  # (M⁻¹)ᵀ applied to row vectors
+        if np.linalg.det(linear) < 0.0:  # a mirror turns the winding: swap to keep fronts counter-clockwise
+            faces = faces[:, [0, 2, 1]]
+    uvs = colors = image = None
+    color = None
+    visual = getattr(mesh, "visual", None)
+    kind = getattr(visual, "kind", None)
+    if kind == "texture":
+        uv = getattr(visual, "uv", None)
+        if uv is not None and len(uv) == positions.shape[0]:
+            uvs = np.array(uv, dtype=np.float64).reshape(-1, 2)
+            uvs[:, 1] = 1.0 - uvs[:, 1]  # trimesh's v up -> the course's v down
+        image, color = _material(getattr(visual, "material", None))
+    elif kind == "vertex":
+        colors = np.asarray(visual.vertex_colors, dtype=np.float64)[:, :3] / 255.0
+    elif kind == "face":
+        face_colors = np.asarray(visual.face_colors, dtype=np.float64)[:, :3] / 255.0
+        colors = np.repeat(face_colors[:, None, :], 3, axis=1)
+    return _Part(positions, faces, normals, uvs, colors, image, color)
+
+
+def _file_normals(mesh: Any, count: int) -> NDArray[np.float64] | None:
+    """The vertex normals the file gave, or None. trimesh keeps given normals in the
+    mesh's cache (its exporters test the same way); asking ``mesh.vertex_normals``
+    would compute some instead."""
+    cache = getattr(mesh, "_cache", None)
+    try:
+        given = cache["vertex_normals"] if cache is not None and "vertex_normals" in cache else None
+    except Exception:
+        return None
+    if given is None:
+        return None
+    normals = np.array(given, dtype=np.float64)
+    return normals if normals.shape == (count, 3) else None
+
+
+def _material(material: Any) -> tuple[NDArray[np.uint8] | None, tuple[float, float, float, float] | None]:
+    """The base colour image (RGBA, row 0 at the top) and glTF base colour factor of a trimesh material."""
+    if material is None:
+        return None, None
+    picture = getattr(material, "baseColorTexture", None)
+    if picture is None:
+        # An OBJ material's map_Kd: an image decoded from a file has a format; the 2x2 grey
+        # placeholder trimesh gives an OBJ with uvs but no material file has none.
+        picture = getattr(material, "image", None)
+        if getattr(picture, "format", None) is None:
+            picture = None
+    image = None
+    if picture is not None:
+        try:
+            image = np.ascontiguousarray(np.asarray(picture.convert("RGBA"), dtype=np.uint8))
+        except Exception:
+            image = None
+        if image is not None and (image.ndim != 3 or 0 in image.shape):
+            image = None
+    factor = getattr(material, "baseColorFactor", None)
+    color = None
+    if factor is not None:
+        f = np.asarray(factor, dtype=np.float64).reshape(-1)
+        if f.size >= 3:
+            f = f / 255.0 if f.dtype.kind in "iu" or f.max() > 1.0 else f
+            rgb = np.clip(np.nan_to_num(f[:3], nan=1.0), 0.0, 1.0)
+            color = (float(rgb[0]), float(rgb[1]), float(rgb[2]), 1.0)
+    return image, color
+
+
+# --- from parts to one mesh ------------------------------------------------
+
+
+def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode: str, crease: float) -> Model:
+    vertex_total = sum(part.positions.shape[0] for part in parts)
+    if not parts or sum(part.faces.shape[0] for part in parts) == 0:
+        what = f" (only {vertex_total:,} vertices)" if vertex_total else ""
+        raise SandboxError(f"model file {p} has no faces{what}")
+    # One vertex and face list for all parts.
+    offsets = np.cumsum([0] + [part.positions.shape[0] for part in parts])
+    positions = np.concatenate([part.positions for part in parts])
+    faces = np.concatenate([part.faces + offset for part, offset in zip(parts, offsets)])
+    bad = np.flatnonzero(~np.isfinite(positions).all(axis=1))
+    if bad.size:
+        raise SandboxError(f"model file {p}: {_count(bad.size, 'vertex', 'vertices')} with NaN or infinite "
+                           f"coordinates (the first is vertex {int(bad[0])})")
+    outside = (faces < 0) | (faces >= positions.shape[0])
+    if outside.any():
+        f = int(np.flatnonzero(outside.any(axis=1))[0])
+        index = int(faces[f][outside[f]][0])
+        raise SandboxError(f"model file {p}: face {f} refers to vertex {index}, but the file has "
+                           f"{positions.shape[0]:,} vertices (index out of range)")
+    # Optional attributes: a part without them gets neutral values when another has them.
+    has_uvs = any(part.uvs is not None for part in parts)
+    uvs = np.concatenate([part.uvs if part.uvs is not None else np.zeros((part.positions.shape[0], 2))
+                          for part in parts]) if has_uvs else None
+    if uvs is not None and not np.isfinite(uvs).all():
+        raise SandboxError(f"model file {p}: texture coordinates are NaN or infinite")
+    corner_colors = _corner_colors(parts) if any(part.colors is not None for part in parts) else None
+    file_normals = None
+    if all(part.normals is not None for part in parts):
+        file_normals = np.concatenate([part.normals for part in parts])  # type: ignore[misc]
+    # Degenerate faces: dropped and counted.
+    keep = ~_degenerate(positions, faces)
+    dropped = int(faces.shape[0] - keep.sum())
+    if not keep.any():
+        raise SandboxError(f"model file {p} has no faces: all {faces.shape[0]:,} are degenerate "
+                           "(zero area or a repeated vertex)")
+    faces = faces[keep]
+    if corner_colors is not None:
+        corner_colors = corner_colors[keep]
+    normals, how = _corner_normals(p, positions, faces, file_normals, normals_mode, crease)
+    # Per-corner attributes, then vertices made unique again by everything they carry.
+    corners = faces.reshape(-1)
+    rows = [positions[corners], normals.reshape(-1, 3)]
+    if uvs is not None:
+        rows.append(uvs[corners])
+    if corner_colors is not None:
+        rows.append(corner_colors.reshape(-1, 3))
+    index, first = unique_vertices(np.concatenate(rows, axis=1))
+    chosen = corners[first]
+    notes = [f"{p.name}: {_count(faces.shape[0], 'triangle')} ({file_type.upper()})"]
+    if dropped:
+        notes.append(f"{_count(dropped, 'degenerate face')} dropped (zero area or a repeated vertex)")
+    notes.append(f"normals {'from the file' if how == 'file' else how}")
+    image, color, textures = _texture(parts)
+    if textures > 1:
+        notes.append(f"{textures} textures in the file, only the first is used")
+    if fit:
+        notes.append("fitted into -1..1")
+    mesh = Mesh(p.name, positions[chosen], index.astype(np.uint32), normals.reshape(-1, 3)[first],
+                None if uvs is None else uvs[chosen],
+                None if corner_colors is None else corner_colors.reshape(-1, 3)[first], notes=tuple(notes))
+    if fit:
+        mesh = fit_mesh(mesh)
+    texture = None
+    if image is not None:
+        if uvs is None:
+            notes_without = (*mesh.notes, "its texture is not used: the mesh has no texture coordinates")
+            mesh = replace(mesh, notes=notes_without)
+        else:
+            texture = Texture(f"{p}#base_color", image=image)
+    return Model(p, mesh, texture, color, int(faces.shape[0]), dropped, how)
+
+
+def _count(n: int, one: str, many: str | None = None) -> str:
+    """``1 triangle``, ``1,280 triangles``."""
+    return f"{n:,} {one if n == 1 else many or one + 's'}"
+
+
+def _corner_colors(parts: list[_Part]) -> NDArray[np.float64]:
+    """Colours per face corner, (F, 3, 3), for all parts (white where a part has none)."""
+    blocks = []
+    for part in parts:
+        if part.colors is None:
+            blocks.append(np.ones((part.faces.shape[0], 3, 3)))
+        elif part.colors.ndim == 3:
+            blocks.append(part.colors)
+        else:
+            blocks.append(part.colors[part.faces])
+    return np.concatenate(blocks)
+
+
+def _degenerate(positions: NDArray[np.float64], faces: NDArray[np.int64]) -> NDArray[np.bool_]:
+    """Faces with a repeated index or (numerically) zero area."""
+    repeated = (faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 0] == faces[:, 2])
+    a, b, c = positions[faces[:, 0]], positions[faces[:, 1]], positions[faces[:, 2]]
+    with np.errstate(all="ignore"):
+        doubled_area = np.linalg.norm(np.cross(b - a, c - a), axis=1)
+        longest = np.max(np.stack([np.einsum("ij,ij->i", e, e) for e in (b - a, c - b, a - c)]), axis=0)
+        flat = ~(doubled_area > DEGENERATE_SHARE * longest)
+    return repeated | flat
+
+
+def _corner_normals(p: Path, positions: NDArray[np.float64], faces: NDArray[np.int64],
+                    file_normals: NDArray[np.float64] | None, mode: str,
+                    crease: float) -> tuple[NDArray[np.float64], str]:
+    """A unit normal per face corner, (F, 3, 3), and how it was made."""
+    if mode in ("auto", "file"):
+        usable = None
+        if file_normals is not None:
+            used = file_normals[faces]
+            with np.errstate(all="ignore"):
+                size = np.linalg.norm(used, axis=2, keepdims=True)
+                if np.isfinite(used).all() and (size > 1e-12).all():
+                    usable = used / size
+        if usable is not None:
+            return usable, "file"
+        if mode == "file":
+            why = "has no vertex normals" if file_normals is None else "has zero-length or non-finite normals"
+            raise SandboxError(f"model file {p} {why} (normals = \"file\"); use \"auto\" to compute them")
+        mode = "crease"
+    normals = corner_normals(positions, faces.astype(np.intp), mode, crease)
+    return normals, f"crease {crease:g}°" if mode == "crease" else mode
+
+
+def _texture(parts: list[_Part]) -> tuple[NDArray[np.uint8] | None, tuple[float, float, float, float] | None, int]:
+    """The first part's base colour image and factor, and how many distinct images the parts have."""
+    images = [part.image for part in parts if part.image is not None]
+    distinct: list[NDArray[np.uint8]] = []
+    for image in images:
+        if not any(image.shape == d.shape and np.array_equal(image, d) for d in distinct):
+            distinct.append(image)
+    color = next((part.color for part in parts if part.color is not None), None)
+    return (distinct[0] if distinct else None), color, len(distinct)

@@ -1,0 +1,475 @@
+"""A bounding volume hierarchy: the course's "Hızlandırma: AABB" taken to its conclusion.
+
+The course puts one axis-aligned box around each object: a ray that misses
+the box skips every triangle inside. A BVH does the same *recursively*: the
+box of a model holds two boxes, each holding two more, down to leaves of a
+few triangles. A ray that misses a box skips its whole subtree, so a ray
+visits a number of boxes that grows with the *logarithm* of the triangle
+count instead of testing every triangle: a million triangles cost a few
+dozen box tests and a handful of triangle tests per ray.
+
+Building: binned SAH
+--------------------
+Where to cut a box in two? The surface area heuristic (SAH, Goldsmith &
+Salmon 1987; MacDonald & Booth 1990) estimates the cost of a split as
+
+    cost = N_left · A(left) + N_right · A(right)
+
+because a random ray that hits a box hits a child box with a probability
+proportional to the child's surface area ``A`` (for convex boxes, Cauchy's
+formula), and then tests its ``N`` triangles. Among the candidate cuts the
+cheapest wins. The candidates are those of *binned* SAH (Wald 2007): along
+each axis the node's box is cut into :data:`BINS` equal slabs; every triangle
+falls into the slab of its centroid; the bins' counts and boxes are
+summed from the left and from the right, and the ``BINS − 1`` cuts between
+bins are scored at once.
+
+The build runs breadth first, one level of the tree per step: every node of
+a level is binned and split by the same few numpy operations over all of
+its triangles (``bincount`` for the counts, ``np.minimum.at`` for the bin
+boxes), so the Python loop runs once per *level*, never per triangle or per
+node. A node of at most ``leaf_size`` triangles becomes a leaf; a node whose
+triangles all fall into one bin (all centroids in one point) is cut in half
+by count. The boxes used for binning are the heuristic's; the stored node
+boxes are recomputed exactly from the triangles at the end, leaves first.
+
+Layout (flat arrays, what :mod:`glsandbox.raytrace.gpu_bvh` uploads)
+------------------------------------------------------------------
+Node ``i`` has the box ``node_min[i] .. node_max[i]`` (float64, exact: the
+min and max of its triangles' vertices) and
+
+- ``node_count[i] == 0``: an inner node; its children are ``node_first[i]``
+  and ``node_first[i] + 1`` (children are always made in pairs);
+- ``node_count[i] > 0``: a leaf of triangles ``node_first[i] ..
+  node_first[i] + node_count[i] − 1`` in the BVH's own triangle order.
+
+Node 0 is the root. The triangles are stored reordered (``v0, v1, v2``,
+leaf after leaf); ``tri_index[k]`` is the caller's index of stored triangle
+``k``, the one the tie rule and the results use. Degenerate (zero-area)
+triangles, which no ray can hit (the course's
+:data:`~glsandbox.raytrace.triangle.DEGENERATE_SIN` rule), are left out.
+
+Caching
+-------
+:func:`bvh_for_triangles` and :func:`bvh_for_mesh` keep the last few BVHs
+(:data:`CACHE_SIZE`) by a blake2b digest of what they were built from: the
+triangles' bytes, or a :class:`~glsandbox.geometry.Mesh`'s positions and
+indices with the model matrix. Rendering the same model again (another
+frame, another camera) builds nothing.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import weakref
+from collections import OrderedDict
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from glsandbox import transforms
+from glsandbox.geometry import Mesh
+from glsandbox.raytrace.errors import RayTraceError
+from glsandbox.raytrace.watertight import nondegenerate
+
+__all__ = [
+    "BINS",
+    "BVH",
+    "CACHE_SIZE",
+    "LEAF_SIZE",
+    "build_bvh",
+    "bvh_for_mesh",
+    "bvh_for_triangles",
+    "clear_cache",
+    "mesh_digest",
+    "mesh_world_triangles",
+]
+
+#: Most triangles in a leaf.
+LEAF_SIZE: int = 4
+#: Bins per axis of the binned SAH.
+BINS: int = 16
+#: Triangles of a node whose boxes the SAH bins (a big node's are sampled, see ``_split_levels``).
+SAMPLE: int = 1024
+#: BVHs kept by :func:`bvh_for_triangles` / :func:`bvh_for_mesh`.
+CACHE_SIZE: int = 4
+
+
+@dataclass(frozen=True, eq=False)
+class BVH:
+    """A built hierarchy over ``M`` triangles (layout in the module docstring)."""
+
+    node_min: NDArray[np.float64]  # (N, 3)
+    node_max: NDArray[np.float64]  # (N, 3)
+    node_first: NDArray[np.int64]  # (N,) left child (inner) or first stored triangle (leaf)
+    node_count: NDArray[np.int64]  # (N,) 0 for inner nodes, triangles in a leaf otherwise
+    v0: NDArray[np.float64]  # (M, 3) the stored triangles, leaf after leaf
+    v1: NDArray[np.float64]
+    v2: NDArray[np.float64]
+    tri_index: NDArray[np.int64]  # (M,) the caller's index of each stored triangle
+    depth: int  # levels: 1 for a lone leaf
+    input_count: int  # triangles given, degenerate ones included
+
+    def __post_init__(self) -> None:
+        for array in (self.node_min, self.node_max, self.node_first, self.node_count, self.v0, self.v1, self.v2,
+                      self.tri_index):
+            array.flags.writeable = False
+
+    @property
+    def node_total(self) -> int:
+        return int(self.node_count.shape[0])
+
+    @property
+    def triangle_count(self) -> int:
+        """Triangles stored (the non-degenerate ones)."""
+        return int(self.tri_index.shape[0])
+
+    @property
+    def leaf_count(self) -> int:
+        return int(np.count_nonzero(self.node_count))
+
+    @property
+    def empty(self) -> bool:
+        return self.triangle_count == 0
+
+    def __repr__(self) -> str:
+        return (f"BVH({self.triangle_count} triangles of {self.input_count}, {self.node_total} nodes, "
+                f"{self.leaf_count} leaves, depth {self.depth})")
+
+
+def _triangle_arrays(v0: ArrayLike, v1: ArrayLike, v2: ArrayLike
+                     ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    arrays = tuple(np.ascontiguousarray(np.asarray(v, dtype=np.float64)) for v in (v0, v1, v2))
+    a, b, c = arrays
+    if a.ndim != 2 or a.shape[1:] != (3,) or a.shape != b.shape or a.shape != c.shape:
+        raise RayTraceError(f"triangle corners must be three (M, 3) arrays, got {a.shape}, {b.shape}, {c.shape}")
+    if not (np.isfinite(a).all() and np.isfinite(b).all() and np.isfinite(c).all()):
+        raise RayTraceError("triangle vertices must be finite (a NaN or infinite coordinate)")
+    return a, b, c
+
+
+def _empty_bvh(count: int) -> BVH:
+    """A root with no triangles: an inverted box that every ray misses."""
+    zeros3 = np.zeros((0, 3))
+    return BVH(np.full((1, 3), np.inf), np.full((1, 3), -np.inf), np.zeros(1, dtype=np.int64),
+               np.zeros(1, dtype=np.int64), zeros3, zeros3.copy(), zeros3.copy(), np.zeros(0, dtype=np.int64), 1, count)
+
+
+def _sweep(lo: NDArray[np.float32], hi: NDArray[np.float32], forward: bool
+           ) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
+    """Running boxes over the bins of ``(3, B, n)`` arrays: bins ``0..s`` (forward)
+    or ``s..B−1`` (backward), one numpy call per bin on contiguous ``(3, n)`` slices."""
+    run_lo = lo.copy()
+    run_hi = hi.copy()
+    count = lo.shape[1]
+    steps = range(1, count) if forward else range(count - 2, -1, -1)
+    for s in steps:
+        prev = s - 1 if forward else s + 1
+        np.minimum(run_lo[:, prev], lo[:, s], out=run_lo[:, s])
+        np.maximum(run_hi[:, prev], hi[:, s], out=run_hi[:, s])
+    return run_lo, run_hi
+
+
+def _half_area(lo: NDArray[np.float32], hi: NDArray[np.float32]) -> NDArray[np.float32]:
+    """Half the surface area ``ex·ey + ey·ez + ez·ex`` of boxes stored one component
+    per row (``(3, ...)``); an empty box (``lo = inf, hi = −inf``) has 0."""
+    e = np.maximum(hi - lo, np.float32(0.0))
+    result: NDArray[np.float32] = e[0] * e[1] + e[1] * e[2] + e[2] * e[0]
+    return result
+
+
+def build_bvh(v0: ArrayLike, v1: ArrayLike, v2: ArrayLike, *, leaf_size: int = LEAF_SIZE, bins: int = BINS) -> BVH:
+    """Build a BVH over the triangles ``v0[k], v1[k], v2[k]`` (``(M, 3)`` arrays) by binned SAH.
+
+    Degenerate triangles are left out (no ray hits them); the others are
+    each in exactly one leaf of at most ``leaf_size`` triangles.
+    """
+    if not 1 <= int(leaf_size) <= 64 or not 2 <= int(bins) <= 64:
+        raise RayTraceError(f"leaf_size must be in 1..64 and bins in 2..64, got {leaf_size} and {bins}")
+    a, b, c = _triangle_arrays(v0, v1, v2)
+    total = a.shape[0]
+    keep = np.flatnonzero(nondegenerate(a, b, c))
+    if keep.size == 0:
+        return _empty_bvh(total)
+    lo = np.minimum(np.minimum(a, b), c)
+    hi = np.maximum(np.maximum(a, b), c)
+    if keep.size < total:
+        a, b, c, lo, hi = a[keep], b[keep], c[keep], lo[keep], hi[keep]
+    # The binning works on float32 copies, one row per quantity (centroid,
+    # box min, box max; x, y, z each): the SAH is a heuristic, and half the
+    # bytes make its scattered reads faster. The stored boxes are exact
+    # float64, computed from the triangles at the end.
+    rows = np.empty((9, keep.size), dtype=np.float32)
+    rows[0:3] = ((lo + hi) * 0.5).T
+    rows[3:6] = lo.T
+    rows[6:9] = hi.T
+    leaf_of, leaf_rank, first, count, levels = _split_levels(rows, int(leaf_size), int(bins))
+    # The triangles leaf after leaf: a leaf's first slot plus the place within it.
+    leaves = np.flatnonzero(count)
+    offsets = np.zeros(count.shape[0], dtype=np.int64)
+    offsets[leaves[1:]] = np.cumsum(count[leaves][:-1])
+    first[leaves] = offsets[leaves]
+    order = np.empty(keep.size, dtype=np.int64)
+    order[offsets[leaf_of] + leaf_rank] = np.arange(keep.size)
+    a, b, c = a[order], b[order], c[order]
+    node_min, node_max = _exact_boxes(np.minimum(np.minimum(a, b), c), np.maximum(np.maximum(a, b), c), first, count,
+                                      leaves, levels)
+    return BVH(node_min, node_max, first, count, a, b, c, keep[order].astype(np.int64),
+               len(levels), total)
+
+
+def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
+                  ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.int64],
+                             list[NDArray[np.int64]]]:
+    """The breadth-first binned-SAH splitting (see the module docstring).
+
+    ``rows`` is ``(9, K)``: centroid, box min and box max of each triangle.
+    Returns each triangle's leaf and its place in it, ``first`` (an inner node's left child),
+    ``count`` (a leaf's triangles, 0 for inner nodes) and the nodes made at
+    each level, root first.
+
+    The triangles still to split are kept grouped by node (``rows`` columns
+    in node order, ``counts`` per node), so per-node values reach their
+    triangles by ``np.repeat`` and the scattered bin updates stay local in
+    memory; each level partitions every node's columns into its two
+    children's in one pass (a counting sort: no ``argsort`` per level).
+    """
+    k = rows.shape[1]
+    leaf_of = np.zeros(k, dtype=np.int64)
+    leaf_rank = np.arange(k)  # each triangle's place within its leaf
+    firsts: list[NDArray[np.int64]] = [np.zeros(1, dtype=np.int64)]
+    counts_of: list[NDArray[np.int64]] = [np.array([k], dtype=np.int64)]
+    levels = [np.zeros(1, dtype=np.int64)]
+    if k <= leaf_size:
+        return leaf_of, leaf_rank, firsts[0], counts_of[0], levels
+    tris = np.arange(k)  # the caller's triangle of each column
+    counts = np.array([k], dtype=np.int64)  # columns per open node, in column order
+    box_lo = rows[3:6].min(axis=1)[None, :].astype(np.float64)  # the open nodes' binning boxes
+    box_hi = rows[6:9].max(axis=1)[None, :].astype(np.float64)
+    open_pos = np.zeros(1, dtype=np.int64)  # where the open nodes are in their level's arrays
+    next_id = 1
+    while counts.size:
+        n = counts.size
+        width = tris.size
+        # Bins per node: max_bins, fewer once nodes are small (about one per
+        # triangle), so the per-bin work never exceeds the per-triangle work.
+        bins = int(min(max_bins, max(4, 1 << int(np.log2(max(1, width // n))))))
+        # Binning range per node and axis: the node's box (from its parent's
+        # sweep), cut into `bins` equal slabs; a flat axis puts all in bin 0.
+        extent = box_hi - box_lo
+        scale = np.where(extent > 0.0, bins * (1.0 - 1e-6) / np.where(extent > 0.0, extent, 1.0), 0.0)
+        rel = (rows[0:3] - np.repeat(box_lo.T.astype(np.float32), counts, axis=1)) * np.repeat(
+            scale.T.astype(np.float32), counts, axis=1)
+        bin_of = np.clip(rel, 0, bins - 1).astype(np.int64)  # (3, width)
+        node_key = np.repeat(np.arange(n, dtype=np.int64) * bins, counts)
+        best_cost = np.full(n, np.inf)
+        best_axis = np.zeros(n, dtype=np.int64)
+        best_cut = np.ones(n, dtype=np.int64)
+        child_lo = np.empty((n, 2, 3))
+        child_hi = np.empty((n, 2, 3))
+        nodes = np.arange(n)
+        # A big node's bin boxes come from every stride-th of its triangles
+        # (about SAMPLE of them): the boxes are only the heuristic's estimate
+        # of the children's areas (bin counts are exact). Nodes of up to
+        # 2·SAMPLE triangles use them all.
+        stride = np.maximum(1, counts // SAMPLE)
+        if stride.max() > 1:
+            rank = np.arange(width) - np.repeat(np.cumsum(counts) - counts, counts)
+            sample = np.flatnonzero(rank % np.repeat(stride, counts) == 0)
+            box_rows = np.take(rows[3:9], sample, axis=1)
+            box_key, box_bins = node_key[sample], np.take(bin_of, sample, axis=1)
+        else:
+            box_rows, box_key, box_bins = rows[3:9], node_key, bin_of
+        for axis in range(3):
+            key = node_key + bin_of[axis]  # node-major: node i's bins are i·B .. i·B + B − 1
+            cnt = np.bincount(key, minlength=n * bins).reshape(n, bins)
+            blo = np.full((3, n * bins), np.inf, dtype=np.float32)
+            bhi = np.full((3, n * bins), -np.inf, dtype=np.float32)
+            key = box_key + box_bins[axis]
+            for j in range(3):
+                np.minimum.at(blo[j], key, box_rows[j])
+                np.maximum.at(bhi[j], key, box_rows[3 + j])
+            # Bin-major copies, (3, B, n): the sweep below then runs over contiguous rows.
+            blo3 = np.ascontiguousarray(blo.reshape(3, n, bins).transpose(0, 2, 1))
+            bhi3 = np.ascontiguousarray(bhi.reshape(3, n, bins).transpose(0, 2, 1))
+            # The sweep: boxes of bins [0, s) and [s, B) for every cut s, and
+            # the SAH cost N_left·A_left + N_right·A_right of each cut.
+            llo, lhi = _sweep(blo3, bhi3, forward=True)
+            rlo, rhi = _sweep(blo3, bhi3, forward=False)
+            n_left = np.cumsum(cnt.T[:-1], axis=0)
+            n_right = counts - n_left
+            sah = n_left * _half_area(llo[:, :-1], lhi[:, :-1]) + n_right * _half_area(rlo[:, 1:], rhi[:, 1:])
+            sah = np.where((n_left > 0) & (n_right > 0), sah, np.inf)  # a cut must leave both sides something
+            cut = np.argmin(sah, axis=0)  # the best cut on this axis, minus one
+            cost = sah[cut, nodes]
+            better = np.flatnonzero(cost < best_cost)
+            if better.size:
+                cb = cut[better]
+                best_cost[better] = cost[better]
+                best_axis[better] = axis
+                best_cut[better] = cb + 1  # bins below the cut go left
+                child_lo[better, 0] = llo[:, cb, better].T
+                child_hi[better, 0] = lhi[:, cb, better].T
+                child_lo[better, 1] = rlo[:, cb + 1, better].T
+                child_hi[better, 1] = rhi[:, cb + 1, better].T
+        # A child whose sampled triangles were none of its own has no box:
+        # bin it over its parent's.
+        empty = ~np.isfinite(child_lo).all(axis=2) | ~np.isfinite(child_hi).all(axis=2)
+        if empty.any():
+            child_lo = np.where(empty[:, :, None], box_lo[:, None, :], child_lo)
+            child_hi = np.where(empty[:, :, None], box_hi[:, None, :], child_hi)
+        # Each column's side (True: the right child) on its node's chosen axis.
+        axis_t = np.repeat(best_axis, counts)
+        chosen = np.where(axis_t == 0, bin_of[0], np.where(axis_t == 1, bin_of[1], bin_of[2]))
+        right = chosen >= np.repeat(best_cut, counts)
+        stuck = np.flatnonzero(~np.isfinite(best_cost))
+        if stuck.size:
+            # No cut separates them (every centroid in one bin on every axis):
+            # split in half by count, in column order.
+            starts = np.cumsum(counts) - counts
+            where = np.repeat(~np.isfinite(best_cost), counts)
+            rank = np.arange(width) - np.repeat(starts, counts)
+            right[where] = (rank >= np.repeat(counts // 2, counts))[where]
+            child_lo[stuck] = box_lo[stuck][:, None, :]
+            child_hi[stuck] = box_hi[stuck][:, None, :]
+        # Children in pairs: open node i gets next_id + 2i (left) and + 2i + 1.
+        child = 2 * np.repeat(nodes, counts) + right
+        child_count = np.bincount(child, minlength=2 * n)
+        child_ids = next_id + np.arange(2 * n, dtype=np.int64)
+        level_first = np.zeros(2 * n, dtype=np.int64)
+        level_count = np.zeros(2 * n, dtype=np.int64)
+        next_id += 2 * n
+        is_leaf = child_count <= leaf_size
+        level_count[is_leaf] = child_count[is_leaf]
+        # The parents: inner nodes pointing at their left child.
+        firsts[-1][open_pos] = child_ids[0::2]
+        counts_of[-1][open_pos] = 0
+        firsts.append(level_first)
+        counts_of.append(level_count)
+        levels.append(child_ids)
+        # Each column's rank within its child (lefts keep their order, rights
+        # too): with the child's start, its place in the partition below.
+        r = right.astype(np.int64)
+        rights_before = np.cumsum(r) - r  # rights in columns [0, i)
+        node_start = np.cumsum(counts) - counts
+        rights_in_node = rights_before - np.repeat(rights_before[node_start], counts)
+        rank = np.where(right, rights_in_node, np.arange(width) - np.repeat(node_start, counts) - rights_in_node)
+        tri_leaf = is_leaf[child]
+        leaf_of[tris[tri_leaf]] = child_ids[child[tri_leaf]]
+        leaf_rank[tris[tri_leaf]] = rank[tri_leaf]
+        # Partition the open columns into the children that stay open (a
+        # stable counting sort, no argsort).
+        kept_children = np.flatnonzero(~is_leaf)
+        if kept_children.size == 0:
+            break
+        new_counts = child_count[kept_children]
+        child_start = np.zeros(2 * n, dtype=np.int64)
+        child_start[kept_children] = np.cumsum(new_counts) - new_counts
+        keep = np.flatnonzero(~tri_leaf)
+        dest = child_start[child[keep]] + rank[keep]
+        source = np.empty(keep.size, dtype=np.int64)
+        source[dest] = keep
+        rows = np.take(rows, source, axis=1)
+        tris = tris[source]
+        counts = new_counts
+        open_pos = kept_children
+        box_lo = child_lo.reshape(2 * n, 3)[kept_children]
+        box_hi = child_hi.reshape(2 * n, 3)[kept_children]
+    return leaf_of, leaf_rank, np.concatenate(firsts), np.concatenate(counts_of), levels
+
+
+def _exact_boxes(lo: NDArray[np.float64], hi: NDArray[np.float64], first: NDArray[np.int64],
+                 count: NDArray[np.int64], leaves: NDArray[np.int64], levels: list[NDArray[np.int64]]
+                 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Exact float64 node boxes: leaves from their (stored, reordered) triangles'
+    boxes, then each level's inner nodes from their two children, deepest first."""
+    total = count.shape[0]
+    node_min = np.empty((total, 3))
+    node_max = np.empty((total, 3))
+    node_min[leaves] = np.minimum.reduceat(lo, first[leaves], axis=0)
+    node_max[leaves] = np.maximum.reduceat(hi, first[leaves], axis=0)
+    for ids in reversed(levels):
+        inner = ids[count[ids] == 0]
+        if inner.size:
+            left = first[inner]
+            node_min[inner] = np.minimum(node_min[left], node_min[left + 1])
+            node_max[inner] = np.maximum(node_max[left], node_max[left + 1])
+    return node_min, node_max
+
+
+# --- the cache ---------------------------------------------------------------
+
+_CACHE: OrderedDict[bytes, BVH] = OrderedDict()
+_MESH_DIGESTS: weakref.WeakKeyDictionary[Mesh, bytes] = weakref.WeakKeyDictionary()
+
+
+def clear_cache() -> None:
+    """Forget every cached BVH."""
+    _CACHE.clear()
+
+
+def _cached(key: bytes, build: object) -> BVH:
+    found = _CACHE.get(key)
+    if found is not None:
+        _CACHE.move_to_end(key)
+        return found
+    assert callable(build)
+    result: BVH = build()
+    _CACHE[key] = result
+    while len(_CACHE) > CACHE_SIZE:
+        _CACHE.popitem(last=False)
+    return result
+
+
+def _digest(*parts: bytes) -> bytes:
+    h = hashlib.blake2b(digest_size=20)
+    for part in parts:
+        h.update(len(part).to_bytes(8, "little"))
+        h.update(part)
+    return h.digest()
+
+
+def bvh_for_triangles(v0: ArrayLike, v1: ArrayLike, v2: ArrayLike, *, leaf_size: int = LEAF_SIZE,
+                      bins: int = BINS) -> BVH:
+    """:func:`build_bvh`, cached by a digest of the triangles' float64 bytes."""
+    a, b, c = _triangle_arrays(v0, v1, v2)
+    key = _digest(b"triangles", a.tobytes(), b.tobytes(), c.tobytes(), bytes([leaf_size, bins % 256]))
+    return _cached(key, lambda: build_bvh(a, b, c, leaf_size=leaf_size, bins=bins))
+
+
+def mesh_digest(mesh: Mesh) -> bytes:
+    """A blake2b digest of a mesh's triangles: mode, positions and indices (kept per Mesh object:
+    meshes are immutable)."""
+    found = _MESH_DIGESTS.get(mesh)
+    if found is None:
+        positions = np.ascontiguousarray(np.asarray(mesh.positions, dtype=np.float64))
+        indices = b"" if mesh.indices is None else np.ascontiguousarray(np.asarray(mesh.indices, dtype=np.int64)).tobytes()
+        found = _digest(b"mesh", mesh.mode.encode(), positions.tobytes(), indices)
+        _MESH_DIGESTS[mesh] = found
+    return found
+
+
+def mesh_world_triangles(mesh: Mesh, model: ArrayLike | None = None
+                         ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """A mesh's triangles in world space, ``(M, 3)`` corners each: positions moved by
+    ``model`` exactly as :func:`glsandbox.raytrace.world.build_world` moves them (strips
+    unrolled with their winding, :meth:`~glsandbox.geometry.Mesh.triangles`; a line mesh
+    has none)."""
+    positions = np.asarray(mesh.positions, dtype=np.float64)
+    if model is not None:
+        positions = transforms.transform_points(np.asarray(model, dtype=np.float64), positions)
+    tris = Mesh(mesh.name, positions, mesh.indices, mode=mesh.mode).triangles().reshape(-1, 3, 3)
+    return (np.ascontiguousarray(tris[:, 0]), np.ascontiguousarray(tris[:, 1]), np.ascontiguousarray(tris[:, 2]))
+
+
+def bvh_for_mesh(mesh: Mesh, model: ArrayLike | None = None, *, leaf_size: int = LEAF_SIZE, bins: int = BINS) -> BVH:
+    """The BVH of ``mesh`` moved to world space by ``model`` (identity when None),
+    cached by (mesh digest, model bytes): the same model in another frame builds nothing.
+    Triangle indices are the mesh's own (triangle ``k`` is indices ``3k .. 3k+2``)."""
+    m = np.eye(4) if model is None else np.asarray(model, dtype=np.float64)
+    if m.shape != (4, 4):
+        raise RayTraceError(f"a model matrix is 4x4, got shape {m.shape}")
+    key = _digest(b"mesh-bvh", mesh_digest(mesh), np.ascontiguousarray(m).tobytes(), bytes([leaf_size, bins % 256]))
+    return _cached(key, lambda: build_bvh(*mesh_world_triangles(mesh, None if model is None else m),
+                                          leaf_size=leaf_size, bins=bins))

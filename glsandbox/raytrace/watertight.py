@@ -1,0 +1,167 @@
+"""The watertight ray-triangle test for many (ray, triangle) pairs at once.
+
+Woop, Benthin & Wald (2013), "Watertight Ray/Triangle Intersection", the
+test the course's Işın-Üçgen kesim testi ends with (the scalar version, with
+its derivation, is ``_watertight`` in :mod:`glsandbox.raytrace.triangle`).
+This module runs the *same arithmetic* on numpy arrays: for every pair the
+same float64 operations in the same order, so a pair's ``t`` is bit for bit
+the scalar test's ``t``. The steps, per ray:
+
+1. **Permute** the axes so the direction's largest component is ``z``
+   (``kz``), keeping the winding (``kx, ky`` swapped when ``d[kz] < 0``);
+2. **shear** with ``sx = dx/dz, sy = dy/dz, sz = 1/dz``: after
+   ``x − sx·z, y − sy·z`` the ray is the ``+z`` axis through ``(0, 0)``;
+
+and per pair:
+
+3. move the vertices so the ray starts at the origin, shear them, and form
+   the 2D edge functions ``U = E(C, B)``, ``V = E(A, C)``, ``W = E(B, A)``
+   with ``E(p, q) = px·qy − py·qx`` (the scaled barycentrics of ``V0, V1,
+   V2``). Two triangles sharing an edge compute *the same products* for it,
+   subtracted in the opposite order, so a ray can never slip between them;
+4. inside when ``U, V, W`` share a sign (zeros count on both sides;
+   backface culling keeps only ``U, V, W >= 0``, the front faces, ``N·d <
+   0``); ``det = U + V + W = 0`` is a triangle seen edge-on;
+5. ``t = (U·z_A + V·z_B + W·z_C)/det`` with the sheared ``z = sz·z``.
+
+When an edge function rounds to exactly 0, its sign is not trustworthy. The
+scalar test recomputes it in exact rational arithmetic; here the same
+number comes from an error-free transformation instead: ``fl(p1 − p2) = 0``
+means the two rounded products are equal, so the exact value
+``(p1 + e1) − (p2 + e2)`` is ``e1 − e2``, where ``e = a·b − fl(a·b)`` is
+exact (Dekker's product with Veltkamp's split), and ``fl(e1 − e2)`` is the
+correctly rounded exact value: what ``float(Fraction(...))`` gives. (Both
+differ only where the products underflow, below about 1e-290.)
+
+The test itself knows nothing about degenerate (zero-area) triangles: like
+the scalar one it leaves that to the caller (the BVH excludes them at build
+time with the course's :data:`~glsandbox.raytrace.triangle.DEGENERATE_SIN`
+rule, see :func:`nondegenerate`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from glsandbox.raytrace.base import broadcast_rays
+from glsandbox.raytrace.triangle import DEGENERATE_SIN
+from glsandbox.raytrace.vec import cross, length
+
+__all__ = ["RaySetup", "nondegenerate", "ray_setup", "watertight_pairs"]
+
+#: Veltkamp's splitting constant for float64: 2^27 + 1 cuts a double into two
+#: halves of 26 bits whose pairwise products are exact.
+_SPLITTER = 134217729.0
+
+
+@dataclass(frozen=True)
+class RaySetup:
+    """The per-ray constants of the watertight test, ``(N,)`` each.
+
+    ``kx, ky, kz`` are the permuted axes, ``sx, sy, sz`` the shear, and
+    ``ox, oy, oz`` the origin's components on the permuted axes.
+    """
+
+    kx: NDArray[np.intp]
+    ky: NDArray[np.intp]
+    kz: NDArray[np.intp]
+    sx: NDArray[np.float64]
+    sy: NDArray[np.float64]
+    sz: NDArray[np.float64]
+    ox: NDArray[np.float64]
+    oy: NDArray[np.float64]
+    oz: NDArray[np.float64]
+
+    def __len__(self) -> int:
+        return int(self.kx.shape[0])
+
+
+def ray_setup(origins: ArrayLike, directions: ArrayLike) -> RaySetup:
+    """Steps 1 and 2 for ``N`` rays (``origins`` may be one shared ``(3,)`` point)."""
+    o, d = broadcast_rays(origins, directions)
+    n = d.shape[0]
+    rows = np.arange(n)
+    kz = np.argmax(np.abs(d), axis=1)  # the first largest component, as np.argmax in the scalar test
+    kx = (kz + 1) % 3
+    ky = (kx + 1) % 3
+    flip = d[rows, kz] < 0.0  # keep the winding: swap kx and ky
+    kx, ky = np.where(flip, ky, kx), np.where(flip, kx, ky)
+    dx, dy, dz = d[rows, kx], d[rows, ky], d[rows, kz]
+    with np.errstate(divide="ignore", invalid="ignore"):  # a zero direction: NaN, and it misses
+        sx = dx / dz
+        sy = dy / dz
+        sz = 1.0 / dz
+    return RaySetup(kx, ky, kz, sx, sy, sz, o[rows, kx], o[rows, ky], o[rows, kz])
+
+
+def nondegenerate(v0: NDArray[np.float64], v1: NDArray[np.float64], v2: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """``(M,)``: the triangles with area, ``|e1 × e2| > DEGENERATE_SIN·|e1|·|e2|``
+    (exactly the rule of :class:`~glsandbox.raytrace.triangle.TriangleBatch`)."""
+    e1 = v1 - v0
+    e2 = v2 - v0
+    result: NDArray[np.bool_] = length(cross(e1, e2)) > DEGENERATE_SIN * length(e1) * length(e2)
+    return result
+
+
+def _product_error(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``a·b − fl(a·b)``, exactly (Dekker's two-product with Veltkamp's split)."""
+    p = a * b
+    ca = _SPLITTER * a
+    a_hi = ca - (ca - a)
+    a_lo = a - a_hi
+    cb = _SPLITTER * b
+    b_hi = cb - (cb - b)
+    b_lo = b - b_hi
+    result: NDArray[np.float64] = ((a_hi * b_hi - p) + a_hi * b_lo + a_lo * b_hi) + a_lo * b_lo
+    return result
+
+
+def _edge(px: NDArray[np.float64], py: NDArray[np.float64], qx: NDArray[np.float64],
+          qy: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``E(p, q) = px·qy − py·qx``; where it rounds to 0, the correctly rounded exact value."""
+    e = px * qy - py * qx
+    zero = np.flatnonzero(e == 0.0)
+    if zero.size:
+        pxz, pyz, qxz, qyz = px[zero], py[zero], qx[zero], qy[zero]
+        e[zero] = _product_error(pxz, qyz) - _product_error(pyz, qxz)
+    return e
+
+
+def watertight_pairs(setup: RaySetup, rays: NDArray[np.intp], v0: NDArray[np.float64], v1: NDArray[np.float64],
+                     v2: NDArray[np.float64], tris: NDArray[np.intp], cull_backfaces: bool = False
+                     ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Ray ``rays[i]`` against triangle ``tris[i]`` for every ``i``: ``(t, u, v)``, ``(P,)`` each.
+
+    ``t`` is ``inf`` for a miss (outside, edge-on, culled, or ``t <= 0``);
+    ``(u, v)`` are the hit's barycentrics in the course's form
+    ``P = V0 + u·(V1 − V0) + v·(V2 − V0)`` (meaningless for a miss).
+    ``v0, v1, v2`` are ``(M, 3)`` float64 arrays.
+    """
+    kx, ky, kz = setup.kx[rays], setup.ky[rays], setup.kz[rays]
+    sx, sy, sz = setup.sx[rays], setup.sy[rays], setup.sz[rays]
+    ox, oy, oz = setup.ox[rays], setup.oy[rays], setup.oz[rays]
+    base = tris * 3  # flat (M·3,) rows: vertex component k of triangle j is [3j + k]
+    ix, iy, iz = base + kx, base + ky, base + kz
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        coords = []
+        for vertex in (v0, v1, v2):
+            flat = vertex.reshape(-1)
+            # Step 3: relative to the origin (the scalar's V − O), then sheared.
+            x, y, z = flat[ix] - ox, flat[iy] - oy, flat[iz] - oz
+            coords.append((x - sx * z, y - sy * z, z))
+        (ax, ay, az), (bx, by, bz), (cx, cy, cz) = coords
+        u = _edge(cx, cy, bx, by)  # edge V1-V2: the weight of V0
+        v = _edge(ax, ay, cx, cy)  # edge V2-V0: the weight of V1
+        w = _edge(bx, by, ax, ay)  # edge V0-V1: the weight of V2
+        negative = (u < 0.0) | (v < 0.0) | (w < 0.0)
+        # Step 4: all signs alike (zeros on both sides); culling keeps the front faces only.
+        inside = ~negative if cull_backfaces else ~(negative & ((u > 0.0) | (v > 0.0) | (w > 0.0)))
+        det = u + v + w
+        inside &= det != 0.0
+        # Step 5: the sheared z interpolated with the scaled barycentrics is t along d.
+        t = (u * (sz * az) + v * (sz * bz) + w * (sz * cz)) / det
+        hit = inside & (t > 0.0)
+        return np.where(hit, t, np.inf), v / det, w / det
