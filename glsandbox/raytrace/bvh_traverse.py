@@ -44,7 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from glsandbox.raytrace.base import broadcast_rays
+from glsandbox.raytrace.base import broadcast_rays, shared_origin
 from glsandbox.raytrace.bvh import BVH
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.watertight import RaySetup, nondegenerate, ray_setup, watertight_pairs
@@ -87,25 +87,49 @@ def _rays(origins: ArrayLike, directions: ArrayLike, t_max: ArrayLike
     limit = np.broadcast_to(np.asarray(t_max, dtype=np.float64), (d.shape[0],)).copy()
     if np.isnan(limit).any():
         raise RayTraceError("t_max must not be NaN")
-    return np.ascontiguousarray(o), np.ascontiguousarray(d), limit
+    return o, np.ascontiguousarray(d), limit  # o stays a stride-0 view when one origin is shared
+
+
+class _Boxes:
+    """The nodes' padded boxes as contiguous rows, one per axis, made once per call.
+
+    Rays that share one origin (primary rays from the eye) get the boxes
+    already moved to that origin, ``(plane − pad) − O``: the slab test is then
+    a gather and a product per plane.
+    """
+
+    def __init__(self, bvh: BVH, o: NDArray[np.float64]) -> None:
+        pad = _node_pad(bvh)[None, :]
+        self.lo = bvh.node_min.T - pad
+        self.hi = bvh.node_max.T + pad
+        origin = shared_origin(o)
+        self.shared = origin.ndim == 1
+        if self.shared:
+            o_pad = BOX_PAD * float(np.abs(origin).max(initial=0.0))
+            self.lo = self.lo - o_pad - origin[:, None]
+            self.hi = self.hi + o_pad - origin[:, None]
+        self.lo = np.ascontiguousarray(self.lo)
+        self.hi = np.ascontiguousarray(self.hi)
 
 
 class _Block:
     """One block of rays: what the slab test needs per ray, and the best hits so far."""
 
-    def __init__(self, node_pad: NDArray[np.float64], o: NDArray[np.float64], d: NDArray[np.float64],
+    def __init__(self, boxes: _Boxes, o: NDArray[np.float64], d: NDArray[np.float64],
                  limit: NDArray[np.float64]) -> None:
         self.n = d.shape[0]
-        self.o = o.T.copy()  # (3, n): one contiguous row per axis
+        self.boxes = boxes
         with np.errstate(divide="ignore"):
-            self.inv = 1.0 / d.T  # 1/(+0) = +inf, 1/(−0) = −inf: the slab test's special cases
+            self.inv = np.ascontiguousarray(1.0 / d.T)  # 1/(+0) = +inf, 1/(−0) = −inf: the slab test's special cases
         self.setup: RaySetup = ray_setup(o, d)
-        self.o_pad = BOX_PAD * np.abs(o).max(axis=1)
+        if not boxes.shared:  # the ray's part of the padding goes with its origin
+            o_pad = BOX_PAD * np.abs(o).max(axis=1)
+            self.o_lo = np.ascontiguousarray((o + o_pad[:, None]).T)
+            self.o_hi = np.ascontiguousarray((o - o_pad[:, None]).T)
         self.limit = limit
         self.best_t = limit.copy()
         self.best_tri = np.full(self.n, _NO_TRIANGLE, dtype=np.int64)
         self.best_slot = np.full(self.n, -1, dtype=np.int64)
-        self.node_pad = node_pad
 
     def slab(self, bvh: BVH, rays: NDArray[np.intp], nodes: NDArray[np.intp]
              ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -115,17 +139,20 @@ class _Block:
         ``minimum``/``maximum`` keep the NaN of ``0·inf`` (an origin on a plane
         the ray runs along) and ``fmax``/``fmin`` then skip it: inside the slab.
         """
-        pad = self.node_pad[nodes] + self.o_pad[rays]
         near = np.full(rays.size, -np.inf)
         far = np.full(rays.size, np.inf)
+        boxes = self.boxes
         with np.errstate(invalid="ignore"):
             for axis in range(3):
-                o = self.o[axis, rays]
                 inv = self.inv[axis, rays]
-                ta = (bvh.node_min[nodes, axis] - pad - o) * inv
-                tb = (bvh.node_max[nodes, axis] + pad - o) * inv
-                near = np.fmax(near, np.minimum(ta, tb))
-                far = np.fmin(far, np.maximum(ta, tb))
+                if boxes.shared:
+                    ta = boxes.lo[axis, nodes] * inv
+                    tb = boxes.hi[axis, nodes] * inv
+                else:
+                    ta = (boxes.lo[axis, nodes] - self.o_lo[axis, rays]) * inv
+                    tb = (boxes.hi[axis, nodes] - self.o_hi[axis, rays]) * inv
+                np.fmax(near, np.minimum(ta, tb), out=near)
+                np.fmin(far, np.maximum(ta, tb, out=tb), out=far)
         return near, far
 
 
@@ -192,10 +219,10 @@ def closest_hit(bvh: BVH, origins: ArrayLike, directions: ArrayLike, t_max: Arra
     out = Hits.misses(n)
     if bvh.empty or n == 0:
         return out
-    pad = _node_pad(bvh)
+    boxes = _Boxes(bvh, o)
     for lo in range(0, n, RAY_BLOCK):
         part = slice(lo, min(n, lo + RAY_BLOCK))
-        block = _Block(pad, o[part], d[part], limit[part])
+        block = _Block(boxes, o[part], d[part], limit[part])
         _closest_block(bvh, block, bool(cull_backfaces))
         hit = np.flatnonzero(block.best_slot >= 0)
         if hit.size:
@@ -221,10 +248,10 @@ def any_hit(bvh: BVH, origins: ArrayLike, directions: ArrayLike, t_max: ArrayLik
     if bvh.empty or n == 0:
         return found
     cull = bool(cull_backfaces)
-    pad = _node_pad(bvh)
+    boxes = _Boxes(bvh, o)
     for lo in range(0, n, RAY_BLOCK):
         part = slice(lo, min(n, lo + RAY_BLOCK))
-        block = _Block(pad, o[part], d[part], limit[part])
+        block = _Block(boxes, o[part], d[part], limit[part])
         done = np.zeros(block.n, dtype=bool)
         rays = np.arange(block.n)
         nodes = np.zeros(block.n, dtype=np.int64)

@@ -13,8 +13,10 @@ Integers travel as float32, exact up to ``2^24`` (16,777,216): more nodes or
 triangles than that are refused.
 
 Tracing: ``shaders/bvh_probe.glsl`` runs one fragment per ray over a grid of
-rays (origins and directions uploaded as two more float textures) and writes
-``(t, index, u, v)`` and ``(overflow, steps, any)`` into two float targets.
+rays (origins and directions uploaded as two more float textures; or, for
+:meth:`GpuBVH.trace_camera`, a camera's primary rays made in the shader as
+``shaders/raytrace.glsl`` makes them) and writes ``(t, index, u, v)`` and
+``(overflow, steps, any)`` into two float targets.
 
 Overflow: llvmpipe stops a shader invocation's loops after 65,535 iterations
 in all, silently. The GLSL traversal therefore bounds its one loop by
@@ -39,6 +41,8 @@ from glsandbox.plan import ProgramVariant
 from glsandbox.raytrace.base import broadcast_rays
 from glsandbox.raytrace.bvh import BVH
 from glsandbox.raytrace.errors import RayTraceError
+from glsandbox.raytrace.world import camera_basis
+from glsandbox.scene import Camera
 
 __all__ = ["EXACT_INTEGERS", "LOOP_LIMIT", "MAX_STEPS", "TEX_WIDTH", "GpuBVH", "GpuHits", "pack_bvh"]
 
@@ -143,21 +147,46 @@ class GpuBVH:
         self._tris = _texture(ctx, tris, TEX_WIDTH)
         #: The shader's stack: the ordered traversal pushes at most one entry per level.
         self.stack = max(2, bvh.depth + 1)
-        self._programs: dict[bool, tuple[moderngl.Program, moderngl.VertexArray]] = {}
+        self._programs: dict[tuple[bool, bool], tuple[moderngl.Program, moderngl.VertexArray]] = {}
         # A far point the padding rays of a grid start from, pointing away: they miss the root at once.
         root_hi = np.where(np.isfinite(bvh.node_max[0]), bvh.node_max[0], 0.0)
         self._away = root_hi + 1.0 + np.abs(root_hi)
 
-    def defines(self, any_hit: bool = False) -> tuple[tuple[str, str], ...]:
+    def defines(self, any_hit: bool = False, camera: bool = False) -> tuple[tuple[str, str], ...]:
         """The ``#define`` lines of the probe program (what an including shader sets too)."""
         return (("BVH_TEX_WIDTH", str(TEX_WIDTH)), ("BVH_STACK", str(self.stack)),
-                ("BVH_MAX_STEPS", str(self.max_steps)), ("BVH_ANY", str(int(any_hit))))
+                ("BVH_MAX_STEPS", str(self.max_steps)), ("BVH_ANY", str(int(any_hit))),
+                ("BVH_CAMERA", str(int(camera))))
 
-    def _program(self, any_hit: bool) -> tuple[moderngl.Program, moderngl.VertexArray]:
-        if any_hit not in self._programs:
-            program = compile_program(self.ctx, ProgramVariant("bvh_probe", self.defines(any_hit)))
-            self._programs[any_hit] = (program, self.ctx.vertex_array(program, []))
-        return self._programs[any_hit]
+    def _program(self, any_hit: bool, camera: bool = False) -> tuple[moderngl.Program, moderngl.VertexArray]:
+        key = (any_hit, camera)
+        if key not in self._programs:
+            program = compile_program(self.ctx, ProgramVariant("bvh_probe", self.defines(any_hit, camera)))
+            self._programs[key] = (program, self.ctx.vertex_array(program, []))
+        return self._programs[key]
+
+    def _draw(self, program: moderngl.Program, vao: moderngl.VertexArray, width: int, height: int,
+              rays: dict[str, moderngl.Texture]) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
+        """One fragment per ray over a ``width x height`` grid: the two result targets, row 0 first."""
+        outputs = [self.ctx.texture((width, height), 4, dtype="f4") for _ in range(2)]
+        fbo = self.ctx.framebuffer(color_attachments=outputs)
+        try:
+            textures = {"u_bvh_nodes": self._nodes, "u_bvh_tris": self._tris, **rays}
+            for unit, (name, texture) in enumerate(textures.items()):
+                texture.use(unit)
+                if name in program:
+                    program[name].value = unit
+            fbo.use()
+            fbo.viewport = (0, 0, width, height)
+            self.ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
+            vao.render(moderngl.TRIANGLE_STRIP, vertices=4)
+            hit = np.frombuffer(fbo.read(components=4, attachment=0, dtype="f4"), dtype=np.float32)
+            info = np.frombuffer(fbo.read(components=4, attachment=1, dtype="f4"), dtype=np.float32)
+        finally:
+            fbo.release()
+            for texture in outputs:
+                texture.release()
+        return hit.reshape(-1, 4), info.reshape(-1, 4)
 
     def _run(self, origins: ArrayLike, directions: ArrayLike, t_max: ArrayLike, cull: bool, any_hit: bool
              ) -> tuple[NDArray[np.float32], NDArray[np.float32], int]:
@@ -176,26 +205,43 @@ class GpuBVH:
         program, vao = self._program(any_hit)
         ray_o = self.ctx.texture((width, height), 4, rays_o.tobytes(), dtype="f4")
         ray_d = self.ctx.texture((width, height), 4, rays_d.tobytes(), dtype="f4")
-        outputs = [self.ctx.texture((width, height), 4, dtype="f4") for _ in range(2)]
-        fbo = self.ctx.framebuffer(color_attachments=outputs)
         try:
-            for unit, (name, texture) in enumerate((("u_bvh_nodes", self._nodes), ("u_bvh_tris", self._tris),
-                                                    ("u_ray_origins", ray_o), ("u_ray_dirs", ray_d))):
+            for texture in (ray_o, ray_d):
                 texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
-                texture.use(unit)
-                if name in program:
-                    program[name].value = unit
-            fbo.use()
-            fbo.viewport = (0, 0, width, height)
-            self.ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
-            vao.render(moderngl.TRIANGLE_STRIP, vertices=4)
-            hit = np.frombuffer(fbo.read(components=4, attachment=0, dtype="f4"), dtype=np.float32)
-            info = np.frombuffer(fbo.read(components=4, attachment=1, dtype="f4"), dtype=np.float32)
+            hit, info = self._draw(program, vao, width, height, {"u_ray_origins": ray_o, "u_ray_dirs": ray_d})
         finally:
-            fbo.release()
-            for texture in (ray_o, ray_d, *outputs):
-                texture.release()
-        return hit.reshape(-1, 4)[:n], info.reshape(-1, 4)[:n], n
+            ray_o.release()
+            ray_d.release()
+        return hit[:n], info[:n], n
+
+    @staticmethod
+    def _hits(hit: NDArray[np.float32], info: NDArray[np.float32]) -> GpuHits:
+        index = np.rint(hit[:, 1]).astype(np.int64)
+        found = index >= 0
+        return GpuHits(np.where(found, hit[:, 0].astype(np.float64), np.inf), np.where(found, index, -1),
+                       np.where(found, hit[:, 2], 0.0).astype(np.float64),
+                       np.where(found, hit[:, 3], 0.0).astype(np.float64),
+                       info[:, 0] > 0.5, np.rint(info[:, 1]).astype(np.int64))
+
+    def trace_camera(self, camera: Camera, width: int, height: int, *, cull_backfaces: bool = False,
+                     strict: bool = True) -> GpuHits:
+        """The primary rays of ``camera`` at ``width x height``, made in the shader as
+        ``shaders/raytrace.glsl`` makes them, in the order of
+        :func:`~glsandbox.raytrace.world.camera_rays` (row 0 at the top)."""
+        eye, basis, half_w, half_h = camera_basis(camera, width / height)
+        program, vao = self._program(False, camera=True)
+        values = {"u_size": (float(width), float(height)), "u_eye": tuple(eye), "u_half": (half_w, half_h),
+                  "u_t_max": float("inf"), "u_cull": bool(cull_backfaces)}
+        for name, value in values.items():
+            if name in program:
+                program[name].value = value
+        program["u_basis"].write(np.asarray(basis, dtype="f4").T.tobytes())  # column-major
+        hit, info = self._draw(program, vao, width, height, {})
+        flip = np.arange(width * height).reshape(height, width)[::-1].reshape(-1)  # GL's row 0 is the bottom
+        result = self._hits(hit[flip], info[flip])
+        if strict:
+            result.check(self.max_steps)
+        return result
 
     def trace(self, origins: ArrayLike, directions: ArrayLike, t_max: ArrayLike = np.inf, *,
               cull_backfaces: bool = False, strict: bool = True) -> GpuHits:
@@ -204,13 +250,8 @@ class GpuBVH:
         ``strict=True`` raises :class:`RayTraceError` when any ray was cut
         off by the loop bound; ``strict=False`` returns its ``overflow`` flag instead.
         """
-        hit, info, n = self._run(origins, directions, t_max, bool(cull_backfaces), False)
-        index = np.rint(hit[:, 1]).astype(np.int64)
-        found = index >= 0
-        result = GpuHits(np.where(found, hit[:, 0].astype(np.float64), np.inf), np.where(found, index, -1),
-                         np.where(found, hit[:, 2], 0.0).astype(np.float64),
-                         np.where(found, hit[:, 3], 0.0).astype(np.float64),
-                         info[:, 0] > 0.5, np.rint(info[:, 1]).astype(np.int64))
+        hit, info, _ = self._run(origins, directions, t_max, bool(cull_backfaces), False)
+        result = self._hits(hit, info)
         if strict:
             result.check(self.max_steps)
         return result

@@ -214,3 +214,22 @@ def test_bad_bounds_are_refused(ctx) -> None:
     for bad in (0, 70_000, 2.5):
         with pytest.raises(RayTraceError, match="max_steps"):
             GpuBVH(ctx, bvh, max_steps=bad)
+
+
+def test_camera_rays_made_in_the_shader_match_the_numpy_camera_rays(ctx) -> None:
+    a, b, c = mesh_world_triangles(meshgen.terrain(30))
+    bvh = build_bvh(a, b, c)
+    camera = Camera(eye=(0.3, 1.0, 2.0))
+    eye, dirs = camera_rays(camera, 64, 48)
+    want = closest_hit(bvh, eye, dirs)
+    gpu = GpuBVH(ctx, bvh)
+    try:
+        got = gpu.trace_camera(camera, 64, 48)
+    finally:
+        gpu.release()
+    assert not got.overflow.any() and 0.2 < want.hit.mean() < 0.9
+    differ = got.triangle != want.triangle
+    excused = (want.hit & near_edge(want.u, want.v)) | (got.hit & near_edge(got.u, got.v))
+    assert np.all(excused[differ]) and differ.mean() < 0.01
+    same = ~differ & want.hit
+    np.testing.assert_allclose(got.t[same], want.t[same], rtol=2e-5)
