@@ -195,7 +195,7 @@ def _check_bytes(path: Path, fmt: str, data: bytes) -> bytes:
                 raise SandboxError(f"{path}: not a glTF file: invalid JSON ({exc})") from None
         return data
     if fmt == "ply":
-        if not (data.startswith(b"ply\n") or data.startswith(b"ply\r\n")):
+        if not data.startswith((b"ply\n", b"ply\r\n")):
             raise SandboxError(f"{path}: not a PLY file (it does not start with a 'ply' line)")
         return data
     if fmt == "glb":
@@ -283,11 +283,15 @@ def _file_normals(geometry: Any) -> NDArray[np.float64] | None:
 
 
 def _visual(geometry: Any, vertex_count: int
-            ) -> tuple[NDArray[np.float64] | None, NDArray[np.float64] | None, Any, tuple[float, ...] | None]:
+            ) -> tuple[NDArray[np.float64] | None, NDArray[np.float64] | None, Any,
+                       tuple[float, float, float, float] | None]:
     """``(uvs, colours, image, base colour)`` of a trimesh geometry."""
     visual = getattr(geometry, "visual", None)
     kind = getattr(visual, "kind", None)
-    uvs = colors = image = base = None
+    uvs: NDArray[np.float64] | None = None
+    colors: NDArray[np.float64] | None = None
+    image: Any = None
+    base: tuple[float, float, float, float] | None = None
     if kind == "texture":
         uv = getattr(visual, "uv", None)
         if uv is not None and np.shape(uv) == (vertex_count, 2):
@@ -303,11 +307,13 @@ def _visual(geometry: Any, vertex_count: int
         if factor is None:
             factor = getattr(material, "diffuse", None)
         if factor is not None:
-            base = tuple(float(x) / 255.0 for x in np.asarray(factor, dtype=np.float64).reshape(-1)[:4])
+            rgba = [float(x) / 255.0 for x in np.asarray(factor, dtype=np.float64).reshape(-1)[:4]]
+            rgba += [1.0] * (4 - len(rgba))
+            base = (rgba[0], rgba[1], rgba[2], rgba[3])
         attribute = getattr(geometry, "vertex_attributes", {}).get("color")
         if attribute is not None and np.shape(attribute)[0] == vertex_count:
             colors = np.asarray(attribute, dtype=np.float64)[:, :3] / 255.0
-    elif kind == "vertex":
+    elif kind == "vertex" and visual is not None:
         colors = np.asarray(visual.vertex_colors, dtype=np.float64)[:, :3] / 255.0
     return uvs, colors, image, base
 

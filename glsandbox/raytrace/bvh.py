@@ -315,7 +315,7 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
                 child_hi[better, 1] = rhi[:, cb + 1, better].T
         # A child whose sampled triangles were none of its own has no box:
         # bin it over its parent's.
-        empty = ~np.isfinite(child_lo).all(axis=2) | ~np.isfinite(child_hi).all(axis=2)
+        empty = np.logical_not(np.logical_and(np.isfinite(child_lo).all(axis=2), np.isfinite(child_hi).all(axis=2)))
         if empty.any():
             child_lo = np.where(empty[:, :, None], box_lo[:, None, :], child_lo)
             child_hi = np.where(empty[:, :, None], box_hi[:, None, :], child_hi)

@@ -259,7 +259,7 @@ class GpuBVH:
     def any_hit(self, origins: ArrayLike, directions: ArrayLike, t_max: ArrayLike = 1.0, *,
                 cull_backfaces: bool = False, strict: bool = True) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
         """``(blocked, overflow)``: whether anything lies at ``0 < t < t_max`` along each ray (shadow rays)."""
-        _, info, n = self._run(origins, directions, t_max, bool(cull_backfaces), True)
+        _, info, _ = self._run(origins, directions, t_max, bool(cull_backfaces), True)
         overflow = info[:, 0] > 0.5
         if strict:
             _check_overflow(overflow, self.max_steps)
