@@ -434,7 +434,7 @@ def bvh_for_triangles(v0: ArrayLike, v1: ArrayLike, v2: ArrayLike, *, leaf_size:
                       bins: int = BINS) -> BVH:
     """:func:`build_bvh`, cached by a digest of the triangles' float64 bytes."""
     a, b, c = _triangle_arrays(v0, v1, v2)
-    key = _digest(b"triangles", a.tobytes(), b.tobytes(), c.tobytes(), bytes([leaf_size, bins % 256]))
+    key = _digest(b"triangles", a.tobytes(), b.tobytes(), c.tobytes(), f"{leaf_size},{bins}".encode())
     return _cached(key, lambda: build_bvh(a, b, c, leaf_size=leaf_size, bins=bins))
 
 
@@ -470,6 +470,6 @@ def bvh_for_mesh(mesh: Mesh, model: ArrayLike | None = None, *, leaf_size: int =
     m = np.eye(4) if model is None else np.asarray(model, dtype=np.float64)
     if m.shape != (4, 4):
         raise RayTraceError(f"a model matrix is 4x4, got shape {m.shape}")
-    key = _digest(b"mesh-bvh", mesh_digest(mesh), np.ascontiguousarray(m).tobytes(), bytes([leaf_size, bins % 256]))
+    key = _digest(b"mesh-bvh", mesh_digest(mesh), np.ascontiguousarray(m).tobytes(), f"{leaf_size},{bins}".encode())
     return _cached(key, lambda: build_bvh(*mesh_world_triangles(mesh, None if model is None else m),
                                           leaf_size=leaf_size, bins=bins))
