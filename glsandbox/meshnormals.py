@@ -103,9 +103,10 @@ def corner_normals(positions: NDArray[np.float64], tris: NDArray[np.intp], mode:
     pid, _ = row_ids(positions)
     corner_pid = pid[tris].reshape(-1)  # the welded position of each corner
     w = weighted.reshape(-1, 3)
+    total: NDArray[np.float64]
     if mode == "smooth":
         sums = np.stack([np.bincount(corner_pid, w[:, j], minlength=int(pid.max()) + 1) for j in range(3)], axis=1)
-        total = sums[corner_pid]
+        total = np.asarray(sums[corner_pid], dtype=np.float64)
     else:
         total = _crease_sums(corner_pid, np.repeat(faces, 3, axis=0), w, float(np.cos(np.radians(crease_angle))))
     size = np.linalg.norm(total, axis=1, keepdims=True)
@@ -133,7 +134,9 @@ def _crease_sums(corner_pid: NDArray[np.intp], own: NDArray[np.float64], weighte
     # Small groups: every pair at once, in blocks of about 4M pairs.
     group_ids = np.flatnonzero(small)
     work = np.cumsum(sizes[group_ids].astype(np.int64) ** 2)
-    cuts = np.searchsorted(work, np.arange(1 << 22, int(work[-1]) + (1 << 22), 1 << 22), side="right") if work.size else []
+    cuts: NDArray[np.intp] = np.zeros(0, dtype=np.intp)
+    if work.size:
+        cuts = np.searchsorted(work, np.arange(1 << 22, int(work[-1]) + (1 << 22), 1 << 22), side="right")
     lo = 0
     for hi in np.unique(np.r_[cuts, group_ids.size]):
         if hi > lo:

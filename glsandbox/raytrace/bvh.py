@@ -195,7 +195,7 @@ def build_bvh(v0: ArrayLike, v1: ArrayLike, v2: ArrayLike, *, leaf_size: int = L
     lo = np.minimum(np.minimum(a, b), c)
     hi = np.maximum(np.maximum(a, b), c)
     if keep.size < total:
-        a, b, c, lo, hi = a[keep], b[keep], c[keep], lo[keep], hi[keep]
+        a, b, c, lo, hi = (np.take(x, keep, axis=0) for x in (a, b, c, lo, hi))
     # The binning works on float32 copies, one row per quantity (centroid,
     # box min, box max; x, y, z each): the SAH is a heuristic, and half the
     # bytes make its scattered reads faster. The stored boxes are exact
@@ -212,7 +212,7 @@ def build_bvh(v0: ArrayLike, v1: ArrayLike, v2: ArrayLike, *, leaf_size: int = L
     first[leaves] = offsets[leaves]
     order = np.empty(keep.size, dtype=np.int64)
     order[offsets[leaf_of] + leaf_rank] = np.arange(keep.size)
-    a, b, c = a[order], b[order], c[order]
+    a, b, c = (np.take(x, order, axis=0) for x in (a, b, c))  # np.take: several times faster than x[order] here
     node_min, node_max = _exact_boxes(np.minimum(np.minimum(a, b), c), np.maximum(np.maximum(a, b), c), first, count,
                                       leaves, levels)
     return BVH(node_min, node_max, first, count, a, b, c, keep[order].astype(np.int64),
@@ -261,7 +261,7 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
         scale = np.where(extent > 0.0, bins * (1.0 - 1e-6) / np.where(extent > 0.0, extent, 1.0), 0.0)
         rel = (rows[0:3] - np.repeat(box_lo.T.astype(np.float32), counts, axis=1)) * np.repeat(
             scale.T.astype(np.float32), counts, axis=1)
-        bin_of = np.clip(rel, 0, bins - 1).astype(np.int64)  # (3, width)
+        bin_of = np.clip(rel, 0, bins - 1, out=rel).astype(np.int32)  # (3, width)
         node_key = np.repeat(np.arange(n, dtype=np.int64) * bins, counts)
         best_cost = np.full(n, np.inf)
         best_axis = np.zeros(n, dtype=np.int64)
@@ -315,7 +315,7 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
                 child_hi[better, 1] = rhi[:, cb + 1, better].T
         # A child whose sampled triangles were none of its own has no box:
         # bin it over its parent's.
-        empty = ~np.isfinite(child_lo).all(axis=2) | ~np.isfinite(child_hi).all(axis=2)
+        empty = np.logical_not(np.logical_and(np.isfinite(child_lo).all(axis=2), np.isfinite(child_hi).all(axis=2)))
         if empty.any():
             child_lo = np.where(empty[:, :, None], box_lo[:, None, :], child_lo)
             child_hi = np.where(empty[:, :, None], box_hi[:, None, :], child_hi)
@@ -434,7 +434,7 @@ def bvh_for_triangles(v0: ArrayLike, v1: ArrayLike, v2: ArrayLike, *, leaf_size:
                       bins: int = BINS) -> BVH:
     """:func:`build_bvh`, cached by a digest of the triangles' float64 bytes."""
     a, b, c = _triangle_arrays(v0, v1, v2)
-    key = _digest(b"triangles", a.tobytes(), b.tobytes(), c.tobytes(), bytes([leaf_size, bins % 256]))
+    key = _digest(b"triangles", a.tobytes(), b.tobytes(), c.tobytes(), f"{leaf_size},{bins}".encode())
     return _cached(key, lambda: build_bvh(a, b, c, leaf_size=leaf_size, bins=bins))
 
 
@@ -470,6 +470,6 @@ def bvh_for_mesh(mesh: Mesh, model: ArrayLike | None = None, *, leaf_size: int =
     m = np.eye(4) if model is None else np.asarray(model, dtype=np.float64)
     if m.shape != (4, 4):
         raise RayTraceError(f"a model matrix is 4x4, got shape {m.shape}")
-    key = _digest(b"mesh-bvh", mesh_digest(mesh), np.ascontiguousarray(m).tobytes(), bytes([leaf_size, bins % 256]))
+    key = _digest(b"mesh-bvh", mesh_digest(mesh), np.ascontiguousarray(m).tobytes(), f"{leaf_size},{bins}".encode())
     return _cached(key, lambda: build_bvh(*mesh_world_triangles(mesh, None if model is None else m),
                                           leaf_size=leaf_size, bins=bins))

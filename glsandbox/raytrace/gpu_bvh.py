@@ -1,0 +1,275 @@
+"""The BVH on the GPU: pack a :class:`~glsandbox.raytrace.bvh.BVH` for ``shaders/common/bvh.glsl``
+and trace batches of rays with it (float32), to test the GLSL traversal against numpy's.
+
+Packing (the layout ``bvh.glsl`` documents): two RGBA32F textures
+:data:`TEX_WIDTH` texels wide, read with ``texelFetch``:
+
+- nodes, 2 texels each: ``(min.xyz, first)``, ``(max.xyz, count)``; the boxes
+  rounded *outwards* to float32 (a float64 box edge never moves inside);
+- triangles in the BVH's storage order, 3 texels each: ``(v0.xyz, caller's
+  index)``, ``(v1.xyz, 0)``, ``(v2.xyz, 0)``.
+
+Integers travel as float32, exact up to ``2^24`` (16,777,216): more nodes or
+triangles than that are refused.
+
+Tracing: ``shaders/bvh_probe.glsl`` runs one fragment per ray over a grid of
+rays (origins and directions uploaded as two more float textures; or, for
+:meth:`GpuBVH.trace_camera`, a camera's primary rays made in the shader as
+``shaders/raytrace.glsl`` makes them) and writes ``(t, index, u, v)`` and
+``(overflow, steps, any)`` into two float targets.
+
+Overflow: llvmpipe stops a shader invocation's loops after 65,535 iterations
+in all, silently. The GLSL traversal therefore bounds its one loop by
+``max_steps`` (:data:`MAX_STEPS`: node visits plus triangle tests per ray)
+and flags every ray that did not finish within it (or would have overflowed
+its stack). :class:`GpuHits` carries the flags; with ``strict=True`` (the
+default) :meth:`GpuBVH.trace` raises :class:`~glsandbox.raytrace.errors.RayTraceError`
+saying how many rays were cut off, rather than return hits that may be wrong.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import moderngl
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from glsandbox.gl.shaders import compile_program
+from glsandbox.plan import ProgramVariant
+from glsandbox.raytrace.base import broadcast_rays
+from glsandbox.raytrace.bvh import BVH
+from glsandbox.raytrace.errors import RayTraceError
+from glsandbox.raytrace.world import camera_basis
+from glsandbox.scene import Camera
+
+__all__ = ["EXACT_INTEGERS", "LOOP_LIMIT", "MAX_STEPS", "TEX_WIDTH", "GpuBVH", "GpuHits", "pack_bvh"]
+
+#: Texels per row of the node and triangle textures (``BVH_TEX_WIDTH`` in the shader).
+TEX_WIDTH: int = 4096
+#: Node visits plus triangle tests one ray may use (``BVH_MAX_STEPS``).
+MAX_STEPS: int = 8192
+#: llvmpipe's loop iterations per shader invocation, all loops together.
+LOOP_LIMIT: int = 65535
+#: Integers float32 holds exactly.
+EXACT_INTEGERS: int = 1 << 24
+#: Rays per row of the ray grid.
+RAY_ROW: int = 1024
+
+
+def _outward(values: NDArray[np.float64], down: bool) -> NDArray[np.float32]:
+    """``values`` as float32, rounded towards −inf (``down``) or +inf: a box stays around its triangles."""
+    rounded = values.astype(np.float32)
+    wrong = rounded > values if down else rounded < values
+    towards = np.float32(-np.inf if down else np.inf)
+    return np.where(wrong, np.nextafter(rounded, towards), rounded).astype(np.float32)
+
+
+def pack_bvh(bvh: BVH) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
+    """The node and triangle records of ``bvh`` as ``(texels, 4)`` float32 arrays (module docstring)."""
+    if bvh.node_total * 2 > EXACT_INTEGERS or bvh.triangle_count * 3 > EXACT_INTEGERS or \
+            bvh.input_count > EXACT_INTEGERS:
+        raise RayTraceError(f"the gpu BVH holds at most {EXACT_INTEGERS // 3:,} triangles and "
+                            f"{EXACT_INTEGERS // 2:,} nodes; this one has {bvh.triangle_count:,} and {bvh.node_total:,}")
+    nodes = np.zeros((bvh.node_total, 2, 4), dtype=np.float32)
+    tris = np.zeros((max(1, bvh.triangle_count), 3, 4), dtype=np.float32)
+    if bvh.empty:
+        # No triangles: a root leaf holding one zero-area triangle at the origin,
+        # which the watertight test never hits (det = 0).
+        nodes[0, 1, 3] = 1
+        return nodes.reshape(-1, 4), tris.reshape(-1, 4)
+    nodes[:, 0, :3] = _outward(bvh.node_min, down=True)
+    nodes[:, 1, :3] = _outward(bvh.node_max, down=False)
+    nodes[:, 0, 3] = bvh.node_first
+    nodes[:, 1, 3] = bvh.node_count
+    if bvh.triangle_count:
+        tris[:, 0, :3], tris[:, 1, :3], tris[:, 2, :3] = bvh.v0, bvh.v1, bvh.v2
+        tris[:, 0, 3] = bvh.tri_index
+    return nodes.reshape(-1, 4), tris.reshape(-1, 4)
+
+
+@dataclass
+class GpuHits:
+    """What the GLSL traversal found per ray (float32 results, as float64 arrays).
+
+    ``t`` is ``inf`` and ``triangle`` −1 for a miss; ``overflow`` marks rays
+    the traversal could not finish (their ``t``/``triangle`` are not to be
+    trusted); ``steps`` is the loop iterations each ray used.
+    """
+
+    t: NDArray[np.float64]
+    triangle: NDArray[np.int64]
+    u: NDArray[np.float64]
+    v: NDArray[np.float64]
+    overflow: NDArray[np.bool_]
+    steps: NDArray[np.int64]
+
+    @property
+    def hit(self) -> NDArray[np.bool_]:
+        result: NDArray[np.bool_] = self.triangle >= 0
+        return result
+
+    def check(self, max_steps: int = MAX_STEPS) -> None:
+        """Raise :class:`RayTraceError` if any ray was cut off by the loop bound."""
+        _check_overflow(self.overflow, max_steps)
+
+
+def _check_overflow(overflow: NDArray[np.bool_], max_steps: int) -> None:
+    count = int(np.count_nonzero(overflow))
+    if count:
+        raise RayTraceError(f"the gpu BVH traversal cut off {count:,} of {overflow.size:,} rays at its bound of "
+                            f"{max_steps:,} node visits and triangle tests per ray (llvmpipe ends a shader's loops "
+                            f"after {LOOP_LIMIT:,} iterations); their hits would be wrong")
+
+
+def _texture(ctx: moderngl.Context, rows: NDArray[np.float32], width: int) -> moderngl.Texture:
+    """``(n, 4)`` float32 records as a ``width``-wide RGBA32F texture (zero-padded)."""
+    height = max(1, math.ceil(rows.shape[0] / width))
+    data = np.zeros((height * width, 4), dtype=np.float32)
+    data[: rows.shape[0]] = rows
+    texture = ctx.texture((width, height), 4, data.tobytes(), dtype="f4")
+    texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+    return texture
+
+
+class GpuBVH:
+    """A BVH uploaded to ``ctx``, with the probe programs that trace rays through it."""
+
+    def __init__(self, ctx: moderngl.Context, bvh: BVH, *, max_steps: int = MAX_STEPS) -> None:
+        if int(max_steps) != max_steps or not 1 <= max_steps <= LOOP_LIMIT - 16:
+            raise RayTraceError(f"max_steps must be an integer in 1..{LOOP_LIMIT - 16}, got {max_steps!r}")
+        self.ctx = ctx
+        self.bvh = bvh
+        self.max_steps = int(max_steps)
+        nodes, tris = pack_bvh(bvh)
+        self._nodes = _texture(ctx, nodes, TEX_WIDTH)
+        self._tris = _texture(ctx, tris, TEX_WIDTH)
+        #: The shader's stack: the ordered traversal pushes at most one entry per level.
+        self.stack = max(2, bvh.depth + 1)
+        self._programs: dict[tuple[bool, bool], tuple[moderngl.Program, moderngl.VertexArray]] = {}
+        # A far point the padding rays of a grid start from, pointing away: they miss the root at once.
+        root_hi = np.where(np.isfinite(bvh.node_max[0]), bvh.node_max[0], 0.0)
+        self._away = root_hi + 1.0 + np.abs(root_hi)
+
+    def defines(self, any_hit: bool = False, camera: bool = False) -> tuple[tuple[str, str], ...]:
+        """The ``#define`` lines of the probe program (what an including shader sets too)."""
+        return (("BVH_TEX_WIDTH", str(TEX_WIDTH)), ("BVH_STACK", str(self.stack)),
+                ("BVH_MAX_STEPS", str(self.max_steps)), ("BVH_ANY", str(int(any_hit))),
+                ("BVH_CAMERA", str(int(camera))))
+
+    def _program(self, any_hit: bool, camera: bool = False) -> tuple[moderngl.Program, moderngl.VertexArray]:
+        key = (any_hit, camera)
+        if key not in self._programs:
+            program = compile_program(self.ctx, ProgramVariant("bvh_probe", self.defines(any_hit, camera)))
+            self._programs[key] = (program, self.ctx.vertex_array(program, []))
+        return self._programs[key]
+
+    def _draw(self, program: moderngl.Program, vao: moderngl.VertexArray, width: int, height: int,
+              rays: dict[str, moderngl.Texture]) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
+        """One fragment per ray over a ``width x height`` grid: the two result targets, row 0 first."""
+        outputs = [self.ctx.texture((width, height), 4, dtype="f4") for _ in range(2)]
+        fbo = self.ctx.framebuffer(color_attachments=outputs)
+        try:
+            textures = {"u_bvh_nodes": self._nodes, "u_bvh_tris": self._tris, **rays}
+            for unit, (name, texture) in enumerate(textures.items()):
+                texture.use(unit)
+                if name in program:
+                    program[name].value = unit
+            fbo.use()
+            fbo.viewport = (0, 0, width, height)
+            self.ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
+            vao.render(moderngl.TRIANGLE_STRIP, vertices=4)
+            hit = np.frombuffer(fbo.read(components=4, attachment=0, dtype="f4"), dtype=np.float32)
+            info = np.frombuffer(fbo.read(components=4, attachment=1, dtype="f4"), dtype=np.float32)
+        finally:
+            fbo.release()
+            for texture in outputs:
+                texture.release()
+        return hit.reshape(-1, 4), info.reshape(-1, 4)
+
+    def _run(self, origins: ArrayLike, directions: ArrayLike, t_max: ArrayLike, cull: bool, any_hit: bool
+             ) -> tuple[NDArray[np.float32], NDArray[np.float32], int]:
+        o, d = broadcast_rays(origins, directions)
+        n = d.shape[0]
+        limit = np.broadcast_to(np.asarray(t_max, dtype=np.float64), (n,))
+        width = max(1, min(RAY_ROW, n))
+        height = max(1, math.ceil(n / width))
+        total = width * height
+        rays_o = np.zeros((total, 4), dtype=np.float32)
+        rays_d = np.zeros((total, 4), dtype=np.float32)
+        rays_o[:n, :3], rays_o[:n, 3] = o, limit
+        rays_d[:n, :3], rays_d[:n, 3] = d, 1.0 if cull else 0.0
+        rays_o[n:, :3], rays_o[n:, 3] = self._away, 0.0
+        rays_d[n:, 0] = 1.0
+        program, vao = self._program(any_hit)
+        ray_o = self.ctx.texture((width, height), 4, rays_o.tobytes(), dtype="f4")
+        ray_d = self.ctx.texture((width, height), 4, rays_d.tobytes(), dtype="f4")
+        try:
+            for texture in (ray_o, ray_d):
+                texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            hit, info = self._draw(program, vao, width, height, {"u_ray_origins": ray_o, "u_ray_dirs": ray_d})
+        finally:
+            ray_o.release()
+            ray_d.release()
+        return hit[:n], info[:n], n
+
+    @staticmethod
+    def _hits(hit: NDArray[np.float32], info: NDArray[np.float32]) -> GpuHits:
+        index = np.rint(hit[:, 1]).astype(np.int64)
+        found = index >= 0
+        return GpuHits(np.where(found, hit[:, 0].astype(np.float64), np.inf), np.where(found, index, -1),
+                       np.where(found, hit[:, 2], 0.0).astype(np.float64),
+                       np.where(found, hit[:, 3], 0.0).astype(np.float64),
+                       info[:, 0] > 0.5, np.rint(info[:, 1]).astype(np.int64))
+
+    def trace_camera(self, camera: Camera, width: int, height: int, *, cull_backfaces: bool = False,
+                     strict: bool = True) -> GpuHits:
+        """The primary rays of ``camera`` at ``width x height``, made in the shader as
+        ``shaders/raytrace.glsl`` makes them, in the order of
+        :func:`~glsandbox.raytrace.world.camera_rays` (row 0 at the top)."""
+        eye, basis, half_w, half_h = camera_basis(camera, width / height)
+        program, vao = self._program(False, camera=True)
+        values = {"u_size": (float(width), float(height)), "u_eye": tuple(eye), "u_half": (half_w, half_h),
+                  "u_t_max": float("inf"), "u_cull": bool(cull_backfaces)}
+        for name, value in values.items():
+            if name in program:
+                program[name].value = value
+        program["u_basis"].write(np.asarray(basis, dtype="f4").T.tobytes())  # column-major
+        hit, info = self._draw(program, vao, width, height, {})
+        flip = np.arange(width * height).reshape(height, width)[::-1].reshape(-1)  # GL's row 0 is the bottom
+        result = self._hits(hit[flip], info[flip])
+        if strict:
+            result.check(self.max_steps)
+        return result
+
+    def trace(self, origins: ArrayLike, directions: ArrayLike, t_max: ArrayLike = np.inf, *,
+              cull_backfaces: bool = False, strict: bool = True) -> GpuHits:
+        """The nearest hit of each ray with ``0 < t < t_max``, traced by ``bvh.glsl`` in float32.
+
+        ``strict=True`` raises :class:`RayTraceError` when any ray was cut
+        off by the loop bound; ``strict=False`` returns its ``overflow`` flag instead.
+        """
+        hit, info, _ = self._run(origins, directions, t_max, bool(cull_backfaces), False)
+        result = self._hits(hit, info)
+        if strict:
+            result.check(self.max_steps)
+        return result
+
+    def any_hit(self, origins: ArrayLike, directions: ArrayLike, t_max: ArrayLike = 1.0, *,
+                cull_backfaces: bool = False, strict: bool = True) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
+        """``(blocked, overflow)``: whether anything lies at ``0 < t < t_max`` along each ray (shadow rays)."""
+        _, info, _ = self._run(origins, directions, t_max, bool(cull_backfaces), True)
+        overflow = info[:, 0] > 0.5
+        if strict:
+            _check_overflow(overflow, self.max_steps)
+        return info[:, 2] > 0.5, overflow
+
+    def release(self) -> None:
+        """Free the textures and programs (the context stays)."""
+        for program, vao in self._programs.values():
+            vao.release()
+            program.release()
+        self._programs.clear()
+        self._nodes.release()
+        self._tris.release()

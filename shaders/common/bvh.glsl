@@ -1,0 +1,263 @@
+// BVH traversal for a fragment (or compute) shader: the course's "Hızlandırma:
+// AABB" taken to its conclusion. #include it, then call bvh_closest() or
+// bvh_any(). The host side (glsandbox/raytrace/gpu_bvh.py) packs a
+// glsandbox.raytrace.bvh.BVH into two RGBA32F textures read with texelFetch,
+// texel i at (i % BVH_TEX_WIDTH, i / BVH_TEX_WIDTH):
+//
+//   u_bvh_nodes  2 texels per node i:  2i   = (box min xyz, first)
+//                                      2i+1 = (box max xyz, count)
+//                count == 0: an inner node, children first and first + 1;
+//                count >  0: a leaf of stored triangles first .. first+count-1.
+//                Boxes are rounded outwards to float32. Node 0 is the root.
+//   u_bvh_tris   3 texels per stored triangle k: 3k = (v0 xyz, caller's index),
+//                3k+1 = (v1 xyz, 0), 3k+2 = (v2 xyz, 0).
+// Integers are stored as floats: exact up to 2^24 (the host checks).
+//
+// Defines (with defaults): BVH_TEX_WIDTH (4096), BVH_STACK (64: at least
+// the tree's depth; the host sets it), BVH_MAX_STEPS (8192), BVH_PAD (2^-18).
+//
+// The loop budget. llvmpipe ends a shader invocation's loops after 65,535
+// iterations IN TOTAL, silently: sequential loops and nested loops share one
+// counter (measured: two loops of 40,000 ran 40,000 and 25,534). A ray that
+// needed more would just lose triangles. So the traversal is ONE loop whose
+// every iteration is one unit of work (visiting an inner node: its two
+// children's boxes; or testing one triangle of a leaf), bounded by
+// BVH_MAX_STEPS, far below the limit. A ray that reaches the bound (or
+// would overflow the stack) is not finished: the result says so
+// (BvhHit.overflow) and the host raises instead of using it. A shader that
+// traces several rays per invocation must keep the SUM of its loops' bounds
+// under 65,535 (e.g. BVH_MAX_STEPS 8192 leaves room for 7 traversals).
+//
+// Tie rule: the course's min_indis, as the numpy engine: the smallest t with
+// 0 < t < t_max wins; on an equal t the lower caller's triangle index wins.
+// So a box entered at exactly the best t is still opened (near <= best).
+//
+// The triangle test is the watertight one (Woop, Benthin & Wald 2013) in
+// float32, as glsandbox/raytrace/watertight.py does in float64: permute the
+// axes so d's largest component is z, shear so the ray is the +z axis, and
+// test the 2D edge functions. `precise` (GLSL 4.00) keeps the compiler from
+// fusing a*b - c*d into an fma, which would break the exact antisymmetry that
+// makes neighbouring triangles watertight; an edge function that rounds to 0
+// is recomputed in double (exact for float inputs) where doubles exist.
+
+#ifndef BVH_TEX_WIDTH
+#define BVH_TEX_WIDTH 4096
+#endif
+#ifndef BVH_STACK
+#define BVH_STACK 64
+#endif
+#ifndef BVH_MAX_STEPS
+#define BVH_MAX_STEPS 8192
+#endif
+#ifndef BVH_PAD
+#define BVH_PAD 3.814697265625e-06
+#endif
+#if __VERSION__ >= 400
+#define BVH_PRECISE precise
+#define BVH_DOUBLE_EDGES 1
+#else
+#define BVH_PRECISE
+#define BVH_DOUBLE_EDGES 0
+#endif
+
+uniform sampler2D u_bvh_nodes;
+uniform sampler2D u_bvh_tris;
+
+struct BvhHit {
+    float t;        // t_max (and index -1) for a miss
+    int index;      // the caller's triangle index, -1 for a miss
+    vec2 uv;        // barycentrics: P = V0 + u (V1 - V0) + v (V2 - V0)
+    bool overflow;  // the ray ran out of steps or stack: t and index are NOT to be trusted
+    int steps;      // loop iterations used
+};
+
+vec4 bvh_texel(sampler2D s, int i) {
+    return texelFetch(s, ivec2(i % BVH_TEX_WIDTH, i / BVH_TEX_WIDTH), 0);
+}
+
+// What the watertight test needs per ray (steps 1 and 2 of the paper).
+struct BvhRay {
+    vec3 o;
+    vec3 inv_d;     // for the slab test (zero components made tiny: no NaN)
+    mat3 m;         // permute then shear: m (V - O) = (x - sx z, y - sy z, sz z) on the axes kx, ky, kz
+    float pad;      // the ray's part of the box padding, BVH_PAD * max|o|
+};
+
+BvhRay bvh_ray(vec3 o, vec3 d) {
+    BvhRay r;
+    r.o = o;
+    vec3 ad = abs(d);
+    int kz = ad.x >= ad.y ? (ad.x >= ad.z ? 0 : 2) : (ad.y >= ad.z ? 1 : 2);
+    int kx = kz == 2 ? 0 : kz + 1;
+    int ky = kx == 2 ? 0 : kx + 1;
+    if (d[kz] < 0.0) { int k = kx; kx = ky; ky = k; }  // keep the winding
+    float sx = d[kx] / d[kz], sy = d[ky] / d[kz], sz = 1.0 / d[kz];
+    // The permutation and the shear as one matrix, made once per ray, so a
+    // triangle's corners need no per-lane vector indexing (slow on llvmpipe).
+    // Its rows pick x - sx z, y - sy z and sz z; a corner shared by two
+    // triangles still gets the same numbers in both, which is all the
+    // watertight argument needs of them.
+    vec3 ex = vec3(equal(ivec3(kx), ivec3(0, 1, 2)));
+    vec3 ey = vec3(equal(ivec3(ky), ivec3(0, 1, 2)));
+    vec3 ez = vec3(equal(ivec3(kz), ivec3(0, 1, 2)));
+    r.m = transpose(mat3(ex - sx * ez, ey - sy * ez, sz * ez));
+    vec3 safe = mix(d, mix(vec3(-1e-30), vec3(1e-30), greaterThanEqual(d, vec3(0.0))), lessThan(ad, vec3(1e-30)));
+    r.inv_d = 1.0 / safe;
+    r.pad = BVH_PAD * max(max(abs(o.x), abs(o.y)), abs(o.z));
+    return r;
+}
+
+// The slab test against node `node`'s box (Hızlandırma: AABB): the ray is in
+// the box between the largest entry and the smallest exit. `near` is the entry.
+bool bvh_box(BvhRay r, int node, float limit, out float near) {
+    vec3 lo = bvh_texel(u_bvh_nodes, 2 * node).xyz - r.pad;
+    vec3 hi = bvh_texel(u_bvh_nodes, 2 * node + 1).xyz + r.pad;
+    vec3 ta = (lo - r.o) * r.inv_d;
+    vec3 tb = (hi - r.o) * r.inv_d;
+    vec3 tn = min(ta, tb);
+    vec3 tf = max(ta, tb);
+    near = max(max(tn.x, tn.y), tn.z);
+    float far = min(min(tf.x, tf.y), tf.z);
+    return near <= far && far >= 0.0 && near <= limit;
+}
+
+// E(p, q) = px qy - py qx, recomputed exactly when it rounds to 0.
+float bvh_edge(float px, float py, float qx, float qy) {
+    BVH_PRECISE float e = px * qy - py * qx;
+#if BVH_DOUBLE_EDGES
+    if (e == 0.0) e = float(double(px) * double(qy) - double(py) * double(qx));
+#endif
+    return e;
+}
+
+// The watertight test against stored triangle k: t (or -1.0 for a miss),
+// the caller's index and the barycentrics.
+float bvh_triangle(BvhRay r, int k, bool cull, out int index, out vec2 uv) {
+    vec4 t0 = bvh_texel(u_bvh_tris, 3 * k);
+    index = int(t0.w);
+    vec3 a = r.m * (t0.xyz - r.o);  // (sheared x, sheared y, sz z) of each corner
+    vec3 b = r.m * (bvh_texel(u_bvh_tris, 3 * k + 1).xyz - r.o);
+    vec3 c = r.m * (bvh_texel(u_bvh_tris, 3 * k + 2).xyz - r.o);
+    float u = bvh_edge(c.x, c.y, b.x, b.y);  // the weight of V0
+    float v = bvh_edge(a.x, a.y, c.x, c.y);  // of V1
+    float w = bvh_edge(b.x, b.y, a.x, a.y);  // of V2
+    bool negative = u < 0.0 || v < 0.0 || w < 0.0;
+    bool positive = u > 0.0 || v > 0.0 || w > 0.0;
+    float det = u + v + w;
+    uv = vec2(v, w) / det;
+    if ((cull ? negative : (negative && positive)) || det == 0.0) return -1.0;
+    float t = (u * a.z + v * b.z + w * c.z) / det;
+    return t > 0.0 ? t : -1.0;
+}
+
+// The nearest hit with 0 < t < t_max: an ordered, stackful traversal (the
+// nearer child first, the other pushed with its entry distance so it can be
+// skipped once a nearer hit is known), one unit of work per loop iteration.
+BvhHit bvh_closest(vec3 o, vec3 d, float t_max, bool cull) {
+    BvhHit hit = BvhHit(t_max, -1, vec2(0.0), false, 0);
+    BvhRay r = bvh_ray(o, d);
+    int stack[BVH_STACK];
+    float stack_near[BVH_STACK];
+    int sp = 0;
+    float near;
+    int node = bvh_box(r, 0, t_max, near) ? 0 : -1;
+    int tri = 0;
+    int tri_end = 0;
+    bool finished = node < 0;
+    for (int step = 0; step < BVH_MAX_STEPS && !finished; ++step) {
+        hit.steps = step + 1;
+        if (tri < tri_end) {  // one triangle of the current leaf
+            int index;
+            vec2 uv;
+            float t = bvh_triangle(r, tri, cull, index, uv);
+            if (t > 0.0 && t < t_max && (t < hit.t || (t == hit.t && index < hit.index))) {
+                hit.t = t;
+                hit.index = index;
+                hit.uv = uv;
+            }
+            ++tri;
+            continue;
+        }
+        if (node < 0) {  // pop the next subtree still worth entering
+            if (sp == 0) { finished = true; continue; }
+            --sp;
+            if (stack_near[sp] <= hit.t) node = stack[sp];
+            continue;
+        }
+        vec4 lo = bvh_texel(u_bvh_nodes, 2 * node);
+        int count = int(bvh_texel(u_bvh_nodes, 2 * node + 1).w);
+        int first = int(lo.w);
+        if (count > 0) {  // a leaf: its triangles in the next iterations
+            tri = first;
+            tri_end = first + count;
+            node = -1;
+            continue;
+        }
+        float near_l, near_r;
+        bool hit_l = bvh_box(r, first, hit.t, near_l);
+        bool hit_r = bvh_box(r, first + 1, hit.t, near_r);
+        if (hit_l && hit_r) {
+            if (sp == BVH_STACK) { hit.overflow = true; break; }  // never drop a subtree silently
+            bool left_first = near_l <= near_r;
+            stack[sp] = left_first ? first + 1 : first;
+            stack_near[sp] = left_first ? near_r : near_l;
+            ++sp;
+            node = left_first ? first : first + 1;
+        } else {
+            node = hit_l ? first : (hit_r ? first + 1 : -1);
+        }
+    }
+    if (!finished) hit.overflow = true;
+    return hit;
+}
+
+// Whether anything is hit with 0 < t < t_max (a shadow ray): the same walk,
+// ending at the first hit. Unfinished rays set `overflow`.
+bool bvh_any(vec3 o, vec3 d, float t_max, bool cull, out bool overflow) {
+    BvhRay r = bvh_ray(o, d);
+    int stack[BVH_STACK];
+    int sp = 0;
+    float near;
+    int node = bvh_box(r, 0, t_max, near) ? 0 : -1;
+    int tri = 0;
+    int tri_end = 0;
+    bool finished = node < 0;
+    bool found = false;
+    overflow = false;
+    for (int step = 0; step < BVH_MAX_STEPS && !finished; ++step) {
+        if (tri < tri_end) {
+            int index;
+            vec2 uv;
+            float t = bvh_triangle(r, tri, cull, index, uv);
+            if (t > 0.0 && t < t_max) { found = true; finished = true; }
+            ++tri;
+            continue;
+        }
+        if (node < 0) {
+            if (sp == 0) { finished = true; continue; }
+            node = stack[--sp];
+            continue;
+        }
+        vec4 lo = bvh_texel(u_bvh_nodes, 2 * node);
+        int count = int(bvh_texel(u_bvh_nodes, 2 * node + 1).w);
+        int first = int(lo.w);
+        if (count > 0) {
+            tri = first;
+            tri_end = first + count;
+            node = -1;
+            continue;
+        }
+        float near_l, near_r;
+        bool hit_l = bvh_box(r, first, t_max, near_l);
+        bool hit_r = bvh_box(r, first + 1, t_max, near_r);
+        if (hit_l && hit_r) {
+            if (sp == BVH_STACK) { overflow = true; break; }
+            stack[sp++] = first + 1;
+            node = first;
+        } else {
+            node = hit_l ? first : (hit_r ? first + 1 : -1);
+        }
+    }
+    if (!finished) overflow = true;
+    return found;
+}

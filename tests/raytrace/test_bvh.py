@@ -1,0 +1,316 @@
+"""The BVH (course "Hızlandırma: AABB" taken to its conclusion): its structure, and
+hits identical to testing every triangle with the watertight test."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from glsandbox import geometry, meshgen
+from glsandbox.raytrace.bvh import (
+    BVH,
+    build_bvh,
+    bvh_for_mesh,
+    bvh_for_triangles,
+    clear_cache,
+    mesh_world_triangles,
+)
+from glsandbox.raytrace.bvh_traverse import any_hit, closest_hit, closest_hit_brute_force
+from glsandbox.raytrace.ray import Ray
+from glsandbox.raytrace.triangle import Triangle, _watertight
+from glsandbox.raytrace.watertight import nondegenerate, ray_setup, watertight_pairs
+
+
+def soup(seed: int, count: int, spread: float = 4.0, size: float = 0.6) -> tuple[np.ndarray, ...]:
+    """``count`` random triangles, some of them degenerate and some duplicated."""
+    rng = np.random.default_rng(seed)
+    a = rng.uniform(-spread, spread, (count, 3))
+    b = a + rng.normal(0.0, size, (count, 3))
+    c = a + rng.normal(0.0, size, (count, 3))
+    if count >= 6:
+        c[0] = b[0]  # a repeated corner: zero area
+        c[1] = a[1] + 2.0 * (b[1] - a[1])  # collinear: zero area
+        a[2], b[2], c[2] = a[3], b[3], c[3]  # a duplicate: a tie at every t
+    return a, b, c
+
+
+def rays(seed: int, count: int, spread: float = 6.0) -> tuple[np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(seed + 1000)
+    return rng.uniform(-spread, spread, (count, 3)), rng.normal(size=(count, 3))
+
+
+def assert_same_hits(got, want) -> None:
+    np.testing.assert_array_equal(got.triangle, want.triangle)
+    np.testing.assert_array_equal(got.t, want.t)
+    np.testing.assert_array_equal(got.u, want.u)
+    np.testing.assert_array_equal(got.v, want.v)
+
+
+# --- structure ------------------------------------------------------------------
+
+
+def check_structure(bvh: BVH, a: np.ndarray, b: np.ndarray, c: np.ndarray, leaf_size: int = 4) -> None:
+    ok = nondegenerate(a, b, c)
+    leaves = np.flatnonzero(bvh.node_count)
+    inner = np.flatnonzero(bvh.node_count == 0)
+    # Every non-degenerate triangle in exactly one leaf, no degenerate one anywhere.
+    slots = np.concatenate([np.arange(bvh.node_first[k], bvh.node_first[k] + bvh.node_count[k]) for k in leaves])
+    assert np.array_equal(np.sort(slots), np.arange(bvh.triangle_count))
+    assert np.array_equal(np.sort(bvh.tri_index), np.flatnonzero(ok))
+    assert bvh.node_count.max() <= leaf_size
+    np.testing.assert_array_equal(bvh.v0, a[bvh.tri_index])
+    np.testing.assert_array_equal(bvh.v1, b[bvh.tri_index])
+    np.testing.assert_array_equal(bvh.v2, c[bvh.tri_index])
+    # Leaf boxes are exactly their triangles' boxes.
+    for k in leaves:
+        part = slice(bvh.node_first[k], bvh.node_first[k] + bvh.node_count[k])
+        corners = np.concatenate([bvh.v0[part], bvh.v1[part], bvh.v2[part]])
+        np.testing.assert_array_equal(bvh.node_min[k], corners.min(axis=0))
+        np.testing.assert_array_equal(bvh.node_max[k], corners.max(axis=0))
+    # Inner nodes: two children after them, boxes inside, each node reached once.
+    left = bvh.node_first[inner]
+    assert np.all(left > inner) and np.all(left + 1 < bvh.node_total)
+    for child in (left, left + 1):
+        assert np.all(bvh.node_min[child] >= bvh.node_min[inner])
+        assert np.all(bvh.node_max[child] <= bvh.node_max[inner])
+    reached = np.concatenate([[0], left, left + 1])
+    assert np.array_equal(np.sort(reached), np.arange(bvh.node_total))
+    if ok.any():
+        np.testing.assert_array_equal(bvh.node_min[0], np.minimum(np.minimum(a[ok], b[ok]), c[ok]).min(axis=0))
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 10**6), count=st.integers(1, 400), leaf_size=st.integers(1, 6))
+def test_every_triangle_is_in_exactly_one_leaf_and_children_lie_inside_parents(seed: int, count: int,
+                                                                               leaf_size: int) -> None:
+    a, b, c = soup(seed, count)
+    bvh = build_bvh(a, b, c, leaf_size=leaf_size)
+    assert bvh.input_count == count
+    check_structure(bvh, a, b, c, leaf_size)
+
+
+def test_triangles_that_no_cut_separates_are_split_by_count() -> None:
+    # 50 copies of one triangle: every centroid in one point, no bin boundary between them.
+    tri = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+    a, b, c = (np.repeat(tri[i][None], 50, axis=0) for i in range(3))
+    bvh = build_bvh(a, b, c)
+    check_structure(bvh, a, b, c)
+    hits = closest_hit(bvh, (0.2, 0.2, 1.0), (0.0, 0.0, -1.0))
+    assert hits.triangle[0] == 0 and hits.t[0] == 1.0  # all 50 tie: the first wins
+
+
+def test_a_real_model_builds_a_shallow_tree_with_full_leaves() -> None:
+    a, b, c = mesh_world_triangles(meshgen.rock(5))
+    bvh = build_bvh(a, b, c)
+    check_structure(bvh, a, b, c)
+    assert bvh.triangle_count == 20480
+    assert bvh.depth <= 24
+    assert bvh.triangle_count / bvh.leaf_count > 2.5  # leaves mostly filled
+
+
+def test_no_triangles_or_only_degenerate_ones_give_an_empty_bvh_that_every_ray_misses() -> None:
+    for a, b, c in [(np.zeros((0, 3)),) * 3, (np.zeros((3, 3)), np.ones((3, 3)), np.ones((3, 3)))]:
+        bvh = build_bvh(a, b, c)
+        assert bvh.empty and bvh.triangle_count == 0
+        hits = closest_hit(bvh, np.zeros(3), np.array([[1.0, 1.0, 1.0]]))
+        assert hits.triangle[0] == -1 and hits.t[0] == np.inf
+        assert not any_hit(bvh, np.zeros(3), np.array([[1.0, 1.0, 1.0]]))[0]
+
+
+def test_bad_triangles_are_refused() -> None:
+    from glsandbox.errors import SandboxError
+
+    with pytest.raises(SandboxError, match="finite"):
+        build_bvh(np.array([[np.nan, 0, 0]]), np.ones((1, 3)), np.zeros((1, 3)))
+    with pytest.raises(SandboxError, match=r"\(M, 3\)"):
+        build_bvh(np.zeros((2, 2)), np.zeros((2, 2)), np.zeros((2, 2)))
+
+
+# --- the watertight kernel ------------------------------------------------------
+
+
+def test_the_vectorised_watertight_test_is_the_scalar_test_bit_for_bit() -> None:
+    a, b, c = soup(7, 40)
+    o, d = rays(7, 120)
+    d[:60] = a[np.arange(60) % 40] - o[:60]  # aimed at vertices: edge functions of exactly 0
+    d[60:80] = (b[np.arange(20)] + c[np.arange(20)]) / 2 - o[60:80]  # aimed at edge midpoints
+    setup = ray_setup(o, d)
+    rr = np.repeat(np.arange(len(o)), len(a))
+    tt = np.tile(np.arange(len(a)), len(o))
+    for cull in (False, True):
+        t, _, _ = watertight_pairs(setup, rr, a, b, c, tt, cull)
+        want = []
+        for r, k in zip(rr, tt):
+            hit = _watertight(Triangle(a[k], b[k], c[k]), Ray(o[r], d[r]), cull)
+            want.append(np.inf if hit is None else hit)
+        np.testing.assert_array_equal(t, np.array(want))
+
+
+def test_barycentrics_rebuild_the_hit_point() -> None:
+    a, b, c = soup(3, 200)
+    o, d = rays(3, 2000)
+    hits = closest_hit(build_bvh(a, b, c), o, d)
+    k = hits.triangle[hits.hit]
+    p = o[hits.hit] + hits.t[hits.hit, None] * d[hits.hit]
+    q = a[k] + hits.u[hits.hit, None] * (b[k] - a[k]) + hits.v[hits.hit, None] * (c[k] - a[k])
+    np.testing.assert_allclose(p, q, atol=1e-9)
+    assert np.all(hits.u[hits.hit] >= -1e-12) and np.all(hits.v[hits.hit] >= -1e-12)
+
+
+# --- hits: the BVH against every triangle ----------------------------------------
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 10**6), count=st.integers(1, 300), cull=st.booleans(), limited=st.booleans())
+def test_closest_hit_equals_brute_force(seed: int, count: int, cull: bool, limited: bool) -> None:
+    a, b, c = soup(seed, count)
+    o, d = rays(seed, 300)
+    d[:50] = a[np.arange(50) % count] - o[:50]  # some rays straight at vertices
+    t_max = np.random.default_rng(seed).uniform(0.2, 3.0, len(o)) if limited else np.inf
+    bvh = build_bvh(a, b, c)
+    want = closest_hit_brute_force(a, b, c, o, d, t_max, cull_backfaces=cull)
+    assert_same_hits(closest_hit(bvh, o, d, t_max, cull_backfaces=cull), want)
+    np.testing.assert_array_equal(any_hit(bvh, o, d, t_max, cull_backfaces=cull), want.hit)
+
+
+def test_shared_origin_rays_of_a_camera_on_a_real_model() -> None:
+    from glsandbox.raytrace.world import camera_rays
+    from glsandbox.scene import Camera
+
+    mesh = meshgen.terrain(24)
+    a, b, c = mesh_world_triangles(mesh)
+    eye, dirs = camera_rays(Camera(eye=(0.3, 1.0, 2.0)), 64, 48)
+    want = closest_hit_brute_force(a, b, c, eye, dirs)
+    got = closest_hit(build_bvh(a, b, c), eye, dirs)
+    assert_same_hits(got, want)
+    assert 0.2 < got.hit.mean() < 0.9
+
+
+def test_brute_force_keeps_the_first_minimum_and_the_scalar_t() -> None:
+    a, b, c = soup(11, 30)
+    o, d = rays(11, 40)
+    want = closest_hit_brute_force(a, b, c, o, d)
+    for i in range(len(o)):
+        ts = []
+        for k in range(len(a)):
+            tri = Triangle(a[k], b[k], c[k])
+            hit = None if tri.is_degenerate else _watertight(tri, Ray(o[i], d[i]), False)
+            ts.append(np.inf if hit is None else hit)
+        k = int(np.argmin(ts))
+        assert want.t[i] == ts[k] and want.triangle[i] == (k if np.isfinite(ts[k]) else -1)
+
+
+def test_on_equal_t_the_lower_triangle_index_wins_wherever_the_bvh_stores_it() -> None:
+    # A floor of 200 quads, then the same floor again in reverse order: every
+    # ray meets two coincident triangles at the same t. The copy with the lower
+    # index must win, as the course's min_indis loop keeps the first minimum.
+    mesh = meshgen.terrain(10, height=0.0)
+    a, b, c = mesh_world_triangles(mesh)
+    m = len(a)
+    a2, b2, c2 = (np.concatenate([x, x[::-1]]) for x in (a, b, c))
+    o = np.array([0.0, 5.0, 0.0])
+    xs = np.linspace(-0.9, 0.9, 23)
+    d = np.stack(np.meshgrid(xs, [-5.0], xs), axis=-1).reshape(-1, 3)
+    for first_half in (True, False):
+        order = np.arange(2 * m) if first_half else np.r_[m:2 * m, 0:m]
+        hits = closest_hit(build_bvh(a2[order], b2[order], c2[order]), o, d)
+        want = closest_hit_brute_force(a2[order], b2[order], c2[order], o, d)
+        assert_same_hits(hits, want)
+        assert hits.hit.all()
+        np.testing.assert_array_equal(hits.t, 1.0)
+        # The winner is the lower of the two indices holding that triangle.
+        original = order[hits.triangle]  # index in the floor, floor-reversed
+        floor = np.where(original < m, original, 2 * m - 1 - original)
+        position = np.argsort(order)  # where each of a2's triangles went
+        np.testing.assert_array_equal(hits.triangle, np.minimum(position[floor], position[2 * m - 1 - floor]))
+
+
+def test_backface_culling_skips_triangles_facing_away() -> None:
+    a, b, c = (np.array([p]) for p in ((0.0, 0, 0), (1.0, 0, 0), (0.0, 1, 0)))  # normal +z
+    bvh = build_bvh(a, b, c)
+    front = closest_hit(bvh, (0.2, 0.2, 1.0), (0.0, 0.0, -1.0), cull_backfaces=True)
+    back = closest_hit(bvh, (0.2, 0.2, -1.0), (0.0, 0.0, 1.0), cull_backfaces=True)
+    both = closest_hit(bvh, (0.2, 0.2, -1.0), (0.0, 0.0, 1.0), cull_backfaces=False)
+    assert front.triangle[0] == 0 and front.t[0] == 1.0
+    assert back.triangle[0] == -1
+    assert both.triangle[0] == 0 and both.t[0] == 1.0
+
+
+def test_any_hit_counts_only_what_lies_strictly_between() -> None:
+    a, b, c = (np.array([p]) for p in ((-1.0, -1, 0), (1.0, -1, 0), (0.0, 1, 0)))
+    bvh = build_bvh(a, b, c)
+    start = np.array([[0.0, 0.0, 2.0]] * 3)
+    light = np.array([[0.0, 0.0, -2.0], [0.0, 0.0, 0.0], [0.0, 0.0, 1.0]])  # beyond, on, before the triangle
+    blocked = any_hit(bvh, start, light - start, 1.0)
+    assert blocked.tolist() == [True, False, False]
+
+
+# --- watertight: rays aimed exactly at vertices and edges never escape ------------
+
+CLOSED = {"icosphere3": lambda: meshgen.icosphere(3), "rock3": lambda: meshgen.rock(3, seed=5),
+          "cube": geometry.cube}
+
+
+def edge_midpoints(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
+    return np.concatenate([(a + b) / 2, (b + c) / 2, (c + a) / 2])
+
+
+@pytest.mark.parametrize("name", CLOSED)
+def test_from_inside_a_closed_mesh_every_ray_at_a_vertex_or_an_edge_hits(name: str) -> None:
+    a, b, c = mesh_world_triangles(CLOSED[name]())
+    bvh = build_bvh(a, b, c)
+    targets = np.concatenate([a, b, c, edge_midpoints(a, b, c)])
+    for inside in ([0.0, 0.0, 0.0], [0.013, -0.021, 0.017], [0.3, 0.2, -0.25]):
+        o = np.array(inside)
+        assert closest_hit(bvh, o, targets - o).hit.all()
+        assert any_hit(bvh, o, 3.0 * (targets - o)).all()
+
+
+@pytest.mark.parametrize("name", CLOSED)
+def test_from_outside_rays_at_vertices_and_edges_inside_the_silhouette_hit(name: str) -> None:
+    # A ray at a vertex on the silhouette only grazes it (rounding decides);
+    # one at a vertex or edge whose faces all face the eye is inside the
+    # projected mesh, and must hit: no crack between two triangles lets it through.
+    a, b, c = mesh_world_triangles(CLOSED[name]())
+    bvh = build_bvh(a, b, c)
+    normal = np.cross(b - a, c - a)
+    for eye in ([3.0, 2.0, 4.0], [-4.0, 0.5, -0.25], [0.0, 0.0, 6.0]):
+        o = np.array(eye)
+        facing = np.einsum("ij,ij->i", normal, (a + b + c) / 3 - o) < 0.0
+        corners = np.concatenate([a, b, c])
+        facing3 = np.tile(facing, 3)
+        # A target counts when every face that touches it faces the eye.
+        points, inverse = np.unique(corners, axis=0, return_inverse=True)
+        all_front = np.ones(len(points), dtype=bool)
+        np.logical_and.at(all_front, inverse.reshape(-1), facing3)
+        mids = edge_midpoints(a, b, c)
+        mid_points, mid_inverse = np.unique(mids, axis=0, return_inverse=True)
+        mid_front = np.ones(len(mid_points), dtype=bool)
+        np.logical_and.at(mid_front, mid_inverse.reshape(-1), facing3)
+        targets = np.concatenate([points[all_front], mid_points[mid_front]])
+        assert len(targets) > 0
+        hits = closest_hit(bvh, o, targets - o)
+        assert hits.hit.all()
+        assert np.all(hits.t <= 1.0 + 1e-12)  # nothing behind the target point is taken
+        # Culled, the front faces still answer.
+        assert closest_hit(bvh, o, targets - o, cull_backfaces=True).hit.all()
+
+
+# --- the cache -----------------------------------------------------------------
+
+
+def test_the_cache_returns_the_same_bvh_for_the_same_content() -> None:
+    clear_cache()
+    mesh = meshgen.icosphere(2)
+    model = np.diag([2.0, 2.0, 2.0, 1.0])
+    first = bvh_for_mesh(mesh, model)
+    assert bvh_for_mesh(mesh, model.copy()) is first  # same mesh, same matrix values
+    assert bvh_for_mesh(mesh, np.eye(4)) is not first
+    a, b, c = mesh_world_triangles(mesh, model)
+    np.testing.assert_array_equal(first.v0, a[first.tri_index])
+    assert bvh_for_triangles(a, b, c) is bvh_for_triangles(a.copy(), b.copy(), c.copy())
+    for k in range(6):  # older entries leave the LRU
+        bvh_for_mesh(mesh, np.diag([1.0 + k, 1.0, 1.0, 1.0]))
+    assert bvh_for_mesh(mesh, model) is not first
