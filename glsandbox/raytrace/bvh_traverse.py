@@ -19,7 +19,7 @@ Rays are traced in blocks (:data:`RAY_BLOCK`) so a block's frontier stays
 small. Shadow rays (:func:`any_hit`) leave the frontier at their first hit.
 
 The nearest hit keeps the course's ``min_indis`` rule exactly as
-:func:`glsandbox.raytrace.render._nearest` does: the smallest ``t`` with
+:func:`glsandbox.raytrace.numpy_engine._nearest` does: the smallest ``t`` with
 ``0 < t < t_max`` wins, and on an equal ``t`` the lower triangle index (the
 caller's index, not the BVH's storage order) wins. The result is the same,
 bit for bit, as testing every triangle (:func:`closest_hit_brute_force`).

@@ -13,7 +13,7 @@ loop over nodes in scene order, each taking the rays whose box test passes
 (vectorised over the rays). A node's rays are traced with ``t_max`` equal to
 their best hit so far: strictly nearer hits replace it, so on an equal
 ``t`` the earlier node keeps it, and within a node the lower triangle: the
-same tie rule as :func:`glsandbox.raytrace.render._nearest`, by world
+same tie rule as :func:`glsandbox.raytrace.numpy_engine._nearest`, by world
 triangle index.
 
 Analytic spheres (``kind == "sphere"``) are not the BVH's business: this
