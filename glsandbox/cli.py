@@ -40,7 +40,7 @@ class ArgumentParser(argparse.ArgumentParser):
     """argparse with the project's error contract: one ``error:`` line, exit 2 (no usage dump)."""
 
     def error(self, message: str) -> NoReturn:
-        print(f"error: {self.prog}: {message} (see {self.prog} --help)", file=sys.stderr)
+        print(f"error: {SandboxError(f'{self.prog}: {message} (see {self.prog} --help)')}", file=sys.stderr)
         raise SystemExit(EXIT_USAGE)
 
 

@@ -82,3 +82,10 @@ def test_a_reader_that_stops_early_ends_the_command_quietly() -> None:
     command = f"{sys.executable} -m glsandbox.cli plan mirror | true"
     proc = subprocess.run(["bash", "-c", command], capture_output=True, text=True, cwd=REPO, timeout=60)
     assert proc.stderr == "", proc.stderr
+
+
+def test_control_characters_in_a_value_keep_the_message_on_one_line() -> None:
+    # "\x1e" (and "\r", "\u2028", ...) end a line for str.splitlines: the value is shown escaped.
+    proc = glsandbox("render", "indexed_cube", "--set", "time=0\x1e0", "--out", "x.png")
+    assert_user_error(proc, "--set time=0\\x1e0: expected a number")
+    assert_user_error(glsandbox("render", "cube\u2028x", "--out", "x.png"), "unknown lesson 'cube\\u2028x'")
