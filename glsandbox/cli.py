@@ -345,7 +345,8 @@ def lesson_main(lesson_cls: type[Lesson], argv: list[str] | None = None) -> int:
             frame = render_to_file(lesson, out, size, args.samples, args.backend)
             print(f"wrote {out} ({size[0]}x{size[1]}, {frame.seconds * 1000:.1f} ms)")
         else:
-            run_window(lesson, size, args.samples, args.backend)
+            run_window(lesson, size, args.samples, args.backend,
+                       instead=f"or render it headless: python -m lessons.{lesson_cls.name} --headless --out FILE.png")
         return 0
 
     return run_guarded(body)

@@ -3,6 +3,7 @@ traceback, never a half-written file or an empty folder left behind (issue 12)."
 
 from __future__ import annotations
 
+import ctypes.util
 import errno
 import os
 import subprocess
@@ -89,3 +90,44 @@ def test_control_characters_in_a_value_keep_the_message_on_one_line() -> None:
     proc = glsandbox("render", "indexed_cube", "--set", "time=0\x1e0", "--out", "x.png")
     assert_user_error(proc, "--set time=0\\x1e0: expected a number")
     assert_user_error(glsandbox("render", "cube\u2028x", "--out", "x.png"), "unknown lesson 'cube\\u2028x'")
+
+
+def test_an_osmesa_that_is_not_osmesa_is_one_line_naming_it(tmp_path: Path) -> None:
+    libc = ctypes.util.find_library("c")
+    text_file = tmp_path / "libOSMesa.so"
+    text_file.write_text("not a library\n")
+    out = tmp_path / "x.png"
+    cases = [(str(text_file), f"cannot load GLSANDBOX_OSMESA={text_file}")]
+    if libc:
+        cases.append((libc, f"GLSANDBOX_OSMESA={libc} is not an OSMesa library (it has no OSMesaCreateContextAttribs)"))
+    if hasattr(os, "mkfifo"):
+        os.mkfifo(tmp_path / "pipe.so")  # the dynamic loader would block reading it
+        cases.append((str(tmp_path / "pipe.so"), "is not a regular file"))
+    for value, fragment in cases:
+        proc = glsandbox("render", "triangle", "--backend", "osmesa", "--out", str(out),
+                         env={"GLSANDBOX_OSMESA": value})
+        assert_user_error(proc, "OSMesa backend unavailable", fragment)
+    assert not out.exists()
+
+
+def test_a_display_with_no_server_is_exactly_one_line() -> None:
+    # pyGLFW printed a GLFWError warning (two lines) before the error.
+    proc = glsandbox("run", "indexed_cube", env={"DISPLAY": ":77", "WAYLAND_DISPLAY": ""})
+    assert_user_error(proc, "':77'")
+    assert "GLFWError" not in proc.stderr and "warn" not in proc.stderr
+
+
+def test_no_display_errors_offer_what_the_command_can_do() -> None:
+    env = {"DISPLAY": "", "WAYLAND_DISPLAY": ""}
+    # render is headless already: it suggests a headless backend, not --headless.
+    proc = glsandbox("render", "indexed_cube", "--backend", "window", "--out", "x.png", env=env)
+    assert_user_error(proc, "no display", "--backend egl")
+    assert "--headless" not in proc.stderr
+    # run has no --headless either: it suggests glsandbox render.
+    proc = glsandbox("run", "indexed_cube", "--backend", "egl", env=env)
+    assert_user_error(proc, "glsandbox render indexed_cube --out FILE.png")
+    assert "--headless" not in proc.stderr
+    # A lesson module has --headless.
+    proc = subprocess.run([sys.executable, "-m", "lessons.triangle"], capture_output=True, text=True, cwd=REPO,
+                          env={**os.environ, **env}, timeout=60)
+    assert_user_error(proc, "python -m lessons.triangle --headless --out FILE.png")
