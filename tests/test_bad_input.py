@@ -85,6 +85,26 @@ def test_a_reader_that_stops_early_ends_the_command_quietly() -> None:
     assert proc.stderr == "", proc.stderr
 
 
+@pytest.mark.parametrize("renderer", ["raster", "ray", "ray_numpy"])
+def test_successful_renders_of_every_lesson_print_no_warning(tmp_path: Path, capsys, gl, renderer: str) -> None:
+    # RuntimeWarnings (numpy's overflow, invalid value, division by zero), Pillow's and glfw's
+    # warnings reach stderr beside the output: a successful run prints only its "wrote" line.
+    import warnings
+
+    from glsandbox.lesson import all_lessons
+
+    out = tmp_path / "x.png"
+    for cls in all_lessons():
+        for time in ("0", "1.7"):
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                status = cli.main(["render", cls.name, "--size", "32x24", "--set", f"renderer={renderer}",
+                                   "--set", f"time={time}", "--out", str(out)])
+            captured = capsys.readouterr()
+            assert status == 0 and captured.err == "", (cls.name, captured.err)
+            assert [str(w.message) for w in caught] == [], cls.name
+
+
 def test_control_characters_in_a_value_keep_the_message_on_one_line() -> None:
     # "\x1e" (and "\r", "\u2028", ...) end a line for str.splitlines: the value is shown escaped.
     proc = glsandbox("render", "indexed_cube", "--set", "time=0\x1e0", "--out", "x.png")
