@@ -38,7 +38,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from glsandbox.errors import SandboxError
+from glsandbox.errors import SandboxError, plain
 from glsandbox.scene import Camera, Scene
 
 #: One A/D press: the course's 15° turn.
@@ -142,7 +142,7 @@ class FlyCamera:
     def __post_init__(self) -> None:
         self.eye = np.asarray(self.eye, dtype=np.float64).reshape(3).copy()
         if not np.all(np.isfinite(self.eye)):
-            raise SandboxError(f"camera eye must be finite, got {tuple(self.eye)}")
+            raise SandboxError(f"camera eye must be finite, got {plain(self.eye)}")
         self.pitch = max(-MAX_PITCH, min(MAX_PITCH, float(self.pitch)))
 
     @classmethod
@@ -152,7 +152,7 @@ class FlyCamera:
         offset = np.asarray(camera.target, dtype=np.float64) - eye
         distance = float(np.linalg.norm(offset))
         if distance == 0.0:
-            raise SandboxError(f"camera eye and target are the same point {tuple(eye)}")
+            raise SandboxError(f"camera eye and target are the same point {plain(eye)}")
         f = offset / distance
         pitch = math.degrees(math.asin(max(-1.0, min(1.0, f[1]))))
         # forward = (-sin yaw cos pitch, ., -cos yaw cos pitch)

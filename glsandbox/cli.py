@@ -40,7 +40,7 @@ class ArgumentParser(argparse.ArgumentParser):
     """argparse with the project's error contract: one ``error:`` line, exit 2 (no usage dump)."""
 
     def error(self, message: str) -> NoReturn:
-        print(f"error: {self.prog}: {message} (see {self.prog} --help)", file=sys.stderr)
+        print(f"error: {SandboxError(f'{self.prog}: {message} (see {self.prog} --help)')}", file=sys.stderr)
         raise SystemExit(EXIT_USAGE)
 
 
@@ -345,7 +345,8 @@ def lesson_main(lesson_cls: type[Lesson], argv: list[str] | None = None) -> int:
             frame = render_to_file(lesson, out, size, args.samples, args.backend)
             print(f"wrote {out} ({size[0]}x{size[1]}, {frame.seconds * 1000:.1f} ms)")
         else:
-            run_window(lesson, size, args.samples, args.backend)
+            run_window(lesson, size, args.samples, args.backend,
+                       instead=f"or render it headless: python -m lessons.{lesson_cls.name} --headless --out FILE.png")
         return 0
 
     return run_guarded(body)

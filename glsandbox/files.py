@@ -1,4 +1,4 @@
-"""Reading and writing files: PNG images and text, written atomically.
+"""Reading and writing files: PNG images and text, written atomically; inputs opened only when regular.
 
 Every file glsandbox writes (rendered PNGs, goldens, the tour's JSON and
 gallery, reports, plots) goes through :func:`atomic_write`: the bytes go to a
@@ -6,12 +6,17 @@ temporary file in the target folder under a unique name, are flushed to disk
 and then moved over the target with :func:`os.replace`. A reader sees the old
 file or the complete new one, never half of one; two writers of the same name
 never share a temporary file; on any error the temporary file is removed.
+
+Every file glsandbox reads by a name the user gave (scene files, textures,
+shaders) is opened by :func:`open_regular`: a named pipe, a device or a
+folder is refused at once instead of blocking forever or failing later.
 """
 
 from __future__ import annotations
 
 import io
 import os
+import stat
 import tempfile
 import time
 from collections.abc import Callable
@@ -22,7 +27,8 @@ import numpy as np
 import numpy.typing as npt
 from PIL import Image
 
-__all__ = ["atomic_write", "load_png", "png_bytes", "save_png", "write_text"]
+__all__ = ["NotARegularFile", "atomic_write", "load_png", "open_regular", "png_bytes", "read_regular", "save_png",
+           "write_text"]
 
 
 #: A file name may have 255 bytes; ``mkstemp`` adds 8 random characters and the suffix.
@@ -88,6 +94,49 @@ def atomic_write(path: str | os.PathLike[str], data: bytes | Callable[[BinaryIO]
             pass
         raise
     return target
+
+
+class NotARegularFile(OSError):
+    """A path that names something other than a regular file: a named pipe, a device, a socket."""
+
+    def __init__(self, path: str | os.PathLike[str], kind: str) -> None:
+        super().__init__(f"{os.fspath(path)} is {kind}, not a regular file")
+        self.kind = kind
+
+
+_KINDS = ((stat.S_ISFIFO, "a named pipe (FIFO)"), (stat.S_ISSOCK, "a socket"), (stat.S_ISCHR, "a character device"),
+          (stat.S_ISBLK, "a block device"))
+
+
+def open_regular(path: str | os.PathLike[str]) -> BinaryIO:
+    """Open a regular file for reading (binary), refusing anything else.
+
+    The file is opened without blocking and checked on the open descriptor
+    (no window between a check and the open): a named pipe with no writer
+    would otherwise block the open, or the read, forever. Raises
+    :class:`FileNotFoundError`, :class:`IsADirectoryError`,
+    :class:`PermissionError`, :class:`NotARegularFile` or another
+    :class:`OSError`.
+    """
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
+    try:
+        mode = os.fstat(fd).st_mode
+        if stat.S_ISDIR(mode):
+            raise IsADirectoryError(21, "Is a directory", os.fspath(path))
+        if not stat.S_ISREG(mode):
+            raise NotARegularFile(path, next((kind for test, kind in _KINDS if test(mode)), "not a regular file"))
+        if hasattr(os, "set_blocking"):
+            os.set_blocking(fd, True)
+        return os.fdopen(fd, "rb")
+    except BaseException:
+        os.close(fd)
+        raise
+
+
+def read_regular(path: str | os.PathLike[str]) -> bytes:
+    """The bytes of a regular file (see :func:`open_regular`)."""
+    with open_regular(path) as handle:
+        return handle.read()
 
 
 def write_text(path: str | os.PathLike[str], text: str) -> Path:

@@ -14,12 +14,14 @@ a test can read back which level was sampled.
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont, UnidentifiedImageError
 
 from glsandbox.errors import SandboxError
+from glsandbox.files import NotARegularFile, open_regular
 from glsandbox.scene import BUILTIN_TEXTURES, Texture
 
 #: The colours of the four quadrants of the ``labels`` image, by the uv
@@ -121,31 +123,68 @@ def load_image(path: str | Path, max_size: int | None = None) -> np.ndarray:
     """Read an image file as RGBA ``uint8`` (row 0 at the top).
 
     Every failure is a one-line :class:`SandboxError` naming the file: not
-    found, a folder, unreadable, not an image or corrupt, or larger than
-    ``max_size`` on a side (checked from the header, before decoding).
+    found, a folder, a named pipe or device (refused before anything is read:
+    a pipe would block forever), unreadable, not an image or corrupt, larger
+    than ``max_size`` on a side (checked from the header, before decoding), or
+    more pixels than Pillow decodes safely (its decompression-bomb limit,
+    :data:`PIL.Image.MAX_IMAGE_PIXELS`: refused, not warned about). 16-bit
+    greyscale images are scaled to 8 bits (see :func:`to_rgba8`).
     """
     p = Path(path)
-    if not p.exists():
-        raise SandboxError(f"texture file {p} not found")
-    if p.is_dir():
-        raise SandboxError(f"texture file {p} is a folder, expected an image file")
     try:
-        with Image.open(p) as image:
-            width, height = image.size
-            if max_size is not None and max(width, height) > max_size:
-                raise SandboxError(f"texture file {p} is {width}x{height}, larger than this context "
-                                   f"allows ({max_size}x{max_size})")
-            rgba = np.asarray(image.convert("RGBA"), dtype=np.uint8)
+        handle = open_regular(p)
+    except FileNotFoundError:
+        raise SandboxError(f"texture file {p} not found") from None
+    except IsADirectoryError:
+        raise SandboxError(f"texture file {p} is a folder, expected an image file") from None
+    except NotARegularFile as exc:
+        raise SandboxError(f"texture file {p} is {exc.kind}, expected an image file") from None
+    except PermissionError:
+        raise SandboxError(f"texture file {p} is not readable (permission denied)") from None
+    except OSError as exc:
+        raise SandboxError(f"texture file {p} cannot be opened ({exc.strerror or exc})") from None
+    try:
+        with handle, warnings.catch_warnings():
+            # Pillow warns (on stderr) above MAX_IMAGE_PIXELS and refuses above twice that: refuse both.
+            warnings.simplefilter("error", Image.DecompressionBombWarning)
+            with Image.open(handle) as image:
+                width, height = image.size
+                if max_size is not None and max(width, height) > max_size:
+                    raise SandboxError(f"texture file {p} is {width}x{height}, larger than this context "
+                                       f"allows ({max_size}x{max_size})")
+                rgba = to_rgba8(image)
     except SandboxError:
         raise
     except UnidentifiedImageError:
         raise SandboxError(f"texture file {p} is not an image Pillow can read") from None
     except PermissionError:
         raise SandboxError(f"texture file {p} is not readable (permission denied)") from None
-    except Image.DecompressionBombError as exc:
-        raise SandboxError(f"texture file {p} is too large to decode safely ({exc})") from None
+    except (Image.DecompressionBombError, Image.DecompressionBombWarning) as exc:
+        raise SandboxError(f"texture file {p} is too large to decode safely ({' '.join(str(exc).split())})") from None
     except (OSError, SyntaxError, ValueError) as exc:  # truncated or corrupt data
         raise SandboxError(f"texture file {p} is corrupt or unreadable ({' '.join(str(exc).split())})") from None
     if rgba.ndim != 3 or rgba.shape[0] == 0 or rgba.shape[1] == 0:
         raise SandboxError(f"texture file {p} has no pixels")
     return np.ascontiguousarray(rgba)
+
+
+#: Pillow's modes of 16-bit greyscale samples (a 16-bit greyscale PNG opens as
+#: ``I;16``) and of 32-bit integer ones (``I``), which PNG and TIFF readers
+#: also use for 16-bit greyscale.
+_WIDE_GREY = ("I;16", "I;16L", "I;16B", "I;16N", "I")
+
+
+def to_rgba8(image: Image.Image) -> np.ndarray:
+    """An open image as RGBA ``uint8``.
+
+    Pillow's own ``convert("RGBA")`` clips 16-bit greyscale to 0..255 (a
+    full-range ramp comes out 99.6% white); here its samples are scaled,
+    ``round(v * 255 / 65535)``, so 0 stays black and 65535 becomes 255 (``I``
+    samples are taken as 16-bit, clipped to 0..65535). Pillow already reduces
+    16-bit RGB, RGBA and greyscale-with-alpha to 8 bits itself.
+    """
+    if image.mode in _WIDE_GREY:
+        wide = np.clip(np.asarray(image, dtype=np.int64), 0, 65535)
+        grey = ((wide * 255 + 32767) // 65535).astype(np.uint8)
+        return np.ascontiguousarray(np.stack([grey, grey, grey, np.full_like(grey, 255)], axis=-1))
+    return np.asarray(image.convert("RGBA"), dtype=np.uint8)

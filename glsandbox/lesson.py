@@ -18,14 +18,13 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, ClassVar
 
-from glsandbox.errors import SandboxError
+from glsandbox.errors import NUMBER_LIMIT, SandboxError
 from glsandbox.scene import RENDERERS
 from glsandbox.scene import PLAN_MODES, Scene
 from glsandbox.scene_file import load_scene
 
-
-#: The largest magnitude a number parameter takes unless it says otherwise.
-NUMBER_LIMIT = 1e6
+# NUMBER_LIMIT (glsandbox.errors) is the largest magnitude a number parameter
+# takes unless it says otherwise: the same bound the scene's dataclasses keep.
 
 
 @dataclass(frozen=True)

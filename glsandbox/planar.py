@@ -16,9 +16,18 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from glsandbox import transforms
-from glsandbox.errors import SandboxError
+from glsandbox.errors import NUMBER_LIMIT, SandboxError, check_number, check_numbers, plain
 
 Color = tuple[float, float, float, float]
+
+
+def _bounded_plane(plane: tuple[float, ...], what: str) -> tuple[float, ...]:
+    """The plane normalized (:func:`glsandbox.transforms.normalize_plane`), its distance
+    from the origin within the scene's bound."""
+    normalized = tuple(float(v) for v in transforms.normalize_plane(plane))
+    check_number(normalized[3], f"{what} plane's distance from the origin (d of the normalized plane)")
+    return normalized
+
 
 @dataclass(frozen=True)
 class Mirror:
@@ -40,7 +49,7 @@ class Mirror:
 
     def __post_init__(self) -> None:
         # Normalized once here, so the plan and the executor see the same numbers.
-        object.__setattr__(self, "plane", tuple(float(v) for v in transforms.normalize_plane(self.plane)))
+        object.__setattr__(self, "plane", _bounded_plane(self.plane, "mirror"))
         if self.node in self.reflected:
             raise SandboxError(f"mirror node {self.node!r} cannot reflect itself")
 
@@ -74,12 +83,12 @@ class PlanarShadow:
     color: Color = (0.0, 0.0, 0.0, 0.5)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "plane", tuple(float(v) for v in transforms.normalize_plane(self.plane)))
+        object.__setattr__(self, "plane", _bounded_plane(self.plane, "shadow"))
+        check_numbers(self.light, "shadow light", (4,))  # a point light within the scene's bound
         object.__setattr__(self, "light", tuple(float(v) for v in transforms.light_vector(self.light)))
-        if not math.isfinite(self.lift) or self.lift < 0.0:
-            raise SandboxError(f"shadow lift must be a finite number >= 0, got {self.lift!r}")
-        if any(not 0.0 <= c <= 1.0 for c in self.color) or len(self.color) != 4:
-            raise SandboxError(f"shadow colour must be four numbers in 0..1, got {self.color!r}")
+        if not (isinstance(self.lift, (int, float)) and math.isfinite(self.lift) and 0.0 <= self.lift <= NUMBER_LIMIT):
+            raise SandboxError(f"shadow lift must be a finite number >= 0, got {plain(self.lift)}")
+        object.__setattr__(self, "color", check_numbers(self.color, "shadow colour", (4,), low=0.0, high=1.0))
 
     @property
     def height(self) -> float:

@@ -16,7 +16,7 @@ import numpy as np
 
 from glsandbox import transforms
 from glsandbox.planar import Mirror, PlanarShadow
-from glsandbox.errors import SandboxError
+from glsandbox.errors import NUMBER_LIMIT, SandboxError, check_number, check_numbers, plain
 from glsandbox.geometry import Mesh
 from glsandbox.overlay import Overlay
 
@@ -65,6 +65,23 @@ DEPTH_MODES = ("standard", "reverse_z")
 BUILTIN_TEXTURES = ("checker", "labels", "mip_levels")
 
 
+# --- the checks values pass on their way in ------------------------------------
+# Lessons and scene files build the same dataclasses, so their numbers are
+# checked here, once, in __post_init__ (glsandbox.errors.check_numbers): finite,
+# within +-NUMBER_LIMIT, colours within 0..1, so that neither renderer meets a
+# NaN or an overflow it would turn into a silent miss.
+
+#: The least a lit node's model may scale any direction by: its normal matrix,
+#: the inverse, then stays within +-NUMBER_LIMIT (a flatter node has no
+#: normals a renderer can use; the ray tracer traces such a node's triangles
+#: with their face normals).
+MIN_SCALE = 1.0 / NUMBER_LIMIT
+
+
+def _set(obj: object, name: str, value: object) -> None:
+    object.__setattr__(obj, name, value)  # a frozen dataclass normalizing its own field
+
+
 @dataclass(frozen=True)
 class Camera:
     """A perspective camera. Defaults are the course's: eye (0,3,-10) in
@@ -78,6 +95,19 @@ class Camera:
     near: float = 0.01
     far: float = 100.0
 
+    def __post_init__(self) -> None:
+        for name in ("eye", "target", "up"):
+            _set(self, name, check_numbers(getattr(self, name), f"camera {name}"))
+        _set(self, "fov_y", check_number(self.fov_y, "camera fov_y"))
+        if not 0.0 < self.fov_y < 180.0:
+            raise SandboxError(f"camera fov_y must lie strictly between 0 and 180 degrees, got {plain(self.fov_y)}")
+        _set(self, "near", check_number(self.near, "camera near"))
+        _set(self, "far", check_number(self.far, "camera far"))
+        if not 0.0 < self.near < self.far:
+            raise SandboxError(f"camera near and far need 0 < near < far, got near={plain(self.near)}, "
+                               f"far={plain(self.far)}")
+        self.view()  # eye on the target, or up along the view: refused with the reason
+
     def view(self) -> np.ndarray:
         return transforms.look_at(self.eye, self.target, self.up)
 
@@ -90,7 +120,12 @@ class Light:
     """A point light."""
 
     position: tuple[float, float, float]
+    #: Its colour (intensity per channel, >= 0; above 1 is a brighter light).
     color: tuple[float, float, float] = (1.0, 1.0, 1.0)
+
+    def __post_init__(self) -> None:
+        _set(self, "position", check_numbers(self.position, "light position"))
+        _set(self, "color", check_numbers(self.color, "light colour", low=0.0))
 
 
 #: Digests of in-memory texture images by array identity (the arrays are read-only), so that
@@ -181,16 +216,19 @@ class Material:
     reflectivity: float = 0.0
 
     def __post_init__(self) -> None:
-        if not (math.isfinite(self.reflectivity) and 0.0 <= self.reflectivity <= 1.0):
-            raise SandboxError(f"material reflectivity must lie in 0..1, got {self.reflectivity!r}")
+        _set(self, "color", check_numbers(self.color, "material colour", (4,), low=0.0, high=1.0))
+        if not (isinstance(self.reflectivity, (int, float)) and math.isfinite(self.reflectivity)
+                and 0.0 <= self.reflectivity <= 1.0):
+            raise SandboxError(f"material reflectivity must lie in 0..1, got {plain(self.reflectivity)}")
         if self.shading not in SHADINGS:
             raise SandboxError(f"unknown shading {self.shading!r}; use one of {', '.join(SHADINGS)}")
         if self.normals not in NORMAL_MODES:
             raise SandboxError(f"unknown normals {self.normals!r}; use one of {', '.join(NORMAL_MODES)}")
         for name in ("ambient", "diffuse", "specular", "shininess"):
             value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0.0):
-                raise SandboxError(f"material {name} must be a finite number >= 0, got {value!r}")
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and 0.0 <= value <= NUMBER_LIMIT):
+                raise SandboxError(f"material {name} must be a finite number in 0..{NUMBER_LIMIT:g}, "
+                                   f"got {plain(value)}")
 
     @property
     def lit(self) -> bool:
@@ -212,6 +250,33 @@ class Node:
     material: Material = Material()
     cull_back_faces: bool = True
     viewports: tuple[int, ...] | None = None
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str):
+            raise SandboxError(f"a node's name must be text, got {plain(self.name)}")
+        model = np.asarray(self.model)
+        if model.shape != (4, 4) or not np.issubdtype(model.dtype, np.number):
+            raise SandboxError(f"node {self.name!r}: model matrix must be 4x4 numbers, got {plain(self.model)}")
+        if not np.all(np.isfinite(model)):
+            raise SandboxError(f"node {self.name!r}: model matrix has a non-finite entry: {plain(model)}")
+        if np.max(np.abs(model)) > NUMBER_LIMIT:
+            raise SandboxError(f"node {self.name!r}: model matrix entry {plain(np.max(np.abs(model)))} is beyond "
+                               f"+-{NUMBER_LIMIT:g} (scale and position within +-{NUMBER_LIMIT:g})")
+        # What the material reads from the mesh (the renderers would fail later, naming no node).
+        # Normals are not among them: a lit mesh without normals is shaded flat by both
+        # renderers (glsandbox.geometry.with_face_normals).
+        for needed, data, attribute in (("a texture", self.material.texture is not None, "uvs"),
+                                        ("vertex_color shading", self.material.shading == "vertex_color", "colors")):
+            if data and getattr(self.mesh, attribute, None) is None:
+                raise SandboxError(f"node {self.name!r}: mesh {self.mesh.name!r} has no {attribute[:-1]} data, "
+                                   f"which {needed} needs")
+        if self.material.lit:
+            smallest = transforms.smallest_scale(model)
+            if smallest < MIN_SCALE:
+                what = ("is singular (a scale of 0?)" if smallest == 0.0 else
+                        f"shrinks one direction to {smallest:.3g}, below {MIN_SCALE:g}")
+                raise SandboxError(f"node {self.name!r}: model matrix {what}, so a lit node has no usable normals; "
+                                   f"scale every axis by at least {MIN_SCALE:g}, or use an unlit shading")
 
     def shown_in(self, viewport: int) -> bool:
         """Whether the node is drawn in viewport ``viewport`` (by index)."""
@@ -238,6 +303,15 @@ class Viewport:
     def __post_init__(self) -> None:
         if self.renderer not in RENDERERS:
             raise SandboxError(f"unknown renderer {self.renderer!r}; use one of {', '.join(RENDERERS)}")
+        rect = check_numbers(self.rect, "viewport rect", (4,), low=0.0, high=1.0)
+        x, y, w, h = rect
+        if w <= 0.0 or h <= 0.0 or x + w > 1.0 + 1e-9 or y + h > 1.0 + 1e-9:
+            raise SandboxError(f"viewport rect {plain(rect)} must lie inside 0..1 with positive size")
+        _set(self, "rect", rect)
+        if self.clear_color is not None:
+            _set(self, "clear_color", check_numbers(self.clear_color, "viewport clear colour", (4,), 0.0, 1.0))
+        if self.camera is not None and not isinstance(self.camera, Camera):
+            raise SandboxError(f"viewport camera must be a Camera, got {plain(self.camera)}")
 
     def pixels(self, width: int, height: int) -> tuple[int, int, int, int]:
         """(x, y, w, h) in pixels; edges are rounded so tiles meet without gaps."""
@@ -273,6 +347,7 @@ class Scene:
     plan_mode: str = "needed"
 
     def __post_init__(self) -> None:
+        _set(self, "clear_color", check_numbers(self.clear_color, "scene clear colour", (4,), 0.0, 1.0))
         if self.depth_mode not in DEPTH_MODES:
             raise SandboxError(f"unknown depth mode {self.depth_mode!r}; use one of {', '.join(DEPTH_MODES)}")
         if self.plan_mode not in PLAN_MODES:

@@ -5,7 +5,18 @@ The format is the README's "Scene files" section: top-level ``name``,
 ``[[nodes]]``, ``[[lights]]`` and ``[[viewports]]`` arrays, and the optional
 ``[mirror]`` and ``[shadow]`` tables that tie the planar effects to nodes by
 name. Every value is checked here; a mistake is one :class:`SandboxError`
-naming the file, the line and the key (``scene.toml:7: nodes[0].mesh: ...``).
+naming the file, the line and the key (``scene.toml:7: nodes[0].mesh: ...``),
+once: a value of the wrong type (a number where a table, list or text is
+expected), a number that is not finite or lies beyond
+:data:`~glsandbox.errors.NUMBER_LIMIT`, and what the scene's dataclasses
+refuse (:mod:`glsandbox.scene`) are all reported that way.
+
+The ``[shadow]`` light must be one of the scene's ``[[lights]]`` (a point
+light at its position, or a directional light pointing at it from the
+origin, the mirror lesson's far light): the raster shadow is cast along it
+and the shading and the ray tracer use the lights, so a light of its own
+would make the two disagree. With exactly one light, ``light`` may be left
+out: the shadow is cast from that light.
 """
 
 from __future__ import annotations
@@ -17,8 +28,11 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from glsandbox import transforms
-from glsandbox.errors import SandboxError
+from glsandbox.errors import NUMBER_LIMIT, SandboxError, plain
+from glsandbox.files import NotARegularFile, read_regular
 from glsandbox.geometry import builtin_mesh
 from glsandbox.meshfile import CREASE_ANGLE, NORMALS as MESH_NORMALS, Model, is_model_path, load_model
 from glsandbox.planar import Mirror, PlanarShadow
@@ -40,7 +54,8 @@ class _Locator:
     """
 
     _header = re.compile(r"^\s*(\[\[?)\s*([A-Za-z0-9_.\-]+)\s*\]\]?")
-    _key = re.compile(r"^\s*([A-Za-z0-9_\-]+)\s*=")
+    # ``key =`` or a dotted ``key.sub =`` (its first part is the key of this table).
+    _key = re.compile(r"^\s*([A-Za-z0-9_\-]+)\s*(?:\.\s*[A-Za-z0-9_\-]+\s*)*=")
 
     def __init__(self, text: str) -> None:
         self.lines: dict[tuple[str, int, str], int] = {}
@@ -60,9 +75,19 @@ class _Locator:
                 self.lines.setdefault((table, index, m.group(1)), number)
 
     def line(self, table: str, index: int, key: str | None) -> int | None:
+        """The line of ``key`` in ``table`` (element ``index`` of an array of
+        tables), else of the table's header, else of ``table = ...`` written
+        as a key of the top level (an inline table or array, a dotted key)."""
         if key is not None and (table, index, key) in self.lines:
             return self.lines[(table, index, key)]
-        return self.tables.get((table, index))
+        if (table, index) in self.tables:
+            return self.tables[(table, index)]
+        return self.lines.get(("", 0, table)) if table else None
+
+
+def _guess_key(message: str, keys: tuple[str, ...]) -> str | None:
+    """The key a dataclass's message is about (it names the field), if any."""
+    return next((k for k in keys if k in message), None)
 
 
 class _SceneReader:
@@ -71,6 +96,19 @@ class _SceneReader:
     def __init__(self, path: Path, text: str) -> None:
         self.path = path
         self.where = _Locator(text)
+
+    def table(self, value: Any, table: str, index: int = 0) -> dict[str, Any]:
+        """``value``, which must be a table (``[table]``, an element of ``[[table]]``, or ``{...}``)."""
+        if not isinstance(value, dict):
+            shape = f"[[{table}]]" if table in ("nodes", "lights", "viewports") else f"[{table}]"
+            raise self.fail(table, index, None, f"expected a table ({shape} or {{ ... }}), got {plain(value)}")
+        return value
+
+    def text(self, data: dict[str, Any], key: str, table: str, index: int = 0, default: str = "") -> str:
+        value = data.get(key, default)
+        if not isinstance(value, str):
+            raise self.fail(table, index, key, f"expected text (a quoted string), got {plain(value)}")
+        return value
 
     def fail(self, table: str, index: int, key: str | None, message: str) -> SandboxError:
         line = self.where.line(table, index, key)
@@ -93,20 +131,22 @@ class _SceneReader:
             isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value)
         if not ok:
             want = " or ".join(str(c) for c in count)
-            raise self.fail(table, index, key, f"expected a list of {want} finite numbers, got {value!r}")
+            raise self.fail(table, index, key, f"expected a list of {want} finite numbers, got {plain(value)}")
+        if any(abs(v) > NUMBER_LIMIT for v in value):
+            raise self.fail(table, index, key, f"numbers must lie within +-{NUMBER_LIMIT:g}, got {plain(value)}")
         return tuple(float(v) for v in value)
 
     def flag(self, data: dict[str, Any], key: str, table: str, index: int = 0, default: bool = True) -> bool:
         value = data.get(key, default)
         if not isinstance(value, bool):
-            raise self.fail(table, index, key, f"expected true or false, got {value!r}")
+            raise self.fail(table, index, key, f"expected true or false, got {plain(value)}")
         return value
 
     def names(self, data: dict[str, Any], key: str, table: str, known: set[str]) -> tuple[str, ...]:
         """A list of node names, each one a node of the file."""
         value = data.get(key)
         if not (isinstance(value, list) and all(isinstance(v, str) for v in value)):
-            raise self.fail(table, 0, key, f"expected a list of node names, got {value!r}")
+            raise self.fail(table, 0, key, f"expected a list of node names, got {plain(value)}")
         for name in value:
             if name not in known:
                 raise self.fail(table, 0, key, f"no node is named {name!r} (nodes: {', '.join(sorted(known))})")
@@ -124,7 +164,9 @@ class _SceneReader:
             return default
         value = data[key]
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            raise self.fail(table, index, key, f"expected a finite number, got {value!r}")
+            raise self.fail(table, index, key, f"expected a finite number, got {plain(value)}")
+        if abs(value) > NUMBER_LIMIT:
+            raise self.fail(table, index, key, f"must lie within +-{NUMBER_LIMIT:g}, got {plain(value)}")
         return float(value)
 
     def color(self, data: dict[str, Any], key: str, table: str, index: int = 0,
@@ -133,28 +175,29 @@ class _SceneReader:
         if rgba is None:
             return default
         if any(not 0.0 <= c <= 1.0 for c in rgba):
-            raise self.fail(table, index, key, f"colour channels must lie in 0..1, got {list(rgba)}")
+            raise self.fail(table, index, key, f"colour channels must lie in 0..1, got {plain(list(rgba))}")
         return (*rgba, 1.0) if len(rgba) == 3 else rgba  # type: ignore[return-value]
 
-    def camera(self, data: dict[str, Any]) -> Camera:
+    def camera(self, data: Any) -> Camera:
+        data = self.table(data, "camera")
         self.check_keys(data, {"eye", "target", "up", "fov_y", "near", "far"}, "camera")
         base = Camera()
-        cam = Camera(
-            eye=self.numbers(data, "eye", (3,), "camera", default=base.eye),  # type: ignore[arg-type]
-            target=self.numbers(data, "target", (3,), "camera", default=base.target),  # type: ignore[arg-type]
-            up=self.numbers(data, "up", (3,), "camera", default=base.up),  # type: ignore[arg-type]
-            fov_y=self.number(data, "fov_y", "camera", default=base.fov_y),  # type: ignore[arg-type]
-            near=self.number(data, "near", "camera", default=base.near),  # type: ignore[arg-type]
-            far=self.number(data, "far", "camera", default=base.far),  # type: ignore[arg-type]
+        values = dict(
+            eye=self.numbers(data, "eye", (3,), "camera", default=base.eye),
+            target=self.numbers(data, "target", (3,), "camera", default=base.target),
+            up=self.numbers(data, "up", (3,), "camera", default=base.up),
+            fov_y=self.number(data, "fov_y", "camera", default=base.fov_y),
+            near=self.number(data, "near", "camera", default=base.near),
+            far=self.number(data, "far", "camera", default=base.far),
         )
-        try:  # build both matrices once so a degenerate camera is reported here
-            cam.view()
-            cam.projection(1.0)
+        try:  # Camera checks the lens and builds the view once: a degenerate camera is reported here
+            return Camera(**values)  # type: ignore[arg-type]
         except SandboxError as exc:
-            raise self.fail("camera", 0, None, str(exc)) from None
-        return cam
+            key = _guess_key(str(exc).split(":")[0], ("fov_y", "near", "far"))
+            raise self.fail("camera", 0, key, str(exc)) from None
 
-    def node(self, data: dict[str, Any], i: int) -> Node:
+    def node(self, data: Any, i: int) -> Node:
+        data = self.table(data, "nodes", i)
         allowed = {"name", "mesh", "order", "scale", "translate", "rotate", "color", "shading",
                    "cull_back_faces", "viewports", *_MATERIAL_NUMBERS, "normals", "texture", "filter", "wrap",
                    *_MODEL_FILE_KEYS}
@@ -167,9 +210,9 @@ class _SceneReader:
             mesh = loaded.mesh if loaded is not None else builtin_mesh(mesh_name)
         except SandboxError as exc:
             raise self.fail("nodes", i, "mesh", str(exc)) from None
-        order = data.get("order", "STR")
+        order = self.text(data, "order", "nodes", i, default="STR")
         try:
-            order = transforms.parse_order(order) if isinstance(order, str) else transforms.parse_order(repr(order))
+            order = transforms.parse_order(order)
         except SandboxError as exc:
             raise self.fail("nodes", i, "order", str(exc)) from None
         s = self.numbers(data, "scale", (3,), "nodes", i, default=(1.0, 1.0, 1.0))
@@ -179,24 +222,31 @@ class _SceneReader:
         rx, ry, rz = (math.radians(a) for a in r)
         rotation = transforms.rotate_z(rz) @ transforms.rotate_y(ry) @ transforms.rotate_x(rx)
         model = transforms.compose(order, S=transforms.scale(*s), T=transforms.translate(*t), R=rotation)
-        shading = data.get("shading", "vertex_color" if mesh.colors is not None else "solid")
+        shading = self.text(data, "shading", "nodes", i, default="vertex_color" if mesh.colors is not None else "solid")
         if shading not in SHADINGS:
             raise self.fail("nodes", i, "shading", f"unknown shading {shading!r}; use one of {', '.join(SHADINGS)}")
         if shading == "vertex_color" and mesh.colors is None:
             raise self.fail("nodes", i, "shading", f"mesh {mesh_name!r} has no vertex colours")
         cull = self.flag(data, "cull_back_faces", "nodes", i)
         views = data.get("viewports")
-        if views is not None and not (isinstance(views, list) and all(isinstance(v, int) for v in views)):
-            raise self.fail("nodes", i, "viewports", f"expected a list of viewport indices, got {views!r}")
-        return Node(
-            name=str(data.get("name", f"node{i}")),
-            mesh=mesh,
-            model=model,
-            material=self.material(data, i, shading) if loaded is None else self.model_material(data, i, shading,
-                                                                                                 loaded),
-            cull_back_faces=cull,
-            viewports=tuple(views) if views is not None else None,
-        )
+        if views is not None and not (isinstance(views, list) and all(isinstance(v, int) and not isinstance(v, bool)
+                                                                      for v in views)):
+            raise self.fail("nodes", i, "viewports", f"expected a list of viewport indices, got {plain(views)}")
+        name = self.text(data, "name", "nodes", i, default=f"node{i}")
+        material = self.material(data, i, shading) if loaded is None else self.model_material(data, i, shading,
+                                                                                             loaded)
+        try:
+            return Node(name=name, mesh=mesh, model=model, material=material, cull_back_faces=cull,
+                        viewports=tuple(views) if views is not None else None)
+        except SandboxError as exc:  # the mesh lacks what the material reads, or the model is out of bounds
+            message = str(exc)
+            if "which a texture needs" in message:
+                key: str | None = "texture"
+            elif "shading needs" in message:
+                key = "shading"
+            else:
+                key = next((k for k in ("scale", "translate") if k in data), None)
+            raise self.fail("nodes", i, key, message) from None
 
     def model_file(self, data: dict[str, Any], i: int, mesh_name: str) -> Model | None:
         """A node's model file (``mesh = "path/to/model.obj"``, relative to the scene file),
@@ -254,82 +304,101 @@ class _SceneReader:
         if "texture" in data:
             source = data["texture"]
             if not isinstance(source, str):
-                raise self.fail("nodes", i, "texture", f"expected an image name or file path, got {source!r}")
+                raise self.fail("nodes", i, "texture", f"expected an image name or file path, got {plain(source)}")
             if source not in BUILTIN_TEXTURES and not Path(source).is_absolute():
                 source = str(self.path.parent / source)  # relative to the scene file, not the shell
+            filter_name = self.text(data, "filter", "nodes", i, default="mip_linear")
+            wrap = self.text(data, "wrap", "nodes", i, default="repeat")
             try:
-                texture = Texture(source, filter=str(data.get("filter", "mip_linear")),
-                                  wrap=str(data.get("wrap", "repeat")))
+                texture = Texture(source, filter=filter_name, wrap=wrap)
             except SandboxError as exc:
                 bad = "filter" if "filter" in str(exc) else "wrap" if "wrap" in str(exc) else "texture"
                 raise self.fail("nodes", i, bad, str(exc)) from None
         elif "filter" in data or "wrap" in data:
             raise self.fail("nodes", i, "filter" if "filter" in data else "wrap", "needs texture = \"<image>\"")
+        color = self.color(data, "color", "nodes", i, default=(1.0, 1.0, 1.0, 1.0))
+        normals = self.text(data, "normals", "nodes", i, default="correct")
         try:
-            return Material(color=self.color(data, "color", "nodes", i, default=(1.0, 1.0, 1.0, 1.0)),  # type: ignore[arg-type]
-                            shading=shading, normals=str(data.get("normals", "correct")), texture=texture,
+            return Material(color=color, shading=shading, normals=normals, texture=texture,  # type: ignore[arg-type]
                             **numbers)
         except SandboxError as exc:
             key = next((k for k in (*_MATERIAL_NUMBERS, "normals") if k in data and k in str(exc)), None)
             raise self.fail("nodes", i, key, str(exc)) from None
 
-    def viewport(self, data: dict[str, Any], i: int) -> Viewport:
+    def viewport(self, data: Any, i: int) -> Viewport:
+        data = self.table(data, "viewports", i)
         self.check_keys(data, {"rect", "clear_color", "label"}, "viewports", i)
         rect = self.numbers(data, "rect", (4,), "viewports", i, default=(0.0, 0.0, 1.0, 1.0))
         assert rect is not None
         x, y, w, h = rect
         if w <= 0 or h <= 0 or x < 0 or y < 0 or x + w > 1 + 1e-9 or y + h > 1 + 1e-9:
-            raise self.fail("viewports", i, "rect", f"rect {list(rect)} must lie inside 0..1 with positive size")
+            raise self.fail("viewports", i, "rect", f"rect {plain(list(rect))} must lie inside 0..1 with positive size")
         return Viewport(rect=rect, clear_color=self.color(data, "clear_color", "viewports", i),  # type: ignore[arg-type]
-                        label=str(data.get("label", "")))
+                        label=self.text(data, "label", "viewports", i))
 
-    def light(self, data: dict[str, Any], i: int) -> Light:
+    def light(self, data: Any, i: int) -> Light:
+        data = self.table(data, "lights", i)
         self.check_keys(data, {"position", "color"}, "lights", i)
         pos = self.numbers(data, "position", (3,), "lights", i)
         if pos is None:
             raise self.fail("lights", i, None, "every light needs position = [x, y, z]")
         col = self.numbers(data, "color", (3,), "lights", i, default=(1.0, 1.0, 1.0))
-        return Light(position=pos, color=col)  # type: ignore[arg-type]
+        try:
+            return Light(position=pos, color=col)  # type: ignore[arg-type]
+        except SandboxError as exc:
+            raise self.fail("lights", i, "color" if "colour" in str(exc) else "position", str(exc)) from None
 
-    def mirror(self, data: dict[str, Any], known: set[str]) -> Mirror:
+    def mirror(self, data: Any, known: set[str]) -> Mirror:
         """``[mirror]``: the glass node, its plane (a, b, c, d with ax + by + cz + d = 0), what it reflects."""
+        data = self.table(data, "mirror")
         self.check_keys(data, {"node", "plane", "reflected", "stencil"}, "mirror")
         node = self.node_name(data, "node", "mirror", known)
         plane = self.numbers(data, "plane", (4,), "mirror")
         if plane is None:
             raise self.fail("mirror", 0, None, "needs plane = [a, b, c, d] (the glass's plane ax + by + cz + d = 0)")
         reflected = self.names(data, "reflected", "mirror", known)
+        stencil = self.flag(data, "stencil", "mirror")
         try:
-            return Mirror(node, plane, reflected, stencil=self.flag(data, "stencil", "mirror"))  # type: ignore[arg-type]
+            return Mirror(node, plane, reflected, stencil=stencil)  # type: ignore[arg-type]
         except SandboxError as exc:
             raise self.fail("mirror", 0, "reflected" if "reflect" in str(exc) else "plane", str(exc)) from None
 
-    def shadow(self, data: dict[str, Any], known: set[str]) -> PlanarShadow:
-        """``[shadow]``: casters flattened onto the receiver's plane along the light."""
+    def shadow(self, data: Any, known: set[str], lights: tuple[Light, ...]) -> PlanarShadow:
+        """``[shadow]``: casters flattened onto the receiver's plane along the light (one of ``lights``)."""
+        data = self.table(data, "shadow")
         self.check_keys(data, {"receiver", "plane", "light", "casters", "lift", "polygon_offset", "stencil", "color"},
                         "shadow")
         receiver = self.node_name(data, "receiver", "shadow", known)
         plane = self.numbers(data, "plane", (4,), "shadow")
         light = self.numbers(data, "light", (4,), "shadow")
-        for key, value, what in (("plane", plane, "[a, b, c, d]"), ("light", light, "[x, y, z, 1] (point) or "
-                                                                               "[x, y, z, 0] (directional)")):
-            if value is None:
-                raise self.fail("shadow", 0, None, f"needs {key} = {what}")
+        if plane is None:
+            raise self.fail("shadow", 0, None, "needs plane = [a, b, c, d]")
+        if light is None:
+            if len(lights) != 1:
+                raise self.fail("shadow", 0, None, "needs light = [x, y, z, 1] (point) or [x, y, z, 0] (directional), "
+                                f"one of the scene's lights (it has {len(lights)}; with one, light may be left out)")
+            light = (*lights[0].position, 1.0)
         casters = self.names(data, "casters", "shadow", known)
+        options = dict(lift=self.number(data, "lift", "shadow", default=0.005),
+                       polygon_offset=self.flag(data, "polygon_offset", "shadow"),
+                       stencil=self.flag(data, "stencil", "shadow"),
+                       color=self.numbers(data, "color", (4,), "shadow", default=(0.0, 0.0, 0.0, 0.5)))
         try:
-            shadow = PlanarShadow(receiver, plane, light, casters,  # type: ignore[arg-type]
-                                  lift=self.number(data, "lift", "shadow", default=0.005),  # type: ignore[arg-type]
-                                  polygon_offset=self.flag(data, "polygon_offset", "shadow"),
-                                  stencil=self.flag(data, "stencil", "shadow"),
-                                  color=self.numbers(data, "color", (4,), "shadow",  # type: ignore[arg-type]
-                                                     default=(0.0, 0.0, 0.0, 0.5)))
+            shadow = PlanarShadow(receiver, plane, light, casters, **options)  # type: ignore[arg-type]
         except SandboxError as exc:
-            key = next((k for k in ("lift", "color", "light", "plane") if k in str(exc)), None)
-            raise self.fail("shadow", 0, key, str(exc)) from None
+            key = next((k for k in ("lift", "colour", "light", "plane") if k in str(exc)), None)
+            raise self.fail("shadow", 0, "color" if key == "colour" else key, str(exc)) from None
         try:  # a light in the plane or parallel to it has no shadow matrix
             transforms.shadow_matrix(shadow.plane, shadow.light)
         except SandboxError as exc:
             raise self.fail("shadow", 0, "light", str(exc)) from None
+        if not any(_shadow_light_is(shadow.light, li.position) for li in lights):
+            kind = "point light at" if shadow.light[3] == 1.0 else "directional light from"
+            have = ", ".join(plain(li.position) for li in lights[:4]) + (", ..." if len(lights) > 4 else "")
+            raise self.fail("shadow", 0, "light" if "light" in data else None,
+                            f"the shadow's {kind} {plain(shadow.light[:3])} is none of the scene's lights "
+                            f"({have or 'it has none'}), so the shadow and the shading would disagree: use a light's "
+                            "position with w = 1, or with w = 0 a direction pointing at a light from the origin")
         return shadow
 
     def scene(self, data: dict[str, Any]) -> Scene:
@@ -339,7 +408,7 @@ class _SceneReader:
         for key, kind in tables.items():
             if key in data and not isinstance(data[key], kind):
                 shape = f"[{key}]" if kind is dict else f"[[{key}]]"
-                raise self.fail("", 0, key, f"expected a {shape} table")
+                raise self.fail("", 0, key, f"expected a {shape} table, got {plain(data[key])}")
         viewports = tuple(self.viewport(v, i) for i, v in enumerate(data.get("viewports", []))) or (Viewport(),)
         nodes = tuple(self.node(n, i) for i, n in enumerate(data.get("nodes", [])))
         for i, n in enumerate(nodes):
@@ -347,24 +416,35 @@ class _SceneReader:
                 if not 0 <= v < len(viewports):
                     raise self.fail("nodes", i, "viewports", f"viewport {v} does not exist ({len(viewports)} defined)")
         depth = self.flag(data, "depth_test", "")
-        depth_mode = data.get("depth_mode", "standard")
+        depth_mode = self.text(data, "depth_mode", "", default="standard")
         if depth_mode not in DEPTH_MODES:
             raise self.fail("", 0, "depth_mode", f"unknown depth mode {depth_mode!r}; use one of {', '.join(DEPTH_MODES)}")
         known = {n.name for n in nodes}
         if len(known) < len(nodes) and ("mirror" in data or "shadow" in data):
             raise self.fail("", 0, None, "node names must differ when a mirror or shadow names them")
+        lights = tuple(self.light(v, i) for i, v in enumerate(data.get("lights", [])))
         return Scene(
-            name=str(data.get("name", self.path.stem)),
+            name=self.text(data, "name", "", default=self.path.stem),
             nodes=nodes,
             camera=self.camera(data.get("camera", {})),
-            lights=tuple(self.light(v, i) for i, v in enumerate(data.get("lights", []))),
+            lights=lights,
             clear_color=self.color(data, "clear_color", "", default=COURSE_BLUE),  # type: ignore[arg-type]
             viewports=viewports,
             depth_test=depth,
             mirror=self.mirror(data["mirror"], known) if "mirror" in data else None,
-            shadow=self.shadow(data["shadow"], known) if "shadow" in data else None,
+            shadow=self.shadow(data["shadow"], known, lights) if "shadow" in data else None,
             depth_mode=depth_mode,
         )
+
+
+def _shadow_light_is(light: tuple[float, ...], position: tuple[float, float, float]) -> bool:
+    """Whether the shadow's homogeneous ``light`` is the scene light at ``position``:
+    a point light there (w = 1), or a direction pointing at it from the origin (w = 0)."""
+    p = np.asarray(position, dtype=np.float64)
+    if light[3] == 1.0:
+        return bool(np.allclose(light[:3], p, rtol=1e-9, atol=1e-9))
+    length = float(np.linalg.norm(p))
+    return length > 0.0 and bool(np.allclose(light[:3], p / length, rtol=0.0, atol=1e-9))
 
 
 def load_scene(path: str | Path) -> Scene:
@@ -375,13 +455,28 @@ def load_scene(path: str | Path) -> Scene:
     """
     p = Path(path)
     try:
-        text = p.read_text(encoding="utf-8")
+        raw = read_regular(p)
     except FileNotFoundError:
         raise SandboxError(f"{p}: scene file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SandboxError(f"{p}: cannot read scene file ({exc})") from None
+    except IsADirectoryError:
+        raise SandboxError(f"{p}: is a folder, expected a scene .toml file") from None
+    except NotARegularFile as exc:
+        raise SandboxError(f"{p}: is {exc.kind}, expected a scene .toml file") from None
+    except PermissionError:
+        raise SandboxError(f"{p}: cannot read scene file (permission denied)") from None
+    except OSError as exc:
+        raise SandboxError(f"{p}: cannot read scene file ({exc.strerror or exc})") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw[:exc.start].count(b"\n") + 1
+        raise SandboxError(f"{p}:{line}: not UTF-8 text (byte 0x{raw[exc.start]:02x})") from None
     try:
         data = tomllib.loads(text)
+    except RecursionError:  # tomllib recurses once per level of nested arrays and inline tables
+        line = _deep_line(text)
+        raise SandboxError(f"{p}:{line}: malformed TOML: arrays or tables nested too deeply" if line
+                           else f"{p}: malformed TOML: arrays or tables nested too deeply") from None
     except tomllib.TOMLDecodeError as exc:
         # tomllib ends its message with "(at line L, column C)".
         m = re.search(r"\(at line (\d+), column (\d+)\)", str(exc))
@@ -389,3 +484,23 @@ def load_scene(path: str | Path) -> Scene:
         reason = re.sub(r"\s*\(at line \d+, column \d+\)", "", str(exc)) or "malformed TOML"
         raise SandboxError(f"{where}: malformed TOML: {reason}") from None
     return _SceneReader(p, text).scene(data)
+
+
+def _deep_line(text: str, depth: int = 100) -> int | None:
+    """The line where ``[`` and ``{`` first nest ``depth`` deep (strings and comments skipped roughly)."""
+    level, line, quote = 0, 1, ""
+    for char in text:
+        if char == "\n":
+            line += 1
+            quote = "" if quote == "#" else quote
+        elif quote:
+            quote = "" if char == quote and quote != "#" else quote
+        elif char in "\"'#":
+            quote = char
+        elif char in "[{":
+            level += 1
+            if level >= depth:
+                return line
+        elif char in "]}":
+            level = max(0, level - 1)
+    return None

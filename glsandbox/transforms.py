@@ -47,7 +47,7 @@ from collections.abc import Sequence
 import numpy as np
 import pyrr
 
-from glsandbox.errors import SandboxError
+from glsandbox.errors import SandboxError, plain
 
 Matrix = np.ndarray  # a (4, 4) float64 array acting on column vectors
 
@@ -62,7 +62,7 @@ MIRROR_Z: Matrix = np.diag([1.0, 1.0, -1.0, 1.0])
 def _vec3(value: Sequence[float] | np.ndarray, name: str = "vector") -> np.ndarray:
     arr = np.asarray(value, dtype=np.float64).reshape(-1)
     if arr.shape != (3,) or not np.all(np.isfinite(arr)):
-        raise SandboxError(f"{name} must be three finite numbers, got {value!r}")
+        raise SandboxError(f"{name} must be three finite numbers, got {plain(value)}")
     return arr
 
 
@@ -158,6 +158,14 @@ def normal_matrix(model: Matrix) -> np.ndarray:
     return np.linalg.inv(block).T
 
 
+def smallest_scale(model: Matrix) -> float:
+    """How much the model matrix shrinks some direction the most: the smallest
+    singular value of its upper-left 3x3 block (0 for a scale of 0 along an
+    axis, which flattens the mesh; its inverse, and the normal matrix, then
+    do not exist, and grow as 1 / this value near it)."""
+    return float(np.linalg.svd(np.asarray(model, dtype=np.float64)[:3, :3], compute_uv=False)[-1])
+
+
 def transform_points(m: Matrix, points: np.ndarray) -> np.ndarray:
     """Apply a 4x4 matrix to an (N, 3) array of points (w = 1), with the divide."""
     pts = np.asarray(points, dtype=np.float64)
@@ -199,14 +207,14 @@ def _look_at(eye: Sequence[float], target: Sequence[float], up: Sequence[float])
     f_len = float(np.linalg.norm(forward))
     u_len = float(np.linalg.norm(u))
     if f_len == 0.0:
-        raise SandboxError(f"camera eye and target are the same point {tuple(e)}")
+        raise SandboxError(f"camera eye and target are the same point {plain(tuple(e))}")
     if u_len == 0.0:
         raise SandboxError("camera up vector is zero")
     # sin of the angle between up and the view direction.
     sin_angle = float(np.linalg.norm(np.cross(forward / f_len, u / u_len)))
     if sin_angle < 1e-9:
         raise SandboxError(
-            f"camera up {tuple(u)} is parallel to the view direction {tuple(forward / f_len)}: "
+            f"camera up {plain(tuple(u))} is parallel to the view direction {plain(tuple(forward / f_len))}: "
             "no camera orientation exists; choose an up vector not along the view"
         )
     return _from_pyrr(pyrr.matrix44.create_look_at(e, t, u, dtype=np.float64))
@@ -294,10 +302,10 @@ def normalize_plane(plane: Sequence[float]) -> np.ndarray:
     """
     arr = np.asarray(plane, dtype=np.float64).reshape(-1)
     if arr.shape != (4,) or not np.all(np.isfinite(arr)):
-        raise SandboxError(f"a plane must be four finite numbers (a, b, c, d), got {plane!r}")
+        raise SandboxError(f"a plane must be four finite numbers (a, b, c, d), got {plain(plane)}")
     length = float(np.linalg.norm(arr[:3]))
     if length < 1e-12:
-        raise SandboxError(f"plane {tuple(arr)} has a zero normal (a, b, c): it is not a plane")
+        raise SandboxError(f"plane {plain(tuple(arr))} has a zero normal (a, b, c): it is not a plane")
     return arr / length
 
 
@@ -344,7 +352,7 @@ def light_vector(light: Sequence[float]) -> np.ndarray:
     course's ``toMainLight = -lightDir``). Directions are normalized."""
     arr = np.asarray(light, dtype=np.float64).reshape(-1)
     if arr.shape != (4,) or not np.all(np.isfinite(arr)) or arr[3] not in (0.0, 1.0):
-        raise SandboxError(f"a light must be (x, y, z, w) with w = 1 (point) or 0 (direction), got {light!r}")
+        raise SandboxError(f"a light must be (x, y, z, w) with w = 1 (point) or 0 (direction), got {plain(light)}")
     if arr[3] == 0.0:
         length = float(np.linalg.norm(arr[:3]))
         if length < 1e-12:
@@ -377,7 +385,7 @@ def shadow_matrix(plane: Sequence[float], light: Sequence[float]) -> Matrix:
     if abs(dot) < SHADOW_EPSILON:
         what = "parallel to" if l[3] == 0.0 else "in"
         raise SandboxError(
-            f"light {tuple(float(v) for v in l)} lies {what} the shadow plane {tuple(float(v) for v in p)}: "
+            f"light {plain(tuple(l))} lies {what} the shadow plane {plain(tuple(p))}: "
             "no planar shadow exists (P·L = 0)")
     return dot * np.eye(4) - np.outer(l, p)
 

@@ -31,12 +31,14 @@ __all__ = ["attach_camera_input", "run_window"]
 
 def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: int = 0,
                backend: str | None = None, screenshot_dir: Path = Path("screenshots"),
-               max_frames: int | None = None) -> None:
+               max_frames: int | None = None, instead: str | None = None) -> None:
     """Open a window and run the lesson until ESC or the window closes.
 
     Keys: ESC quits; F12 writes ``screenshots/<lesson>-<n>.png``; R reloads the
     shaders from disk (a broken shader keeps the last good program and shows
     its error in the title and on stderr); other keys go to the lesson.
+    ``instead`` is what the errors offer when no window can open (the
+    command's headless form, e.g. ``glsandbox render``).
 
     Each frame is drawn as headless draws it (a :class:`FrameRenderer`
     target with the plan's buffers, ``samples`` MSAA resolved there) and
@@ -44,11 +46,12 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
     """
     import glfw
 
+    instead = instead or f"or render it headless: glsandbox render {lesson.name} --out FILE.png"
     host = open_context(backend if backend not in (None, "auto") else "auto", window=True, size=size,
-                        title=f"glsandbox: {lesson.name}")
+                        title=f"glsandbox: {lesson.name}", instead=instead)
     if host.backend != "window":
         host.release()
-        raise SandboxError("no display for a window: set DISPLAY or run under Xvfb, or use --headless")
+        raise SandboxError(f"no display for a window: set DISPLAY or run under Xvfb, {instead}")
     renderer = FrameRenderer(host)
     executor = renderer.executor
     motion = InteractiveResolution()  # ray-traced viewports: coarser while the camera moves

@@ -3,6 +3,7 @@ traceback, never a half-written file or an empty folder left behind (issue 12)."
 
 from __future__ import annotations
 
+import ctypes.util
 import errno
 import os
 import subprocess
@@ -105,3 +106,71 @@ def test_tradeoffs_into_an_unwritable_folder_or_a_full_disk_is_one_line(tmp_path
     err = capsys.readouterr().err.strip().splitlines()
     assert err[-1] == f"error: --out {full_out}: cannot write (No space left on device)"
     assert not [line for line in err if line.startswith("Traceback")]
+
+
+@pytest.mark.parametrize("renderer", ["raster", "ray", "ray_numpy"])
+def test_successful_renders_of_every_lesson_print_no_warning(tmp_path: Path, capsys, gl, renderer: str) -> None:
+    # RuntimeWarnings (numpy's overflow, invalid value, division by zero), Pillow's and glfw's
+    # warnings reach stderr beside the output: a successful run prints only its "wrote" line.
+    import warnings
+
+    from glsandbox.lesson import all_lessons
+
+    out = tmp_path / "x.png"
+    for cls in all_lessons():
+        for time in ("0", "1.7"):
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                status = cli.main(["render", cls.name, "--size", "32x24", "--set", f"renderer={renderer}",
+                                   "--set", f"time={time}", "--out", str(out)])
+            captured = capsys.readouterr()
+            assert status == 0 and captured.err == "", (cls.name, captured.err)
+            assert [str(w.message) for w in caught] == [], cls.name
+
+
+def test_control_characters_in_a_value_keep_the_message_on_one_line() -> None:
+    # "\x1e" (and "\r", "\u2028", ...) end a line for str.splitlines: the value is shown escaped.
+    proc = glsandbox("render", "indexed_cube", "--set", "time=0\x1e0", "--out", "x.png")
+    assert_user_error(proc, "--set time=0\\x1e0: expected a number")
+    assert_user_error(glsandbox("render", "cube\u2028x", "--out", "x.png"), "unknown lesson 'cube\\u2028x'")
+
+
+def test_an_osmesa_that_is_not_osmesa_is_one_line_naming_it(tmp_path: Path) -> None:
+    libc = ctypes.util.find_library("c")
+    text_file = tmp_path / "libOSMesa.so"
+    text_file.write_text("not a library\n")
+    out = tmp_path / "x.png"
+    cases = [(str(text_file), f"cannot load GLSANDBOX_OSMESA={text_file}")]
+    if libc:
+        cases.append((libc, f"GLSANDBOX_OSMESA={libc} is not an OSMesa library (it has no OSMesaCreateContextAttribs)"))
+    if hasattr(os, "mkfifo"):
+        os.mkfifo(tmp_path / "pipe.so")  # the dynamic loader would block reading it
+        cases.append((str(tmp_path / "pipe.so"), "is not a regular file"))
+    for value, fragment in cases:
+        proc = glsandbox("render", "triangle", "--backend", "osmesa", "--out", str(out),
+                         env={"GLSANDBOX_OSMESA": value})
+        assert_user_error(proc, "OSMesa backend unavailable", fragment)
+    assert not out.exists()
+
+
+def test_a_display_with_no_server_is_exactly_one_line() -> None:
+    # pyGLFW printed a GLFWError warning (two lines) before the error.
+    proc = glsandbox("run", "indexed_cube", env={"DISPLAY": ":77", "WAYLAND_DISPLAY": ""})
+    assert_user_error(proc, "':77'")
+    assert "GLFWError" not in proc.stderr and "warn" not in proc.stderr
+
+
+def test_no_display_errors_offer_what_the_command_can_do() -> None:
+    env = {"DISPLAY": "", "WAYLAND_DISPLAY": ""}
+    # render is headless already: it suggests a headless backend, not --headless.
+    proc = glsandbox("render", "indexed_cube", "--backend", "window", "--out", "x.png", env=env)
+    assert_user_error(proc, "no display", "--backend egl")
+    assert "--headless" not in proc.stderr
+    # run has no --headless either: it suggests glsandbox render.
+    proc = glsandbox("run", "indexed_cube", "--backend", "egl", env=env)
+    assert_user_error(proc, "glsandbox render indexed_cube --out FILE.png")
+    assert "--headless" not in proc.stderr
+    # A lesson module has --headless.
+    proc = subprocess.run([sys.executable, "-m", "lessons.triangle"], capture_output=True, text=True, cwd=REPO,
+                          env={**os.environ, **env}, timeout=60)
+    assert_user_error(proc, "python -m lessons.triangle --headless --out FILE.png")

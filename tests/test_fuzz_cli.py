@@ -6,7 +6,10 @@ one of two ways:
 
 - exit 0 and a readable PNG of the asked size, or
 - exit 2, exactly one ``error:`` line on stderr, no traceback, and no new
-  file in the output folder.
+  file in the output folder;
+
+and in neither case a warning (numpy's RuntimeWarnings, Pillow's, glfw's),
+which would reach stderr beside the output.
 
 The examples per test are bounded so the suite stays fast; set
 ``GLSANDBOX_FUZZ=long`` for a longer run (the ``long`` hypothesis profile).
@@ -17,6 +20,7 @@ from __future__ import annotations
 import io
 import math
 import os
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -71,20 +75,28 @@ def toml_table(header: str, table: dict[str, Any]) -> str:
 
 nodes = st.fixed_dictionaries({"mesh": words}, optional={
     "scale": vectors, "translate": vectors, "rotate": vectors, "color": colors, "shading": shadings,
-    "order": words, "texture": st.sampled_from(["checker", "labels", "img.png", "missing.png"]),
+    "order": words, "texture": st.sampled_from(["checker", "labels", "img.png", "missing.png", "pipe.png"]),
     "filter": words, "wrap": words, "ambient": numbers, "shininess": numbers, "cull_back_faces": st.booleans(),
     "viewports": st.one_of(st.just([0]), st.just([5]), st.just(["a"])),
 })
 cameras = st.fixed_dictionaries({}, optional={"eye": vectors, "target": vectors, "up": vectors,
                                               "fov_y": numbers, "near": numbers, "far": numbers})
 lights = st.fixed_dictionaries({"position": vectors}, optional={"color": colors})
+# A planar shadow on the first node, cast by the second, from a light that may or may not be one of the scene's.
+shadows = st.fixed_dictionaries({"receiver": st.sampled_from(["node0", "ghost"]), "casters": st.just(["node1"])},
+                                optional={"plane": st.one_of(st.just([0, 1, 0, 0]), vectors),
+                                          "light": st.one_of(st.just([1, 4, 2, 1]), st.just([0, 1, 0, 0]), vectors),
+                                          "lift": numbers})
 scenes = st.builds(
-    lambda top, camera, node_list, light_list: "".join(
+    lambda top, camera, node_list, light_list, shadow: "".join(
         [toml_table("", top).lstrip("\n"), toml_table("[camera]", camera) if camera else "",
-         *(toml_table("[[nodes]]", n) for n in node_list), *(toml_table("[[lights]]", li) for li in light_list)]),
+         *(toml_table("[[nodes]]", n) for n in node_list), *(toml_table("[[lights]]", li) for li in light_list),
+         toml_table("[shadow]", shadow) if shadow else ""]),
     st.fixed_dictionaries({}, optional={"name": words, "clear_color": colors, "samples": st.integers(-1, 5),
                                         "depth_mode": words, "nodes": st.just([1, 2])}),
-    cameras, st.lists(nodes, max_size=3), st.lists(lights, max_size=3),
+    cameras, st.lists(nodes, max_size=3),
+    st.one_of(st.lists(lights, max_size=3), st.just([{"position": [1, 4, 2]}])),
+    st.one_of(st.none(), shadows),
 )
 hostile_text = st.one_of(st.text(max_size=200), st.just("a = " + "[" * 2000 + "]" * 2000),
                          st.just("[[nodes]]\nmesh = 'cube'\n" * 3 + "\x00\xff"))
@@ -118,8 +130,11 @@ images = st.one_of(
 def run_cli(args: list[str], out_dir: Path, capsys) -> tuple[int, str]:
     before = set(out_dir.iterdir())
     capsys.readouterr()
-    status = cli.main(args)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        status = cli.main(args)
     err = capsys.readouterr().err
+    assert [f"{w.category.__name__}: {w.message}" for w in caught] == []
     after = set(out_dir.iterdir())
     if status == 0:
         out = Path(args[args.index("--out") + 1])
@@ -137,6 +152,8 @@ def run_cli(args: list[str], out_dir: Path, capsys) -> tuple[int, str]:
 
 @pytest.fixture
 def workdir(tmp_path: Path, gl) -> Path:  # `gl`: a GL backend, or a skip (fail under CI)
+    if hasattr(os, "mkfifo"):  # a named pipe where an image belongs: reading it would wait forever
+        os.mkfifo(tmp_path / "pipe.png")
     return tmp_path
 
 
@@ -155,7 +172,8 @@ def test_generated_scene_files_keep_the_contract(workdir: Path, capsys, text: st
 
 SET_LESSONS = ["indexed_cube", "transform_order", "phong", "texture", "mirror", "ray_spheres"]
 set_texts = st.one_of(st.sampled_from(["1e308", "-1e308", "nan", "inf", "-0", "0", "180", "1e-320", "3", "on",
-                                       "off", "STR", "tsr", "split", "directional", "reverse_z", "img.png"]),
+                                       "off", "STR", "tsr", "split", "directional", "reverse_z", "img.png",
+                                       "pipe.png"]),
                       st.floats(allow_nan=True).map(repr), st.text(max_size=6))
 
 

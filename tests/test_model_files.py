@@ -6,8 +6,6 @@ from __future__ import annotations
 
 import os
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +18,7 @@ from glsandbox.files import load_png
 from glsandbox.lesson import scene_file_lesson
 from glsandbox.scene_file import load_scene
 from test_cli import REPO, assert_user_error, glsandbox
-from test_meshfile import CUBE_OBJ, quadrant_image, textured_quad_glb
+from test_meshfile import CUBE_OBJ, textured_quad_glb
 
 LIT = """\
 [camera]

@@ -8,7 +8,6 @@ import subprocess
 import zipfile
 from pathlib import Path
 
-import pytest
 from conftest import need
 
 from glsandbox.files import load_png

@@ -8,6 +8,7 @@ The backend comes from ``--backend`` or the ``GLSANDBOX_BACKEND`` variable.
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -76,18 +77,26 @@ def has_display() -> bool:
     return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
 
 
+#: What to do instead of a window, said by errors when none can open, for a
+#: frame rendered offscreen (``glsandbox render`` with ``--backend window``).
+HEADLESS_INSTEAD = "or use a headless backend: --backend egl (or osmesa)"
+
+
 def open_context(backend: str | None = None, *, window: bool = False, size: tuple[int, int] = (640, 480),
-                 title: str = "glsandbox", samples: int = 0) -> GLHost:
+                 title: str = "glsandbox", samples: int = 0, instead: str | None = None) -> GLHost:
     """Open a context. ``window=True`` asks for an on-screen window.
 
     With ``auto``, a window is used when asked for and a display exists;
     otherwise EGL, falling back to OSMesa. Errors say what is missing and
-    how to install it.
+    how to install it; ``instead`` is the alternative they offer when no
+    window can open (the command's own: ``glsandbox render``, ``--headless``),
+    by default :data:`HEADLESS_INSTEAD`.
     """
+    instead = instead or HEADLESS_INSTEAD
     name = requested_backend(backend)
     if name == "auto":
         if window and has_display():
-            return _open_window(size, title, samples)
+            return _open_window(size, title, samples, instead)
         try:
             return _open_egl()
         except SandboxError as egl_error:
@@ -96,10 +105,9 @@ def open_context(backend: str | None = None, *, window: bool = False, size: tupl
             except SandboxError as osmesa_error:
                 raise SandboxError(f"no OpenGL available: {egl_error}; {osmesa_error}") from None
     if name == "window":
-        return _open_window(size, title, samples)
+        return _open_window(size, title, samples, instead)
     if window:
-        raise SandboxError(f"backend {name!r} is headless and cannot open a window; use --backend window "
-                           "or render with --headless")
+        raise SandboxError(f"backend {name!r} is headless and cannot open a window; use --backend window, {instead}")
     return _open_egl() if name == "egl" else _open_osmesa()
 
 
@@ -134,15 +142,40 @@ def _open_osmesa() -> GLHost:
                   _make_current=osmesa.make_current)
 
 
-def _open_window(size: tuple[int, int], title: str, samples: int) -> GLHost:
+def _glfw_reason(exc: Exception) -> str:
+    """pyGLFW's ``GLFWError`` text, ``(65550) b'X11: Failed to open display :77'``, as ``X11: Failed ...``."""
+    text = " ".join(str(exc).split())
+    m = re.fullmatch(r"\(\d+\)\s*b?(['\"])(.*)\1", text)
+    return m.group(2) if m else text
+
+
+def _open_window(size: tuple[int, int], title: str, samples: int, instead: str) -> GLHost:
     if not has_display():
         raise SandboxError("no display for a window: set DISPLAY, or run under Xvfb "
-                           "(apt-get install xvfb; xvfb-run -a ...), or render with --headless")
+                           f"(apt-get install xvfb; xvfb-run -a ...), {instead}")
     try:
         import glfw
     except Exception as exc:  # the wheel bundles libglfw, but it needs X11 libraries
         raise SandboxError(f"glfw is unavailable ({exc}); apt-get install libx11-6 libxrandr2 libxinerama1 "
                            "libxcursor1 libxi6") from None
+    # pyGLFW reports GLFW's errors as Python warnings by default (a second line on
+    # stderr before ours): while the window is set up they are raised instead,
+    # and each becomes the reason in one error line.
+    reporting = glfw.ERROR_REPORTING
+    glfw.ERROR_REPORTING = "raise"
+    try:
+        return _glfw_window(glfw, size, title, samples)
+    except glfw.GLFWError as exc:
+        glfw.ERROR_REPORTING = "ignore"
+        glfw.terminate()  # whatever the failed set-up opened (a no-op before glfw.init)
+        raise SandboxError(f"glfw could not open a window on display {os.environ.get('DISPLAY')!r} "
+                           f"({_glfw_reason(exc)}): start an X server there or run under Xvfb, {instead}") from None
+    finally:
+        glfw.ERROR_REPORTING = reporting
+
+
+def _glfw_window(glfw: Any, size: tuple[int, int], title: str, samples: int) -> GLHost:
+    """The window and its context, once glfw is imported (its errors raise ``GLFWError``)."""
     if not glfw.init():
         raise SandboxError(f"glfw could not initialise on display {os.environ.get('DISPLAY')!r}; "
                            "is the X server running?")

@@ -12,6 +12,7 @@ from __future__ import annotations
 import ctypes
 import ctypes.util
 import os
+import stat
 
 from glsandbox.errors import SandboxError
 
@@ -28,24 +29,47 @@ GL_UNSIGNED_BYTE = 0x1401
 
 INSTALL_HINT = "install it with: apt-get install libosmesa6"
 
+#: The entry points used here: a library without them is not OSMesa.
+REQUIRED_SYMBOLS = ("OSMesaCreateContextAttribs", "OSMesaMakeCurrent", "OSMesaGetProcAddress", "OSMesaDestroyContext")
+
+
+def _missing_symbol(lib: ctypes.CDLL) -> str | None:
+    """The first OSMesa entry point ``lib`` lacks, or None."""
+    return next((name for name in REQUIRED_SYMBOLS if not hasattr(lib, name)), None)
+
 
 def _load_library() -> ctypes.CDLL:
     """libOSMesa: ``GLSANDBOX_OSMESA`` (a path, for a custom Mesa build) or the system's."""
     override = os.environ.get("GLSANDBOX_OSMESA")
     if override:
+        where = f"GLSANDBOX_OSMESA={override}"
+        if os.sep in override:  # a path (a bare name is looked up by the dynamic loader)
+            try:
+                mode = os.stat(override).st_mode
+            except OSError as exc:
+                raise SandboxError(f"OSMesa backend unavailable: {where}: {exc.strerror}") from None
+            if not stat.S_ISREG(mode):  # a named pipe would block the loader forever
+                raise SandboxError(f"OSMesa backend unavailable: {where} is not a regular file") from None
         try:
-            return ctypes.CDLL(override)
-        except OSError:
-            raise SandboxError(f"OSMesa backend unavailable: cannot load GLSANDBOX_OSMESA={override}") from None
+            lib = ctypes.CDLL(override)
+        except OSError as exc:
+            reason = " ".join(str(exc).split())
+            raise SandboxError(f"OSMesa backend unavailable: cannot load {where} ({reason})") from None
+        missing = _missing_symbol(lib)
+        if missing:
+            raise SandboxError(f"OSMesa backend unavailable: {where} is not an OSMesa library (it has no {missing})")
+        return lib
     names = ["libOSMesa.so.8", "libOSMesa.so.6", "libOSMesa.so"]
     found = ctypes.util.find_library("OSMesa")
     if found:
         names.insert(0, found)
     for name in names:
         try:
-            return ctypes.CDLL(name)
+            lib = ctypes.CDLL(name)
         except OSError:
             continue
+        if _missing_symbol(lib) is None:
+            return lib
     raise SandboxError(f"OSMesa backend unavailable: libOSMesa not found; {INSTALL_HINT}")
 
 

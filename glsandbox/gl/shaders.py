@@ -30,6 +30,7 @@ from pathlib import Path
 import moderngl
 
 from glsandbox.errors import SandboxError
+from glsandbox.files import NotARegularFile, read_regular
 from glsandbox.plan import ProgramVariant
 
 _INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"\s*$')
@@ -102,11 +103,7 @@ def assemble(name: str, stage: str, defines: tuple[tuple[str, str], ...] = (), r
     def read(path: Path, included_from: str | None, stack: tuple[Path, ...]) -> None:
         if path in stack:
             raise SandboxError(f"{included_from}: #include cycle through {path.name}")
-        try:
-            lines = path.read_text(encoding="utf-8").splitlines()
-        except OSError:
-            where = f"{included_from}: " if included_from else ""
-            raise SandboxError(f"{where}shader file {path} not found") from None
+        lines = _read_lines(path, included_from)
         for line_no, line in enumerate(lines, start=1):
             if _VERSION.match(line):
                 if included_from is not None:
@@ -131,6 +128,25 @@ def assemble(name: str, stage: str, defines: tuple[tuple[str, str], ...] = (), r
     if not out or not _VERSION.match(out[0]):
         raise SandboxError(f"{top}:1: a shader file must start with #version")
     return Source("\n".join(out) + "\n", origins)
+
+
+def _read_lines(path: Path, included_from: str | None) -> list[str]:
+    """The lines of a shader file; a missing, unreadable or non-UTF-8 file is one error naming it."""
+    where = f"{included_from}: " if included_from else ""
+    try:
+        raw = read_regular(path)
+    except FileNotFoundError:
+        raise SandboxError(f"{where}shader file {path} not found") from None
+    except NotARegularFile as exc:
+        raise SandboxError(f"{where}shader file {path} is {exc.kind}, expected a text file") from None
+    except OSError as exc:
+        raise SandboxError(f"{where}shader file {path} cannot be read ({exc.strerror or exc})") from None
+    try:
+        return raw.decode("utf-8").splitlines()
+    except UnicodeDecodeError as exc:
+        line = raw[:exc.start].count(b"\n") + 1
+        raise SandboxError(f"{path}:{line}: shader file is not UTF-8 text (byte 0x{raw[exc.start]:02x})"
+                           + (f", included from {included_from}" if included_from else "")) from None
 
 
 def _first_error(log: str, source: Source, stage: str) -> str:

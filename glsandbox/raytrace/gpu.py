@@ -117,16 +117,22 @@ UNROLL_TRIS = 2
 #: GL_MAX_UNIFORM_BLOCK_SIZE is smaller (OpenGL guarantees 16 KiB).
 BLOCK_RECORDS = 4096
 
-_TRACERS: dict[int, tuple[moderngl.Context, GpuTracer]] = {}
+#: The attribute of a moderngl context that holds its tracer. The tracer lives
+#: and dies with its context object: a module-level table would keep every
+#: tracer (and, through its programs, every context) alive after its renderer
+#: closed, about 0.1 MB per renderer opened and closed; it cannot be keyed
+#: weakly, since the tracer's GL objects refer to their context.
+_TRACER_ATTRIBUTE = "_glsandbox_gpu_tracer"
 
 
 def gpu_tracer(ctx: moderngl.Context) -> GpuTracer:
-    """The tracer of ``ctx`` (made once per context: programs and targets are kept)."""
-    entry = _TRACERS.get(id(ctx))
-    if entry is None or entry[0] is not ctx:
-        entry = (ctx, GpuTracer(ctx))
-        _TRACERS[id(ctx)] = entry
-    return entry[1]
+    """The tracer of ``ctx`` (made once per context: programs and targets are kept),
+    kept on the context object itself and freed with it."""
+    tracer = getattr(ctx, _TRACER_ATTRIBUTE, None)
+    if tracer is None:
+        tracer = GpuTracer(ctx)
+        setattr(ctx, _TRACER_ATTRIBUTE, tracer)
+    return tracer
 
 
 def _at_least_one(rows: NDArray[np.float32]) -> NDArray[np.float32]:

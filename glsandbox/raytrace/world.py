@@ -20,7 +20,12 @@ once per viewport by :func:`build_world` from the *same*
   renormalising is needed. The rasterizer draws the tessellation; the
   difference at the silhouette is one of the approximations the
   raster-versus-ray comparison shows. ``analytic_spheres=False`` traces the
-  triangles instead;
+  triangles instead, and so does a sphere whose model matrix has no usable
+  inverse (a scale of 0, or below :data:`~glsandbox.scene.MIN_SCALE`, along
+  a direction flattens it to a disc: the triangles the rasterizer draws are
+  then the only honest shape);
+- a model matrix that flattens a mesh that way has no normal matrix: its
+  triangles get their face normals, the flat sheet they now form;
 - each node gets a world axis-aligned bounding box, the course's
   "Hızlandırma: AABB": a ray that misses the box skips every triangle inside.
   An unlit node (``solid``/``vertex_color``) whose box holds a light is that
@@ -58,7 +63,7 @@ from glsandbox.geometry import Mesh
 from glsandbox.images import texture_levels
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.triangle import TriangleBatch
-from glsandbox.scene import Camera, Node, Scene, Texture
+from glsandbox.scene import MIN_SCALE, Camera, Node, Scene, Texture
 
 __all__ = [
     "MODES",
@@ -177,6 +182,21 @@ def is_unit_sphere(mesh: Mesh) -> bool:
     return bool(np.all(np.abs(radii - 1.0) < 1e-9))
 
 
+def _unit_rows(v: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Each row of ``v`` scaled to length 1 (a zero row stays zero). A row too
+    small for its squares (a triangle of a tiny node: ``|v|² < 1e-300``
+    underflows) is rescaled by its largest component first, so its direction
+    survives instead of blowing up by ``1/1e-300``."""
+    length = np.linalg.norm(v, axis=1, keepdims=True)
+    tiny = length[:, 0] < 1e-150
+    if np.any(tiny):
+        big = np.abs(v[tiny]).max(axis=1, keepdims=True)
+        v = v.copy()
+        v[tiny] = np.divide(v[tiny], big, out=np.zeros_like(v[tiny]), where=big > 0.0)
+        length[tiny] = np.linalg.norm(v[tiny], axis=1, keepdims=True)
+    return v / np.maximum(length, 1e-300)
+
+
 def _texture_image(texture: Texture) -> NDArray[np.float64]:
     """The base level of a texture as float rgba in 0..1 (the ray tracer samples level 0 only)."""
     return np.asarray(texture_levels(texture)[0], dtype=np.float64) / 255.0
@@ -233,7 +253,9 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
             shininess=float(material.shininess), reflectivity=_reflectivity(scene, node),
             texture=tex,
         )
-        if analytic_spheres and is_unit_sphere(mesh):
+        # A model that flattens the node (a scale of 0, or below MIN_SCALE) has no usable inverse.
+        invertible = transforms.smallest_scale(model) >= MIN_SCALE
+        if analytic_spheres and is_unit_sphere(mesh) and invertible:
             corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=np.float64)
             world_corners = transforms.transform_points(model, corners)
             nodes.append(NodeInfo(kind="sphere", start=start, count=0, box_min=world_corners.min(axis=0),
@@ -251,13 +273,12 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
             continue
         world = transforms.transform_points(model, np.asarray(mesh.positions, dtype=np.float64))
         a, b, c = world[tri[:, 0]], world[tri[:, 1]], world[tri[:, 2]]
-        if mesh.normals is not None:
+        if mesh.normals is not None and invertible:
             n_world = np.asarray(mesh.normals, dtype=np.float64) @ transforms.normal_matrix(model).T
             n_world /= np.maximum(np.linalg.norm(n_world, axis=1, keepdims=True), 1e-300)
             n = n_world[tri]
-        else:  # flat: the face normal, counter-clockwise front (OpenGL's rule)
-            face = np.cross(b - a, c - a)
-            face /= np.maximum(np.linalg.norm(face, axis=1, keepdims=True), 1e-300)
+        else:  # flat (or flattened by the model): the face normal, counter-clockwise front (OpenGL's rule)
+            face = _unit_rows(np.cross(b - a, c - a))
             n = np.repeat(face[:, None, :], 3, axis=1)
         uv = np.asarray(mesh.uvs, dtype=np.float64)[tri] if mesh.uvs is not None else np.zeros((len(tri), 3, 2))
         col = np.asarray(mesh.colors, dtype=np.float64)[tri] if mesh.colors is not None else np.ones((len(tri), 3, 3))
