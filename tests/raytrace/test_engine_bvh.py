@@ -64,3 +64,10 @@ def test_render_through_the_bvh_counts_its_tests_and_matches_the_scan() -> None:
     assert differ.mean() < 0.01  # only where a ray grazes an edge
     assert with_bvh.primary == scan.primary and with_bvh.shadow == scan.shadow
     assert 0 < with_bvh.tests < scan.tests / 10 and with_bvh.box_tests > scan.box_tests > 0
+
+
+def test_the_model_lesson_shows_the_bvh_figures() -> None:
+    from lessons.model import bvh_figures, generated
+
+    line = bvh_figures(generated("rock"))
+    assert line.startswith("BVH: ") and " nodes, " in line and " ms" in line and "not built" not in line
