@@ -1,4 +1,4 @@
-"""Ray tracing lesson 5: acceleration by backface culling and bounding boxes.
+"""Ray tracing lesson 5: acceleration by backface culling, bounding boxes and a BVH.
 
 Course section "Hızlandırma: backface culling, AABB". Nine low-poly spheres
 (traced as their 224 triangles each, not as exact spheres) on a floor.
@@ -8,13 +8,24 @@ Course section "Hızlandırma: backface culling, AABB". Nine low-poly spheres
   skip them after one dot product.
 - **AABB**: a box around each node; a ray that misses the box (the slab test)
   skips all of the node's triangles.
+- **BVH** (bounding volume hierarchy): the box test asked again inside the
+  box, for two smaller boxes, and so on down to leaves of a few triangles
+  (``glsandbox.raytrace.bvh``); a ray tests a few dozen boxes and triangles
+  instead of all of a node's triangles. Shadow rays stop at their first hit.
 
-The table renders the scene with the numpy engine at a small size under the
-four combinations and lists the ray-shape tests each did (the same picture
-every time) and, with ``timing=on``, the measured time and speed-up. The
-numpy engine computes every lane of a vectorized test anyway, so backface
+The table renders the scene with the numpy engine at a small size under six
+combinations and lists the ray-shape and ray-box tests each did (the same
+picture every time) and, with ``timing=on``, the measured time and speed-up.
+The numpy engine computes every lane of a vectorized test anyway, so backface
 culling saves it nothing; the GLSL engine returns early per triangle
-(``benchmarks/raytrace.py`` measures both).
+(``benchmarks/raytrace.py`` measures both). Below it, with ``rock=on`` (the
+default), the BVH and the AABB alone are timed on a generated rock of 5,120
+triangles (:data:`ROCK_SIZE`): the speed-up a real model sees (these times
+change every run). On the nine small spheres the BVH does twenty times fewer
+shape tests than the AABB but is no faster in numpy: with 224 triangles a
+node, the per-level bookkeeping of the packet traversal (and the first
+render's BVH builds) costs what the tests save; on the rock it wins by an
+order of magnitude.
 """
 
 from __future__ import annotations
@@ -35,6 +46,7 @@ from glsandbox import (
     Param,
     Scene,
     geometry,
+    meshgen,
     register,
     text_image,
     transforms,
@@ -43,7 +55,11 @@ from glsandbox.raytrace import RenderStats, render
 
 #: Measured at this size, so the lesson stays quick.
 MEASURE_SIZE = (64, 48)
-COMBINATIONS = (("none", False, False), ("backface", True, False), ("AABB", False, True), ("both", True, True))
+#: (label, cull_backfaces, aabb, bvh)
+COMBINATIONS = (("none", False, False, False), ("backface", True, False, False), ("AABB", False, True, False),
+                ("both", True, True, False), ("BVH", False, True, True), ("BVH+backface", True, True, True))
+#: The rock is timed at this size (the AABB alone tests every ray against its 5,120 triangles).
+ROCK_SIZE = (48, 36)
 
 
 def scene(name: str) -> Scene:
@@ -63,33 +79,64 @@ def scene(name: str) -> Scene:
 def table(base_name: str, timing: bool) -> tuple[str, ...]:
     """The table's rows (computed once per process: the window rebuilds the scene every frame)."""
     base = scene(base_name)
-    rows: list[str | list[str]] = [["culling", "ray-shape tests", *(["ms", "speed-up"] if timing else [])]]
+    rows: list[str | list[str]] = [["culling", "ray-shape tests", "box tests",
+                                    *(["ms", "speed-up"] if timing else [])]]
     first = None
-    for label, cull, aabb in COMBINATIONS:
+    for label, cull, aabb, bvh in COMBINATIONS:
         stats = RenderStats()
         start = time.perf_counter()
-        render(base, MEASURE_SIZE, cull_backfaces=cull, aabb=aabb, stats=stats)
+        render(base, MEASURE_SIZE, cull_backfaces=cull, aabb=aabb, bvh=bvh, stats=stats)
         seconds = time.perf_counter() - start
         first = first or seconds
-        cells = [label, f"{stats.tests:,}"]
+        cells = [label, f"{stats.tests:,}", f"{stats.box_tests:,}"]
         if timing:
             cells += [f"{seconds * 1000:.0f}", f"{first / seconds:.1f}x"]
         rows.append(cells)
     return (f"numpy engine, {MEASURE_SIZE[0]}x{MEASURE_SIZE[1]}, shadows on", *rows)  # type: ignore[arg-type]
 
 
+def rock_scene() -> Scene:
+    """A generated rock of 5,120 triangles on the floor: a real model for the BVH."""
+    rock = glsandbox.fit_mesh(meshgen.rock(4, seed=4, roughness=0.3))
+    base = scene("rock")
+    material = base.nodes[1].material
+    return replace(base, nodes=(base.nodes[0], Node("rock", rock, transforms.translate(0.0, 0.0, 0.0), material)),
+                   camera=Camera(eye=(0.0, 1.6, 4.0), target=(0.0, -0.1, 0.0)))
+
+
+@functools.lru_cache(maxsize=1)
+def rock_rows() -> tuple[str, ...]:
+    """The rock's line: the AABB alone against the BVH, timed (computed once per process)."""
+    rock = rock_scene()
+    cells = {}
+    for label, bvh in (("AABB", False), ("BVH", True)):
+        stats = RenderStats()
+        start = time.perf_counter()
+        render(rock, ROCK_SIZE, bvh=bvh, stats=stats)
+        cells[label] = (time.perf_counter() - start, stats.tests)
+    (aabb_s, aabb_tests), (bvh_s, bvh_tests) = cells["AABB"], cells["BVH"]
+    triangles = int(rock.nodes[1].mesh.triangle_indices().shape[0])
+    return (f"rock, {triangles:,} triangles, {ROCK_SIZE[0]}x{ROCK_SIZE[1]} (times change every run):",
+            f"AABB {aabb_s * 1000:.0f} ms, {aabb_tests:,} shape tests",
+            f"BVH {bvh_s * 1000:.0f} ms, {bvh_tests:,} shape tests: {aabb_s / bvh_s:.0f}x faster")
+
+
 @register
 class RayAcceleration(Lesson):
     name = "ray_acceleration"
-    title = "Acceleration: backface culling and AABB, measured"
+    title = "Acceleration: backface culling, AABB and BVH, measured"
     course_section = "Hızlandırma: backface culling, AABB"
     order = 150
     defaults = {"renderer": "ray"}
-    params = (Param("timing", False, "measure and show times and speed-ups (changes every run)"),)
+    params = (Param("timing", False, "measure and show times and speed-ups (changes every run)"),
+              Param("rock", True, "time the BVH against the AABB on a 5,120-triangle rock (changes every run)"))
 
     def build(self) -> Scene:
         base = scene(self.name)
-        panel = text_image(table(self.name, bool(self.values["timing"])))
+        rows = table(self.name, bool(self.values["timing"]))
+        if self.values["rock"]:
+            rows = (*rows, "", *rock_rows())
+        panel = text_image(rows)
         return replace(base, overlays=(Overlay("table", panel, None, (4, 4)),))
 
 

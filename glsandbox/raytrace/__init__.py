@@ -19,7 +19,10 @@ checks that these reproduce every worked example of the notes):
 - the whole picture: :func:`render` traces a :class:`glsandbox.scene.Scene`,
   the same one the rasterizer draws, with the float64 ``"numpy"`` engine or
   the GLSL ``"gpu"`` engine (one of :data:`ENGINES`); :class:`RenderStats`
-  counts what a numpy render did.
+  counts what a numpy render did;
+- Hızlandırma beyond the course's AABB: :func:`bvh_for_mesh`, a mesh's
+  :class:`BVH` (binned SAH, cached by content), the numpy engine's
+  ``bvh=True`` traversal.
 
 The modules, each importing only those above it: ``errors``, ``vec``, ``ray``,
 ``base``, then the shapes (``plane``, ``triangle``, ``sphere``, ``aabb``) and
@@ -36,6 +39,7 @@ from __future__ import annotations
 
 from glsandbox.raytrace.aabb import AABB
 from glsandbox.raytrace.base import Shape
+from glsandbox.raytrace.bvh import BVH, bvh_for_mesh
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.plane import Plane
 from glsandbox.raytrace.ray import Ray
@@ -64,6 +68,7 @@ from glsandbox.raytrace.world import camera_rays, course_image_plane
 
 __all__ = [
     "AABB",
+    "BVH",
     "DEFAULT_METHOD",
     "ENGINES",
     "INSIDE_TESTS",
@@ -79,6 +84,7 @@ __all__ = [
     "Sphere",
     "Triangle",
     "TriangleBatch",
+    "bvh_for_mesh",
     "camera_rays",
     "course_image_plane",
     "cross",

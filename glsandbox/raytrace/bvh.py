@@ -61,6 +61,7 @@ frame, another camera) builds nothing.
 from __future__ import annotations
 
 import hashlib
+import time
 import weakref
 from collections import OrderedDict
 from dataclasses import dataclass
@@ -93,7 +94,7 @@ BINS: int = 16
 #: Triangles of a node whose boxes the SAH bins (a big node's are sampled, see ``_split_levels``).
 SAMPLE: int = 1024
 #: BVHs kept by :func:`bvh_for_triangles` / :func:`bvh_for_mesh`.
-CACHE_SIZE: int = 4
+CACHE_SIZE: int = 16
 
 
 @dataclass(frozen=True, eq=False)
@@ -110,6 +111,7 @@ class BVH:
     tri_index: NDArray[np.int64]  # (M,) the caller's index of each stored triangle
     depth: int  # levels: 1 for a lone leaf
     input_count: int  # triangles given, degenerate ones included
+    build_seconds: float = 0.0  # the time build_bvh took (a cached BVH keeps its first build's)
 
     def __post_init__(self) -> None:
         for array in (self.node_min, self.node_max, self.node_first, self.node_count, self.v0, self.v1, self.v2,
@@ -180,6 +182,14 @@ def _half_area(lo: NDArray[np.float32], hi: NDArray[np.float32]) -> NDArray[np.f
 
 
 def build_bvh(v0: ArrayLike, v1: ArrayLike, v2: ArrayLike, *, leaf_size: int = LEAF_SIZE, bins: int = BINS) -> BVH:
+    """:func:`_build_bvh`, its time kept in :attr:`BVH.build_seconds`."""
+    start = time.perf_counter()
+    result = _build_bvh(v0, v1, v2, leaf_size=leaf_size, bins=bins)
+    object.__setattr__(result, "build_seconds", time.perf_counter() - start)  # frozen: set once, here
+    return result
+
+
+def _build_bvh(v0: ArrayLike, v1: ArrayLike, v2: ArrayLike, *, leaf_size: int = LEAF_SIZE, bins: int = BINS) -> BVH:
     """Build a BVH over the triangles ``v0[k], v1[k], v2[k]`` (``(M, 3)`` arrays) by binned SAH.
 
     Degenerate triangles are left out (no ray hits them); the others are

@@ -49,13 +49,22 @@ from glsandbox.raytrace.bvh import BVH
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.watertight import RaySetup, nondegenerate, ray_setup, watertight_pairs
 
-__all__ = ["BOX_PAD", "RAY_BLOCK", "Hits", "any_hit", "closest_hit", "closest_hit_brute_force"]
+__all__ = ["BOX_PAD", "RAY_BLOCK", "Hits", "TraversalCounts", "any_hit", "closest_hit", "closest_hit_brute_force"]
 
 #: Relative widening of every box in the slab test (see the module docstring).
 BOX_PAD: float = 2.0**-40
 #: Rays traced together.
 RAY_BLOCK: int = 1 << 14
 _NO_TRIANGLE = np.iinfo(np.int64).max
+
+
+@dataclass
+class TraversalCounts:
+    """What a traversal did, added up over calls: ray-box slab tests and ray-triangle tests
+    (the engine's :class:`~glsandbox.raytrace.numpy_engine.RenderStats` reads them)."""
+
+    boxes: int = 0
+    triangles: int = 0
 
 
 @dataclass
@@ -173,17 +182,21 @@ def _leaf_pairs(bvh: BVH, rays: NDArray[np.intp], nodes: NDArray[np.intp]) -> tu
     return rr, slots
 
 
-def _closest_block(bvh: BVH, block: _Block, cull: bool) -> None:
+def _closest_block(bvh: BVH, block: _Block, cull: bool, counts: TraversalCounts | None = None) -> None:
     rays = np.arange(block.n)
     nodes = np.zeros(block.n, dtype=np.int64)
     while rays.size:
         near, far = block.slab(bvh, rays, nodes)
+        if counts is not None:
+            counts.boxes += rays.size
         keep = (near <= far) & (far >= 0.0) & (near <= block.best_t[rays])
         rays, nodes = rays[keep], nodes[keep]
         leaf = bvh.node_count[nodes] > 0
         if leaf.any():
             rr, slots = _leaf_pairs(bvh, rays[leaf], nodes[leaf])
             t, _, _ = watertight_pairs(block.setup, rr, bvh.v0, bvh.v1, bvh.v2, slots, cull)
+            if counts is not None:
+                counts.triangles += rr.size
             ok = t < block.limit[rr]
             if ok.any():
                 rr, slots, t = rr[ok], slots[ok], t[ok]
@@ -207,12 +220,14 @@ def _closest_block(bvh: BVH, block: _Block, cull: bool) -> None:
 
 
 def closest_hit(bvh: BVH, origins: ArrayLike, directions: ArrayLike, t_max: ArrayLike = np.inf, *,
-                cull_backfaces: bool = False) -> Hits:
+                cull_backfaces: bool = False, counts: TraversalCounts | None = None) -> Hits:
     """The nearest hit with ``0 < t < t_max`` of each ray (``origins`` may be one shared point).
 
     ``t_max`` is one number or one per ray. ``cull_backfaces=True`` skips
     triangles facing away from the ray (course "Hızlandırma: backface
     culling"). Results are float64 and identical to :func:`closest_hit_brute_force`.
+    ``counts`` adds up the box and triangle tests done (the winners' second
+    test, for their barycentrics, included).
     """
     o, d, limit = _rays(origins, directions, t_max)
     n = d.shape[0]
@@ -223,9 +238,11 @@ def closest_hit(bvh: BVH, origins: ArrayLike, directions: ArrayLike, t_max: Arra
     for lo in range(0, n, RAY_BLOCK):
         part = slice(lo, min(n, lo + RAY_BLOCK))
         block = _Block(boxes, o[part], d[part], limit[part])
-        _closest_block(bvh, block, bool(cull_backfaces))
+        _closest_block(bvh, block, bool(cull_backfaces), counts)
         hit = np.flatnonzero(block.best_slot >= 0)
         if hit.size:
+            if counts is not None:
+                counts.triangles += hit.size
             # The winners' barycentrics, from the same test (so the same t).
             t, u, v = watertight_pairs(block.setup, hit, bvh.v0, bvh.v1, bvh.v2, block.best_slot[hit],
                                        bool(cull_backfaces))
@@ -238,10 +255,11 @@ def closest_hit(bvh: BVH, origins: ArrayLike, directions: ArrayLike, t_max: Arra
 
 
 def any_hit(bvh: BVH, origins: ArrayLike, directions: ArrayLike, t_max: ArrayLike = 1.0, *,
-            cull_backfaces: bool = False) -> NDArray[np.bool_]:
+            cull_backfaces: bool = False, counts: TraversalCounts | None = None) -> NDArray[np.bool_]:
     """Whether anything is hit with ``0 < t < t_max`` (the course's Gölge testi: a shadow
     ray from ``P`` towards the light ``L`` with ``d = L − P`` and ``t_max = 1``).
-    A ray stops at its first hit, in whatever order the tree gives."""
+    A ray stops at its first hit, in whatever order the tree gives. ``counts``
+    adds up the box and triangle tests done."""
     o, d, limit = _rays(origins, directions, t_max)
     n = d.shape[0]
     found = np.zeros(n, dtype=bool)
@@ -257,12 +275,16 @@ def any_hit(bvh: BVH, origins: ArrayLike, directions: ArrayLike, t_max: ArrayLik
         nodes = np.zeros(block.n, dtype=np.int64)
         while rays.size:
             near, far = block.slab(bvh, rays, nodes)
+            if counts is not None:
+                counts.boxes += rays.size
             keep = (near <= far) & (far >= 0.0) & (near < block.limit[rays])
             rays, nodes = rays[keep], nodes[keep]
             leaf = bvh.node_count[nodes] > 0
             if leaf.any():
                 rr, slots = _leaf_pairs(bvh, rays[leaf], nodes[leaf])
                 t, _, _ = watertight_pairs(block.setup, rr, bvh.v0, bvh.v1, bvh.v2, slots, cull)
+                if counts is not None:
+                    counts.triangles += rr.size
                 done[rr[t < block.limit[rr]]] = True
             inner = ~leaf & ~done[rays]
             rays, nodes = rays[inner], nodes[inner]

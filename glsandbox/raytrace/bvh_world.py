@@ -64,6 +64,8 @@ class WorldBVH:
 
     def __init__(self, nodes: list[NodeBVH], box_min: NDArray[np.float64], box_max: NDArray[np.float64]) -> None:
         self.nodes = nodes
+        #: The entries by ``World.nodes`` index (mesh nodes with triangles of non-zero area only).
+        self.by_node = {entry.node: entry for entry in nodes}
         self.box_min = box_min
         self.box_max = box_max
 

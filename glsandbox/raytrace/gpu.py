@@ -59,8 +59,11 @@ llvmpipe's loop limit
 ---------------------
 llvmpipe ends a shader invocation's loops after 65,535 iterations, all
 loops counted together (Mesa gallivm's ``LP_MAX_TGSI_LOOP_ITERATIONS``),
-silently. This engine does **not** check it. Every triangle a ray tests in
-a loop is an iteration, for the primary ray, each shadow ray and each
+silently. This engine refuses (:class:`RayTraceError`, naming the largest
+node and suggesting ``renderer=ray_numpy``) a render whose worst case could
+pass it (:func:`check_loop_budget`: every ray of a pixel testing every
+triangle and node record), rather than drawing a wrong picture. Every
+triangle a ray tests in a loop is an iteration, for the primary ray, each shadow ray and each
 bounce (in the general program every node record too), and a pixel that
 runs past the limit keeps whatever it had found: one node of about 65,000
 triangles that the primary ray's box test lets in is enough, and fewer
@@ -92,7 +95,7 @@ from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.world import MODES, World, build_world, camera_basis
 from glsandbox.scene import Scene
 
-__all__ = ["GpuTracer", "MAX_TEXTURES", "gpu_tracer"]
+__all__ = ["LOOP_LIMIT", "GpuTracer", "MAX_TEXTURES", "check_loop_budget", "gpu_tracer"]
 
 #: Width of the record textures (must match TEX_WIDTH in the shader).
 TEX_WIDTH = 1024
@@ -100,6 +103,26 @@ TRI_RECORDS = 9
 NODE_RECORDS = 12
 #: Samplers the shader declares at most.
 MAX_TEXTURES = 4
+#: llvmpipe's loop iterations per shader invocation, all loops together (see the module docstring).
+LOOP_LIMIT = 65_535
+
+
+def check_loop_budget(world: World, lights: int, shadows: bool, reflect: bool, max_depth: int) -> int:
+    """The most loop iterations one pixel could run: every ray it casts (the primary ray,
+    a shadow ray per light, and as much again per bounce) testing every triangle and every
+    node record. Raises :class:`RayTraceError` when that could pass :data:`LOOP_LIMIT`,
+    where llvmpipe would silently stop testing (a wrong picture): a conservative bound,
+    never a guess."""
+    rays = (1 + (lights if shadows else 0)) * (1 + (max_depth if reflect else 0))
+    meshes = [node for node in world.nodes if node.kind != "sphere"]
+    worst = rays * (sum(node.count for node in meshes) + len(world.nodes))
+    if worst > LOOP_LIMIT:
+        largest = max(meshes, key=lambda node: node.count)
+        raise RayTraceError(
+            f"the gpu engine could run {worst:,} loop iterations a pixel, past llvmpipe's {LOOP_LIMIT:,} "
+            f"(node {largest.name!r} has {largest.count:,} triangles, {rays} rays a pixel): "
+            "use renderer=ray_numpy (engine='numpy'), which traces meshes through a BVH")
+    return worst
 #: Scenes with at most this many nodes, of which at most UNROLL_LOOPS have
 #: more than UNROLL_TRIS triangles, get a program with the node list
 #: unrolled (``SCENE_NODES`` in ``shaders/raytrace.glsl``). The bounds keep
@@ -385,6 +408,7 @@ class GpuTracer:
         lights = world.light_positions.shape[0]
         # The bounce loop only where some node reflects.
         reflect = max_depth > 0 and any(node.reflectivity > 0.0 for node in world.nodes)
+        check_loop_budget(world, lights, bool(shadows), reflect, int(max_depth))
         program, vao = self._program(lights, len(world.textures), shadows=bool(shadows), reflect=reflect,
                                      meshes=uploaded.mesh_count > 0, spheres=uploaded.sphere_count > 0,
                                      scene=uploaded.defines(cull_backfaces))

@@ -17,21 +17,25 @@ of rays at once:
 Primary rays are traced :data:`RAY_BLOCK` at a time, each block through every
 step before the next.
 
-Where an acceleration structure plugs in
-----------------------------------------
-:func:`_nearest` and :func:`_occluded` are the only places that look for hits,
-and both go through :func:`_scan_nodes`: every node in scene order, its
-world box first (course "Hızlandırma: AABB"), then :func:`_hit_node` on the
-rays that enter it. A BVH over the nodes replaces :func:`_scan_nodes`
-(keeping ``_Hits`` and the tie rule: an equal ``t`` goes to the earlier
-node, then the earlier triangle); a BVH over one mesh's triangles replaces
-the brute-force ``world.batches[k].nearest_many`` call in :func:`_hit_node`,
-built by :func:`~glsandbox.raytrace.world.build_world` next to the node's
-:class:`~glsandbox.raytrace.triangle.TriangleBatch`. Today :func:`_occluded`
-is the nearest-hit scan cut at ``t = 1``, so the ray-shape tests it counts in
-:class:`RenderStats` are those of that scan (the ``ray_acceleration`` lesson
-shows them); an any-hit traversal may stop at a ray's first hit, and
-changes those counts.
+The BVH
+-------
+:func:`_nearest` and :func:`_occluded` are the only places that look for hits.
+Both loop over the nodes in scene order (:func:`_scan_nodes`; the top level
+is the nodes' boxes, course "Hızlandırma: AABB"). With ``bvh=True`` (the
+default) a mesh node's rays that enter its box are traced through the node's
+BVH (:class:`~glsandbox.raytrace.bvh_world.WorldBVH`, built once per mesh and
+cached by content; :func:`~glsandbox.raytrace.bvh_traverse.closest_hit`, the
+watertight triangle test) with ``t_max`` their best hit so far: only strictly
+nearer hits replace it, so the tie rule holds (an equal ``t`` goes to the
+earlier node, then the lower triangle). Spheres stay analytic
+(:func:`_hit_node`). Shadow rays are an any-hit query
+(:func:`~glsandbox.raytrace.bvh_traverse.any_hit`): a ray leaves at its first
+occluder. With ``bvh=False``, :func:`_scan_nodes` tests every triangle of a
+node whose box a ray enters (Möller–Trumbore,
+``world.batches[k].nearest_many``), and :func:`_occluded` is that scan cut at
+``t = 1``: what ``ray_acceleration`` compares the BVH with.
+:class:`RenderStats` counts the ray-shape tests and the ray-box tests either
+way.
 """
 
 from __future__ import annotations
@@ -42,6 +46,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from glsandbox.raytrace.aabb import AABB, reciprocals
+from glsandbox.raytrace.bvh_traverse import TraversalCounts, any_hit, closest_hit
+from glsandbox.raytrace.bvh_world import NodeBVH, WorldBVH
 from glsandbox.raytrace.constants import SHADOW_OFFSET
 from glsandbox.raytrace.sphere import Sphere
 from glsandbox.raytrace.vec import length
@@ -70,8 +76,11 @@ class RenderStats:
     shadow: int = 0
     reflection: int = 0
     #: Ray-shape tests done (one per ray and triangle, or ray and sphere):
-    #: what backface and AABB culling save.
+    #: what backface culling, the AABB and the BVH save.
     tests: int = 0
+    #: Ray-box slab tests done: the nodes' boxes (``aabb``), and with ``bvh``
+    #: every BVH box a ray was tested against. What the shape tests saved costs these.
+    box_tests: int = 0
     seconds: float = 0.0
 
     @property
@@ -96,43 +105,124 @@ def _rows(o: NDArray[np.float64], rays: NDArray[np.intp] | NDArray[np.bool_]) ->
 
 
 def _nearest(world: World, o: NDArray[np.float64], d: NDArray[np.float64], cull: bool | None, aabb: bool,
-             stats: RenderStats | None = None) -> _Hits:
+             stats: RenderStats | None = None, bvh: WorldBVH | None = None) -> _Hits:
     """Nearest hit with ``t > 0`` of each ray over every node (the course's ``min_indis`` loop).
 
     ``o`` is ``(N, 3)``, or ``(3,)`` for rays that share one origin (the eye):
     the kernels then form the origin's terms once (see
     :func:`~glsandbox.raytrace.base.shared_origin`). ``cull`` is the render's
     ``cull_backfaces`` (None: each node's own), ``aabb`` whether boxes are
-    tested first.
+    tested first; ``bvh`` (the render's ``bvh=True``) traces mesh nodes through
+    their BVHs instead of testing all their triangles.
     """
-    return _scan_nodes(world, o, d, np.inf, cull, aabb, -1, stats)
+    return _scan_nodes(world, o, d, np.inf, cull, aabb, -1, stats, bvh)
 
 
 def _occluded(world: World, o: NDArray[np.float64], d: NDArray[np.float64], light: int, cull: bool | None,
-              aabb: bool, stats: RenderStats | None = None) -> NDArray[np.bool_]:
+              aabb: bool, stats: RenderStats | None = None, bvh: WorldBVH | None = None) -> NDArray[np.bool_]:
     """Gölge testi for shadow rays towards light ``light``: whether each ray ``o + s·d``
     hits something at ``0 < s < 1`` (``d`` reaches the light at ``s = 1``, so an
-    occluder beyond the light never counts). The light's lamp is skipped."""
-    return _scan_nodes(world, o, d, 1.0, cull, aabb, light, stats).node >= 0
+    occluder beyond the light never counts). The light's lamp is skipped.
+
+    Without a BVH, the nearest-hit scan cut at ``s = 1``; with one, an any-hit
+    query: a ray leaves at its first occluder, nodes and triangles in any order."""
+    if bvh is None:
+        return _scan_nodes(world, o, d, 1.0, cull, aabb, light, stats, None).node >= 0
+    n = d.shape[0]
+    found = np.zeros(n, dtype=bool)
+    inverse = reciprocals(d)
+    entries = bvh.by_node
+    for k, node in enumerate(world.nodes):
+        if light >= 0 and node.lamp_of >> light & 1:
+            continue
+        if node.kind == "sphere":
+            idx = np.flatnonzero(~found)
+            if aabb:
+                if stats is not None:
+                    stats.box_tests += idx.size
+                near, far = AABB(node.box_min, node.box_max).slabs_reciprocal(_rows(o, idx), inverse[:, idx])
+                idx = idx[(near <= far) & (far > 0.0) & (near < 1.0)]
+            if idx.size == 0:
+                continue
+            if stats is not None:
+                stats.tests += idx.size
+            t, _ = _hit_node(world, k, _rows(o, idx), d[idx], node.cull if cull is None else cull)
+            found[idx[t < 1.0]] = True
+            continue
+        entry = entries.get(k)
+        if entry is None:  # no triangle of non-zero area
+            continue
+        idx = np.flatnonzero(~found)
+        idx = idx[_box_candidates(entry, _rows(o, idx), inverse[:, idx], 1.0, stats)]
+        if idx.size == 0:
+            continue
+        counts = TraversalCounts()
+        one_sided = entry.cull if cull is None else bool(cull)
+        found[idx] |= any_hit(entry.bvh, _rows(o, idx), d[idx], 1.0, cull_backfaces=one_sided, counts=counts)
+        _add_counts(stats, counts)
+    return found
+
+
+def _box_candidates(entry: NodeBVH, o: NDArray[np.float64], inverse: NDArray[np.float64],
+                    limit: NDArray[np.float64] | float, stats: RenderStats | None) -> NDArray[np.intp]:
+    """Which rays enter a mesh node's BVH root box before ``limit``: the node's world box
+    (course "Hızlandırma: AABB"), widened as the BVH's own boxes are (a ray aimed
+    exactly at a corner vertex must not miss it)."""
+    if stats is not None:
+        stats.box_tests += inverse.shape[1]
+    lo, hi = entry.bvh.node_min[0], entry.bvh.node_max[0]
+    pad = 2.0**-30 * (1.0 + max(np.abs(lo).max(), np.abs(hi).max(), float(np.abs(o).max(initial=0.0))))
+    near, far = AABB(lo - pad, hi + pad).slabs_reciprocal(o, inverse)
+    return np.flatnonzero((near <= far) & (far >= 0.0) & (near <= limit))
+
+
+def _add_counts(stats: RenderStats | None, counts: TraversalCounts) -> None:
+    if stats is not None:
+        stats.box_tests += counts.boxes
+        stats.tests += counts.triangles
 
 
 def _scan_nodes(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_max: float, cull: bool | None,
-                aabb: bool, light: int, stats: RenderStats | None) -> _Hits:
+                aabb: bool, light: int, stats: RenderStats | None, bvh: WorldBVH | None = None) -> _Hits:
     """Nearest hit with ``0 < t < t_max``, every node in scene order; ``light >= 0`` skips that light's lamp.
 
     Each node's box (its slab test, ``1/d`` formed once for all nodes) picks the
     rays that enter it before the best hit so far; only those are tested
-    against the node. A strict ``<`` keeps ties with the earlier node.
+    against the node. A strict ``<`` keeps ties with the earlier node. With
+    ``bvh``, a mesh node's rays are traced through its BVH with ``t_max`` their
+    best hit so far (strictly nearer hits only, so the tie rule holds: the
+    earlier node, then the lower triangle index); spheres stay analytic.
     """
     n = d.shape[0]
     best_t = np.broadcast_to(np.asarray(t_max, dtype=np.float64), (n,)).copy()
     best_node = np.full(n, -1, dtype=np.intp)
     best_tri = np.full(n, -1, dtype=np.intp)
-    inverse = reciprocals(d) if aabb else None  # 1/d once for every node's slab test
+    inverse = reciprocals(d) if aabb or bvh is not None else None  # 1/d once for every node's slab test
     for k, node in enumerate(world.nodes):
         if light >= 0 and node.lamp_of >> light & 1:
             continue
-        if inverse is not None:
+        one_sided = node.cull if cull is None else cull
+        if bvh is not None and node.kind != "sphere":
+            entry = bvh.by_node.get(k)
+            if entry is None:  # no triangle of non-zero area
+                continue
+            assert inverse is not None
+            idx = _box_candidates(entry, o, inverse, best_t, stats)
+            if idx.size == 0:
+                continue
+            counts = TraversalCounts()
+            hits = closest_hit(entry.bvh, _rows(o, idx), d[idx], best_t[idx], cull_backfaces=bool(one_sided),
+                               counts=counts)
+            _add_counts(stats, counts)
+            won = hits.triangle >= 0  # strictly nearer than every earlier node's hit
+            sel = idx[won]
+            best_t[sel] = hits.t[won]
+            best_node[sel] = k
+            best_tri[sel] = entry.start + hits.triangle[won]
+            continue
+        if inverse is not None and aabb:
+            if stats is not None:
+                stats.box_tests += n
             near, far = AABB(node.box_min, node.box_max).slabs_reciprocal(o, inverse)
             idx = np.nonzero((near <= far) & (far > 0.0) & (near < best_t))[0]
         else:
@@ -141,7 +231,7 @@ def _scan_nodes(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_
             continue
         if stats is not None:
             stats.tests += idx.size * max(node.count, 1)
-        t, j = _hit_node(world, k, _rows(o, idx), d[idx], node.cull if cull is None else cull)
+        t, j = _hit_node(world, k, _rows(o, idx), d[idx], one_sided)
         better = t < best_t[idx]
         sel = idx[better]
         best_t[sel] = t[better]
@@ -277,7 +367,7 @@ def _offset(point: NDArray[np.float64], normal: NDArray[np.float64], side: NDArr
 
 
 def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.float64], shadows: bool,
-           cull: bool | None, aabb: bool, stats: RenderStats
+           cull: bool | None, aabb: bool, stats: RenderStats, bvh: WorldBVH | None = None
            ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """Local colour of hit rays (the raster's per-light formula), plus point and normal for bounces."""
     point, normal, base = _surface(world, hits, o, d)
@@ -314,7 +404,7 @@ def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.floa
             if shadows:
                 start = _offset(p, nrm, light - p)
                 stats.shadow += idx.size
-                blocked = _occluded(world, start, light - start, index, cull, aabb, stats)
+                blocked = _occluded(world, start, light - start, index, cull, aabb, stats, bvh)
                 lighting *= np.where(blocked, 0.0, 1.0)[:, None]  # in shadow only the ambient term stays
             total += np.minimum(ka * mesh + lighting, 1.0)
         color[idx] = total
@@ -322,21 +412,21 @@ def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.floa
 
 
 def _trace(world: World, o: NDArray[np.float64], d: NDArray[np.float64], max_depth: int, shadows: bool,
-           cull: bool | None, aabb: bool, stats: RenderStats) -> NDArray[np.float64]:
+           cull: bool | None, aabb: bool, stats: RenderStats, bvh: WorldBVH | None = None) -> NDArray[np.float64]:
     """Colour of each ray, reflections followed iteratively: ``(1−r)·local + r·reflected``."""
     n = d.shape[0]
     out = np.zeros((n, 3))
     weight = np.ones(n)
     alive = np.arange(n)
     for depth in range(max_depth + 1):
-        hits = _nearest(world, o, d, cull, aabb, stats)
+        hits = _nearest(world, o, d, cull, aabb, stats, bvh)
         miss = hits.node < 0
         out[alive[miss]] += weight[miss, None] * world.background
         hit = ~miss
         if not hit.any():
             break
         sub = _Hits(hits.t[hit], hits.node[hit], hits.tri[hit])
-        local, point, normal = _shade(world, sub, _rows(o, hit), d[hit], shadows, cull, aabb, stats)
+        local, point, normal = _shade(world, sub, _rows(o, hit), d[hit], shadows, cull, aabb, stats, bvh)
         r = world.materials.reflectivity[sub.node] if depth < max_depth else np.zeros(sub.node.size)
         w = weight[hit]
         out[alive[hit]] += (w * (1.0 - r))[:, None] * local
@@ -363,7 +453,8 @@ def to_rgba8(rgb: NDArray[np.float64]) -> NDArray[np.uint8]:
 
 def render_viewport(scene: Scene, size: tuple[int, int], viewport: int = 0, *, max_depth: int = 2,
                     shadows: bool = True, cull_backfaces: bool | None = None, aabb: bool = True,
-                    analytic_spheres: bool = True, stats: RenderStats | None = None) -> NDArray[np.uint8]:
+                    bvh: bool = True, analytic_spheres: bool = True,
+                    stats: RenderStats | None = None) -> NDArray[np.uint8]:
     """Trace one viewport at ``size``: ``(H, W, 4)`` uint8, top row first (see :func:`to_rgba8`).
 
     The options are :func:`glsandbox.raytrace.render`'s; ``stats`` counts the rays cast.
@@ -371,11 +462,12 @@ def render_viewport(scene: Scene, size: tuple[int, int], viewport: int = 0, *, m
     width, height = size
     vp = scene.viewports[viewport]
     world = build_world(scene, viewport, analytic_spheres=analytic_spheres)
+    accel = WorldBVH.from_world(world) if bvh else None  # built once per mesh (cached by content)
     eye, dirs = camera_rays(vp.camera or scene.camera, width, height)
     stats = stats if stats is not None else RenderStats()
     stats.primary += dirs.shape[0]
     rgb = np.empty((dirs.shape[0], 3))
     for lo in range(0, dirs.shape[0], RAY_BLOCK):
         rays = slice(lo, lo + RAY_BLOCK)
-        rgb[rays] = _trace(world, eye, dirs[rays], max_depth, shadows, cull_backfaces, aabb, stats)
+        rgb[rays] = _trace(world, eye, dirs[rays], max_depth, shadows, cull_backfaces, aabb, stats, accel)
     return to_rgba8(rgb.reshape(height, width, 3))

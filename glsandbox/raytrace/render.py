@@ -20,6 +20,14 @@ The algorithm, in the course's order (first half of the notes):
 2. **Nearest hit** (``tDistances``/``min_indis``): for each node, the AABB
    slab test first (course "Hızlandırma: AABB"; ``aabb=False`` skips it),
    then Möller–Trumbore against its triangles, or the exact sphere test.
+   The numpy engine's ``bvh=True`` (the default) traces each mesh node's rays
+   through a BVH over its triangles instead (:mod:`glsandbox.raytrace.bvh`,
+   built once per mesh and cached), with the watertight triangle test
+   (:mod:`glsandbox.raytrace.watertight`: a ray through a shared edge or
+   vertex hits one of its triangles, never none); spheres stay exact, and
+   shadow rays stop at their first occluder. ``bvh=False`` is the per-node
+   scan above (what ``ray_acceleration`` compares it with). The gpu engine
+   does not traverse a BVH yet and ignores the option.
    **Backface culling** (course "Hızlandırma: backface culling"): a node the
    rasterizer culls (``cull_back_faces``) is one-sided for *every* ray, as
    ``det > 0`` in Möller–Trumbore; ``cull_backfaces=True``/``False``
@@ -84,7 +92,7 @@ def _check(size: tuple[int, int], engine: str, max_depth: int) -> None:
 
 def render(scene: Scene, size: tuple[int, int], engine: str = "numpy", *, ctx: object | None = None,
            max_depth: int = 2, shadows: bool = True, cull_backfaces: bool | None = None, aabb: bool = True,
-           analytic_spheres: bool = True, stats: RenderStats | None = None) -> NDArray[np.uint8]:
+           bvh: bool = True, analytic_spheres: bool = True, stats: RenderStats | None = None) -> NDArray[np.uint8]:
     """Ray-trace ``scene`` at ``size = (width, height)``: an ``(H, W, 4)`` uint8 image, top row first.
 
     Every viewport is traced in its rectangle with its camera and clear
@@ -92,8 +100,10 @@ def render(scene: Scene, size: tuple[int, int], engine: str = "numpy", *, ctx: o
     are the rasterizer's). ``engine="gpu"`` needs ``ctx``, a ModernGL
     context (the GLSL engine renders on it). Options: ``max_depth``
     reflection bounces, ``shadows``, ``cull_backfaces`` (None: per node, as
-    the rasterizer), ``aabb`` culling, ``analytic_spheres`` (see
-    :mod:`glsandbox.raytrace.world`). ``stats`` (numpy engine) counts the rays.
+    the rasterizer), ``aabb`` culling, ``bvh`` (numpy engine: mesh nodes
+    through their BVH; ``False``: every triangle of each node the box test
+    lets through), ``analytic_spheres`` (see :mod:`glsandbox.raytrace.world`).
+    ``stats`` (numpy engine) counts the rays and the box and shape tests.
     """
     _check(size, engine, max_depth)
     width, height = int(size[0]), int(size[1])
@@ -111,7 +121,7 @@ def render(scene: Scene, size: tuple[int, int], engine: str = "numpy", *, ctx: o
 
         tracer = partial(gpu_tracer(ctx).render_viewport, scene, **options)
     else:
-        tracer = partial(numpy_engine.render_viewport, scene, stats=stats, **options)
+        tracer = partial(numpy_engine.render_viewport, scene, stats=stats, bvh=bool(bvh), **options)
     for index, vp in enumerate(scene.viewports):
         x, y, w, h = vp.pixels(width, height)
         if w <= 0 or h <= 0:

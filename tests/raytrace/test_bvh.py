@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 from glsandbox import geometry, meshgen
 from glsandbox.raytrace.bvh import (
     BVH,
+    CACHE_SIZE,
     build_bvh,
     bvh_for_mesh,
     bvh_for_triangles,
@@ -311,6 +312,6 @@ def test_the_cache_returns_the_same_bvh_for_the_same_content() -> None:
     a, b, c = mesh_world_triangles(mesh, model)
     np.testing.assert_array_equal(first.v0, a[first.tri_index])
     assert bvh_for_triangles(a, b, c) is bvh_for_triangles(a.copy(), b.copy(), c.copy())
-    for k in range(6):  # older entries leave the LRU
+    for k in range(CACHE_SIZE + 2):  # older entries leave the LRU
         bvh_for_mesh(mesh, np.diag([1.0 + k, 1.0, 1.0, 1.0]))
     assert bvh_for_mesh(mesh, model) is not first

@@ -60,7 +60,7 @@ def test_world_bvh_finds_the_node_the_engine_finds(lesson: str) -> None:
     # watertight test: they may differ only where a ray grazes an edge.
     world, eye, dirs = world_of(lesson)
     hits = WorldBVH.from_world(world).closest_hit(eye, dirs)
-    engine = _nearest(world, eye, dirs, None, True)
+    engine = _nearest(world, eye, dirs, None, True)  # the per-node scan (no BVH): Möller-Trumbore
     same = hits.node == engine.node
     assert same.mean() > 0.995
     both = same & (hits.node >= 0)
