@@ -81,6 +81,11 @@ def check_number(value: object, what: str, low: float = -NUMBER_LIMIT, high: flo
 def check_numbers(value: object, what: str, counts: tuple[int, ...] = (3,), low: float = -NUMBER_LIMIT,
                   high: float = NUMBER_LIMIT) -> tuple[float, ...]:
     """A tuple of ``counts`` numbers (floats), each checked as :func:`check_number` does."""
+    # The common case, checked every frame: a tuple of floats in range (a NaN fails
+    # the comparison, so it takes the slow path below and gets its message).
+    if type(value) is tuple and len(value) in counts \
+            and all(type(v) is float and low <= v <= high for v in value):
+        return value
     try:
         items = list(value)  # type: ignore[call-overload]
     except TypeError:

@@ -255,11 +255,12 @@ class Node:
         if not isinstance(self.name, str):
             raise SandboxError(f"a node's name must be text, got {plain(self.name)}")
         model = np.asarray(self.model)
-        if model.shape != (4, 4) or not np.issubdtype(model.dtype, np.number):
+        if model.shape != (4, 4) or model.dtype.kind not in "biuf":
             raise SandboxError(f"node {self.name!r}: model matrix must be 4x4 numbers, got {plain(self.model)}")
-        if not np.all(np.isfinite(model)):
+        in_bounds = bool((np.abs(model) <= NUMBER_LIMIT).all())  # False for NaN and inf too
+        if not in_bounds and not np.all(np.isfinite(model)):
             raise SandboxError(f"node {self.name!r}: model matrix has a non-finite entry: {plain(model)}")
-        if np.max(np.abs(model)) > NUMBER_LIMIT:
+        if not in_bounds:
             raise SandboxError(f"node {self.name!r}: model matrix entry {plain(np.max(np.abs(model)))} is beyond "
                                f"+-{NUMBER_LIMIT:g} (scale and position within +-{NUMBER_LIMIT:g})")
         # What the material reads from the mesh (the renderers would fail later, naming no node).
@@ -270,7 +271,7 @@ class Node:
             if data and getattr(self.mesh, attribute, None) is None:
                 raise SandboxError(f"node {self.name!r}: mesh {self.mesh.name!r} has no {attribute[:-1]} data, "
                                    f"which {needed} needs")
-        if self.material.lit:
+        if self.material.lit and not transforms.scales_at_least(model, MIN_SCALE):
             smallest = transforms.smallest_scale(model)
             if smallest < MIN_SCALE:
                 what = ("is singular (a scale of 0?)" if smallest == 0.0 else

@@ -166,6 +166,20 @@ def smallest_scale(model: Matrix) -> float:
     return float(np.linalg.svd(np.asarray(model, dtype=np.float64)[:3, :3], compute_uv=False)[-1])
 
 
+def scales_at_least(model: Matrix, bound: float) -> bool:
+    """Whether :func:`smallest_scale` of ``model`` is at least ``bound``, cheaply.
+
+    For the 3x3 block A with singular values s1 >= s2 >= s3:
+    s3 = |det A| / (s1 s2) and s1 s2 <= (s1² + s2²) / 2 <= |A|²_F / 2, so
+    s3 >= 2 |det A| / |A|²_F. When that lower bound clears ``bound`` (every
+    ordinary model matrix) no singular value decomposition is needed."""
+    a = np.asarray(model, dtype=np.float64)[:3, :3]
+    frobenius2 = float(np.einsum("ij,ij->", a, a))
+    if frobenius2 > 0.0 and 2.0 * abs(float(np.linalg.det(a))) / frobenius2 >= bound:
+        return True
+    return smallest_scale(model) >= bound
+
+
 def transform_points(m: Matrix, points: np.ndarray) -> np.ndarray:
     """Apply a 4x4 matrix to an (N, 3) array of points (w = 1), with the divide."""
     pts = np.asarray(points, dtype=np.float64)
