@@ -176,7 +176,7 @@ def test_depth_knob_counts_z_fighting_pixels(quick_report: Path) -> None:
     report = (quick_report / "report.md").read_text(encoding="utf-8")
     assert "## Depth precision (`depth`)" in report
     fights = int(rows["standard 24-bit, lift 0, no offset"]["count_px"])
-    assert f"| standard 24-bit, lift 0, no offset | " in report and f" | {fights} | " in report
+    assert "| standard 24-bit, lift 0, no offset | " in report and f" | {fights} | " in report
     assert "| default: reverse-Z float, lift 0.005, polygon offset (reference) | " in report
 
 
