@@ -27,6 +27,8 @@ import numpy as np
 import numpy.typing as npt
 from PIL import Image
 
+from glsandbox.errors import SandboxError
+
 __all__ = ["NotARegularFile", "atomic_write", "load_png", "open_regular", "png_bytes", "read_regular", "save_png",
            "write_text"]
 
@@ -137,6 +139,35 @@ def read_regular(path: str | os.PathLike[str]) -> bytes:
     """The bytes of a regular file (see :func:`open_regular`)."""
     with open_regular(path) as handle:
         return handle.read()
+
+
+def open_user_file(path: str | os.PathLike[str], what: str, expected: str) -> BinaryIO:
+    """:func:`open_regular` for a file the user named, every failure one line:
+    ``<what> <path> not found``, ``... is a folder, expected <expected>``, ``... is a
+    named pipe (FIFO), expected <expected>``, ``... is not readable (permission
+    denied)`` or ``... cannot be read (<reason>)``, as :class:`SandboxError`."""
+    where = f"{what} {os.fspath(path)}"
+    try:
+        return open_regular(path)
+    except FileNotFoundError:
+        raise SandboxError(f"{where} not found") from None
+    except IsADirectoryError:
+        raise SandboxError(f"{where} is a folder, expected {expected}") from None
+    except NotARegularFile as exc:
+        raise SandboxError(f"{where} is {exc.kind}, expected {expected}") from None
+    except PermissionError:
+        raise SandboxError(f"{where} is not readable (permission denied)") from None
+    except OSError as exc:
+        raise SandboxError(f"{where} cannot be read ({exc.strerror or exc})") from None
+
+
+def read_user_file(path: str | os.PathLike[str], what: str, expected: str) -> bytes:
+    """The bytes of a file the user named (:func:`open_user_file`'s errors, and read errors alike)."""
+    with open_user_file(path, what, expected) as handle:
+        try:
+            return handle.read()
+        except OSError as exc:
+            raise SandboxError(f"{what} {os.fspath(path)} cannot be read ({exc.strerror or exc})") from None
 
 
 def write_text(path: str | os.PathLike[str], text: str) -> Path:

@@ -21,7 +21,7 @@ import numpy as np
 from PIL import Image, ImageDraw, ImageFont, UnidentifiedImageError
 
 from glsandbox.errors import SandboxError
-from glsandbox.files import NotARegularFile, open_regular
+from glsandbox.files import open_user_file
 from glsandbox.scene import BUILTIN_TEXTURES, Texture
 
 #: The colours of the four quadrants of the ``labels`` image, by the uv
@@ -131,18 +131,7 @@ def load_image(path: str | Path, max_size: int | None = None) -> np.ndarray:
     greyscale images are scaled to 8 bits (see :func:`to_rgba8`).
     """
     p = Path(path)
-    try:
-        handle = open_regular(p)
-    except FileNotFoundError:
-        raise SandboxError(f"texture file {p} not found") from None
-    except IsADirectoryError:
-        raise SandboxError(f"texture file {p} is a folder, expected an image file") from None
-    except NotARegularFile as exc:
-        raise SandboxError(f"texture file {p} is {exc.kind}, expected an image file") from None
-    except PermissionError:
-        raise SandboxError(f"texture file {p} is not readable (permission denied)") from None
-    except OSError as exc:
-        raise SandboxError(f"texture file {p} cannot be opened ({exc.strerror or exc})") from None
+    handle = open_user_file(p, "texture file", "an image file")
     try:
         with handle, warnings.catch_warnings():
             # Pillow warns (on stderr) above MAX_IMAGE_PIXELS and refuses above twice that: refuse both.

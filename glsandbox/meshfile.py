@@ -47,18 +47,18 @@ import io
 import logging
 import math
 import os
-import stat
 import warnings
 from collections import OrderedDict
 from collections.abc import Iterator
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 import numpy as np
 from numpy.typing import NDArray
 
 from glsandbox.errors import SandboxError
+from glsandbox.files import open_user_file
 from glsandbox.geometry import Mesh
 from glsandbox.meshnormals import corner_normals, unique_vertices
 from glsandbox.scene import Material, Texture
@@ -141,18 +141,22 @@ def load_model(path: str | os.PathLike[str], *, fit: bool = False, normals: str 
             or not (math.isfinite(crease_angle) and 0.0 <= crease_angle <= 180.0):
         raise SandboxError(f"crease angle must be a number of degrees in 0..180, got {crease_angle!r}")
     p = Path(path)
-    info = _regular_file(p)
-    file_type = FORMATS.get(p.suffix.lower())
-    if file_type is None:
-        known = ", ".join(FORMATS)
-        what = f"extension {p.suffix!r}" if p.suffix else "no extension"
-        raise SandboxError(f"model file {p}: unknown format ({what}); use one of {known}")
-    key = (str(p.resolve()), info.st_mtime_ns, info.st_size, bool(fit), normals, float(crease_angle))
-    model = _CACHE.get(key)
-    if model is not None:
-        _CACHE.move_to_end(key)
-        return model
-    data = _read(p)
+    handle, info = _open(p)
+    with handle:
+        file_type = FORMATS.get(p.suffix.lower())
+        if file_type is None:
+            known = ", ".join(FORMATS)
+            what = f"extension {p.suffix!r}" if p.suffix else "no extension"
+            raise SandboxError(f"model file {p}: unknown format ({what}); use one of {known}")
+        key = (str(p.resolve()), info.st_mtime_ns, info.st_size, bool(fit), normals, float(crease_angle))
+        model = _CACHE.get(key)
+        if model is not None:
+            _CACHE.move_to_end(key)
+            return model
+        try:
+            data = handle.read()
+        except OSError as exc:
+            raise SandboxError(f"model file {p} cannot be read ({exc.strerror or exc})") from None
     parts = _parts(p, _trimesh_scene(p, data, file_type))
     model = _model(p, file_type, parts, bool(fit), normals, float(crease_angle))
     _CACHE[key] = model
@@ -181,37 +185,15 @@ _CACHE: OrderedDict[tuple[Any, ...], Model] = OrderedDict()
 # --- the file -------------------------------------------------------------
 
 
-def _regular_file(p: Path) -> os.stat_result:
-    """``stat`` the path and refuse anything that is not a regular, non-empty file, before opening it
-    (opening a FIFO for reading would wait for a writer forever)."""
-    try:
-        info = os.stat(p)
-    except FileNotFoundError:
-        raise SandboxError(f"model file {p} not found") from None
-    except PermissionError:
-        raise SandboxError(f"model file {p} is not readable (permission denied)") from None
-    except OSError as exc:
-        raise SandboxError(f"model file {p} cannot be read ({exc.strerror or exc})") from None
-    mode = info.st_mode
-    if stat.S_ISDIR(mode):
-        raise SandboxError(f"model file {p} is a folder, expected a model file")
-    if not stat.S_ISREG(mode):
-        kind = ("a FIFO (named pipe)" if stat.S_ISFIFO(mode) else "a socket" if stat.S_ISSOCK(mode)
-                else "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode) else "not a regular file")
-        raise SandboxError(f"model file {p} is {kind}, expected a regular file")
+def _open(p: Path) -> tuple[BinaryIO, os.stat_result]:
+    """The open model file and its ``stat``: anything but a regular, non-empty file is
+    refused before a byte is read (a FIFO would wait for a writer forever)."""
+    handle = open_user_file(p, "model file", "a model file")
+    info = os.fstat(handle.fileno())
     if info.st_size == 0:
+        handle.close()
         raise SandboxError(f"model file {p} is empty")
-    return info
-
-
-def _read(p: Path) -> bytes:
-    try:
-        with open(p, "rb") as f:
-            return f.read()
-    except PermissionError:
-        raise SandboxError(f"model file {p} is not readable (permission denied)") from None
-    except OSError as exc:
-        raise SandboxError(f"model file {p} cannot be read ({exc.strerror or exc})") from None
+    return handle, info
 
 
 @contextlib.contextmanager

@@ -32,7 +32,7 @@ import numpy as np
 
 from glsandbox import transforms
 from glsandbox.errors import NUMBER_LIMIT, SandboxError, plain
-from glsandbox.files import NotARegularFile, read_regular
+from glsandbox.files import read_user_file
 from glsandbox.geometry import builtin_mesh
 from glsandbox.meshfile import CREASE_ANGLE, NORMALS as MESH_NORMALS, Model, is_model_path, load_model
 from glsandbox.planar import Mirror, PlanarShadow
@@ -454,18 +454,7 @@ def load_scene(path: str | Path) -> Scene:
     ``scene.toml:7: nodes[0].mesh: unknown mesh 'cbe'; ...``.
     """
     p = Path(path)
-    try:
-        raw = read_regular(p)
-    except FileNotFoundError:
-        raise SandboxError(f"{p}: scene file not found") from None
-    except IsADirectoryError:
-        raise SandboxError(f"{p}: is a folder, expected a scene .toml file") from None
-    except NotARegularFile as exc:
-        raise SandboxError(f"{p}: is {exc.kind}, expected a scene .toml file") from None
-    except PermissionError:
-        raise SandboxError(f"{p}: cannot read scene file (permission denied)") from None
-    except OSError as exc:
-        raise SandboxError(f"{p}: cannot read scene file ({exc.strerror or exc})") from None
+    raw = read_user_file(p, "scene file", "a scene .toml file")
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:

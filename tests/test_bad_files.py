@@ -48,7 +48,7 @@ def test_a_named_pipe_as_the_lesson_image_or_the_scene_file_is_refused(tmp_path:
                                 "--out", str(out)), "is a named pipe (FIFO)")
     os.mkfifo(tmp_path / "pipe.toml")
     assert_user_error(glsandbox("render", str(tmp_path / "pipe.toml"), "--out", str(out)),
-                      f"{tmp_path / 'pipe.toml'}: is a named pipe (FIFO), expected a scene .toml file")
+                      f"scene file {tmp_path / 'pipe.toml'} is a named pipe (FIFO), expected a scene .toml file")
     assert not out.exists()
 
 

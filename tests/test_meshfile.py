@@ -245,7 +245,7 @@ def test_truncated_and_garbage_binaries_are_refused(tmp_path: Path) -> None:
 def test_folders_fifos_and_missing_files_are_refused_before_opening(tmp_path: Path) -> None:
     (tmp_path / "dir.obj").mkdir()
     os.mkfifo(tmp_path / "pipe.obj")  # opening it for reading would wait for a writer forever
-    for name, message in (("dir.obj", "is a folder"), ("pipe.obj", "is a FIFO (named pipe)"),
+    for name, message in (("dir.obj", "is a folder"), ("pipe.obj", "is a named pipe (FIFO)"),
                           ("none.obj", "not found")):
         with pytest.raises(SandboxError, match=re.escape(f"model file {tmp_path / name} {message}")):
             load_model(tmp_path / name)

@@ -144,7 +144,7 @@ def test_a_fifo_is_refused_without_opening_it(tmp_path: Path) -> None:
     scene = scene_with(tmp_path, "models/pipe.obj")
     out = tmp_path / "x.png"
     proc = glsandbox("render", str(scene), "--out", str(out), "--size", "32x32")  # the helper's timeout applies
-    assert_user_error(proc, f"{scene}:9: nodes[0].mesh: model file {tmp_path / 'models' / 'pipe.obj'} is a FIFO")
+    assert_user_error(proc, f"{scene}:9: nodes[0].mesh: model file {tmp_path / 'models' / 'pipe.obj'} is a named pipe (FIFO)")
     assert not out.exists()
 
 

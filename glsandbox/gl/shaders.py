@@ -30,7 +30,7 @@ from pathlib import Path
 import moderngl
 
 from glsandbox.errors import SandboxError
-from glsandbox.files import NotARegularFile, read_regular
+from glsandbox.files import read_user_file
 from glsandbox.plan import ProgramVariant
 
 _INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"\s*$')
@@ -133,14 +133,7 @@ def assemble(name: str, stage: str, defines: tuple[tuple[str, str], ...] = (), r
 def _read_lines(path: Path, included_from: str | None) -> list[str]:
     """The lines of a shader file; a missing, unreadable or non-UTF-8 file is one error naming it."""
     where = f"{included_from}: " if included_from else ""
-    try:
-        raw = read_regular(path)
-    except FileNotFoundError:
-        raise SandboxError(f"{where}shader file {path} not found") from None
-    except NotARegularFile as exc:
-        raise SandboxError(f"{where}shader file {path} is {exc.kind}, expected a text file") from None
-    except OSError as exc:
-        raise SandboxError(f"{where}shader file {path} cannot be read ({exc.strerror or exc})") from None
+    raw = read_user_file(path, f"{where}shader file", "a text file")
     try:
         return raw.decode("utf-8").splitlines()
     except UnicodeDecodeError as exc:
