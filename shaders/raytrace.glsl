@@ -91,6 +91,20 @@ vec4 node_rec(int k, int r) { return record(u_nodes, k * NODE_RECORDS + r); }
 vec4 tri_rec(int k, int r) { return record(u_tris, k * TRI_RECORDS + r); }
 #endif
 
+#ifndef BVH
+#define BVH 0
+#endif
+#if BVH
+// Mesh nodes traced through their BVHs (gpu.py packs one per mesh node into
+// one texture pair; u_bvh_roots texel k holds mesh slot k's root node). A
+// ray that runs out of BVH_MAX_STEPS sets g_overflow; main writes alpha 0
+// and the host raises instead of showing the picture.
+#include "common/bvh.glsl"
+uniform sampler2D u_bvh_roots;
+bool g_overflow = false;
+int bvh_root(int k) { return int(texelFetch(u_bvh_roots, ivec2(k, 0), 0).x); }
+#endif
+
 // Hızlandırma: AABB. The slab test: the ray is inside the box between the
 // largest entry and the smallest exit; skip the node unless that interval
 // is non-empty, ends after 0 and starts before the best hit so far.
@@ -209,7 +223,15 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
     // the records; an equal t goes to the node first in scene order (r2.z),
     // and within a node to the first triangle.
     float best_order = 1e9;
-#if HAS_MESHES
+#if HAS_MESHES && BVH
+    for (int k = 0; k < u_mesh_count; ++k) {
+        BvhHit h = bvh_closest_at(bvh_root(k), o, d, best, node_cull(node_rec(k, 1)));
+        if (h.overflow) g_overflow = true;
+        if (h.index >= 0 && h.t < best) {
+            best = h.t; best_order = node_rec(k, 2).z; hit_node = k; hit_tri = h.index; hit_uv = h.uv;
+        }
+    }
+#elif HAS_MESHES
     for (int k = 0; k < u_mesh_count; ++k) {
         vec4 r0 = node_rec(k, 0);
         vec4 r1 = node_rec(k, 1);
@@ -269,7 +291,15 @@ bool occluded(vec3 o, vec3 d, int light) {
 #undef SPHERE
     return hit;
 #else
-#if HAS_MESHES
+#if HAS_MESHES && BVH
+    for (int k = 0; k < u_mesh_count; ++k) {
+        if (((int(node_rec(k, 5).z) >> light) & 1) != 0) continue;
+        bool overflow;
+        bool blocked = bvh_any_at(bvh_root(k), o, d, 1.0, node_cull(node_rec(k, 1)), overflow);
+        if (overflow) g_overflow = true;
+        if (blocked) return true;
+    }
+#elif HAS_MESHES
     for (int k = 0; k < u_mesh_count; ++k) {
         vec4 r0 = node_rec(k, 0);
         vec4 r1 = node_rec(k, 1);
@@ -464,6 +494,10 @@ void main() {
         color = shade(k, p, n, base, d);
     }
 #endif
+#if BVH
+    frag_color = vec4(clamp(color, 0.0, 1.0), g_overflow ? 0.0 : 1.0);
+#else
     frag_color = vec4(clamp(color, 0.0, 1.0), 1.0);
+#endif
 }
 #endif

@@ -59,20 +59,34 @@ llvmpipe's loop limit
 ---------------------
 llvmpipe ends a shader invocation's loops after 65,535 iterations, all
 loops counted together (Mesa gallivm's ``LP_MAX_TGSI_LOOP_ITERATIONS``),
-silently. This engine refuses (:class:`RayTraceError`, naming the largest
-node and suggesting ``renderer=ray_numpy``) a render whose worst case could
-pass it (:func:`check_loop_budget`: every ray of a pixel testing every
-triangle and node record), rather than drawing a wrong picture. Every
+silently. A render whose scan could pass it (:func:`check_loop_budget`:
+every ray of a pixel testing every triangle and node record) gets the BVH
+program below; an unrolled scene that could (none known) is refused
+(:class:`RayTraceError`, naming the largest node and suggesting
+``renderer=ray_numpy``), rather than drawing a wrong picture. Every
 triangle a ray tests in a loop is an iteration, for the primary ray, each shadow ray and each
 bounce (in the general program every node record too), and a pixel that
 runs past the limit keeps whatever it had found: one node of about 65,000
 triangles that the primary ray's box test lets in is enough, and fewer
 when shadow rays and bounces enter it too. The lesson scenes stay far
 below it: the largest, ``ray_acceleration`` (2,018 triangles, the general
-program, one light), runs at most about 4,100 iterations a pixel. A
-traversal that visits only the nodes and triangles a ray's boxes let in (a
-BVH) makes the count grow with what a ray passes near rather than with the
-scene's size; that is still no bound.
+program, one light), runs at most about 4,100 iterations a pixel.
+
+The BVH program
+---------------
+A scene too large for that scan (or with a mesh node of more than
+:data:`BVH_TRIANGLES` triangles) that is not unrolled gets the general
+program with ``BVH`` defined: each mesh node's triangles are traced through
+its BVH (:func:`~glsandbox.raytrace.bvh.bvh_for_triangles` on the World's
+triangles, cached; ``shaders/common/bvh.glsl``: the watertight test, nearest
+hit for primary and reflected rays, any hit for shadow rays), all nodes'
+BVHs packed into one node/triangle texture pair with their indices offset
+(``u_bvh_roots`` holds each mesh node's root). Each traversal is one loop
+bounded by ``BVH_MAX_STEPS`` (:func:`bvh_step_cap`: what the loop limit
+leaves after the other loops, shared by every ray of a pixel and every mesh
+node). A ray that reaches the bound writes alpha 0, and the render raises
+:class:`RayTraceError` instead of returning the picture. The lessons' scenes
+stay below :data:`BVH_TRIANGLES` and keep the scan and its pixels.
 
 Float32 differs from float64 in the last bits of ``t`` and of the shading;
 the image agrees with the numpy engine's to within a couple of 8-bit levels
@@ -123,6 +137,41 @@ def check_loop_budget(world: World, lights: int, shadows: bool, reflect: bool, m
             f"(node {largest.name!r} has {largest.count:,} triangles, {rays} rays a pixel): "
             "use renderer=ray_numpy (engine='numpy'), which traces meshes through a BVH")
     return worst
+
+
+#: The most steps (node visits plus triangle tests) one ray's traversal of one
+#: mesh node's BVH may take; None: as many as the loop budget allows
+#: (:func:`bvh_step_cap`). Tests set it small to see the overflow raise.
+BVH_STEP_CAP: int | None = None
+#: The general program traces mesh nodes through BVHs when some mesh node has more
+#: triangles than this (or the scan could pass the loop limit); smaller scenes scan
+#: (their pixels as before: the lessons stay far below it).
+BVH_TRIANGLES = 4096
+#: A BVH render is refused when the budget leaves a ray fewer steps than this.
+BVH_MIN_STEPS = 256
+
+
+def bvh_step_cap(world: World, lights: int, shadows: bool, reflect: bool, max_depth: int) -> int:
+    """The per-ray, per-mesh-node traversal bound (``BVH_MAX_STEPS``) of the BVH program:
+    every ray of a pixel may traverse every mesh node's BVH to the bound, and the
+    sum with the other loops (node records, spheres, lights, bounces) stays within
+    :data:`LOOP_LIMIT`. A ray that reaches it is flagged (alpha 0) and the render
+    raises. Raises :class:`RayTraceError` when the budget leaves too few steps."""
+    bounces = 1 + (max_depth if reflect else 0)
+    rays = (1 + (lights if shadows else 0)) * bounces
+    meshes = sum(1 for node in world.nodes if node.kind != "sphere")
+    other = rays * (len(world.nodes) + 1) + bounces * (lights + 1) + 64
+    cap = (LOOP_LIMIT - other) // max(1, rays * meshes)
+    if BVH_STEP_CAP is not None:
+        cap = min(cap, BVH_STEP_CAP)
+    if cap < min(BVH_MIN_STEPS, BVH_STEP_CAP or BVH_MIN_STEPS):
+        raise RayTraceError(
+            f"the gpu engine's BVH traversal would get only {max(cap, 0):,} steps a ray within llvmpipe's "
+            f"{LOOP_LIMIT:,} loop iterations ({meshes} mesh nodes, {rays} rays a pixel): "
+            "use renderer=ray_numpy (engine='numpy')")
+    return int(cap)
+
+
 #: Scenes with at most this many nodes, of which at most UNROLL_LOOPS have
 #: more than UNROLL_TRIS triangles, get a program with the node list
 #: unrolled (``SCENE_NODES`` in ``shaders/raytrace.glsl``). The bounds keep
@@ -257,6 +306,8 @@ class _Uploaded:
         self.unrolled = (len(world.nodes) <= UNROLL_NODES and loops <= UNROLL_LOOPS
                          and max(1, self.tris.shape[0]) + max(1, self.nodes.shape[0]) <= block_records)
         self.block: moderngl.Buffer | None = None
+        #: The BVH program's stack depth once its textures are uploaded (0: not yet).
+        self.bvh_stack = 0
         #: Samplers by uniform name, in texture unit order.
         self.textures: dict[str, moderngl.Texture] = {}
         if self.unrolled:
@@ -273,6 +324,48 @@ class _Uploaded:
             texture = ctx.texture((w, h), 4, np.ascontiguousarray(pixels).tobytes())
             texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
             self.textures[f"u_tex{slot}"] = texture
+
+    def bvh_textures(self, ctx: moderngl.Context) -> int:
+        """Upload (once) one BVH per mesh node, concatenated into one node/triangle
+        texture pair (``shaders/common/bvh.glsl``'s layout, indices offset per node;
+        stored triangle indices are the World's), and ``u_bvh_roots`` (texel k: mesh
+        slot k's root). Returns the stack depth the shader needs."""
+        if self.bvh_stack:
+            return self.bvh_stack
+        from glsandbox.raytrace.bvh import bvh_for_triangles
+        from glsandbox.raytrace.gpu_bvh import TEX_WIDTH as BVH_TEX_WIDTH, _texture, pack_bvh
+
+        world = self.world
+        node_parts: list[NDArray[np.float32]] = []
+        tri_parts: list[NDArray[np.float32]] = []
+        roots: list[int] = []
+        node_offset = tri_offset = 0
+        depth = 1
+        for k in node_order(world)[: self.mesh_count]:
+            node = world.nodes[k]
+            stop = node.start + node.count
+            bvh = bvh_for_triangles(world.v0[node.start:stop], world.v1[node.start:stop], world.v2[node.start:stop])
+            nodes, tris = pack_bvh(bvh)
+            nodes = nodes.reshape(-1, 2, 4).copy()
+            tris = tris.reshape(-1, 3, 4).copy()
+            leaf = nodes[:, 1, 3] > 0
+            nodes[:, 0, 3] += np.where(leaf, tri_offset, node_offset).astype(np.float32)
+            tris[:, 0, 3] += node.start
+            roots.append(node_offset)
+            node_offset += nodes.shape[0]
+            tri_offset += tris.shape[0]
+            depth = max(depth, bvh.depth)
+            node_parts.append(nodes.reshape(-1, 4))
+            tri_parts.append(tris.reshape(-1, 4))
+        if 2 * node_offset > (1 << 24) or 3 * tri_offset > (1 << 24):
+            raise RayTraceError(f"the gpu BVH holds at most {(1 << 24) // 3:,} triangles, this scene has {tri_offset:,}")
+        self.textures["u_bvh_nodes"] = _texture(ctx, np.concatenate(node_parts), BVH_TEX_WIDTH)
+        self.textures["u_bvh_tris"] = _texture(ctx, np.concatenate(tri_parts), BVH_TEX_WIDTH)
+        root_rows = np.zeros((max(1, len(roots)), 4), dtype=np.float32)
+        root_rows[: len(roots), 0] = roots
+        self.textures["u_bvh_roots"] = _texture(ctx, root_rows, root_rows.shape[0])
+        self.bvh_stack = max(2, depth + 1)
+        return self.bvh_stack
 
     def defines(self, cull: bool | None) -> tuple[tuple[str, str], ...]:
         """The program variant's scene-shaped defines (see ``shaders/raytrace.glsl``)."""
@@ -408,10 +501,25 @@ class GpuTracer:
         lights = world.light_positions.shape[0]
         # The bounce loop only where some node reflects.
         reflect = max_depth > 0 and any(node.reflectivity > 0.0 for node in world.nodes)
-        check_loop_budget(world, lights, bool(shadows), reflect, int(max_depth))
+        scene_defines = uploaded.defines(cull_backfaces)
+        big = max((node.count for node in world.nodes if node.kind != "sphere"), default=0) > BVH_TRIANGLES
+        use_bvh = False
+        try:
+            check_loop_budget(world, lights, bool(shadows), reflect, int(max_depth))
+        except RayTraceError:
+            if uploaded.unrolled or uploaded.mesh_count == 0:
+                raise
+            use_bvh = True
+        if use_bvh or (big and not uploaded.unrolled):
+            # Too large for the scan: trace mesh nodes through their BVHs, each
+            # ray's traversal bounded so the pixel stays within the loop limit.
+            use_bvh = True
+            cap = bvh_step_cap(world, lights, bool(shadows), reflect, int(max_depth))
+            stack = uploaded.bvh_textures(self.ctx)
+            scene_defines += (("BVH", "1"), ("BVH_STACK", str(stack)), ("BVH_MAX_STEPS", str(cap)))
         program, vao = self._program(lights, len(world.textures), shadows=bool(shadows), reflect=reflect,
                                      meshes=uploaded.mesh_count > 0, spheres=uploaded.sphere_count > 0,
-                                     scene=uploaded.defines(cull_backfaces))
+                                     scene=scene_defines)
         if uploaded.block is not None:
             program["SceneData"].binding = 0
             uploaded.block.bind_to_uniform_block(0)
@@ -445,6 +553,14 @@ class GpuTracer:
         self.ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
         vao.render(moderngl.TRIANGLE_STRIP, vertices=4)
         data = target.read(components=4, alignment=1)
+        if use_bvh:
+            alpha = np.frombuffer(data, dtype=np.uint8)[3::4]
+            cut = int(np.count_nonzero(alpha < 128))
+            if cut:
+                raise RayTraceError(
+                    f"the gpu engine's BVH traversal ran out of its {cap:,} steps a ray on {cut:,} of "
+                    f"{alpha.size:,} pixels (llvmpipe ends a shader's loops after {LOOP_LIMIT:,} iterations); "
+                    "their hits would be wrong: use renderer=ray_numpy (engine='numpy')")
         # A read-only view flipped by a negative stride, as the rasterizer's
         # read-back: copying a fresh 800x600 frame costs about 2.5 ms (page
         # faults on new memory), a tenth of a primary-ray render.

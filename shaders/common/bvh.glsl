@@ -153,14 +153,16 @@ float bvh_triangle(BvhRay r, int k, bool cull, out int index, out vec2 uv) {
 // The nearest hit with 0 < t < t_max: an ordered, stackful traversal (the
 // nearer child first, the other pushed with its entry distance so it can be
 // skipped once a nearer hit is known), one unit of work per loop iteration.
-BvhHit bvh_closest(vec3 o, vec3 d, float t_max, bool cull) {
+// bvh_closest_at / bvh_any_at start at node `root` (several BVHs concatenated in
+// one texture pair, their indices offset); bvh_closest / bvh_any at node 0.
+BvhHit bvh_closest_at(int root, vec3 o, vec3 d, float t_max, bool cull) {
     BvhHit hit = BvhHit(t_max, -1, vec2(0.0), false, 0);
     BvhRay r = bvh_ray(o, d);
     int stack[BVH_STACK];
     float stack_near[BVH_STACK];
     int sp = 0;
     float near;
-    int node = bvh_box(r, 0, t_max, near) ? 0 : -1;
+    int node = bvh_box(r, root, t_max, near) ? root : -1;
     int tri = 0;
     int tri_end = 0;
     bool finished = node < 0;
@@ -213,12 +215,12 @@ BvhHit bvh_closest(vec3 o, vec3 d, float t_max, bool cull) {
 
 // Whether anything is hit with 0 < t < t_max (a shadow ray): the same walk,
 // ending at the first hit. Unfinished rays set `overflow`.
-bool bvh_any(vec3 o, vec3 d, float t_max, bool cull, out bool overflow) {
+bool bvh_any_at(int root, vec3 o, vec3 d, float t_max, bool cull, out bool overflow) {
     BvhRay r = bvh_ray(o, d);
     int stack[BVH_STACK];
     int sp = 0;
     float near;
-    int node = bvh_box(r, 0, t_max, near) ? 0 : -1;
+    int node = bvh_box(r, root, t_max, near) ? root : -1;
     int tri = 0;
     int tri_end = 0;
     bool finished = node < 0;
@@ -260,4 +262,9 @@ bool bvh_any(vec3 o, vec3 d, float t_max, bool cull, out bool overflow) {
     }
     if (!finished) overflow = true;
     return found;
+}
+
+BvhHit bvh_closest(vec3 o, vec3 d, float t_max, bool cull) { return bvh_closest_at(0, o, d, t_max, cull); }
+bool bvh_any(vec3 o, vec3 d, float t_max, bool cull, out bool overflow) {
+    return bvh_any_at(0, o, d, t_max, cull, overflow);
 }
