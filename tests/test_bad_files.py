@@ -15,9 +15,14 @@ from PIL import Image
 
 from glsandbox.errors import SandboxError
 from glsandbox.images import load_image
+from conftest import need
 from test_cli import REPO, assert_user_error, glsandbox
 
-needs_fifo = pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no named pipes on this system")
+@pytest.fixture
+def needs_fifo() -> None:
+    """Named pipes are a machine resource: skip locally without them, fail under CI."""
+    if not hasattr(os, "mkfifo"):
+        need("named pipes", "os.mkfifo is missing on this system")
 
 
 def textured_scene(tmp_path: Path, texture: str) -> Path:
@@ -29,7 +34,7 @@ def textured_scene(tmp_path: Path, texture: str) -> Path:
 # --- named pipes and folders where a file belongs -------------------------------------
 
 
-@needs_fifo
+@pytest.mark.usefixtures("needs_fifo")
 @pytest.mark.parametrize("renderer", ["raster", "ray_numpy"])
 def test_a_named_pipe_as_a_texture_is_refused_not_waited_on(tmp_path: Path, renderer: str) -> None:
     os.mkfifo(tmp_path / "pipe.png")  # opening it for reading blocked forever: no writer ever comes
@@ -40,7 +45,7 @@ def test_a_named_pipe_as_a_texture_is_refused_not_waited_on(tmp_path: Path, rend
     assert not out.exists()
 
 
-@needs_fifo
+@pytest.mark.usefixtures("needs_fifo")
 def test_a_named_pipe_as_the_lesson_image_or_the_scene_file_is_refused(tmp_path: Path) -> None:
     os.mkfifo(tmp_path / "pipe")
     out = tmp_path / "x.png"
