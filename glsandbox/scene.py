@@ -348,6 +348,11 @@ class Scene:
     plan_mode: str = "needed"
 
     def __post_init__(self) -> None:
+        # Lists are welcome from Python (Scene("s", nodes=[...])); stored as tuples, so a
+        # Scene stays immutable and the renderers can compare its parts by identity.
+        for field_name in ("nodes", "lights", "viewports", "overlays"):
+            if isinstance(getattr(self, field_name), list):
+                _set(self, field_name, tuple(getattr(self, field_name)))
         _set(self, "clear_color", check_numbers(self.clear_color, "scene clear colour", (4,), 0.0, 1.0))
         if self.depth_mode not in DEPTH_MODES:
             raise SandboxError(f"unknown depth mode {self.depth_mode!r}; use one of {', '.join(DEPTH_MODES)}")

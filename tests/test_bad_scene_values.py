@@ -205,3 +205,14 @@ def test_the_bound_is_one_constant() -> None:
 def test_a_flattened_unlit_node_is_still_drawn() -> None:
     node = Node("disc", geometry.sphere(), transforms.scale(1.0, 0.0, 1.0))  # unlit: no normals needed
     assert node.model[1, 1] == 0.0
+
+
+def test_lists_given_to_a_scene_are_kept_as_tuples() -> None:
+    """``Scene("s", nodes=[...])`` is natural Python; the renderers compare a scene's
+    parts by identity and hash them, which a list would break (the gpu engine's
+    upload cache did, with an AssertionError)."""
+    node = Node("cube", geometry.cube())
+    light = Light((1.0, 2.0, 3.0))
+    scene = Scene("s", nodes=[node], lights=[light], viewports=[Viewport()])
+    assert scene.nodes == (node,) and isinstance(scene.nodes, tuple)
+    assert isinstance(scene.lights, tuple) and isinstance(scene.viewports, tuple)

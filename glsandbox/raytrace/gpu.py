@@ -74,9 +74,9 @@ program, one light), runs at most about 4,100 iterations a pixel.
 
 The BVH program
 ---------------
-A scene too large for that scan (or with a mesh node of more than
-:data:`BVH_TRIANGLES` triangles) that is not unrolled gets the general
-program with ``BVH`` defined: each mesh node's triangles are traced through
+A scene too large for that scan, or with a mesh node of more than
+:data:`BVH_TRIANGLES` triangles, gets the general program with ``BVH``
+defined (never the unrolled one): each mesh node's triangles are traced through
 its BVH (:func:`~glsandbox.raytrace.bvh.bvh_for_triangles` on the World's
 triangles, cached; ``shaders/common/bvh.glsl``: the watertight test, nearest
 hit for primary and reflected rays, any hit for shadow rays), all nodes'
@@ -85,8 +85,9 @@ BVHs packed into one node/triangle texture pair with their indices offset
 bounded by ``BVH_MAX_STEPS`` (:func:`bvh_step_cap`: what the loop limit
 leaves after the other loops, shared by every ray of a pixel and every mesh
 node). A ray that reaches the bound writes alpha 0, and the render raises
-:class:`RayTraceError` instead of returning the picture. The lessons' scenes
-stay below :data:`BVH_TRIANGLES` and keep the scan and its pixels.
+:class:`RayTraceError` instead of returning the picture. Scenes whose mesh
+nodes all have at most :data:`BVH_TRIANGLES` triangles (the cubes, quads and
+floors of most lessons) keep the scan.
 
 Float32 differs from float64 in the last bits of ``t`` and of the shading;
 the image agrees with the numpy engine's to within a couple of 8-bit levels
@@ -143,10 +144,12 @@ def check_loop_budget(world: World, lights: int, shadows: bool, reflect: bool, m
 #: mesh node's BVH may take; None: as many as the loop budget allows
 #: (:func:`bvh_step_cap`). Tests set it small to see the overflow raise.
 BVH_STEP_CAP: int | None = None
-#: The general program traces mesh nodes through BVHs when some mesh node has more
-#: triangles than this (or the scan could pass the loop limit); smaller scenes scan
-#: (their pixels as before: the lessons stay far below it).
-BVH_TRIANGLES = 4096
+#: The program traces mesh nodes through BVHs when some mesh node has more
+#: triangles than this (or the scan could pass the loop limit); smaller scenes scan.
+#: Measured crossover (terrain meshes, 800x600, llvmpipe, warm renders, primary /
+#: shadow+bounce): 32 triangles scan 0.033/0.045 s vs BVH 0.054/0.087 s; 72: 0.060/0.114
+#: vs 0.058/0.093; 128: 0.098/0.148 vs 0.063/0.098; 1,058: 1.43/2.22 vs 0.082/0.179.
+BVH_TRIANGLES = 64
 #: A BVH render is refused when the budget leaves a ray fewer steps than this.
 BVH_MIN_STEPS = 256
 
@@ -303,7 +306,10 @@ class _Uploaded:
         self.mesh_count = sum(1 for node in world.nodes if node.kind != "sphere")
         self.sphere_count = len(world.nodes) - self.mesh_count
         loops = sum(1 for node in world.nodes if node.kind != "sphere" and node.count > UNROLL_TRIS)
-        self.unrolled = (len(world.nodes) <= UNROLL_NODES and loops <= UNROLL_LOOPS
+        #: Some mesh node is large enough that its BVH beats the scan (:data:`BVH_TRIANGLES`).
+        self.large_mesh = max((node.count for node in world.nodes if node.kind != "sphere"),
+                              default=0) > BVH_TRIANGLES
+        self.unrolled = (not self.large_mesh and len(world.nodes) <= UNROLL_NODES and loops <= UNROLL_LOOPS
                          and max(1, self.tris.shape[0]) + max(1, self.nodes.shape[0]) <= block_records)
         self.block: moderngl.Buffer | None = None
         #: The BVH program's stack depth once its textures are uploaded (0: not yet).
@@ -502,7 +508,6 @@ class GpuTracer:
         # The bounce loop only where some node reflects.
         reflect = max_depth > 0 and any(node.reflectivity > 0.0 for node in world.nodes)
         scene_defines = uploaded.defines(cull_backfaces)
-        big = max((node.count for node in world.nodes if node.kind != "sphere"), default=0) > BVH_TRIANGLES
         use_bvh = False
         try:
             check_loop_budget(world, lights, bool(shadows), reflect, int(max_depth))
@@ -510,7 +515,7 @@ class GpuTracer:
             if uploaded.unrolled or uploaded.mesh_count == 0:
                 raise
             use_bvh = True
-        if use_bvh or (big and not uploaded.unrolled):
+        if use_bvh or uploaded.large_mesh:
             # Too large for the scan: trace mesh nodes through their BVHs, each
             # ray's traversal bounded so the pixel stays within the loop limit.
             use_bvh = True
