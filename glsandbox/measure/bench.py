@@ -1,7 +1,9 @@
 """``glsandbox bench``: every benchmark in ``benchmarks/``, one table of ratios.
 
 A benchmark module in ``benchmarks/`` (any ``*.py`` not starting with ``_``)
-defines ``cases(env: BenchEnv) -> list[Case]``. A :class:`Case` pairs a
+defines ``cases(env: BenchEnv) -> list[Case]``, and may define
+``summarize(results: list[Result]) -> list[str]``: lines printed under the
+table from its measured rows (e.g. how a time grows across rows). A :class:`Case` pairs a
 *baseline* side with a *subject* side (e.g. raw ModernGL vs glsandbox, or the
 on-demand plan vs ``effects=all``). All cases run together in alternating
 rounds, in one process and on one GL context: every round times each
@@ -254,6 +256,7 @@ def run_all(json_path: Path | None = None, quick: bool = False, only: Sequence[s
     try:
         cases: list[Case] = []
         found_lines = []
+        summaries = []
         for module in load_modules(folder):
             noted = len(env.notes)
             found = module.cases(env)
@@ -261,6 +264,8 @@ def run_all(json_path: Path | None = None, quick: bool = False, only: Sequence[s
             if not matched:  # a module left out by --only: its notes (what it skipped) do not apply
                 del env.notes[noted:]
             cases += matched
+            if matched and hasattr(module, "summarize"):
+                summaries.append(module.summarize)
             found_lines.append(f"bench: {Path(module.__file__ or '').name}: {len(matched)} of {len(found)} cases")
         if not cases:  # said before any progress line: a mistake is one line
             raise SandboxError(f"--only {' '.join(only)}: no benchmark case matched (see glsandbox bench)")
@@ -273,6 +278,9 @@ def run_all(json_path: Path | None = None, quick: bool = False, only: Sequence[s
             cases = [_quick(c) for c in cases]
         started = time.perf_counter()
         results = measure(cases, rounds, log)
+        for summarize in summaries:
+            for line in summarize(results):
+                env.note(line)
         renderer = env.renderer_name()
     finally:
         env.close()

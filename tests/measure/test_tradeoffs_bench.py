@@ -342,3 +342,88 @@ def test_embree_casts_the_engines_rays() -> None:
         render(scene, (40, 30), stats=stats, **options)
         cast = module.EmbreeCaster(scene, (40, 30), options["shadows"], options["max_depth"]).cast()
         assert abs(cast - stats.rays) <= 0.02 * stats.rays, mode  # spheres are meshes for Embree
+
+
+# --- the ray tracer on models (benchmarks/models.py) -----------------------------------------
+
+
+def _models_module():
+    return _benchmark_module("models.py")
+
+
+def test_model_cases_without_embree_say_so(monkeypatch) -> None:
+    from glsandbox.measure.bench import BenchEnv
+
+    module = _models_module()
+    monkeypatch.setattr(module, "embree_available", lambda: False)
+    env = BenchEnv(quick=True)
+    assert module.cases(env) == []
+    assert len(env.notes) == 1 and "skipped: embreex not installed" in env.notes[0]
+
+
+def test_model_cases_cover_every_size_mode_and_engine(monkeypatch) -> None:
+    from glsandbox.measure.bench import BenchEnv
+
+    module = _models_module()
+    monkeypatch.setattr(module, "embree_available", lambda: True)
+    monkeypatch.setattr(module, "_bunny_path", lambda: None)
+    found = module.cases(BenchEnv())  # nothing is built until a case runs
+    assert [c.name for c in found[:4]] == ["1,000 tris, primary, numpy", "1,000 tris, primary, gpu",
+                                           "1,000 tris, shadow+bounce, numpy", "1,000 tris, shadow+bounce, gpu"]
+    assert len(found) == 4 * len(module.SIZES)
+    assert {c.goal for c in found} == {2.0, 50.0}
+
+
+def test_model_summary_gives_the_time_exponent_and_the_mode_ratio() -> None:
+    """The exponent is fitted from the 10k and 1M rows' medians; the mode ratio is
+    (shadow+bounce engine/Embree) over (primary engine/Embree), per model."""
+    from glsandbox.measure.bench import Case, Result, Side
+
+    module = _models_module()
+    small, large = (module.terrain_triangles(n) for n in module.SIZES[1::2])
+    growth = (large / small) ** 0.25  # time x growth for 100x the triangles: exponent 0.25
+
+    def result(name: str, subject: float, embree: float) -> Result:
+        side = Side("x", lambda k: None)
+        return Result(Case(module.GROUP, name, side, side), [embree, embree * 2, embree / 2],
+                      [subject, subject * 3, subject / 3])
+
+    results = [result("10,000 tris, primary, gpu", 1.0, 0.5),
+               result("1,000,000 tris, primary, gpu", growth, 0.5),
+               result("10,000 tris, shadow+bounce, gpu", 3.0, 0.5)]
+    lines = module.summarize(results)
+    assert lines[0].startswith(f"{module.GROUP}: gpu engine, primary: time exponent 0.25 from 10,000 tris")
+    assert "Embree's in the same rows: 0.00" in lines[0]
+    assert lines[1] == f"{module.GROUP}: gpu engine, shadow+bounce ratio / primary ratio: 10,000 tris 3.00x (goal: within 2x)"
+    assert len(lines) == 2  # numpy rows were not measured: no lines for them
+
+
+def test_near_edge_tells_grazing_rays_from_clear_ones() -> None:
+    from glsandbox.raytrace.bvh import bvh_for_triangles
+
+    module = _models_module()
+    bvh = bvh_for_triangles([[-1.0, -1.0, -5.0]], [[1.0, -1.0, -5.0]], [[0.0, 1.0, -5.0]])
+    dirs = np.array([[0.0, 0.0, -5.0],   # the middle: a hit whichever way it turns
+                     [0.3, -1.0, -5.0],  # exactly on the bottom edge
+                     [0.5, 0.0, -5.0],   # exactly on the right edge
+                     [0.3, -1.0 - 1e-4, -5.0],  # below the edge by far more than float32
+                     [4.0, 4.0, -5.0]])  # a clear miss
+    assert module.near_edge(bvh, np.zeros(3), dirs).tolist() == [False, True, True, False, False]
+
+
+def test_hit_miss_against_embree_counts_the_differing_pixels() -> None:
+    pytest.importorskip("embreex")  # the bench group, not the dev group
+    from glsandbox.raytrace import render
+
+    module = _models_module()
+    size = (40, 30)
+    reference = module.HitMiss("1000", size)
+    image = render(module.model_scene("1000"), size, max_depth=0, shadows=False)
+    assert reference.compare(image).startswith("hit/miss: identical to Embree")
+    hit = reference.embree_hit.reshape(size[1], size[0])
+    # A hit pixel whose 8 neighbours also hit: far from any silhouette edge.
+    inner = hit[1:-1, 1:-1] & hit[:-2, 1:-1] & hit[2:, 1:-1] & hit[1:-1, :-2] & hit[1:-1, 2:]
+    row, col = (int(v) + 1 for v in np.argwhere(inner)[0])
+    holed = image.copy()
+    holed[row, col, :3] = np.round(np.asarray(module.BACKGROUND[:3]) * 255)
+    assert reference.compare(holed) == f"hit/miss: 1 of {40 * 30:,} px differ from Embree, 0 at an edge"
