@@ -14,8 +14,10 @@ folder is refused at once instead of blocking forever or failing later.
 
 from __future__ import annotations
 
+import glob
 import io
 import os
+import re
 import stat
 import tempfile
 import time
@@ -29,7 +31,7 @@ from PIL import Image
 
 from glsandbox.errors import SandboxError
 
-__all__ = ["NotARegularFile", "atomic_write", "load_png", "open_regular", "png_bytes", "read_regular", "save_png",
+__all__ = ["NotARegularFile", "atomic_write", "load_png", "next_numbered", "open_regular", "png_bytes", "read_regular", "save_png",
            "write_text"]
 
 
@@ -209,3 +211,12 @@ def load_png(path: str | os.PathLike[str]) -> np.ndarray:
     """
     with Image.open(path, formats=["PNG"]) as im:
         return np.array(im.convert("RGBA"), dtype=np.uint8)
+
+
+def next_numbered(folder: str | os.PathLike[str], stem: str, suffix: str = ".png") -> Path:
+    """``folder/<stem>-<n><suffix>`` with ``n`` one past the highest already there (1 in
+    an empty folder): a new screenshot never replaces one from an earlier run."""
+    pattern = re.compile(re.escape(stem) + r"-(\d+)" + re.escape(suffix) + "$")
+    folder = Path(folder)
+    taken = [int(m.group(1)) for p in folder.glob(f"{glob.escape(stem)}-*{suffix}") if (m := pattern.match(p.name))]
+    return folder / f"{stem}-{max(taken, default=0) + 1}{suffix}"

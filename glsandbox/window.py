@@ -20,7 +20,7 @@ import numpy as np
 
 from glsandbox.camera import CameraInput
 from glsandbox.errors import SandboxError
-from glsandbox.files import save_png
+from glsandbox.files import next_numbered, save_png
 from glsandbox.frame import DEFAULT_SIZE, FrameRenderer, InteractiveResolution, with_samples
 from glsandbox.gl.context import open_context
 from glsandbox.lesson import Lesson
@@ -34,7 +34,7 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
                max_frames: int | None = None, instead: str | None = None) -> None:
     """Open a window and run the lesson until ESC or the window closes.
 
-    Keys: ESC quits; F12 writes ``screenshots/<lesson>-<n>.png``; R reloads the
+    Keys: ESC quits; F12 writes ``screenshots/<lesson>-<n>.png`` (the next free ``n``); R reloads the
     shaders from disk (a broken shader keeps the last good program and shows
     its error in the title and on stderr); other keys go to the lesson.
     ``instead`` is what the errors offer when no window can open (the
@@ -55,7 +55,7 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
     renderer = FrameRenderer(host)
     executor = renderer.executor
     motion = InteractiveResolution()  # ray-traced viewports: coarser while the camera moves
-    state = {"lesson": lesson, "error": "", "shots": 0}
+    state = {"lesson": lesson, "error": ""}
     start_time = lesson.time
     clock_start = glfw.get_time()
     pending: list[int] = []
@@ -72,8 +72,7 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
             glfw.set_window_should_close(host.window, True)
         elif key == glfw.KEY_F12:
             screenshot_dir.mkdir(parents=True, exist_ok=True)
-            state["shots"] += 1
-            path = screenshot_dir / f"{lesson.name}-{state['shots']}.png"
+            path = next_numbered(screenshot_dir, lesson.name)
             width, height = glfw.get_framebuffer_size(host.window)
             data = host.ctx.screen.read(viewport=(0, 0, width, height), components=4, alignment=1)
             image = np.ascontiguousarray(np.frombuffer(data, dtype=np.uint8).reshape(height, width, 4)[::-1])

@@ -77,3 +77,13 @@ def test_stale_temporaries_of_a_killed_writer_are_removed_fresh_ones_kept(tmp_pa
     files.save_png(np.zeros((2, 2, 4), np.uint8), tmp_path / "a.png")
     assert not stale.exists()
     assert fresh.exists() and other.exists()  # a live writer's file, and another name's
+
+
+def test_next_numbered_continues_after_the_highest_file_there(tmp_path: Path) -> None:
+    from glsandbox.files import next_numbered
+
+    assert next_numbered(tmp_path, "cube") == tmp_path / "cube-1.png"
+    for name in ("cube-1.png", "cube-7.png", "cube-x.png", "cube-2.jpg", "cubes-9.png", "[cube]-4.png"):
+        (tmp_path / name).write_bytes(b"")
+    assert next_numbered(tmp_path, "cube") == tmp_path / "cube-8.png"
+    assert next_numbered(tmp_path, "[cube]") == tmp_path / "[cube]-5.png"  # glob characters in the name

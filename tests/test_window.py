@@ -175,3 +175,32 @@ def test_r_reloads_shaders_and_a_broken_one_keeps_the_last_good_program(window_e
         code = win.close()
     assert code == 0
     assert "error: shader does not compile" in win.proc.stderr.read()
+
+
+def test_a_model_file_renders_in_the_window_through_both_renderers(window_env: str, tmp_path: Path, gl) -> None:
+    """Issue 11's "a model file renders in a window": a scene file naming an STL, opened with
+    ``glsandbox run``, ray traced (the gpu engine through the BVH: 1,280 triangles) and
+    rasterized; each window screenshot matches the headless render of the same settings."""
+    import trimesh
+
+    from glsandbox.lesson import scene_file_lesson
+
+    trimesh.creation.icosphere(subdivisions=3).export(tmp_path / "ball.stl")
+    scene = tmp_path / "ball.toml"
+    scene.write_text('[camera]\neye = [0, 0, 4]\n\n[[lights]]\nposition = [1, 2, 4]\n\n'
+                     '[[nodes]]\nname = "ball"\nmesh = "ball.stl"\nfit = true\nshading = "phong"\n'
+                     'color = [0.9, 0.5, 0.2]\n')
+    for number, renderer in enumerate(("ray", "raster"), start=1):
+        win = LessonWindow(window_env, tmp_path, "glsandbox.cli", "run", str(scene), "--size", "160x120",
+                           "--set", f"renderer={renderer}")
+        try:
+            win.wait_title(lambda t: "fps" in t)
+            win.key("F12")
+            shot = load_png(wait_for(tmp_path / "screenshots" / f"ball-{number}.png"))  # numbers go on across runs
+        finally:
+            code = win.close()
+        assert code == 0
+        headless = gl.render(scene_file_lesson(scene)(renderer=renderer), (160, 120)).image
+        assert compare_images(shot, headless).passed, renderer
+        centre, corner = shot[60, 80].astype(int), shot[5, 5].astype(int)
+        assert centre[0] > centre[2] + 30 and corner[2] > corner[0] + 100, renderer  # an orange ball on blue
