@@ -368,10 +368,11 @@ def test_model_cases_cover_every_size_mode_and_engine(monkeypatch) -> None:
     monkeypatch.setattr(module, "embree_available", lambda: True)
     monkeypatch.setattr(module, "_bunny_path", lambda: None)
     found = module.cases(BenchEnv())  # nothing is built until a case runs
-    assert [c.name for c in found[:4]] == ["1,000 tris, primary, numpy", "1,000 tris, primary, gpu",
+    assert found[0].name == "BVH build, 1,000,000 tris"
+    assert [c.name for c in found[1:5]] == ["1,000 tris, primary, numpy", "1,000 tris, primary, gpu",
                                            "1,000 tris, shadow+bounce, numpy", "1,000 tris, shadow+bounce, gpu"]
-    assert len(found) == 4 * len(module.SIZES)
-    assert {c.goal for c in found} == {2.0, 50.0}
+    assert len(found) == 1 + 4 * len(module.SIZES)
+    assert {c.goal for c in found[1:]} == {2.0, 50.0}
 
 
 def test_model_summary_gives_the_time_exponent_and_the_mode_ratio() -> None:
