@@ -100,25 +100,34 @@ def _rays(origins: ArrayLike, directions: ArrayLike, t_max: ArrayLike
 
 
 class _Boxes:
-    """The nodes' padded boxes as contiguous rows, one per axis, made once per call.
+    """The nodes' padded boxes as contiguous rows, one per axis.
 
     Rays that share one origin (primary rays from the eye) get the boxes
     already moved to that origin, ``(plane − pad) − O``: the slab test is then
-    a gather and a product per plane.
+    a gather and a product per plane. Both are kept on the BVH (the padded
+    boxes, and those moved to the last shared origin): an engine traces a
+    frame in blocks of rays, and remaking them per block cost O(nodes) each
+    time, 2.3 of 5.4 s for a 1M-triangle terrain at 800x600.
     """
 
     def __init__(self, bvh: BVH, o: NDArray[np.float64]) -> None:
-        pad = _node_pad(bvh)[None, :]
-        self.lo = bvh.node_min.T - pad
-        self.hi = bvh.node_max.T + pad
+        padded = bvh.__dict__.get("_padded_boxes")
+        if padded is None:
+            pad = _node_pad(bvh)[None, :]
+            padded = (np.ascontiguousarray(bvh.node_min.T - pad), np.ascontiguousarray(bvh.node_max.T + pad))
+            object.__setattr__(bvh, "_padded_boxes", padded)  # frozen: a cache of what it holds
+        self.lo, self.hi = padded
         origin = shared_origin(o)
         self.shared = origin.ndim == 1
         if self.shared:
-            o_pad = BOX_PAD * float(np.abs(origin).max(initial=0.0))
-            self.lo = self.lo - o_pad - origin[:, None]
-            self.hi = self.hi + o_pad - origin[:, None]
-        self.lo = np.ascontiguousarray(self.lo)
-        self.hi = np.ascontiguousarray(self.hi)
+            key = origin.tobytes()
+            moved = bvh.__dict__.get("_moved_boxes")
+            if moved is None or moved[0] != key:
+                o_pad = BOX_PAD * float(np.abs(origin).max(initial=0.0))
+                moved = (key, np.ascontiguousarray(self.lo - o_pad - origin[:, None]),
+                         np.ascontiguousarray(self.hi + o_pad - origin[:, None]))
+                object.__setattr__(bvh, "_moved_boxes", moved)
+            self.lo, self.hi = moved[1], moved[2]
 
 
 class _Block:

@@ -315,3 +315,14 @@ def test_the_cache_returns_the_same_bvh_for_the_same_content() -> None:
     for k in range(CACHE_SIZE + 2):  # older entries leave the LRU
         bvh_for_mesh(mesh, np.diag([1.0 + k, 1.0, 1.0, 1.0]))
     assert bvh_for_mesh(mesh, model) is not first
+
+
+def test_boxes_kept_between_calls_follow_the_shared_origin() -> None:
+    """The padded boxes, and those moved to the last shared origin, are kept on the BVH
+    between calls (an engine traces a frame in blocks): a new origin must move them again."""
+    a, b, c = soup(11, 300)
+    bvh = build_bvh(a, b, c)
+    _, dirs = rays(12, 200)
+    for origin in ([0.0, 0.0, 9.0], [5.0, -3.0, 1.0], [0.0, 0.0, 9.0], [0.5, 0.5, 0.5]):
+        eye = np.array(origin)
+        assert_same_hits(closest_hit(bvh, eye, dirs), closest_hit_brute_force(a, b, c, eye, dirs))

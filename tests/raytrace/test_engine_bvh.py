@@ -107,3 +107,22 @@ def test_the_gpu_engine_refuses_where_its_bvh_budget_is_too_small(gl, monkeypatc
     message = str(info.value)
     assert "\n" not in message and "65,535" in message and "1 mesh nodes" in message
     assert "renderer=ray_numpy" in message
+
+
+def test_the_numpy_engine_keeps_a_scenes_world_while_the_scene_lives(monkeypatch) -> None:
+    """A Scene is immutable, so the same Scene object rendered again reuses its World and BVHs
+    (built once); a new Scene object, even with equal content, builds its own."""
+    from glsandbox.raytrace import numpy_engine
+
+    built = []
+    real = numpy_engine.build_world
+    monkeypatch.setattr(numpy_engine, "build_world", lambda *a, **k: built.append(1) or real(*a, **k))
+    scene = Scene("rock", nodes=(Node("rock", meshgen.rock(2), material=Material(shading="phong")),),
+                  camera=Camera(eye=(0.0, 0.5, 3.0)), lights=(Light((1.0, 3.0, 2.0)),))
+    first = render(scene, (32, 24))
+    again = render(scene, (32, 24))
+    assert len(built) == 1 and np.array_equal(first, again)
+    render(scene, (32, 24), analytic_spheres=False)  # another World of the same scene
+    copy = Scene("rock", nodes=scene.nodes, camera=scene.camera, lights=scene.lights)
+    assert np.array_equal(render(copy, (32, 24)), first)
+    assert len(built) == 3
