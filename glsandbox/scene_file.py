@@ -253,9 +253,15 @@ class _SceneReader:
         """A node's own GLSL file (``shader = "toon.glsl"``, relative to the scene file) and
         its ``[nodes.uniforms]``: numbers, true/false, or lists of 2 to 4 numbers."""
         uniforms = data.get("uniforms", {})
+
+        def fail_uniforms(message: str) -> SandboxError:  # at the [nodes.uniforms] header, if written so
+            line = self.where.tables.get(("nodes.uniforms", i))
+            return SandboxError(f"{self.path}:{line}: nodes[{i}].uniforms: {message}") if line \
+                else self.fail("nodes", i, "uniforms", message)
+
         if "shader" not in data:
             if "uniforms" in data:
-                raise self.fail("nodes", i, "uniforms", "needs shader = \"<file.glsl>\" (uniforms are the shader's)")
+                raise fail_uniforms("needs shader = \"<file.glsl>\" (uniforms are the shader's)")
             return None, {}
         text = self.text(data, "shader", "nodes", i)
         path = Path(text)
@@ -266,8 +272,7 @@ class _SceneReader:
         if not path.exists():
             raise self.fail("nodes", i, "shader", f"shader file {path} not found")
         if not isinstance(uniforms, dict):
-            raise self.fail("nodes", i, "uniforms", f"expected a table ([nodes.uniforms] or {{ ... }}), "
-                                                    f"got {plain(uniforms)}")
+            raise fail_uniforms(f"expected a table ([nodes.uniforms] or {{ ... }}), got {plain(uniforms)}")
         checked = {}
         for name, value in uniforms.items():
             line = self.where.line("nodes.uniforms", i, name) or self.where.line("nodes", i, "uniforms")
