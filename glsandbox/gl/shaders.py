@@ -208,6 +208,7 @@ def compile_with_sources(ctx: moderngl.Context, variant: ProgramVariant,
             if f"\n{stage}\n" in f"\n{log}":
                 raise SandboxError(f"shader does not compile: {_first_error(log, src, stage)}") from None
         what = f"{variant.shader}: shader" if variant.user else f"shader {variant.key}"
+        log = re.sub(r"^\s*GLSL Linker failed\s*Program\s*=+\s*", "", log)  # moderngl's header, not the log
         raise SandboxError(f"{what} does not link: {' '.join(log.split())}") from None
 
 
