@@ -148,8 +148,9 @@ def assemble(name: str, stage: str, defines: tuple[tuple[str, str], ...] = (), r
     read(top, None, ())
     if not out or not _VERSION.match(out[0]):
         raise SandboxError(f"{top}:1: a shader file must start with #version")
-    if _STAGES[stage] not in stages_seen:
+    if user and _STAGES[stage] not in stages_seen:
         # Without its section the stage would compile the other stage's code, or nothing.
+        # (A built-in file without one fails to compile, at the line the compiler names.)
         raise SandboxError(f"{top}: no {_STAGES[stage]} section; a shader file holds both stages: "
                            "#if defined(VERTEX_SHADER) ... #elif defined(FRAGMENT_SHADER) ... #endif")
     return Source("\n".join(out) + "\n", origins)
