@@ -313,6 +313,9 @@ def check_uniforms(values: object, what: str) -> Mapping[str, UniformValue]:
     return MappingProxyType(checked)
 
 
+_NO_UNIFORMS: Mapping[str, UniformValue] = MappingProxyType({})
+
+
 @dataclass(frozen=True, eq=False)
 class Node:
     """A mesh placed in the world with a model matrix and a material.
@@ -336,7 +339,7 @@ class Node:
     cull_back_faces: bool = True
     viewports: tuple[int, ...] | None = None
     shader: str | os.PathLike[str] | None = None
-    uniforms: Mapping[str, Any] = field(default_factory=dict)
+    uniforms: Mapping[str, Any] = field(default_factory=lambda: _NO_UNIFORMS)
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str):
@@ -443,7 +446,7 @@ class Scene:
     plan_mode: str = "needed"
     #: Uniform values for every node's own shader that declares them
     #: (``--set u.NAME=value``; they win over the nodes' ``uniforms``).
-    uniform_overrides: Mapping[str, Any] = field(default_factory=dict)
+    uniform_overrides: Mapping[str, Any] = field(default_factory=lambda: _NO_UNIFORMS)
 
     def __post_init__(self) -> None:
         if self.uniform_overrides or type(self.uniform_overrides) is not MappingProxyType:
