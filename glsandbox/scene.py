@@ -324,8 +324,8 @@ class Node:
     course); ``viewports`` limits the node to some viewports (None: all).
 
     ``shader`` names a GLSL file of the user's (a path, relative to the
-    working folder or absolute; a scene file's is relative to the scene
-    file) that the rasterizer draws the node with instead of a built-in
+    working folder or absolute, kept absolute; a scene file's is relative to
+    the scene file) that the rasterizer draws the node with instead of a built-in
     program: one file, both stages, inputs as :data:`SHADER_INPUTS` lists.
     ``uniforms`` sets the shader's own uniforms (``{"u_bands": 3.0}``):
     numbers, bools, or 2 to 4 numbers. The ray tracer cannot run GLSL: it
@@ -347,7 +347,9 @@ class Node:
         if self.shader is not None:
             if not isinstance(self.shader, (str, os.PathLike)) or not str(self.shader).strip():
                 raise SandboxError(f"node {self.name!r}: shader must be a GLSL file path, got {plain(self.shader)}")
-            _set(self, "shader", Path(self.shader))
+            # Absolute now: the working folder at the node's making is the one meant, and
+            # programs are cached by path, so two folders' "toon.glsl" stay apart.
+            _set(self, "shader", Path(os.path.abspath(self.shader)))
         if self.uniforms or type(self.uniforms) is not MappingProxyType:
             _set(self, "uniforms", check_uniforms(self.uniforms, f"node {self.name!r}: uniform {{name}}"))
             if self.uniforms and self.shader is None:

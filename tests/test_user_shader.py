@@ -82,6 +82,14 @@ def assert_error(folder: Path, capsys, *fragments: str, settings: tuple[str, ...
     return lines[0]
 
 
+@pytest.fixture
+def fresh(gl):
+    """A renderer of the test's own: reloading recompiles every program an executor holds,
+    and the shared one holds other tests' shaders."""
+    with HeadlessRenderer() as renderer:
+        yield renderer
+
+
 def edit(path: Path, old: str, new: str) -> None:
     text = path.read_text()
     assert old in text
@@ -103,7 +111,7 @@ def test_a_scene_file_names_a_shader_relative_to_itself_with_its_uniforms(folder
 
 def test_python_nodes_take_a_path_and_uniforms() -> None:
     node = Node("n", builtin_mesh("cube24"), shader="my.glsl", uniforms={"k": 2, "on": True, "v": [1, 2]})
-    assert node.shader == Path("my.glsl") and dict(node.uniforms) == {"k": 2.0, "on": True, "v": (1.0, 2.0)}
+    assert node.shader == Path.cwd() / "my.glsl" and dict(node.uniforms) == {"k": 2.0, "on": True, "v": (1.0, 2.0)}
     for bad, message in (({"k": "x"}, "uniform k must be a number"), ({"v": [1]}, "must be 2 or 3 or 4 numbers"),
                          ({"k": float("inf")}, "must be a finite number"), ({"m_model": 1}, "set by the renderer"),
                          ({"2x": 1}, "not a GLSL uniform name")):
@@ -147,6 +155,23 @@ def test_the_shader_draws_with_its_uniforms_and_set_overrides_them(folder: Path,
     # Declared but unused: the compiler dropped it, so there is nothing to set and nothing wrong.
     status, err, _ = render(folder, capsys, "u.unused_knob=3")
     assert status == 0 and err == ""
+
+
+def test_a_python_node_names_its_shader_relative_to_the_working_folder(folder: Path, monkeypatch, fresh) -> None:
+    gl = fresh
+    monkeypatch.chdir(folder)
+    node = Node("box", builtin_mesh("cube24"), shader="tint.glsl", uniforms={"tint": (1, 0, 0)})
+    image = gl.render_scene(Scene("python", nodes=(node,)), (32, 32)).image
+    assert tuple(image[16, 16]) == (255, 0, 0, 255)
+    # 'in vec4 in_position' takes the three floats too (w = 1); an integer attribute is refused.
+    edit(folder / "tint.glsl", "in vec3 in_position;\nvoid main() { gl_Position = to_clip(in_position); }",
+         "in vec4 in_position;\nvoid main() { gl_Position = m_proj * m_view * m_model * in_position; }")
+    moved = replace(node, shader=folder / "tint.glsl", uniforms={"tint": (0, 0, 1)})
+    assert tuple(gl.render_scene(Scene("python", nodes=(moved,)), (32, 32)).image[16, 16]) == (0, 0, 255, 255)
+    edit(folder / "tint.glsl", "in vec4 in_position;", "in ivec4 in_position;")
+    edit(folder / "tint.glsl", "* in_position;", "* vec4(in_position);")
+    with pytest.raises(SandboxError, match="attribute in_position must be a float vector: 'in vec3 in_position'"):
+        gl.executor.reload_shaders()  # compiled programs are kept until a reload (R, or a save in the window)
 
 
 def test_compile_errors_name_the_users_file_and_line(folder: Path, capsys, gl) -> None:
@@ -311,7 +336,8 @@ def test_the_watch_reports_a_saved_file_once(tmp_path: Path) -> None:
     assert watch.changed(now=1.5)
 
 
-def test_a_save_reloads_the_users_shader_and_a_broken_one_keeps_the_last_good(folder: Path, gl) -> None:
+def test_a_save_reloads_the_users_shader_and_a_broken_one_keeps_the_last_good(folder: Path, fresh) -> None:
+    gl = fresh
     scene = load_scene(folder / "scene.toml")
     shader = folder / "tint.glsl"
     watch = ShaderWatch(gl.executor.shader_files, interval=0.0)

@@ -121,7 +121,7 @@ _OTHER_TYPES = {0x8B5A: "mat2", 0x8B5B: "mat3", 0x8B5C: "mat4", 0x8B5E: "sampler
                 0x8B57: "bvec2", 0x8B58: "bvec3", 0x8B59: "bvec4"}
 #: The attributes the executor feeds, with the GL type of each one's GLSL type.
 _ATTRIBUTE_TYPES = {"in_position": (0x8B51, "vec3"), "in_normal": (0x8B51, "vec3"), "in_uv": (0x8B50, "vec2"),
-                    "in_color": (0x8B51, "vec3")}
+                    "in_color": (0x8B51, "vec3")}  # the GL type of what the buffers hold, and its GLSL name
 
 
 def user_uniform_value(user: UserProgram, uniform: moderngl.Uniform, name: str, value: object,
@@ -253,8 +253,10 @@ class Executor:
                 raise SandboxError(f"{user.path}: attribute {name} is none the renderer gives "
                                    f"({', '.join(_ATTRIBUTE_TYPES)})")
             gl_type, glsl = _ATTRIBUTE_TYPES[name]
-            if member.gl_type != gl_type:
-                raise SandboxError(f"{user.path}: attribute {name} must be declared 'in {glsl} {name}'")
+            # GL converts the buffer's floats to any float vector (missing y, z are 0, w is 1:
+            # 'in vec4 in_position' works); integer or matrix attributes it cannot feed.
+            if member.gl_type not in (0x1406, 0x8B50, 0x8B51, 0x8B52):
+                raise SandboxError(f"{user.path}: attribute {name} must be a float vector: 'in {glsl} {name}'")
             array = {"in_uv": "uvs", "in_color": "colors"}.get(name)
             if array and getattr(node.mesh, array) is None:
                 what = "texture coordinates (uvs)" if array == "uvs" else "vertex colours"
