@@ -168,14 +168,15 @@ class FrameRenderer:
         """Draw one frame; returns its plan and the target holding it.
         ``ray_resolution`` < 1 traces ray-traced viewports coarser (the window while moving)."""
         self.host.make_current()
-        for note in user_shader_notes(scene):  # a node's own shader in a ray-traced viewport
-            if note not in self._noted:
-                self._noted.add(note)
-                print(f"warning: {note}", file=sys.stderr, flush=True)
+        notes = user_shader_notes(scene)  # a node's own shader in a ray-traced viewport
         scene = trace_viewports(scene, size, self.host.ctx, ray_resolution)
         frame_plan = plan(scene)
         target = self.target(size, frame_plan.buffers)
         self.executor.render(scene, target.framebuffer, size, frame_plan)
+        for note in notes:  # once per run, after a frame that worked (a failed one says only its error)
+            if note not in self._noted:
+                self._noted.add(note)
+                print(f"warning: {note}", file=sys.stderr, flush=True)
         return frame_plan, target
 
     def close(self) -> None:
