@@ -174,6 +174,41 @@ def test_a_python_node_names_its_shader_relative_to_the_working_folder(folder: P
         gl.executor.reload_shaders()  # compiled programs are kept until a reload (R, or a save in the window)
 
 
+def test_a_textured_material_gives_the_shader_its_texture(folder: Path, gl) -> None:
+    # TEXTURED is defined and u_texture holds the material's texture on unit 0: a shader that
+    # samples it as basic.glsl does draws what basic.glsl draws.
+    (folder / "textured.glsl").write_text("""#version 330 core
+#if defined(VERTEX_SHADER)
+#include "common/transform.glsl"
+in vec3 in_position;
+in vec2 in_uv;
+out vec2 v_uv;
+void main() { v_uv = in_uv; gl_Position = to_clip(in_position); }
+#elif defined(FRAGMENT_SHADER)
+uniform vec4 u_color;
+in vec2 v_uv;
+#ifdef TEXTURED
+uniform sampler2D u_texture;
+#endif
+out vec4 frag_color;
+void main() {
+#ifdef TEXTURED
+    frag_color = u_color * texture(u_texture, v_uv);
+#else
+    frag_color = vec4(1.0, 0.0, 1.0, 1.0);
+#endif
+}
+#endif
+""")
+    (folder / "textured.toml").write_text('[[nodes]]\nmesh = "cube24"\nrotate = [20, 30, 0]\ntexture = "checker"\n'
+                                          'color = [1, 0.8, 0.6]\nshader = "textured.glsl"\n')
+    scene = load_scene(folder / "textured.toml")
+    builtin = replace(scene, nodes=(replace(scene.nodes[0], shader=None),))
+    own = gl.render_scene(scene, (64, 48)).image
+    np.testing.assert_array_equal(own, gl.render_scene(builtin, (64, 48)).image)
+    assert len({tuple(p) for p in own.reshape(-1, 4)}) > 4  # the checker shows
+
+
 def test_compile_errors_name_the_users_file_and_line(folder: Path, capsys, gl) -> None:
     edit(folder / "tint.glsl", "vec4(tint, 1.0)", "vec4(tint, 1.0) * missing_thing")
     assert_error(folder, capsys, f"shader does not compile: {folder / 'tint.glsl'}:12: ", "missing_thing")
