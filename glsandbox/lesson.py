@@ -124,7 +124,9 @@ def parse_uniform_text(text: str) -> Any:
     try:
         numbers = [float(part) for part in parts]
     except ValueError:
-        raise SandboxError("expected a number, on/off, or 2 to 4 numbers (1,0.5,0)") from None
+        numbers = []
+    if not numbers:
+        raise SandboxError("expected a number, on/off, or 2 to 4 numbers (1,0.5,0)")
     return check_uniform_value(numbers[0] if len(numbers) == 1 else tuple(numbers), "value")
 
 

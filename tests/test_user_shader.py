@@ -287,6 +287,10 @@ def test_set_u_needs_a_shader_that_declares_it(folder: Path, capsys, gl) -> None
     assert_error(folder, capsys, "--set u.tnit: no shader of the scene declares uniform tnit", settings=("u.tnit=1",))
     assert_error(folder, capsys, "--set u.tint=green: expected a number, on/off, or 2 to 4 numbers",
                  settings=("u.tint=green",))
+    assert_error(folder, capsys, "--set u.tint=: expected a number", settings=("u.tint=",))
+    assert_error(folder, capsys, "--set u.tint=1,2,3,4,5: value must be 2 or 3 or 4 numbers",
+                 settings=("u.tint=1,2,3,4,5",))
+    assert_error(folder, capsys, "--set u.tint=nan: value must be a finite number", settings=("u.tint=nan",))
     assert_error(folder, capsys, "--set u.m_proj: set by the renderer", settings=("u.m_proj=1",))
     with pytest.raises(SandboxError, match="--set u.tint: no node of indexed_cube has a shader of its own"):
         find_lesson("indexed_cube").from_settings(["u.tint=1,0,0"]).scene()
