@@ -119,9 +119,10 @@ _SETTABLE_UNIFORMS = {
 #: Other GL types, named in errors.
 _OTHER_TYPES = {0x8B5A: "mat2", 0x8B5B: "mat3", 0x8B5C: "mat4", 0x8B5E: "sampler2D", 0x8B60: "samplerCube",
                 0x8B57: "bvec2", 0x8B58: "bvec3", 0x8B59: "bvec4"}
-#: The attributes the executor feeds, with the GL type of each one's GLSL type.
-_ATTRIBUTE_TYPES = {"in_position": (0x8B51, "vec3"), "in_normal": (0x8B51, "vec3"), "in_uv": (0x8B50, "vec2"),
-                    "in_color": (0x8B51, "vec3")}  # the GL type of what the buffers hold, and its GLSL name
+#: The attributes the executor feeds, with the GLSL type of what their buffers hold.
+_ATTRIBUTE_GLSL = {attr: f"vec{width}" for _, attr, width in _ATTRIBUTES}
+#: GL's float, vec2, vec3, vec4: the types a buffer of floats can feed.
+_FLOAT_VECTORS = (0x1406, 0x8B50, 0x8B51, 0x8B52)
 
 
 def user_uniform_value(user: UserProgram, uniform: moderngl.Uniform, name: str, value: object,
@@ -218,7 +219,7 @@ class Executor:
                 if user is not None:
                     users[key] = user
                     for node in self._user_nodes.get(key, {}).values():
-                        self._user_uniforms(user, program, frozenset(program), node)
+                        self._check_user_draw(user, program, frozenset(program), node)
         except SandboxError:
             for _, program in fresh.values():
                 program.release()
@@ -236,7 +237,7 @@ class Executor:
         """The files the nodes' own shader programs were built from (with their includes)."""
         return frozenset(path for user in self._user.values() for path in user.files)
 
-    def _user_uniforms(self, user: UserProgram, program: moderngl.Program, members: Collection[str],
+    def _check_user_draw(self, user: UserProgram, program: moderngl.Program, members: Collection[str],
                        node: Node) -> dict[str, object]:
         """The values to write into a node's own shader program, each checked against the program.
 
@@ -249,13 +250,13 @@ class Executor:
             member = program[name]
             if not isinstance(member, moderngl.Attribute):
                 continue
-            if name not in _ATTRIBUTE_TYPES:
+            if name not in _ATTRIBUTE_GLSL:
                 raise SandboxError(f"{user.path}: attribute {name} is none the renderer gives "
-                                   f"({', '.join(_ATTRIBUTE_TYPES)})")
-            gl_type, glsl = _ATTRIBUTE_TYPES[name]
+                                   f"({', '.join(_ATTRIBUTE_GLSL)})")
+            glsl = _ATTRIBUTE_GLSL[name]
             # GL converts the buffer's floats to any float vector (missing y, z are 0, w is 1:
             # 'in vec4 in_position' works); integer or matrix attributes it cannot feed.
-            if member.gl_type not in (0x1406, 0x8B50, 0x8B51, 0x8B52):
+            if member.gl_type not in _FLOAT_VECTORS:
                 raise SandboxError(f"{user.path}: attribute {name} must be a float vector: 'in {glsl} {name}'")
             array = {"in_uv": "uvs", "in_color": "colors"}.get(name)
             if array and getattr(node.mesh, array) is None:
@@ -415,7 +416,7 @@ class Executor:
         user = self._user.get(draw.program)
         own: dict[str, object] = {}
         if user is not None:  # a node's own shader: checked before anything is drawn with it
-            own = self._user_uniforms(user, program, members, node)
+            own = self._check_user_draw(user, program, members, node)
             self._user_nodes.setdefault(draw.program, {})[node.name] = node
         mesh = node.mesh
         if mesh.normals is None and "in_normal" in members:
