@@ -18,6 +18,7 @@ the window (:mod:`glsandbox.window`) copies the target onto the screen.
 from __future__ import annotations
 
 import math
+import sys
 import time
 from dataclasses import dataclass, replace
 
@@ -29,7 +30,7 @@ from glsandbox.gl.executor import Executor
 from glsandbox.gl.target import OffscreenTarget
 from glsandbox.lesson import Lesson
 from glsandbox.overlay import Overlay
-from glsandbox.plan import Buffers, Plan, plan
+from glsandbox.plan import Buffers, Plan, plan, user_shader_notes
 from glsandbox.scene import Scene
 
 __all__ = ["DEFAULT_SIZE", "Frame", "FrameRenderer", "HeadlessRenderer", "InteractiveResolution",
@@ -151,6 +152,7 @@ class FrameRenderer:
         self.host = host
         self.executor = Executor(host)
         self._targets: dict[tuple[tuple[int, int], Buffers], OffscreenTarget] = {}
+        self._noted: set[str] = set()  # user-shader notes already printed: once per run, not per frame
 
     def target(self, size: tuple[int, int], buffers: Buffers) -> OffscreenTarget:
         key = (size, buffers)
@@ -166,10 +168,15 @@ class FrameRenderer:
         """Draw one frame; returns its plan and the target holding it.
         ``ray_resolution`` < 1 traces ray-traced viewports coarser (the window while moving)."""
         self.host.make_current()
+        notes = user_shader_notes(scene)  # a node's own shader in a ray-traced viewport
         scene = trace_viewports(scene, size, self.host.ctx, ray_resolution)
         frame_plan = plan(scene)
         target = self.target(size, frame_plan.buffers)
         self.executor.render(scene, target.framebuffer, size, frame_plan)
+        for note in notes:  # once per run, after a frame that worked (a failed one says only its error)
+            if note not in self._noted:
+                self._noted.add(note)
+                print(f"warning: {note}", file=sys.stderr, flush=True)
         return frame_plan, target
 
     def close(self) -> None:

@@ -20,7 +20,7 @@ from typing import Any, ClassVar
 
 from glsandbox.errors import NUMBER_LIMIT, SandboxError
 from glsandbox.scene import RENDERERS
-from glsandbox.scene import PLAN_MODES, Scene
+from glsandbox.scene import PLAN_MODES, Scene, check_uniform_name, check_uniform_value
 from glsandbox.scene_file import load_scene
 
 # NUMBER_LIMIT (glsandbox.errors) is the largest magnitude a number parameter
@@ -104,6 +104,32 @@ RENDERER = Param("renderer", "raster", "who draws the 3D content: the rasterizer
                  "(the same Scene)", choices=RENDERERS)
 
 
+#: ``--set u.NAME=value``: a uniform of the scene's own shaders (README "Your own shader").
+UNIFORM_PREFIX = "u."
+
+
+def uniform_param(key: str, flag: str = "--set") -> Param:
+    """The parameter behind ``u.NAME``: its text is a number, on/off (true/false), or 2 to 4
+    numbers separated by commas or spaces (``1,0.5,0`` or ``[1, 0.5, 0]``)."""
+    check_uniform_name(key[len(UNIFORM_PREFIX):], f"{flag} {key}")
+    return Param(key, None, "a uniform of the scene's own shaders", convert=parse_uniform_text)
+
+
+def parse_uniform_text(text: str) -> Any:
+    """``--set u.NAME`` text -> a bool, a float or a tuple of floats, checked as scene values are."""
+    lowered = text.strip().lower()
+    if lowered in ("true", "on", "false", "off"):
+        return lowered in ("true", "on")
+    parts = lowered.strip("[]() ").replace(",", " ").split()
+    try:
+        numbers = [float(part) for part in parts]
+    except ValueError:
+        numbers = []
+    if not numbers:
+        raise SandboxError("expected a number, on/off, or 2 to 4 numbers (1,0.5,0)")
+    return check_uniform_value(numbers[0] if len(numbers) == 1 else tuple(numbers), "value")
+
+
 class Lesson:
     """Base class. Subclasses set the class attributes and implement :meth:`build`."""
 
@@ -123,7 +149,9 @@ class Lesson:
         known = {p.name: p for p in self.all_params()}
         self.values: dict[str, Any] = {p.name: self.defaults.get(p.name, p.default) for p in known.values()}
         for key, value in values.items():
-            if key not in known:
+            if key.startswith(UNIFORM_PREFIX):
+                uniform_param(key)  # checks the name; the value is checked with the scene
+            elif key not in known:
                 raise SandboxError(unknown_param_message(self, key))
             self.values[key] = value
 
@@ -139,6 +167,8 @@ class Lesson:
         if not sep or not key:
             raise SandboxError(f"{flag} {item!r}: expected {expected}")
         known = {p.name: p for p in cls.all_params()}
+        if key.startswith(UNIFORM_PREFIX):
+            return uniform_param(key, flag), text.strip()
         if key not in known:
             raise SandboxError(unknown_param_message(cls, key, flag))
         return known[key], text.strip()
@@ -172,7 +202,12 @@ class Lesson:
         if renderer != "raster":  # traced by glsandbox.frame.trace_viewports
             scene = replace(scene, viewports=tuple(replace(vp, renderer=renderer) for vp in scene.viewports))
         plan_mode = self.values.get("effects", "needed")  # effects=all: the bench's everything-on plan
-        return scene if scene.plan_mode == plan_mode else replace(scene, plan_mode=plan_mode)
+        scene = scene if scene.plan_mode == plan_mode else replace(scene, plan_mode=plan_mode)
+        uniforms = {k[len(UNIFORM_PREFIX):]: v for k, v in self.values.items() if k.startswith(UNIFORM_PREFIX)}
+        if uniforms and not any(node.shader is not None for node in scene.nodes):
+            raise SandboxError(f"--set {UNIFORM_PREFIX}{next(iter(uniforms))}: no node of {self.name} has a shader "
+                               "of its own (shader = \"file.glsl\") to take it")
+        return replace(scene, uniform_overrides={**scene.uniform_overrides, **uniforms}) if uniforms else scene
 
     def build(self) -> Scene:
         raise NotImplementedError

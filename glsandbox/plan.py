@@ -24,10 +24,15 @@ from glsandbox.scene import Node, Scene
 
 @dataclass(frozen=True, order=True)
 class ProgramVariant:
-    """A shader file compiled with a set of ``#define`` lines."""
+    """A shader file compiled with a set of ``#define`` lines.
+
+    ``shader`` is a built-in program's name (``phong``: ``shaders/phong.glsl``),
+    or with ``user`` the path of a node's own GLSL file (:attr:`Node.shader`).
+    """
 
     shader: str
     defines: tuple[tuple[str, str], ...] = ()
+    user: bool = False
     #: ``shader[DEFINE,NAME=value]``: names the compiled program in plans and caches.
     key: str = field(init=False, compare=False, repr=False)
 
@@ -171,6 +176,9 @@ class Plan:
     #: :attr:`~glsandbox.geometry.Mesh.notes`: triangles, degenerate faces
     #: dropped, where the normals came from); empty for built-in meshes.
     meshes: tuple[str, ...] = ()
+    #: What the frame does differently from what the scene asks (a node's own
+    #: shader in a ray-traced viewport: :func:`user_shader_note`).
+    notes: tuple[str, ...] = ()
 
     def describe(self) -> str:
         """A readable listing, as ``glsandbox plan`` prints it."""
@@ -181,6 +189,9 @@ class Plan:
         if self.meshes:
             lines.append("meshes:")
             lines += [f"  {line}" for line in self.meshes]
+        if self.notes:
+            lines.append("notes:")
+            lines += [f"  {line}" for line in self.notes]
         return "\n".join(lines)
 
     def to_dict(self) -> dict[str, Any]:
@@ -193,17 +204,41 @@ class Plan:
         }
         if self.meshes:
             result["meshes"] = list(self.meshes)
+        if self.notes:
+            result["notes"] = list(self.notes)
         return result
 
 
 def program_for(node: Node, lights: int = 0) -> ProgramVariant:
     """The shader variant a node needs: ``basic`` with its colour source, or
     ``phong`` (:func:`lit_program_for`) when its material is lit; ``TEXTURED``
-    only when it has a texture. ``lights`` is the number of lights in the scene."""
+    only when it has a texture. ``lights`` is the number of lights in the scene.
+    A node with a shader of its own gets that file, with ``NUM_LIGHTS`` (and
+    ``TEXTURED``) defined, whatever its material's shading."""
     material = node.material
+    if node.shader is not None:
+        return _user_variant(str(node.shader), lights, material.texture is not None)
     if material.lit:
         return lit_program_for(node, lights)
     return _basic_variant(material.shading == "vertex_color", material.texture is not None)
+
+
+@functools.cache
+def _user_variant(path: str, lights: int, textured: bool) -> ProgramVariant:
+    return ProgramVariant(path, (("NUM_LIGHTS", str(lights)), *_texture_defines(textured)), user=True)
+
+
+def user_shader_note(viewport: int, node: Node) -> str:
+    """What a ray-traced viewport does with a node that has a shader of its own."""
+    return (f"viewport {viewport} is ray-traced: the ray tracer cannot run GLSL, so node {node.name!r} "
+            f"(shader {node.shader}) is traced with its material ({node.material.shading})")
+
+
+def user_shader_notes(scene: Scene) -> tuple[str, ...]:
+    """One :func:`user_shader_note` per node with its own shader in each ray-traced viewport."""
+    return tuple(user_shader_note(index, node) for index, viewport in enumerate(scene.viewports)
+                 if viewport.renderer != "raster" for node in scene.nodes
+                 if node.shader is not None and node.shown_in(index))
 
 
 def _texture_defines(textured: bool) -> tuple[tuple[str, str], ...]:
@@ -322,6 +357,7 @@ def plan(scene: Scene) -> Plan:
         programs=tuple(sorted(programs)),
         passes=tuple(passes),
         meshes=tuple(f"{node.name}: {', '.join(node.mesh.notes)}" for node in scene.nodes if node.mesh.notes),
+        notes=user_shader_notes(scene),
     )
 
 

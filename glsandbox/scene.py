@@ -9,8 +9,14 @@ from __future__ import annotations
 
 import hashlib
 import math
+import os
+import re
 import weakref
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
 
 import numpy as np
 
@@ -236,12 +242,94 @@ class Material:
         return self.shading in LIT_SHADINGS
 
 
+# --- a node's own shader (README "Your own shader") -----------------------------
+
+#: What the rasterizer gives a node's own shader (``Node.shader``), as
+#: ``(name, GLSL type, space, what)``: the vertex attributes, then the
+#: uniforms. The same ones the built-in shaders read (``shaders/basic.glsl``,
+#: ``shaders/phong.glsl``); ``common/transform.glsl`` declares the matrices,
+#: ``common/lighting.glsl`` the colour, eye, lights and coefficients. The
+#: program is compiled with ``NUM_LIGHTS`` (the scene's light count) and, for
+#: a textured material, ``TEXTURED`` defined. An attribute the mesh lacks is
+#: an error (normals excepted: a mesh without them gets face normals).
+SHADER_INPUTS: tuple[tuple[str, str, str, str], ...] = (
+    ("in_position", "in vec3", "model", "vertex position"),
+    ("in_normal", "in vec3", "model", "vertex normal (face normals if the mesh has none)"),
+    ("in_uv", "in vec2", "texture", "texture coordinates (the mesh must have them)"),
+    ("in_color", "in vec3", "-", "vertex colour (the mesh must have them)"),
+    ("m_model", "uniform mat4", "model -> world", "the node's model matrix"),
+    ("m_view", "uniform mat4", "world -> view", "the camera's view matrix"),
+    ("m_proj", "uniform mat4", "view -> clip", "the projection"),
+    ("m_normal", "uniform mat3", "model -> world", "normal matrix, inverse transpose of m_model's 3x3"),
+    ("u_color", "uniform vec4", "-", "material colour (rgba, 0..1)"),
+    ("u_eye", "uniform vec3", "world", "camera position"),
+    ("u_light_pos", "uniform vec3[NUM_LIGHTS]", "world", "light positions (only if NUM_LIGHTS > 0)"),
+    ("u_light_color", "uniform vec3[NUM_LIGHTS]", "-", "light colours"),
+    ("u_ambient", "uniform float", "-", "material coefficient (0.1)"),
+    ("u_diffuse", "uniform float", "-", "material coefficient (0.4)"),
+    ("u_specular", "uniform float", "-", "material coefficient (0.3)"),
+    ("u_shininess", "uniform float", "-", "specular exponent (32)"),
+    ("u_texture", "uniform sampler2D", "texture", "the material's texture on unit 0 (with TEXTURED)"),
+)
+
+#: The names the renderer sets; a node's own uniforms may not use them.
+STANDARD_SHADER_NAMES = frozenset(name for name, *_ in SHADER_INPUTS)
+
+_GLSL_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+#: A uniform value: a number (float, int or uint uniforms), a bool, or 2 to 4 numbers (vecN, ivecN, uvecN).
+UniformValue = float | bool | tuple[float, ...]
+
+
+def check_uniform_name(name: object, what: str) -> str:
+    """A GLSL identifier that is not one of the renderer's own (:data:`STANDARD_SHADER_NAMES`)."""
+    if not isinstance(name, str) or not _GLSL_NAME.fullmatch(name) or name.startswith("gl_"):
+        raise SandboxError(f"{what}: not a GLSL uniform name (letters, digits and _, not gl_...)")
+    if name in STANDARD_SHADER_NAMES:
+        raise SandboxError(f"{what}: set by the renderer (the README's table of shader inputs), not by a scene")
+    return name
+
+
+def check_uniform_value(value: object, what: str) -> UniformValue:
+    """A uniform value as the scene keeps it: a bool, a float, or a tuple of 2 to 4 floats,
+    each number finite and within +-NUMBER_LIMIT (:func:`~glsandbox.errors.check_numbers`)."""
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__len__"):
+        return check_number(value, what)
+    return check_numbers(value, what, (2, 3, 4))
+
+
+def check_uniforms(values: object, what: str) -> Mapping[str, UniformValue]:
+    """``{name: value}`` checked name by name, as a read-only mapping; ``what`` names
+    each in errors, with ``{name}`` replaced by the uniform's name."""
+    if not isinstance(values, Mapping):
+        raise SandboxError(f"{what.format(name='').rstrip(' .')} must be a table of name = value, "
+                           f"got {plain(values)}")
+    checked = {}
+    for name, value in values.items():
+        label = what.format(name=name if isinstance(name, str) else plain(name))
+        checked[check_uniform_name(name, label)] = check_uniform_value(value, label)
+    return MappingProxyType(checked)
+
+
+_NO_UNIFORMS: Mapping[str, UniformValue] = MappingProxyType({})
+
+
 @dataclass(frozen=True, eq=False)
 class Node:
     """A mesh placed in the world with a model matrix and a material.
 
     ``cull_back_faces`` is the rasterizer state (on by default, as in the
     course); ``viewports`` limits the node to some viewports (None: all).
+
+    ``shader`` names a GLSL file of the user's (a path, relative to the
+    working folder or absolute, kept absolute; a scene file's is relative to
+    the scene file) that the rasterizer draws the node with instead of a built-in
+    program: one file, both stages, inputs as :data:`SHADER_INPUTS` lists.
+    ``uniforms`` sets the shader's own uniforms (``{"u_bands": 3.0}``):
+    numbers, bools, or 2 to 4 numbers. The ray tracer cannot run GLSL: it
+    traces such a node with its ``material``.
     """
 
     name: str
@@ -250,10 +338,22 @@ class Node:
     material: Material = Material()
     cull_back_faces: bool = True
     viewports: tuple[int, ...] | None = None
+    shader: str | os.PathLike[str] | None = None
+    uniforms: Mapping[str, Any] = field(default_factory=lambda: _NO_UNIFORMS)
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str):
             raise SandboxError(f"a node's name must be text, got {plain(self.name)}")
+        if self.shader is not None:
+            if not isinstance(self.shader, (str, os.PathLike)) or not str(self.shader).strip():
+                raise SandboxError(f"node {self.name!r}: shader must be a GLSL file path, got {plain(self.shader)}")
+            # Absolute now: the working folder at the node's making is the one meant, and
+            # programs are cached by path, so two folders' "toon.glsl" stay apart.
+            _set(self, "shader", Path(os.path.abspath(self.shader)))
+        if self.uniforms or type(self.uniforms) is not MappingProxyType:
+            _set(self, "uniforms", check_uniforms(self.uniforms, f"node {self.name!r}: uniform {{name}}"))
+            if self.uniforms and self.shader is None:
+                raise SandboxError(f"node {self.name!r}: uniforms need a shader of the node's own (shader = ...)")
         model = np.asarray(self.model)
         if model.shape != (4, 4) or model.dtype.kind not in "biuf":
             raise SandboxError(f"node {self.name!r}: model matrix must be 4x4 numbers, got {plain(self.model)}")
@@ -346,6 +446,9 @@ class Scene:
     #: every buffer and pass state forced on (the everything-on baseline that
     #: ``glsandbox bench`` measures on-demand planning against). See :data:`PLAN_MODES`.
     plan_mode: str = "needed"
+    #: Uniform values for every node's own shader that declares them
+    #: (``--set u.NAME=value``; they win over the nodes' ``uniforms``).
+    uniform_overrides: Mapping[str, Any] = field(default_factory=lambda: _NO_UNIFORMS)
 
     def __post_init__(self) -> None:
         # Lists are welcome from Python (Scene("s", nodes=[...])); stored as tuples, so a
@@ -353,6 +456,8 @@ class Scene:
         for field_name in ("nodes", "lights", "viewports", "overlays"):
             if isinstance(getattr(self, field_name), list):
                 _set(self, field_name, tuple(getattr(self, field_name)))
+        if self.uniform_overrides or type(self.uniform_overrides) is not MappingProxyType:
+            _set(self, "uniform_overrides", check_uniforms(self.uniform_overrides, "--set u.{name}"))
         _set(self, "clear_color", check_numbers(self.clear_color, "scene clear colour", (4,), 0.0, 1.0))
         if self.depth_mode not in DEPTH_MODES:
             raise SandboxError(f"unknown depth mode {self.depth_mode!r}; use one of {', '.join(DEPTH_MODES)}")

@@ -37,7 +37,7 @@ from glsandbox.geometry import builtin_mesh
 from glsandbox.meshfile import CREASE_ANGLE, NORMALS as MESH_NORMALS, Model, is_model_path, load_model
 from glsandbox.planar import Mirror, PlanarShadow
 from glsandbox.scene import (BUILTIN_TEXTURES, COURSE_BLUE, DEPTH_MODES, SHADINGS, Camera, Color, Light, Material,
-                             Node, Scene, Texture, Viewport)
+                             Node, Scene, Texture, Viewport, check_uniforms)
 
 #: Lighting coefficients a scene file may set on a node (see :class:`~glsandbox.scene.Material`).
 _MATERIAL_NUMBERS = ("ambient", "diffuse", "specular", "shininess")
@@ -68,8 +68,8 @@ class _Locator:
                 if m.group(1) == "[[":
                     index = counts.get(table, 0)
                     counts[table] = index + 1
-                else:
-                    index = 0
+                else:  # [nodes.uniforms] is a table of the last [[nodes]] element
+                    index = max(counts.get(table.rpartition(".")[0], 0) - 1, 0)
                 self.tables[(table, index)] = number
             elif m := self._key.match(line):
                 self.lines.setdefault((table, index, m.group(1)), number)
@@ -200,7 +200,7 @@ class _SceneReader:
         data = self.table(data, "nodes", i)
         allowed = {"name", "mesh", "order", "scale", "translate", "rotate", "color", "shading",
                    "cull_back_faces", "viewports", *_MATERIAL_NUMBERS, "normals", "texture", "filter", "wrap",
-                   *_MODEL_FILE_KEYS}
+                   *_MODEL_FILE_KEYS, "shader", "uniforms"}
         self.check_keys(data, allowed, "nodes", i)
         mesh_name = data.get("mesh")
         if not isinstance(mesh_name, str):
@@ -235,9 +235,10 @@ class _SceneReader:
         name = self.text(data, "name", "nodes", i, default=f"node{i}")
         material = self.material(data, i, shading) if loaded is None else self.model_material(data, i, shading,
                                                                                              loaded)
+        shader, uniforms = self.shader(data, i)
         try:
             return Node(name=name, mesh=mesh, model=model, material=material, cull_back_faces=cull,
-                        viewports=tuple(views) if views is not None else None)
+                        viewports=tuple(views) if views is not None else None, shader=shader, uniforms=uniforms)
         except SandboxError as exc:  # the mesh lacks what the material reads, or the model is out of bounds
             message = str(exc)
             if "which a texture needs" in message:
@@ -247,6 +248,40 @@ class _SceneReader:
             else:
                 key = next((k for k in ("scale", "translate") if k in data), None)
             raise self.fail("nodes", i, key, message) from None
+
+    def shader(self, data: dict[str, Any], i: int) -> tuple[Path | None, dict[str, Any]]:
+        """A node's own GLSL file (``shader = "toon.glsl"``, relative to the scene file) and
+        its ``[nodes.uniforms]``: numbers, true/false, or lists of 2 to 4 numbers."""
+        uniforms = data.get("uniforms", {})
+
+        def fail_uniforms(message: str) -> SandboxError:  # at the [nodes.uniforms] header, if written so
+            line = self.where.tables.get(("nodes.uniforms", i))
+            return SandboxError(f"{self.path}:{line}: nodes[{i}].uniforms: {message}") if line \
+                else self.fail("nodes", i, "uniforms", message)
+
+        if "shader" not in data:
+            if "uniforms" in data:
+                raise fail_uniforms("needs shader = \"<file.glsl>\" (uniforms are the shader's)")
+            return None, {}
+        text = self.text(data, "shader", "nodes", i)
+        path = Path(text)
+        if not text.strip():
+            raise self.fail("nodes", i, "shader", "expected a GLSL file path, got an empty text")
+        if not path.is_absolute():
+            path = self.path.parent / path  # relative to the scene file, not the shell
+        if not path.exists():
+            raise self.fail("nodes", i, "shader", f"shader file {path} not found")
+        if not isinstance(uniforms, dict):
+            raise fail_uniforms(f"expected a table ([nodes.uniforms] or {{ ... }}), got {plain(uniforms)}")
+        checked = {}
+        for name, value in uniforms.items():
+            line = self.where.line("nodes.uniforms", i, name) or self.where.line("nodes", i, "uniforms")
+            at = f"{self.path}:{line}" if line else str(self.path)
+            try:
+                checked.update(check_uniforms({name: value}, "{name}"))
+            except SandboxError as exc:
+                raise SandboxError(f"{at}: nodes[{i}].uniforms.{exc}") from None
+        return path, checked
 
     def model_file(self, data: dict[str, Any], i: int, mesh_name: str) -> Model | None:
         """A node's model file (``mesh = "path/to/model.obj"``, relative to the scene file),

@@ -23,6 +23,7 @@ from glsandbox.errors import SandboxError
 from glsandbox.files import next_numbered, save_png
 from glsandbox.frame import DEFAULT_SIZE, FrameRenderer, InteractiveResolution, with_samples
 from glsandbox.gl.context import open_context
+from glsandbox.gl.shader_watch import ShaderWatch
 from glsandbox.lesson import Lesson
 from glsandbox.scene import Scene
 
@@ -36,7 +37,8 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
 
     Keys: ESC quits; F12 writes ``screenshots/<lesson>-<n>.png`` (the next free ``n``); R reloads the
     shaders from disk (a broken shader keeps the last good program and shows
-    its error in the title and on stderr); other keys go to the lesson.
+    its error in the title and on stderr), as saving a node's own shader file
+    does; other keys go to the lesson.
     ``instead`` is what the errors offer when no window can open (the
     command's headless form, e.g. ``glsandbox render``).
 
@@ -67,6 +69,17 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
     glfw.set_key_callback(host.window, on_key)
     camera_input, repeat_keys = attach_camera_input(host.window, lambda: state["lesson"].scene())
 
+    def reload_shaders() -> None:
+        try:
+            executor.reload_shaders()
+            state["error"] = ""
+            print("shaders reloaded", file=sys.stderr, flush=True)
+        except SandboxError as exc:
+            state["error"] = str(exc)
+            print(f"error: {exc}", file=sys.stderr, flush=True)
+
+    watch = ShaderWatch(executor.shader_files)  # nodes' own shader files: saving one reloads
+
     def handle(key: int) -> None:
         if key == glfw.KEY_ESCAPE:
             glfw.set_window_should_close(host.window, True)
@@ -83,13 +96,7 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
             save_png(image, path)
             print(f"screenshot: {path}", file=sys.stderr, flush=True)
         elif key == glfw.KEY_R:
-            try:
-                executor.reload_shaders()
-                state["error"] = ""
-                print("shaders reloaded", file=sys.stderr, flush=True)
-            except SandboxError as exc:
-                state["error"] = str(exc)
-                print(f"error: {exc}", file=sys.stderr, flush=True)
+            reload_shaders()
         else:
             name = glfw.get_key_name(key, 0) or {glfw.KEY_TAB: "tab", glfw.KEY_SPACE: "space"}.get(key, "") \
                 or _arrow_key_names(glfw).get(key, "")
@@ -102,6 +109,8 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
             glfw.poll_events()
             while pending:
                 handle(pending.pop(0))
+            if watch.changed():
+                reload_shaders()
             current: Lesson = state["lesson"]
             if current.animated:
                 current.values["time"] = start_time + glfw.get_time() - clock_start

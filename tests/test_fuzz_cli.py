@@ -40,6 +40,7 @@ settings.register_profile("long", max_examples=400, deadline=None,
 PROFILE = "long" if os.environ.get("GLSANDBOX_FUZZ") == "long" else "ci"
 
 SIZE = (24, 18)
+REPO = Path(__file__).resolve().parent.parent
 
 # --- values, from ordinary to hostile ---------------------------------------
 
@@ -66,6 +67,8 @@ def toml_value(value: Any) -> str:
         return '"' + value.encode("unicode_escape").decode("ascii").replace('"', '\\"') + '"'
     if isinstance(value, list):
         return "[" + ", ".join(toml_value(v) for v in value) + "]"
+    if isinstance(value, dict):  # an inline table
+        return "{" + ", ".join(f"{toml_value(k)} = {toml_value(v)}" for k, v in value.items()) + "}"
     raise TypeError(value)
 
 
@@ -78,6 +81,10 @@ nodes = st.fixed_dictionaries({"mesh": words}, optional={
     "order": words, "texture": st.sampled_from(["checker", "labels", "img.png", "missing.png", "pipe.png"]),
     "filter": words, "wrap": words, "ambient": numbers, "shininess": numbers, "cull_back_faces": st.booleans(),
     "viewports": st.one_of(st.just([0]), st.just([5]), st.just(["a"])),
+    # A node's own shader (toon.glsl is the example's, copied in) and its uniforms.
+    "shader": st.sampled_from(["toon.glsl", "missing.glsl", "img.png", "pipe.png", ""]),
+    "uniforms": st.dictionaries(st.sampled_from(["bands", "outline", "nope", "m_model", "x y"]),
+                                st.one_of(numbers, vectors, st.booleans()), max_size=3),
 })
 cameras = st.fixed_dictionaries({}, optional={"eye": vectors, "target": vectors, "up": vectors,
                                               "fov_y": numbers, "near": numbers, "far": numbers})
@@ -154,6 +161,7 @@ def run_cli(args: list[str], out_dir: Path, capsys) -> tuple[int, str]:
 def workdir(tmp_path: Path, gl) -> Path:  # `gl`: a GL backend, or a skip (fail under CI)
     if hasattr(os, "mkfifo"):  # a named pipe where an image belongs: reading it would wait forever
         os.mkfifo(tmp_path / "pipe.png")
+    (tmp_path / "toon.glsl").write_bytes((REPO / "examples" / "toon" / "toon.glsl").read_bytes())
     return tmp_path
 
 

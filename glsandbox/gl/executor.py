@@ -10,8 +10,9 @@ from __future__ import annotations
 import functools
 import hashlib
 import weakref
-from collections.abc import Collection
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass
+from pathlib import Path
 
 import moderngl
 import numpy as np
@@ -22,7 +23,7 @@ from glsandbox.geometry import Mesh, with_face_normals
 from glsandbox.gl import depth as gl_depth, planar as gl_planar
 from glsandbox.gl.context import GLHost
 from glsandbox.gl.overlay import OverlayDrawer
-from glsandbox.gl.shaders import compile_program
+from glsandbox.gl.shaders import compile_with_sources, declared_uniforms, source_files
 from glsandbox.gl.textures import TextureCache
 from glsandbox.plan import PLANAR_PASS_KINDS, Draw, Pass, Plan, ProgramVariant, plan as make_plan
 from glsandbox.scene import Light, Material, Node, Scene
@@ -97,6 +98,59 @@ def _normal_matrix_bytes(model: bytes) -> bytes:
     return transforms.gl_bytes(transforms.normal_matrix(np.frombuffer(model).reshape(4, 4)))
 
 
+@dataclass(frozen=True)
+class UserProgram:
+    """What the executor knows of a node's own shader program besides the program itself."""
+
+    path: Path  # the user's file
+    files: frozenset[Path]  # it and every file it includes (watched by the window)
+    declared: frozenset[str]  # the uniform names its text declares
+
+
+#: GL types of the uniforms a scene may set (``Node.uniforms``, ``--set u.NAME``):
+#: GLSL name, component kind, component count.
+_SETTABLE_UNIFORMS = {
+    0x1406: ("float", "float", 1), 0x8B50: ("vec2", "float", 2), 0x8B51: ("vec3", "float", 3),
+    0x8B52: ("vec4", "float", 4), 0x1404: ("int", "int", 1), 0x8B53: ("ivec2", "int", 2),
+    0x8B54: ("ivec3", "int", 3), 0x8B55: ("ivec4", "int", 4), 0x1405: ("uint", "uint", 1),
+    0x8DC6: ("uvec2", "uint", 2), 0x8DC7: ("uvec3", "uint", 3), 0x8DC8: ("uvec4", "uint", 4),
+    0x8B56: ("bool", "bool", 1),
+}
+#: Other GL types, named in errors.
+_OTHER_TYPES = {0x8B5A: "mat2", 0x8B5B: "mat3", 0x8B5C: "mat4", 0x8B5E: "sampler2D", 0x8B60: "samplerCube",
+                0x8B57: "bvec2", 0x8B58: "bvec3", 0x8B59: "bvec4"}
+#: The attributes the executor feeds, with the GLSL type of what their buffers hold.
+_ATTRIBUTE_GLSL = {attr: f"vec{width}" for _, attr, width in _ATTRIBUTES}
+#: GL's float, vec2, vec3, vec4: the types a buffer of floats can feed.
+_FLOAT_VECTORS = (0x1406, 0x8B50, 0x8B51, 0x8B52)
+
+
+def user_uniform_value(user: UserProgram, uniform: moderngl.Uniform, name: str, value: object,
+                       given_by: str) -> object:
+    """``value`` as ``uniform`` takes it, or a :class:`SandboxError` naming the user's file:
+    a number for float, int and uint (whole numbers for the last two), a bool for bool,
+    N numbers for vecN, ivecN and uvecN; arrays, matrices and samplers are not set this way."""
+    settable = _SETTABLE_UNIFORMS.get(uniform.gl_type)
+    glsl = settable[0] if settable else _OTHER_TYPES.get(uniform.gl_type, f"GL type 0x{uniform.gl_type:04X}")
+    if uniform.array_length > 1:
+        glsl += f"[{uniform.array_length}]"
+    if settable is None or uniform.array_length > 1:
+        raise SandboxError(f"{user.path}: uniform {name} is a {glsl}; {given_by} may set float, int, uint, bool, "
+                           "vecN, ivecN and uvecN uniforms only")
+    _, kind, count = settable
+    items = value if isinstance(value, tuple) else (value,)
+    fits = len(items) == count and all(isinstance(v, bool) == (kind == "bool") for v in items)
+    if fits and kind in ("int", "uint"):
+        fits = all(float(v).is_integer() and (kind == "int" or v >= 0) for v in items)
+    if not fits:
+        shown = ("true" if value else "false") if isinstance(value, bool) else \
+            ", ".join(f"{v:g}" for v in items) if len(items) > 1 else f"{items[0]:g}"
+        raise SandboxError(f"{user.path}: uniform {name} is a {glsl}, but {given_by} gives it {shown}")
+    if kind in ("int", "uint"):
+        items = tuple(int(v) for v in items)
+    return items if count > 1 else items[0]
+
+
 @dataclass
 class _GpuMesh:
     buffers: dict[str, moderngl.Buffer]
@@ -119,6 +173,11 @@ class Executor:
         self.ctx = host.ctx
         self.raw = host.raw  # the GL calls moderngl lacks (stencil, write masks, clip control)
         self._programs: dict[str, tuple[ProgramVariant, moderngl.Program]] = {}
+        # Nodes' own shaders: what each program read and declares, and the nodes drawn with it lately
+        # (by name), so that a reload checks the new program against them before replacing the old one.
+        self._user: dict[str, UserProgram] = {}
+        self._user_nodes: dict[str, dict[str, Node]] = {}
+        self._overrides: Mapping[str, object] = {}  # the frame's --set u.NAME values
         self._member_names: dict[str, frozenset[str]] = {}
         self._meshes: dict[tuple[str, str], _GpuMesh] = {}
         self._mesh_last_frame: dict[tuple[str, str], int] = {}
@@ -134,21 +193,87 @@ class Executor:
     def program(self, variant: ProgramVariant) -> moderngl.Program:
         entry = self._programs.get(variant.key)
         if entry is None:
-            entry = (variant, compile_program(self.ctx, variant))
+            program, user = self._compile(variant)
+            entry = (variant, program)
             self._programs[variant.key] = entry
+            if user is not None:
+                self._user[variant.key] = user
         return entry[1]
 
+    def _compile(self, variant: ProgramVariant) -> tuple[moderngl.Program, UserProgram | None]:
+        program, sources = compile_with_sources(self.ctx, variant)
+        if not variant.user:
+            return program, None
+        return program, UserProgram(Path(variant.shader), source_files(sources), declared_uniforms(sources))
+
     def reload_shaders(self) -> None:
-        """Recompile every program from disk. All or nothing: if one fails,
-        the old programs stay and the :class:`SandboxError` propagates."""
-        fresh = {key: (variant, compile_program(self.ctx, variant)) for key, (variant, _) in self._programs.items()}
+        """Recompile every program from disk. All or nothing: if one fails, or a
+        node's own shader no longer fits the nodes drawn with it lately (a uniform
+        or attribute), the old programs stay and the :class:`SandboxError` propagates."""
+        fresh: dict[str, tuple[ProgramVariant, moderngl.Program]] = {}
+        users: dict[str, UserProgram] = {}
+        try:
+            for key, (variant, _) in self._programs.items():
+                program, user = self._compile(variant)
+                fresh[key] = (variant, program)
+                if user is not None:
+                    users[key] = user
+                    for node in self._user_nodes.get(key, {}).values():
+                        self._check_user_draw(user, program, frozenset(program), node)
+        except SandboxError:
+            for _, program in fresh.values():
+                program.release()
+            raise
         for _, old in self._programs.values():
             old.release()
         for vao in self._vaos.values():
             vao.release()
         self._vaos.clear()
         self._programs = fresh
+        self._user = users
         self._member_names.clear()
+
+    def shader_files(self) -> frozenset[Path]:
+        """The files the nodes' own shader programs were built from (with their includes)."""
+        return frozenset(path for user in self._user.values() for path in user.files)
+
+    def _check_user_draw(self, user: UserProgram, program: moderngl.Program, members: Collection[str],
+                       node: Node) -> dict[str, object]:
+        """The values to write into a node's own shader program, each checked against the program.
+
+        Also checks the attributes against the node's mesh. The node's ``uniforms``
+        must be declared by the shader (a typo is an error); one declared but
+        unused has no uniform in the program, and is skipped as GL would. A
+        ``--set u.NAME`` value applies where the shader declares NAME.
+        """
+        for name in members:
+            member = program[name]
+            if not isinstance(member, moderngl.Attribute):
+                continue
+            if name not in _ATTRIBUTE_GLSL:
+                raise SandboxError(f"{user.path}: attribute {name} is none the renderer gives "
+                                   f"({', '.join(_ATTRIBUTE_GLSL)})")
+            glsl = _ATTRIBUTE_GLSL[name]
+            # GL converts the buffer's floats to any float vector (missing y, z are 0, w is 1:
+            # 'in vec4 in_position' works); integer or matrix attributes it cannot feed.
+            if member.gl_type not in _FLOAT_VECTORS:
+                raise SandboxError(f"{user.path}: attribute {name} must be a float vector: 'in {glsl} {name}'")
+            array = {"in_uv": "uvs", "in_color": "colors"}.get(name)
+            if array and getattr(node.mesh, array) is None:
+                what = "texture coordinates (uvs)" if array == "uvs" else "vertex colours"
+                raise SandboxError(f"{user.path}: in {glsl} {name} needs {what}, which node {node.name!r}'s "
+                                   f"mesh {node.mesh.name!r} does not have")
+        values = {}
+        for name, value in node.uniforms.items():
+            if name not in user.declared:
+                raise SandboxError(f"{user.path}: node {node.name!r} sets uniform {name}, which the shader does not "
+                                   f"declare (it declares: {', '.join(sorted(user.declared)) or 'none'})")
+            if name in members:
+                values[name] = user_uniform_value(user, program[name], name, value, f"node {node.name!r}")
+        for name, value in self._overrides.items():
+            if name in members and name in user.declared:
+                values[name] = user_uniform_value(user, program[name], name, value, f"--set u.{name}")
+        return values
 
     def _gpu_mesh(self, mesh: Mesh) -> tuple[tuple[str, str], _GpuMesh]:
         key = _mesh_key(mesh)
@@ -211,6 +336,12 @@ class Executor:
         self._frame += 1
         for variant in frame_plan.programs:
             self.program(variant)
+        self._overrides = scene.uniform_overrides
+        users = [self._user[v.key] for v in frame_plan.programs if v.user]
+        for name in scene.uniform_overrides if users else ():
+            if not any(name in user.declared for user in users):
+                raise SandboxError(f"--set u.{name}: no shader of the scene declares uniform {name} "
+                                   f"({', '.join(sorted(str(user.path) for user in users))})")
         nodes = {node.name: node for node in scene.nodes}
         self._lights = scene.lights
         self._clear_depth = gl_depth.clear_depth_value(scene)
@@ -282,6 +413,11 @@ class Executor:
         """
         program = self._programs[draw.program][1]
         members = self._members(draw.program)
+        user = self._user.get(draw.program)
+        own: dict[str, object] = {}
+        if user is not None:  # a node's own shader: checked before anything is drawn with it
+            own = self._check_user_draw(user, program, members, node)
+            self._user_nodes.setdefault(draw.program, {})[node.name] = node
         mesh = node.mesh
         if mesh.normals is None and "in_normal" in members:
             # A lit draw of a mesh without normals (the course's 8-vertex cube, a
@@ -308,9 +444,11 @@ class Executor:
         for name, data in uniforms.items():
             if name in members:
                 program[name].write(data)
-        if material.lit:
+        if material.lit or user is not None:  # a node's own shader may light itself whatever the shading
             write_light_uniforms(program, self._lights if lights is None else lights, camera.eye, members)
             write_material_uniforms(program, material, members)
+        for name, value in own.items():
+            program[name].value = value
         texture = material.texture
         if texture is not None:
             self._textures.bind(texture, 0)
@@ -346,6 +484,8 @@ class Executor:
         self._mesh_last_frame.clear()
         self._programs.clear()
         self._member_names.clear()
+        self._user.clear()
+        self._user_nodes.clear()
 
 
 # --- lighting uniforms (course section "Lighting") --------------------------

@@ -18,6 +18,11 @@ assembled text, the file and line it came from. The compiler's messages
 table into a one-line :class:`SandboxError` naming the original file and
 line. (``#line`` directives with source-string numbers would do the same in
 theory, but Mesa 22 attributes some errors to the wrong string.)
+
+A node's own shader (:attr:`glsandbox.scene.Node.shader`, a variant with
+``user``) is the same form in a file of the user's: its ``#include`` lines
+look next to the including file first, then in the shader folders, so
+``#include "common/lighting.glsl"`` reaches the course's lighting.
 """
 
 from __future__ import annotations
@@ -33,9 +38,14 @@ from glsandbox.errors import SandboxError
 from glsandbox.files import read_user_file
 from glsandbox.plan import ProgramVariant
 
-_INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"\s*$')
+_INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"\s*(?://.*)?$')
+_ANY_INCLUDE = re.compile(r"^\s*#\s*include\b")
 _VERSION = re.compile(r"^\s*#\s*version\b")
 _STAGES = {"vertex_shader": "VERTEX_SHADER", "fragment_shader": "FRAGMENT_SHADER"}
+_STAGE_MACRO = re.compile(r"\b(VERTEX_SHADER|FRAGMENT_SHADER)\b")
+# "uniform [precision] type name[, name...][ = value];" (the names, not the type).
+_UNIFORM_DECLARATION = re.compile(r"\buniform\s+(?:(?:lowp|mediump|highp)\s+)?\w+\s+([^;]+);")
+_DECLARED_NAME = re.compile(r"^\s*([A-Za-z_]\w*)")
 # Mesa: "3:12(1): error: ..."; other drivers: "ERROR: 3:12: ..." or "3(12) : error ...".
 _MESSAGE = re.compile(r"(?:ERROR:\s*)?(\d+)[:(](\d+)\)?(?:\(\d+\))?\s*:\s*(.*)")
 
@@ -87,14 +97,18 @@ class Source:
         return f"{self.origins[0][0]}:?" if self.origins else "<shader>"
 
 
-def assemble(name: str, stage: str, defines: tuple[tuple[str, str], ...] = (), root: Path | None = None) -> Source:
+def assemble(name: str, stage: str, defines: tuple[tuple[str, str], ...] = (), root: Path | None = None,
+             *, user: bool = False) -> Source:
     """Read ``<name>.glsl`` for one stage, with includes and defines.
 
     ``root`` searches one folder only; by default :func:`shader_roots`.
+    With ``user``, ``name`` is the path of a file of the user's; a file
+    outside the shader folders includes relative to itself first.
     """
     roots = [root] if root is not None else shader_roots()
     out: list[str] = []
     origins: list[tuple[Path, int]] = []
+    stages_seen: set[str] = set()  # the stage macros the files mention
 
     def emit(text: str, path: Path, line_no: int) -> None:
         out.append(text)
@@ -115,19 +129,44 @@ def assemble(name: str, stage: str, defines: tuple[tuple[str, str], ...] = (), r
                     emit(f"#define {key} {value}".rstrip(), path, line_no)
                 continue
             include = _INCLUDE.match(line)
+            if include is None and _ANY_INCLUDE.match(line):
+                raise SandboxError(f"{path}:{line_no}: expected #include \"file.glsl\", got {line.strip()!r}")
             if include:
-                read(find_shader_file(include.group(1), roots), f"{path}:{line_no}", (*stack, path))
+                read(_include(include.group(1), path, roots, f"{path}:{line_no}"), f"{path}:{line_no}",
+                     (*stack, path))
                 continue
+            stages_seen.update(_STAGE_MACRO.findall(line.split("//")[0]))
             emit(line, path, line_no)
 
-    top = find_shader_file(f"{name}.glsl", roots)
-    if not top.is_file():
-        known = sorted({p.stem for r in roots for p in r.glob("*.glsl")})
-        raise SandboxError(f"shader {name!r} not found in {', '.join(map(str, roots))}; known: {', '.join(known)}")
+    if user:
+        top = Path(name)
+    else:
+        top = find_shader_file(f"{name}.glsl", roots)
+        if not top.is_file():
+            known = sorted({p.stem for r in roots for p in r.glob("*.glsl")})
+            raise SandboxError(f"shader {name!r} not found in {', '.join(map(str, roots))}; known: {', '.join(known)}")
     read(top, None, ())
     if not out or not _VERSION.match(out[0]):
         raise SandboxError(f"{top}:1: a shader file must start with #version")
+    if user and _STAGES[stage] not in stages_seen:
+        # Without its section the stage would compile the other stage's code, or nothing.
+        # (A built-in file without one fails to compile, at the line the compiler names.)
+        raise SandboxError(f"{top}: no {_STAGES[stage]} section; a shader file holds both stages: "
+                           "#if defined(VERTEX_SHADER) ... #elif defined(FRAGMENT_SHADER) ... #endif")
     return Source("\n".join(out) + "\n", origins)
+
+
+def _include(relative: str, including: Path, roots: list[Path], where: str) -> Path:
+    """The file an ``#include "relative"`` in ``including`` means: next to a file outside the
+    shader folders first (a user's shader and its own includes), then the shader folders."""
+    inside = any(including.resolve().is_relative_to(root.resolve()) for root in roots)
+    folders = roots if inside else [including.parent, *roots]
+    for folder in folders:
+        if (folder / relative).is_file():
+            return folder / relative
+    if any((folder / relative).exists() for folder in folders):  # a folder or a pipe: read_user_file names it
+        return next(folder / relative for folder in folders if (folder / relative).exists())
+    raise SandboxError(f"{where}: #include \"{relative}\" not found (looked in {', '.join(map(str, folders))})")
 
 
 def _read_lines(path: Path, included_from: str | None) -> list[str]:
@@ -154,13 +193,40 @@ def _first_error(log: str, source: Source, stage: str) -> str:
 
 def compile_program(ctx: moderngl.Context, variant: ProgramVariant, root: Path | None = None) -> moderngl.Program:
     """Compile and link a program variant; errors name the file and line."""
-    sources = {stage: assemble(variant.shader, stage, variant.defines, root) for stage in _STAGES}
+    return compile_with_sources(ctx, variant, root)[0]
+
+
+def compile_with_sources(ctx: moderngl.Context, variant: ProgramVariant,
+                         root: Path | None = None) -> tuple[moderngl.Program, dict[str, Source]]:
+    """:func:`compile_program`, and the assembled source of each stage (which files it read, what it declares)."""
+    sources = {stage: assemble(variant.shader, stage, variant.defines, root, user=variant.user) for stage in _STAGES}
     try:
-        return ctx.program(**{stage: src.text for stage, src in sources.items()})
+        return ctx.program(**{stage: src.text for stage, src in sources.items()}), sources
     except moderngl.Error as exc:
         log = str(exc)
         # moderngl prefixes the failing stage's log with its name and a rule.
         for stage, src in sources.items():
             if f"\n{stage}\n" in f"\n{log}":
                 raise SandboxError(f"shader does not compile: {_first_error(log, src, stage)}") from None
-        raise SandboxError(f"shader {variant.key} does not link: {' '.join(log.split())}") from None
+        what = f"{variant.shader}: shader" if variant.user else f"shader {variant.key}"
+        log = re.sub(r"^\s*GLSL Linker failed\s*Program\s*=+\s*", "", log)  # moderngl's header, not the log
+        raise SandboxError(f"{what} does not link: {' '.join(log.split())}") from None
+
+
+def declared_uniforms(sources: dict[str, Source]) -> frozenset[str]:
+    """The uniform names the stages' text declares, active or not (the compiler
+    drops unused ones from the program; a declaration says the name is meant)."""
+    names = set()
+    for source in sources.values():
+        text = re.sub(r"//[^\n]*|/\*.*?\*/", " ", source.text, flags=re.S)
+        for declaration in _UNIFORM_DECLARATION.finditer(text):
+            for part in declaration.group(1).split(","):
+                m = _DECLARED_NAME.match(part)
+                if m:
+                    names.add(m.group(1))
+    return frozenset(names)
+
+
+def source_files(sources: dict[str, Source]) -> frozenset[Path]:
+    """Every file the stages were assembled from (the top file and its includes)."""
+    return frozenset(path for source in sources.values() for path, _ in source.origins)
