@@ -331,7 +331,7 @@ def _the_lesson_in(module: types.ModuleType, path: Path) -> type[Lesson]:
     """The one lesson a loaded lesson file defines (see :func:`lesson_file_lesson`)."""
     chosen = module.__dict__.get("LESSON")
     if chosen is not None and not (isinstance(chosen, type) and issubclass(chosen, Lesson)):
-        raise SandboxError(f"{path}: LESSON must be a Lesson subclass, got {plain(repr(chosen))}")
+        raise SandboxError(f"{path}: LESSON must be a Lesson subclass, got {plain(chosen)}")
     if chosen is None:
         own = [value for value in module.__dict__.values()
                if isinstance(value, type) and issubclass(value, Lesson) and value.__module__ == module.__name__]
