@@ -161,3 +161,21 @@ def test_a_folder_of_submissions(tmp_path: Path, gl) -> None:
     proc = glsandbox("check", str(subs), "--golden", str(ref))
     assert proc.returncode == 0, proc.stdout
     assert "2 passed, 0 failed, 0 broken of 2" in proc.stdout
+
+
+def test_a_shader_that_does_not_compile_is_broken_and_the_others_go_on(tmp_path: Path, gl) -> None:
+    # The built-in solid program replaced by one that does not compile (GLSANDBOX_SHADER_DIR):
+    # the submission drawing a cube is BROKEN with the shader's file and line, the empty one passes.
+    shaders = tmp_path / "shaders"
+    shaders.mkdir()
+    (shaders / "basic.glsl").write_text("#version 330 core\nthis is not glsl\n")
+    subs = tmp_path / "subs"
+    lesson_file(subs, "a_cube.toml", 'name = "cube"\n[[nodes]]\nmesh = "cube"\n')
+    lesson_file(subs, "b_empty.toml", 'name = "empty"\n')
+    ref = tmp_path / "ref.png"
+    assert glsandbox("check", str(subs / "b_empty.toml"), "--golden", str(ref), "--update", "--size", SIZE,
+                     env={"GLSANDBOX_SHADER_DIR": str(shaders)}).returncode == 0
+    proc = glsandbox("check", str(subs), "--golden", str(ref), env={"GLSANDBOX_SHADER_DIR": str(shaders)})
+    assert proc.returncode == 1
+    assert f"BROKEN a_cube: shader does not compile: {shaders / 'basic.glsl'}:2:" in proc.stdout
+    assert "PASS   b_empty: identical" in proc.stdout

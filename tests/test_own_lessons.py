@@ -11,7 +11,9 @@ import pytest
 from glsandbox.errors import SandboxError
 from glsandbox.files import load_png
 from glsandbox.lesson import all_lessons, find_lesson, lesson_files
+from glsandbox.measure.golden import compare_images
 from test_cli import assert_user_error, glsandbox
+from test_window import LessonWindow, wait_for, window_env  # noqa: F401 (window_env: a fixture)
 
 SPIN = '''
 import glsandbox
@@ -180,3 +182,18 @@ def test_tour_lessons_dir_renders_each_file_and_goes_on_past_a_broken_one(tmp_pa
     assert not_blank(load_png(out / "room.png")) and load_png(out / "spin.png").shape == (48, 64, 4)
     assert "[1/3] broken: FAILED" in proc.stderr and "[3/3] spin: ok" in proc.stderr
     assert_user_error(glsandbox("tour", "--lessons", str(tmp_path / "none"), "--out", str(out)), "not a folder")
+
+
+def test_a_lesson_file_in_a_window_with_the_window_keys(window_env: str, tmp_path: Path, gl) -> None:
+    assert glsandbox("new", "mine", "--dir", str(tmp_path)).returncode == 0
+    win = LessonWindow(window_env, tmp_path, "glsandbox.cli", "run", "mine.py", "--size", "320x240",
+                       "--set", "speed=0")
+    try:
+        assert win.wait_title(lambda t: "fps" in t).startswith("glsandbox: mine | ")
+        win.key("F12")
+        shot = load_png(wait_for(tmp_path / "screenshots" / "mine-1.png"))
+    finally:
+        code = win.close()
+    assert code == 0
+    headless = gl.render(find_lesson(str(tmp_path / "mine.py")).from_settings(["speed=0"]), (320, 240)).image
+    assert compare_images(shot, headless).passed  # the window shows what headless renders
