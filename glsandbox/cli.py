@@ -263,7 +263,8 @@ def cmd_new(args: argparse.Namespace) -> int:
     targets = {folder / f"{name}.py": "lesson.py.tmpl", folder / f"{name}.toml": "scene.toml.tmpl"}
     existing = [str(path) for path in targets if path.exists() or path.is_symlink()]
     if existing:  # both or neither: never half a starter
-        raise SandboxError(f"{', '.join(existing)} already exists; not overwritten (pick another NAME or --dir)")
+        verb = "exists" if len(existing) == 1 else "exist"
+        raise SandboxError(f"{' and '.join(existing)} already {verb}; not overwritten (pick another NAME or --dir)")
     # The class name: my_lesson -> MyLesson (a name of capitals only stays as it is).
     cls = "".join(part[:1].upper() + part[1:] for part in name.split("_")) or "MyLesson"
     templates = package_files("glsandbox") / "templates"

@@ -307,8 +307,14 @@ def lesson_file_lesson(path: Path) -> type[Lesson]:
                            f"{_cut(str(exc))}") from None
     finally:
         sys.path.remove(folder)
-        _REGISTRY.clear()  # a user's @register must not shadow or join the built-in lessons
-        _REGISTRY.update(registry_before)
+        # A user's @register must neither join nor shadow the built-in lessons;
+        # a built-in module the file imported (to subclass a lesson) keeps its entry.
+        for key, cls in list(_REGISTRY.items()):
+            if cls.__module__ == module.__name__:
+                if key in registry_before:
+                    _REGISTRY[key] = registry_before[key]
+                else:
+                    del _REGISTRY[key]
     return _the_lesson_in(module, path)
 
 

@@ -197,3 +197,18 @@ def test_a_lesson_file_in_a_window_with_the_window_keys(window_env: str, tmp_pat
     assert code == 0
     headless = gl.render(find_lesson(str(tmp_path / "mine.py")).from_settings(["speed=0"]), (320, 240)).image
     assert compare_images(shot, headless).passed  # the window shows what headless renders
+
+
+def test_a_lesson_file_may_subclass_a_builtin_lesson(tmp_path: Path) -> None:
+    # In a fresh interpreter, so the user's file is the first to import lessons.triangle
+    # (its @register runs inside the loader, and must survive it).
+    import subprocess
+    import sys
+
+    path = tmp_path / "my_triangle.py"
+    path.write_text("from lessons.triangle import Triangle\n\nclass MyTriangle(Triangle):\n    name = 'my_triangle'\n")
+    script = ("import sys; from glsandbox.lesson import find_lesson; "
+              "cls = find_lesson(sys.argv[1]); base = find_lesson('triangle'); "
+              "print(cls.__name__, cls.name, issubclass(cls, base), base.name)")
+    proc = subprocess.run([sys.executable, "-c", script, str(path)], capture_output=True, text=True, timeout=120)
+    assert proc.stdout.split() == ["MyTriangle", "my_triangle", "True", "triangle"], proc.stderr
