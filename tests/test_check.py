@@ -111,6 +111,10 @@ def test_check_bad_input_is_one_line_exit_2(tmp_path: Path, gl) -> None:
                       "give one lesson, not the folder")
     assert_user_error(glsandbox("check", str(tmp_path / "missing.py"), "--golden", str(ref), "--update"),
                       "missing.py not found")
+    assert_user_error(glsandbox("check", str(tmp_path / "subs"), "--golden", str(ref)), "no .py or .toml lesson files")
+    lesson_file(tmp_path / "subs")
+    assert_user_error(glsandbox("check", str(tmp_path / "subs"), "--golden", str(ref)),
+                      f"reference {ref} not found", "--update")
     assert not ref.exists() and not (tmp_path / "r.csv").exists()
     # a lesson whose own build() raises: one line naming its file and line
     crash = lesson_file(tmp_path, "crash.py", VANDAL.replace("ctx = moderngl.get_context()", "{}['x']"))

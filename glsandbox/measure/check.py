@@ -166,6 +166,9 @@ def check_folder(folder: Path, reference: Path, settings: Sequence[str], size: t
     submissions = lesson_files(folder)
     if not submissions:
         raise SandboxError(f"{folder}: no .py or .toml lesson files (nor subfolders holding one)")
+    if not reference.exists():
+        raise SandboxError(f"reference {reference} not found; make it from the model answer first: "
+                           f"glsandbox check ANSWER.py --golden {reference} --update")
     expected = read_reference(reference)
     size = size or (expected.shape[1], expected.shape[0])
     with HeadlessRenderer(backend):  # no GL at all is the machine's problem, not every submission's
