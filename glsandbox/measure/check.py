@@ -9,8 +9,8 @@ images and a diff picture are written (:func:`~glsandbox.measure.golden.write_ar
 A folder of submissions (:func:`glsandbox.lesson.lesson_files`) is checked one
 by one, each rendered in this process on a fresh headless context of its
 own, so a submission that breaks GL state, or raises anywhere in its code,
-is reported as BROKEN and the next one starts clean. A fresh context costs
-about 30 ms on llvmpipe; a Python subprocess per submission about 1.5 s (the
+is reported as BROKEN and the next one starts clean. A fresh context adds
+about 20 ms on llvmpipe; a Python subprocess per submission 1.2 to 1.5 s (the
 imports), so the context is the isolation used. What a context cannot
 contain (a submission that calls ``os._exit``, crashes the interpreter or
 never returns) stops the run.
