@@ -1,8 +1,9 @@
 """The ``glsandbox`` command, and ``python -m lessons.<module>``.
 
-``list``, ``run LESSON``, ``render LESSON --out FILE.png``, ``tour [--out DIR]``,
-``plan LESSON``, ``compare``, ``tradeoffs`` and ``bench``, where LESSON is a
-lesson name or a scene ``.toml`` file. :func:`lesson_main` is the entry point
+``list``, ``run LESSON``, ``render LESSON --out FILE.png``, ``tour [--out DIR]
+[--lessons DIR]``, ``plan LESSON``, ``compare``, ``new NAME``, ``check LESSON
+--golden REF.png``, ``tradeoffs`` and ``bench``, where LESSON is a lesson
+name, a lesson ``.py`` file or a scene ``.toml`` file. :func:`lesson_main` is the entry point
 of a lesson module (a window, or ``--headless --out FILE.png``). User errors
 print ``error: <one line>`` and exit with status 2.
 """
@@ -26,7 +27,7 @@ from glsandbox.errors import SandboxError
 from glsandbox.files import save_png, write_text
 from glsandbox.frame import DEFAULT_SIZE, Frame, HeadlessRenderer, with_samples
 from glsandbox.gl.context import BACKENDS
-from glsandbox.lesson import Lesson, all_lessons, find_lesson
+from glsandbox.lesson import Lesson, all_lessons, find_lesson, lesson_files, submission_lesson
 from glsandbox.plan import plan
 from glsandbox.scene import Scene
 from glsandbox.window import run_window
@@ -182,9 +183,13 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
 
 def cmd_tour(args: argparse.Namespace) -> int:
+    from glsandbox.measure.check import render_lesson, user_code_error
+
     out: Path = args.out
     if args.settings:  # refused before the output folder exists
         raise SandboxError("--set is per lesson; use glsandbox render LESSON --set ... instead of tour")
+    if args.lessons is not None and not args.lessons.is_dir():
+        raise SandboxError(f"--lessons {args.lessons}: not a folder")
     size = _size(args)
     with_samples(Scene("samples"), args.samples)  # a bad --samples fails now, not once per lesson
     try:
@@ -193,18 +198,30 @@ def cmd_tour(args: argparse.Namespace) -> int:
         raise SandboxError(f"--out {out}: cannot create folder ({exc.strerror})") from None
     if not os.access(out, os.W_OK | os.X_OK):
         raise SandboxError(f"--out {out}: folder is not writable")
-    lessons = all_lessons()
+    # (name, how to load it): the course's lessons, or with --lessons DIR the files in DIR instead
+    if args.lessons is not None:
+        found = lesson_files(args.lessons)
+        if not found:
+            raise SandboxError(f"--lessons {args.lessons}: no .py or .toml lesson files (nor subfolders holding one)")
+        lessons = [(name, lambda path=path: submission_lesson(path)) for name, path in found]
+    else:
+        lessons = [(cls.name, lambda cls=cls: cls) for cls in all_lessons()]
     results = []
     started = time.perf_counter()
     with HeadlessRenderer(args.backend) as renderer:
         print(f"tour: {len(lessons)} lessons at {size[0]}x{size[1]} on {renderer.host.backend} "
               f"({renderer.host.ctx.info['GL_RENDERER']}) -> {out}/", file=sys.stderr)
-        for number, cls in enumerate(lessons, start=1):
-            entry = {"lesson": cls.name, "title": cls.title, "course_section": cls.course_section}
-            prefix = f"[{number}/{len(lessons)}] {cls.name}"
+        for number, (name, load) in enumerate(lessons, start=1):
+            entry = {"lesson": name, "title": "", "course_section": ""}
+            prefix = f"[{number}/{len(lessons)}] {name}"
             try:
-                frame = renderer.render(cls(), size, args.samples)
-                image_path = out / f"{cls.name}.png"
+                cls = load()
+                entry.update(title=cls.title, course_section=cls.course_section)
+                if args.lessons is None:
+                    frame = renderer.render(cls(), size, args.samples)
+                else:  # a user's file: its own exceptions are one line, and a fresh context each
+                    frame = render_lesson(cls(), size, args.samples, args.backend)
+                image_path = out / f"{name}.png"
                 write_png(frame.image, image_path)
                 entry.update(ok=True, image=image_path.name, render_ms=round(frame.seconds * 1000, 2),
                              plan=frame.plan.to_dict(), plan_text=frame.plan.describe())
@@ -229,6 +246,88 @@ def cmd_tour(args: argparse.Namespace) -> int:
         print(f"tour: failed: {', '.join(failed)}", file=sys.stderr)
         return 1
     return 0
+
+
+def cmd_new(args: argparse.Namespace) -> int:
+    """``glsandbox new NAME``: a commented starting lesson ``NAME.py`` and scene file ``NAME.toml``."""
+    from importlib.resources import files as package_files
+    from string import Template
+
+    name: str = args.name
+    if not name.isidentifier() or name.startswith("_") or not name.isascii():
+        raise SandboxError(f"new {name!r}: the name must be a Python identifier: letters, digits and _, "
+                           "not starting with a digit or _ (e.g. my_lesson)")
+    folder: Path = args.dir
+    if not folder.is_dir():
+        raise SandboxError(f"--dir {folder}: folder does not exist")
+    targets = {folder / f"{name}.py": "lesson.py.tmpl", folder / f"{name}.toml": "scene.toml.tmpl"}
+    existing = [str(path) for path in targets if path.exists() or path.is_symlink()]
+    if existing:  # both or neither: never half a starter
+        verb = "exists" if len(existing) == 1 else "exist"
+        raise SandboxError(f"{' and '.join(existing)} already {verb}; not overwritten (pick another NAME or --dir)")
+    # The class name: my_lesson -> MyLesson (a name of capitals only stays as it is).
+    cls = "".join(part[:1].upper() + part[1:] for part in name.split("_")) or "MyLesson"
+    templates = package_files("glsandbox") / "templates"
+    for path, template in targets.items():
+        text = Template(templates.joinpath(template).read_text(encoding="utf-8")).substitute(name=name, cls=cls)
+        try:
+            write_text(path, text)
+        except OSError as exc:
+            raise SandboxError(f"{path}: cannot write ({exc.strerror or exc})") from None
+        print(f"wrote {path}")
+    print(f"next: glsandbox run {folder / name}.py   (or glsandbox render {folder / name}.py --out {name}.png)")
+    return 0
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    """``glsandbox check``: render, compare with a reference PNG by the golden rule; 0 match, 1 differs."""
+    from glsandbox.measure.check import (
+        check_folder,
+        check_one,
+        parse_tolerances,
+        summary_table,
+        write_reports,
+    )
+
+    reference: Path = args.golden
+    if reference.suffix.lower() != ".png":
+        raise SandboxError(f"--golden {reference}: the reference must be a .png file")
+    tolerances = parse_tolerances(args.tolerance)
+    size = parse_size(args.size) if args.size else None
+    for flag, path in (("--csv", args.csv), ("--json", args.json)):
+        if path is not None and path.is_dir():
+            raise SandboxError(f"{flag} {path}: is a folder, expected a file name")
+    target = Path(args.lesson)
+    if target.is_dir():
+        if args.update:
+            raise SandboxError(f"--update writes one reference: give one lesson, not the folder {target}")
+        results = check_folder(target, reference, args.settings, size, tolerances, args.samples, args.backend,
+                               progress=lambda text: print(text, file=sys.stderr, flush=True))
+        for result in results:
+            print(result.line())
+            for kind, path in result.artifacts.items():
+                print(f"       {kind:<8}: {path}")
+        print()
+        print(summary_table(results))
+        for path in write_reports(results, args.csv, args.json, reference):
+            print(f"wrote {path}")
+        return 0 if all(r.status == "PASS" for r in results) else 1
+    if args.csv or args.json:
+        raise SandboxError("--csv and --json report a folder of submissions; give a folder")
+    match, paths, updated = check_one(args.lesson, reference, args.settings, size, tolerances, args.update,
+                                      args.samples, args.backend)
+    if updated == "written":
+        print(f"wrote reference {reference}")
+        return 0
+    print(f"{args.lesson}: {match.summary()}")
+    if updated == "rewritten":
+        print(f"rewrote reference {reference}")
+        return 0
+    if updated == "unchanged":
+        print(f"reference {reference} unchanged (it passes)")
+    for kind, path in paths.items():
+        print(f"  {kind:<8}: {path}")
+    return 0 if match.passed else 1
 
 
 def _gallery(summary: dict) -> str:
@@ -287,7 +386,7 @@ def build_parser() -> argparse.ArgumentParser:
                                   ("render", cmd_render, "render a lesson headless to a PNG"),
                                   ("plan", cmd_plan, "print the passes a lesson's scene needs")):
         p = sub.add_parser(name, help=help_text)
-        p.add_argument("lesson", metavar="LESSON", help="a lesson name or a scene .toml file")
+        p.add_argument("lesson", metavar="LESSON", help="a lesson name, a lesson .py file or a scene .toml file")
         add_render_options(p)
         if name == "render":
             p.add_argument("--out", type=Path, required=True, help="the PNG file to write")
@@ -295,16 +394,36 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("tour", help="render every lesson headless, with a gallery page")
     add_render_options(p)
+    p.add_argument("--lessons", type=Path, default=None, metavar="DIR",
+                   help="the lesson files (.py, .toml) in DIR instead of the course's lessons")
     p.add_argument("--out", type=Path, default=Path("out"), help="output folder (default out/)")
     p.set_defaults(func=cmd_tour)
 
     p = sub.add_parser("compare", help="render one lesson with several parameter values side by side")
-    p.add_argument("lesson", metavar="LESSON", help="a lesson name or a scene .toml file")
+    p.add_argument("lesson", metavar="LESSON", help="a lesson name, a lesson .py file or a scene .toml file")
     p.add_argument("--vary", action="append", default=[], metavar="KEY=V1,V2,...",
                    help="a parameter and its values, one tile each (twice: a grid)")
     add_render_options(p)
     p.add_argument("--out", type=Path, default=None, help="the PNG to write (default compare_LESSON.png)")
     p.set_defaults(func=cmd_compare)
+
+    p = sub.add_parser("new", help="write a small commented starting lesson NAME.py and scene file NAME.toml")
+    p.add_argument("name", metavar="NAME", help="the lesson's name, a Python identifier (e.g. my_lesson)")
+    p.add_argument("--dir", type=Path, default=Path("."), help="the folder to write into (default: here)")
+    p.set_defaults(func=cmd_new)
+
+    p = sub.add_parser("check", help="render a lesson and compare it with a reference PNG (0 match, 1 differs)")
+    p.add_argument("lesson", metavar="LESSON_OR_DIR",
+                   help="a lesson name, .py or .toml file, or a folder of them (one line each, and a table)")
+    p.add_argument("--golden", type=Path, required=True, metavar="REF.png", help="the reference image")
+    p.add_argument("--update", action="store_true",
+                   help="write the reference when it is missing or differs (a passing one is kept)")
+    p.add_argument("--tolerance", action="append", default=[], metavar="KEY=VALUE",
+                   help="threshold=LEVELS (default 2) or max_bad_share=FRACTION (default 0.0005); repeatable")
+    p.add_argument("--csv", type=Path, default=None, metavar="FILE", help="folder mode: the figures as CSV")
+    p.add_argument("--json", type=Path, default=None, metavar="FILE", help="folder mode: the figures as JSON")
+    add_render_options(p)
+    p.set_defaults(func=cmd_check)
 
     p = sub.add_parser("tradeoffs", help="what accuracy costs in time: each knob timed and compared with a reference")
     p.add_argument("--out", type=Path, default=Path("out/tradeoffs"), help="output folder (default out/tradeoffs)")

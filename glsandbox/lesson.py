@@ -11,14 +11,18 @@ from __future__ import annotations
 import copy
 import difflib
 import importlib
+import itertools
 import math
 import pkgutil
+import sys
+import types
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, ClassVar
 
-from glsandbox.errors import NUMBER_LIMIT, SandboxError
+from glsandbox.errors import NUMBER_LIMIT, SandboxError, plain
+from glsandbox.files import read_user_file
 from glsandbox.scene import RENDERERS
 from glsandbox.scene import PLAN_MODES, Scene, check_uniform_name, check_uniform_value
 from glsandbox.scene_file import load_scene
@@ -264,15 +268,23 @@ def all_lessons() -> list[type[Lesson]]:
     return sorted(_REGISTRY.values(), key=lambda c: (c.order, c.name))
 
 
+#: The file kinds a lesson can come from, besides a built-in lesson's name.
+LESSON_SUFFIXES = (".py", ".toml")
+
+
 def find_lesson(name_or_path: str) -> type[Lesson]:
-    """A lesson by name, or a scene ``.toml`` file; suggest the closest name.
+    """A lesson by name, a scene ``.toml`` file or a lesson ``.py`` file; suggest the closest name.
 
     A built-in lesson lives in the module of its name (``lessons/<name>.py``),
     so that module alone is imported; other names look through every lesson.
     """
     path = Path(name_or_path)
-    if name_or_path.endswith(".toml") or path.is_file():
+    if name_or_path.endswith(".py"):
+        return lesson_file_lesson(path)
+    if name_or_path.endswith(".toml"):
         return scene_file_lesson(path)
+    if path.is_file() or path.is_dir():
+        raise SandboxError(f"{path}: expected a lesson name, a lesson .py file or a scene .toml file")
     if name_or_path.isidentifier() and not name_or_path.startswith("_"):
         try:
             importlib.import_module(f"lessons.{name_or_path}")
@@ -287,3 +299,144 @@ def find_lesson(name_or_path: str) -> type[Lesson]:
     close = difflib.get_close_matches(name_or_path, list(lessons_by_name), n=1, cutoff=0.4)
     hint = f"; did you mean {close[0]!r}?" if close else ""
     raise SandboxError(f"unknown lesson {name_or_path!r}{hint} (see glsandbox list)")
+
+
+# --- lesson files outside the package -----------------------------------------
+
+_loaded_files = itertools.count()
+
+
+def lesson_file_lesson(path: Path) -> type[Lesson]:
+    """The Lesson subclass a ``.py`` file outside the package defines.
+
+    The rule: the file's own Lesson subclasses (defined in it, not imported)
+    are the candidates; exactly one is the lesson, or, with several, the one
+    the file names in ``LESSON = TheClass``. A class without a ``name`` takes
+    the file's stem. The file is imported under a fresh module name each
+    time (``_glsandbox_lesson_<n>_<stem>``), with its folder on ``sys.path``
+    while it imports (a helper module beside it is found); ``@register`` in
+    it does not reach the built-in registry (``glsandbox list`` and the tour
+    stay the course's). Every failure is one :class:`SandboxError` naming
+    the file: missing, unreadable, a syntax error (with its line), an
+    exception while importing, no lesson, several lessons.
+    """
+    source = read_user_file(path, "lesson file", "a .py file").decode("utf-8", errors="replace")
+    try:
+        code = compile(source, str(path), "exec")
+    except SyntaxError as exc:
+        raise SandboxError(f"{path}:{exc.lineno or 0}: syntax error: {exc.msg}") from None
+    stem = "".join(c if c.isalnum() else "_" for c in path.stem)
+    module = types.ModuleType(f"_glsandbox_lesson_{next(_loaded_files)}_{stem}")
+    module.__file__ = str(path)
+    registry_before = dict(_REGISTRY)
+    folder = str(path.resolve().parent)
+    sys.modules[module.__name__] = module  # dataclasses and pickling look a class's module up here
+    sys.path.insert(0, folder)
+    try:
+        exec(code, module.__dict__)
+    except SystemExit as exc:
+        raise SandboxError(f"{path}: exited while importing (SystemExit {exc.code}); "
+                           "keep glsandbox.run(...) under if __name__ == \"__main__\"") from None
+    except Exception as exc:
+        raise SandboxError(f"{path}:{_user_line(exc, str(path))}: {type(exc).__name__} while importing: "
+                           f"{_cut(str(exc))}") from None
+    finally:
+        sys.path.remove(folder)
+        # A user's @register must neither join nor shadow the built-in lessons;
+        # a built-in module the file imported (to subclass a lesson) keeps its entry.
+        for key, cls in list(_REGISTRY.items()):
+            if cls.__module__ == module.__name__:
+                if key in registry_before:
+                    _REGISTRY[key] = registry_before[key]
+                else:
+                    del _REGISTRY[key]
+    return _the_lesson_in(module, path)
+
+
+def _cut(text: str, limit: int = 200) -> str:
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def _user_line(exc: BaseException, filename: str) -> int:
+    """The line of ``filename`` deepest in the traceback (0 when the file is not in it)."""
+    line = 0
+    tb = exc.__traceback__
+    while tb is not None:
+        if tb.tb_frame.f_code.co_filename == filename:
+            line = tb.tb_lineno
+        tb = tb.tb_next
+    return line
+
+
+def _the_lesson_in(module: types.ModuleType, path: Path) -> type[Lesson]:
+    """The one lesson a loaded lesson file defines (see :func:`lesson_file_lesson`)."""
+    chosen = module.__dict__.get("LESSON")
+    if chosen is not None and not (isinstance(chosen, type) and issubclass(chosen, Lesson)):
+        raise SandboxError(f"{path}: LESSON must be a Lesson subclass, got {plain(chosen)}")
+    if chosen is None:
+        own = [value for value in module.__dict__.values()
+               if isinstance(value, type) and issubclass(value, Lesson) and value.__module__ == module.__name__]
+        if not own:
+            raise SandboxError(f"{path}: defines no Lesson subclass (class MyLesson(glsandbox.Lesson) "
+                               "with a build() method)")
+        if len(own) > 1:
+            names = ", ".join(cls.__name__ for cls in own)
+            raise SandboxError(f"{path}: defines {len(own)} Lesson subclasses ({names}); "
+                               "say which one with LESSON = TheClass")
+        chosen = own[0]
+    if not chosen.name:
+        chosen.name = path.stem
+    if not chosen.title:
+        chosen.title = f"lesson file {path}"
+    if not chosen.course_section:
+        chosen.course_section = "lesson file"
+    return chosen
+
+
+def lesson_files(folder: Path) -> list[tuple[str, Path]]:
+    """The lesson files in ``folder``, as (name, path), sorted by name: the rule
+    of ``glsandbox tour --lessons DIR`` and ``glsandbox check DIR``.
+
+    Each ``.py`` and ``.toml`` file directly in the folder is one lesson,
+    named by its stem (by its file name when a ``.py`` and a ``.toml`` share
+    a stem). Each subfolder is one lesson too, named by the subfolder: its one
+    ``.py`` file, else its one ``.toml`` file (a student's folder, with its
+    textures or helper modules beside). A subfolder with none, or with
+    several of the kind that counts, is listed with the folder itself as its
+    path, and loading it (:func:`find_lesson`) reports why. Hidden and
+    ``_``-prefixed names are skipped.
+    """
+    if not folder.is_dir():
+        raise SandboxError(f"{folder}: not a folder")
+    files, subfolders = [], []
+    for entry in sorted(folder.iterdir()):
+        if entry.name.startswith((".", "_")):
+            continue
+        if entry.is_dir():
+            subfolders.append(entry)
+        elif entry.suffix in LESSON_SUFFIXES and entry.is_file():
+            files.append(entry)
+    stems = [f.stem for f in files]
+    found = [(f.stem if stems.count(f.stem) == 1 else f.name, f) for f in files]
+    for sub in subfolders:
+        for suffix in LESSON_SUFFIXES:
+            inside = sorted(p for p in sub.iterdir() if p.suffix == suffix and p.is_file()
+                            and not p.name.startswith((".", "_")))
+            if inside:
+                found.append((sub.name, inside[0] if len(inside) == 1 else sub))
+                break
+        else:
+            found.append((sub.name, sub))
+    return sorted(found)
+
+
+def submission_lesson(path: Path) -> type[Lesson]:
+    """:func:`find_lesson` for an entry of :func:`lesson_files`, a subfolder's problem named."""
+    if path.is_dir():
+        kinds = " or ".join(LESSON_SUFFIXES)
+        count = {s: sum(1 for p in path.iterdir() if p.suffix == s) for s in LESSON_SUFFIXES}
+        if not any(count.values()):
+            raise SandboxError(f"{path}: no {kinds} lesson file in this folder")
+        several = next(s for s in LESSON_SUFFIXES if count[s] > 1)
+        raise SandboxError(f"{path}: {count[several]} {several} files in this folder; expected one")
+    return find_lesson(str(path))

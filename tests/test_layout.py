@@ -25,7 +25,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("renderers", ("glsandbox.gl", "glsandbox.raytrace")),
     ("one frame", ("glsandbox.frame",)),
     ("window and measuring", ("glsandbox.window", "glsandbox.measure")),
-    ("command line", ("glsandbox.cli",)),
+    ("command line", ("glsandbox.cli", "glsandbox.pytest_plugin")),
 ]
 
 #: The two doors up, each opened only when called: lesson discovery

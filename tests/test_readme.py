@@ -24,3 +24,51 @@ def test_the_readme_lesson_of_your_own_renders(tmp_path: Path, gl) -> None:
     image = load_png(out)
     assert image.shape == (48, 64, 4)
     assert (image[24, 32, :3] > 200).all()  # the white cube in the middle of the course's blue
+
+
+def tutorial_section() -> str:
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    return re.search(r"## Your own lesson, step by step\n(.*?)\n## ", text, re.S).group(1)
+
+
+def test_the_readme_tutorial_works_step_by_step(tmp_path: Path, gl) -> None:
+    """Every command of "Your own lesson, step by step", as written, in a fresh folder
+    (``uv run glsandbox`` / ``uv run pytest`` become this interpreter's ``-m glsandbox.cli`` /
+    ``-m pytest``; ``glsandbox run`` opens a window and is only looked up, not run)."""
+    import shlex
+
+    section = tutorial_section()
+    commands = [line.split(" #")[0].strip() for block in re.findall(r"```sh\n(.*?)```", section, re.S)
+                for line in block.splitlines() if line.strip()]
+    (test_code,) = re.findall(r"```python\n(.*?)```", section, re.S)
+    assert "test_my_lesson.py" in section
+    cwd = tmp_path
+    ran = []
+    for command in commands:
+        for part in command.split(" && "):
+            words = shlex.split(part)
+            if words[:2] == ["mkdir", "-p"]:
+                (cwd / words[2]).mkdir(parents=True, exist_ok=True)
+                continue
+            if words[0] == "cd":
+                cwd = cwd / words[1]
+                continue
+            assert words[:2] == ["uv", "run"], part
+            if words[2:4] == ["glsandbox", "run"]:  # a window
+                assert (cwd / words[4]).is_file()
+                continue
+            if words[2] == "glsandbox":
+                args = [sys.executable, "-m", "glsandbox.cli", *words[3:]]
+            else:
+                assert words[2] == "pytest", part
+                (cwd / "test_my_lesson.py").write_text(test_code, encoding="utf-8")
+                args = [sys.executable, "-m", "pytest", "-p", "no:cacheprovider", *words[3:]]
+            proc = subprocess.run(args, cwd=cwd, capture_output=True, text=True, timeout=300)
+            assert proc.returncode == 0, f"{part}\n{proc.stdout}\n{proc.stderr}"
+            ran.append(words[2:4])
+    assert ["glsandbox", "new"] in ran and ["glsandbox", "check"] in ran and ["pytest", "test_my_lesson.py"] in ran
+    mine = tmp_path / "mine"
+    for picture in ("my_lesson.png", "my_scene.png", "compare_my_lesson.png", "goldens/my_lesson.png"):
+        image = load_png(mine / picture)
+        assert len({tuple(px) for px in image.reshape(-1, 4)[::7]}) > 20, picture  # a picture, not a clear colour
+    assert "1 passed" in proc.stdout  # the fixture checked goldens/my_lesson.png

@@ -32,6 +32,9 @@ def test_wheel_installs_in_a_fresh_venv_and_renders_outside_the_repository(tmp_p
     names = zipfile.ZipFile(wheel).namelist()
     assert "glsandbox/shaders/basic.glsl" in names and "glsandbox/shaders/common/transform.glsl" in names
     assert "lessons/indexed_cube.py" in names
+    assert "glsandbox/templates/lesson.py.tmpl" in names and "glsandbox/templates/scene.toml.tmpl" in names
+    entry_points = zipfile.ZipFile(wheel).read(next(n for n in names if n.endswith("entry_points.txt"))).decode()
+    assert "[pytest11]" in entry_points and "glsandbox = glsandbox.pytest_plugin" in entry_points
 
     venv = tmp_path / "venv"
     run(uv, "venv", "--quiet", str(venv), cwd=tmp_path)
@@ -43,6 +46,11 @@ def test_wheel_installs_in_a_fresh_venv_and_renders_outside_the_repository(tmp_p
         cwd=elsewhere)
     run(str(python), "-m", "lessons.triangle", "--headless", "--out", "tri.png", "--size", "64x48", cwd=elsewhere)
     assert load_png(elsewhere / "cube.png").shape == (48, 64, 4)
+    # glsandbox new reads its templates from the installed package, and what it writes renders
+    run(str(venv / "bin" / "glsandbox"), "new", "starter", cwd=elsewhere)
+    run(str(venv / "bin" / "glsandbox"), "render", "starter.py", "--size", "64x48", "--out", "starter.png",
+        cwd=elsewhere)
+    assert load_png(elsewhere / "starter.png").shape == (48, 64, 4)
     assert load_png(elsewhere / "tri.png").shape == (48, 64, 4)
     # The installed copy found its own shaders, not the repository's.
     located = run(str(python), "-c", "from glsandbox.gl.shaders import shader_root; print(shader_root())",

@@ -411,6 +411,7 @@ def check_golden(
     threshold: int = DEFAULT_THRESHOLD,
     max_bad_share: float = DEFAULT_MAX_BAD_SHARE,
     name: str | None = None,
+    hint: str = UPDATE_HINT,
 ) -> ImageMatch:
     """Check a rendered RGBA image against the golden PNG at ``golden_path``.
 
@@ -433,6 +434,8 @@ def check_golden(
         results_dir: folder for the failure artefacts.
         threshold, max_bad_share: tolerances, see :func:`compare_images`.
         name: artefact file name stem; defaults to the golden's stem.
+        hint: how to update, in the messages (the pytest plugin's flag is
+            not the project's).
 
     Raises:
         GoldenUpdateRefused: ``update`` is true while ``CI`` is set (non-empty).
@@ -454,7 +457,7 @@ def check_golden(
             _write_golden(img, golden, "was missing")
             cmp = compare_images(img, img, threshold=threshold, max_bad_share=max_bad_share)
             return replace(cmp, updated=True)
-        raise AssertionError(f"missing golden {golden}; {UPDATE_HINT}")
+        raise AssertionError(f"missing golden {golden}; {hint}")
 
     try:
         expected = files.load_png(golden)
@@ -463,7 +466,7 @@ def check_golden(
             _write_golden(img, golden, f"was unreadable: {exc}")
             cmp = compare_images(img, img, threshold=threshold, max_bad_share=max_bad_share)
             return replace(cmp, updated=True)
-        raise AssertionError(f"cannot read golden {golden}: {exc}; {UPDATE_HINT}") from exc
+        raise AssertionError(f"cannot read golden {golden}: {exc}; {hint}") from exc
 
     cmp = compare_images(img, expected, threshold=threshold, max_bad_share=max_bad_share)
     if cmp.passed:
@@ -477,5 +480,6 @@ def check_golden(
     )
     lines = [f"golden mismatch for {golden}", f"  {cmp.summary()}"]
     lines += [f"  {kind:8}: {path}" for kind, path in paths.items()]
-    lines.append(f"  if the change is intended, {UPDATE_HINT} and explain it in the issue note")
+    note = " and explain it in the issue note" if hint == UPDATE_HINT else ""  # the project's own flow
+    lines.append(f"  if the change is intended, {hint}{note}")
     raise AssertionError("\n".join(lines))

@@ -1,0 +1,185 @@
+"""`glsandbox check`: one lesson against a reference, and a folder of submissions."""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+
+from glsandbox.files import load_png, save_png
+from glsandbox.measure.golden import compare_images
+from test_cli import assert_user_error, glsandbox
+from test_own_lessons import SPIN
+
+SIZE = "64x48"
+
+#: Leaves the GL context broken (wireframe, a 4x4 scissor behind moderngl's back), then raises:
+#: on a shared context the next submission would draw wrong; each gets a fresh one.
+VANDAL = '''
+import moderngl
+from glsandbox import Lesson, Scene
+
+class Vandal(Lesson):
+    def build(self) -> Scene:
+        ctx = moderngl.get_context()
+        ctx.wireframe = True
+        ctx.enable_direct(0x0C11)  # GL_SCISSOR_TEST
+        ctx.scissor = (0, 0, 4, 4)
+        raise RuntimeError("left the GL state broken")
+'''
+
+
+def lesson_file(folder: Path, name: str = "spin.py", text: str = SPIN) -> Path:
+    path = folder / name
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text)
+    return path
+
+
+def test_missing_reference_update_pass_fail_and_artifacts(tmp_path: Path, gl) -> None:
+    lesson = lesson_file(tmp_path)
+    ref = tmp_path / "ref.png"
+    assert_user_error(glsandbox("check", str(lesson), "--golden", str(ref)), f"reference {ref} not found", "--update")
+    assert not ref.exists()
+
+    proc = glsandbox("check", str(lesson), "--golden", str(ref), "--update", "--size", SIZE, "--set", "time=0.5")
+    assert proc.returncode == 0, proc.stderr
+    assert f"wrote reference {ref}" in proc.stdout
+    reference = load_png(ref)
+    assert reference.shape == (48, 64, 4)  # --size; later checks take the reference's size
+
+    proc = glsandbox("check", str(lesson), "--golden", str(ref), "--set", "time=0.5")
+    assert proc.returncode == 0, proc.stderr
+    assert "PASS: identical (3072 pixels)" in proc.stdout
+    assert not (tmp_path / "ref-diff.png").exists()
+
+    proc = glsandbox("check", str(lesson), "--golden", str(ref), "--set", "time=0.5", "--set", "speed=0")
+    assert proc.returncode == 1, proc.stderr
+    line = next(text for text in proc.stdout.splitlines() if "FAIL" in text)
+    assert "bad of 3072 pixels" in line and "max channel diff" in line and "(threshold 2)" in line
+    actual, expected, diff = (tmp_path / f"ref-{kind}.png" for kind in ("actual", "expected", "diff"))
+    assert np.array_equal(load_png(expected), reference)
+    assert not compare_images(load_png(actual), reference).passed
+    assert load_png(diff).shape == reference.shape
+    assert np.array_equal(load_png(ref), reference)  # a failing check never touches the reference
+
+    # the same difference passes when the tolerances allow it
+    proc = glsandbox("check", str(lesson), "--golden", str(ref), "--set", "time=0.5", "--set", "speed=0",
+                     "--tolerance", "max_bad_share=1")
+    assert proc.returncode == 0, proc.stdout
+
+    # --update keeps a passing reference byte for byte, rewrites a failing one
+    before = ref.read_bytes()
+    proc = glsandbox("check", str(lesson), "--golden", str(ref), "--update", "--set", "time=0.5")
+    assert proc.returncode == 0 and "unchanged" in proc.stdout and ref.read_bytes() == before
+    proc = glsandbox("check", str(lesson), "--golden", str(ref), "--update", "--set", "time=0.5", "--set", "speed=0")
+    assert proc.returncode == 0 and "rewrote reference" in proc.stdout
+    assert np.array_equal(load_png(ref), load_png(actual))
+
+
+def test_check_a_builtin_lesson_and_a_scene_file(tmp_path: Path, gl) -> None:
+    ref = tmp_path / "cube.png"
+    save_png(gl.render(__import__("glsandbox.lesson").lesson.find_lesson("indexed_cube")(time=0.5), (80, 60)).image,
+             ref)
+    proc = glsandbox("check", "indexed_cube", "--golden", str(ref), "--set", "time=0.5")
+    assert proc.returncode == 0 and "identical" in proc.stdout, proc.stdout + proc.stderr
+    room = Path(__file__).parents[1] / "examples" / "mirror_room.toml"
+    proc = glsandbox("check", str(room), "--golden", str(ref))
+    assert proc.returncode == 1 and "FAIL" in proc.stdout
+
+
+def test_check_bad_input_is_one_line_exit_2(tmp_path: Path, gl) -> None:
+    lesson = lesson_file(tmp_path)
+    ref = tmp_path / "ref.png"
+    garbage = tmp_path / "garbage.png"
+    garbage.write_bytes(b"not a png at all")
+    (tmp_path / "subs").mkdir()
+    cases = [
+        (["--golden", str(tmp_path / "ref.jpg")], "the reference must be a .png file"),
+        (["--golden", str(garbage)], "not a PNG image"),
+        (["--golden", str(ref), "--tolerance", "threshold=1.5", "--update"], "threshold is a whole number"),
+        (["--golden", str(ref), "--tolerance", "max_bad_share=2", "--update"], "max_bad_share is a fraction"),
+        (["--golden", str(ref), "--tolerance", "fuzz=1", "--update"], "expected threshold=LEVELS"),
+        (["--golden", str(ref), "--update", "--set", "nope=1"], "has no parameter 'nope'"),
+        (["--golden", str(ref), "--csv", str(tmp_path / "r.csv"), "--update"], "give a folder"),
+    ]
+    for extra, fragment in cases:
+        assert_user_error(glsandbox("check", str(lesson), *extra), fragment)
+    assert_user_error(glsandbox("check", str(tmp_path / "subs"), "--golden", str(ref), "--update"),
+                      "give one lesson, not the folder")
+    assert_user_error(glsandbox("check", str(tmp_path / "missing.py"), "--golden", str(ref), "--update"),
+                      "missing.py not found")
+    assert_user_error(glsandbox("check", str(tmp_path / "subs"), "--golden", str(ref)), "no .py or .toml lesson files")
+    lesson_file(tmp_path / "subs")
+    assert_user_error(glsandbox("check", str(tmp_path / "subs"), "--golden", str(ref)),
+                      f"reference {ref} not found", "--update")
+    assert not ref.exists() and not (tmp_path / "r.csv").exists()
+    # a lesson whose own build() raises: one line naming its file and line
+    crash = lesson_file(tmp_path, "crash.py", VANDAL.replace("ctx = moderngl.get_context()", "{}['x']"))
+    assert_user_error(glsandbox("check", str(crash), "--golden", str(ref), "--update"), f"KeyError at {crash}:7")
+
+
+def test_a_folder_of_submissions(tmp_path: Path, gl) -> None:
+    ref = tmp_path / "ref.png"
+    good = lesson_file(tmp_path / "spare")
+    assert glsandbox("check", str(good), "--golden", str(ref), "--update", "--size", SIZE).returncode == 0
+    subs = tmp_path / "subs"
+    lesson_file(subs, "b_alice.py")
+    lesson_file(subs, "c_bob.py", SPIN.replace('Param("speed", 1.0', 'Param("speed", 0.0').replace(
+        "rotate_y(", "rotate_x(0.4) @ transforms.rotate_y("))
+    lesson_file(subs, "d_carol/lesson.py")
+    (subs / "d_carol" / "notes.toml").write_text("# a .py in the folder is the submission\n")
+    lesson_file(subs, "e_dave.py", "def oops(:\n")
+    lesson_file(subs, "f_erin.toml", 'name = "x"\n[[nodes]]\nmesh = "cube"\ncolor = [2, 0, 0]\n')
+    lesson_file(subs, "a_vandal.py", VANDAL)
+    (subs / "g_empty").mkdir()
+    proc = glsandbox("check", str(subs), "--golden", str(ref), "--csv", str(tmp_path / "out" / "r.csv"),
+                     "--json", str(tmp_path / "out" / "r.json"))
+    assert proc.returncode == 1, proc.stderr
+    status = {line.split()[1].rstrip(":"): line.split()[0] for line in proc.stdout.splitlines()
+              if line.split() and line.split()[0] in ("PASS", "FAIL", "BROKEN")}
+    assert status == {"a_vandal": "BROKEN", "b_alice": "PASS", "c_bob": "FAIL", "d_carol": "PASS",
+                      "e_dave": "BROKEN", "f_erin": "BROKEN", "g_empty": "BROKEN"}
+    # the vandal's broken context did not reach the next submission: alice is identical
+    assert "PASS   b_alice: identical (3072 pixels)" in proc.stdout
+    assert "e_dave.py:1: syntax error" in proc.stdout and "f_erin.toml:4: nodes[0].color" in proc.stdout
+    assert "RuntimeError at" in proc.stdout and "a_vandal.py:11: left the GL state broken" in proc.stdout
+    assert "2 passed, 1 failed, 4 broken of 7" in proc.stdout  # the summary table's last line
+    assert [f"[{n}/7]" in proc.stderr for n in range(1, 8)] == [True] * 7  # progress
+    bob = tmp_path / "ref-results" / "c_bob-diff.png"
+    assert bob.exists() and not (tmp_path / "ref-results" / "b_alice-diff.png").exists()
+
+    rows = list(csv.DictReader((tmp_path / "out" / "r.csv").open()))
+    assert [r["status"] for r in rows] == ["BROKEN", "PASS", "FAIL", "PASS", "BROKEN", "BROKEN", "BROKEN"]
+    assert float(rows[2]["bad_share"]) > 0.0005 and int(rows[2]["max_diff"]) > 2 and rows[1]["bad_pixels"] == "0"
+    report = json.loads((tmp_path / "out" / "r.json").read_text())
+    assert (report["pass"], report["fail"], report["broken"]) == (2, 1, 4)
+    assert report["submissions"][4]["error"].endswith("e_dave.py:1: syntax error: invalid syntax")
+
+    # all passing: exit 0
+    for path in (subs / "c_bob.py", subs / "e_dave.py", subs / "f_erin.toml", subs / "a_vandal.py"):
+        path.unlink()
+    (subs / "g_empty").rmdir()
+    proc = glsandbox("check", str(subs), "--golden", str(ref))
+    assert proc.returncode == 0, proc.stdout
+    assert "2 passed, 0 failed, 0 broken of 2" in proc.stdout
+
+
+def test_a_shader_that_does_not_compile_is_broken_and_the_others_go_on(tmp_path: Path, gl) -> None:
+    # The built-in solid program replaced by one that does not compile (GLSANDBOX_SHADER_DIR):
+    # the submission drawing a cube is BROKEN with the shader's file and line, the empty one passes.
+    shaders = tmp_path / "shaders"
+    shaders.mkdir()
+    (shaders / "basic.glsl").write_text("#version 330 core\nthis is not glsl\n")
+    subs = tmp_path / "subs"
+    lesson_file(subs, "a_cube.toml", 'name = "cube"\n[[nodes]]\nmesh = "cube"\n')
+    lesson_file(subs, "b_empty.toml", 'name = "empty"\n')
+    ref = tmp_path / "ref.png"
+    assert glsandbox("check", str(subs / "b_empty.toml"), "--golden", str(ref), "--update", "--size", SIZE,
+                     env={"GLSANDBOX_SHADER_DIR": str(shaders)}).returncode == 0
+    proc = glsandbox("check", str(subs), "--golden", str(ref), env={"GLSANDBOX_SHADER_DIR": str(shaders)})
+    assert proc.returncode == 1
+    assert f"BROKEN a_cube: shader does not compile: {shaders / 'basic.glsl'}:2:" in proc.stdout
+    assert "PASS   b_empty: identical" in proc.stdout
