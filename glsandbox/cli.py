@@ -249,7 +249,8 @@ def cmd_tour(args: argparse.Namespace) -> int:
 
 
 def cmd_new(args: argparse.Namespace) -> int:
-    """``glsandbox new NAME``: a commented starting lesson ``NAME.py`` and scene file ``NAME.toml``."""
+    """``glsandbox new NAME``: a commented starting lesson ``NAME.py``, scene file ``NAME.toml``
+    and shader ``NAME.glsl`` (the scene's ball is drawn with it)."""
     from importlib.resources import files as package_files
     from string import Template
 
@@ -260,11 +261,12 @@ def cmd_new(args: argparse.Namespace) -> int:
     folder: Path = args.dir
     if not folder.is_dir():
         raise SandboxError(f"--dir {folder}: folder does not exist")
-    targets = {folder / f"{name}.py": "lesson.py.tmpl", folder / f"{name}.toml": "scene.toml.tmpl"}
+    targets = {folder / f"{name}.py": "lesson.py.tmpl", folder / f"{name}.toml": "scene.toml.tmpl",
+               folder / f"{name}.glsl": "shader.glsl.tmpl"}
     existing = [str(path) for path in targets if path.exists() or path.is_symlink()]
-    if existing:  # both or neither: never half a starter
+    if existing:  # all or none: never part of a starter
         verb = "exists" if len(existing) == 1 else "exist"
-        raise SandboxError(f"{' and '.join(existing)} already {verb}; not overwritten (pick another NAME or --dir)")
+        raise SandboxError(f"{', '.join(existing)} already {verb}; not overwritten (pick another NAME or --dir)")
     # The class name: my_lesson -> MyLesson (a name of capitals only stays as it is).
     cls = "".join(part[:1].upper() + part[1:] for part in name.split("_")) or "MyLesson"
     templates = package_files("glsandbox") / "templates"
@@ -407,7 +409,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", type=Path, default=None, help="the PNG to write (default compare_LESSON.png)")
     p.set_defaults(func=cmd_compare)
 
-    p = sub.add_parser("new", help="write a small commented starting lesson NAME.py and scene file NAME.toml")
+    p = sub.add_parser("new", help="write a small commented starting lesson NAME.py, scene file NAME.toml and shader NAME.glsl")
     p.add_argument("name", metavar="NAME", help="the lesson's name, a Python identifier (e.g. my_lesson)")
     p.add_argument("--dir", type=Path, default=Path("."), help="the folder to write into (default: here)")
     p.set_defaults(func=cmd_new)

@@ -143,12 +143,24 @@ def test_new_writes_a_lesson_and_a_scene_that_render_as_they_are(tmp_path: Path,
     b = gl.render(cls.from_settings(["time=1", "speed=0.3"]), (96, 72)).image
     c = gl.render(cls.from_settings(["time=1", "shading=gouraud"]), (96, 72)).image
     assert not np.array_equal(a, b) and not np.array_equal(a, c)
+    # the scene's ball is drawn with the new shader file, whose rim is a uniform of its own
+    assert 'shader = "my_lesson.glsl"' in scene.read_text() and (tmp_path / "my_lesson.glsl").is_file()
+    rims = []
+    for power in ("3", "1"):
+        out = tmp_path / f"rim{power}.png"
+        proc = glsandbox("render", str(scene), "--out", str(out), "--size", "96x72", "--set", f"u.rim_power={power}")
+        assert proc.returncode == 0, proc.stderr
+        rims.append(load_png(out).astype(int))
+    changed = np.any(rims[0] != rims[1], axis=-1)
+    assert 0 < changed.mean() < 0.2  # only the ball, where the rim widened
+    assert (rims[1][..., 2] - rims[0][..., 2])[changed].mean() > 5  # and bluer (rim_color is blue)
 
 
 def test_new_refuses_to_overwrite_and_bad_names(tmp_path: Path) -> None:
     (tmp_path / "taken.toml").write_text("# mine\n")
     assert_user_error(glsandbox("new", "taken", "--dir", str(tmp_path)), "taken.toml already exists", "not overwritten")
     assert (tmp_path / "taken.toml").read_text() == "# mine\n" and not (tmp_path / "taken.py").exists()
+    assert not (tmp_path / "taken.glsl").exists()
     for name in ("9lives", "my-lesson", "_hidden", "a b", "../up"):
         assert_user_error(glsandbox("new", name, "--dir", str(tmp_path)), "must be a Python identifier")
     assert_user_error(glsandbox("new", "fine", "--dir", str(tmp_path / "nowhere")), "does not exist")
