@@ -183,3 +183,38 @@ def test_a_shader_that_does_not_compile_is_broken_and_the_others_go_on(tmp_path:
     assert proc.returncode == 1
     assert f"BROKEN a_cube: shader does not compile: {shaders / 'basic.glsl'}:2:" in proc.stdout
     assert "PASS   b_empty: identical" in proc.stdout
+
+
+def test_submissions_with_their_own_shader_files(tmp_path: Path, gl) -> None:
+    """A teacher's folder where each student's scene draws its ball with the student's own
+    shader file: the reference student's passes, a shader computing another colour fails,
+    one that does not compile is BROKEN naming the student's file and line."""
+    subs = tmp_path / "subs"
+    scene = ('name = "ball"\n[camera]\neye = [0, 0, 4]\n[[lights]]\nposition = [1, 2, 4]\n'
+             '[[nodes]]\nname = "ball"\nmesh = "sphere"\nshading = "phong"\nshader = "ball.glsl"\n'
+             '[nodes.uniforms]\ngain = 1.0\n')
+    body = ('#version 330 core\n#include "common/lighting.glsl"\nuniform float gain;\n'
+            '#if defined(VERTEX_SHADER)\n#include "common/transform.glsl"\nuniform mat3 m_normal;\n'
+            'in vec3 in_position;\nin vec3 in_normal;\nout vec3 v_world;\nout vec3 v_normal;\n'
+            'void main() { vec4 w = m_model * vec4(in_position, 1.0); gl_Position = m_proj * m_view * w;\n'
+            '  v_world = w.xyz; v_normal = m_normal * in_normal; }\n'
+            '#elif defined(FRAGMENT_SHADER)\nin vec3 v_world;\nin vec3 v_normal;\nout vec4 frag_color;\n'
+            'void main() { frag_color = vec4(gain * shade(v_world, normalize(v_normal), COLOR), 1.0); }\n#endif\n')
+    shaders = {"a_ann": body.replace("COLOR", "u_color.rgb"),
+               "b_ben": body.replace("COLOR", "vec3(0.2, 1.0, 0.2)"),
+               "c_cem": body.replace("COLOR", "u_color.rgb").replace("frag_color = vec4", "frag_colour = vec4")}
+    for student, text in shaders.items():
+        lesson_file(subs / student, "ball.toml", scene)
+        (subs / student / "ball.glsl").write_text(text)
+    ref = tmp_path / "ref.png"
+    proc = glsandbox("check", str(subs / "a_ann" / "ball.toml"), "--golden", str(ref), "--update", "--size", SIZE)
+    assert proc.returncode == 0, proc.stderr
+    assert glsandbox("check", str(subs / "a_ann" / "ball.toml"), "--golden", str(ref),
+                     "--set", "u.gain=0.5").returncode == 1  # the uniform reaches the student's shader
+    proc = glsandbox("check", str(subs), "--golden", str(ref))
+    assert proc.returncode == 1
+    status = {line.split()[1].rstrip(":"): line.split()[0] for line in proc.stdout.splitlines()
+              if line.split() and line.split()[0] in ("PASS", "FAIL", "BROKEN")}
+    assert status == {"a_ann": "PASS", "b_ben": "FAIL", "c_cem": "BROKEN"}
+    broken = next(line for line in proc.stdout.splitlines() if line.startswith("BROKEN"))
+    assert f"{subs / 'c_cem' / 'ball.glsl'}:" in broken, broken
