@@ -65,6 +65,11 @@ class Panel:
         self.texts: dict[str, str] = {}  # text fields being edited, by parameter
         self.message = ""
         self._keys = _key_map(glfw, imgui)
+        # Mouse buttons reach ImGui one per frame, never in the frame the mouse moved:
+        # a widget that acts on the press (a tab) must have seen the mouse over it first,
+        # and a press and release polled together (a quick click) must not cancel out.
+        self._buttons: list[tuple[int, bool]] = []
+        self._moved = False
         self._install()
 
     # --- input ------------------------------------------------------------
@@ -91,17 +96,21 @@ class Panel:
             io.add_input_character(codepoint)
 
         def on_button(win: Any, button: int, action: int, mods: int) -> None:
-            self._mods(mods)
             if button < 5:
-                io.add_mouse_button_event(button, action == glfw.PRESS)
+                self._buttons.append((button, action == glfw.PRESS))
             keep = action == glfw.PRESS and self.over(*glfw.get_cursor_pos(win))
             if not keep and prev["button"]:  # releases always go on: a camera drag ends
                 prev["button"](win, button, action, mods)
 
         def on_cursor(win: Any, x: float, y: float) -> None:
             io.add_mouse_pos_event(x, y)
+            self._moved = True
             if prev["cursor"]:
                 prev["cursor"](win, x, y)
+
+        def on_enter(win: Any, entered: int) -> None:
+            if not entered:  # the mouse left the window: nothing is hovered (no tooltip stays up)
+                io.add_mouse_pos_event(-3.4e38, -3.4e38)
 
         def on_scroll(win: Any, dx: float, dy: float) -> None:
             io.add_mouse_wheel_event(dx, dy)
@@ -113,7 +122,8 @@ class Panel:
         prev["cursor"] = glfw.set_cursor_pos_callback(window, on_cursor)
         prev["scroll"] = glfw.set_scroll_callback(window, on_scroll)
         glfw.set_char_callback(window, on_char)
-        self._handlers = (on_key, on_char, on_button, on_cursor, on_scroll)  # kept alive with the panel
+        glfw.set_cursor_enter_callback(window, on_enter)
+        self._handlers = (on_key, on_char, on_button, on_cursor, on_enter, on_scroll)  # kept alive with the panel
 
     def _mods(self, mods: int) -> None:
         glfw, imgui = self.glfw, self.imgui
@@ -135,6 +145,9 @@ class Panel:
         self.io.display_framebuffer_scale = (fb_w / win_w, fb_h / win_h)
         self.io.delta_time = max(now - self.last_time, 1e-4)
         self.last_time = now
+        if self._buttons and not self._moved:
+            self.io.add_mouse_button_event(*self._buttons.pop(0))
+        self._moved = False
         imgui.backends.opengl3_new_frame()
         imgui.new_frame()
         self.layout = {}
@@ -164,29 +177,36 @@ class Panel:
         lesson = session.lesson
         imgui.text_wrapped(lesson.title or lesson.name)
         controls = lesson_controls(lesson)
-        if imgui.collapsing_header("Parameters", imgui.TreeNodeFlags_.default_open):
-            for control in controls:
-                if control.param.name not in RENDER_PARAMS:
-                    self._control(session, control)
-        if imgui.collapsing_header("Time", imgui.TreeNodeFlags_.default_open):
-            self._time(session, now)
-        if imgui.collapsing_header("Renderer", imgui.TreeNodeFlags_.default_open):
-            for control in controls:
-                if control.param.name in RENDER_PARAMS:
-                    self._control(session, control)
-            index = SAMPLE_CHOICES.index(session.samples) if session.samples in SAMPLE_CHOICES else 0
-            changed, index = imgui.combo("MSAA", index, [str(s) if s else "off" for s in SAMPLE_CHOICES])
-            self._item("MSAA")
-            if changed:
-                session.samples = SAMPLE_CHOICES[index]
-        if imgui.collapsing_header("Camera", imgui.TreeNodeFlags_.default_open):
-            self._camera(session)
-        if imgui.collapsing_header("Live compare"):
-            self._live(session, session.live)
-        if imgui.collapsing_header("Plan"):
-            imgui.text_unformatted(session.plan_text)
+        if not imgui.begin_tab_bar("sections"):
+            return
+        for title, body in (("Lesson", lambda: self._lesson(session, controls)),
+                            ("Time & camera", lambda: (self._time(session, now), self._camera(session))),
+                            ("Compare", lambda: self._live(session, session.live)),
+                            ("Plan", lambda: imgui.text_unformatted(session.plan_text))):
+            selected, _ = imgui.begin_tab_item(title)
+            self._item(title)
+            if selected:
+                body()
+                imgui.end_tab_item()
+        imgui.end_tab_bar()
         if self.message:
             imgui.text_colored((1.0, 0.5, 0.4, 1.0), self.message)
+
+    def _lesson(self, session: Session, controls: list[Control]) -> None:
+        """The lesson's own parameters, then the renderer's (renderer, effects, MSAA)."""
+        imgui = self.imgui
+        for control in controls:
+            if control.param.name not in RENDER_PARAMS:
+                self._control(session, control)
+        imgui.separator_text("renderer")
+        for control in controls:
+            if control.param.name in RENDER_PARAMS:
+                self._control(session, control)
+        index = SAMPLE_CHOICES.index(session.samples) if session.samples in SAMPLE_CHOICES else 0
+        changed, index = imgui.combo("MSAA", index, [str(s) if s else "off" for s in SAMPLE_CHOICES])
+        self._item("MSAA")
+        if changed:
+            session.samples = SAMPLE_CHOICES[index]
 
     def _control(self, session: Session, control: Control) -> None:
         """One parameter's widget; a change goes straight into the lesson's values (drawn next frame)."""
@@ -221,6 +241,7 @@ class Panel:
 
     def _time(self, session: Session, now: float) -> None:
         imgui, clock, values = self.imgui, session.clock, session.lesson.values
+        imgui.separator_text("time")
         changed, paused = imgui.checkbox("pause", clock.paused)
         self._item("pause")
         if changed:
@@ -242,6 +263,7 @@ class Panel:
 
     def _camera(self, session: Session) -> None:
         imgui = self.imgui
+        imgui.separator_text("camera")
         fly = session.camera.camera
         camera = fly.camera() if fly is not None else session.lesson.scene().camera
         imgui.text(f"eye    {camera.eye[0]:.3f}, {camera.eye[1]:.3f}, {camera.eye[2]:.3f}")
@@ -258,13 +280,16 @@ class Panel:
             print(f"set line: {line}", file=sys.stderr, flush=True)
             self.message = "copied: glsandbox render LESSON + that line"
         self._item("copy --set line")
+        imgui.text_disabled("glsandbox render LESSON ...")
+        imgui.text_wrapped(session.drawn_line)
 
     def _live(self, session: Session, live: LiveCompare) -> None:
         imgui = self.imgui
         names = [p.name for p in session.lesson.all_params() if p.name not in ("camera", "effects")]
         changed, live.enabled = imgui.checkbox("split into tiles", live.enabled)
         self._item("split into tiles")
-        index = names.index(live.param) if live.param in names else 0
+        own = [p.name for p in type(session.lesson).params]  # start with the lesson's first own parameter
+        index = names.index(live.param) if live.param in names else names.index(own[0]) if own else 0
         picked, index = imgui.combo("vary", index, names)
         self._item("vary")
         if picked or live.param not in names:
