@@ -153,9 +153,10 @@ class Panel:
         self.layout = {}
         if self.visible:
             imgui.set_next_window_pos((MARGIN, MARGIN), imgui.Cond_.first_use_ever)
-            imgui.set_next_window_size((PANEL_WIDTH, max(100, win_h - 2 * MARGIN)), imgui.Cond_.first_use_ever)
+            # A fixed width; the height fits the open tab, up to the window's.
+            imgui.set_next_window_size_constraints((PANEL_WIDTH, 0), (PANEL_WIDTH, max(100, win_h - 2 * MARGIN)))
             imgui.set_next_window_bg_alpha(0.85)
-            imgui.begin(f"{session.lesson.name} (F1 hides)")
+            imgui.begin(f"{session.lesson.name} (F1 hides)", None, imgui.WindowFlags_.always_auto_resize)
             x, y = imgui.get_window_pos()
             w, h = imgui.get_window_size()
             self.rect = (x, y, w, h)
