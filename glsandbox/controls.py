@@ -173,9 +173,24 @@ class Session:
     samples: int
     camera: CameraInput
     live: LiveCompare = field(default_factory=LiveCompare)
-    plan_text: str = ""
-    drawn_line: str = ""
     compare_error: str = ""
+    #: What the last frame drew: the lesson at its time, the frame size, MSAA, the camera and the plan.
+    drawn: tuple[Lesson, tuple[int, int], int, tuple[float, ...] | None, Any] | None = None
+
+    def record(self, size: tuple[int, int], plan: Any) -> None:
+        """Note the frame just drawn (cheap: the texts below are made only when shown)."""
+        self.drawn = (self.lesson.at(self.lesson.time), size, self.samples, camera_numbers(self.camera), plan)
+
+    def drawn_line(self) -> str:
+        """The ``--set`` line that renders the last frame headless (see :func:`set_line`)."""
+        if self.drawn is None:
+            return ""
+        lesson, size, samples, camera, _ = self.drawn
+        return set_line(lesson, size, samples, camera)
+
+    def plan_text(self) -> str:
+        """The last frame's plan, as ``glsandbox plan`` prints it."""
+        return "" if self.drawn is None else self.drawn[4].describe()
 
 
 def frame_image_scene(image: np.ndarray, name: str = "live-compare") -> Scene:

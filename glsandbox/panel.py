@@ -183,7 +183,7 @@ class Panel:
         for title, body in (("Lesson", lambda: self._lesson(session, controls)),
                             ("Time & camera", lambda: (self._time(session, now), self._camera(session))),
                             ("Compare", lambda: self._live(session, session.live)),
-                            ("Plan", lambda: imgui.text_unformatted(session.plan_text))):
+                            ("Plan", lambda: imgui.text_unformatted(session.plan_text()))):
             selected, _ = imgui.begin_tab_item(title)
             self._item(title)
             if selected:
@@ -276,13 +276,13 @@ class Panel:
         self._item("reset camera")
         imgui.same_line()
         if imgui.button("copy --set line"):
-            line = session.drawn_line
+            line = session.drawn_line()
             self.glfw.set_clipboard_string(self.window, line)
             print(f"set line: {line}", file=sys.stderr, flush=True)
             self.message = "copied: glsandbox render LESSON + that line"
         self._item("copy --set line")
         imgui.text_disabled("glsandbox render LESSON ...")
-        imgui.text_wrapped(session.drawn_line)
+        imgui.text_wrapped(session.drawn_line())
 
     def _live(self, session: Session, live: LiveCompare) -> None:
         imgui = self.imgui

@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from glsandbox.camera import CameraInput
-from glsandbox.controls import Clock, Session, camera_numbers, compare_scene, set_line
+from glsandbox.controls import Clock, Session, compare_scene
 from glsandbox.errors import SandboxError
 from glsandbox.files import save_png
 from glsandbox.frame import DEFAULT_SIZE, FrameRenderer, InteractiveResolution, with_samples
@@ -116,9 +116,7 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
                     state["shoot"] = False
                     screenshot(target.read(), screenshot_dir, f"{lesson.name}-{state['shots'] + 1}")
                     state["shots"] += 1
-                session.plan_text = frame_plan.describe()
-                session.drawn_line = set_line(current, (width, height), session.samples,
-                                              camera_numbers(camera_input))
+                session.record((width, height), frame_plan)
                 host.raw.blit_color(target.resolved().glo, host.ctx.screen.glo, (width, height))
                 host.ctx.screen.use()
                 panel.draw(session)

@@ -95,3 +95,16 @@ def test_live_compare_builds_the_compare_variants_from_the_current_values() -> N
     assert repr(variants[1].scene) == repr(find_lesson("phong")(speed=0.0, shading="gouraud").scene())
     with pytest.raises(SandboxError, match="shading=flat: expected one of"):
         LiveCompare("shading", ["phong", "flat"], enabled=True).variants(lesson)
+
+
+def test_the_session_keeps_the_drawn_frame_not_later_edits() -> None:
+    from glsandbox.controls import Session
+    from glsandbox.plan import plan
+
+    lesson = find_lesson("phong")(speed=0.0)
+    session = Session(lesson, Clock(0.0, 0.0), 2, CameraInput())
+    assert session.drawn_line() == "" and session.plan_text() == ""
+    session.record((320, 240), plan(lesson.scene()))
+    lesson.values["specular"] = False  # a panel edit after the frame: the next frame's
+    assert session.drawn_line() == "--size 320x240 --samples 2 --set speed=0.0"
+    assert session.plan_text() == plan(find_lesson("phong")(speed=0.0).scene()).describe()
