@@ -35,7 +35,7 @@ from glsandbox.controls import (SAMPLE_CHOICES, Control, LiveCompare, Session, c
 from glsandbox.errors import SandboxError
 from glsandbox.files import write_text
 
-#: The panel's width in pixels, and its margin from the window's top-left corner.
+#: The panel's width in pixels, and its margin from the window's top-right corner.
 PANEL_WIDTH = 300
 MARGIN = 8
 #: The step buttons' time step: one frame at 30 frames a second.
@@ -152,11 +152,13 @@ class Panel:
         imgui.new_frame()
         self.layout = {}
         if self.visible:
-            imgui.set_next_window_pos((MARGIN, MARGIN), imgui.Cond_.first_use_ever)
+            # Top right: lessons put their own text panels at the top left.
+            imgui.set_next_window_pos((win_w - PANEL_WIDTH - MARGIN, MARGIN), imgui.Cond_.always)
             # A fixed width; the height fits the open tab, up to the window's.
             imgui.set_next_window_size_constraints((PANEL_WIDTH, 0), (PANEL_WIDTH, max(100, win_h - 2 * MARGIN)))
             imgui.set_next_window_bg_alpha(0.85)
-            imgui.begin(f"{session.lesson.name} (F1 hides)", None, imgui.WindowFlags_.always_auto_resize)
+            imgui.begin(f"{session.lesson.name} (F1 hides)", None,
+                        imgui.WindowFlags_.always_auto_resize | imgui.WindowFlags_.no_move)
             x, y = imgui.get_window_pos()
             w, h = imgui.get_window_size()
             self.rect = (x, y, w, h)

@@ -74,7 +74,12 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
     glfw.set_key_callback(host.window, on_key)
     camera_input, repeat_keys = attach_camera_input(host.window, lambda: state["lesson"].scene())
     session.camera = camera_input
-    panel = Panel(host.window)  # chained in front of the callbacks above
+    try:
+        panel = Panel(host.window)  # chained in front of the callbacks above
+    except Exception:
+        renderer.close()
+        host.release()
+        raise
 
     def handle(key: int) -> None:
         if key == glfw.KEY_ESCAPE:

@@ -74,15 +74,14 @@ def test_clicking_a_checkbox_renders_what_the_same_set_renders_headless(window_e
         win.click("specular")
         after_shot = win.shot()
         after = win.screen()
-        x, _, w, _ = win.layout()["rect"]
-        panel_right = int(x + w) + 1
+        panel_left = int(win.layout()["rect"][0]) - 1
     finally:
         code = win.close()
     assert code == 0
     headless = gl.render(find_lesson("phong").from_settings(["speed=0", "specular=off"]), SIZE).image
     np.testing.assert_array_equal(after_shot, headless)  # the frame: exactly the headless picture
-    # On the screen, right of the panel, the window shows the same pixels, and they changed.
-    region = np.s_[:SIZE[1], panel_right:SIZE[0]]
+    # On the screen, left of the panel, the window shows the same pixels, and they changed.
+    region = np.s_[:SIZE[1], :panel_left]
     np.testing.assert_array_equal(after[region], headless[region][..., :3])
     assert not np.array_equal(before[region], after[region])
 
