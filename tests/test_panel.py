@@ -3,13 +3,16 @@
 from __future__ import annotations
 
 import json
+import os
+import subprocess
+import sys
 from dataclasses import replace
 import shlex
 import time
 from pathlib import Path
 
 import numpy as np
-from test_window import LessonWindow, wait_for, window_env  # noqa: F401 (the fixture: Xvfb and xdotool via need())
+from test_window import REPO, LessonWindow, wait_for, window_env  # noqa: F401 (the fixture: Xvfb and xdotool via need())
 
 from glsandbox.cli import parse_size
 from glsandbox.files import load_png
@@ -155,3 +158,28 @@ def test_live_compare_splits_the_window_into_the_compare_tiles(window_env: str, 
     expected = difference_image(a, b)
     np.testing.assert_array_equal(difference[:-40], expected[:-40])  # above the label at the bottom
     assert difference[:-40, ..., :3].any()  # phong and gouraud differ somewhere
+
+
+def _bench(display: str, *args: str) -> subprocess.CompletedProcess:
+    env = {**os.environ, "DISPLAY": display, "WAYLAND_DISPLAY": "", "GLSANDBOX_BACKEND": "egl"}
+    return subprocess.run([sys.executable, "-m", "glsandbox.cli", "bench", "--quick", "--only", "panel", *args],
+                          capture_output=True, text=True, timeout=300, env=env, cwd=REPO)
+
+
+def test_the_panel_bench_row_times_a_window_frame_with_and_without_the_panel(window_env: str,
+                                                                           tmp_path: Path) -> None:
+    out = tmp_path / "bench.json"
+    proc = _bench(window_env, "--json", str(out))
+    assert proc.returncode == 0, proc.stderr
+    (case,) = json.loads(out.read_text())["cases"]
+    assert case["group"] == "window" and case["goal"] == 1.15
+    assert case["baseline"] == "window frame, no panel" and case["subject"] == "window frame + panel"
+    assert case["ratio"] > 0.5  # drawing more never takes much less time; the figure itself is printed, not asserted
+
+
+def test_the_panel_bench_row_without_a_display_says_why_in_one_line() -> None:
+    proc = _bench("")
+    assert proc.returncode == 2
+    assert proc.stderr.strip().splitlines() == [
+        "error: --only panel: no benchmark case matched (see glsandbox bench); skipped: panel (window frame with "
+        "the live controls): no display; run under Xvfb, e.g. xvfb-run glsandbox bench --only panel"]
