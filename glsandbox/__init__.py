@@ -54,7 +54,7 @@ __all__ = [
     "Camera", "Lesson", "Light", "Material", "Mesh", "Mirror", "Model", "Node", "Overlay", "Param", "PlanarShadow",
     "SandboxError", "Scene", "Texture", "Viewport",
     "__version__", "camera", "fit_mesh", "geometry", "load_mesh", "load_model", "meshgen", "register", "run",
-    "text_image", "transforms",
+    "show", "text_image", "transforms", "widget",
 ]
 
 
@@ -68,3 +68,18 @@ def run(lesson_cls: type[Lesson], argv: list[str] | None = None) -> int:
     from glsandbox.cli import lesson_main
 
     return lesson_main(lesson_cls, argv)
+
+
+def show(lesson_or_scene: object, *args: object, **params: object) -> object:
+    """A lesson (name, class or instance, with ``--set``-style ``params``) or a Scene rendered
+    headless as a picture that Jupyter shows inline (:mod:`glsandbox.notebook`, imported when called)."""
+    from glsandbox.notebook import show as _show
+
+    return _show(lesson_or_scene, *args, **params)
+
+
+def widget(lesson: object, *args: object, **params: object) -> object:
+    """The lesson's parameters as ipywidgets (the ``notebook`` extra) over its picture, re-rendered on change."""
+    from glsandbox.notebook import widget as _widget
+
+    return _widget(lesson, *args, **params)

@@ -179,6 +179,13 @@ class FrameRenderer:
                 print(f"warning: {note}", file=sys.stderr, flush=True)
         return frame_plan, target
 
+    def render_scene(self, scene: Scene, size: tuple[int, int]) -> Frame:
+        """Draw one frame and read it back (headless, and the window's live compare tiles)."""
+        start = time.perf_counter()
+        frame_plan, target = self.draw(scene, size)
+        image = target.read()
+        return Frame(image, frame_plan, time.perf_counter() - start)
+
     def close(self) -> None:
         self.host.make_current()  # deletes must reach this context's objects
         for target in self._targets.values():
@@ -192,12 +199,6 @@ class HeadlessRenderer(FrameRenderer):
 
     def __init__(self, backend: str | None = None) -> None:
         super().__init__(open_context(backend))
-
-    def render_scene(self, scene: Scene, size: tuple[int, int]) -> Frame:
-        start = time.perf_counter()
-        frame_plan, target = self.draw(scene, size)
-        image = target.read()
-        return Frame(image, frame_plan, time.perf_counter() - start)
 
     def render(self, lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: int = 0) -> Frame:
         return self.render_scene(with_samples(lesson.scene(), samples), size)

@@ -24,7 +24,7 @@ from typing import Any, ClassVar
 from glsandbox.errors import NUMBER_LIMIT, SandboxError, plain
 from glsandbox.files import read_user_file
 from glsandbox.scene import RENDERERS
-from glsandbox.scene import PLAN_MODES, Scene, check_uniform_name, check_uniform_value
+from glsandbox.scene import PLAN_MODES, Camera, Scene, check_uniform_name, check_uniform_value
 from glsandbox.scene_file import load_scene
 
 # NUMBER_LIMIT (glsandbox.errors) is the largest magnitude a number parameter
@@ -134,6 +134,38 @@ def parse_uniform_text(text: str) -> Any:
     return check_uniform_value(numbers[0] if len(numbers) == 1 else tuple(numbers), "value")
 
 
+def parse_camera(text: str) -> tuple[float, ...] | None:
+    """``--set camera=ex,ey,ez,tx,ty,tz[,fov,near,far]``: a camera replacing the lesson's (up is +y).
+
+    Empty text keeps the lesson's own camera. The window's "copy --set line"
+    writes all nine numbers with Python's shortest exact repr, so the headless
+    render sees the same floats the window's camera had.
+    """
+    if not str(text).strip():
+        return None
+    parts = [p.strip() for p in str(text).split(",")]
+    if len(parts) not in (6, 9):
+        raise SandboxError("expected eye x,y,z, target x,y,z and optionally fov,near,far (6 or 9 numbers)")
+    try:
+        numbers = [float(p) for p in parts]
+    except ValueError:
+        raise SandboxError("expected numbers separated by commas") from None
+    camera_from_numbers(Camera(), tuple(numbers))  # refuses non-finite values, eye on target, near >= far
+    return tuple(numbers)
+
+
+def camera_from_numbers(base: Camera, numbers: tuple[float, ...]) -> Camera:
+    """``base`` with eye and target (and fov, near, far when nine numbers) from ``numbers``; up is +y."""
+    lens = dict(zip(("fov_y", "near", "far"), numbers[6:]))
+    return replace(base, eye=tuple(numbers[:3]), target=tuple(numbers[3:6]), up=(0.0, 1.0, 0.0), **lens)
+
+
+#: Every lesson has ``camera``: empty keeps its own; the window's "copy --set line"
+#: fills it with the interactive camera so a window state renders headless exactly.
+CAMERA = Param("camera", "", "replace the lesson's camera: eye x,y,z, target x,y,z[, fov, near, far] "
+               "(empty: the lesson's own)", convert=parse_camera)
+
+
 class Lesson:
     """Base class. Subclasses set the class attributes and implement :meth:`build`."""
 
@@ -161,7 +193,7 @@ class Lesson:
 
     @classmethod
     def all_params(cls) -> tuple[Param, ...]:
-        return (TIME, RENDERER, EFFECTS_PARAM, *cls.params)
+        return (TIME, RENDERER, EFFECTS_PARAM, CAMERA, *cls.params)
 
     @classmethod
     def setting(cls, item: str, flag: str = "--set", expected: str = "key=value") -> tuple[Param, str]:
@@ -205,6 +237,9 @@ class Lesson:
         renderer = self.values.get("renderer", "raster")
         if renderer != "raster":  # traced by glsandbox.frame.trace_viewports
             scene = replace(scene, viewports=tuple(replace(vp, renderer=renderer) for vp in scene.viewports))
+        camera = self.values.get("camera")
+        if camera:  # --set camera=...: the lens stays the lesson's where not given
+            scene = replace(scene, camera=camera_from_numbers(scene.camera, camera))
         plan_mode = self.values.get("effects", "needed")  # effects=all: the bench's everything-on plan
         scene = scene if scene.plan_mode == plan_mode else replace(scene, plan_mode=plan_mode)
         uniforms = {k[len(UNIFORM_PREFIX):]: v for k, v in self.values.items() if k.startswith(UNIFORM_PREFIX)}

@@ -5,7 +5,10 @@ F12 for a screenshot, R to reload shaders, the shared camera keys
 (:mod:`glsandbox.camera`), the frame rate in the title, and resizing. Each
 frame is drawn exactly as headless draws it (:class:`glsandbox.frame.FrameRenderer`,
 into an offscreen target with the plan's buffers) and its colour copied onto
-the window, so the window shows the headless pixels.
+the window, so the window shows the headless pixels. The live controls
+(:mod:`glsandbox.panel`, F1 hides them) are drawn over the copy, never into
+the frame, and change the lesson's values, the clock, MSAA and live compare
+(:class:`glsandbox.controls.Session`).
 """
 
 from __future__ import annotations
@@ -13,12 +16,14 @@ from __future__ import annotations
 import sys
 import time as _time
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from glsandbox.camera import CameraInput
+from glsandbox.controls import Clock, Session, compare_scene
 from glsandbox.errors import SandboxError
 from glsandbox.files import next_numbered, save_png
 from glsandbox.frame import DEFAULT_SIZE, FrameRenderer, InteractiveResolution, with_samples
@@ -35,7 +40,8 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
                max_frames: int | None = None, instead: str | None = None) -> None:
     """Open a window and run the lesson until ESC or the window closes.
 
-    Keys: ESC quits; F12 writes ``screenshots/<lesson>-<n>.png`` (the next free ``n``); R reloads the
+    Keys: ESC quits; F1 hides or shows the panel; F12 writes ``screenshots/<lesson>-<n>.png``
+    (the next free ``n``; the frame without the panel); R reloads the
     shaders from disk (a broken shader keeps the last good program and shows
     its error in the title and on stderr), as saving a node's own shader file
     does; other keys go to the lesson.
@@ -48,6 +54,8 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
     """
     import glfw
 
+    from glsandbox.panel import Panel  # imgui only where a window opens (not for headless commands)
+
     instead = instead or f"or render it headless: glsandbox render {lesson.name} --out FILE.png"
     host = open_context(backend if backend not in (None, "auto") else "auto", window=True, size=size,
                         title=f"glsandbox: {lesson.name}", instead=instead)
@@ -57,9 +65,8 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
     renderer = FrameRenderer(host)
     executor = renderer.executor
     motion = InteractiveResolution()  # ray-traced viewports: coarser while the camera moves
-    state = {"lesson": lesson, "error": ""}
-    start_time = lesson.time
-    clock_start = glfw.get_time()
+    state = {"lesson": lesson, "error": "", "shoot": False}
+    session = Session(lesson, Clock(lesson.time, glfw.get_time()), samples, CameraInput())
     pending: list[int] = []
 
     def on_key(window: object, key: int, scancode: int, action: int, mods: int) -> None:
@@ -68,6 +75,13 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
 
     glfw.set_key_callback(host.window, on_key)
     camera_input, repeat_keys = attach_camera_input(host.window, lambda: state["lesson"].scene())
+    session.camera = camera_input
+    try:
+        panel = Panel(host.window)  # chained in front of the callbacks above
+    except Exception:
+        renderer.close()
+        host.release()
+        raise
 
     def reload_shaders() -> None:
         try:
@@ -83,18 +97,10 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
     def handle(key: int) -> None:
         if key == glfw.KEY_ESCAPE:
             glfw.set_window_should_close(host.window, True)
+        elif key == glfw.KEY_F1:
+            panel.visible = not panel.visible
         elif key == glfw.KEY_F12:
-            screenshot_dir.mkdir(parents=True, exist_ok=True)
-            path = next_numbered(screenshot_dir, lesson.name)
-            width, height = glfw.get_framebuffer_size(host.window)
-            data = host.ctx.screen.read(viewport=(0, 0, width, height), components=4, alignment=1)
-            image = np.ascontiguousarray(np.frombuffer(data, dtype=np.uint8).reshape(height, width, 4)[::-1])
-            # What the screen shows: the window is opaque whatever its framebuffer's alpha
-            # holds (the frame copied there has alpha 1, glsandbox.gl.target, but a driver
-            # whose blit honours the colour mask would leave the window's own alpha).
-            image[..., 3] = 255
-            save_png(image, path)
-            print(f"screenshot: {path}", file=sys.stderr, flush=True)
+            state["shoot"] = True  # taken from the next frame's target, before the panel is drawn
         elif key == glfw.KEY_R:
             reload_shaders()
         else:
@@ -113,13 +119,20 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
                 reload_shaders()
             current: Lesson = state["lesson"]
             if current.animated:
-                current.values["time"] = start_time + glfw.get_time() - clock_start
+                current.values["time"] = session.clock.time(glfw.get_time())
             width, height = glfw.get_framebuffer_size(host.window)
             if width > 0 and height > 0:  # minimised windows have no framebuffer
                 # The camera keys' camera, once moved, replaces the scene's.
-                scene = camera_input.apply(with_samples(current.scene(), samples))
-                _, target = renderer.draw(scene, (width, height), motion.resolution(scene))
+                scene = camera_input.apply(with_samples(current.scene(), session.samples))
+                scene = _live_compare(session, renderer, (width, height)) or scene
+                frame_plan, target = renderer.draw(scene, (width, height), motion.resolution(scene))
+                if state["shoot"]:
+                    state["shoot"] = False
+                    screenshot(target.read(), next_numbered(screenshot_dir, lesson.name))
+                session.record((width, height), frame_plan)
                 host.raw.blit_color(target.resolved().glo, host.ctx.screen.glo, (width, height))
+                host.ctx.screen.use()
+                panel.draw(session)
                 glfw.swap_buffers(host.window)
             frames += 1
             fps_frames += 1
@@ -132,8 +145,33 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
             if max_frames is not None and frames >= max_frames:
                 break
     finally:
+        panel.close()
         renderer.close()
         host.release()
+
+
+def screenshot(image: np.ndarray, path: Path) -> Path:
+    """Write the frame (never the panel: it is drawn on the window, not the target) to ``path``."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    image = np.ascontiguousarray(image)
+    image[..., 3] = 255  # what the screen shows: the window is opaque
+    save_png(image, path)
+    print(f"screenshot: {path}", file=sys.stderr, flush=True)
+    return path
+
+
+def _live_compare(session: Session, renderer: FrameRenderer, size: tuple[int, int]) -> Scene | None:
+    """The live compare frame (tiles, or the difference view) when the panel asks for one."""
+    if not session.live.active():
+        return None
+    try:
+        variants, columns = session.live.variants(session.lesson)
+    except SandboxError as exc:
+        session.compare_error = str(exc)
+        return None
+    session.compare_error = ""
+    variants = [replace(v, scene=session.camera.apply(with_samples(v.scene, session.samples))) for v in variants]
+    return compare_scene(variants, columns, size, renderer, session.live.difference)
 
 
 def _arrow_key_names(glfw: Any) -> dict[int, str]:

@@ -24,7 +24,8 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("scene logic", ("glsandbox.scene_file", "glsandbox.plan", "glsandbox.camera", "glsandbox.lesson")),
     ("renderers", ("glsandbox.gl", "glsandbox.raytrace")),
     ("one frame", ("glsandbox.frame",)),
-    ("window and measuring", ("glsandbox.window", "glsandbox.measure")),
+    ("window and measuring", ("glsandbox.window", "glsandbox.panel", "glsandbox.controls", "glsandbox.notebook",
+                              "glsandbox.measure")),
     ("command line", ("glsandbox.cli", "glsandbox.pytest_plugin")),
 ]
 

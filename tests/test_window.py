@@ -158,6 +158,8 @@ def test_r_reloads_shaders_and_a_broken_one_keeps_the_last_good_program(window_e
                        env={"GLSANDBOX_SHADER_DIR": str(shaders)})
     try:
         win.wait_title(lambda t: "fps" in t)
+        win.key("F1")  # the live controls off: the pixels read below are the frame's
+        time.sleep(0.3)
         before = win.screen()[:240, :320]
         basic.write_text(good.replace("frag_color = u_color;", "frag_color = u_color * broken;"))
         win.key("r")

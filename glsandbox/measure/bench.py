@@ -257,10 +257,13 @@ def run_all(json_path: Path | None = None, quick: bool = False, only: Sequence[s
         cases: list[Case] = []
         found_lines = []
         summaries = []
+        skipped: list[str] = []  # notes of modules with no case at all here (e.g. no display for a window)
         for module in load_modules(folder):
             noted = len(env.notes)
             found = module.cases(env)
             matched = [c for c in found if not only or any(o in f"{c.group}: {c.name}" for o in only)]
+            if not found:
+                skipped += env.notes[noted:]
             if not matched:  # a module left out by --only: its notes (what it skipped) do not apply
                 del env.notes[noted:]
             cases += matched
@@ -268,7 +271,8 @@ def run_all(json_path: Path | None = None, quick: bool = False, only: Sequence[s
                 summaries.append(module.summarize)
             found_lines.append(f"bench: {Path(module.__file__ or '').name}: {len(matched)} of {len(found)} cases")
         if not cases:  # said before any progress line: a mistake is one line
-            raise SandboxError(f"--only {' '.join(only)}: no benchmark case matched (see glsandbox bench)")
+            why = "".join(f"; {text}" for text in skipped if any(o in text for o in only))  # the rows asked for
+            raise SandboxError(f"--only {' '.join(only)}: no benchmark case matched (see glsandbox bench){why}")
         for line in found_lines:
             log(line)
         groups = list(dict.fromkeys(c.group for c in cases))

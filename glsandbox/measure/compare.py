@@ -149,6 +149,11 @@ def compose(variants: list[Variant], columns: int, size: tuple[int, int], labels
     """One scene with every variant in its tile: viewports mapped into the tile,
     nodes and overlays renamed and restricted to their variant's viewports."""
     viewports: list[Viewport] = []
+    if len(variants) % columns:
+        # A grid with empty cells: nothing would draw there, and a target reused
+        # from an earlier frame (the window's, a shared renderer's) would show its
+        # old pixels; a first black viewport clears the whole frame.
+        viewports.append(Viewport(clear_color=(0.0, 0.0, 0.0, 1.0)))
     nodes: list[Node] = []
     overlays: list[Overlay] = []
     for index, (variant, tile) in enumerate(zip(variants, tile_rects(len(variants), columns))):

@@ -132,3 +132,14 @@ def test_variants_that_cannot_share_a_frame_are_stitched_tile_by_tile(gl, lesson
         alone = gl.render_scene(variant.scene, (w, h)).image
         # Identical except where the tile's label is drawn (bottom-right corner).
         np.testing.assert_array_equal(result.image[top:top + h // 2, x:x + w], alone[: h // 2])
+
+
+def test_an_empty_grid_cell_is_black_even_on_a_reused_target(gl) -> None:
+    # Three tiles in a 2x2 grid leave the bottom-right cell empty; the target of
+    # that size already holds a full phong frame, which must not show through.
+    size = (400, 200)
+    variants, columns = build_variants(find_lesson("phong"), ["shading=phong,gouraud,blinn_phong"], [])
+    gl.render(find_lesson("phong")(), size)
+    image = gl.render_scene(compose(variants, columns, size), size).image
+    assert (image[100:, 200:, :3] == 0).all()
+    assert image[:100, :200, :3].any()

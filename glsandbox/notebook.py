@@ -1,0 +1,145 @@
+"""Notebook helpers: ``glsandbox.show`` (an inline picture) and ``glsandbox.widget`` (sliders).
+
+In Jupyter::
+
+    import glsandbox
+    glsandbox.show("phong", specular=False)      # a picture, shown inline
+    glsandbox.widget("transform_order")           # the parameters as ipywidgets, re-rendering on change
+
+Both render headless on one shared :class:`~glsandbox.frame.HeadlessRenderer`
+(EGL, else OSMesa), opened on first use: the pictures are exactly what
+``glsandbox render`` writes. :func:`widget` needs the optional ``notebook``
+extra (ipywidgets); without it, it raises one :class:`SandboxError` line.
+The widgets are the window panel's (:mod:`glsandbox.controls`): a combo
+becomes a dropdown, a checkbox a checkbox, a number a slider with the same range.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from glsandbox.controls import Control, lesson_controls, to_text
+from glsandbox.errors import SandboxError
+from glsandbox.files import png_bytes
+from glsandbox.frame import DEFAULT_SIZE, LazyRenderer, with_samples
+from glsandbox.lesson import Lesson, find_lesson
+from glsandbox.scene import Scene
+
+#: The renderer every helper shares (a context opens once per kernel).
+_RENDERER = LazyRenderer()
+NOTEBOOK_MISSING = ("glsandbox.widget needs ipywidgets: install the notebook extra "
+                    "(pip install 'glsandbox[notebook]', or uv sync --extra notebook)")
+
+
+class Picture:
+    """A rendered frame that Jupyter shows inline (``_repr_png_``); ``image`` is (H, W, 4) uint8."""
+
+    def __init__(self, image: np.ndarray, title: str = "") -> None:
+        self.image = image
+        self.title = title
+
+    def png(self) -> bytes:
+        return png_bytes(self.image)
+
+    def _repr_png_(self) -> bytes:
+        return self.png()
+
+    def to_pil(self) -> Any:
+        from PIL import Image
+
+        return Image.fromarray(self.image)
+
+    def __repr__(self) -> str:
+        return f"<glsandbox picture {self.title} {self.image.shape[1]}x{self.image.shape[0]}>"
+
+
+def make_lesson(lesson: str | type[Lesson] | Lesson, **params: Any) -> Lesson:
+    """A lesson from a name, a class or an instance, with ``params`` checked as ``--set`` checks them
+    (a value may be given as Python or as its ``--set`` text)."""
+    if isinstance(lesson, str):
+        lesson = find_lesson(lesson)
+    cls = lesson if isinstance(lesson, type) else type(lesson)
+    values = dict(lesson.values) if isinstance(lesson, Lesson) else cls().values
+    for name, value in params.items():
+        param, _ = cls.setting(f"{name}=", "show")  # an unknown name: refused with the lesson's parameters
+        values[name] = param.parse(value if isinstance(value, str) else to_text(param, value), "show")
+    return cls(**values)
+
+
+def render(lesson_or_scene: Any, size: tuple[int, int] = DEFAULT_SIZE, samples: int = 0, **params: Any) -> Picture:
+    """Render a lesson (name, class or instance, with ``params``) or a :class:`Scene` headless."""
+    if isinstance(lesson_or_scene, Scene):
+        if params:
+            raise SandboxError(f"show: a Scene takes no parameters (got {', '.join(params)})")
+        scene, title = lesson_or_scene, lesson_or_scene.name
+    else:
+        lesson = make_lesson(lesson_or_scene, **params)
+        scene, title = lesson.scene(), lesson.name
+    frame = _RENDERER.renderer.render_scene(with_samples(scene, samples), tuple(size))
+    return Picture(frame.image.copy(), title)
+
+
+def show(lesson_or_scene: Any, size: tuple[int, int] = DEFAULT_SIZE, samples: int = 0, **params: Any) -> Picture:
+    """The picture of a lesson (``glsandbox.show("phong", specular=False)``) or a Scene; Jupyter shows it inline."""
+    return render(lesson_or_scene, size, samples, **params)
+
+
+def _ipywidgets() -> Any:
+    try:
+        import ipywidgets
+    except ImportError:
+        raise SandboxError(NOTEBOOK_MISSING) from None
+    return ipywidgets
+
+
+def _widget_for(widgets: Any, control: Control, value: Any) -> Any:
+    name, tip = control.param.name, control.param.help
+    if control.kind == "combo":
+        return widgets.Dropdown(options=list(control.options), value=value, description=name, tooltip=tip)
+    if control.kind == "checkbox":
+        return widgets.Checkbox(value=bool(value), description=name, tooltip=tip)
+    if control.kind == "slider_int":
+        return widgets.IntSlider(value=int(value), min=int(control.low), max=int(control.high), description=name,
+                                 continuous_update=False)
+    if control.kind == "slider_float":
+        return widgets.FloatSlider(value=float(value), min=control.low, max=control.high,
+                                   step=(control.high - control.low) / 200, description=name, continuous_update=False)
+    return widgets.Text(value=to_text(control.param, value), description=name, continuous_update=False)
+
+
+def widget(lesson: str | type[Lesson] | Lesson, size: tuple[int, int] = (480, 360), **params: Any) -> Any:
+    """The lesson's parameters as ipywidgets above its picture; a change re-renders.
+
+    Returns an ``ipywidgets.VBox`` with ``.controls`` (parameter name -> widget),
+    ``.image`` (the ``ipywidgets.Image``), ``.lesson`` and ``.error`` (a Label
+    showing a refused value)."""
+    widgets = _ipywidgets()
+    current = make_lesson(lesson, **params)
+    controls = lesson_controls(current)
+    time_param = next(p for p in current.all_params() if p.name == "time")
+    time_control = Control(time_param, "slider_float", (), 0.0, max(10.0, current.time))
+    made = {c.param.name: _widget_for(widgets, c, current.values[c.param.name]) for c in [time_control, *controls]}
+    image = widgets.Image(value=render(current, size).png(), format="png", width=size[0], height=size[1])
+    error = widgets.Label(value="")
+
+    def changed(change: dict) -> None:
+        owner = change["owner"]
+        name = next(n for n, w in made.items() if w is owner)
+        value = change["new"]
+        try:
+            param = next(p for p in current.all_params() if p.name == name)
+            parsed = param.parse(value if isinstance(value, str) else to_text(param, value), "widget")
+            # Rendered before it is kept: a value that fails (a missing image file) leaves the last picture.
+            image.value = render(type(current)(**{**current.values, name: parsed}), size).png()
+            current.values[name] = parsed
+            error.value = ""
+        except SandboxError as exc:
+            error.value = f"error: {exc}"
+
+    for w in made.values():
+        w.observe(changed, names="value")
+    box = widgets.VBox([*made.values(), error, image])
+    box.controls, box.image, box.lesson, box.error = made, image, current, error
+    return box
