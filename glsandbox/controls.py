@@ -174,6 +174,8 @@ class Session:
     camera: CameraInput
     live: LiveCompare = field(default_factory=LiveCompare)
     compare_error: str = ""
+    #: The last shader reload's error (R or a saved shader file); the last good program draws meanwhile.
+    shader_error: str = ""
     #: What the last frame drew: the lesson at its time, the frame size, MSAA, the camera and the plan.
     drawn: tuple[Lesson, tuple[int, int], int, tuple[float, ...] | None, Any] | None = None
 

@@ -91,6 +91,7 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
         except SandboxError as exc:
             state["error"] = str(exc)
             print(f"error: {exc}", file=sys.stderr, flush=True)
+        session.shader_error = state["error"]  # the panel shows it too
 
     watch = ShaderWatch(executor.shader_files)  # nodes' own shader files: saving one reloads
 
