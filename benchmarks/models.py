@@ -47,7 +47,7 @@ from typing import Any
 
 import numpy as np
 
-from raytrace import EMBREE_MISSING, MODES, EmbreeCaster, embree_available
+from raytrace import EMBREE_MISSING, MODES, embree_available, embree_side
 
 from glsandbox import Camera, Light, Material, Mesh, Node, Scene, load_model, meshgen
 from glsandbox.raytrace import render
@@ -193,15 +193,7 @@ def cases(env: Any) -> list:
         return Side(ENGINE_LABELS[kind], run)
 
     def embree(label: str, mode: str) -> Side:
-        caster: list[EmbreeCaster] = []
-
-        def run(_: int) -> int:
-            if not caster:
-                options = MODES[mode]
-                caster.append(EmbreeCaster(model_scene(label), size, options["shadows"], options["max_depth"]))
-            return caster[0].cast()
-
-        return Side("Embree (embreex)", run)
+        return embree_side(lambda: model_scene(label), size, mode)
 
     def hit_miss(label: str) -> Callable[[Any, Any], str]:
         return lambda _rays, image: reference(label).compare(image)

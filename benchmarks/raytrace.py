@@ -162,6 +162,22 @@ class EmbreeCaster:
         return cast
 
 
+def embree_side(make_scene: Callable[[], object], size: tuple[int, int], mode: str) -> object:
+    """A bench :class:`~glsandbox.measure.bench.Side`: Embree casting a scene's rays in ``mode``
+    (:data:`MODES`), its scene built at the first call (the warm-up) and kept; returns the ray count."""
+    from glsandbox.measure.bench import Side
+
+    caster: list[EmbreeCaster] = []
+
+    def run(_: int) -> int:
+        if not caster:
+            options = MODES[mode]
+            caster.append(EmbreeCaster(make_scene(), size, options["shadows"], options["max_depth"]))
+        return caster[0].cast()
+
+    return Side("Embree (embreex)", run)
+
+
 def cases(env: object) -> list:
     """``glsandbox bench`` cases: per scene and mode (primary; shadow+bounce: the
     secondary rays), the numpy and gpu engines against Embree casting the same
@@ -203,15 +219,7 @@ def cases(env: object) -> list:
         return Side("gpu engine (GLSL float32)" if kind == "gpu" else "numpy engine (float64)", run)
 
     def embree(name: str, mode: str) -> Side:
-        caster: list[EmbreeCaster] = []
-
-        def run(_: int) -> int:
-            if not caster:
-                options = MODES[mode]
-                caster.append(EmbreeCaster(scene_of(name), size, options["shadows"], options["max_depth"]))
-            return caster[0].cast()
-
-        return Side("Embree (embreex)", run)
+        return embree_side(lambda: scene_of(name), size, mode)
 
     def same_rays(baseline: int, subject: int) -> str:
         return f"{subject:,} rays each" if baseline == subject else f"rays: {subject:,}, Embree {baseline:,}"
