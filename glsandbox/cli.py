@@ -183,7 +183,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
 
 def cmd_tour(args: argparse.Namespace) -> int:
-    from glsandbox.measure.check import render_lesson, user_code_error
+    from glsandbox.measure.check import render_lesson
 
     out: Path = args.out
     if args.settings:  # refused before the output folder exists

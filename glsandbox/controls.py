@@ -176,6 +176,8 @@ class Session:
     compare_error: str = ""
     #: The last shader reload's error (R or a saved shader file); the last good program draws meanwhile.
     shader_error: str = ""
+    #: The lesson file's error (a mistake saved in it); the last good lesson draws meanwhile.
+    lesson_error: str = ""
     #: What the last frame drew: the lesson at its time, the frame size, MSAA, the camera and the plan.
     drawn: tuple[Lesson, tuple[int, int], int, tuple[float, ...] | None, Any] | None = None
 

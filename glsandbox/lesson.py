@@ -339,6 +339,8 @@ def find_lesson(name_or_path: str) -> type[Lesson]:
 # --- lesson files outside the package -----------------------------------------
 
 _loaded_files = itertools.count()
+#: The module name prefix of lesson files loaded from outside the package.
+_FILE_MODULE = "_glsandbox_lesson_"
 
 
 def lesson_file_lesson(path: Path) -> type[Lesson]:
@@ -361,7 +363,7 @@ def lesson_file_lesson(path: Path) -> type[Lesson]:
     except SyntaxError as exc:
         raise SandboxError(f"{path}:{exc.lineno or 0}: syntax error: {exc.msg}") from None
     stem = "".join(c if c.isalnum() else "_" for c in path.stem)
-    module = types.ModuleType(f"_glsandbox_lesson_{next(_loaded_files)}_{stem}")
+    module = types.ModuleType(f"{_FILE_MODULE}{next(_loaded_files)}_{stem}")
     module.__file__ = str(path)
     registry_before = dict(_REGISTRY)
     folder = str(path.resolve().parent)
@@ -475,3 +477,57 @@ def submission_lesson(path: Path) -> type[Lesson]:
         several = next(s for s in LESSON_SUFFIXES if count[s] > 1)
         raise SandboxError(f"{path}: {count[several]} {several} files in this folder; expected one")
     return find_lesson(str(path))
+
+
+# --- reading a lesson's file again (the window's reload on save) --------------
+
+
+def lesson_source(cls: type[Lesson]) -> Path | None:
+    """The file a lesson came from: its ``.py`` lesson file or ``.toml`` scene file (None: built in)."""
+    if issubclass(cls, SceneFileLesson):
+        return cls.path
+    module = sys.modules.get(cls.__module__)
+    if cls.__module__.startswith(_FILE_MODULE) and module is not None and module.__file__:
+        return Path(module.__file__)
+    return None
+
+
+def reload_lesson(lesson: Lesson) -> Lesson:
+    """``lesson``'s file read again: the class it defines now, with the values the window
+    had (those its parameters still accept; else the new defaults at the same time), its
+    scene built once, so a mistake is a :class:`SandboxError` here (one line naming the
+    file and line) and the window keeps the lesson it has."""
+    path = lesson_source(type(lesson))
+    if path is None:
+        raise SandboxError(f"lesson {lesson.name!r} is built in: there is no file of its own to read again")
+    cls = find_lesson(str(path))
+    names = {p.name for p in cls.all_params()}
+    kept = {k: v for k, v in lesson.values.items() if k in names or k.startswith(UNIFORM_PREFIX)}
+    try:
+        try:
+            fresh = cls(**kept)
+            fresh.scene()
+        except SandboxError:
+            fresh = cls(time=lesson.time)
+            fresh.scene()
+    except SandboxError:
+        raise
+    except Exception as exc:  # the user's own code
+        raise user_code_error(exc) from None
+    return fresh
+
+
+def user_code_error(exc: BaseException) -> SandboxError:
+    """An exception raised by a lesson's own code as one line, with the deepest line outside glsandbox."""
+    library = tuple(str(Path(p).resolve()) for p in {sys.prefix, sys.base_prefix, sys.exec_prefix})
+    ours = str(Path(__file__).resolve().parent)  # the glsandbox package
+    where = ""
+    tb = exc.__traceback__
+    while tb is not None:
+        filename = tb.tb_frame.f_code.co_filename
+        if not filename.startswith(("<", ours, *library)):
+            where = f" at {filename}:{tb.tb_lineno}"
+        tb = tb.tb_next
+    text = str(exc)
+    text = text if len(text) <= 200 else text[:197] + "..."
+    return SandboxError(f"{type(exc).__name__}{where}: {text}")

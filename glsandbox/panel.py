@@ -179,10 +179,12 @@ class Panel:
         imgui = self.imgui
         lesson = session.lesson
         imgui.text_wrapped(lesson.title or lesson.name)
-        if session.shader_error:  # on screen, not only in the title bar: the last good program draws meanwhile
-            imgui.push_text_wrap_pos(0.0)
-            imgui.text_colored((1.0, 0.5, 0.4, 1.0), f"shader error: {session.shader_error}")
-            imgui.pop_text_wrap_pos()
+        # On screen, not only in the title bar: the last good lesson and program draw meanwhile.
+        for what, error in (("lesson", session.lesson_error), ("shader", session.shader_error)):
+            if error:
+                imgui.push_text_wrap_pos(0.0)
+                imgui.text_colored((1.0, 0.5, 0.4, 1.0), f"{what} error: {error}")
+                imgui.pop_text_wrap_pos()
         controls = lesson_controls(lesson)
         if not imgui.begin_tab_bar("sections"):
             return

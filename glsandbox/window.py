@@ -28,8 +28,9 @@ from glsandbox.errors import SandboxError
 from glsandbox.files import next_numbered, save_png
 from glsandbox.frame import DEFAULT_SIZE, FrameRenderer, InteractiveResolution, with_samples
 from glsandbox.gl.context import open_context
-from glsandbox.gl.shader_watch import ShaderWatch
-from glsandbox.lesson import Lesson
+from glsandbox.file_watch import FileWatch
+from glsandbox.lesson import Lesson, lesson_source, user_code_error
+from glsandbox.lesson import reload_lesson as reload_lesson_file
 from glsandbox.scene import Scene
 
 __all__ = ["attach_camera_input", "run_window"]
@@ -44,7 +45,9 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
     (the next free ``n``; the frame without the panel); R reloads the
     shaders from disk (a broken shader keeps the last good program and shows
     its error in the title and on stderr), as saving a node's own shader file
-    does; other keys go to the lesson.
+    does; a lesson from a file (``.py`` or ``.toml``) is read again on R and on
+    save, a mistake keeping the last good lesson with its error shown the
+    same way; other keys go to the lesson.
     ``instead`` is what the errors offer when no window can open (the
     command's headless form, e.g. ``glsandbox render``).
 
@@ -65,7 +68,7 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
     renderer = FrameRenderer(host)
     executor = renderer.executor
     motion = InteractiveResolution()  # ray-traced viewports: coarser while the camera moves
-    state = {"lesson": lesson, "error": "", "shoot": False}
+    state = {"lesson": lesson, "error": "", "lesson_error": "", "shoot": False}
     session = Session(lesson, Clock(lesson.time, glfw.get_time()), samples, CameraInput())
     pending: list[int] = []
 
@@ -74,7 +77,47 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
             pending.append(key)
 
     glfw.set_key_callback(host.window, on_key)
-    camera_input, repeat_keys = attach_camera_input(host.window, lambda: state["lesson"].scene())
+    source = lesson_source(type(lesson))  # a lesson .py or scene .toml file: saving it reloads the lesson
+    last_good: dict[str, Scene] = {}
+
+    # Two kinds of lesson error: reading its file again failed (kept until a read
+    # succeeds), or building a frame failed (kept until a frame builds).
+    lesson_errors = {"file": "", "frame": ""}
+
+    def report_lesson_error(kind: str, error: str) -> None:
+        if error and error != lesson_errors[kind]:
+            print(f"error: {error}", file=sys.stderr, flush=True)
+        lesson_errors[kind] = error
+        state["lesson_error"] = session.lesson_error = lesson_errors["file"] or lesson_errors["frame"]
+
+    def lesson_scene() -> Scene:
+        """The lesson's scene; while its file (or a value) has a mistake, the last good one,
+        the error on screen. A built-in lesson's own exceptions, and a first frame that
+        fails, end the window as before."""
+        try:
+            scene = state["lesson"].scene()
+        except Exception as exc:
+            if "scene" not in last_good or not (isinstance(exc, SandboxError) or source is not None):
+                raise
+            report_lesson_error("frame", str(exc if isinstance(exc, SandboxError) else user_code_error(exc)))
+            return last_good["scene"]
+        last_good["scene"] = scene
+        if lesson_errors["frame"]:
+            report_lesson_error("frame", "")
+        return scene
+
+    def reload_lesson() -> None:
+        try:
+            fresh = reload_lesson_file(state["lesson"])
+        except SandboxError as exc:
+            report_lesson_error("file", str(exc))
+            return
+        state["lesson"] = session.lesson = fresh
+        report_lesson_error("file", "")
+        print("lesson reloaded", file=sys.stderr, flush=True)
+
+    lesson_watch = FileWatch(lambda: [source] if source is not None else [])
+    camera_input, repeat_keys = attach_camera_input(host.window, lesson_scene)
     session.camera = camera_input
     try:
         panel = Panel(host.window)  # chained in front of the callbacks above
@@ -93,7 +136,7 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
             print(f"error: {exc}", file=sys.stderr, flush=True)
         session.shader_error = state["error"]  # the panel shows it too
 
-    watch = ShaderWatch(executor.shader_files)  # nodes' own shader files: saving one reloads
+    watch = FileWatch(executor.shader_files)  # nodes' own shader files: saving one reloads
 
     def handle(key: int) -> None:
         if key == glfw.KEY_ESCAPE:
@@ -104,10 +147,12 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
             state["shoot"] = True  # taken from the next frame's target, before the panel is drawn
         elif key == glfw.KEY_R:
             reload_shaders()
+            if source is not None:
+                reload_lesson()
         else:
             name = glfw.get_key_name(key, 0) or {glfw.KEY_TAB: "tab", glfw.KEY_SPACE: "space"}.get(key, "") \
                 or _arrow_key_names(glfw).get(key, "")
-            if name and not camera_input.key(name, state["lesson"].scene()):
+            if name and not camera_input.key(name, lesson_scene()):
                 state["lesson"].on_key(name)
 
     frames, fps_frames, fps_start, fps = 0, 0, _time.perf_counter(), 0.0
@@ -118,13 +163,15 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
                 handle(pending.pop(0))
             if watch.changed():
                 reload_shaders()
+            if lesson_watch.changed():
+                reload_lesson()
             current: Lesson = state["lesson"]
             if current.animated:
                 current.values["time"] = session.clock.time(glfw.get_time())
             width, height = glfw.get_framebuffer_size(host.window)
             if width > 0 and height > 0:  # minimised windows have no framebuffer
                 # The camera keys' camera, once moved, replaces the scene's.
-                scene = camera_input.apply(with_samples(current.scene(), session.samples))
+                scene = camera_input.apply(with_samples(lesson_scene(), session.samples))
                 scene = _live_compare(session, renderer, (width, height)) or scene
                 frame_plan, target = renderer.draw(scene, (width, height), motion.resolution(scene))
                 if state["shoot"]:
@@ -141,7 +188,8 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
             if now - fps_start >= 0.5:
                 fps = fps_frames / (now - fps_start)
                 fps_frames, fps_start = 0, now
-                suffix = f" | shader error: {state['error']}" if state["error"] else ""
+                suffix = "".join(f" | {what} error: {state[key]}" for what, key in
+                                 (("lesson", "lesson_error"), ("shader", "error")) if state[key])
                 glfw.set_window_title(host.window, f"glsandbox: {current.name} | {fps:.0f} fps{suffix}")
             if max_frames is not None and frames >= max_frames:
                 break

@@ -224,3 +224,65 @@ def test_a_lesson_file_may_subclass_a_builtin_lesson(tmp_path: Path) -> None:
               "print(cls.__name__, cls.name, issubclass(cls, base), base.name)")
     proc = subprocess.run([sys.executable, "-c", script, str(path)], capture_output=True, text=True, timeout=120)
     assert proc.stdout.split() == ["MyTriangle", "my_triangle", "True", "triangle"], proc.stderr
+
+
+COLORED = '''
+from glsandbox import Lesson, Scene
+
+class Flat(Lesson):
+    def build(self) -> Scene:
+        return Scene("flat", clear_color=COLOR)
+'''
+
+
+def test_saving_a_lesson_file_reloads_it_in_the_window(window_env: str, tmp_path: Path) -> None:
+    """Saving the lesson file redraws the window with the new code; a mistake saved (a syntax
+    error, an exception in build()) keeps the last good lesson drawing and shows the error
+    with the file and line; the fixed file draws again."""
+    path = tmp_path / "flat.py"
+    path.write_text(COLORED.replace("COLOR", "(0.0, 1.0, 0.0, 1.0)"))
+    win = LessonWindow(window_env, tmp_path, "glsandbox.cli", "run", "flat.py", "--size", "320x240")
+    try:
+        win.wait_title(lambda t: "fps" in t)
+        win.key("F1")  # the panel hides: the pixel looked at is the frame's
+        win._wait(lambda: tuple(win.screen()[120, 160]) == (0, 255, 0))
+        path.write_text(COLORED.replace("COLOR", "(1.0, 0.0, 0.0, 1.0)"))  # saved: no key pressed
+        win._wait(lambda: tuple(win.screen()[120, 160]) == (255, 0, 0))
+        path.write_text(COLORED.replace("COLOR", "(1.0, 0.0, 0.0, 1.0))"))  # one parenthesis too many
+        title = win.wait_title(lambda t: "lesson error" in t)
+        assert "flat.py:6: syntax error" in title, title  # the path as given: run flat.py
+        assert tuple(win.screen()[120, 160]) == (255, 0, 0)  # still the last good lesson
+        path.write_text(COLORED.replace("COLOR", "(0.0, 0.0, 1.0, 1.0)").replace("return", "1 / 0\n        return"))
+        win.wait_title(lambda t: "ZeroDivisionError" in t and "flat.py:6" in t)
+        path.write_text(COLORED.replace("COLOR", "(0.0, 0.0, 1.0, 1.0)"))
+        win._wait(lambda: tuple(win.screen()[120, 160]) == (0, 0, 255))
+        assert "lesson error" not in win.wait_title(lambda t: "fps" in t and "error" not in t)
+    finally:
+        code = win.close()
+    assert code == 0
+    err = win.proc.stderr.read()
+    assert err.count("lesson reloaded") == 2 and "error: flat.py:6: syntax error" in err
+
+
+def test_reloading_a_lesson_file_keeps_the_values_it_still_accepts(tmp_path: Path) -> None:
+    from glsandbox.lesson import lesson_source, reload_lesson
+
+    path = tmp_path / "spin.py"
+    path.write_text(SPIN)
+    lesson = find_lesson(str(path))(speed=2.5, time=1.25)
+    assert lesson_source(type(lesson)) == path
+    path.write_text(SPIN.replace('params = (Param("speed", 1.0, "radians per second"),)',
+                                 'params = (Param("speed", 1.0, "radians per second"), Param("size", 0.5, "edge"))'))
+    fresh = reload_lesson(lesson)
+    assert type(fresh) is not type(lesson) and fresh.values["speed"] == 2.5 and fresh.time == 1.25
+    assert fresh.values["size"] == 0.5  # the new parameter at its default
+    path.write_text(SPIN.replace("speed", "rate"))
+    assert reload_lesson(fresh).values["rate"] == 1.0  # a parameter gone: the new one's default
+    path.write_text(SPIN.replace("return Scene", "return undefined_name or Scene"))
+    with pytest.raises(SandboxError, match=r"NameError at .*spin\.py:\d+: name 'undefined_name' is not defined"):
+        reload_lesson(fresh)
+    with pytest.raises(SandboxError, match="built in"):
+        reload_lesson(find_lesson("triangle")())
+    scene_file = tmp_path / "box.toml"
+    scene_file.write_text('name = "box"\n')
+    assert lesson_source(find_lesson(str(scene_file))) == scene_file

@@ -20,7 +20,7 @@ from glsandbox.errors import SandboxError
 from glsandbox.files import load_png
 from glsandbox.frame import HeadlessRenderer
 from glsandbox.geometry import builtin_mesh
-from glsandbox.gl.shader_watch import ShaderWatch
+from glsandbox.file_watch import FileWatch
 from glsandbox.lesson import find_lesson
 from glsandbox.plan import plan
 from glsandbox.scene import SHADER_INPUTS, Node, Scene
@@ -361,7 +361,7 @@ def test_the_watch_reports_a_saved_file_once(tmp_path: Path) -> None:
     path = tmp_path / "a.glsl"
     path.write_text("one")
     files = [path]
-    watch = ShaderWatch(lambda: files, interval=0.25)
+    watch = FileWatch(lambda: files, interval=0.25)
     assert not watch.changed(now=0.0)  # first sight: recorded
     path.write_text("two, longer")
     assert not watch.changed(now=0.1)  # within the interval: the disk is not looked at
@@ -379,7 +379,7 @@ def test_a_save_reloads_the_users_shader_and_a_broken_one_keeps_the_last_good(fo
     gl = fresh
     scene = load_scene(folder / "scene.toml")
     shader = folder / "tint.glsl"
-    watch = ShaderWatch(gl.executor.shader_files, interval=0.0)
+    watch = FileWatch(gl.executor.shader_files, interval=0.0)
     assert tuple(gl.render_scene(scene, (32, 32)).image[16, 16]) == (0, 255, 0, 255)
     assert shader in gl.executor.shader_files()
     assert any(path.name == "transform.glsl" for path in gl.executor.shader_files())  # its include too

@@ -22,7 +22,6 @@ import csv
 import io
 import json
 import math
-import sys
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -33,7 +32,7 @@ import numpy as np
 from glsandbox import files
 from glsandbox.errors import SandboxError
 from glsandbox.frame import DEFAULT_SIZE, Frame, HeadlessRenderer
-from glsandbox.lesson import Lesson, find_lesson, lesson_files, submission_lesson
+from glsandbox.lesson import Lesson, find_lesson, lesson_files, submission_lesson, user_code_error
 from glsandbox.measure.golden import DEFAULT_MAX_BAD_SHARE, DEFAULT_THRESHOLD, ImageMatch, compare_images, write_artifacts
 
 #: The tolerances ``--tolerance KEY=VALUE`` (and the pytest fixture's keywords) accept.
@@ -77,22 +76,6 @@ def reference_size(path: Path, size: tuple[int, int] | None) -> tuple[int, int]:
         image = read_reference(path)
         return image.shape[1], image.shape[0]
     return DEFAULT_SIZE
-
-
-def user_code_error(exc: BaseException) -> SandboxError:
-    """An exception raised by a lesson's own code as one line, with the deepest line outside glsandbox."""
-    library = tuple(str(Path(p).resolve()) for p in {sys.prefix, sys.base_prefix, sys.exec_prefix})
-    ours = str(Path(__file__).resolve().parents[1])  # the glsandbox package
-    where = ""
-    tb = exc.__traceback__
-    while tb is not None:
-        filename = tb.tb_frame.f_code.co_filename
-        if not filename.startswith(("<", ours, *library)):
-            where = f" at {filename}:{tb.tb_lineno}"
-        tb = tb.tb_next
-    text = str(exc)
-    text = text if len(text) <= 200 else text[:197] + "..."
-    return SandboxError(f"{type(exc).__name__}{where}: {text}")
 
 
 def render_lesson(lesson: Lesson, size: tuple[int, int], samples: int = 0, backend: str | None = None,

@@ -1,8 +1,9 @@
-"""Watching shader files: saving one tells the window to reload (README "Your own shader").
+"""Watching the files a window shows: saving one tells the window to reload it
+(a node's own shader, README "Your own shader"; a lesson file, "Your own lesson").
 
 A cheap modification-time poll, not a file-system notifier (``watchdog``):
 no extra dependency, the files are a handful (a node's own shader and its
-includes), and :meth:`ShaderWatch.changed` stats them at most a few times a
+includes, the lesson's file), and :meth:`FileWatch.changed` stats them at most a few times a
 second, a few microseconds each, from the window's loop. Editors that save by
 writing a new file and renaming it over the old one are seen the same way.
 """
@@ -28,7 +29,7 @@ def stamp(path: Path) -> Stamp:
     return info.st_mtime_ns, info.st_size
 
 
-class ShaderWatch:
+class FileWatch:
     """Polls the files ``files()`` lists; :meth:`changed` says whether one changed since the last poll.
 
     A file seen for the first time is recorded, not reported (it was just
