@@ -198,10 +198,14 @@ def cases(env: Any) -> list:
     def hit_miss(label: str) -> Callable[[Any, Any], str]:
         return lambda _rays, image: reference(label).compare(image)
 
+    @cache
+    def triangles(label: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        world = build_world(model_scene(label), 0)  # made at the warm-up, not timed after it
+        return world.v0, world.v1, world.v2
+
     def build(label: str) -> Side:
         def run(_: int) -> float:
-            world = build_world(model_scene(label), 0)
-            return build_bvh(world.v0, world.v1, world.v2).build_seconds  # not the cached one
+            return build_bvh(*triangles(label)).build_seconds  # build_bvh: never the cached one
 
         return Side("build_bvh (binned SAH, numpy)", run)
 
@@ -210,9 +214,8 @@ def cases(env: Any) -> list:
             from embreex import rtcore_scene
             from embreex.mesh_construction import TriangleMesh
 
-            world = build_world(model_scene(label), 0)
             scene = rtcore_scene.EmbreeScene()
-            TriangleMesh(scene, np.stack([world.v0, world.v1, world.v2], axis=1).astype(np.float32))
+            TriangleMesh(scene, np.stack(triangles(label), axis=1).astype(np.float32))
             one = np.zeros((1, 3), dtype=np.float32)
             scene.run(one, one + np.float32(1.0), output=1)  # Embree builds at its first query
 
@@ -220,8 +223,8 @@ def cases(env: Any) -> list:
 
     largest = labels[-1]
     found = [Case(GROUP, f"BVH build, {int(largest):,} tris", embree_build(largest), build(largest), repeat=1,
-                  unit="s", note=f"goal: under {BUILD_GOAL_S:g} s for 1M triangles (build_bvh's own time; "
-                                 "both sides include the World of the scene)")]
+                  unit="s", note=f"goal: under {BUILD_GOAL_S:g} s for 1M triangles (both sides from the "
+                                 "same float64 world triangles, made once)")]
     for label in labels:
         name = "bunny" if label == "bunny" else f"{int(label):,} tris"
         for mode in MODES:
@@ -252,7 +255,7 @@ def summarize(results: Sequence[Any]) -> list[str]:
             built = statistics.median(result.subject_s)
             verdict = ("met" if built < BUILD_GOAL_S else "NOT met") if f"{SIZES[-1]:,}" in result.case.name \
                 else "not judged: a smaller model"
-            lines.append(f"{GROUP}: {result.case.name}: {built:.2f} s with the World "
+            lines.append(f"{GROUP}: {result.case.name}: {built:.2f} s "
                          f"(goal: under {BUILD_GOAL_S:g} s for 1M triangles: {verdict})")
     small, large = f"{SIZES[1]:,} tris", f"{SIZES[-1]:,} tris"
     counts = {small: terrain_triangles(SIZES[1]), large: terrain_triangles(SIZES[-1])}
