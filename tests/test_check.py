@@ -109,8 +109,9 @@ def test_check_bad_input_is_one_line_exit_2(tmp_path: Path, gl) -> None:
         assert_user_error(glsandbox("check", str(lesson), *extra), fragment)
     assert_user_error(glsandbox("check", str(tmp_path / "subs"), "--golden", str(ref), "--update"),
                       "give one lesson, not the folder")
-    assert_user_error(glsandbox("check", str(tmp_path / "missing.py"), "--golden", str(ref), "--update"),
-                      "missing.py not found")
+    for update in (["--update"], []):  # the lesson's mistake is the one said, whether or not the reference exists
+        assert_user_error(glsandbox("check", str(tmp_path / "missing.py"), "--golden", str(ref), *update),
+                          "missing.py not found")
     assert_user_error(glsandbox("check", str(tmp_path / "subs"), "--golden", str(ref)), "no .py or .toml lesson files")
     lesson_file(tmp_path / "subs")
     assert_user_error(glsandbox("check", str(tmp_path / "subs"), "--golden", str(ref)),

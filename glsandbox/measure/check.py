@@ -228,9 +228,9 @@ def check_one(spec: str, reference: Path, settings: Sequence[str], size: tuple[i
     and a passing one is left as it is (the project's golden flow); the match
     is then against the old reference (None when there was none).
     """
+    lesson = find_lesson(spec).from_settings(settings)  # the lesson's own mistakes first
     if not update and not reference.exists():
         raise SandboxError(f"reference {reference} not found; write it with --update")
-    lesson = find_lesson(spec).from_settings(settings)
     expected = read_reference(reference) if reference.exists() else None
     size = size or ((expected.shape[1], expected.shape[0]) if expected is not None else DEFAULT_SIZE)
     actual = render_lesson(lesson, size, samples, backend).image
