@@ -60,7 +60,7 @@ from numpy.typing import NDArray
 from glsandbox.errors import SandboxError
 from glsandbox.files import open_user_file
 from glsandbox.geometry import Mesh
-from glsandbox.meshnormals import corner_normals, unique_vertices
+from glsandbox.meshnormals import face_cross, normal_groups, row_ids, split_vertices
 from glsandbox.scene import Material, Texture
 
 __all__ = ["CREASE_ANGLE", "FORMATS", "NORMALS", "Model", "fit_mesh", "is_model_path", "load_mesh", "load_model"]
@@ -157,7 +157,10 @@ def load_model(path: str | os.PathLike[str], *, fit: bool = False, normals: str 
             data = handle.read()
         except OSError as exc:
             raise SandboxError(f"model file {p} cannot be read ({exc.strerror or exc})") from None
-    parts = _parts(p, _trimesh_scene(p, data, file_type))
+    scene = _trimesh_scene(p, data, file_type)
+    del data  # the file's bytes are not needed past the reader: not held while the mesh is made
+    parts = _parts(p, scene)
+    del scene
     model = _model(p, file_type, parts, bool(fit), normals, float(crease_angle))
     _CACHE[key] = model
     while len(_CACHE) > CACHE_SIZE:
@@ -394,15 +397,11 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
     faces = faces[keep]
     if corner_colors is not None:
         corner_colors = corner_colors[keep]
-    normals, how = _corner_normals(p, positions, faces, file_normals, normals_mode, crease)
-    # Per-corner attributes, then vertices made unique again by everything they carry.
+    position_ids = row_ids(positions)[0]
+    group, group_normals, how = _normal_groups(p, positions, faces, file_normals, normals_mode, crease,
+                                               position_ids)
     corners = faces.reshape(-1)
-    rows = [positions[corners], normals.reshape(-1, 3)]
-    if uvs is not None:
-        rows.append(uvs[corners])
-    if corner_colors is not None:
-        rows.append(corner_colors.reshape(-1, 3))
-    index, first = unique_vertices(np.concatenate(rows, axis=1))
+    index, first = _split_vertices(position_ids, uvs, corners, corner_colors, group, group_normals)
     chosen = corners[first]
     notes = [f"{p.name}: {_count(faces.shape[0], 'triangle')} ({file_type.upper()})"]
     if dropped:
@@ -413,7 +412,7 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
         notes.append(f"{textures} textures in the file, only the first is used")
     if fit:
         notes.append("fitted into -1..1")
-    mesh = Mesh(p.name, positions[chosen], index.astype(np.uint32), normals.reshape(-1, 3)[first],
+    mesh = Mesh(p.name, positions[chosen], index.astype(np.uint32), group_normals[group[first]],
                 None if uvs is None else uvs[chosen],
                 None if corner_colors is None else corner_colors.reshape(-1, 3)[first], notes=tuple(notes))
     if fit:
@@ -451,32 +450,53 @@ def _degenerate(positions: NDArray[np.float64], faces: NDArray[np.int64]) -> NDA
     repeated = (faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 0] == faces[:, 2])
     a, b, c = positions[faces[:, 0]], positions[faces[:, 1]], positions[faces[:, 2]]
     with np.errstate(all="ignore"):
-        doubled_area = np.linalg.norm(np.cross(b - a, c - a), axis=1)
-        longest = np.max(np.stack([np.einsum("ij,ij->i", e, e) for e in (b - a, c - b, a - c)]), axis=0)
-        flat = ~(doubled_area > DEGENERATE_SHARE * longest)
+        cross = face_cross(a, b, c)
+        doubled_area_sq = np.einsum("ij,ij->i", cross, cross)
+        del cross
+        longest = np.zeros(faces.shape[0])
+        for e in (b - a, c - b, a - c):
+            np.maximum(longest, np.einsum("ij,ij->i", e, e), out=longest)
+        # |cross| > share * longest², compared squared (both sides are non-negative).
+        flat = ~(doubled_area_sq > (DEGENERATE_SHARE * longest) ** 2)
     return repeated | flat
 
 
-def _corner_normals(p: Path, positions: NDArray[np.float64], faces: NDArray[np.int64],
-                    file_normals: NDArray[np.float64] | None, mode: str,
-                    crease: float) -> tuple[NDArray[np.float64], str]:
-    """A unit normal per face corner, (F, 3, 3), and how it was made."""
+def _normal_groups(p: Path, positions: NDArray[np.float64], faces: NDArray[np.int64],
+                   file_normals: NDArray[np.float64] | None, mode: str, crease: float,
+                   position_ids: NDArray[np.intp]) -> tuple[NDArray[np.intp], NDArray[np.float64], str]:
+    """Corner normals as ``(group (C,), unit normals (G, 3))`` (corner ``c`` has ``normals[group[c]]``,
+    :func:`glsandbox.meshnormals.normal_groups`), and how they were made."""
     if mode in ("auto", "file"):
         usable = None
         if file_normals is not None:
-            used = file_normals[faces]
             with np.errstate(all="ignore"):
-                size = np.linalg.norm(used, axis=2, keepdims=True)
-                if np.isfinite(used).all() and (size > 1e-12).all():
-                    usable = used / size
+                size = np.sqrt(np.einsum("ij,ij->i", file_normals, file_normals))
+                fine = np.isfinite(file_normals).all(axis=1) & (size > 1e-12)
+                if fine[faces].all():  # only the vertices the faces use need a normal
+                    usable = file_normals / np.where(fine, size, 1.0)[:, None]
         if usable is not None:
-            return usable, "file"
+            return faces.reshape(-1).astype(np.intp), usable, "file"
         if mode == "file":
             why = "has no vertex normals" if file_normals is None else "has zero-length or non-finite normals"
             raise SandboxError(f"model file {p} {why} (normals = \"file\"); use \"auto\" to compute them")
         mode = "crease"
-    normals = corner_normals(positions, faces.astype(np.intp), mode, crease)
-    return normals, f"crease {crease:g}°" if mode == "crease" else mode
+    group, normals = normal_groups(positions, np.asarray(faces, dtype=np.intp), mode, crease, position_ids)
+    return group, normals, f"crease {crease:g}°" if mode == "crease" else mode
+
+
+def _split_vertices(position_ids: NDArray[np.intp], uvs: NDArray[np.float64] | None, corners: NDArray[np.int64],
+                    corner_colors: NDArray[np.float64] | None, group: NDArray[np.intp],
+                    group_normals: NDArray[np.float64]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """The drawn vertices: ``(index (C,), a corner of each)``. Corners share a vertex exactly when
+    their position, uv, colour and normal are bit-identical; each is numbered once (positions and
+    uvs per file vertex, normals per group), so only integers are compared per corner."""
+    attribute = position_ids
+    if uvs is not None:
+        attribute = split_vertices(position_ids, row_ids(uvs)[0])[0]
+    attribute = attribute[corners]
+    if corner_colors is not None:
+        attribute = split_vertices(attribute, row_ids(corner_colors.reshape(-1, 3))[0])[0]
+    return split_vertices(attribute, row_ids(group_normals)[0][group])
 
 
 def _texture(parts: list[_Part]) -> tuple[NDArray[np.uint8] | None, tuple[float, float, float, float] | None, int]:
