@@ -397,7 +397,7 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
     faces = faces[keep]
     if corner_colors is not None:
         corner_colors = corner_colors[keep]
-    position_ids = row_ids(positions)[0]
+    position_ids = row_ids(positions, ordered=False)[0]
     group, group_normals, how = _normal_groups(p, positions, faces, file_normals, normals_mode, crease,
                                                position_ids)
     corners = faces.reshape(-1)
@@ -492,11 +492,11 @@ def _split_vertices(position_ids: NDArray[np.intp], uvs: NDArray[np.float64] | N
     uvs per file vertex, normals per group), so only integers are compared per corner."""
     attribute = position_ids
     if uvs is not None:
-        attribute = split_vertices(position_ids, row_ids(uvs)[0])[0]
+        attribute = split_vertices(position_ids, row_ids(uvs, ordered=False)[0])[0]
     attribute = attribute[corners]
     if corner_colors is not None:
-        attribute = split_vertices(attribute, row_ids(corner_colors.reshape(-1, 3))[0])[0]
-    return split_vertices(attribute, row_ids(group_normals)[0][group])
+        attribute = split_vertices(attribute, row_ids(corner_colors.reshape(-1, 3), ordered=False)[0])[0]
+    return split_vertices(attribute, row_ids(group_normals, ordered=False)[0][group])
 
 
 def _texture(parts: list[_Part]) -> tuple[NDArray[np.uint8] | None, tuple[float, float, float, float] | None, int]:

@@ -113,13 +113,15 @@ def _by_first_appearance(first: NDArray[np.intp], inverse: NDArray[np.intp]) -> 
     return rank[inverse.reshape(-1)], first[by_first]
 
 
-def row_ids(rows: NDArray[np.float64]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+def row_ids(rows: NDArray[np.float64], ordered: bool = True) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
     """``(ids, firsts)``: ``ids[i] == ids[j]`` exactly when rows ``i`` and ``j`` are bit-identical
-    (``-0.0`` counted as ``0.0``), numbered by first appearance; ``firsts[g]`` is the first row of id ``g``.
+    (``-0.0`` counted as ``0.0``); ``firsts[g]`` is a row of id ``g``. ``ordered``: ids numbered by
+    first appearance and ``firsts[g]`` the first row of id ``g`` (a second sort); otherwise in no
+    particular order, for ids only compared with each other.
 
     A 64-bit hash of each row is sorted (much faster than ``np.unique(axis=0)``),
-    then every row is compared with its group's first row: on a hash collision
-    the exact (slower) row sort answers instead.
+    then every row is compared with its group's representative: on a hash
+    collision the exact (slower) row sort answers instead.
     """
     rows = np.ascontiguousarray(rows + 0.0)  # -0.0 + 0.0 == +0.0: one bit pattern for zero
     n = rows.shape[0]
@@ -132,10 +134,18 @@ def row_ids(rows: NDArray[np.float64]) -> tuple[NDArray[np.intp], NDArray[np.int
             h ^= bits[:, col]
             h *= np.uint64(0x100000001B3)
             h ^= h >> np.uint64(29)
-    _, first, inverse = np.unique(h, return_index=True, return_inverse=True)
+    if ordered:
+        _, first, inverse = np.unique(h, return_index=True, return_inverse=True)
+    else:
+        _, inverse = np.unique(h, return_inverse=True)
+        first = np.empty(int(inverse.max()) + 1, dtype=np.intp)
+        first[inverse] = np.arange(n)  # any row of each id: they are all the same, or a collision shows
+    inverse = inverse.reshape(-1)
+    del h
     if not np.array_equal(bits[first[inverse]], bits):  # a collision: sort the rows themselves
         _, first, inverse = np.unique(bits, axis=0, return_index=True, return_inverse=True)
-    return _by_first_appearance(first, inverse)
+        inverse = inverse.reshape(-1)
+    return _by_first_appearance(first, inverse) if ordered else (inverse, first)
 
 
 def split_vertices(attribute_ids: NDArray[np.intp], normal_ids: NDArray[np.intp]) -> tuple[NDArray[np.intp],
@@ -213,13 +223,13 @@ def normal_groups(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: 
         return np.repeat(np.arange(f, dtype=np.intp), 3), faces
     angles = _corner_angles(p0, p1, p2, doubled_area).reshape(-1)
     del p0, p1, p2, doubled_area
-    pid = row_ids(positions)[0] if position_ids is None else position_ids
+    pid = row_ids(positions, ordered=False)[0] if position_ids is None else position_ids
     corner_pid = pid[tris.reshape(-1)]  # the welded position of each corner
     del pid
     npos = int(corner_pid.max()) + 1
     corner_face = np.repeat(np.arange(f, dtype=np.intp), 3)
     if mode == "smooth":
-        sums = _sums(corner_pid, corner_face, faces, angles, npos)
+        sums = _sums(corner_pid, faces, angles, npos)
         return _finish(corner_pid, sums, corner_face, faces)
     cos_limit = math.cos(math.radians(crease_angle))
     # Tier 1: positions whose normals all lie within half the crease angle of their mean direction.
@@ -233,7 +243,7 @@ def normal_groups(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: 
     rough_pos[corner_pid[spread < math.cos(half)]] = True
     del spread
     rough = rough_pos[corner_pid]
-    smooth_sums = _sums(corner_pid[~rough], corner_face[~rough], faces, angles[~rough], npos)
+    smooth_sums = _sums(corner_pid, faces, np.where(rough, 0.0, angles), npos)  # rough corners weigh nothing
     group = corner_pid.copy()
     parts = [smooth_sums]
     if rough.any():
@@ -257,10 +267,11 @@ def normal_groups(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: 
     return _finish(group, np.concatenate(parts), corner_face, faces)
 
 
-def _sums(corner_group: NDArray[np.intp], corner_face: NDArray[np.intp], faces: NDArray[np.float64],
-          angles: NDArray[np.float64], groups: int) -> NDArray[np.float64]:
-    """The angle-weighted sum of face normals over the corners of each group, ``(groups, 3)``."""
-    return np.stack([np.bincount(corner_group, faces[corner_face, j] * angles, minlength=groups)
+def _sums(corner_group: NDArray[np.intp], faces: NDArray[np.float64], angles: NDArray[np.float64],
+          groups: int) -> NDArray[np.float64]:
+    """The angle-weighted sum of face normals over the corners of each group, ``(groups, 3)``
+    (every corner given: corner ``c`` is of face ``c // 3``)."""
+    return np.stack([np.bincount(corner_group, np.repeat(faces[:, j], 3) * angles, minlength=groups)
                      for j in range(3)], axis=1)
 
 
