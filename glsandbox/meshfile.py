@@ -43,6 +43,7 @@ file changes. trimesh's log messages and warnings are kept off stderr.
 from __future__ import annotations
 
 import contextlib
+import gc
 import io
 import logging
 import math
@@ -60,7 +61,7 @@ from numpy.typing import NDArray
 from glsandbox.errors import SandboxError
 from glsandbox.files import open_user_file
 from glsandbox.geometry import Mesh
-from glsandbox.meshnormals import face_cross, normal_groups, row_ids, split_vertices
+from glsandbox.meshnormals import BLOCK_FACES, face_cross, normal_groups, row_ids, split_vertices
 from glsandbox.scene import Material, Texture
 
 __all__ = ["CREASE_ANGLE", "FORMATS", "NORMALS", "Model", "fit_mesh", "is_model_path", "load_mesh", "load_model"]
@@ -161,6 +162,7 @@ def load_model(path: str | os.PathLike[str], *, fit: bool = False, normals: str 
     del data  # the file's bytes are not needed past the reader: not held while the mesh is made
     parts = _parts(p, scene)
     del scene
+    gc.collect()  # trimesh's objects hold reference cycles: its copies of the data go now, not later
     model = _model(p, file_type, parts, bool(fit), normals, float(crease_angle))
     _CACHE[key] = model
     while len(_CACHE) > CACHE_SIZE:
@@ -282,8 +284,9 @@ def _parts(p: Path, scene: Any) -> list[_Part]:
 
 
 def _part(mesh: Any, transform: NDArray[np.float64]) -> _Part:
-    positions = np.array(mesh.vertices, dtype=np.float64).reshape(-1, 3)
-    faces = np.array(mesh.faces, dtype=np.int64).reshape(-1, 3)
+    # Views of trimesh's arrays where their types already fit (no copy: every step below makes new arrays).
+    positions = np.asarray(mesh.vertices, dtype=np.float64).reshape(-1, 3)
+    faces = np.asarray(mesh.faces, dtype=np.int64).reshape(-1, 3)
     normals = _file_normals(mesh, positions.shape[0])
     linear = transform[:3, :3]
     if not np.array_equal(transform, np.eye(4)):
@@ -366,8 +369,7 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
         raise SandboxError(f"model file {p} has no faces{what}")
     # One vertex and face list for all parts.
     offsets = np.cumsum([0] + [part.positions.shape[0] for part in parts])
-    positions = np.concatenate([part.positions for part in parts])
-    faces = np.concatenate([part.faces + offset for part, offset in zip(parts, offsets)])
+    positions, faces = _joined(parts, offsets)
     bad = np.flatnonzero(~np.isfinite(positions).all(axis=1))
     if bad.size:
         raise SandboxError(f"model file {p}: {_count(bad.size, 'vertex', 'vertices')} with NaN or infinite "
@@ -394,7 +396,8 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
     if not keep.any():
         raise SandboxError(f"model file {p} has no faces: all {faces.shape[0]:,} are degenerate "
                            "(zero area or a repeated vertex)")
-    faces = faces[keep]
+    if dropped:
+        faces = faces[keep]
     if corner_colors is not None:
         corner_colors = corner_colors[keep]
     position_ids = row_ids(positions, ordered=False)[0]
@@ -427,6 +430,14 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
     return Model(p, mesh, texture, color, int(faces.shape[0]), dropped, how)
 
 
+def _joined(parts: list[_Part], offsets: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """All parts' positions and faces as one list (a single part's arrays as they are: no copy)."""
+    if len(parts) == 1:
+        return parts[0].positions, parts[0].faces
+    return (np.concatenate([part.positions for part in parts]),
+            np.concatenate([part.faces + offset for part, offset in zip(parts, offsets)]))
+
+
 def _count(n: int, one: str, many: str | None = None) -> str:
     """``1 triangle``, ``1,280 triangles``."""
     return f"{n:,} {one if n == 1 else many or one + 's'}"
@@ -446,18 +457,21 @@ def _corner_colors(parts: list[_Part]) -> NDArray[np.float64]:
 
 
 def _degenerate(positions: NDArray[np.float64], faces: NDArray[np.int64]) -> NDArray[np.bool_]:
-    """Faces with a repeated index or (numerically) zero area."""
+    """Faces with a repeated index or (numerically) zero area, worked out in blocks of faces
+    (bounded temporaries)."""
+    flat = np.empty(faces.shape[0], dtype=bool)
+    for lo in range(0, faces.shape[0], BLOCK_FACES):
+        block = faces[lo:lo + BLOCK_FACES]
+        a, b, c = positions[block[:, 0]], positions[block[:, 1]], positions[block[:, 2]]
+        with np.errstate(all="ignore"):
+            cross = face_cross(a, b, c)
+            doubled_area_sq = np.einsum("ij,ij->i", cross, cross)
+            longest = np.zeros(block.shape[0])
+            for e in (b - a, c - b, a - c):
+                np.maximum(longest, np.einsum("ij,ij->i", e, e), out=longest)
+            # |cross| > share * longest², compared squared (both sides are non-negative).
+            flat[lo:lo + BLOCK_FACES] = ~(doubled_area_sq > (DEGENERATE_SHARE * longest) ** 2)
     repeated = (faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 0] == faces[:, 2])
-    a, b, c = positions[faces[:, 0]], positions[faces[:, 1]], positions[faces[:, 2]]
-    with np.errstate(all="ignore"):
-        cross = face_cross(a, b, c)
-        doubled_area_sq = np.einsum("ij,ij->i", cross, cross)
-        del cross
-        longest = np.zeros(faces.shape[0])
-        for e in (b - a, c - b, a - c):
-            np.maximum(longest, np.einsum("ij,ij->i", e, e), out=longest)
-        # |cross| > share * longest², compared squared (both sides are non-negative).
-        flat = ~(doubled_area_sq > (DEGENERATE_SHARE * longest) ** 2)
     return repeated | flat
 
 

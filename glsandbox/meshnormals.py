@@ -53,7 +53,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["MODES", "PAIR_LIMIT", "corner_normals", "face_normals", "normal_groups", "row_ids", "split_vertices",
+__all__ = ["BLOCK_FACES", "MODES", "PAIR_LIMIT", "corner_normals", "face_normals", "normal_groups", "row_ids", "split_vertices",
            "unique_vertices"]
 
 #: The ways to make normals.
@@ -62,6 +62,10 @@ MODES = ("flat", "smooth", "crease")
 #: A position with more corners than this that is not smooth all round is split by
 #: walking its ring of corners (tier 3 of the module docstring), not pair by pair.
 PAIR_LIMIT = 64
+
+#: Faces worked on at once where a step needs several temporary arrays per face (bounds the
+#: memory a big model needs: a few megabytes per array, not one per triangle of the model).
+BLOCK_FACES = 1 << 16
 
 #: Pairs tested at once by the pairwise tier (bounds its temporary arrays).
 _PAIR_BLOCK = 1 << 21
@@ -92,6 +96,22 @@ def _unit_rows(rows: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[
     """``(rows / |row|, |row|)``; a zero row stays zero."""
     size = np.sqrt(np.einsum("ij,ij->i", rows, rows))
     return np.divide(rows, size[:, None], out=np.zeros_like(rows), where=size[:, None] > 0.0), size
+
+
+def _faces_and_angles(positions: NDArray[np.float64], tris: NDArray[np.intp],
+                      with_angles: bool) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Unit face normals ``(F, 3)`` and the corner angles ``(3F,)`` (empty unless ``with_angles``),
+    in blocks of :data:`BLOCK_FACES` faces."""
+    f = tris.shape[0]
+    faces = np.empty((f, 3))
+    angles = np.empty((f, 3) if with_angles else (0, 3))
+    for lo in range(0, f, BLOCK_FACES):
+        block = tris[lo:lo + BLOCK_FACES]
+        p0, p1, p2 = (positions[block[:, k]] for k in range(3))
+        faces[lo:lo + BLOCK_FACES], doubled_area = _unit_rows(face_cross(p0, p1, p2))
+        if with_angles:
+            angles[lo:lo + BLOCK_FACES] = _corner_angles(p0, p1, p2, doubled_area)
+    return faces, angles.reshape(-1)
 
 
 def _corner_angles(p0: NDArray[np.float64], p1: NDArray[np.float64], p2: NDArray[np.float64],
@@ -217,20 +237,16 @@ def normal_groups(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: 
         raise ValueError(f"unknown normals mode {mode!r}; use one of {', '.join(MODES)}")
     tris = np.asarray(tris, dtype=np.intp)
     f = tris.shape[0]
-    p0, p1, p2 = (positions[tris[:, k]] for k in range(3))
-    faces, doubled_area = _unit_rows(face_cross(p0, p1, p2))
+    faces, angles = _faces_and_angles(positions, tris, with_angles=mode != "flat")
     if mode == "flat" or f == 0:
         return np.repeat(np.arange(f, dtype=np.intp), 3), faces
-    angles = _corner_angles(p0, p1, p2, doubled_area).reshape(-1)
-    del p0, p1, p2, doubled_area
     pid = row_ids(positions, ordered=False)[0] if position_ids is None else position_ids
     corner_pid = pid[tris.reshape(-1)]  # the welded position of each corner
     del pid
     npos = int(corner_pid.max()) + 1
-    corner_face = np.repeat(np.arange(f, dtype=np.intp), 3)
     if mode == "smooth":
         sums = _sums(corner_pid, faces, angles, npos)
-        return _finish(corner_pid, sums, corner_face, faces)
+        return _finish(corner_pid, sums, faces)
     cos_limit = math.cos(math.radians(crease_angle))
     # Tier 1: positions whose normals all lie within half the crease angle of their mean direction.
     mean = _unit_rows(np.stack([np.bincount(corner_pid, np.repeat(faces[:, j], 3), minlength=npos)
@@ -243,39 +259,45 @@ def normal_groups(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: 
     rough_pos[corner_pid[spread < math.cos(half)]] = True
     del spread
     rough = rough_pos[corner_pid]
-    smooth_sums = _sums(corner_pid, faces, np.where(rough, 0.0, angles), npos)  # rough corners weigh nothing
-    group = corner_pid.copy()
-    parts = [smooth_sums]
-    if rough.any():
-        # Tiers 2 and 3: every rough corner gets a group of its own numbered after the positions;
-        # corners of one smoothing group get the same sum, so they merge again by their normal.
-        which = np.flatnonzero(rough)
-        counts = np.bincount(corner_pid[which], minlength=npos)
-        big = counts[corner_pid[which]] > PAIR_LIMIT
-        rough_sums = np.zeros((which.size, 3))
-        small_corners, big_corners = which[~big], which[big]
-        if small_corners.size:
-            rough_sums[~big] = _pair_sums(corner_pid[small_corners], faces[corner_face[small_corners]],
-                                          faces[corner_face[small_corners]] * angles[small_corners, None],
-                                          cos_limit)
-        if big_corners.size:
-            rough_sums[big] = _ring_sums(positions, tris, big_corners, corner_pid[big_corners],
-                                         faces[corner_face[big_corners]], angles[big_corners],
-                                         mean[corner_pid[big_corners]], cos_limit)
-        group[which] = npos + np.arange(which.size)
-        parts.append(rough_sums)
-    return _finish(group, np.concatenate(parts), corner_face, faces)
+    del rough_pos
+    which = np.flatnonzero(rough)
+    if which.size == 0:
+        return _finish(corner_pid, _sums(corner_pid, faces, angles, npos), faces)
+    # Tiers 2 and 3: every rough corner gets a group of its own numbered after the positions;
+    # corners of one smoothing group get the same sum, so they merge again by their normal.
+    rough_angles = angles[which]
+    angles[which] = 0.0  # rough corners weigh nothing in their position's tier-1 sum
+    smooth_sums = _sums(corner_pid, faces, angles, npos)
+    del angles, rough
+    rough_pid = corner_pid[which]
+    big = np.bincount(rough_pid, minlength=npos)[rough_pid] > PAIR_LIMIT
+    rough_sums = np.zeros((which.size, 3))
+    small_corners = which[~big]
+    if small_corners.size:
+        own = faces[small_corners // 3]
+        rough_sums[~big] = _pair_sums(rough_pid[~big], own, own * rough_angles[~big, None], cos_limit)
+    big_corners = which[big]
+    if big_corners.size:
+        rough_sums[big] = _ring_sums(positions, tris, big_corners, rough_pid[big], faces[big_corners // 3],
+                                     rough_angles[big], mean[rough_pid[big]], cos_limit)
+    group = corner_pid
+    group[which] = npos + np.arange(which.size)
+    return _finish(group, np.concatenate([smooth_sums, rough_sums]), faces)
 
 
 def _sums(corner_group: NDArray[np.intp], faces: NDArray[np.float64], angles: NDArray[np.float64],
           groups: int) -> NDArray[np.float64]:
     """The angle-weighted sum of face normals over the corners of each group, ``(groups, 3)``
     (every corner given: corner ``c`` is of face ``c // 3``)."""
-    return np.stack([np.bincount(corner_group, np.repeat(faces[:, j], 3) * angles, minlength=groups)
-                     for j in range(3)], axis=1)
+    sums = np.empty((groups, 3))
+    for j in range(3):
+        weight = np.repeat(faces[:, j], 3)
+        weight *= angles
+        sums[:, j] = np.bincount(corner_group, weight, minlength=groups)
+    return sums
 
 
-def _finish(group: NDArray[np.intp], sums: NDArray[np.float64], corner_face: NDArray[np.intp],
+def _finish(group: NDArray[np.intp], sums: NDArray[np.float64],
             faces: NDArray[np.float64]) -> tuple[NDArray[np.intp], NDArray[np.float64]]:
     """Unit normals from the groups' sums; a corner whose group's sum cancels takes its face's normal."""
     size = np.sqrt(np.einsum("ij,ij->i", sums, sums))
@@ -285,7 +307,7 @@ def _finish(group: NDArray[np.intp], sums: NDArray[np.float64], corner_face: NDA
     if cancelled.size:  # a knife edge: those corners get groups of their own, with their face's normal
         group = group.copy()
         group[cancelled] = unit.shape[0] + np.arange(cancelled.size)
-        unit = np.concatenate([unit, faces[corner_face[cancelled]]])
+        unit = np.concatenate([unit, faces[cancelled // 3]])
     return group, unit
 
 
