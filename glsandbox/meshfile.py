@@ -61,6 +61,7 @@ from numpy.typing import NDArray
 from glsandbox.errors import SandboxError
 from glsandbox.files import open_user_file
 from glsandbox.geometry import Mesh
+from glsandbox.meshcheck import MEMORY_ENV, check_memory, checked_data, claimed_triangles
 from glsandbox.meshnormals import BLOCK_FACES, face_cross, normal_groups, row_ids, split_vertices
 from glsandbox.scene import Material, Texture
 
@@ -158,12 +159,23 @@ def load_model(path: str | os.PathLike[str], *, fit: bool = False, normals: str 
             data = handle.read()
         except OSError as exc:
             raise SandboxError(f"model file {p} cannot be read ({exc.strerror or exc})") from None
+    data = checked_data(p, data, file_type)
+    claimed = claimed_triangles(data, file_type)
+    if claimed is not None:
+        check_memory(p, claimed)  # before the reader makes a single array
     scene = _trimesh_scene(p, data, file_type)
     del data  # the file's bytes are not needed past the reader: not held while the mesh is made
     parts = _parts(p, scene)
     del scene
     gc.collect()  # trimesh's objects hold reference cycles: its copies of the data go now, not later
-    model = _model(p, file_type, parts, bool(fit), normals, float(crease_angle))
+    triangles = sum(part.faces.shape[0] for part in parts)
+    check_memory(p, triangles)  # the count itself, for a glTF whose count no header gives
+    try:
+        model = _model(p, file_type, parts, bool(fit), normals, float(crease_angle))
+    except MemoryError:
+        raise SandboxError(f"model file {p}: out of memory making {triangles:,} triangles drawable (set "
+                           f"{MEMORY_ENV} below the memory this machine has, so a model too big is refused "
+                           "before loading)") from None
     _CACHE[key] = model
     while len(_CACHE) > CACHE_SIZE:
         _CACHE.popitem(last=False)
@@ -240,6 +252,10 @@ def _trimesh_scene(p: Path, data: bytes, file_type: str) -> Any:
 
         try:
             resolver = RegularFiles(str(p))
+            # trimesh names the scene's nodes after the file and hashes the names as UTF-8: a name
+            # with bytes that are not UTF-8 (kept by Python as surrogates) is given printable stand-ins.
+            resolver.file_name = _printable(resolver.file_name)
+            resolver.file_path = _printable(resolver.file_path)
             loader = getattr(trimesh, "load_scene", None)
             if loader is not None:
                 return loader(io.BytesIO(data), file_type=file_type, resolver=resolver, process=False)
@@ -249,6 +265,11 @@ def _trimesh_scene(p: Path, data: bytes, file_type: str) -> Any:
             raise
         except (Exception, RecursionError) as exc:  # anything a reader raises on bad data
             raise SandboxError(f"model file {p}: not a readable {file_type.upper()} file: {_reason(exc)}") from None
+
+
+def _printable(name: str) -> str:
+    """``name`` with the undecodable bytes of a file name (surrogates) replaced by U+FFFD."""
+    return name.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
 
 
 @dataclass
