@@ -76,10 +76,11 @@ def claimed_triangles(data: bytes, file_type: str) -> int | None:
     if file_type == "off":
         counts = _off_counts_line(data)
         return counts[1] if counts else None
-    if file_type == "stl" and len(data) >= 84 and not data[:5].lower() == b"solid":
-        return int.from_bytes(data[80:84], "little")
-    if file_type == "stl":
-        return data.count(b"facet")
+    if file_type == "stl" and len(data) >= 84:
+        count = int.from_bytes(data[80:84], "little")
+        if len(data) == 84 + 50 * count:  # a binary STL: its count is its size (else the reader refuses it)
+            return count
+        return data.count(b"endfacet")  # ASCII: one per facet
     if file_type == "obj":
         return data.count(b"\nf ") + data.startswith(b"f ")
     return None
