@@ -292,16 +292,52 @@ def _parts(p: Path, scene: Any) -> list[_Part]:
     parts = []
     with _quiet():
         try:
-            for node in scene.graph.nodes_geometry:
-                transform, name = scene.graph[node]
+            for transform, name in _placements(scene.graph):
                 geometry = scene.geometry.get(name)
                 if isinstance(geometry, trimesh.Trimesh):
-                    parts.append(_part(geometry, np.asarray(transform, dtype=np.float64)))
+                    parts.append(_part(geometry, transform))
         except SandboxError:
             raise
         except Exception as exc:
             raise SandboxError(f"model file {p}: not a readable model: {_reason(exc)}") from None
     return parts
+
+
+def _placements(graph: Any) -> list[tuple[NDArray[np.float64], Any]]:
+    """``(world transform, geometry name)`` of every node with geometry, in trimesh's node order.
+
+    Asking trimesh's graph (``graph[node]``) walks the path from the root for
+    every node and checks a hash of the whole graph on each call: a chain of
+    5,000 nested nodes took minutes. Here each node's world transform is its
+    parent's times its own edge's, each worked out once (linear in the nodes).
+    """
+    from trimesh.transformations import fix_rigid
+
+    forest = graph.transforms
+    base = graph.base_frame
+    world: dict[Any, NDArray[np.float64]] = {base: np.eye(4)}
+
+    def transform_of(node: Any) -> NDArray[np.float64]:
+        chain = []  # the node and its ancestors whose transforms are not known yet, deepest first
+        while node not in world:
+            parent = forest.parents.get(node)
+            if parent is None:  # not under the root: trimesh would not place it either
+                world[node] = np.eye(4)
+                break
+            chain.append((parent, node))
+            node = parent
+        for parent, child in reversed(chain):
+            edge = forest.edge_data.get((parent, child), {}).get("matrix")
+            world[child] = world[parent] if edge is None else world[parent] @ np.asarray(edge, dtype=np.float64)
+        return world[node if not chain else chain[0][1]]
+
+    placed = []
+    for node in graph.nodes_geometry:
+        matrix = transform_of(node)
+        if graph.repair_rigid is not None:  # as trimesh does: an almost rigid product made rigid again
+            matrix = fix_rigid(matrix, max_deviance=graph.repair_rigid)
+        placed.append((np.asarray(matrix, dtype=np.float64), forest.node_data[node].get("geometry")))
+    return placed
 
 
 def _part(mesh: Any, transform: NDArray[np.float64]) -> _Part:
