@@ -20,7 +20,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("core", ("glsandbox.errors", "glsandbox.transforms", "glsandbox.meshnormals", "glsandbox.geometry",
               "glsandbox.meshgen", "glsandbox.files", "glsandbox.file_watch")),
     ("scene data", ("glsandbox.scene", "glsandbox.planar", "glsandbox.images",
-                    "glsandbox.overlay", "glsandbox.meshfile")),
+                    "glsandbox.overlay", "glsandbox.meshfile", "glsandbox.meshcheck")),
     ("scene logic", ("glsandbox.scene_file", "glsandbox.plan", "glsandbox.camera", "glsandbox.lesson")),
     ("renderers", ("glsandbox.gl", "glsandbox.raytrace")),
     ("one frame", ("glsandbox.frame",)),
