@@ -43,6 +43,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from _bunny import bunny_path
 
 GROUP = "model files: load"
 #: Issue 20's goals: load + first frame against trimesh + raw upload; BVH build against Embree.
@@ -52,16 +53,6 @@ BYTES_GOAL = 250
 FAN_TRIANGLES = 1_000_000
 _TMP = tempfile.TemporaryDirectory(prefix="glsandbox-models-")
 _ANGLES = itertools.count()
-
-
-def bunny_path() -> Path | None:
-    """pymeshlab's copy of the Stanford bunny, or None when pymeshlab is not installed."""
-    try:
-        import pymeshlab
-    except ImportError:
-        return None
-    path = Path(pymeshlab.__file__).parent / "tests" / "sample_meshes" / "bunny.obj"
-    return path if path.is_file() else None
 
 
 @cache
