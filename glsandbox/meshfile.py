@@ -426,7 +426,7 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
         raise SandboxError(f"model file {p} has no faces{what}")
     # One vertex and face list for all parts.
     offsets = np.cumsum([0] + [part.positions.shape[0] for part in parts])
-    positions, faces = _joined(parts, offsets)
+    positions, faces = _all_parts(parts, offsets)
     bad = np.flatnonzero(~np.isfinite(positions).all(axis=1))
     if bad.size:
         raise SandboxError(f"model file {p}: {_count(bad.size, 'vertex', 'vertices')} with NaN or infinite "
@@ -487,7 +487,7 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
     return Model(p, mesh, texture, color, int(faces.shape[0]), dropped, how)
 
 
-def _joined(parts: list[_Part], offsets: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+def _all_parts(parts: list[_Part], offsets: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     """All parts' positions and faces as one list (a single part's arrays as they are: no copy)."""
     if len(parts) == 1:
         return parts[0].positions, parts[0].faces
