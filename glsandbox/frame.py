@@ -30,7 +30,7 @@ from glsandbox.gl.executor import Executor
 from glsandbox.gl.target import OffscreenTarget
 from glsandbox.lesson import Lesson
 from glsandbox.overlay import Overlay
-from glsandbox.plan import Buffers, Plan, plan, user_shader_notes
+from glsandbox.plan import Buffers, Plan, mesh_warnings, plan, user_shader_notes
 from glsandbox.scene import Scene
 
 __all__ = ["DEFAULT_SIZE", "Frame", "FrameRenderer", "HeadlessRenderer", "InteractiveResolution",
@@ -113,7 +113,7 @@ class InteractiveResolution:
     """The interactive ray tracer's rule: coarse while the camera moves, full when still.
 
     :meth:`resolution` is called once per window frame with the scene about
-    to be drawn; while its camera differs from the last frame's (or did
+    to be drawn; while its camera or a node's model matrix differs from the last frame's (or did
     within ``settle`` seconds) it answers ``moving`` (a quarter of the
     pixels each way by default: 16 times fewer rays), then 1.
     """
@@ -126,7 +126,10 @@ class InteractiveResolution:
 
     def resolution(self, scene: Scene, now: float | None = None) -> float:
         now = time.perf_counter() if now is None else now
-        cameras = tuple(vp.camera or scene.camera for vp in scene.viewports)
+        # The picture moves when a camera does or a node does (the model lesson's turning
+        # model): a big model is then traced coarse, and the window keeps answering.
+        cameras = (tuple(vp.camera or scene.camera for vp in scene.viewports),
+                   tuple(np.asarray(node.model).tobytes() for node in scene.nodes))
         if self._last is not None and cameras != self._last:
             self._moved_at = now
         self._last = cameras
@@ -168,7 +171,9 @@ class FrameRenderer:
         """Draw one frame; returns its plan and the target holding it.
         ``ray_resolution`` < 1 traces ray-traced viewports coarser (the window while moving)."""
         self.host.make_current()
-        notes = user_shader_notes(scene)  # a node's own shader in a ray-traced viewport
+        # A node's own shader in a ray-traced viewport; what a model file holds that is not drawn
+        # (from the scene as given: a traced viewport's nodes are an image after trace_viewports).
+        notes = (*user_shader_notes(scene), *mesh_warnings(scene))
         scene = trace_viewports(scene, size, self.host.ctx, ray_resolution)
         frame_plan = plan(scene)
         target = self.target(size, frame_plan.buffers)

@@ -115,7 +115,7 @@ __all__ = ["LOOP_LIMIT", "GpuTracer", "MAX_TEXTURES", "check_loop_budget", "gpu_
 #: Width of the record textures (must match TEX_WIDTH in the shader).
 TEX_WIDTH = 1024
 TRI_RECORDS = 9
-NODE_RECORDS = 12
+NODE_RECORDS = 13
 #: Samplers the shader declares at most.
 MAX_TEXTURES = 4
 #: llvmpipe's loop iterations per shader invocation, all loops together (see the module docstring).
@@ -265,6 +265,8 @@ def pack_nodes(world: World) -> NDArray[np.float32]:
         rec[slot, 5] = (node.reflectivity, node.texture, node.lamp_of, 0.0)
         rec[slot, 6:9] = node.inverse[:3, :4]
         rec[slot, 9:12, :3] = node.normal_matrix
+        rec[slot, 12] = (node.alpha, node.alpha_mode, node.alpha_cutoff,
+                         int(node.vertex_colors) | 2 * int(node.two_sided))
     return rec.reshape(-1, 4).astype(np.float32)
 
 
@@ -375,7 +377,8 @@ class _Uploaded:
 
     def defines(self, cull: bool | None) -> tuple[tuple[str, str], ...]:
         """The program variant's scene-shaped defines (see ``shaders/raytrace.glsl``)."""
-        found = [("VERTEX_COLORS", str(int(any(node.mode == MODES["vertex_color"] for node in self.world.nodes))))]
+        found = [("VERTEX_COLORS", str(int(any(node.mode == MODES["vertex_color"] or node.vertex_colors
+                                               for node in self.world.nodes))))]
         if self.unrolled:
             found += [("SCENE_NODES", self.scene_nodes(cull)), ("NODE_COUNT", str(max(1, len(self.world.nodes)))),
                       ("TRI_COUNT", str(max(1, self.world.triangle_count)))]
@@ -505,8 +508,8 @@ class GpuTracer:
         vp = scene.viewports[viewport]
         eye, basis, half_w, half_h = camera_basis(vp.camera or scene.camera, width / height)
         lights = world.light_positions.shape[0]
-        # The bounce loop only where some node reflects.
-        reflect = max_depth > 0 and any(node.reflectivity > 0.0 for node in world.nodes)
+        # The bounce loop only where some node reflects or lets rays through (a cut-out, a blend).
+        reflect = max_depth > 0 and any(node.reflectivity > 0.0 or node.see_through for node in world.nodes)
         scene_defines = uploaded.defines(cull_backfaces)
         use_bvh = False
         try:
