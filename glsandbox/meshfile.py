@@ -460,7 +460,8 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
                 warnings.append(f"model file {p}, part {look.name!r}: its texture not drawn "
                                 "(the mesh has no texture coordinates)")
             else:
-                texture = Texture(f"{p}#{look.name}", image=look.image)
+                where = "" if len(built) == 1 else f"{look.name}/"
+                texture = Texture(f"{p}#{where}base_color", image=look.image)
         if transform is not None:
             notes.append("fitted into -1..1")
             mesh = replace(mesh, positions=(np.asarray(mesh.positions) - transform[0]) * transform[1])
