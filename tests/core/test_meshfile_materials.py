@@ -1,0 +1,253 @@
+"""A model file's materials as loaded (glsandbox.meshfile, glsandbox.meshlooks): one part per
+material with its colour, texture, alpha mode and sidedness; what the file holds that is not
+drawn, one warning line each; and the plan, which shows blending and two-sided lighting only
+for a part that asks. Every model is written by the test (trimesh or by hand)."""
+
+from __future__ import annotations
+
+import io
+import json
+import struct
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+from PIL import Image
+from trimesh.visual import TextureVisuals
+from trimesh.visual.material import PBRMaterial
+
+import glsandbox
+from glsandbox.meshlooks import is_closed
+from glsandbox.plan import plan
+from glsandbox.scene import Material, Node, Scene
+from glsandbox.scene_file import load_scene
+
+QUAD_FACES = np.array([[0, 1, 2], [0, 2, 3]])
+
+
+def quad(x0: float, x1: float, z: float = 0.0, facing: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """A square from x0 to x1, y -1..1 at depth z; facing +z (counter-clockwise seen from +z) or -z."""
+    vertices = np.array([[x0, -1, z], [x1, -1, z], [x1, 1, z], [x0, 1, z]], dtype=np.float64)
+    return vertices, QUAD_FACES if facing > 0 else QUAD_FACES[:, ::-1]
+
+
+def gltf_part(vertices: np.ndarray, faces: np.ndarray, **material: object) -> trimesh.Trimesh:
+    mesh = trimesh.Trimesh(vertices, faces, process=False)
+    mesh.visual = TextureVisuals(material=PBRMaterial(**material))
+    return mesh
+
+
+def two_material_glb(path: Path) -> Path:
+    """An opaque red square on the left and a half-transparent blue one in front, on the right."""
+    red = gltf_part(*quad(-1.0, 0.2), name="paint", baseColorFactor=[255, 0, 0, 255])
+    glass = gltf_part(*quad(-0.2, 1.0, z=0.4), name="glass", baseColorFactor=[0, 0, 255, 128], alphaMode="BLEND")
+    trimesh.Scene([red, glass]).export(path)
+    return path
+
+
+def two_usemtl_obj(folder: Path, extra_mtl: str = "") -> Path:
+    """Two squares side by side, one usemtl group each: red on the left, blue on the right (Kd)."""
+    (folder / "two.mtl").write_text("newmtl red\nKd 1 0 0\nnewmtl blue\nKd 0 0 1\n" + extra_mtl)
+    (folder / "two.obj").write_text(
+        "mtllib two.mtl\n"
+        "v -1 -1 0\nv 0 -1 0\nv 0 1 0\nv -1 1 0\n"
+        "v 0.05 -1 0\nv 1 -1 0\nv 1 1 0\nv 0.05 1 0\n"
+        "usemtl red\nf 1 2 3\nf 1 3 4\n"
+        "usemtl blue\nf 5 6 7\nf 5 7 8\n")
+    return folder / "two.obj"
+
+
+def coloured_ply(path: Path) -> Path:
+    """Two squares with vertex colours, red on the left and blue on the right (ASCII PLY)."""
+    rows = [(-1, -1, 255, 0, 0), (0, -1, 255, 0, 0), (0, 1, 255, 0, 0), (-1, 1, 255, 0, 0),
+            (0.05, -1, 0, 0, 255), (1, -1, 0, 0, 255), (1, 1, 0, 0, 255), (0.05, 1, 0, 0, 255)]
+    header = ("ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
+              "property uchar red\nproperty uchar green\nproperty uchar blue\nelement face 4\n"
+              "property list uchar int vertex_indices\nend_header\n")
+    body = "".join(f"{x} {y} 0 {r} {g} {b}\n" for x, y, r, g, b in rows)
+    path.write_text(header + body + "3 0 1 2\n3 0 2 3\n3 4 5 6\n3 4 6 7\n")
+    return path
+
+
+def reversed_obj(folder: Path) -> Path:
+    """An open square wound clockwise as seen from +z (its front faces -z: a scan the wrong way
+    round), green."""
+    (folder / "back.mtl").write_text("newmtl green\nKd 0 1 0\n")
+    (folder / "back.obj").write_text("mtllib back.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n"
+                                     "usemtl green\nf 1 3 2\nf 1 4 3\n")
+    return folder / "back.obj"
+
+
+CUBE_OBJ = ("v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n"
+            "f 1 4 3\nf 1 3 2\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 4 8 7\nf 4 7 3\nf 1 5 8\nf 1 8 4\n"
+            "f 2 3 7\nf 2 7 6\n")
+
+
+# --- parts and their materials -------------------------------------------------------
+
+
+def test_a_gltf_with_two_materials_is_two_parts_each_with_its_colour_and_alpha_mode(tmp_path: Path) -> None:
+    model = glsandbox.load_model(two_material_glb(tmp_path / "two.glb"))
+    parts = {part.name: part for part in model.parts}
+    assert sorted(parts) == ["glass", "paint"] and model.triangles == 4
+    assert parts["paint"].color == (1.0, 0.0, 0.0, 1.0) and parts["paint"].alpha_mode == "opaque"
+    glass = parts["glass"]
+    assert glass.color is not None and glass.color[:3] == (0.0, 0.0, 1.0) and glass.color[3] == pytest.approx(128 / 255)
+    assert glass.alpha_mode == "blend" and not glass.double_sided
+    material = glass.material(shading="phong")
+    assert (material.alpha_mode, material.color, material.shading) == ("blend", glass.color, "phong")
+    # Node names: the part's name after the model's; the whole model as one mesh still exists.
+    assert sorted(node.name for node in model.nodes("duck")) == ["duck/glass", "duck/paint"]
+    assert model.mesh.vertex_count == sum(part.mesh.vertex_count for part in model.parts)
+
+
+def test_gltf_double_sided_and_mask_cutoff_are_read(tmp_path: Path) -> None:
+    plane = gltf_part(*quad(-1, 1, facing=-1), name="leaf", baseColorFactor=[0, 255, 0, 255], doubleSided=True,
+                      alphaMode="MASK", alphaCutoff=0.25)
+    path = tmp_path / "leaf.glb"
+    trimesh.Scene([plane]).export(path)
+    (part,) = glsandbox.load_model(path).parts
+    assert (part.double_sided, part.alpha_mode, part.alpha_cutoff) == (True, "mask", 0.25)
+    node = Node("leaf", part.mesh, material=part.material(shading="phong"))
+    assert node.cull_back_faces is False  # a double-sided material turns culling off
+
+
+def test_an_obj_with_two_usemtl_groups_is_two_parts_with_their_kd(tmp_path: Path) -> None:
+    model = glsandbox.load_model(two_usemtl_obj(tmp_path))
+    colours = {part.name: part.color for part in model.parts}
+    assert colours == {"red": (1.0, 0.0, 0.0, 1.0), "blue": (0.0, 0.0, 1.0, 1.0)}
+    assert not model.closed and all(part.double_sided for part in model.parts)  # open: seen from both sides
+    assert model.warnings == ()
+
+
+def test_a_ply_with_vertex_colours_tints_a_lit_material(tmp_path: Path) -> None:
+    (part,) = glsandbox.load_model(coloured_ply(tmp_path / "c.ply")).parts
+    assert part.mesh.colors is not None and part.color is None
+    assert part.material(shading="phong").vertex_colors
+    assert not part.material(shading="vertex_color").vertex_colors  # unlit vertex colours: as before
+
+
+def test_sidedness_of_formats_without_materials_follows_closedness(tmp_path: Path) -> None:
+    (tmp_path / "cube.obj").write_text(CUBE_OBJ)
+    cube = glsandbox.load_model(tmp_path / "cube.obj")
+    assert cube.closed and not cube.parts[0].double_sided  # a closed cube: back faces culled
+    scan = glsandbox.load_model(reversed_obj(tmp_path))
+    assert not scan.closed and scan.parts[0].double_sided
+
+
+def test_closedness_welds_equal_positions_and_needs_opposite_windings() -> None:
+    box = trimesh.creation.box()
+    assert is_closed(np.asarray(box.vertices), np.asarray(box.faces))
+    # Split into per-face vertices (as uvs or normals split them): still closed.
+    corners = np.asarray(box.vertices)[np.asarray(box.faces).reshape(-1)]
+    assert is_closed(corners, np.arange(corners.shape[0]).reshape(-1, 3))
+    flipped = np.asarray(box.faces).copy()
+    flipped[0] = flipped[0][::-1]  # one face wound the other way: not consistently closed
+    assert not is_closed(np.asarray(box.vertices), flipped)
+    assert not is_closed(np.asarray(box.vertices), np.asarray(box.faces)[:-1])  # a hole
+
+
+# --- what is not drawn -----------------------------------------------------------
+
+
+def glb_with(doc_extra: dict, material_extra: dict) -> bytes:
+    """A one-triangle GLB written by hand, with extra top-level keys and material keys."""
+    positions = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=np.float32).tobytes()
+    doc = {
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]}],
+        "materials": [{"name": "skin", "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1]}, **material_extra}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                       "min": [0, 0, 0], "max": [1, 1, 0]}],
+        "bufferViews": [{"buffer": 0, "byteLength": len(positions)}],
+        "buffers": [{"byteLength": len(positions)}], **doc_extra}
+    text = json.dumps(doc).encode()
+    text += b" " * (-len(text) % 4)
+    chunks = struct.pack("<I4s", len(text), b"JSON") + text + struct.pack("<I4s", len(positions), b"BIN\x00") + positions
+    return struct.pack("<4sII", b"glTF", 2, 12 + len(chunks)) + chunks
+
+
+def test_what_a_gltf_holds_that_is_not_drawn_is_one_warning_per_part(tmp_path: Path) -> None:
+    path = tmp_path / "robot.glb"
+    path.write_bytes(glb_with({"cameras": [{"type": "perspective", "perspective": {"yfov": 1, "znear": 0.1}}],
+                               "animations": [{"channels": [], "samplers": []}] * 2},
+                              {"normalTexture": {"index": 0}, "emissiveFactor": [1, 0, 0]}))
+    model = glsandbox.load_model(path)
+    assert model.warnings == (f"model file {path}: 2 animations, a camera not drawn",
+                              f"model file {path}, part 'skin': normal map, emissive colour not drawn")
+    scene = Scene("s", nodes=model.nodes("robot"))
+    described = plan(scene).describe().splitlines()
+    assert [line for line in described if line.startswith("warning:")] == [f"warning: {w}" for w in model.warnings]
+
+
+def test_a_missing_obj_texture_and_a_normal_map_are_warned_about(tmp_path: Path) -> None:
+    path = two_usemtl_obj(tmp_path, extra_mtl="map_Kd nowhere.png\nmap_Bump bumps.png\n")
+    model = glsandbox.load_model(path)
+    assert model.warnings == (f"model file {path}, part 'blue': its texture nowhere.png (missing or unreadable), "
+                              "bump map not drawn",)
+
+
+def test_render_prints_each_warning_once(tmp_path: Path, gl, capsys) -> None:
+    path = two_usemtl_obj(tmp_path, extra_mtl="map_Kd nowhere.png\n")
+    from lessons.model import ModelLesson
+
+    gl.render(ModelLesson(mesh=str(path), view="raster"), (32, 24))
+    gl.render(ModelLesson(mesh=str(path), view="raster"), (32, 24))
+    err = capsys.readouterr().err
+    assert err.count(f"warning: model file {path}, part 'blue': its texture nowhere.png") == 1
+
+
+# --- the plan --------------------------------------------------------------------
+
+
+def test_blending_and_two_sided_lighting_appear_in_the_plan_only_when_a_part_needs_them(tmp_path: Path) -> None:
+    from lessons.model import ModelLesson
+
+    rock = plan(ModelLesson(view="raster").scene()).describe()
+    assert "no depth writes" not in rock and "TWO_SIDED" not in rock and "ALPHA_MASK" not in rock and "VERTEX_COLOR" not in rock
+    two = plan(ModelLesson(view="raster", mesh=str(two_material_glb(tmp_path / "two.glb"))).scene())
+    (draw_pass,) = [p for p in two.passes if p.kind == "draw"]
+    assert [d.node for d in draw_pass.draws] == ["floor", "model/paint", "model/glass"]  # blended last
+    assert [d.blend for d in draw_pass.draws] == [False, False, True]
+    assert "model/glass with phong[NUM_LIGHTS=2] (blended, no depth writes)" in two.describe()
+    scan = plan(ModelLesson(view="raster", mesh=str(reversed_obj(tmp_path))).scene()).describe()
+    assert "model with phong[NUM_LIGHTS=2,TWO_SIDED] (no culling)" in scan
+    ply = plan(ModelLesson(view="raster", mesh=str(coloured_ply(tmp_path / "c.ply"))).scene()).describe()
+    assert "phong[NUM_LIGHTS=2,VERTEX_COLOR,TWO_SIDED]" in ply
+
+
+def test_blended_nodes_are_drawn_farthest_first() -> None:
+    square = glsandbox.geometry.quad_list()
+    glass = Material(color=(0, 0, 1, 0.5), alpha_mode="blend")
+    near = Node("near", square, glsandbox.transforms.translate(0, 0, 2), glass)
+    far = Node("far", square, glsandbox.transforms.translate(0, 0, -2), glass)
+    solid = Node("solid", square, np.eye(4), Material())
+    (draw_pass,) = [p for p in plan(Scene("s", nodes=(near, solid, far))).passes if p.kind == "draw"]
+    assert [d.node for d in draw_pass.draws] == ["solid", "far", "near"]
+
+
+def test_material_refuses_an_unknown_alpha_mode_or_cutoff() -> None:
+    with pytest.raises(glsandbox.SandboxError, match="unknown alpha mode 'glass'"):
+        Material(alpha_mode="glass")
+    with pytest.raises(glsandbox.SandboxError, match="alpha cutoff must lie in 0..1"):
+        Material(alpha_cutoff=2.0)
+
+
+# --- scene files -------------------------------------------------------------------
+
+
+def test_a_scene_file_node_becomes_one_node_per_material_and_up_z_stands_it_upright(tmp_path: Path) -> None:
+    two_usemtl_obj(tmp_path)
+    scene_path = tmp_path / "scene.toml"
+    scene_path.write_text('[[lights]]\nposition = [0, 2, 3]\n\n[[nodes]]\nname = "sign"\nmesh = "two.obj"\n'
+                          'shading = "phong"\nup = "z"\n')
+    nodes = load_scene(scene_path).nodes
+    assert sorted((n.name, n.material.color) for n in nodes) == [("sign/blue", (0.0, 0.0, 1.0, 1.0)),
+                                                                 ("sign/red", (1.0, 0.0, 0.0, 1.0))]
+    # up = "z": the file's +z turns to +y (and its +y to -z).
+    assert np.allclose(nodes[0].model[:3, :3] @ [0, 0, 1], [0, 1, 0])
+    assert np.allclose(nodes[0].model[:3, :3] @ [0, 1, 0], [0, 0, -1])
+    scene_path.write_text('[[nodes]]\nmesh = "two.obj"\nup = "x"\n')
+    with pytest.raises(glsandbox.SandboxError, match=r"scene.toml:3: nodes\[0\].up: unknown up axis 'x'"):
+        load_scene(scene_path)
