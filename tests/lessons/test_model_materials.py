@@ -1,0 +1,115 @@
+"""The ``model`` lesson draws a file's parts as the file describes them, in the rasterizer
+and in both ray engines: each part's colour is read from the frame at the place the camera
+sees it (the models are written by tests/support.py)."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from glsandbox.scene import Node, Scene
+from support import coloured_ply, double_sided_glb, masked_glb, reversed_obj, two_material_glb, two_usemtl_obj
+
+SIZE = (160, 120)
+#: The three renderers: the rasterizer, the GLSL ray tracer, the numpy (float64) ray tracer.
+RENDERERS = {"raster": dict(view="raster"), "ray": dict(view="ray"), "ray_numpy": dict(view="ray", renderer="ray_numpy")}
+
+
+def frame_and_scene(gl, path: Path, renderer: str, **values: object) -> tuple[np.ndarray, Scene]:
+    from lessons.model import ModelLesson
+
+    lesson = ModelLesson(mesh=str(path), **RENDERERS[renderer], **values)
+    return gl.render(lesson, SIZE).image.astype(int), lesson.scene()
+
+
+def node(scene: Scene, name: str) -> Node:
+    return next(n for n in scene.nodes if n.name == name)
+
+
+def colour_at(image: np.ndarray, scene: Scene, owner: Node, point: tuple[float, float, float]) -> np.ndarray:
+    """The rgb of the pixel where ``point`` (in ``owner``'s model space) lands, through the scene's camera."""
+    height, width = image.shape[:2]
+    world = np.asarray(owner.model, dtype=np.float64) @ np.append(point, 1.0)
+    clip = scene.camera.projection(width / height) @ scene.camera.view() @ world
+    x, y = clip[:2] / clip[3]
+    return image[int((1.0 - y) / 2.0 * height), int((x + 1.0) / 2.0 * width), :3]
+
+
+def centre_z(scene: Scene, name: str) -> float:
+    """The depth (model space) at which a flat part lies, after the lesson's fit."""
+    return float(np.asarray(node(scene, name).mesh.positions)[:, 2].mean())
+
+
+@pytest.mark.parametrize("renderer", RENDERERS)
+def test_a_gltf_opaque_part_and_a_blended_part_in_front_of_it(gl, tmp_path: Path, renderer: str) -> None:
+    image, scene = frame_and_scene(gl, two_material_glb(tmp_path / "two.glb"), renderer)
+    paint, glass = node(scene, "model/paint"), node(scene, "model/glass")
+    z_paint, z_glass = centre_z(scene, "model/paint"), centre_z(scene, "model/glass")
+    red = colour_at(image, scene, paint, (-0.6, 0.0, z_paint))  # the opaque red part alone
+    blue = colour_at(image, scene, glass, (0.6, 0.0, z_glass))  # the glass over the background
+    both = colour_at(image, scene, glass, (0.0, 0.0, z_glass))  # the glass over the red part
+    assert red[0] > red[2] + 60, red
+    assert blue[2] > blue[0] + 20, blue
+    # Half blue, half what lies behind: redder than the glass alone, bluer than the paint alone.
+    assert both[0] > blue[0] + 30 and both[2] > red[2] + 30, (red, blue, both)
+
+
+@pytest.mark.parametrize("renderer", RENDERERS)
+def test_a_double_sided_plane_is_seen_from_behind_and_a_single_sided_one_is_not(gl, tmp_path: Path,
+                                                                                renderer: str) -> None:
+    image, scene = frame_and_scene(gl, double_sided_glb(tmp_path / "leaf.glb"), renderer)
+    leaf = colour_at(image, scene, node(scene, "model"), (0.0, 0.0, 0.0))
+    # Lit from the front it shows (the normal reversed for the side seen), not dark.
+    assert leaf[1] > leaf[0] + 40 and leaf[1] > leaf[2] + 40 and leaf[1] > 80, leaf
+    image, scene = frame_and_scene(gl, double_sided_glb(tmp_path / "one.glb", double_sided=False), renderer)
+    behind = colour_at(image, scene, node(scene, "model"), (0.0, 0.0, 0.0))
+    assert not behind[1] > behind[0] + 40, behind  # culled: the sky or the floor behind it
+
+
+@pytest.mark.parametrize("renderer", RENDERERS)
+def test_an_obj_with_two_usemtl_groups_shows_each_kd(gl, tmp_path: Path, renderer: str) -> None:
+    image, scene = frame_and_scene(gl, two_usemtl_obj(tmp_path), renderer)
+    red = colour_at(image, scene, node(scene, "model/red"), (-0.5, 0.0, 0.0))
+    blue = colour_at(image, scene, node(scene, "model/blue"), (0.5, 0.0, 0.0))
+    assert red[0] > red[2] + 60, red
+    assert blue[2] > blue[0] + 40, blue
+
+
+@pytest.mark.parametrize("shading", ["phong", "gouraud"])
+@pytest.mark.parametrize("renderer", RENDERERS)
+def test_ply_vertex_colours_tint_the_lit_colour(gl, tmp_path: Path, renderer: str, shading: str) -> None:
+    from lessons.model import ModelLesson
+
+    lesson = ModelLesson(mesh=str(coloured_ply(tmp_path / "c.ply")), **RENDERERS[renderer])
+    scene = lesson.scene()
+    tinted = tuple(dataclasses.replace(n, material=dataclasses.replace(n.material, shading=shading))
+                   if n.name == "model" else n for n in scene.nodes)
+    scene = dataclasses.replace(scene, nodes=tinted)
+    image = gl.render_scene(scene, SIZE).image.astype(int)
+    model = node(scene, "model")
+    assert model.material.vertex_colors
+    left = colour_at(image, scene, model, (-0.5, 0.0, 0.0))
+    right = colour_at(image, scene, model, (0.5, 0.0, 0.0))
+    assert left[0] > left[2] + 60, left
+    assert right[2] > right[0] + 40, right
+
+
+@pytest.mark.parametrize("renderer", RENDERERS)
+def test_an_open_mesh_wound_the_wrong_way_round_is_seen(gl, tmp_path: Path, renderer: str) -> None:
+    image, scene = frame_and_scene(gl, reversed_obj(tmp_path), renderer)
+    green = colour_at(image, scene, node(scene, "model"), (0.0, 0.0, 0.0))
+    assert green[1] > green[0] + 40 and green[1] > 80, green
+
+
+@pytest.mark.parametrize("renderer", RENDERERS)
+def test_an_alpha_mask_cuts_the_texture_s_transparent_half_away(gl, tmp_path: Path, renderer: str) -> None:
+    image, scene = frame_and_scene(gl, masked_glb(tmp_path / "mask.glb"), renderer)
+    stencil = node(scene, "model/stencil")
+    z = centre_z(scene, "model/stencil")
+    cut = colour_at(image, scene, stencil, (-0.5, 0.0, z))  # alpha 0: the red wall behind shows
+    kept = colour_at(image, scene, stencil, (0.5, 0.0, z))  # alpha 1: the white stencil
+    assert cut[0] > cut[2] + 60, cut
+    assert kept[2] > 80 and abs(int(kept[0]) - int(kept[2])) < 80, kept
