@@ -113,3 +113,16 @@ def test_an_alpha_mask_cuts_the_texture_s_transparent_half_away(gl, tmp_path: Pa
     kept = colour_at(image, scene, stencil, (0.5, 0.0, z))  # alpha 1: the white stencil
     assert cut[0] > cut[2] + 60, cut
     assert kept[2] > 80 and abs(int(kept[0]) - int(kept[2])) < 80, kept
+
+
+def test_the_turning_model_is_traced_coarse_and_a_still_one_at_full_resolution() -> None:
+    """The window's rule (InteractiveResolution): a picture that moves (here the model turning,
+    not the camera) is traced coarse, so a big model keeps the window answering."""
+    from glsandbox.frame import InteractiveResolution
+    from lessons.model import ModelLesson
+
+    motion = InteractiveResolution(moving=0.25, settle=0.3)
+    assert motion.resolution(ModelLesson(time=0.0).scene(), now=0.0) == 1.0
+    assert motion.resolution(ModelLesson(time=0.1).scene(), now=0.1) == 0.25  # it turned
+    assert motion.resolution(ModelLesson(time=0.1).scene(), now=0.2) == 0.25  # still settling
+    assert motion.resolution(ModelLesson(time=0.1).scene(), now=0.5) == 1.0  # still for 0.4 s
