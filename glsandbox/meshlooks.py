@@ -185,7 +185,7 @@ def _gltf_warnings(doc: dict[str, Any], looks: list[Look]) -> dict[str, list[str
         what = []
         pbr = material.get("pbrMetallicRoughness") or {}
         if "baseColorTexture" in pbr and name not in textured:
-            what.append("its base colour texture (missing or unreadable)")
+            what.append(f"its base colour texture{_image_name(doc, pbr['baseColorTexture'])} (missing or unreadable)")
         if "metallicRoughnessTexture" in pbr:
             what.append("metallic-roughness map")
         what += [label for key, label in _GLTF_MAPS if key in material]
@@ -195,6 +195,16 @@ def _gltf_warnings(doc: dict[str, Any], looks: list[Look]) -> dict[str, list[str
         if what:
             found.setdefault(name, []).extend(what)
     return found
+
+
+def _image_name(doc: dict[str, Any], reference: Any) -> str:
+    """`` skin.png`` for a texture reference whose image is a file, else nothing."""
+    try:
+        image = doc["images"][doc["textures"][reference["index"]]["source"]]
+        uri = image.get("uri", "")
+    except (KeyError, IndexError, TypeError, AttributeError):
+        return ""
+    return f" {uri}" if isinstance(uri, str) and uri and not uri.startswith("data:") else ""
 
 
 _MTLLIB = re.compile(rb"^[ \t]*mtllib[ \t]+(.+?)[ \t]*$", re.MULTILINE)

@@ -187,3 +187,26 @@ def test_a_scene_file_node_becomes_one_node_per_material_and_up_z_stands_it_upri
     scene_path.write_text('[[nodes]]\nmesh = "two.obj"\nup = "x"\n')
     with pytest.raises(glsandbox.SandboxError, match=r"scene.toml:3: nodes\[0\].up: unknown up axis 'x'"):
         load_scene(scene_path)
+
+
+def test_a_gltf_whose_texture_image_is_missing_or_garbage_loads_and_says_so(tmp_path: Path) -> None:
+    from PIL import Image
+
+    square = trimesh.Trimesh(*quad(-1, 1), process=False)
+    square.visual = trimesh.visual.TextureVisuals(
+        uv=[[0, 0], [1, 0], [1, 1], [0, 1]],
+        material=trimesh.visual.material.PBRMaterial(name="skin", baseColorTexture=Image.new("RGB", (4, 4))))
+    for case, content in (("missing", None), ("garbage", b"not a png")):
+        folder = tmp_path / case  # a folder each: loads are cached by the model file
+        folder.mkdir()
+        for name, data in trimesh.Scene([square]).export(file_type="gltf").items():
+            (folder / name).write_bytes(data)
+        doc = json.loads((folder / "model.gltf").read_text())
+        doc["images"] = [{"uri": "skin.png"}]  # an image file next to it, instead of the embedded one
+        (folder / "model.gltf").write_text(json.dumps(doc))
+        if content is not None:
+            (folder / "skin.png").write_bytes(content)
+        model = glsandbox.load_model(folder / "model.gltf")
+        assert model.parts[0].texture is None
+        assert model.warnings == (f"model file {folder / 'model.gltf'}, part 'skin': its base colour texture "
+                                  "skin.png (missing or unreadable) not drawn",)
