@@ -123,20 +123,38 @@ def _rgba(factor: Any) -> Rgba | None:
 
 def is_closed(positions: NDArray[np.float64], faces: NDArray[np.int64]) -> bool:
     """Whether the triangles close a volume with a consistent winding: with vertices at
-    equal positions taken as one, every directed edge ``a→b`` occurs once and its
-    reverse ``b→a`` once (the faces on either side run it in opposite directions).
-    Then back faces can never be seen from outside and culling them is safe."""
+    equal positions taken as one, the directed edges ``a→b`` of all faces are, as a
+    multiset, their own reverses ``b→a`` (the faces on either side of an edge run it in
+    opposite directions). Then back faces can never be seen from outside, and culling
+    them is safe.
+
+    Tested in linear time, without sorting: each position gets a 64-bit hash of its
+    bits, each directed edge a hash of its two ends' (order matters), and the sum of
+    the edges' hashes must equal the sum of the reversed edges' (mod 2⁶⁴). Two
+    different multisets agree by chance with odds of about 2⁻⁶⁴; then an open mesh
+    would be culled as if closed."""
     if faces.shape[0] == 0:
         return False
-    _, welded = np.unique(positions, axis=0, return_inverse=True)
-    corners = welded.reshape(-1)[faces]
-    a = corners.reshape(-1)
-    b = corners[:, [1, 2, 0]].reshape(-1)
-    n = np.int64(max(int(welded.max()) + 1, 1))
-    forward = np.sort(a.astype(np.int64) * n + b)
-    if forward.size > 1 and bool((forward[1:] == forward[:-1]).any()):
-        return False  # an edge run twice the same way: a fold or a flipped face
-    return bool(np.array_equal(forward, np.sort(b.astype(np.int64) * n + a)))
+    bits = np.ascontiguousarray(positions + 0.0, dtype=np.float64).view(np.uint64).reshape(-1, 3)  # -0 is 0
+    with np.errstate(over="ignore"):
+        key = _mix(_mix(_mix(bits[:, 0]) ^ bits[:, 1]) ^ bits[:, 2])[faces]
+        ends = key[:, [1, 2, 0]]
+        forward = _mix(key * _ODD ^ ends)
+        backward = _mix(ends * _ODD ^ key)
+        return bool(forward.sum(dtype=np.uint64) == backward.sum(dtype=np.uint64))
+
+
+#: An odd 64-bit constant: ``a * _ODD ^ b`` is not symmetric in a and b.
+_ODD = np.uint64(0x9E3779B97F4A7C15)
+
+
+def _mix(x: NDArray[np.uint64]) -> NDArray[np.uint64]:
+    """SplitMix64's finaliser: every input bit flips about half the output bits."""
+    x = x ^ (x >> np.uint64(30))
+    x = x * np.uint64(0xBF58476D1CE4E5B9)
+    x = x ^ (x >> np.uint64(27))
+    x = x * np.uint64(0x94D049BB133111EB)
+    return x ^ (x >> np.uint64(31))
 
 
 # --- what is not drawn ------------------------------------------------------
