@@ -9,10 +9,15 @@ count, and the ray side the BVH's figures once the ray tracer builds one
 
 ``--set mesh=PATH`` loads any OBJ, PLY, STL, OFF, glTF or GLB file
 (``glsandbox.load_model``: normals from the file or made with a 30° crease
-angle, a glTF's base colour texture); the default is a generated rock
-(``glsandbox.meshgen``: no file, no download, the same every run).
-``--set fit=off`` keeps the file's own size and place; ``on`` centres it and
-scales it into the box -1..1.
+angle), one node per material of the file with its colour, texture, alpha
+mode and sidedness, vertex colours tinting the lit colour; the default is a
+generated rock (``glsandbox.meshgen``: no file, no download, the same every
+run). ``--set fit=off`` keeps the file's own size and place; ``on`` (the
+default) centres it and scales it into the box -1..1. ``--set up=z`` stands a
+Z-up file (a scan, CAD) upright; glTF is +Y up, as OpenGL, and stands as
+written. In the window the ray-traced side is traced coarse while the model
+turns or the camera moves (:class:`glsandbox.frame.InteractiveResolution`),
+so a big model keeps the window answering.
 
 Both ray engines trace a mesh through its BVH (the GLSL engine for a mesh
 node of more than 64 triangles, where the BVH measured faster than testing
