@@ -18,9 +18,11 @@ flatten it into ``vec4`` records, :data:`TRI_RECORDS` per triangle and
 shader). A small scene (see the program variants below) has its records in
 one uniform block, the shader's ``SceneData``; a larger one in two RGBA32F
 textures :data:`TEX_WIDTH` wide, read with ``texelFetch``. The materials'
-images become RGBA8 textures (at most :data:`MAX_TEXTURES` a viewport)
+images become RGBA8 textures (at most :data:`MAX_TEXTURES` a viewport),
 sampled by hand, bilinear in the base level with the wrap mode done in the
-shader, exactly as the numpy engine samples them. Uploads are kept (the
+shader, exactly as the numpy engine samples them; the nodes of any more
+textures (a model file with many materials) are traced with their colour
+alone, and a ``warning:`` line says so. Uploads are kept (the
 last :attr:`GpuTracer.KEEP_SCENES`): a render of the same node objects,
 lights and viewport, or of new objects that pack to the same records, only
 moves the camera.
@@ -98,6 +100,7 @@ except on a few pixels where a ray grazes an edge or a shadow boundary
 from __future__ import annotations
 
 import math
+import sys
 
 import moderngl
 import numpy as np
@@ -222,6 +225,27 @@ def _records(rows: NDArray[np.float32]) -> tuple[tuple[int, int], bytes]:
     data = np.zeros((height * TEX_WIDTH, 4), dtype=np.float32)
     data[: rows.shape[0]] = rows
     return (TEX_WIDTH, height), data.tobytes()
+
+
+#: The warnings already printed by this process (once per run, not per frame).
+_WARNED: set[str] = set()
+
+
+def _keep_first_textures(scene: Scene, world: World) -> None:
+    """A viewport with more textures than the shader's samplers (a model file with many
+    materials): the nodes of the textures beyond :data:`MAX_TEXTURES` are traced with their
+    colour alone, and one ``warning:`` line says so (the numpy engine samples them all)."""
+    untextured = [node.name for node in world.nodes if node.texture >= MAX_TEXTURES]
+    for node in world.nodes:
+        if node.texture >= MAX_TEXTURES:
+            node.texture = -1
+    del world.textures[MAX_TEXTURES:]
+    shown = ", ".join(untextured[:3]) + (f" and {len(untextured) - 3} more" if len(untextured) > 3 else "")
+    line = (f"warning: scene {scene.name!r}: the GLSL ray tracer samples at most {MAX_TEXTURES} textures per "
+            f"viewport; {shown} traced without their textures (renderer=ray_numpy samples them all)")
+    if line not in _WARNED:
+        _WARNED.add(line)
+        print(line, file=sys.stderr, flush=True)
 
 
 def pack_triangles(world: World) -> NDArray[np.float32]:
@@ -477,8 +501,7 @@ class GpuTracer:
                 return entry
         world = build_world(scene, viewport, analytic_spheres=analytic_spheres)
         if len(world.textures) > MAX_TEXTURES:
-            raise RayTraceError(f"the gpu engine samples at most {MAX_TEXTURES} textures per viewport, "
-                                f"scene {scene.name!r} has {len(world.textures)}")
+            _keep_first_textures(scene, world)
         for i, entry in enumerate(self._scenes):  # new objects, same data (glsandbox.frame.trace_viewports rebuilds nodes)
             if entry.same_data(world):
                 entry.key = key

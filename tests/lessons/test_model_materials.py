@@ -126,3 +126,27 @@ def test_the_turning_model_is_traced_coarse_and_a_still_one_at_full_resolution()
     assert motion.resolution(ModelLesson(time=0.1).scene(), now=0.1) == 0.25  # it turned
     assert motion.resolution(ModelLesson(time=0.1).scene(), now=0.2) == 0.25  # still settling
     assert motion.resolution(ModelLesson(time=0.1).scene(), now=0.5) == 1.0  # still for 0.4 s
+
+
+def test_the_glsl_ray_tracer_traces_parts_beyond_its_texture_slots_with_their_colour(gl, capsys) -> None:
+    """Five textured nodes, one texture each: the GLSL engine has four samplers, so the fifth
+    node is traced with its colour alone (white here), and one warning line says so."""
+    from glsandbox import Camera, Light, Material, Texture, Viewport, geometry, transforms
+    from glsandbox.raytrace.gpu import MAX_TEXTURES
+
+    def red_image(shade: int) -> np.ndarray:
+        image = np.zeros((2, 2, 4), dtype=np.uint8)
+        image[..., 0], image[..., 3] = shade, 255
+        return image
+
+    square = geometry.cube24()
+    nodes = tuple(Node(f"tile{i}", square, transforms.translate(2.5 * i - 5.0, 0.0, 0.0),
+                       Material(texture=Texture(f"red{i}", filter="nearest", image=red_image(200 + i))))
+                  for i in range(MAX_TEXTURES + 1))
+    scene = Scene("tiles", nodes=nodes, camera=Camera(eye=(0.0, 0.0, 14.0)), lights=(Light((0.0, 5.0, 9.0)),),
+                  viewports=(Viewport(renderer="ray"),))
+    image = gl.render_scene(scene, (200, 60)).image.astype(int)
+    colours = [colour_at(image, scene, n, (0.0, 0.0, 1.0)) for n in nodes]  # each cube's front face
+    assert all(c[0] > 150 and c[1] < 40 for c in colours[:MAX_TEXTURES]), colours
+    assert colours[MAX_TEXTURES][1] > 150, colours  # white: its colour alone
+    assert capsys.readouterr().err.count("the GLSL ray tracer samples at most 4 textures per viewport; tile4 traced") == 1
