@@ -13,7 +13,8 @@ instead of silently seeing less:
   skins (not drawn); a base colour texture that the file names but that
   could not be read (not drawn, and said). Read from the file's own JSON
   (trimesh drops animations and cameras, and a texture it could not read).
-- **OBJ**: ``Kd`` and ``map_Kd`` (drawn); a ``map_Kd`` that is missing or
+- **OBJ**: ``Kd`` and ``map_Kd`` (drawn), ``d`` (or ``Tr``) below 1: blended,
+  with that alpha (drawn); a ``map_Kd`` that is missing or
   unreadable, and bump, normal, specular and alpha maps (not drawn). Read
   from the ``.mtl`` files the OBJ names (the ``mtllib`` lines).
 - **PLY, STL, OFF** have no materials; vertex colours are drawn.
@@ -103,10 +104,30 @@ def look_of(material: Any, index: int) -> Look:
         factor = getattr(material, "diffuse", None)
     color = _rgba(factor)
     mode = _ALPHA.get(str(getattr(material, "alphaMode", None) or "OPAQUE").upper(), "opaque")
+    dissolve = _dissolve(getattr(material, "kwargs", None))
+    if dissolve is not None and dissolve < 1.0:  # an OBJ's see-through material: blended, as glTF's BLEND
+        color = (*(color or (1.0, 1.0, 1.0, 1.0))[:3], dissolve)
+        mode = "blend"
     cutoff = getattr(material, "alphaCutoff", None)
     cutoff = 0.5 if cutoff is None or not np.isfinite(cutoff) else float(np.clip(cutoff, 0.0, 1.0))
     sided = getattr(material, "doubleSided", None)
     return Look(name, image, color, mode, cutoff, None if sided is None else bool(sided))
+
+
+def _dissolve(options: Any) -> float | None:
+    """An OBJ material's opacity: ``d`` (1 opaque), or ``Tr`` (its complement); None if neither."""
+    if not isinstance(options, dict):
+        return None
+    for key, flip in (("d", False), ("tr", True)):
+        value = options.get(key)
+        try:
+            number = float(value[0] if isinstance(value, (list, tuple)) else value)
+        except (TypeError, ValueError, IndexError):
+            continue
+        if np.isfinite(number):
+            number = float(np.clip(number, 0.0, 1.0))
+            return 1.0 - number if flip else number
+    return None
 
 
 def _rgba(factor: Any) -> Rgba | None:

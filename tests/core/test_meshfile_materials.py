@@ -57,6 +57,13 @@ def test_an_obj_with_two_usemtl_groups_is_two_parts_with_their_kd(tmp_path: Path
     assert model.warnings == ()
 
 
+def test_an_obj_material_with_dissolve_below_one_is_blended(tmp_path: Path) -> None:
+    path = two_usemtl_obj(tmp_path, extra_mtl="d 0.25\n")  # on the blue material
+    parts = {part.name: part for part in glsandbox.load_model(path).parts}
+    assert (parts["blue"].alpha_mode, parts["blue"].color) == ("blend", (0.0, 0.0, 1.0, 0.25))
+    assert (parts["red"].alpha_mode, parts["red"].color) == ("opaque", (1.0, 0.0, 0.0, 1.0))
+
+
 def test_a_ply_with_vertex_colours_tints_a_lit_material(tmp_path: Path) -> None:
     (part,) = glsandbox.load_model(coloured_ply(tmp_path / "c.ply")).parts
     assert part.mesh.colors is not None and part.color is None
