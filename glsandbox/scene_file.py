@@ -211,9 +211,11 @@ class _SceneReader:
             raise self.fail("nodes", i, "mesh" if "mesh" in data else None, "every node needs mesh = \"<name>\"")
         loaded = self.model_file(data, i, mesh_name)
         try:
-            mesh = loaded.mesh if loaded is not None else builtin_mesh(mesh_name)
+            # A model file's first part (its only one, mostly): the parts are drawn, never joined.
+            mesh = loaded.parts[0].mesh if loaded is not None else builtin_mesh(mesh_name)
         except SandboxError as exc:
             raise self.fail("nodes", i, "mesh", str(exc)) from None
+        coloured = mesh.colors is not None if loaded is None else all(p.mesh.colors is not None for p in loaded.parts)
         order = self.text(data, "order", "nodes", i, default="STR")
         try:
             order = transforms.parse_order(order)
@@ -228,10 +230,10 @@ class _SceneReader:
         model = transforms.compose(order, S=transforms.scale(*s), T=transforms.translate(*t), R=rotation)
         if loaded is not None and data.get("up", "y") == "z":
             model = model @ transforms.rotate_x(-math.pi / 2)  # the file's z becomes y, before the node's own transform
-        shading = self.text(data, "shading", "nodes", i, default="vertex_color" if mesh.colors is not None else "solid")
+        shading = self.text(data, "shading", "nodes", i, default="vertex_color" if coloured else "solid")
         if shading not in SHADINGS:
             raise self.fail("nodes", i, "shading", f"unknown shading {shading!r}; use one of {', '.join(SHADINGS)}")
-        if shading == "vertex_color" and mesh.colors is None:
+        if shading == "vertex_color" and not coloured:
             raise self.fail("nodes", i, "shading", f"mesh {mesh_name!r} has no vertex colours")
         cull = self.flag(data, "cull_back_faces", "nodes", i)
         views = data.get("viewports")
@@ -241,8 +243,8 @@ class _SceneReader:
         name = self.text(data, "name", "nodes", i, default=f"node{i}")
         if loaded is None:
             looks = [(name, mesh, self.material(data, i, shading))]
-        elif len(loaded.parts) == 1 or "color" in data or "texture" in data:
-            looks = [(name, mesh, self.model_material(data, i, shading, loaded.parts[0], mesh))]
+        elif len(loaded.parts) == 1 or "color" in data or "texture" in data:  # one look: one node, all parts
+            looks = [(name, loaded.mesh, self.model_material(data, i, shading, loaded.parts[0], loaded.mesh))]
         else:
             looks = [(f"{name}/{part.name}", part.mesh, self.model_material(data, i, shading, part, part.mesh))
                      for part in loaded.parts]

@@ -217,3 +217,13 @@ def test_a_gltf_whose_texture_image_is_missing_or_garbage_loads_and_says_so(tmp_
         assert model.parts[0].texture is None
         assert model.warnings == (f"model file {folder / 'model.gltf'}, part 'skin': its base colour texture "
                                   "skin.png (missing or unreadable) not drawn",)
+
+
+def test_a_scene_file_node_with_its_own_colour_stays_one_node_with_every_part(tmp_path: Path) -> None:
+    two_usemtl_obj(tmp_path)
+    scene_path = tmp_path / "scene.toml"
+    scene_path.write_text('[[nodes]]\nname = "sign"\nmesh = "two.obj"\ncolor = [1, 1, 0]\n')
+    (node,) = load_scene(scene_path).nodes
+    assert node.name == "sign" and node.material.color == (1.0, 1.0, 0.0, 1.0)
+    assert node.mesh.triangle_indices().shape[0] == 4  # both parts' squares
+
