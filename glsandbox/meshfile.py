@@ -1,16 +1,19 @@
 """Model files: triangle meshes from OBJ, PLY, STL, OFF and glTF/GLB, read by trimesh.
 
-:func:`load_model` reads a file into a :class:`Model`: a
+:func:`load_model` reads a file into a :class:`Model`: one
+:class:`ModelPart` per material of the file, each a
 :class:`~glsandbox.geometry.Mesh` (positions, normals, uvs and vertex colours
-where the file has them), the base colour texture of a glTF material (or of
-an OBJ's ``map_Kd``) as an in-memory :class:`~glsandbox.scene.Texture`, and
-what loading did. :func:`load_mesh` is the mesh alone. No format is parsed
-here: trimesh reads them (``process=False``: the file's vertices and faces as
-written, nothing merged); this module turns what it read into the course's
+where the file has them) with its material as the file gives it (base
+colour, base colour texture in memory as a :class:`~glsandbox.scene.Texture`,
+alpha mode and cutoff, sidedness: :mod:`glsandbox.meshlooks`), and what
+loading did. :meth:`Model.nodes` makes one scene node per part;
+:func:`load_mesh` is all parts as one mesh. No format is parsed here: trimesh
+reads them (``process=False``: the file's vertices and faces as written,
+nothing merged); this module turns what it read into the course's
 conventions and checks it.
 
-- **Positions** as written; a glTF's node transforms are applied (its parts
-  become one mesh); a mirroring transform gets its triangles' winding swapped
+- **Positions** as written; a glTF's node transforms are applied (its meshes
+  that share a material become one part); a mirroring transform gets its triangles' winding swapped
   so fronts stay counter-clockwise.
 - **Normals** (``normals=``): ``"auto"`` takes the file's vertex normals when
   it has usable ones (OBJ ``vn``, PLY ``nx ny nz``, glTF ``NORMAL``) and

@@ -9,10 +9,13 @@ of rays at once:
   ray over the :class:`~glsandbox.raytrace.world.World`'s nodes;
 - :func:`_occluded`: the shadow query (Gölge testi), whether anything but the
   light's lamp lies at ``0 < s < 1`` along each shadow ray;
-- :func:`_surface`: point, normal and base colour at the hits (barycentric
-  normals, uv and vertex colours; textures sampled bilinearly by hand);
+- :func:`_surface`: point, normal, base colour and alpha at the hits
+  (barycentric normals, uv and vertex colours; textures sampled bilinearly by
+  hand; a two-sided node's back face lit with its normal reversed);
 - :func:`_shade`: the rasterizer's per-light Phong with a shadow ray per light;
-- :func:`_trace`: reflections followed iteratively, ``(1 − r)·local + r·reflected``.
+- :func:`_trace`: reflections followed iteratively, ``(1 − r)·local + r·reflected``,
+  and rays passed on straight through cut-outs and blended surfaces,
+  ``a·local + (1 − a)·behind``.
 
 Primary rays are traced :data:`RAY_BLOCK` at a time, each block through every
 step before the next.
