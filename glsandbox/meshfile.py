@@ -64,7 +64,7 @@ from numpy.typing import NDArray
 from glsandbox.errors import SandboxError
 from glsandbox.files import open_user_file
 from glsandbox.geometry import Mesh
-from glsandbox.meshlooks import file_warnings, is_closed, look_of
+from glsandbox.meshlooks import Look, file_warnings, is_closed, look_of
 from glsandbox.meshnormals import corner_normals, unique_vertices
 from glsandbox.scene import Material, Node, Texture
 
@@ -347,13 +347,14 @@ def _parts(p: Path, scene: Any) -> list[_Part]:
     import trimesh
 
     parts = []
+    looks: dict[int, Look] = {}  # by material object: many meshes may share one (and its big image)
     with _quiet():
         try:
             for node in scene.graph.nodes_geometry:
                 transform, name = scene.graph[node]
                 geometry = scene.geometry.get(name)
                 if isinstance(geometry, trimesh.Trimesh):
-                    parts.append(_part(geometry, np.asarray(transform, dtype=np.float64), len(parts)))
+                    parts.append(_part(geometry, np.asarray(transform, dtype=np.float64), len(parts), looks))
         except SandboxError:
             raise
         except Exception as exc:
@@ -361,7 +362,7 @@ def _parts(p: Path, scene: Any) -> list[_Part]:
     return parts
 
 
-def _part(mesh: Any, transform: NDArray[np.float64], index: int) -> _Part:
+def _part(mesh: Any, transform: NDArray[np.float64], index: int, looks: dict[int, Look]) -> _Part:
     positions = np.array(mesh.vertices, dtype=np.float64).reshape(-1, 3)
     faces = np.array(mesh.faces, dtype=np.int64).reshape(-1, 3)
     normals = _file_normals(mesh, positions.shape[0])
@@ -376,7 +377,12 @@ def _part(mesh: Any, transform: NDArray[np.float64], index: int) -> _Part:
     uvs = colors = None
     visual = getattr(mesh, "visual", None)
     kind = getattr(visual, "kind", None)
-    look = look_of(getattr(visual, "material", None), index)
+    material = getattr(visual, "material", None)
+    look = looks.get(id(material)) if material is not None else None
+    if look is None:
+        look = look_of(material, index)
+        if material is not None:
+            looks[id(material)] = look
     if kind == "texture":
         uv = getattr(visual, "uv", None)
         if uv is not None and len(uv) == positions.shape[0]:

@@ -28,6 +28,7 @@ drawn from both sides.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import re
@@ -55,7 +56,7 @@ _MTL_MAPS = {"map_bump": "bump map", "bump": "bump map", "norm": "normal map", "
 _MTL_LIMIT = 1 << 22
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Look:
     """A part's material as the file gives it (None: the file does not say)."""
 
@@ -66,9 +67,9 @@ class Look:
     alpha_cutoff: float = 0.5
     double_sided: bool | None = None
 
-    @property
+    @functools.cached_property
     def key(self) -> tuple[Any, ...]:
-        """Parts with equal keys are drawn alike and become one node."""
+        """Parts with equal keys are drawn alike and become one node (the image by a hash of its pixels)."""
         digest = None
         if self.image is not None:
             digest = hashlib.blake2b(np.asarray(self.image.shape).tobytes() + self.image.tobytes(),
