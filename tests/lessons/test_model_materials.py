@@ -150,3 +150,18 @@ def test_the_glsl_ray_tracer_traces_parts_beyond_its_texture_slots_with_their_co
     assert all(c[0] > 150 and c[1] < 40 for c in colours[:MAX_TEXTURES]), colours
     assert colours[MAX_TEXTURES][1] > 150, colours  # white: its colour alone
     assert capsys.readouterr().err.count("the GLSL ray tracer samples at most 4 textures per viewport; tile4 traced") == 1
+
+
+def test_up_z_stands_a_z_up_file_upright(tmp_path: Path) -> None:
+    """A tall thin box along the file's z: with up=z the lesson turns it so that it stands along y."""
+    import trimesh
+
+    from lessons.model import ModelLesson
+
+    trimesh.creation.box((0.2, 0.2, 2.0)).export(tmp_path / "post.stl")
+    for up, axis in (("y", 2), ("z", 1)):
+        scene = ModelLesson(mesh=str(tmp_path / "post.stl"), up=up, view="raster").scene()
+        model = node(scene, "model")
+        corners = np.asarray(model.mesh.positions) @ np.asarray(model.model)[:3, :3].T
+        extent = corners.max(axis=0) - corners.min(axis=0)
+        assert int(np.argmax(extent)) == axis, (up, extent)
