@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from glsandbox.scene import Node, Scene
-from support import coloured_ply, double_sided_glb, masked_glb, reversed_obj, two_material_glb, two_usemtl_obj
+from support import (coloured_ply, double_sided_glb, masked_glb, reversed_obj, run_cli, two_material_glb,
+                     two_usemtl_obj)
 
 SIZE = (160, 120)
 #: The three renderers: the rasterizer, the GLSL ray tracer, the numpy (float64) ray tracer.
@@ -165,3 +166,16 @@ def test_up_z_stands_a_z_up_file_upright(tmp_path: Path) -> None:
         corners = np.asarray(model.mesh.positions) @ np.asarray(model.model)[:3, :3].T
         extent = corners.max(axis=0) - corners.min(axis=0)
         assert int(np.argmax(extent)) == axis, (up, extent)
+
+
+def test_render_and_plan_say_what_the_file_holds_that_is_not_drawn(tmp_path: Path) -> None:
+    """One warning line naming the file and the part, with exit 0 and the picture written."""
+    path = two_usemtl_obj(tmp_path, extra_mtl="map_Kd nowhere.png\n")
+    line = f"warning: model file {path}, part 'blue': its texture nowhere.png (missing or unreadable) not drawn"
+    out = tmp_path / "two.png"
+    run = run_cli("render", "model", "--set", f"mesh={path}", "--size", "64x48", "--out", str(out))
+    assert run.returncode == 0 and out.is_file(), run
+    assert run.stderr.splitlines() == [line]
+    run = run_cli("plan", "model", "--set", f"mesh={path}")
+    assert run.returncode == 0 and run.stdout.splitlines()[-1] == line, run
+
