@@ -399,3 +399,21 @@ def masked_glb(path: Path) -> Path:
         pixels[0:1].repeat(4, axis=0), "RGBA"), alphaMode="MASK", alphaCutoff=0.5))
     trimesh.Scene([red, stencil]).export(path)
     return path
+
+
+def two_textures_glb(path: Path) -> Path:
+    """Two squares side by side with a texture each (white factor): red pixels on the left
+    part, blue on the right (the boat of issue 20: several textures, each part its own)."""
+    import trimesh
+    from PIL import Image
+
+    parts = []
+    for name, x0, x1, rgb in (("hull", -1.0, 0.0, (255, 0, 0)), ("sail", 0.05, 1.0, (0, 0, 255))):
+        vertices, faces = quad(x0, x1)
+        square = trimesh.Trimesh(vertices, faces, process=False)
+        square.visual = trimesh.visual.TextureVisuals(
+            uv=[[0, 0], [1, 0], [1, 1], [0, 1]],
+            material=trimesh.visual.material.PBRMaterial(name=name, baseColorTexture=Image.new("RGB", (4, 4), rgb)))
+        parts.append(square)
+    trimesh.Scene(parts).export(path)
+    return path

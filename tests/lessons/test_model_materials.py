@@ -12,7 +12,7 @@ import pytest
 
 from glsandbox.scene import Node, Scene
 from support import (coloured_ply, double_sided_glb, masked_glb, reversed_obj, run_cli, two_material_glb,
-                     two_usemtl_obj)
+                     two_textures_glb, two_usemtl_obj)
 
 SIZE = (160, 120)
 #: The three renderers: the rasterizer, the GLSL ray tracer, the numpy (float64) ray tracer.
@@ -68,6 +68,15 @@ def test_a_double_sided_plane_is_seen_from_behind_and_a_single_sided_one_is_not(
     image, scene = frame_and_scene(gl, double_sided_glb(tmp_path / "one.glb", double_sided=False), renderer)
     behind = colour_at(image, scene, node(scene, "model"), (0.0, 0.0, 0.0))
     assert not behind[1] > behind[0] + 40, behind  # culled: the sky or the floor behind it
+
+
+@pytest.mark.parametrize("renderer", RENDERERS)
+def test_each_part_shows_its_own_texture(gl, tmp_path: Path, renderer: str) -> None:
+    image, scene = frame_and_scene(gl, two_textures_glb(tmp_path / "boat.glb"), renderer)
+    hull = colour_at(image, scene, node(scene, "model/hull"), (-0.5, 0.0, 0.0))
+    sail = colour_at(image, scene, node(scene, "model/sail"), (0.5, 0.0, 0.0))
+    assert hull[0] > hull[2] + 60, hull
+    assert sail[2] > sail[0] + 40, sail
 
 
 @pytest.mark.parametrize("renderer", RENDERERS)
