@@ -41,6 +41,8 @@ from glsandbox.scene import (BUILTIN_TEXTURES, COURSE_BLUE, DEPTH_MODES, SHADING
 
 #: Lighting coefficients a scene file may set on a node (see :class:`~glsandbox.scene.Material`).
 _MATERIAL_NUMBERS = ("ambient", "diffuse", "specular", "shininess")
+#: A material's alpha and sides (glsandbox.scene.Material; a model file's parts bring their own).
+_MATERIAL_LOOKS = ("alpha_mode", "alpha_cutoff", "double_sided", "vertex_colors")
 
 #: Keys only a node whose mesh is a model file takes (:mod:`glsandbox.meshfile`).
 _MODEL_FILE_KEYS = ("fit", "mesh_normals", "crease_angle", "up")
@@ -203,7 +205,8 @@ class _SceneReader:
         node per material, named ``name/material``, unless the table sets its own colour or texture."""
         data = self.table(data, "nodes", i)
         allowed = {"name", "mesh", "order", "scale", "translate", "rotate", "color", "shading",
-                   "cull_back_faces", "viewports", *_MATERIAL_NUMBERS, "normals", "texture", "filter", "wrap",
+                   "cull_back_faces", "viewports", *_MATERIAL_NUMBERS, *_MATERIAL_LOOKS, "normals", "texture",
+                   "filter", "wrap",
                    *_MODEL_FILE_KEYS, "shader", "uniforms"}
         self.check_keys(data, allowed, "nodes", i)
         mesh_name = data.get("mesh")
@@ -259,6 +262,8 @@ class _SceneReader:
                 key: str | None = "texture"
             elif "shading needs" in message:
                 key = "shading"
+            elif "vertex_colors = true needs" in message:
+                key = "vertex_colors"
             else:
                 key = next((k for k in ("scale", "translate") if k in data), None)
             raise self.fail("nodes", i, key, message) from None
@@ -344,9 +349,11 @@ class _SceneReader:
             material = replace(material, color=model.color)
         if material.texture is not None and mesh.uvs is None:
             raise self.fail("nodes", i, "texture", f"{mesh.name} has no texture coordinates to map it with")
+        # The file's alpha and sides, unless the node says (cull_back_faces = true makes it one-sided).
         sided = model.double_sided if "cull_back_faces" not in data else not data["cull_back_faces"]
-        return replace(material, alpha_mode=model.alpha_mode, alpha_cutoff=model.alpha_cutoff, double_sided=sided,
-                       vertex_colors=mesh.colors is not None and material.lit)
+        file_look = dict(alpha_mode=model.alpha_mode, alpha_cutoff=model.alpha_cutoff, double_sided=sided,
+                         vertex_colors=mesh.colors is not None and material.lit)
+        return replace(material, **{k: v for k, v in file_look.items() if k not in data})
 
     def material(self, data: dict[str, Any], i: int, shading: str) -> Material:
         """A node's material: colour, shading, the lighting coefficients, a texture."""
@@ -373,11 +380,17 @@ class _SceneReader:
             raise self.fail("nodes", i, "filter" if "filter" in data else "wrap", "needs texture = \"<image>\"")
         color = self.color(data, "color", "nodes", i, default=(1.0, 1.0, 1.0, 1.0))
         normals = self.text(data, "normals", "nodes", i, default="correct")
+        looks = dict(alpha_mode=self.text(data, "alpha_mode", "nodes", i, default="opaque"),
+                     alpha_cutoff=self.number(data, "alpha_cutoff", "nodes", i, default=0.5),
+                     double_sided=self.flag(data, "double_sided", "nodes", i, default=False),
+                     vertex_colors=self.flag(data, "vertex_colors", "nodes", i, default=False))
         try:
             return Material(color=color, shading=shading, normals=normals, texture=texture,  # type: ignore[arg-type]
-                            **numbers)
+                            **numbers, **looks)
         except SandboxError as exc:
-            key = next((k for k in (*_MATERIAL_NUMBERS, "normals") if k in data and k in str(exc)), None)
+            words = str(exc).replace(" ", "_")
+            key = next((k for k in (*_MATERIAL_NUMBERS, "normals", *_MATERIAL_LOOKS) if k in data and k in words),
+                       None)
             raise self.fail("nodes", i, key, str(exc)) from None
 
     def viewport(self, data: Any, i: int) -> Viewport:

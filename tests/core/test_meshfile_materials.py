@@ -227,3 +227,27 @@ def test_a_scene_file_node_with_its_own_colour_stays_one_node_with_every_part(tm
     assert node.name == "sign" and node.material.color == (1.0, 1.0, 0.0, 1.0)
     assert node.mesh.triangle_indices().shape[0] == 4  # both parts' squares
 
+
+
+def test_scene_file_material_keys_for_alpha_and_sides(tmp_path: Path) -> None:
+    scene_path = tmp_path / "scene.toml"
+    scene_path.write_text('[[nodes]]\nmesh = "cube24"\ncolor = [0, 0, 1, 0.5]\nalpha_mode = "blend"\n'
+                          'double_sided = true\n\n[[nodes]]\nmesh = "quad_list"\nalpha_mode = "mask"\n'
+                          'alpha_cutoff = 0.3\n')
+    glass, leaf = load_scene(scene_path).nodes
+    assert (glass.material.alpha_mode, glass.material.double_sided, glass.cull_back_faces) == ("blend", True, False)
+    assert (leaf.material.alpha_mode, leaf.material.alpha_cutoff) == ("mask", 0.3)
+    for text, where in (('alpha_mode = "glass"', r"scene.toml:3: nodes\[0\].alpha_mode: unknown alpha mode 'glass'"),
+                        ("alpha_cutoff = 1.5", r"scene.toml:3: nodes\[0\].alpha_cutoff: material alpha cutoff"),
+                        ("vertex_colors = true", r"scene.toml:3: nodes\[0\].vertex_colors: .* no color data")):
+        scene_path.write_text(f'[[nodes]]\nmesh = "cube24"\n{text}\n')
+        with pytest.raises(glsandbox.SandboxError, match=where):
+            load_scene(scene_path)
+
+
+def test_a_scene_file_node_s_own_alpha_mode_wins_over_its_model_file_s(tmp_path: Path) -> None:
+    two_material_glb(tmp_path / "two.glb")
+    scene_path = tmp_path / "scene.toml"
+    scene_path.write_text('[[nodes]]\nname = "m"\nmesh = "two.glb"\nalpha_mode = "opaque"\n')
+    assert {n.name: n.material.alpha_mode for n in load_scene(scene_path).nodes} == {"m/paint": "opaque",
+                                                                                     "m/glass": "opaque"}
