@@ -1,0 +1,44 @@
+"""Benchmark: a frame of ``glsandbox.view`` (the orbitable notebook view) for phong at 480x360.
+
+Baseline: the headless frame ``glsandbox.show`` makes (render and read back).
+Subject: one orbit step of the view, what a drag costs the kernel: the camera
+turned, the frame rendered and read back (``LessonCanvas.draw``) and encoded
+as the JPEG that jupyter_rfb sends while the camera moves. Sending it over
+the wire and the browser's decoding are not in it. Needs the ``notebook``
+extra (jupyter_rfb); without it the module has no case.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+
+SIZE = (480, 360)
+
+
+def cases(env) -> list:
+    try:
+        from jupyter_rfb._utils import array2compressed
+
+        from glsandbox.notebook_view import LessonCanvas
+    except ImportError:
+        env.note("notebook_view: no jupyter_rfb (the notebook extra): no view rows")
+        return []
+    from glsandbox.lesson import find_lesson
+    from glsandbox.measure.bench import Case, Side
+
+    lesson = find_lesson("phong")()
+    with contextlib.redirect_stdout(io.StringIO()):  # outside a kernel the widget prints its output area
+        canvas = LessonCanvas(lesson, lambda: env.renderer, SIZE)
+
+    def show(k: int):
+        return env.renderer.render_scene(lesson.scene(), SIZE).image
+
+    def orbit_step(k: int):
+        canvas.camera.drag(3.0, 0.0, lesson.scene())  # 3 pixels of drag: about 1 degree of orbit
+        image = canvas.draw()
+        array2compressed(image, canvas.quality)
+        return image
+
+    return [Case("notebook view", "phong 480x360: a frame while orbiting", Side("show (render + read)", show),
+                 Side("view (orbit + render + read + JPEG)", orbit_step), repeat=20)]
