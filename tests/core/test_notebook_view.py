@@ -13,6 +13,7 @@ import ast
 import base64
 import io
 import json
+import subprocess
 import sys
 import time
 from collections.abc import Callable, Iterator
@@ -20,16 +21,13 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
+import jupyter_client  # the dev group has it (and ipykernel, and the notebook extra)
 import numpy as np
 import pytest
 from PIL import Image
 
 from glsandbox.lesson import find_lesson
 from glsandbox.scene import Camera
-
-pytest.importorskip("jupyter_rfb")  # the notebook extra; the dev group has it
-jupyter_client = pytest.importorskip("jupyter_client")
-pytest.importorskip("ipykernel")
 
 pytestmark = pytest.mark.slow
 SIZE = (160, 120)
@@ -193,3 +191,13 @@ def test_view_time_slider_redraws_at_that_moment(kernel: FrontEnd, gl) -> None:
     kernel.update(slider, {"value": 2.5})  # the user drags the time slider
     lesson = find_lesson("transform_order")(time=2.5)
     np.testing.assert_array_equal(kernel.next_lossless_frame(), gl.render(lesson, SIZE).image)
+
+
+def test_without_jupyter_rfb_view_says_what_to_install() -> None:
+    code = ("import sys; sys.modules['jupyter_rfb'] = None\n"
+            "import glsandbox\n"
+            "try:\n    glsandbox.view('phong')\n"
+            "except glsandbox.SandboxError as exc:\n    print(exc)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.stdout.strip() == ("glsandbox.view needs jupyter_rfb: install the notebook extra "
+                                  "(pip install 'glsandbox[notebook]', or uv sync --extra notebook)")
