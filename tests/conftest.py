@@ -140,3 +140,19 @@ def xvfb_display():
     yield f":{number}"
     proc.terminate()
     proc.wait(timeout=10)
+
+
+# --- a browser ---------------------------------------------------------------
+
+
+@pytest.fixture(scope="session")
+def chromium() -> str:
+    """The path of a headless-capable Chromium (Debian's ``chromium`` package; .ci/run installs it)."""
+    import shutil
+
+    for name in ("chromium", "chromium-browser", "google-chrome"):
+        found = shutil.which(name)
+        if found:
+            return found
+    need("Chromium", "no chromium binary on PATH (apt-get install chromium)")
+    raise AssertionError("unreachable")  # need() skips or fails
