@@ -273,7 +273,12 @@ def _tour_contrasts(cls: type[Lesson], out: Path, size: tuple[int, int], rendere
             rows = -(-len(variants) // columns)
             grid_size = (columns * max(1, size[0] // 2), rows * max(1, size[1] // 2))
             image_path = out / f"{cls.name}.contrast{number}.png"
-            write_png(render_grid(variants, columns, grid_size, renderer), image_path)
+            grid = render_grid(variants, columns, grid_size, renderer).copy()
+            tile = (grid_size[0] // columns, grid_size[1] // rows)
+            for slot in range(len(variants), rows * columns):  # the last row's empty tiles: transparent
+                x, y = (slot % columns) * tile[0], (slot // columns) * tile[1]
+                grid[y:y + tile[1], x:x + tile[0]] = 0
+            write_png(grid, image_path)
             entry.update(image=image_path.name, size=list(grid_size), labels=[v.label for v in variants])
         except SandboxError as exc:
             entry["error"] = str(exc)

@@ -187,7 +187,7 @@ pre code { background: none; padding: 0; font-size: 1em; }
 details { margin-top: .7rem; border-top: 1px solid #e6e9f0; padding-top: .5rem; }
 summary { cursor: pointer; color: var(--accent); font-weight: 600; }
 figure.contrast { margin: .4rem 0 .9rem; }
-figure.contrast img { border-radius: 8px; }
+figure.contrast img { border-radius: 8px; background: none; }
 figcaption { margin-top: .35rem; font-size: .92rem; color: var(--muted); }
 figcaption strong { color: var(--ink); }
 .tiles { font-size: .85rem; }
