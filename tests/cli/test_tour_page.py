@@ -17,13 +17,12 @@ import os
 import re
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+from support import EXAMPLES_DIR, run_cli
 
 pytestmark = pytest.mark.slow
-REPO = Path(__file__).resolve().parents[2]
 PHONE = (390, 844)
 DESKTOP = (1400, 900)
 
@@ -49,11 +48,6 @@ window.addEventListener("load", () => {
   if (window.parent !== window) window.parent.postMessage(document.title, "*");
 });
 </script>"""
-
-
-def glsandbox(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "glsandbox.cli", *args], capture_output=True, text=True,
-                          cwd=REPO, timeout=600)
 
 
 def chromium_command(binary: str, profile: Path, size: tuple[int, int]) -> list[str]:
@@ -100,7 +94,7 @@ def assert_fits(result: dict, size: tuple[int, int]) -> None:
 @pytest.fixture(scope="module")
 def course_tour(tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("tour")
-    proc = glsandbox("tour", "--out", str(out), "--size", "320x240")
+    proc = run_cli("tour", "--out", str(out), "--size", "320x240")
     assert proc.returncode == 0, proc.stderr
     return out
 
@@ -152,9 +146,9 @@ def test_users_lesson_files_with_any_names_are_escaped_and_their_pictures_load(
     for name in odd_names:
         path = os.fsencode(lessons / f"{name}.py")  # "\udce9": the byte 0xE9, not UTF-8
         Path(os.fsdecode(path)).write_text(ODD_LESSON.format(long="x" * 300), encoding="utf-8")
-    shutil.copy(REPO / "examples" / "mirror_room.toml", lessons / "room.toml")
+    shutil.copy(EXAMPLES_DIR / "mirror_room.toml", lessons / "room.toml")
     out = tmp_path / "tour"
-    proc = glsandbox("tour", "--lessons", str(lessons), "--out", str(out), "--size", "96x72")
+    proc = run_cli("tour", "--lessons", str(lessons), "--out", str(out), "--size", "96x72")
     assert proc.returncode == 0, proc.stderr
     page = (out / "index.html").read_bytes().decode("utf-8")  # valid UTF-8 whatever the names' bytes
     assert "<script>alert" not in page and "<img src=x" not in page and "<b>bold" not in page

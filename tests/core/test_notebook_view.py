@@ -17,13 +17,13 @@ import sys
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import replace
-from pathlib import Path
 from typing import Any
 
 import jupyter_client  # the dev group has it (and ipykernel, and the notebook extra)
 import numpy as np
 import pytest
 from PIL import Image
+from support import REPO_ROOT
 
 from glsandbox.lesson import find_lesson
 from glsandbox.scene import Camera
@@ -112,7 +112,7 @@ def kernel(tmp_path_factory: pytest.TempPathFactory) -> Iterator[FrontEnd]:
     manager = jupyter_client.KernelManager(kernel_name="glsandbox-test", transport="ipc",
                                            ip=str(spec_dir.parent.parent / "kernel"))
     manager.kernel_spec_manager.kernel_dirs = [str(spec_dir.parent)]
-    manager.start_kernel(cwd=str(Path(__file__).resolve().parents[2]))
+    manager.start_kernel(cwd=str(REPO_ROOT))
     client = manager.client()
     client.start_channels()
     try:
