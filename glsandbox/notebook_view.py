@@ -3,7 +3,9 @@
 A remote frame buffer widget: the browser sends pointer and wheel events to
 the kernel as comm messages, the kernel renders the lesson headless (the
 notebook helpers' shared renderer) and sends the frame back as a JPEG while
-the camera moves, then a lossless PNG once it rests. Drag orbits the camera
+the camera moves, then a lossless PNG once it rests; a ray-traced lesson is
+traced at a quarter of the resolution each way while the camera moves, as in
+the window, and again in full when it rests. Drag orbits the camera
 about its focus, the wheel zooms towards it, a double click puts the lesson's
 own camera back: the window's camera (:class:`glsandbox.camera.CameraInput`),
 fed by the browser instead of glfw. Under the picture a play button and a
@@ -16,6 +18,7 @@ is missing.
 
 from __future__ import annotations
 
+import asyncio
 import time
 from typing import Any, NamedTuple
 
@@ -25,7 +28,7 @@ from jupyter_rfb import RemoteFrameBuffer
 
 from glsandbox.camera import CameraInput
 from glsandbox.errors import SandboxError
-from glsandbox.frame import FrameRenderer
+from glsandbox.frame import FrameRenderer, InteractiveResolution
 from glsandbox.lesson import Lesson
 from glsandbox.scene import Scene
 
@@ -52,6 +55,8 @@ class LessonCanvas(RemoteFrameBuffer):
         self._renderer_source = renderer_source  # () -> FrameRenderer, opened on first draw
         self.size = size
         self.camera = CameraInput()
+        self.motion = InteractiveResolution()
+        self.resolution = 1.0
         self.last_image: np.ndarray | None = None
         self.frame_ms: list[float] = []
         self.error = ""
@@ -63,13 +68,19 @@ class LessonCanvas(RemoteFrameBuffer):
         """The lesson's scene seen through the view's camera."""
         return self.camera.apply(self.lesson.scene())
 
-    def draw(self) -> np.ndarray:
-        """Render one frame now (``get_frame`` calls this; tests and benchmarks may too)."""
+    def draw(self, resolution: float | None = None) -> np.ndarray:
+        """Render one frame now (``get_frame`` calls this; tests and benchmarks may too).
+
+        A ray-traced viewport is traced at ``resolution`` of its pixels each way;
+        by default the window's rule (:class:`~glsandbox.frame.InteractiveResolution`):
+        coarse while the camera moves, full once it has rested."""
         renderer: FrameRenderer = self._renderer_source()
+        scene = self.scene()
+        self.resolution = self.motion.resolution(scene) if resolution is None else resolution
         start = time.perf_counter()
-        frame = renderer.render_scene(self.scene(), self.size)
+        _, target = renderer.draw(scene, self.size, self.resolution)
+        self.last_image = target.read().copy()
         self.frame_ms.append((time.perf_counter() - start) * 1000.0)
-        self.last_image = frame.image.copy()
         return self.last_image
 
     def get_frame(self) -> np.ndarray | None:
@@ -80,7 +91,15 @@ class LessonCanvas(RemoteFrameBuffer):
             self.print(self.error)
             return None
         self.error = ""
+        if self.resolution < 1.0:  # a coarse frame: draw it again at full resolution once the camera rests
+            self._redraw_later(self.motion.settle + 0.05)
         return image
+
+    def _redraw_later(self, seconds: float) -> None:
+        try:
+            asyncio.get_running_loop().call_later(seconds, self.request_draw)
+        except RuntimeError:  # no event loop (outside a kernel): nothing draws later anyway
+            pass
 
     # --- what the browser sends ---------------------------------------------
 

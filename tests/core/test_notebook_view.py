@@ -133,9 +133,10 @@ def output_png(outputs: list[dict]) -> np.ndarray:
     return decode(base64.b64decode(bundles[0]["image/png"]))
 
 
-def camera_of(front: FrontEnd) -> Camera:
+def camera_of(front: FrontEnd, view: str = "v") -> Camera:
+    """The camera of the kernel's view ``view`` (a variable name in the kernel)."""
     eye, target, up, fov, near, far = front.value(
-        "[[list(c.eye), list(c.target), list(c.up), c.fov_y, c.near, c.far] for c in [v.canvas.scene().camera]][0]")
+        f"[[list(c.eye), list(c.target), list(c.up), c.fov_y, c.near, c.far] for c in [{view}.canvas.scene().camera]][0]")
     return Camera(eye=tuple(eye), target=tuple(target), up=tuple(up), fov_y=fov, near=near, far=far)
 
 
@@ -191,3 +192,19 @@ def test_view_time_slider_redraws_at_that_moment(kernel: FrontEnd, gl) -> None:
     lesson = find_lesson("transform_order")(time=2.5)
     np.testing.assert_array_equal(kernel.next_lossless_frame(), gl.render(lesson, SIZE).image)
 
+
+
+def test_a_ray_traced_view_is_coarse_while_dragged_and_full_once_it_rests(kernel: FrontEnd, gl) -> None:
+    kernel.execute(f"r = glsandbox.view('ray_interactive', {SIZE})")
+    comm = [cid for cid, state in kernel.opened.items() if state.get("css_width") == f"{SIZE[0]}px"][-1]
+    kernel.update(comm, {"_has_visible_views": True})
+    kernel.event(comm, type="resize", width=SIZE[0], height=SIZE[1], ratio=1.0)
+    kernel.next_lossless_frame()
+    kernel.event(comm, type="pointer_down", x=60, y=60, button=1, buttons=[1], modifiers=[])
+    kernel.event(comm, type="pointer_move", x=90, y=50, button=1, buttons=[1], modifiers=[])
+    kernel.event(comm, type="pointer_up", x=90, y=50, button=1, buttons=[], modifiers=[])
+    coarse = kernel.next_lossless_frame()  # the drag's frame, traced at a quarter of the pixels each way
+    camera = camera_of(kernel, "r")
+    full = gl.render_scene(replace(find_lesson("ray_interactive")().scene(), camera=camera), SIZE).image
+    assert not np.array_equal(coarse, full)
+    np.testing.assert_array_equal(kernel.next_lossless_frame(), full)  # drawn again once the camera rests
