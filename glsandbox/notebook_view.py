@@ -76,7 +76,10 @@ class LessonCanvas(RemoteFrameBuffer):
         coarse while the camera moves, full once it has rested."""
         renderer: FrameRenderer = self._renderer_source()
         scene = self.scene()
-        self.resolution = self.motion.resolution(scene) if resolution is None else resolution
+        if resolution is None:  # only a ray-traced viewport has a resolution to lower
+            traced = any(vp.renderer != "raster" for vp in scene.viewports)
+            resolution = self.motion.resolution(scene) if traced else 1.0
+        self.resolution = resolution
         start = time.perf_counter()
         _, target = renderer.draw(scene, self.size, self.resolution)
         self.last_image = target.read().copy()

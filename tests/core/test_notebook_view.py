@@ -189,8 +189,12 @@ def test_view_time_slider_redraws_at_that_moment(kernel: FrontEnd, gl) -> None:
     kernel.next_lossless_frame()
     slider = [cid for cid, state in kernel.opened.items() if state.get("description") == "time"][-1]
     kernel.update(slider, {"value": 2.5})  # the user drags the time slider
-    lesson = find_lesson("transform_order")(time=2.5)
-    np.testing.assert_array_equal(kernel.next_lossless_frame(), gl.render(lesson, SIZE).image)
+    lesson = find_lesson("transform_order")
+    np.testing.assert_array_equal(kernel.next_lossless_frame(), gl.render(lesson(time=2.5), SIZE).image)
+    play = [cid for cid, state in kernel.opened.items() if state.get("_model_name") == "PlayModel"][-1]
+    kernel.update(play, {"value": 20})  # the play button's 20th step: 20 x 0.05 s
+    assert kernel.value("w.time.value") == pytest.approx(1.0)
+    np.testing.assert_array_equal(kernel.next_lossless_frame(), gl.render(lesson(time=1.0), SIZE).image)
 
 
 
