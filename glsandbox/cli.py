@@ -230,7 +230,7 @@ def cmd_tour(args: argparse.Namespace) -> int:
                              plan=frame.plan.to_dict(), plan_text=frame.plan.describe())
                 print(f"{prefix}: ok, {frame.seconds * 1000:.1f} ms", file=sys.stderr, flush=True)
                 if args.lessons is None:  # a user's lesson file runs only where its errors are caught
-                    entry["contrasts"] = _tour_contrasts(cls, out, size, renderer, prefix)
+                    entry["contrasts"] = _tour_contrasts(cls, out, size, args.samples, renderer, prefix)
             except SandboxError as exc:  # one broken lesson must not stop the tour
                 entry.update(ok=False, error=str(exc))
                 print(f"{prefix}: FAILED: {exc}", file=sys.stderr, flush=True)
@@ -257,8 +257,8 @@ def cmd_tour(args: argparse.Namespace) -> int:
 CONTRAST_COLUMNS = 3
 
 
-def _tour_contrasts(cls: type[Lesson], out: Path, size: tuple[int, int], renderer: HeadlessRenderer,
-                    prefix: str) -> list[dict]:
+def _tour_contrasts(cls: type[Lesson], out: Path, size: tuple[int, int], samples: int,
+                    renderer: HeadlessRenderer, prefix: str) -> list[dict]:
     """The lesson's contrasts (``Lesson.contrasts``) as tile grids beside its picture: each tile
     half the tour's frame each way, the grid as ``glsandbox compare`` lays it out."""
     from glsandbox.measure.compare import build_variants, render_grid
@@ -269,6 +269,7 @@ def _tour_contrasts(cls: type[Lesson], out: Path, size: tuple[int, int], rendere
                        "command": f"glsandbox compare {cls.name} --vary {shlex.quote(vary)}"}
         try:
             variants, _ = build_variants(cls, [vary], [])
+            variants = [replace(v, scene=with_samples(v.scene, samples)) for v in variants]
             columns = min(len(variants), CONTRAST_COLUMNS)
             rows = -(-len(variants) // columns)
             grid_size = (columns * max(1, size[0] // 2), rows * max(1, size[1] // 2))

@@ -153,6 +153,7 @@ def test_users_lesson_files_with_any_names_are_escaped_and_their_pictures_load(
     page = (out / "index.html").read_bytes().decode("utf-8")  # valid UTF-8 whatever the names' bytes
     assert "<script>alert" not in page and "<img src=x" not in page and "<b>bold" not in page
     assert "&lt;img src=x onerror=" in page and "caf\ufffd 100%" in page
+    assert "It shows <code>one cube</code> &amp; &lt;b&gt;bold&lt;/b&gt;" in page  # the file's docstring, as text
     for result in (measure(chromium, out / "index.html", size, tmp_path) for size in (DESKTOP, PHONE)):
         assert_fits(result, (result["innerWidth"], 0))
         assert len(result["images"]) == len(odd_names) + 1
