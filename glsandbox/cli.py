@@ -238,6 +238,7 @@ def cmd_tour(args: argparse.Namespace) -> int:
         renderer_name = renderer.host.renderer
         backend = renderer.host.backend
     summary = {"size": list(size), "samples": args.samples, "backend": backend, "renderer": renderer_name,
+               "folder": None if args.lessons is None else str(args.lessons),
                "seconds": round(time.perf_counter() - started, 3), "lessons": results}
     for name, text in (("tour.json", json.dumps(summary, indent=2) + "\n"), ("index.html", course_page(summary))):
         try:

@@ -196,22 +196,34 @@ footer { padding: 0 clamp(.75rem, 3vw, 3rem) 2rem; color: var(--muted); font-siz
 """
 
 
+COURSE_HEADER = """<h1>Real-time graphics, lesson by lesson</h1>
+<p>Every lesson of the course as it renders: the picture, what it shows, the command that runs it, and the
+comparisons it is about. Click a picture for full size. With glsandbox installed, <code>glsandbox run NAME</code>
+opens a lesson in a window (drag to orbit), <code>glsandbox list -v</code> lists the lessons and their parameters,
+and <code>glsandbox compare NAME --vary KEY=A,B</code> draws any comparison of your own.</p>"""
+
+
+def folder_header(folder: str) -> str:
+    return (f"<h1>Lessons in {esc(folder)}</h1><p>Each lesson file of the folder as it renders, with what its "
+            "docstring says and the command that runs it. Click a picture for full size.</p>")
+
+
 def course_page(summary: dict) -> str:
-    """The whole page for a tour's summary (``tour.json``'s contents)."""
+    """The whole page for a tour's summary (``tour.json``'s contents); with ``summary["folder"]``
+    (``tour --lessons DIR``) the page is about that folder's lessons, not the course."""
     size = (int(summary["size"][0]), int(summary["size"][1]))
     lessons = summary["lessons"]
     cards = "\n".join(card(number, entry, size) for number, entry in enumerate(lessons, start=1))
     rendered = sum(1 for entry in lessons if entry.get("ok"))
+    folder = summary.get("folder")
+    title = f"glsandbox: {esc(folder)}" if folder else "glsandbox: the course, lesson by lesson"
     return f"""<!doctype html>
 <html lang="en"><head><meta charset="utf-8">
 <meta name="viewport" content="width=device-width, initial-scale=1">
-<title>glsandbox: the course, lesson by lesson</title>
+<title>{title}</title>
 <style>{STYLE}</style></head><body>
 <header>
-<h1>Real-time graphics, lesson by lesson</h1>
-<p>Every lesson of the course as it renders: the picture, what it shows, the command that runs it, and the
-comparisons it is about. Click a picture for full size. Install with <code>pip install glsandbox</code>, then run
-any lesson in a window with <code>glsandbox run NAME</code>, or list them with <code>glsandbox list</code>.</p>
+{folder_header(folder) if folder else COURSE_HEADER}
 </header>
 <main><div class="grid">
 {cards}
