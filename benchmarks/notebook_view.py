@@ -12,9 +12,6 @@ extra (jupyter_rfb); without it the module has no case.
 
 from __future__ import annotations
 
-import contextlib
-import io
-
 SIZE = (480, 360)
 
 
@@ -30,8 +27,7 @@ def cases(env) -> list:
     from glsandbox.measure.bench import Case, Side
 
     def canvas_of(name: str) -> LessonCanvas:
-        with contextlib.redirect_stdout(io.StringIO()):  # outside a kernel the widget prints its output area
-            return LessonCanvas(find_lesson(name)(), lambda: env.renderer, SIZE)
+        return LessonCanvas(find_lesson(name)(), lambda: env.renderer, SIZE)
 
     def show(canvas: LessonCanvas):
         return lambda k: env.renderer.render_scene(canvas.lesson.scene(), SIZE).image

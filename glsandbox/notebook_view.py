@@ -23,6 +23,7 @@ import time
 from typing import Any, NamedTuple
 
 import ipywidgets
+from IPython.utils.capture import capture_output
 import numpy as np
 from jupyter_rfb import RemoteFrameBuffer
 
@@ -50,7 +51,11 @@ class LessonCanvas(RemoteFrameBuffer):
     time of each frame drawn; ``last_image`` the last frame, (H, W, 4) uint8."""
 
     def __init__(self, lesson: Lesson, renderer_source: Any, size: tuple[int, int]) -> None:
-        super().__init__(css_width=f"{size[0]}px", css_height=f"{size[1]}px", resizable=True, cursor="grab")
+        # jupyter_rfb displays its output area (where errors in callbacks go) in the cell as it is
+        # made; held back here, make_view puts it in the box instead, so the cell's output is the
+        # box alone (a static viewer shows its picture, not an "RFBOutputContext()" line).
+        with capture_output(stdout=True, stderr=False, display=True):
+            super().__init__(css_width=f"{size[0]}px", css_height=f"{size[1]}px", resizable=True, cursor="grab")
         self.lesson = lesson
         self._renderer_source = renderer_source  # () -> FrameRenderer, opened on first draw
         self.size = size
@@ -142,7 +147,7 @@ class ViewParts(NamedTuple):
     canvas: LessonCanvas
     time: ipywidgets.FloatSlider
     play: ipywidgets.Play
-    #: top to bottom: the canvas, the play button and slider, a line of help
+    #: top to bottom: the canvas, the play button and slider, a line of help, the canvas's output area
     children: list[Any]
 
 
@@ -160,4 +165,4 @@ def make_view(lesson: Lesson, renderer_source: Any, size: tuple[int, int]) -> Vi
     play.observe(lambda change: setattr(slider, "value", change["new"] * PLAY_STEP_SECONDS), names="value")
     slider.observe(lambda change: canvas.set_time(change["new"]), names="value")
     hint = ipywidgets.HTML("<small>drag: orbit &middot; wheel: zoom &middot; double click: the lesson's camera</small>")
-    return ViewParts(canvas, slider, play, [canvas, ipywidgets.HBox([play, slider]), hint])
+    return ViewParts(canvas, slider, play, [canvas, ipywidgets.HBox([play, slider]), hint, canvas._output_context])

@@ -148,6 +148,7 @@ def test_widget_leaves_its_picture_in_the_saved_output(kernel: FrontEnd, gl) -> 
 
 def test_view_draws_orbits_on_a_drag_and_zooms_on_the_wheel(kernel: FrontEnd, gl) -> None:
     outputs, _ = kernel.execute(f"v = glsandbox.view('phong', {SIZE})\nv")
+    assert len(outputs) == 1  # the box alone: its picture and its widget
     phong = find_lesson("phong")()
     first_expected = gl.render(phong, SIZE).image
     np.testing.assert_array_equal(output_png(outputs), first_expected)  # the picture for static viewers
