@@ -109,15 +109,14 @@ def _picture_box_class(widgets: Any) -> type:
     """``widgets.VBox`` whose output bundle also carries its picture (see the module's docstring)."""
 
     class PictureBox(widgets.VBox):  # type: ignore[misc, name-defined]
-        #: () -> (H, W, 4) uint8 or None: the picture a static viewer shows
+        #: () -> PNG bytes: the picture a static viewer shows
         picture_source: Any = None
         title: str = ""
 
         def _repr_mimebundle_(self, **kwargs: Any) -> Any:
             data = super()._repr_mimebundle_(**kwargs)
-            image = self.picture_source() if self.picture_source is not None else None
-            if isinstance(data, dict) and image is not None:
-                data["image/png"] = base64.b64encode(png_bytes(image)).decode("ascii")
+            if isinstance(data, dict) and self.picture_source is not None:
+                data["image/png"] = base64.b64encode(self.picture_source()).decode("ascii")
                 data["text/plain"] = f"<glsandbox {self.title}>"
             return data
 
@@ -176,19 +175,9 @@ def widget(lesson: str | type[Lesson] | Lesson, size: tuple[int, int] = (480, 36
 
     for w in made.values():
         w.observe(changed, names="value")
-    box = _picture_box(widgets, [*made.values(), error, image], f"widget {current.name}",
-                       lambda: png_pixels(image.value))
+    box = _picture_box(widgets, [*made.values(), error, image], f"widget {current.name}", lambda: image.value)
     box.controls, box.image, box.lesson, box.error = made, image, current, error
     return box
-
-
-def png_pixels(data: bytes) -> np.ndarray:
-    """A PNG's pixels as (H, W, 4) uint8."""
-    import io
-
-    from PIL import Image
-
-    return np.asarray(Image.open(io.BytesIO(data)).convert("RGBA"))
 
 
 def view(lesson: str | type[Lesson] | Lesson, size: tuple[int, int] = (480, 360), **params: Any) -> Any:
@@ -210,8 +199,8 @@ def view(lesson: str | type[Lesson] | Lesson, size: tuple[int, int] = (480, 360)
     parts = make_view(current, lambda: _RENDERER.renderer, size)
     canvas = parts.canvas
 
-    def picture() -> np.ndarray:  # what the view shows now (drawn now if it has not drawn yet)
-        return canvas.last_image if canvas.last_image is not None else canvas.draw()
+    def picture() -> bytes:  # what the view shows now (drawn now if it has not drawn yet)
+        return png_bytes(canvas.last_image if canvas.last_image is not None else canvas.draw())
 
     box = _picture_box(widgets, parts.children, f"view {current.name}", picture)
     box.canvas, box.time, box.play = canvas, parts.time, parts.play
