@@ -137,7 +137,7 @@ def card(number: int, entry: dict, size: tuple[int, int]) -> str:
         else:
             shot = f'<p class="error">failed: {esc(contrast.get("error", ""))}</p>'
         tiles = " ".join(f"<code>{esc(label)}</code>" for label in contrast.get("labels", ()))
-        order = f'<br><span class="tiles">tiles, left to right: {tiles}</span>' if tiles else ""
+        order = f'<br><span class="tiles">tiles, in reading order: {tiles}</span>' if tiles else ""
         parts.append(f'<figure class="contrast">{shot}<figcaption><strong>{esc(contrast["caption"])}</strong>'
                      f'{order}<pre class="cmd"><code>{esc(contrast["command"])}</code></pre></figcaption></figure>')
     if entry.get("ok"):
