@@ -94,6 +94,23 @@ class FrontEnd:
     def event(self, comm_id: str, **event: Any) -> None:
         self.send(comm_id, {"method": "custom", "content": {"timestamp": time.time(), **event}})
 
+    def show_view(self, code: str) -> tuple[str, list[dict], np.ndarray]:
+        """Run a cell that makes a view; then, as the browser does, show it and give its size.
+        Returns the canvas's comm id, the cell's outputs and the first frame drawn."""
+        outputs, _ = self.execute(code)
+        comm = [cid for cid, state in self.opened.items() if state.get("css_width") == f"{SIZE[0]}px"][-1]
+        self.update(comm, {"_has_visible_views": True})
+        self.event(comm, type="resize", width=SIZE[0], height=SIZE[1], ratio=1.0)
+        return comm, outputs, self.next_lossless_frame()
+
+    def drag(self, comm: str, *points: tuple[int, int]) -> None:
+        """Press the left button at the first point, move through the others, release at the last."""
+        (x, y), *moves = points
+        self.event(comm, type="pointer_down", x=x, y=y, button=1, buttons=[1], modifiers=[])
+        for x, y in moves:
+            self.event(comm, type="pointer_move", x=x, y=y, button=1, buttons=[1], modifiers=[])
+        self.event(comm, type="pointer_up", x=x, y=y, button=1, buttons=[], modifiers=[])
+
     def next_lossless_frame(self) -> np.ndarray:
         """Wait for the next PNG frame (JPEGs are sent while the camera moves, a PNG once it rests)."""
         start = len(self.frames)
@@ -147,24 +164,16 @@ def test_widget_leaves_its_picture_in_the_saved_output(kernel: FrontEnd, gl) -> 
 
 
 def test_view_draws_orbits_on_a_drag_and_zooms_on_the_wheel(kernel: FrontEnd, gl) -> None:
-    outputs, _ = kernel.execute(f"v = glsandbox.view('phong', {SIZE})\nv")
+    comm, outputs, first = kernel.show_view(f"v = glsandbox.view('phong', {SIZE})\nv")
     assert len(outputs) == 1  # the box alone: its picture and its widget
     phong = find_lesson("phong")()
     first_expected = gl.render(phong, SIZE).image
     np.testing.assert_array_equal(output_png(outputs), first_expected)  # the picture for static viewers
-    canvases = [cid for cid, state in kernel.opened.items() if state.get("css_width") == f"{SIZE[0]}px"]
-    comm = canvases[-1]
-    # The browser shows the widget and reports its size: the kernel draws.
-    kernel.update(comm, {"_has_visible_views": True})
-    kernel.event(comm, type="resize", width=SIZE[0], height=SIZE[1], ratio=1.0)
-    np.testing.assert_array_equal(kernel.next_lossless_frame(), first_expected)
+    np.testing.assert_array_equal(first, first_expected)  # the browser's first frame
     start_camera = camera_of(kernel)
 
     # A drag with the left button, 40 pixels to the right: the camera orbits its focus.
-    kernel.event(comm, type="pointer_down", x=60, y=60, button=1, buttons=[1], modifiers=[])
-    for x in (70, 80, 90, 100):
-        kernel.event(comm, type="pointer_move", x=x, y=60, button=1, buttons=[1], modifiers=[])
-    kernel.event(comm, type="pointer_up", x=100, y=60, button=1, buttons=[], modifiers=[])
+    kernel.drag(comm, (60, 60), (70, 60), (80, 60), (90, 60), (100, 60))
     orbited = kernel.next_lossless_frame()
     moved = camera_of(kernel)
     assert moved.eye != start_camera.eye
@@ -183,11 +192,7 @@ def test_view_draws_orbits_on_a_drag_and_zooms_on_the_wheel(kernel: FrontEnd, gl
 
 
 def test_view_time_slider_redraws_at_that_moment(kernel: FrontEnd, gl) -> None:
-    kernel.execute(f"w = glsandbox.view('transform_order', {SIZE})")
-    comm = [cid for cid, state in kernel.opened.items() if state.get("css_width") == f"{SIZE[0]}px"][-1]
-    kernel.update(comm, {"_has_visible_views": True})
-    kernel.event(comm, type="resize", width=SIZE[0], height=SIZE[1], ratio=1.0)
-    kernel.next_lossless_frame()
+    kernel.show_view(f"w = glsandbox.view('transform_order', {SIZE})")
     slider = [cid for cid, state in kernel.opened.items() if state.get("description") == "time"][-1]
     kernel.update(slider, {"value": 2.5})  # the user drags the time slider
     lesson = find_lesson("transform_order")
@@ -198,16 +203,9 @@ def test_view_time_slider_redraws_at_that_moment(kernel: FrontEnd, gl) -> None:
     np.testing.assert_array_equal(kernel.next_lossless_frame(), gl.render(lesson(time=1.0), SIZE).image)
 
 
-
 def test_a_ray_traced_view_is_coarse_while_dragged_and_full_once_it_rests(kernel: FrontEnd, gl) -> None:
-    kernel.execute(f"r = glsandbox.view('ray_interactive', {SIZE})")
-    comm = [cid for cid, state in kernel.opened.items() if state.get("css_width") == f"{SIZE[0]}px"][-1]
-    kernel.update(comm, {"_has_visible_views": True})
-    kernel.event(comm, type="resize", width=SIZE[0], height=SIZE[1], ratio=1.0)
-    kernel.next_lossless_frame()
-    kernel.event(comm, type="pointer_down", x=60, y=60, button=1, buttons=[1], modifiers=[])
-    kernel.event(comm, type="pointer_move", x=90, y=50, button=1, buttons=[1], modifiers=[])
-    kernel.event(comm, type="pointer_up", x=90, y=50, button=1, buttons=[], modifiers=[])
+    comm, _, _ = kernel.show_view(f"r = glsandbox.view('ray_interactive', {SIZE})")
+    kernel.drag(comm, (60, 60), (90, 50))
     coarse = kernel.next_lossless_frame()  # the drag's frame, traced at a quarter of the pixels each way
     camera = camera_of(kernel, "r")
     full = gl.render_scene(replace(find_lesson("ray_interactive")().scene(), camera=camera), SIZE).image
