@@ -147,13 +147,15 @@ def test_users_lesson_files_with_any_names_are_escaped_and_their_pictures_load(
         path = os.fsencode(lessons / f"{name}.py")  # "\udce9": the byte 0xE9, not UTF-8
         Path(os.fsdecode(path)).write_text(ODD_LESSON.format(long="x" * 300), encoding="utf-8")
     shutil.copy(EXAMPLES_DIR / "mirror_room.toml", lessons / "room.toml")
+    (lessons / "zz <broken>.py").write_text("this is not python <script>\n")  # a card that says why
     out = tmp_path / "tour"
     proc = run_cli("tour", "--lessons", str(lessons), "--out", str(out), "--size", "96x72")
-    assert proc.returncode == 0, proc.stderr
+    assert proc.returncode == 1 and "zz <broken>: FAILED" in proc.stderr, proc.stderr
     page = (out / "index.html").read_bytes().decode("utf-8")  # valid UTF-8 whatever the names' bytes
     assert "<script>alert" not in page and "<img src=x" not in page and "<b>bold" not in page
     assert "&lt;img src=x onerror=" in page and "caf\ufffd 100%" in page
     assert "It shows <code>one cube</code> &amp; &lt;b&gt;bold&lt;/b&gt;" in page  # the file's docstring, as text
+    assert '<p class="error">failed: ' in page and "zz &lt;broken&gt;.py" in page
     for result in (measure(chromium, out / "index.html", size, tmp_path) for size in (DESKTOP, PHONE)):
         assert_fits(result, (result["innerWidth"], 0))
         assert len(result["images"]) == len(odd_names) + 1
