@@ -1,7 +1,7 @@
 """The course page ``glsandbox tour`` writes, opened in headless Chromium.
 
-A copy of the page gets one script that, once everything has loaded, writes
-what the browser measured into the page's title: the document's scroll
+A copy of the page gets one script that, once everything has loaded, unfolds
+every ``<details>`` and writes what the browser measured into the page's title: the document's scroll
 width against the window's, the elements reaching past the right edge, the
 grid's column count, and every image's natural size. Chromium prints the DOM
 (``--dump-dom``) and the test reads the title back. Chromium's window is at
@@ -28,6 +28,7 @@ DESKTOP = (1400, 900)
 
 MEASURE = """<script>
 window.addEventListener("load", () => {
+  document.querySelectorAll("details").forEach(d => { d.open = true; });  // the folded text must fit too
   const root = document.documentElement, width = root.clientWidth;
   const images = Array.from(document.images);
   const wide = Array.from(document.body.querySelectorAll("*"))
