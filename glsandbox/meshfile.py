@@ -13,8 +13,8 @@ nothing merged); this module turns what it read into the course's
 conventions and checks it.
 
 - **Positions** as written; a glTF's node transforms are applied (its meshes
-  that share a material become one part); a mirroring transform gets its triangles' winding swapped
-  so fronts stay counter-clockwise.
+  that share a material become one part); a mirroring transform gets its
+  triangles' winding swapped so fronts stay counter-clockwise.
 - **Normals** (``normals=``): ``"auto"`` takes the file's vertex normals when
   it has usable ones (OBJ ``vn``, PLY ``nx ny nz``, glTF ``NORMAL``) and
   otherwise makes them with the crease angle (:mod:`glsandbox.meshnormals`,
@@ -68,7 +68,8 @@ from glsandbox.meshlooks import Look, file_warnings, is_closed, look_of
 from glsandbox.meshnormals import corner_normals, unique_vertices
 from glsandbox.scene import Material, Node, Texture
 
-__all__ = ["CREASE_ANGLE", "FORMATS", "NORMALS", "Model", "ModelPart", "fit_mesh", "is_model_path", "load_mesh", "load_model"]
+__all__ = ["CREASE_ANGLE", "FORMATS", "NORMALS", "Model", "ModelPart", "fit_mesh", "is_model_path", "load_mesh",
+           "load_model"]
 
 #: File extensions (lower case) and the trimesh file type each is read as.
 FORMATS: dict[str, str] = {".obj": "obj", ".ply": "ply", ".stl": "stl", ".off": "off", ".gltf": "gltf",
@@ -118,7 +119,8 @@ class ModelPart:
         fields.setdefault("alpha_mode", self.alpha_mode)
         fields.setdefault("alpha_cutoff", self.alpha_cutoff)
         fields.setdefault("double_sided", self.double_sided)
-        fields.setdefault("vertex_colors", self.mesh.colors is not None and fields.get("shading", "solid") != "vertex_color")
+        unlit_colours = fields.get("shading", "solid") == "vertex_color"  # they are the colour already
+        fields.setdefault("vertex_colors", self.mesh.colors is not None and not unlit_colours)
         return Material(**fields)
 
 
@@ -458,15 +460,15 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
     transform = _fit_transform(np.concatenate([mesh.positions for _, mesh, _, _ in built])) if fit else None
     model_parts = []
     for i, (look, mesh, kept, how) in enumerate(built):
-        warnings = [f"model file {p}: {', '.join(undrawn[''])} not drawn"] if i == 0 and undrawn.get("") else []
+        said = [f"model file {p}: {', '.join(undrawn[''])} not drawn"] if i == 0 and undrawn.get("") else []
         if look.name in undrawn:
-            warnings.append(f"model file {p}, part {look.name!r}: {', '.join(undrawn[look.name])} not drawn")
+            said.append(f"model file {p}, part {look.name!r}: {', '.join(undrawn[look.name])} not drawn")
         texture = None
         notes = list(mesh.notes)
         if look.image is not None:
             if mesh.uvs is None:
                 notes.append("its texture is not used: the mesh has no texture coordinates")
-                warnings.append(f"model file {p}, part {look.name!r}: its texture not drawn "
+                said.append(f"model file {p}, part {look.name!r}: its texture not drawn "
                                 "(the mesh has no texture coordinates)")
             else:
                 where = "" if len(built) == 1 else f"{look.name}/"
@@ -474,7 +476,7 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
         if transform is not None:
             notes.append("fitted into -1..1")
             mesh = replace(mesh, positions=(np.asarray(mesh.positions) - transform[0]) * transform[1])
-        mesh = replace(mesh, notes=tuple(notes), warnings=tuple(warnings))
+        mesh = replace(mesh, notes=tuple(notes), warnings=tuple(said))
         sided = look.double_sided if look.double_sided is not None else not closed
         model_parts.append(ModelPart(look.name, mesh, texture, look.color, look.alpha_mode, look.alpha_cutoff,
                                      sided, kept))

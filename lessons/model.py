@@ -133,7 +133,8 @@ class ModelLesson(Lesson):
         fit = bool(self.values["fit"])
         if source in GENERATED:
             mesh = generated(source)
-            return source, (("model", glsandbox.fit_mesh(mesh) if fit else mesh, Material(color=MODEL_COLOR, **MATERIAL)),)
+            shown = glsandbox.fit_mesh(mesh) if fit else mesh
+            return source, (("model", shown, Material(color=MODEL_COLOR, **MATERIAL)),)
         loaded = glsandbox.load_model(source, fit=fit)
         parts = []
         for part in loaded.parts:

@@ -395,8 +395,10 @@ def masked_glb(path: Path) -> Path:
     pixels[0, :2, 3] = 0  # the left half transparent
     uv = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=np.float64)
     stencil = trimesh.Trimesh(vertices, faces, process=False)
-    stencil.visual = trimesh.visual.TextureVisuals(uv=uv, material=trimesh.visual.material.PBRMaterial(name="stencil", baseColorTexture=Image.fromarray(
-        pixels[0:1].repeat(4, axis=0), "RGBA"), alphaMode="MASK", alphaCutoff=0.5))
+    image = Image.fromarray(pixels.repeat(4, axis=0), "RGBA")  # 4x4: each column's alpha as above
+    material = trimesh.visual.material.PBRMaterial(name="stencil", baseColorTexture=image, alphaMode="MASK",
+                                                   alphaCutoff=0.5)
+    stencil.visual = trimesh.visual.TextureVisuals(uv=uv, material=material)
     trimesh.Scene([red, stencil]).export(path)
     return path
 

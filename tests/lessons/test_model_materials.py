@@ -16,7 +16,8 @@ from support import (coloured_ply, double_sided_glb, masked_glb, reversed_obj, r
 
 SIZE = (160, 120)
 #: The three renderers: the rasterizer, the GLSL ray tracer, the numpy (float64) ray tracer.
-RENDERERS = {"raster": dict(view="raster"), "ray": dict(view="ray"), "ray_numpy": dict(view="ray", renderer="ray_numpy")}
+RENDERERS = {"raster": dict(view="raster"), "ray": dict(view="ray"),
+             "ray_numpy": dict(view="ray", renderer="ray_numpy")}
 
 
 def frame_and_scene(gl, path: Path, renderer: str, **values: object) -> tuple[np.ndarray, Scene]:
@@ -159,7 +160,8 @@ def test_the_glsl_ray_tracer_traces_parts_beyond_its_texture_slots_with_their_co
     colours = [colour_at(image, scene, n, (0.0, 0.0, 1.0)) for n in nodes]  # each cube's front face
     assert all(c[0] > 150 and c[1] < 40 for c in colours[:MAX_TEXTURES]), colours
     assert colours[MAX_TEXTURES][1] > 150, colours  # white: its colour alone
-    assert capsys.readouterr().err.count("the GLSL ray tracer samples at most 4 textures per viewport; tile4 traced") == 1
+    said = "the GLSL ray tracer samples at most 4 textures per viewport; tile4 traced"
+    assert capsys.readouterr().err.count(said) == 1
 
 
 def test_up_z_stands_a_z_up_file_upright(tmp_path: Path) -> None:
