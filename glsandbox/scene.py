@@ -289,6 +289,7 @@ SHADER_INPUTS: tuple[tuple[str, str, str, str], ...] = (
     ("u_specular", "uniform float", "-", "material coefficient (0.3)"),
     ("u_shininess", "uniform float", "-", "specular exponent (32)"),
     ("u_texture", "uniform sampler2D", "texture", "the material's texture on unit 0 (with TEXTURED)"),
+    ("u_alpha_cutoff", "uniform float", "-", "material alpha cutoff (0.5; alpha_mode \"mask\" discards below it)"),
 )
 
 #: The names the renderer sets; a node's own uniforms may not use them.
