@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from support import GOLDENS_DIR, RESULTS_DIR, backend_available, need
+from support import GOLDENS_DIR, RESULTS_DIR, TESTS_DIR, backend_available, need
 
 from glsandbox.measure.golden import ImageMatch, check_golden
 
@@ -86,8 +86,8 @@ def pytest_collection_finish(session: pytest.Session) -> None:
 def compile_imported_modules() -> None:
     for module in list(sys.modules.values()):
         source, cached = getattr(module, "__file__", None), getattr(module, "__cached__", None)
-        if not (source and cached and source.endswith(".py")):
-            continue
+        if not (source and cached and source.endswith(".py")) or source.startswith(str(TESTS_DIR)):
+            continue  # test modules: pytest rewrites and caches them itself
         try:
             if os.path.exists(cached) and os.stat(cached).st_mtime >= os.stat(source).st_mtime:
                 continue

@@ -162,7 +162,7 @@ def test_tradeoffs_errors_fall_where_they_must(quick_report: Path) -> None:
 
 @pytest.mark.slow
 def test_depth_knob_counts_z_fighting_pixels(quick_report: Path) -> None:
-    # Seen from 90 units (tests/test_mirror.py pins it): a 24-bit buffer with no polygon offset
+    # Seen from 90 units (tests/lessons/test_mirror.py pins it): a 24-bit buffer with no polygon offset
     # fights with or without the course's lift, and so does reverse-Z without any lift; each
     # remedy alone (nearer plane, reverse-Z with the lift, polygon offset) has no fighting pixel.
     rows = {r["setting"]: r for r in _rows(quick_report) if r["knob"] == "depth"}
