@@ -139,6 +139,7 @@ def test_control_characters_in_a_value_keep_the_message_on_one_line() -> None:
     assert_user_error(run_cli("render", "cube\u2028x", "--out", "x.png"), "unknown lesson 'cube\\u2028x'")
 
 
+@pytest.mark.slow  # several subprocesses: the process is the point
 def test_an_osmesa_that_is_not_osmesa_is_one_line_naming_it(tmp_path: Path) -> None:
     libc = ctypes.util.find_library("c")
     text_file = tmp_path / "libOSMesa.so"
@@ -171,6 +172,7 @@ def test_a_display_with_no_server_is_exactly_one_line() -> None:
     assert "GLFWError" not in proc.stderr and "warn" not in proc.stderr
 
 
+@pytest.mark.slow  # several subprocesses: the process is the point
 def test_no_display_errors_offer_what_the_command_can_do() -> None:
     env = {"DISPLAY": "", "WAYLAND_DISPLAY": ""}
     # render is headless already: it suggests a headless backend, not --headless.

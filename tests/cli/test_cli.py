@@ -106,6 +106,7 @@ def test_shader_that_does_not_compile_names_file_and_line(tmp_path: Path, gl) ->
     assert not out.exists()
 
 
+@pytest.mark.slow  # several subprocesses: the process is the point
 def test_no_gl_available_says_what_to_install(tmp_path: Path) -> None:
     broken = {"__EGL_VENDOR_LIBRARY_FILENAMES": str(tmp_path / "none.json"), "EGL_PLATFORM": "surfaceless",
               "GLSANDBOX_OSMESA": str(tmp_path / "libOSMesa-missing.so")}
