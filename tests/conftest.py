@@ -73,9 +73,10 @@ def golden(request: pytest.FixtureRequest) -> GoldenCheck:
 # --- bytecode for subprocesses ----------------------------------------------------
 # Where bytecode writing is off (PYTHONDONTWRITEBYTECODE=1) and nothing compiled the
 # installed packages (`uv sync --compile-bytecode`, README "Tests"), every `glsandbox`
-# subprocess compiles numpy, moderngl, Pillow and glsandbox again: 0.6 s a start instead
-# of 0.2 s. The modules this process imported while collecting (the same ones) are
-# compiled once here, and again only when their source is newer.
+# subprocess compiles numpy, moderngl, Pillow and glsandbox again (issue 24: `glsandbox
+# render` started in 0.63 s instead of 0.23 s on a quiet machine). The modules this process
+# imported while collecting (the same ones) are compiled once here, and again only when
+# their source is newer.
 
 
 def pytest_collection_finish(session: pytest.Session) -> None:
