@@ -25,7 +25,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("renderers", ("glsandbox.gl", "glsandbox.raytrace")),
     ("one frame", ("glsandbox.frame",)),
     ("window and measuring", ("glsandbox.window", "glsandbox.panel", "glsandbox.controls", "glsandbox.notebook",
-                              "glsandbox.measure")),
+                              "glsandbox.notebook_view", "glsandbox.course_page", "glsandbox.measure")),
     ("command line", ("glsandbox.cli", "glsandbox.pytest_plugin")),
 ]
 

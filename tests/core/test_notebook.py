@@ -70,9 +70,11 @@ def test_widget_text_fields_report_a_bad_value_and_keep_the_picture(gl) -> None:
     assert box.error.value == "" and box.image.value != before
 
 
-def test_without_ipywidgets_widget_says_what_to_install(monkeypatch) -> None:
-    monkeypatch.setitem(sys.modules, "ipywidgets", None)  # `import ipywidgets` raises ImportError
+@pytest.mark.parametrize("helper, module", [("widget", "ipywidgets"), ("view", "jupyter_rfb")])
+def test_without_the_notebook_extra_the_helpers_say_what_to_install(monkeypatch, helper: str, module: str) -> None:
+    monkeypatch.setitem(sys.modules, module, None)  # `import MODULE` raises ImportError
+    monkeypatch.delitem(sys.modules, "glsandbox.notebook_view", raising=False)  # imported again, without it
     with pytest.raises(SandboxError) as caught:
-        glsandbox.widget("phong")
-    assert str(caught.value).startswith("glsandbox.widget needs ipywidgets: install the notebook extra")
-    assert len(str(caught.value).splitlines()) == 1
+        getattr(glsandbox, helper)("phong")
+    assert str(caught.value) == (f"glsandbox.{helper} needs {module}: install the notebook extra "
+                                 "(pip install 'glsandbox[notebook]', or uv sync --extra notebook)")
