@@ -53,6 +53,11 @@ def test_a_nameless_lesson_takes_the_file_stem_and_a_helper_module_beside_it_imp
     assert str(tmp_path) not in __import__("sys").path  # the folder was on sys.path only while importing
 
 
+def test_unknown_lesson_suggests_the_closest_name() -> None:
+    with pytest.raises(SandboxError, match="did you mean 'indexed_cube'"):
+        find_lesson("indexed_cub")
+
+
 def test_lesson_picks_one_of_several(tmp_path: Path) -> None:
     path = tmp_path / "two.py"
     path.write_text(NAMELESS + NAMELESS.replace("class Box", "class Other").split("\n", 3)[3] + "\nLESSON = Other\n")
