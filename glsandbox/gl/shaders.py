@@ -36,7 +36,15 @@ import moderngl
 
 from glsandbox.errors import SandboxError
 from glsandbox.files import read_user_file
+from glsandbox.gl.shader_limits import check_array_sizes
 from glsandbox.plan import ProgramVariant
+
+#: How deep ``#include`` may nest (the top file is depth 0); deeper is a mistake, most
+#: likely a chain that never ends, and is refused before Python's own recursion limit.
+MAX_INCLUDE_DEPTH = 32
+#: The most lines one assembled stage may have: a file included many times over
+#: (each of 10 includes including 10 ...) grows as a power, without a cycle.
+MAX_SHADER_LINES = 200_000
 
 _INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"\s*(?://.*)?$')
 _ANY_INCLUDE = re.compile(r"^\s*#\s*include\b")
@@ -111,12 +119,18 @@ def assemble(name: str, stage: str, defines: tuple[tuple[str, str], ...] = (), r
     stages_seen: set[str] = set()  # the stage macros the files mention
 
     def emit(text: str, path: Path, line_no: int) -> None:
+        if len(out) >= MAX_SHADER_LINES:
+            raise SandboxError(f"{path}:{line_no}: the shader, with its includes, has more than "
+                               f"{MAX_SHADER_LINES:,} lines (a file included over and over?)")
         out.append(text)
         origins.append((path, line_no))
 
     def read(path: Path, included_from: str | None, stack: tuple[Path, ...]) -> None:
         if path in stack:
             raise SandboxError(f"{included_from}: #include cycle through {path.name}")
+        if len(stack) > MAX_INCLUDE_DEPTH:
+            raise SandboxError(f"{included_from}: #include nested more than {MAX_INCLUDE_DEPTH} files deep "
+                               f"(from {stack[0]}); a chain of includes that never ends?")
         lines = _read_lines(path, included_from)
         for line_no, line in enumerate(lines, start=1):
             if _VERSION.match(line):
@@ -153,7 +167,9 @@ def assemble(name: str, stage: str, defines: tuple[tuple[str, str], ...] = (), r
         # (A built-in file without one fails to compile, at the line the compiler names.)
         raise SandboxError(f"{top}: no {_STAGES[stage]} section; a shader file holds both stages: "
                            "#if defined(VERTEX_SHADER) ... #elif defined(FRAGMENT_SHADER) ... #endif")
-    return Source("\n".join(out) + "\n", origins)
+    text = "\n".join(out) + "\n"
+    check_array_sizes(text, origins, shader_root())
+    return Source(text, origins)
 
 
 def _include(relative: str, including: Path, roots: list[Path], where: str) -> Path:
