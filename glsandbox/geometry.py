@@ -141,9 +141,11 @@ def _as_array(mesh: Mesh, field_name: str, value: object) -> np.ndarray:
 def _check_indices(mesh: Mesh, count: int) -> None:
     """An index buffer of whole numbers, each naming one of the ``count`` vertices."""
     indices = mesh.indices if isinstance(mesh.indices, np.ndarray) else _as_array(mesh, "indices", mesh.indices)
-    if indices.dtype.kind not in "iu" or indices.ndim != 1:
+    if indices.dtype.kind not in "iu" or indices.ndim not in (1, 2):
         raise SandboxError(f"mesh {mesh.name!r}: indices must be a flat array of integers, "
                            f"got shape {indices.shape} of {indices.dtype}")
+    if indices.ndim == 2:  # (T, 3) triangles: the flat buffer the GPU reads, three per row
+        indices = indices.reshape(-1)
     if indices is not mesh.indices:
         object.__setattr__(mesh, "indices", indices)
     if not len(indices):

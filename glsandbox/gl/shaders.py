@@ -42,9 +42,11 @@ from glsandbox.plan import ProgramVariant
 #: How deep ``#include`` may nest (the top file is depth 0); deeper is a mistake, most
 #: likely a chain that never ends, and is refused before Python's own recursion limit.
 MAX_INCLUDE_DEPTH = 32
-#: The most lines one assembled stage may have: a file included many times over
-#: (each of 10 includes including 10 ...) grows as a power, without a cycle.
-MAX_SHADER_LINES = 200_000
+#: The most ``#include`` lines one stage may follow, and the most lines it may
+#: assemble to: a file included many times over (10 includes each including 10
+#: ...) grows as a power without a cycle or a deep chain.
+MAX_INCLUDES = 1_000
+MAX_SHADER_LINES = 100_000
 
 _INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"\s*(?://.*)?$')
 _ANY_INCLUDE = re.compile(r"^\s*#\s*include\b")
@@ -117,6 +119,7 @@ def assemble(name: str, stage: str, defines: tuple[tuple[str, str], ...] = (), r
     out: list[str] = []
     origins: list[tuple[Path, int]] = []
     stages_seen: set[str] = set()  # the stage macros the files mention
+    followed = [0]  # #include lines followed so far
 
     def emit(text: str, path: Path, line_no: int) -> None:
         if len(out) >= MAX_SHADER_LINES:
@@ -146,6 +149,10 @@ def assemble(name: str, stage: str, defines: tuple[tuple[str, str], ...] = (), r
             if include is None and _ANY_INCLUDE.match(line):
                 raise SandboxError(f"{path}:{line_no}: expected #include \"file.glsl\", got {line.strip()!r}")
             if include:
+                followed[0] += 1
+                if followed[0] > MAX_INCLUDES:
+                    raise SandboxError(f"{path}:{line_no}: more than {MAX_INCLUDES:,} #include lines followed "
+                                       "for one shader (a file included over and over?)")
                 read(_include(include.group(1), path, roots, f"{path}:{line_no}"), f"{path}:{line_no}",
                      (*stack, path))
                 continue
