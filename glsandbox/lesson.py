@@ -335,21 +335,18 @@ def _definition_site(cls: type) -> str:
 
 
 def built_scene(lesson: Lesson) -> Scene:
-    """``lesson.build()``, checked to be a Scene. For a lesson file, a mistake in its
-    ``build()`` is one line naming the file and line: a :class:`SandboxError` it
-    raised, or any other exception (:func:`user_code_error`)."""
-    source = lesson_source(type(lesson))
+    """``lesson.build()``, checked to be a Scene. A :class:`SandboxError` raised in a lesson
+    file's ``build()`` (a Scene, Node or Mesh refusing a value) gets the file and line
+    it came from in front. (Any other exception is the lesson's own code: its traceback
+    is shown, see README "The rule for a lesson file".)"""
     try:
         scene = lesson.build()
     except SandboxError as exc:
+        source = lesson_source(type(lesson))
         line = _user_line(exc, str(source)) if source is not None else 0
         if line and not str(exc).startswith(str(source)):
             raise SandboxError(f"{source}:{line}: {exc}") from None
         raise
-    except Exception as exc:
-        if source is None or issubclass(type(lesson), SceneFileLesson):
-            raise  # the project's own code: a bug, with its traceback
-        raise user_code_error(exc) from None
     if not isinstance(scene, Scene):
         code = getattr(type(lesson).build, "__code__", None)
         where = f"{code.co_filename}:{code.co_firstlineno}: " if code is not None else ""

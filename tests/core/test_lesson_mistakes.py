@@ -55,7 +55,6 @@ MISTAKES: dict[str, tuple[str, list[str]]] = {
     "a param named like a shared one": (HEADER + "class Mine(Lesson):\n    params = (Param('time', 1.0, 'a'),)\n\n"
                                         "    def build(self):\n        return Scene('s')\n",
                                         [":5:", "parameter 'time' defined again", "every lesson has it"]),
-    "a ZeroDivisionError in build": (body("return 1 / 0"), ["ZeroDivisionError at ", ":7: division by zero"]),
 }
 
 
