@@ -178,7 +178,7 @@ def test_a_raster_frame_never_loads_the_ray_tracer_and_import_glsandbox_loads_no
     result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=ROOT)
     assert result.returncode == 0, result.stderr
     if result.stdout.startswith("no-gl"):
-        from conftest import need
+        from support import need
 
         need("a GL backend", result.stdout)
     assert result.stdout.strip() == "ok"
