@@ -5,33 +5,31 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from support import run_cli
 
-from glsandbox import cli
 from glsandbox.frame import with_samples
 from glsandbox.lesson import all_lessons, find_lesson
 
 
-def run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
-    capsys.readouterr()
-    status = cli.main(args)
-    captured = capsys.readouterr()
-    return status, captured.out, captured.err
+def run(*args: str) -> tuple[int, str, str]:
+    result = run_cli(*args)
+    return result.returncode, result.stdout, result.stderr
 
 
-def test_plan_of_a_ray_traced_lesson_prints_its_trace_and_no_raster_draws(capsys) -> None:
-    status, out, err = run(["plan", "ray_phong", "--set", "renderer=ray"], capsys)
+def test_plan_of_a_ray_traced_lesson_prints_its_trace_and_no_raster_draws() -> None:
+    status, out, err = run("plan", "ray_phong", "--set", "renderer=ray")
     assert status == 0 and err == ""
     lines = out.splitlines()
     assert lines[:4] == ["plan for ray_phong", "buffers: colour RGBA8, no MSAA", "programs:", "  overlay"]
     assert lines[5].startswith("  1. trace viewport 0 (GLSL ray tracer, float32, 1 primary ray per pixel, ")
     assert "depth 24" not in out and "phong[" not in out and "draw viewport" not in out
     # the same lesson rasterized: Phong draws with a depth buffer, no trace
-    status, out, _ = run(["plan", "ray_phong", "--set", "renderer=raster"], capsys)
+    status, out, _ = run("plan", "ray_phong", "--set", "renderer=raster")
     assert "depth 24" in out and "draw viewport 0 (depth test)" in out and "trace" not in out
 
 
-def test_list_verbose_shows_each_lessons_own_defaults(capsys) -> None:
-    status, out, _ = run(["list", "-v"], capsys)
+def test_list_verbose_shows_each_lessons_own_defaults() -> None:
+    status, out, _ = run("list", "-v")
     assert status == 0
     blocks: dict[str, list[str]] = {}
     for line in out.splitlines():
@@ -58,9 +56,9 @@ def test_list_verbose_shows_each_lessons_own_defaults(capsys) -> None:
     (["--set", "renderer=ray", "--set", "shading=blinn_phong"], []),  # the ray tracer does Blinn-Phong
 ])
 def test_a_setting_the_renderer_ignores_is_one_warning_line(settings: list[str], warned: list[str],
-                                                            tmp_path: Path, capsys, gl) -> None:
+                                                            tmp_path: Path, gl) -> None:
     out = tmp_path / "out.png"
-    status, stdout, err = run(["render", "phong", "--size", "32x24", "--out", str(out), *settings], capsys)
+    status, stdout, err = run("render", "phong", "--size", "32x24", "--out", str(out), *settings)
     assert status == 0 and out.is_file() and stdout.startswith("wrote ")
     lines = err.splitlines()
     assert len(lines) == len(warned), err
@@ -70,8 +68,8 @@ def test_a_setting_the_renderer_ignores_is_one_warning_line(settings: list[str],
 
 def test_the_sampled_picture_really_is_the_same_and_the_warning_says_it_once(tmp_path: Path, capsys, gl) -> None:
     plain, four = tmp_path / "plain.png", tmp_path / "four.png"
-    run(["render", "ray_spheres", "--size", "40x30", "--out", str(plain)], capsys)
-    status, _, err = run(["render", "ray_spheres", "--size", "40x30", "--samples", "4", "--out", str(four)], capsys)
+    run("render", "ray_spheres", "--size", "40x30", "--out", str(plain))
+    status, _, err = run("render", "ray_spheres", "--size", "40x30", "--samples", "4", "--out", str(four))
     assert status == 0 and plain.read_bytes() == four.read_bytes()  # the warning's claim
     assert err.startswith("warning: --samples 4: ") and err.count("\n") == 1
     # a window draws many frames: the warning is said once per run, not per frame

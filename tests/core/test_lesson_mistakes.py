@@ -9,13 +9,13 @@ raises :class:`SandboxError` with one line.
 
 from __future__ import annotations
 
-import warnings
 from pathlib import Path
 
 import numpy as np
 import pytest
+from support import assert_user_error, glsandbox, run_cli
 
-from glsandbox import Lesson, Mesh, Node, Param, SandboxError, Scene, cli, geometry
+from glsandbox import Lesson, Mesh, Node, Param, SandboxError, Scene, geometry
 from glsandbox.files import save_png
 
 HEADER = "import numpy as np\nfrom glsandbox import Lesson, Mesh, Node, Param, Scene, geometry\n\n\n"
@@ -58,20 +58,12 @@ MISTAKES: dict[str, tuple[str, list[str]]] = {
 }
 
 
-def run_cli(args: list[str], folder: Path, capsys: pytest.CaptureFixture[str]) -> str:
-    """Run the CLI in this process; assert the error contract and return the one error line."""
-    before = set(folder.rglob("*"))
-    capsys.readouterr()
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        status = cli.main(args)
-    err = capsys.readouterr().err
-    assert [str(w.message) for w in caught] == []
-    assert status == 2, err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: "), err
-    assert set(folder.rglob("*")) == before, "files left behind"
-    return lines[0]
+def one_error(folder: Path, *args: str) -> str:
+    """Run the CLI in this process; the contract (exit 2, one ``error:`` line, nothing left in
+    ``folder``) is checked by :func:`support.run_cli`; returns the line."""
+    run = run_cli(*args, unchanged=folder)
+    assert run.returncode == 2, run
+    return run.stderr.strip()
 
 
 @pytest.fixture
@@ -89,36 +81,37 @@ def assert_names(line: str, path: Path, expected: list[str]) -> None:
 
 
 @pytest.mark.parametrize("lesson_file", list(MISTAKES), indirect=True)
-def test_render_with_each_renderer_and_plan_say_one_line(lesson_file, tmp_path: Path, capsys, gl) -> None:
+def test_render_with_each_renderer_and_plan_say_one_line(lesson_file, tmp_path: Path, gl) -> None:
     path, expected = lesson_file
     out = tmp_path / "out.png"
     for renderer in ("raster", "ray", "ray_numpy"):
-        line = run_cli(["render", str(path), "--size", "32x24", "--set", f"renderer={renderer}", "--out", str(out)],
-                       tmp_path, capsys)
+        line = one_error(tmp_path, "render", str(path), "--size", "32x24", "--set", f"renderer={renderer}",
+                         "--out", str(out))
         assert_names(line, path, expected)
-    assert_names(run_cli(["plan", str(path)], tmp_path, capsys), path, expected)
+    assert_names(one_error(tmp_path, "plan", str(path)), path, expected)
 
 
 @pytest.mark.parametrize("lesson_file", ["build returns None", "an index past the vertices",
                                          "a default not among the choices"], indirect=True)
-def test_check_against_a_golden_says_one_line(lesson_file, tmp_path: Path, capsys, gl) -> None:
+def test_check_against_a_golden_says_one_line(lesson_file, tmp_path: Path, gl) -> None:
     path, expected = lesson_file
     reference = tmp_path / "ref.png"
     save_png(np.zeros((24, 32, 4), dtype=np.uint8), reference)
     before = reference.read_bytes()
-    assert_names(run_cli(["check", str(path), "--golden", str(reference)], tmp_path, capsys), path, expected)
+    assert_names(one_error(tmp_path, "check", str(path), "--golden", str(reference)), path, expected)
     assert reference.read_bytes() == before
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("lesson_file", ["build returns None", "NaN positions", "params = 5"], indirect=True)
-def test_run_says_one_line_and_opens_no_window_for_long(lesson_file, tmp_path: Path, capsys, monkeypatch,
-                                                        xvfb_display: str) -> None:
+def test_run_says_one_line_and_leaves_no_window(lesson_file, tmp_path: Path, xvfb_display: str) -> None:
+    """``glsandbox run`` in its own process (a window and this process's EGL context do not mix)."""
     path, expected = lesson_file
-    monkeypatch.setenv("DISPLAY", xvfb_display)
-    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
-    monkeypatch.chdir(tmp_path)  # F12's screenshots/ would land here: nothing may
-    assert_names(run_cli(["run", str(path)], tmp_path, capsys), path, expected)
+    before = set(tmp_path.rglob("*"))
+    proc = glsandbox("run", str(path), env={"DISPLAY": xvfb_display, "WAYLAND_DISPLAY": ""}, cwd=tmp_path)
+    assert_user_error(proc)
+    assert_names(proc.stderr.strip(), path, expected)
+    assert set(tmp_path.rglob("*")) == before
 
 
 # --- the same mistakes made in Python ------------------------------------------

@@ -7,17 +7,15 @@ README promised the refusal in red, as the model lesson's mesh field does.
 from __future__ import annotations
 
 import json
-import os
 import shutil
-import subprocess
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 import pytest
+from support import LessonWindow, need, run_cli
 
-from glsandbox import SandboxError, cli
+from glsandbox import SandboxError
 from glsandbox.controls import parse_value
 from glsandbox.files import save_png
 from glsandbox.lesson import find_lesson
@@ -41,13 +39,10 @@ def test_the_image_is_checked_when_it_is_given(tmp_path: Path) -> None:
         assert message.startswith(f"panel image={text}: ") and said in message, message
 
 
-def test_render_refuses_a_bad_image_in_one_line(tmp_path: Path, capsys, gl) -> None:
-    out = tmp_path / "out.png"
-    capsys.readouterr()
-    status = cli.main(["render", "texture", "--set", "ground=nope.jpg", "--size", "32x24", "--out", str(out)])
-    err = capsys.readouterr().err
-    assert status == 2 and err == "error: --set ground=nope.jpg: texture file nope.jpg not found\n"
-    assert not out.exists()
+def test_render_refuses_a_bad_image_in_one_line(tmp_path: Path, gl) -> None:
+    run = run_cli("render", "texture", "--set", "ground=nope.jpg", "--size", "32x24", "--out",
+                  str(tmp_path / "out.png"), unchanged=tmp_path)
+    assert run.returncode == 2 and run.stderr == "error: --set ground=nope.jpg: texture file nope.jpg not found\n"
 
 
 # --- in the window (Xvfb, xdotool) ----------------------------------------------
@@ -68,62 +63,38 @@ class Pictured(Lesson):
 '''
 
 
-class Window:
-    """A ``glsandbox run`` window on the test's X server, its panel's widget boxes in a file."""
+class Window(LessonWindow):
+    """``glsandbox run ARGS`` on the test's X server, its panel's widget boxes in a file."""
 
     def __init__(self, display: str, cwd: Path, *args: str) -> None:
         self.layout = cwd / "layout.json"
-        self.env = {**os.environ, "DISPLAY": display, "GLSANDBOX_PANEL_LAYOUT": str(self.layout)}
-        self.proc = subprocess.Popen([sys.executable, "-m", "glsandbox.cli", "run", *args, "--size",
-                                      f"{SIZE[0]}x{SIZE[1]}"], cwd=cwd, env=self.env,
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        self.id = self.wait(lambda: self.xdotool("search", "--name", "glsandbox").split()[:1])[0]
-
-    def xdotool(self, *args: str) -> str:
-        return subprocess.run(["xdotool", *args], capture_output=True, text=True, env=self.env, timeout=20).stdout
-
-    def wait(self, probe, timeout: float = 30.0):
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            assert self.proc.poll() is None, f"the window closed: {self.proc.stderr.read()}"
-            value = probe()
-            if value:
-                return value
-            time.sleep(0.1)
-        raise AssertionError("timed out")
-
-    def title(self) -> str:
-        return self.xdotool("getwindowname", self.id).strip()
+        super().__init__(display, cwd, "glsandbox.cli", "run", *args, "--size", f"{SIZE[0]}x{SIZE[1]}",
+                         env={"GLSANDBOX_PANEL_LAYOUT": str(self.layout)})
 
     def type_into(self, label: str, text: str) -> None:
+        """Click the panel's text field ``label``, replace its text with ``text``, press Enter."""
         def box():
             return self.layout.exists() and json.loads(self.layout.read_text() or "{}").get("items", {}).get(label)
 
-        x0, y0, x1, y1 = self.wait(box)
-        self.xdotool("mousemove", "--sync", str(int((x0 + x1) / 2)), str(int((y0 + y1) / 2)))
-        self.xdotool("click", "1")
+        x0, y0, x1, y1 = self._wait(box)
+        self._xdotool("mousemove", "--sync", str(int((x0 + x1) / 2)), str(int((y0 + y1) / 2)))
+        self._xdotool("click", "1")
         time.sleep(0.3)
-        self.xdotool("key", "ctrl+a")
-        self.xdotool("type", "--delay", "20", text)
-        self.xdotool("key", "Return")
+        self._xdotool("key", "ctrl+a")
+        self._xdotool("type", "--delay", "20", text)
+        self._xdotool("key", "Return")
         time.sleep(1.0)  # a few frames
 
-    def close(self) -> tuple[int, str]:
-        self.xdotool("windowfocus", "--sync", self.id)
-        self.xdotool("key", "Escape")
-        try:
-            code = self.proc.wait(timeout=20)
-        finally:
-            if self.proc.poll() is None:
-                self.proc.kill()
+    def finish(self) -> tuple[int, str]:
+        """ESC; the exit code and everything the window wrote on stderr."""
+        code = self.close()
         return code, self.proc.stderr.read()
 
 
 @pytest.fixture
 def display(xvfb_display: str) -> str:
-    if shutil.which("xdotool") is None:  # skipped here, a failure on CI (conftest's rule)
-        message = "xdotool unavailable: not installed (apt-get install xdotool)"
-        pytest.fail(message, pytrace=False) if os.environ.get("CI") else pytest.skip(message)
+    if shutil.which("xdotool") is None:
+        need("xdotool", "not installed (apt-get install xdotool)")
     return xvfb_display
 
 
@@ -131,12 +102,12 @@ def display(xvfb_display: str) -> str:
 def test_a_refused_path_in_the_panel_keeps_the_window(display: str, tmp_path: Path) -> None:
     win = Window(display, tmp_path, "texture", "--set", "speed=0")
     try:
-        win.wait(lambda: "fps" in win.title())
+        win.wait_title(lambda t: "fps" in t)
         win.type_into("image", "missing.png")
         assert win.proc.poll() is None  # still open
         assert "error" not in win.title()  # the lesson keeps drawing its last good value
     finally:
-        code, err = win.close()
+        code, err = win.finish()
     assert code == 0, err
     assert "error: panel image=missing.png: texture file missing.png not found" in err.splitlines()
 
@@ -148,13 +119,13 @@ def test_a_value_only_drawing_refuses_keeps_the_last_good_frame(display: str, tm
     (tmp_path / "pictured.py").write_text(OWN_LESSON)
     win = Window(display, tmp_path, "pictured.py")
     try:
-        win.wait(lambda: "fps" in win.title())
+        win.wait_title(lambda t: "fps" in t)
         win.type_into("image", "missing.png")
-        title = win.wait(lambda: "lesson error" in (t := win.title()) and t)
+        title = win.wait_title(lambda t: "lesson error" in t)
         assert "texture file missing.png not found" in title and win.proc.poll() is None
         win.type_into("image", "labels")
-        win.wait(lambda: "error" not in win.title())
+        win.wait_title(lambda t: "error" not in t)
     finally:
-        code, err = win.close()
+        code, err = win.finish()
     assert code == 0, err
     assert err.count("error: texture file missing.png not found") == 1  # said once, not every frame
