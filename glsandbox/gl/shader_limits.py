@@ -15,9 +15,9 @@ The sizes are read as the preprocessor and the compiler would fold them when
 they are integer constants: literals (``100``, ``0x40``, ``8u``), names
 ``#define``'d in the user's files, and ``const int`` names, joined with
 ``+ - * / % << >>`` and parentheses. A size made some other way (a function
-call, a macro with arguments) is left to the compiler. Lines of the built-in
-shader folder are not looked at: their sizes come from the loader's own
-defines.
+call, a macro with arguments, a define the loader adds such as ``NUM_LIGHTS``)
+is left to the compiler. Lines of the built-in shader folder are not looked
+at: their sizes come from the loader's own defines.
 """
 
 from __future__ import annotations
@@ -42,13 +42,16 @@ _INT_LITERAL = re.compile(r"\b(0[xX][0-9a-fA-F]+|\d+)[uU]?\b")
 _CAP = 1 << 62
 
 
-def check_array_sizes(text: str, origins: list[tuple[Path, int]], builtin_root: Path) -> None:
+def check_array_sizes(text: str, origins: list[tuple[Path, int]], builtin_root: Path,
+                      injected: set[int] | frozenset[int] = frozenset()) -> None:
     """Refuse an array above :data:`MAX_ARRAY_ELEMENTS` in the lines of ``text`` that come
-    from files outside ``builtin_root`` (``origins`` gives each line's file and line)."""
+    from files outside ``builtin_root`` (``origins`` gives each line's file and line).
+    The lines at the indices in ``injected`` are the loader's own defines: not the user's,
+    so a size made of them (``NODE_COUNT * NODE_RECORDS``) is not judged."""
     lines = _COMMENTS.sub(lambda m: "\n" * m.group(0).count("\n"), text).split("\n")
     root = builtin_root.resolve()
     outside = {path: not path.resolve().is_relative_to(root) for path in {path for path, _ in origins}}
-    own = [i for i, (path, _) in enumerate(origins[:len(lines)]) if outside[path]]
+    own = [i for i, (path, _) in enumerate(origins[:len(lines)]) if outside[path] and i not in injected]
     if not own:
         return
     names: dict[str, str] = {}

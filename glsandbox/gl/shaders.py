@@ -120,6 +120,7 @@ def assemble(name: str, stage: str, defines: tuple[tuple[str, str], ...] = (), r
     origins: list[tuple[Path, int]] = []
     stages_seen: set[str] = set()  # the stage macros the files mention
     followed = [0]  # #include lines followed so far
+    injected: set[int] = set()  # the loader's own lines (the stage and variant defines), by index
 
     def emit(text: str, path: Path, line_no: int) -> None:
         if len(out) >= MAX_SHADER_LINES:
@@ -141,8 +142,10 @@ def assemble(name: str, stage: str, defines: tuple[tuple[str, str], ...] = (), r
                     raise SandboxError(f"{path}:{line_no}: #version is only allowed in the top file")
                 emit(line, path, line_no)
                 # Injected lines are attributed to the #version line.
+                injected.add(len(out))
                 emit(f"#define {_STAGES[stage]}", path, line_no)
                 for key, value in defines:
+                    injected.add(len(out))
                     emit(f"#define {key} {value}".rstrip(), path, line_no)
                 continue
             include = _INCLUDE.match(line)
@@ -175,7 +178,7 @@ def assemble(name: str, stage: str, defines: tuple[tuple[str, str], ...] = (), r
         raise SandboxError(f"{top}: no {_STAGES[stage]} section; a shader file holds both stages: "
                            "#if defined(VERTEX_SHADER) ... #elif defined(FRAGMENT_SHADER) ... #endif")
     text = "\n".join(out) + "\n"
-    check_array_sizes(text, origins, shader_root())
+    check_array_sizes(text, origins, shader_root(), injected)
     return Source(text, origins)
 
 

@@ -121,3 +121,16 @@ def test_the_cli_renders_nothing_and_says_one_line(tmp_path: Path, gl) -> None:
     scene.write_text(SCENE)
     run = run_cli("render", str(scene), "--size", "32x24", "--out", str(tmp_path / "out.png"), unchanged=tmp_path)
     assert_user_error(run, f"{tmp_path / 'toon.glsl'}:", "100,000,000 elements")
+
+
+def test_an_edited_copy_of_the_built_in_shaders_passes(tmp_path: Path) -> None:
+    """GLSANDBOX_SHADER_DIR's copies are the user's files, but the GLSL ray tracer's record
+    arrays are sized by the loader's defines, which a copy does not spell out: not refused."""
+    import shutil
+
+    copy = tmp_path / "shaders"
+    shutil.copytree(shader_root(), copy)
+    defines = (("NUM_LIGHTS", "2"), ("NODE_COUNT", "100000"), ("TRI_COUNT", "100000"))
+    for stage in ("vertex_shader", "fragment_shader"):
+        source = assemble("raytrace", stage, defines, root=copy)
+        assert any(path.is_relative_to(copy) for path, _ in source.origins)
