@@ -403,7 +403,10 @@ def _trace_pass(scene: Scene, index: int) -> Pass:
 def ignored_settings_notes(scene: Scene) -> tuple[str, ...]:
     """What a ray-traced viewport ignores of what the scene asks, one note each: Gouraud
     shading and naive normals (raster approximations: the ray tracer shades every pixel
-    with the normal matrix), MSAA (one ray per pixel), reverse-Z (a depth buffer)."""
+    with the normal matrix), texture filters other than ``linear`` (a ray samples the
+    base level bilinearly), the planar mirror and shadow (raster techniques: the ray
+    tracer traces reflection and shadow rays), MSAA (one ray per pixel), reverse-Z
+    (a depth buffer)."""
     ray = [i for i, vp in enumerate(scene.viewports) if vp.renderer != "raster"]
     if not ray:
         return ()
@@ -419,6 +422,22 @@ def ignored_settings_notes(scene: Scene) -> tuple[str, ...]:
             notes.append(f"{where} ray-traced: {what} (node{'s' if len(picked) > 1 else ''} "
                          f"{', '.join(repr(name) for name in picked)}) is a raster approximation; "
                          f"the ray tracer ignores it: {instead}")
+    filtered = {}
+    for node in shown:
+        texture = node.material.texture
+        if texture is not None and texture.filter != "linear":
+            filtered.setdefault(texture.filter, []).append(node.name)
+    for name, nodes in filtered.items():
+        notes.append(f"{where} ray-traced: texture filter {name} (node{'s' if len(nodes) > 1 else ''} "
+                     f"{', '.join(repr(n) for n in nodes)}) is the rasterizer's sampler; the ray tracer samples "
+                     "the base level bilinearly (filter=linear, no mipmaps: a ray has no footprint)")
+    if scene.mirror is not None and any(node.name == scene.mirror.node for node in shown):
+        how = "through the stencil" if scene.mirror.stencil else "without the stencil (it leaks)"
+        notes.append(f"{where} ray-traced: the planar mirror {scene.mirror.node!r} drawn {how} is a raster "
+                     "technique; the ray tracer traces reflection rays off the glass instead")
+    if scene.shadow is not None and any(node.name == scene.shadow.receiver for node in shown):
+        notes.append(f"{where} ray-traced: the planar shadow on {scene.shadow.receiver!r} is a raster technique; "
+                     "the ray tracer casts shadow rays to the lights instead")
     if scene.samples > 1:
         every = "every viewport is" if len(ray) == len(scene.viewports) else f"{where}"
         notes.append(f"--samples {scene.samples}: MSAA smooths rasterized edges only and {every} ray-traced "

@@ -96,3 +96,21 @@ def test_the_mirrors_glass_reflects_as_the_tracer_traces_it() -> None:
     assert traced_reflectivity(scene, other) == other.material.reflectivity
     traced = plan(replace(scene, viewports=tuple(replace(v, renderer="ray") for v in scene.viewports)))
     assert f"{glass.name} (" in traced.passes[0].describe()
+
+
+def test_raster_techniques_and_samplers_under_the_ray_tracer_are_notes(gl) -> None:
+    mirror = ignored_settings_notes(lesson_scene("mirror", "renderer=ray", "mirror=no_stencil"))
+    assert [note.split(": ", 1)[1].split(" is ")[0] for note in mirror] == [
+        "the planar mirror 'glass' drawn without the stencil (it leaks)", "the planar shadow on 'floor'",
+        "depth mode reverse_z"]
+    assert ignored_settings_notes(lesson_scene("mirror", "renderer=raster")) == ()
+    texture = ignored_settings_notes(lesson_scene("texture", "renderer=ray", "filter=anisotropic"))
+    assert texture == ("viewport 0 is ray-traced: texture filter anisotropic (nodes 'ground', 'cube') is the "
+                       "rasterizer's sampler; the ray tracer samples the base level bilinearly (filter=linear, "
+                       "no mipmaps: a ray has no footprint)",)
+    assert ignored_settings_notes(lesson_scene("texture", "renderer=ray", "filter=linear")) == ()
+    # the claim: under the ray tracer every filter gives the linear picture
+    pictures = [gl.render_scene(lesson_scene("texture", "renderer=ray", f"filter={name}", "time=1"), (48, 36)).image
+                for name in ("linear", "mip_linear", "nearest")]
+    np.testing.assert_array_equal(pictures[0], pictures[1])
+    np.testing.assert_array_equal(pictures[0], pictures[2])
