@@ -109,7 +109,7 @@ class InteractiveResolution:
     """The interactive ray tracer's rule: coarse while the camera moves, full when still.
 
     :meth:`resolution` is called once per window frame with the scene about
-    to be drawn; while its camera differs from the last frame's (or did
+    to be drawn; while its camera or a node's model matrix differs from the last frame's (or did
     within ``settle`` seconds) it answers ``moving`` (a quarter of the
     pixels each way by default: 16 times fewer rays), then 1.
     """
@@ -122,7 +122,10 @@ class InteractiveResolution:
 
     def resolution(self, scene: Scene, now: float | None = None) -> float:
         now = time.perf_counter() if now is None else now
-        cameras = tuple(vp.camera or scene.camera for vp in scene.viewports)
+        # The picture moves when a camera does or a node does (the model lesson's turning
+        # model): a big model is then traced coarse, and the window keeps answering.
+        cameras = (tuple(vp.camera or scene.camera for vp in scene.viewports),
+                   tuple(np.asarray(node.model).tobytes() for node in scene.nodes))
         if self._last is not None and cameras != self._last:
             self._moved_at = now
         self._last = cameras
@@ -164,16 +167,17 @@ class FrameRenderer:
         """Draw one frame; returns its plan (with a ``trace`` pass per ray-traced viewport)
         and the target holding it. ``ray_resolution`` < 1 traces ray-traced viewports
         coarser (the window while moving). What a ray-traced viewport ignores of the
-        scene is one ``warning:`` line each on stderr, once per run."""
+        scene, and what a model file holds that is not drawn, is one ``warning:`` line
+        each on stderr, once per run."""
         self.host.make_current()
         traced = trace_viewports(scene, size, self.host.ctx, ray_resolution)
         raster_plan = plan(traced)
         target = self.target(size, raster_plan.buffers)
         self.executor.render(traced, target.framebuffer, size, raster_plan)
-        if traced is scene:
-            return raster_plan, target
-        frame_plan = plan(scene)  # the same passes, after the trace passes, with the notes
-        for note in frame_plan.notes:  # once per run, after a frame that worked (a failed one says only its error)
+        # The whole frame's plan: the same raster passes after the trace passes, with the
+        # notes and warnings of the scene as given (a traced viewport's nodes are an image now).
+        frame_plan = raster_plan if traced is scene else plan(scene)
+        for note in (*frame_plan.notes, *frame_plan.warnings):  # once per run, after a frame that worked
             if note not in self._noted:
                 self._noted.add(note)
                 print(f"warning: {note}", file=sys.stderr, flush=True)

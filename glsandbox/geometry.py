@@ -33,6 +33,9 @@ class Mesh:
     ``name`` identifies the mesh (GPU buffers are cached by it). ``notes``
     says where a loaded mesh came from and what loading did to it (dropped
     faces, how its normals were made): ``glsandbox plan`` prints them.
+    ``warnings`` says what of its file is not drawn (a normal map, an
+    animation, a missing texture): ``plan`` lists them and ``render``, ``run``
+    and ``tour`` print each once as a ``warning:`` line.
     """
 
     name: str
@@ -43,6 +46,7 @@ class Mesh:
     colors: np.ndarray | None = None
     mode: str = "triangles"
     notes: tuple[str, ...] = ()
+    warnings: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if self.mode not in MODES:
@@ -186,7 +190,8 @@ def with_face_normals(mesh: Mesh) -> Mesh:
             return None if array is None else np.asarray(array)[corners]
 
         flat = _FACE_NORMALS[mesh] = Mesh(f"{mesh.name}/face_normals", positions[corners], None, normals,
-                                          per_corner(mesh.uvs), per_corner(mesh.colors), notes=mesh.notes)
+                                          per_corner(mesh.uvs), per_corner(mesh.colors), notes=mesh.notes,
+                                          warnings=mesh.warnings)
     return flat
 
 

@@ -20,7 +20,7 @@ from glsandbox.planar import shadow_casters
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh
 from glsandbox.overlay import Overlay
-from glsandbox.scene import Node, Scene
+from glsandbox.scene import Camera, Node, Scene
 
 
 @dataclass(frozen=True, order=True)
@@ -70,6 +70,13 @@ class Draw:
     program: str  # a ProgramVariant key; in a trace pass, the shading the ray tracer gives the node
     cull_back_faces: bool
     texture: str | None = None  # what texture unit 0 holds, only for textured nodes
+    #: Alpha blending on and depth writes off (a material's ``alpha_mode = "blend"``).
+    blend: bool = False
+
+    def describe(self) -> str:
+        return (f"{self.node} with {self.program}" + ("" if self.cull_back_faces else " (no culling)")
+                + (" (blended, no depth writes)" if self.blend else "")
+                + (f" + texture unit 0: {self.texture}" if self.texture else ""))
 
 
 #: Stencil comparisons a pass may use (``glStencilFunc``).
@@ -161,10 +168,7 @@ class Pass:
             if self.clear_stencil:
                 what.append("stencil")
             return f"clear viewport {self.viewport}: " + " + ".join(what)
-        items = "; ".join(
-            f"{d.node} with {d.program}" + ("" if d.cull_back_faces else " (no culling)")
-            + (f" + texture unit 0: {d.texture}" if d.texture else "") for d in self.draws
-        )
+        items = "; ".join(d.describe() for d in self.draws)
         depth = "depth test" if self.depth_test else "no depth test"
         return f"draw viewport {self.viewport} ({depth}): {items}"
 
@@ -184,6 +188,10 @@ class Plan:
     #: What the frame does differently from what the scene asks (a node's own
     #: shader in a ray-traced viewport: :func:`user_shader_note`).
     notes: tuple[str, ...] = ()
+    #: What of the nodes' model files is not drawn (each mesh's
+    #: :attr:`~glsandbox.geometry.Mesh.warnings`, once each): ``render``, ``run``
+    #: and ``tour`` print them as ``warning:`` lines.
+    warnings: tuple[str, ...] = ()
 
     def describe(self) -> str:
         """A readable listing, as ``glsandbox plan`` prints it."""
@@ -197,6 +205,7 @@ class Plan:
         if self.notes:
             lines.append("notes:")
             lines += [f"  {line}" for line in self.notes]
+        lines += [f"warning: {line}" for line in self.warnings]
         return "\n".join(lines)
 
     def to_dict(self) -> dict[str, Any]:
@@ -211,6 +220,8 @@ class Plan:
             result["meshes"] = list(self.meshes)
         if self.notes:
             result["notes"] = list(self.notes)
+        if self.warnings:
+            result["warnings"] = list(self.warnings)
         return result
 
 
@@ -225,7 +236,8 @@ def program_for(node: Node, lights: int = 0) -> ProgramVariant:
         return _user_variant(str(node.shader), lights, material.texture is not None)
     if material.lit:
         return lit_program_for(node, lights)
-    return _basic_variant(material.shading == "vertex_color", material.texture is not None)
+    return _basic_variant(material.shading == "vertex_color", material.texture is not None,
+                          material.alpha_mode == "mask")
 
 
 @functools.cache
@@ -250,11 +262,16 @@ def _texture_defines(textured: bool) -> tuple[tuple[str, str], ...]:
     return (("TEXTURED", ""),) if textured else ()
 
 
+def _mask_defines(mask: bool) -> tuple[tuple[str, str], ...]:
+    """``ALPHA_MASK``: fragments whose alpha is below the material's cutoff are discarded."""
+    return (("ALPHA_MASK", ""),) if mask else ()
+
+
 # One ProgramVariant object per combination: planning runs every frame.
 @functools.cache
-def _basic_variant(vertex_color: bool, textured: bool) -> ProgramVariant:
+def _basic_variant(vertex_color: bool, textured: bool, mask: bool = False) -> ProgramVariant:
     source = "VERTEX_COLOR" if vertex_color else "SOLID_COLOR"
-    return ProgramVariant("basic", ((source, ""), *_texture_defines(textured)))
+    return ProgramVariant("basic", ((source, ""), *_texture_defines(textured), *_mask_defines(mask)))
 
 
 def lit_program_for(node: Node, lights: int) -> ProgramVariant:
@@ -264,13 +281,18 @@ def lit_program_for(node: Node, lights: int) -> ProgramVariant:
     slots are looped over); ``PER_VERTEX`` evaluates the formula at the
     vertices (Gouraud), ``BLINN`` uses the half vector, ``NAIVE_NORMALS``
     the course's ``mul(Input.Norm, world)`` instead of the normal matrix.
+    A model file's materials add ``VERTEX_COLOR`` (the mesh colour times the
+    vertex colours), ``TWO_SIDED`` (back faces lit with the normal reversed)
+    and ``ALPHA_MASK`` (cut-outs), each only for a material that asks.
     """
     material = node.material
-    return _lit_variant(lights, material.shading, material.normals, material.texture is not None)
+    return _lit_variant(lights, material.shading, material.normals, material.texture is not None,
+                        material.vertex_colors, material.double_sided, material.alpha_mode == "mask")
 
 
 @functools.cache
-def _lit_variant(lights: int, shading: str, normals: str, textured: bool) -> ProgramVariant:
+def _lit_variant(lights: int, shading: str, normals: str, textured: bool, vertex_colors: bool = False,
+                 two_sided: bool = False, mask: bool = False) -> ProgramVariant:
     defines: list[tuple[str, str]] = [("NUM_LIGHTS", str(lights))]
     if shading == "gouraud":
         defines.append(("PER_VERTEX", ""))
@@ -279,6 +301,11 @@ def _lit_variant(lights: int, shading: str, normals: str, textured: bool) -> Pro
     if normals == "naive":
         defines.append(("NAIVE_NORMALS", ""))
     defines.extend(_texture_defines(textured))
+    if vertex_colors:
+        defines.append(("VERTEX_COLOR", ""))
+    if two_sided:
+        defines.append(("TWO_SIDED", ""))
+    defines.extend(_mask_defines(mask))
     return ProgramVariant("phong", tuple(defines))
 
 
@@ -299,6 +326,23 @@ def _coplanar(positions: np.ndarray) -> bool:
     spread = points - points.mean(axis=0)
     singular = np.linalg.svd(spread, compute_uv=False)
     return len(singular) < 3 or singular[2] <= 1e-9 * max(singular[0], 1e-300)
+
+
+_CENTRES: weakref.WeakKeyDictionary[Mesh, np.ndarray] = weakref.WeakKeyDictionary()
+
+
+def _distance(node: Node, camera: Camera) -> float:
+    """How far the centre of a node's bounding box lies from the eye, in world space:
+    blended nodes are drawn farthest first, so each blends over what lies behind it
+    (sorted by part, not by triangle: a part that wraps round another can still be
+    wrong, as in any rasterizer that sorts objects)."""
+    centre = _CENTRES.get(node.mesh)
+    if centre is None:  # meshes are immutable: once per mesh, not per frame
+        points = np.asarray(node.mesh.positions, dtype=np.float64)
+        centre = (points.min(axis=0) + points.max(axis=0)) / 2.0 if points.size else np.zeros(3)
+        _CENTRES[node.mesh] = centre
+    world = np.asarray(node.model, dtype=np.float64) @ np.append(centre, 1.0)
+    return float(np.linalg.norm(world[:3] - np.asarray(camera.eye, dtype=np.float64)))
 
 
 def _needs_depth(scene: Scene) -> bool:
@@ -474,7 +518,7 @@ def plan(scene: Scene) -> Plan:
         return replace(drawn, passes=(*(_trace_pass(scene, i) for i in ray), *drawn.passes),
                        meshes=tuple(f"{node.name}: {', '.join(node.mesh.notes)}" for node in scene.nodes
                                     if node.mesh.notes),
-                       notes=renderer_notes(scene))
+                       notes=renderer_notes(scene), warnings=mesh_warnings(scene))
     # plan_mode "all": the everything-on baseline. Depth and stencil are allocated
     # and cleared in every viewport, and the depth test runs in every draw pass
     # (unless the scene turned depth testing off, which would change the picture).
@@ -486,7 +530,7 @@ def plan(scene: Scene) -> Plan:
         color = viewport.clear_color if viewport.clear_color is not None else scene.clear_color
         passes.append(Pass("clear", index, clear_color=color, clear_depth=uses_depth,
                            clear_stencil=force or _needs_stencil(scene)))
-        draws = []
+        draws, blended = [], []
         for node in scene.nodes:
             if not node.shown_in(index):
                 continue
@@ -495,8 +539,12 @@ def plan(scene: Scene) -> Plan:
             variant = program_for(node, len(scene.lights))
             programs.add(variant)
             texture = node.material.texture
-            draws.append(Draw(node.name, variant.key, node.cull_back_faces,
-                              texture=texture.describe() if texture is not None else None))
+            blend = node.material.alpha_mode == "blend"
+            (blended if blend else draws).append(
+                (node, Draw(node.name, variant.key, node.cull_back_faces,
+                            texture=texture.describe() if texture is not None else None, blend=blend)))
+        camera = viewport.camera or scene.camera
+        draws = [d for _, d in draws] + [d for _, d in sorted(blended, key=lambda nd: -_distance(nd[0], camera))]
         if draws:
             passes.append(Pass("draw", index, draws=tuple(draws), depth_test=uses_depth))
         passes.extend(planar_passes(scene, index, programs))
@@ -513,7 +561,13 @@ def plan(scene: Scene) -> Plan:
         passes=tuple(passes),
         meshes=tuple(f"{node.name}: {', '.join(node.mesh.notes)}" for node in scene.nodes if node.mesh.notes),
         notes=user_shader_notes(scene),
+        warnings=mesh_warnings(scene),
     )
+
+
+def mesh_warnings(scene: Scene) -> tuple[str, ...]:
+    """What the scene's model files hold that is not drawn, each line once."""
+    return tuple(dict.fromkeys(line for node in scene.nodes for line in node.mesh.warnings))
 
 
 # --- overlays (labels and figures over the frame) ----------------------------

@@ -158,3 +158,17 @@ def engine(request: pytest.FixtureRequest) -> Engine:
     if request.param == "gpu":
         return Engine("gpu", request.getfixturevalue("gl").host.ctx)
     return Engine("numpy")
+
+
+# --- a browser ---------------------------------------------------------------
+
+
+@pytest.fixture(scope="session")
+def chromium() -> str:
+    """The path of a headless-capable Chromium (Debian's ``chromium`` package; .ci/run installs it)."""
+    for name in ("chromium", "chromium-browser", "google-chrome"):
+        found = shutil.which(name)
+        if found:
+            return found
+    need("Chromium", "no chromium binary on PATH (apt-get install chromium)")
+    raise AssertionError("unreachable")  # need() skips or fails
