@@ -20,7 +20,7 @@ import types
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any, ClassVar, NoReturn
 
 from glsandbox.errors import NUMBER_LIMIT, SandboxError, plain
 from glsandbox.files import read_user_file
@@ -297,35 +297,32 @@ def check_lesson_class(cls: type[Lesson]) -> None:
     :class:`Param`, two parameters with one name (or one of :data:`SHARED_PARAMS`'s), a
     ``defaults`` entry that names no parameter or is not among its choices. The message
     names the class; a lesson file's loader adds the file and line of the class."""
-    where = _definition_site(cls)
+    def refuse(what: str) -> NoReturn:
+        raise SandboxError(f"{_definition_site(cls)}class {cls.__name__}: {what}")
+
     params = cls.__dict__.get("params", cls.params)
     if isinstance(params, list):
         params = tuple(params)
         cls.params = params
     if not isinstance(params, tuple) or not all(isinstance(p, Param) for p in params):
         bad = next((p for p in params if not isinstance(p, Param)), params) if isinstance(params, tuple) else params
-        raise SandboxError(f"{where}class {cls.__name__}: params must be a tuple of Param(...), "
-                           f"got {plain(bad)}{'' if bad is params else ' in it'}")
-    seen = {p.name for p in SHARED_PARAMS}
+        refuse(f"params must be a tuple of Param(...), got {plain(bad)}{'' if bad is params else ' in it'}")
+    shared = {p.name for p in SHARED_PARAMS}
+    seen = set(shared)
     for param in params:
         if param.name in seen:
-            shared = param.name in {p.name for p in SHARED_PARAMS}
-            reason = "every lesson has it already" if shared else "two parameters have that name"
-            raise SandboxError(f"{where}class {cls.__name__}: parameter {param.name!r} defined again ({reason})")
+            reason = "every lesson has it already" if param.name in shared else "two parameters have that name"
+            refuse(f"parameter {param.name!r} defined again ({reason})")
         seen.add(param.name)
-    defaults = cls.defaults
-    if not isinstance(defaults, dict):
-        raise SandboxError(f"{where}class {cls.__name__}: defaults must be a dict of name: value, "
-                           f"got {plain(defaults)}")
+    if not isinstance(cls.defaults, dict):
+        refuse(f"defaults must be a dict of name: value, got {plain(cls.defaults)}")
     known = {p.name: p for p in (*SHARED_PARAMS, *params)}
-    for key, value in defaults.items():
+    for key, value in cls.defaults.items():
         if key not in known:
-            raise SandboxError(f"{where}class {cls.__name__}: defaults names {plain(key)}, which is no parameter "
-                               f"(parameters: {', '.join(known)})")
+            refuse(f"defaults names {plain(key)}, which is no parameter (parameters: {', '.join(known)})")
         choices = known[key].choices
         if choices is not None and value not in choices:
-            raise SandboxError(f"{where}class {cls.__name__}: defaults {key}={plain(value)} is not one of "
-                               f"{', '.join(choices)}")
+            refuse(f"defaults {key}={plain(value)} is not one of {', '.join(choices)}")
 
 
 def _definition_site(cls: type) -> str:
