@@ -250,11 +250,12 @@ def test_model_lesson_plan_is_pinned() -> None:
         "programs:",
         "  overlay",
         "  phong[NUM_LIGHTS=2]",
-        "passes:",
-        "  1. clear viewport 0: colour (0.12, 0.14, 0.2, 1) + depth",
-        f"  2. draw viewport 0 (depth test): {draw}",
-        "  3. clear viewport 1: colour (0.12, 0.14, 0.2, 1) + depth",
-        f"  4. draw viewport 1 (depth test): {draw}",
+        "passes:",  # viewport 1 is ray-traced (issue 22: the plan says so, and draws nothing there)
+        "  1. trace viewport 1 (GLSL ray tracer, float32, 1 primary ray per pixel, shadow rays to 2 lights, "
+        "shown as overlay raytrace/1): floor (phong); model (phong)",
+        "  2. clear viewport 0: colour (0.12, 0.14, 0.2, 1) + depth",
+        f"  3. draw viewport 0 (depth test): {draw}",
+        "  4. clear viewport 1: colour (0.12, 0.14, 0.2, 1) + depth",
         "  5. overlay viewport 0 (blended, no depth test): label0",
-        "  6. overlay viewport 1 (blended, no depth test): label1",
+        "  6. overlay viewport 1 (blended, no depth test): raytrace/1, label1",
     ])
