@@ -37,6 +37,7 @@ from glsandbox import (
     Param,
     Scene,
     Texture,
+    check_texture_source,
     geometry,
     register,
     transforms,
@@ -63,12 +64,16 @@ class TextureLesson(Lesson):
     title = "Texture mapping: the 24-vertex cube, filters, mipmaps and wrap modes"
     course_section = "Texture Mapping (Doku Kaplama)"
     order = 60
+    contrasts = (("the filter grid: minification on the grazing ground",
+                  "filter=nearest,linear,mip_nearest,mip_linear,anisotropic"),)
     animated = True
     params = (
         Param("filter", "mip_linear", "sampler filter", choices=TEXTURE_FILTERS),
         Param("wrap", "repeat", "what uv outside 0..1 reads", choices=TEXTURE_WRAPS),
-        Param("image", "labels", "the cube's image: labels, checker, mip_levels, or an image file path"),
-        Param("ground", "checker", "the ground's image (labels shows mirrored and clamped uv best)"),
+        Param("image", "labels", "the cube's image: labels, checker, mip_levels, or an image file path",
+              convert=check_texture_source),
+        Param("ground", "checker", "the ground's image (labels shows mirrored and clamped uv best)",
+              convert=check_texture_source),
         Param("tile", 3.0, "ground units per texture repeat", minimum=0.01),
         Param("speed", 0.5, "the cube's turn rate in radians per second"),
     )
