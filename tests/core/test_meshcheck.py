@@ -9,9 +9,9 @@ from pathlib import Path
 
 import pytest
 
-from glsandbox import cli
 from glsandbox.errors import SandboxError
 from glsandbox.meshfile import load_model
+from support import assert_user_error, run_cli
 
 PLY_HEAD = ("ply\nformat ascii 1.0\ncomment made by hand\nelement vertex 3\nproperty float x\nproperty float y\n"
             "property float z\nelement face {faces}\nproperty list uchar int vertex_indices\nend_header\n")
@@ -48,14 +48,14 @@ def test_a_broken_text_model_is_one_error_naming_file_and_line(tmp_path: Path, n
     assert "\n" not in message and f"model file {path}, line {line}: " in message and words in message, message
 
 
-def test_a_cut_short_file_on_the_command_line_is_exit_2_and_writes_nothing(tmp_path: Path, capsys) -> None:
+def test_a_cut_short_file_on_the_command_line_is_exit_2_and_writes_nothing(tmp_path: Path) -> None:
     path = tmp_path / "cut.off"
     path.write_text(BAD["cut_short.off"][0])
-    out = tmp_path / "out.png"
-    assert cli.main(["render", "model", "--set", f"mesh={path}", "--out", str(out), "--size", "32x32"]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith("error: ") and f"{path}, line 7" in err[0], err
-    assert not out.exists()
+    out = tmp_path / "out" / "model.png"
+    out.parent.mkdir()
+    run = run_cli("render", "model", "--set", f"mesh={path}", "--out", str(out), "--size", "32x32",
+                  unchanged=out.parent)
+    assert_user_error(run, f"{path}, line 7")
 
 
 @pytest.mark.parametrize("name, text", [

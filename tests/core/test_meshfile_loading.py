@@ -15,11 +15,12 @@ import numpy as np
 import pytest
 import trimesh
 
-from glsandbox import cli, meshgen
+from glsandbox import meshgen
 from glsandbox.errors import SandboxError
 from glsandbox.meshcheck import BYTES_PER_TRIANGLE, MEMORY_ENV
 from glsandbox.meshfile import load_model
 from glsandbox.meshnormals import corner_normals, face_normals
+from support import assert_user_error, run_cli
 
 
 def pairwise_normals(positions: np.ndarray, tris: np.ndarray, crease: float) -> np.ndarray:
@@ -174,14 +175,13 @@ def test_a_model_bigger_than_the_memory_limit_is_refused_before_loading(tmp_path
     assert load_model(path).triangles == 10_000
 
 
-def test_the_memory_refusal_is_one_error_line_and_exit_2(tmp_path: Path, monkeypatch, capsys) -> None:
+def test_the_memory_refusal_is_one_error_line_and_exit_2(tmp_path: Path) -> None:
     path = write_fan(tmp_path / "fan.ply", 10_000)
-    monkeypatch.setenv(MEMORY_ENV, "100K")
-    out = tmp_path / "out.png"
-    assert cli.main(["render", "model", "--set", f"mesh={path}", "--out", str(out), "--size", "32x32"]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith("error: ") and "10,000 triangles need about" in err[0], err
-    assert not out.exists()
+    out = tmp_path / "out" / "model.png"
+    out.parent.mkdir()
+    run = run_cli("render", "model", "--set", f"mesh={path}", "--out", str(out), "--size", "32x32",
+                  env={MEMORY_ENV: "100K"}, unchanged=out.parent)
+    assert_user_error(run, "10,000 triangles need about", f"{MEMORY_ENV}=")
 
 
 def test_a_bad_memory_setting_is_an_error(tmp_path: Path, monkeypatch) -> None:
