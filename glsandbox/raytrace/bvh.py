@@ -94,8 +94,8 @@ LEAF_SIZE: int = 4
 BINS: int = 16
 #: Triangles of a node whose boxes the SAH bins (a big node's are sampled, see ``_split_levels``).
 SAMPLE: int = 1024
-#: An axis whose triangle centroids span less than this share of the node's box is binned
-#: over the centroids' range (``_split_levels``).
+#: An axis whose triangle centroids span less than this share of the node's binning range is
+#: binned over the centroids' own range instead (``_split_levels``).
 CENTROID_RANGE: float = 0.5
 #: A node whose best SAH cut costs at least this share of ``N·A(node)`` is cut evenly by count instead.
 NO_GAIN: float = 0.99
@@ -261,6 +261,8 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
         return leaf_of, leaf_rank, firsts[0], counts_of[0], levels
     tris = np.arange(k)  # the caller's triangle of each column
     counts = np.array([k], dtype=np.int64)  # columns per open node, in column order
+    box_lo = rows[3:6].min(axis=1)[None, :].astype(np.float64)  # the open nodes' binning boxes
+    box_hi = rows[6:9].max(axis=1)[None, :].astype(np.float64)
     open_pos = np.zeros(1, dtype=np.int64)  # where the open nodes are in their level's arrays
     next_id = 1
     while counts.size:
@@ -269,19 +271,19 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
         # Bins per node: max_bins, fewer once nodes are small (about one per
         # triangle), so the per-bin work never exceeds the per-triangle work.
         bins = int(min(max_bins, max(4, 1 << int(np.log2(max(1, width // n))))))
-        # Binning range per node and axis: the node's box, cut into `bins` equal slabs; a flat
-        # axis puts all in bin 0. Where the triangles' centroids span less than CENTROID_RANGE
-        # of the box on an axis, the centroids' own range instead (Wald 2007): slivers meeting at
-        # one point (a fan) have their centroids bunched in one slab of their box, and only the
-        # stragglers could be cut off, one level each (a fan of 1M triangles was 5,000 levels deep).
+        # Binning range per node and axis: the node's box (from its parent's
+        # sweep), cut into `bins` equal slabs; a flat axis puts all in bin 0.
+        # Where the triangles' centroids span less than CENTROID_RANGE of it on
+        # an axis, the centroids' own range instead (Wald 2007): slivers meeting
+        # at one point (a fan) have their centroids bunched in one slab of their
+        # box, and only the stragglers could be cut off, one level each (a fan
+        # of 1M triangles was 5,470 levels deep).
         starts = np.cumsum(counts) - counts
-        node_lo = np.minimum.reduceat(rows[3:6], starts, axis=1)
-        node_hi = np.maximum.reduceat(rows[6:9], starts, axis=1)
-        centre_lo = np.minimum.reduceat(rows[0:3], starts, axis=1)
-        centre_hi = np.maximum.reduceat(rows[0:3], starts, axis=1)
-        bunched = (centre_hi - centre_lo) < CENTROID_RANGE * (node_hi - node_lo)
-        box_lo = np.where(bunched, centre_lo, node_lo).T.astype(np.float64)
-        box_hi = np.where(bunched, centre_hi, node_hi).T.astype(np.float64)
+        centre_lo = np.minimum.reduceat(rows[0:3], starts, axis=1).T.astype(np.float64)
+        centre_hi = np.maximum.reduceat(rows[0:3], starts, axis=1).T.astype(np.float64)
+        bunched = (centre_hi - centre_lo) < CENTROID_RANGE * (box_hi - box_lo)
+        box_lo = np.where(bunched, centre_lo, box_lo)
+        box_hi = np.where(bunched, centre_hi, box_hi)
         extent = box_hi - box_lo
         scale = np.where(extent > 0.0, bins * (1.0 - 1e-6) / np.where(extent > 0.0, extent, 1.0), 0.0)
         rel = (rows[0:3] - np.repeat(box_lo.T.astype(np.float32), counts, axis=1)) * np.repeat(
@@ -291,11 +293,15 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
         best_cost = np.full(n, np.inf)
         best_axis = np.zeros(n, dtype=np.int64)
         best_cut = np.ones(n, dtype=np.int64)
+        child_lo = np.empty((n, 2, 3))
+        child_hi = np.empty((n, 2, 3))
         nodes = np.arange(n)
         # The most even cut by count over all axes: used where no SAH cut gains (below).
         even_gap = np.full(n, np.iinfo(np.int64).max)
         even_axis = np.zeros(n, dtype=np.int64)
         even_cut = np.ones(n, dtype=np.int64)
+        even_lo = np.empty((n, 2, 3))
+        even_hi = np.empty((n, 2, 3))
         # A big node's bin boxes come from every stride-th of its triangles
         # (about SAMPLE of them): the boxes are only the heuristic's estimate
         # of the children's areas (bin counts are exact). Nodes of up to
@@ -338,22 +344,39 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
                 even_gap[evener] = gap[ce, evener]
                 even_axis[evener] = axis
                 even_cut[evener] = ce + 1
+                even_lo[evener, 0] = llo[:, ce, evener].T
+                even_hi[evener, 0] = lhi[:, ce, evener].T
+                even_lo[evener, 1] = rlo[:, ce + 1, evener].T
+                even_hi[evener, 1] = rhi[:, ce + 1, evener].T
             better = np.flatnonzero(cost < best_cost)
             if better.size:
                 cb = cut[better]
                 best_cost[better] = cost[better]
                 best_axis[better] = axis
                 best_cut[better] = cb + 1  # bins below the cut go left
+                child_lo[better, 0] = llo[:, cb, better].T
+                child_hi[better, 0] = lhi[:, cb, better].T
+                child_lo[better, 1] = rlo[:, cb + 1, better].T
+                child_hi[better, 1] = rhi[:, cb + 1, better].T
         # No gain: when the best cut costs about what the node itself does (N·A: every child box
-        # as big as the parent's, as in a fan of slivers meeting at one point), the SAH would
-        # peel a few triangles off per level and the tree grow as deep as the node is large.
-        # The most even cut by count keeps the depth logarithmic there.
+        # as big as the parent's), the SAH would peel a few triangles off per level and the tree
+        # grow as deep as the node is large. The most even cut by count keeps the depth logarithmic.
+        node_lo = np.minimum.reduceat(rows[3:6], starts, axis=1)
+        node_hi = np.maximum.reduceat(rows[6:9], starts, axis=1)
         parent_cost = counts * _half_area(node_lo, node_hi).astype(np.float64)
         no_gain = np.flatnonzero(np.isfinite(best_cost) & (best_cost >= NO_GAIN * parent_cost)
                                  & (even_gap < np.iinfo(np.int64).max))
         if no_gain.size:
             best_axis[no_gain] = even_axis[no_gain]
             best_cut[no_gain] = even_cut[no_gain]
+            child_lo[no_gain] = even_lo[no_gain]
+            child_hi[no_gain] = even_hi[no_gain]
+        # A child whose sampled triangles were none of its own has no box:
+        # bin it over its parent's.
+        empty = np.logical_not(np.logical_and(np.isfinite(child_lo).all(axis=2), np.isfinite(child_hi).all(axis=2)))
+        if empty.any():
+            child_lo = np.where(empty[:, :, None], box_lo[:, None, :], child_lo)
+            child_hi = np.where(empty[:, :, None], box_hi[:, None, :], child_hi)
         # Each column's side (True: the right child) on its node's chosen axis.
         axis_t = np.repeat(best_axis, counts)
         chosen = np.where(axis_t == 0, bin_of[0], np.where(axis_t == 1, bin_of[1], bin_of[2]))
@@ -365,6 +388,8 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
             where = np.repeat(~np.isfinite(best_cost), counts)
             rank = np.arange(width) - np.repeat(starts, counts)
             right[where] = (rank >= np.repeat(counts // 2, counts))[where]
+            child_lo[stuck] = box_lo[stuck][:, None, :]
+            child_hi[stuck] = box_hi[stuck][:, None, :]
         # Children in pairs: open node i gets next_id + 2i (left) and + 2i + 1.
         child = 2 * np.repeat(nodes, counts) + right
         child_count = np.bincount(child, minlength=2 * n)
@@ -406,6 +431,8 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
         tris = tris[source]
         counts = new_counts
         open_pos = kept_children
+        box_lo = child_lo.reshape(2 * n, 3)[kept_children]
+        box_hi = child_hi.reshape(2 * n, 3)[kept_children]
     return leaf_of, leaf_rank, np.concatenate(firsts), np.concatenate(counts_of), levels
 
 

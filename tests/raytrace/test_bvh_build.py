@@ -52,11 +52,11 @@ def test_the_fan_build_grows_linearly() -> None:
 
 def test_a_rock_keeps_a_good_tree() -> None:
     # A lumpy closed surface (what a scan looks like): the SAH cost of its tree against the builder
-    # before the fan fix (32.14 for rock(4), 5,120 triangles; 32.32 after it); a split rule that
+    # before the fan fix (32.142 for rock(4), 5,120 triangles; 32.139 after it); a split rule that
     # builds a worse tree shows here as a higher cost.
     bvh = build_bvh(*mesh_world_triangles(meshgen.rock(4)))
     assert leaves_hold_every_triangle_once(bvh) and bvh.depth <= 20
-    assert sah_cost(bvh) < 1.03 * 32.14, sah_cost(bvh)
+    assert sah_cost(bvh) <= 32.142, sah_cost(bvh)
 
 
 def test_sah_cost_of_a_single_leaf_is_its_triangle_count() -> None:
