@@ -281,55 +281,89 @@ def cmd_new(args: argparse.Namespace) -> int:
     return 0
 
 
-def cmd_check(args: argparse.Namespace) -> int:
-    """``glsandbox check``: render, compare with a reference PNG by the golden rule; 0 match, 1 differs."""
-    from glsandbox.measure.check import (
-        check_folder,
-        check_one,
-        parse_tolerances,
-        summary_table,
-        write_reports,
-    )
+def _checks(args: argparse.Namespace) -> tuple[list, float | None, int | None]:
+    """The checks of ``check``: a rubric's, or one from --golden, --set, --size and --tolerance."""
+    from glsandbox.measure.rubric import Check, load_rubric, parse_tolerances
 
+    if (args.golden is None) == (args.rubric is None):
+        raise SandboxError("check: give the reference with --golden REF.png or a grading file with --rubric FILE "
+                           "(one of the two)")
+    if args.rubric is not None:
+        if args.settings or args.tolerance or args.size or args.samples:
+            raise SandboxError(f"--rubric {args.rubric}: each check's settings, size and tolerance are in the "
+                               "grading file; drop --set, --size, --samples and --tolerance")
+        rubric = load_rubric(args.rubric)
+        return list(rubric.checks), rubric.timeout, rubric.memory
     reference: Path = args.golden
     if reference.suffix.lower() != ".png":
         raise SandboxError(f"--golden {reference}: the reference must be a .png file")
     tolerances = parse_tolerances(args.tolerance)
     size = parse_size(args.size) if args.size else None
-    for flag, path in (("--csv", args.csv), ("--json", args.json)):
+    with_samples(Scene("samples"), args.samples)  # a bad --samples is refused before any work
+    return [Check(reference.stem, reference, tuple(args.settings), size, args.samples, tolerances)], None, None
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    """``glsandbox check``: render, compare with reference PNGs by the golden rule; 0 all pass, 1 not."""
+    from glsandbox.measure.check import Limits, check_folder, check_one, default_jobs, summary_table
+    from glsandbox.measure.reports import REPORTS, write_reports
+
+    checks, rubric_timeout, rubric_memory = _checks(args)
+    timeout = args.timeout if args.timeout is not None else rubric_timeout or 30.0
+    memory = args.memory if args.memory is not None else rubric_memory or 2048
+    if not 0 < timeout <= 3600:
+        raise SandboxError(f"--timeout {timeout:g}: expected seconds, more than 0 and at most 3600")
+    if not 64 <= memory <= 1 << 20:
+        raise SandboxError(f"--memory {memory}: expected MB, at least 64")
+    jobs = args.jobs if args.jobs is not None else default_jobs()
+    if not 1 <= jobs <= 256:
+        raise SandboxError(f"--jobs {jobs}: expected 1 to 256 submissions at once")
+    limits = Limits(float(timeout), int(memory), jobs)
+    reports = {kind: getattr(args, kind) for kind in REPORTS}
+    for kind, path in reports.items():
         if path is not None and path.is_dir():
-            raise SandboxError(f"{flag} {path}: is a folder, expected a file name")
+            raise SandboxError(f"--{kind} {path}: is a folder, expected a file name")
     target = Path(args.lesson)
     if target.is_dir():
         if args.update:
-            raise SandboxError(f"--update writes one reference: give one lesson, not the folder {target}")
-        results = check_folder(target, reference, args.settings, size, tolerances, args.samples, args.backend,
-                               progress=lambda text: print(text, file=sys.stderr, flush=True))
-        for result in results:
-            print(result.line())
-            for kind, path in result.artifacts.items():
-                print(f"       {kind:<8}: {path}")
+            raise SandboxError(f"--update writes references: give one lesson (the model answer), not the folder {target}")
+
+        def progress(done: int, total: int, result) -> None:
+            print(f"[{done}/{total}] {result.line()}", flush=True)
+            for outcome in result.outcomes:
+                for kind, path in outcome.artifacts.items():
+                    print(f"       {kind:<8}: {path}", flush=True)
+
+        results = check_folder(target, checks, args.backend, limits, progress)
         print()
         print(summary_table(results))
-        for path in write_reports(results, args.csv, args.json, reference):
+        title = str(args.rubric or args.golden)
+        for path in write_reports(results, reports, title):
             print(f"wrote {path}")
         return 0 if all(r.status == "PASS" for r in results) else 1
-    if args.csv or args.json:
-        raise SandboxError("--csv and --json report a folder of submissions; give a folder")
-    match, paths, updated = check_one(args.lesson, reference, args.settings, size, tolerances, args.update,
-                                      args.samples, args.backend)
-    if updated == "written":
-        print(f"wrote reference {reference}")
-        return 0
-    print(f"{args.lesson}: {match.summary()}")
-    if updated == "rewritten":
-        print(f"rewrote reference {reference}")
-        return 0
-    if updated == "unchanged":
-        print(f"reference {reference} unchanged (it passes)")
-    for kind, path in paths.items():
-        print(f"  {kind:<8}: {path}")
-    return 0 if match.passed else 1
+    if any(path is not None for path in reports.values()):
+        raise SandboxError(f"--{', --'.join(REPORTS)} report a folder of submissions; give a folder")
+    failed = False
+    for one in check_one(args.lesson, checks, args.update, args.backend, limits):
+        reference = one.check.golden
+        if one.status:
+            print(f"{args.lesson}: {one.status}: {one.error}")
+            failed = True
+            continue
+        if one.updated == "written":
+            print(f"wrote reference {reference}")
+            continue
+        print(f"{args.lesson}: {one.match.summary()}")
+        if one.updated == "rewritten":
+            print(f"rewrote reference {reference}")
+            continue
+        if one.updated == "unchanged":
+            print(f"reference {reference} unchanged (it passes)")
+            continue
+        for kind, path in one.artifacts.items():
+            print(f"  {kind:<8}: {path}")
+        failed = failed or not one.match.passed
+    return 1 if failed else 0
 
 
 def _gallery(summary: dict) -> str:
@@ -417,13 +451,24 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("check", help="render a lesson and compare it with a reference PNG (0 match, 1 differs)")
     p.add_argument("lesson", metavar="LESSON_OR_DIR",
                    help="a lesson name, .py or .toml file, or a folder of them (one line each, and a table)")
-    p.add_argument("--golden", type=Path, required=True, metavar="REF.png", help="the reference image")
+    p.add_argument("--golden", type=Path, default=None, metavar="REF.png", help="the reference image")
+    p.add_argument("--rubric", type=Path, default=None, metavar="FILE.toml",
+                   help="a grading file: several checks, each with its golden, settings and points")
     p.add_argument("--update", action="store_true",
-                   help="write the reference when it is missing or differs (a passing one is kept)")
+                   help="write the references when missing or different (a passing one is kept)")
     p.add_argument("--tolerance", action="append", default=[], metavar="KEY=VALUE",
                    help="threshold=LEVELS (default 2) or max_bad_share=FRACTION (default 0.0005); repeatable")
-    p.add_argument("--csv", type=Path, default=None, metavar="FILE", help="folder mode: the figures as CSV")
-    p.add_argument("--json", type=Path, default=None, metavar="FILE", help="folder mode: the figures as JSON")
+    p.add_argument("--jobs", type=int, default=None, metavar="N",
+                   help="submissions graded at once (default: the number of cores)")
+    p.add_argument("--timeout", type=float, default=None, metavar="SECONDS",
+                   help="time for each picture of a submission (default 30)")
+    p.add_argument("--memory", type=int, default=None, metavar="MB",
+                   help="memory (address space) of each submission (default 2048)")
+    for kind, text in (("csv", "the figures as CSV"), ("json", "the figures as JSON"),
+                       ("html", "a page: a row per student with reference | submission | difference"),
+                       ("junit", "JUnit XML (what CI systems read)"),
+                       ("gradescope", "Gradescope's results.json")):
+        p.add_argument(f"--{kind}", type=Path, default=None, metavar="FILE", help=f"folder mode: {text}")
     add_render_options(p)
     p.set_defaults(func=cmd_check)
 

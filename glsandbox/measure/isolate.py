@@ -1,0 +1,520 @@
+"""Rendering each graded submission in a process of its own, under limits, and getting back only pixels.
+
+The process tree of one grading run::
+
+    grader (never opens a GL context; reads the reference, compares, writes every report)
+     └─ forkserver (Python's multiprocessing: imported glsandbox, numpy and moderngl once)
+         └─ supervisor, one per submission (own session; a "child subreaper": every process
+            │  the submission leaves behind is re-parented to it, and it kills them all)
+            └─ renderer (own session; stdin /dev/null, stdout and stderr into a file;
+               address-space, CPU-time and file-size limits; working folder a private
+               copy of the submission; confined by :mod:`glsandbox.measure.sandbox`)
+
+The renderer opens its GL context (a fork of a process that had opened one
+would deadlock on llvmpipe's threads, so nothing above it ever does), then
+loads the submission and renders each requested picture, writing each as a
+framed message on a pipe: raw RGBA pixels, or an error line. It knows no
+reference. The supervisor reads the pipe against the clock, kills the
+renderer's whole tree when it is done, times out or dies, and sends the
+grader one plain result per picture. Nothing the submission does in its
+own process (``os._exit``, a signal, ``atexit``, threads, ``fork``,
+replacing ``sys.stdout`` or glsandbox's functions) reaches the grader: the
+worst it can do is lose its own pictures.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import json
+import multiprocessing
+import multiprocessing.connection
+import os
+import resource
+import select
+import shutil
+import signal
+import struct
+import sys
+import tempfile
+import time
+from collections import deque
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["Render", "Job", "Picture", "JobResult", "run_jobs", "PRELOAD"]
+
+#: What the forkserver imports once, so each submission starts warm (and no module
+#: opens a GL context at import).
+PRELOAD = ["glsandbox.measure.isolate", "glsandbox.frame", "glsandbox.lesson", "glsandbox.scene_file",
+           "glsandbox.measure.sandbox", "glsandbox.gl.context", "numpy", "moderngl", "PIL.Image"]
+
+#: Outcomes of one picture, besides the grader's PASS and FAIL.
+BROKEN, TIMEOUT, CRASHED, OOM = "BROKEN", "TIMEOUT", "CRASHED", "OUT OF MEMORY"
+#: The renderer's output kept for the report: its last lines, each cut.
+TAIL_LINES, TAIL_WIDTH = 8, 200
+
+_MAGIC = b"GLSB"
+_HEADER = struct.Struct("!4sIQ")  # magic, JSON header length, payload length
+_PR_SET_CHILD_SUBREAPER = 36
+
+
+@dataclass(frozen=True)
+class Render:
+    """One picture to render: the lesson's ``--set`` values, the size and MSAA samples."""
+
+    settings: tuple[str, ...]
+    size: tuple[int, int]
+    samples: int = 0
+
+
+@dataclass(frozen=True)
+class Job:
+    """One submission: where it is, what to render, and the limits.
+
+    ``source`` is the submission's file or folder, copied into the private
+    folder (``copy=True``, grading) or read where it is (``copy=False``: one
+    lesson checked by its author, whose folder is its root); ``target`` is
+    the lesson file to load inside it (relative), or a built-in lesson's
+    name when ``source`` is None.
+    """
+
+    index: int
+    source: str | None
+    target: str
+    renders: tuple[Render, ...]
+    backend: str | None = None
+    timeout: float = 30.0
+    memory_mb: int = 2048
+    copy: bool = True
+
+
+@dataclass
+class Picture:
+    """What came back for one :class:`Render`: the pixels, or an outcome and its line."""
+
+    image: np.ndarray | None = None
+    status: str = ""
+    error: str = ""
+    seconds: float = 0.0
+
+
+@dataclass
+class JobResult:
+    """Every picture of one job, the renderer's last output lines, and whether GL was there at all."""
+
+    job: Job
+    pictures: list[Picture]
+    output: list[str] = field(default_factory=list)
+    no_gl: str = ""
+
+
+# --- the renderer (grandchild) ---------------------------------------------------------------
+
+
+def _send(fd: int, header: dict, payload: bytes = b"") -> None:
+    data = json.dumps(header).encode()
+    message = _HEADER.pack(_MAGIC, len(data), len(payload)) + data + payload
+    view = memoryview(message)
+    while view:
+        view = view[os.write(fd, view):]
+
+
+def _limit(job: Job) -> None:
+    """Address space (--memory), CPU seconds (--timeout for each picture, plus start-up), no core
+    files, and files no larger than 256 MB."""
+    memory = job.memory_mb * 1024 * 1024
+    cpu = int(job.timeout * len(job.renders)) + 10
+    for limit, value in ((resource.RLIMIT_AS, memory), (resource.RLIMIT_CPU, cpu), (resource.RLIMIT_CORE, 0),
+                         (resource.RLIMIT_FSIZE, 256 * 1024 * 1024)):
+        try:
+            resource.setrlimit(limit, (value, value + 1 if limit == resource.RLIMIT_CPU else value))
+        except (ValueError, OSError):
+            pass
+
+
+def _renderer(job: Job, root: str, target: str, work: str, out: int) -> None:
+    """The renderer's whole life; it never returns (``os._exit``)."""
+    from glsandbox.errors import SandboxError
+    from glsandbox.frame import HeadlessRenderer
+    from glsandbox.lesson import find_lesson, submission_lesson, user_code_error
+    from glsandbox.measure.sandbox import confine
+
+    os.setsid()
+    null = os.open(os.devnull, os.O_RDONLY)
+    os.dup2(null, 0)
+    log = os.open(os.path.join(work, "output.txt"), os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o600)
+    os.dup2(log, 1)
+    os.dup2(log, 2)
+    os.close(null)
+    os.close(log)
+    sys.stdin = open(os.devnull)  # noqa: SIM115 - the submission's, for its life
+    sys.argv = ["submission"]
+    cwd = os.path.join(work, "cwd")
+    os.chdir(root if job.copy else cwd)
+    _limit(job)
+    code = 0
+    try:
+        try:
+            renderer = HeadlessRenderer(job.backend)
+        except SandboxError as exc:
+            _send(out, {"kind": "nogl", "error": str(exc)})
+            return
+        confine(root, [root if job.copy else cwd, cwd])
+        try:
+            cls = find_lesson(target) if job.source is None else submission_lesson(Path(root) / target)
+        except MemoryError as exc:
+            _send(out, {"kind": "oom", "index": 0, "error": str(user_code_error(exc)), "all": True})
+            return
+        except SandboxError as exc:
+            _send(out, {"kind": "broken", "index": 0, "error": str(exc), "all": True})
+            return
+        except BaseException as exc:  # noqa: BLE001 - anything the submission raised while loading
+            _send(out, {"kind": "broken", "index": 0, "error": str(user_code_error(exc)), "all": True})
+            return
+        for index, render in enumerate(job.renders):
+            started = time.perf_counter()
+            try:
+                image = renderer.render(cls.from_settings(render.settings), render.size, render.samples).image
+                image = np.ascontiguousarray(image, dtype=np.uint8)
+                header = {"kind": "image", "index": index, "shape": list(image.shape),
+                          "seconds": time.perf_counter() - started}
+                _send(out, header, image.tobytes())
+            except MemoryError as exc:
+                _send(out, {"kind": "oom", "index": index, "error": str(user_code_error(exc))})
+            except SandboxError as exc:
+                _send(out, {"kind": "broken", "index": index, "error": str(exc)})
+            except BaseException as exc:  # noqa: BLE001 - KeyboardInterrupt, SystemExit, its own kinds
+                _send(out, {"kind": "broken", "index": index, "error": str(user_code_error(exc))})
+    except BaseException:  # noqa: BLE001 - the pipe closed, or worse: the supervisor reports it
+        code = 3
+    finally:
+        for stream in (sys.__stdout__, sys.__stderr__):
+            try:
+                stream.flush()
+            except BaseException:  # noqa: BLE001 - replaced or closed by the submission
+                pass
+        os._exit(code)  # no atexit handler, no thread, no finaliser of the submission runs
+
+
+# --- the supervisor (child) ------------------------------------------------------------------
+
+
+def _children_map() -> dict[int, list[int]]:
+    """Every live process's children, from /proc."""
+    children: dict[int, list[int]] = {}
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            with open(f"/proc/{entry}/stat", "rb") as handle:
+                fields = handle.read().rsplit(b")", 1)[1].split()
+        except OSError:
+            continue
+        if fields[0] != b"Z":
+            children.setdefault(int(fields[1]), []).append(int(entry))
+    return children
+
+
+def descendants(pid: int) -> list[int]:
+    """The live (not zombie) descendants of ``pid``."""
+    children = _children_map()
+    found, queue = [], deque(children.get(pid, []))
+    while queue:
+        child = queue.popleft()
+        found.append(child)
+        queue.extend(children.get(child, []))
+    return found
+
+
+def _reap() -> None:
+    while True:
+        try:
+            pid, _ = os.waitpid(-1, os.WNOHANG)
+        except ChildProcessError:
+            return
+        if pid == 0:
+            return
+
+
+def kill_tree(pid: int, keep: Sequence[int] = ()) -> None:
+    """SIGKILL every descendant of ``pid`` (except ``keep`` and theirs) until none is left.
+
+    A process that forks while we look is found on the next pass; orphans come
+    back to us as long as we are a subreaper. Reaps our own children.
+    """
+    deadline = time.monotonic() + 5.0
+    while time.monotonic() < deadline:
+        excluded = set(keep)
+        for kept in keep:
+            excluded.update(descendants(kept))
+        alive = [p for p in descendants(pid) if p not in excluded]
+        if not alive:
+            break
+        for victim in alive:
+            try:
+                os.kill(victim, signal.SIGKILL)
+            except OSError:
+                pass
+        _reap() if pid == os.getpid() else None
+        time.sleep(0.005)
+    if pid == os.getpid():
+        _reap()
+
+
+def _set_subreaper(on: bool = True) -> None:
+    if sys.platform == "linux":
+        ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_CHILD_SUBREAPER, int(on), 0, 0, 0)
+
+
+def _copy_submission(source: Path, into: Path) -> Path:
+    """A private copy of a submission's file or folder; symbolic links are copied as links
+    (one that points outside is refused when read, never followed while copying)."""
+    if source.is_dir():
+        shutil.copytree(source, into, symlinks=True)
+    else:
+        into.mkdir()
+        shutil.copy2(source, into / source.name, follow_symlinks=False)
+    return into
+
+
+class _Reader:
+    """The framed messages of the renderer's pipe, read as they arrive."""
+
+    def __init__(self, fd: int) -> None:
+        self.fd, self.buffer, self.closed = fd, bytearray(), False
+
+    def pump(self, timeout: float) -> None:
+        ready, _, _ = select.select([self.fd], [], [], max(timeout, 0.0))
+        if ready:
+            chunk = os.read(self.fd, 1 << 20)
+            self.closed = not chunk
+            self.buffer += chunk
+
+    def messages(self, limit: int) -> Iterator[tuple[dict, bytes]]:
+        while len(self.buffer) >= _HEADER.size:
+            magic, head, size = _HEADER.unpack_from(self.buffer)
+            if magic != _MAGIC or head > 1 << 16 or size > limit:
+                raise ValueError("a malformed message on the result pipe")
+            end = _HEADER.size + head + size
+            if len(self.buffer) < end:
+                return
+            header = json.loads(bytes(self.buffer[_HEADER.size:_HEADER.size + head]))
+            payload = bytes(self.buffer[_HEADER.size + head:end])
+            del self.buffer[:end]
+            yield header, payload
+
+
+def _exit_reason(status: int, job: Job) -> tuple[str, str]:
+    if os.WIFSIGNALED(status):
+        number = os.WTERMSIG(status)
+        if number == signal.SIGXCPU:
+            return TIMEOUT, f"CPU time limit ({int(job.timeout * len(job.renders)) + 10} s) reached"
+        name = signal.Signals(number).name if number in signal.Signals._value2member_map_ else str(number)
+        return CRASHED, f"killed by signal {name}"
+    return CRASHED, f"exited with code {os.WEXITSTATUS(status)} before its picture was sent"
+
+
+def _collect(job: Job, pid: int, fd: int) -> list[Picture]:
+    """Each picture as it arrives, against the clock: ``job.timeout`` seconds for each."""
+    pictures: list[Picture] = [Picture() for _ in job.renders]
+    limit = max(w * h * 4 for w, h in (r.size for r in job.renders))
+    reader = _Reader(fd)
+    status: int | None = None
+    current, started = 0, time.monotonic()
+
+    def finish(kind: str, error: str) -> list[Picture]:
+        for picture in pictures[current:]:
+            if not picture.status:
+                picture.status, picture.error = kind, error
+        return pictures
+
+    while current < len(pictures):
+        remaining = started + job.timeout - time.monotonic()
+        if remaining <= 0:
+            return finish(TIMEOUT, f"after {job.timeout:g} s")
+        if status is None:
+            done, status_now = os.waitpid(pid, os.WNOHANG)
+            status = status_now if done else None
+        if not reader.closed:
+            reader.pump(0.0 if status is not None else min(remaining, 0.05))
+        elif status is None:  # it closed the pipe but lives on: wait for its end or the clock
+            time.sleep(0.01)
+        try:
+            for header, payload in reader.messages(limit):
+                kind = header.get("kind")
+                if kind == "nogl":
+                    raise _NoGL(str(header.get("error", "")))
+                index = int(header.get("index", -1))
+                if index != current:
+                    raise ValueError("a message out of order on the result pipe")
+                picture = pictures[index]
+                if kind == "image":
+                    shape = tuple(header.get("shape", ()))
+                    w, h = job.renders[index].size
+                    if shape != (h, w, 4) or len(payload) != w * h * 4:
+                        raise ValueError(f"a picture of shape {shape} for a {w}x{h} render")
+                    picture.image = np.frombuffer(payload, dtype=np.uint8).reshape(h, w, 4)
+                    picture.seconds = float(header.get("seconds", 0.0))
+                else:
+                    picture.status = OOM if kind == "oom" else BROKEN
+                    picture.error = str(header.get("error", ""))[:500]
+                    if header.get("all"):  # the lesson did not load: no picture of it can be made
+                        return finish(picture.status, picture.error)
+                current, started = current + 1, time.monotonic()
+        except (ValueError, KeyError, TypeError) as exc:
+            return finish(CRASHED, f"sent {exc}")
+        if status is not None and (reader.closed or not select.select([fd], [], [], 0)[0]) and current < len(pictures):
+            return finish(*_exit_reason(status, job))
+    return pictures
+
+
+class _NoGL(Exception):
+    """The renderer could not open a GL context: the machine's problem, not the submission's."""
+
+
+def _tail(path: str) -> list[str]:
+    try:
+        with open(path, "rb") as handle:
+            handle.seek(max(0, os.fstat(handle.fileno()).st_size - 64 * 1024))
+            lines = handle.read().decode("utf-8", "backslashreplace").splitlines()
+    except OSError:
+        return []
+    return [line[:TAIL_WIDTH] for line in lines[-TAIL_LINES:]]
+
+
+def _supervise(job: Job, conn: multiprocessing.connection.Connection) -> None:
+    """One submission, start to end (runs in a process forked by the forkserver)."""
+    os.setsid()
+    _set_subreaper()
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the grader decides when a run stops
+    work = tempfile.mkdtemp(prefix="glsandbox-grade-")
+    result: dict = {"pictures": None, "output": [], "no_gl": "", "root": ""}
+    try:
+        os.mkdir(os.path.join(work, "cwd"))
+        if job.source is None:
+            root, target = os.path.join(work, "cwd"), job.target
+        elif job.copy:
+            try:
+                root = str(_copy_submission(Path(job.source), Path(work) / "submission"))
+            except (OSError, shutil.Error) as exc:
+                reason = getattr(exc, "strerror", None) or str(exc).splitlines()[0][:200]
+                conn.send({**result, "pictures": [Picture(status=BROKEN, error=f"{job.source}: cannot be copied "
+                                                          f"for grading ({reason})") for _ in job.renders]})
+                return
+            target = job.target
+            result["root"] = root
+        else:
+            root, target = str(Path(job.source).parent), job.target
+        read_end, write_end = os.pipe()
+        pid = os.fork()
+        if pid == 0:  # the renderer: no GL context exists in this process yet, so forking is safe
+            os.close(read_end)
+            conn.close()
+            _renderer(job, root, target, work, write_end)
+        os.close(write_end)
+        try:
+            result["pictures"] = _collect(job, pid, read_end)
+        except _NoGL as exc:
+            result["no_gl"] = str(exc)
+        kill_tree(os.getpid())
+        os.close(read_end)
+        result["output"] = _tail(os.path.join(work, "output.txt"))
+        conn.send(result)
+    finally:
+        kill_tree(os.getpid())
+        shutil.rmtree(work, ignore_errors=True)
+        conn.close()
+
+
+# --- the grader's side -----------------------------------------------------------------------
+
+
+def _context() -> multiprocessing.context.BaseContext:
+    context = multiprocessing.get_context("forkserver")
+    context.set_forkserver_preload(PRELOAD)
+    return context
+
+
+def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None]) -> list[JobResult]:
+    """Run every job, ``workers`` at once; ``done`` is called as each finishes; results in job order.
+
+    The grader becomes a subreaper for the run, so a process a submission
+    leaves behind whose supervisor was killed still comes back here, and is
+    killed at the end with everything else the run started.
+    """
+    context = _context()
+    before = set(descendants(os.getpid()))
+    _set_subreaper()
+    pending = deque(jobs)
+    running: dict[multiprocessing.connection.Connection, tuple[Job, multiprocessing.Process, float]] = {}
+    results: dict[int, JobResult] = {}
+    try:
+        while pending or running:
+            while pending and len(running) < max(1, workers):
+                job = pending.popleft()
+                receive, send = context.Pipe(duplex=False)
+                process = context.Process(target=_supervise, args=(job, send), daemon=True)
+                process.start()
+                send.close()
+                # a supervisor that hangs (it should not) is given up after every picture's time and a margin
+                running[receive] = (job, process, time.monotonic() + job.timeout * len(job.renders) + 60)
+            ready = multiprocessing.connection.wait(list(running), timeout=1.0)
+            for receive in list(running):
+                job, process, deadline = running[receive]
+                if receive not in ready and time.monotonic() < deadline:
+                    continue
+                message = None
+                if receive in ready:
+                    try:
+                        message = receive.recv()
+                    except (EOFError, OSError):
+                        message = None
+                del running[receive]
+                receive.close()
+                _end(process)
+                result = _result(job, message, process)
+                results[job.index] = result
+                if result.no_gl:
+                    return [results[j.index] for j in jobs if j.index in results]
+                done(result)
+    finally:
+        for job, process, _ in running.values():
+            _end(process)
+        from multiprocessing import forkserver, resource_tracker
+
+        forkserver._forkserver._stop()  # the next run starts a fresh one
+        tracker = resource_tracker._resource_tracker._pid
+        kill_tree(os.getpid(), keep=sorted(before | ({tracker} if tracker else set())))
+        _set_subreaper(False)
+    return [results[j.index] for j in jobs]
+
+
+def _end(process: multiprocessing.Process) -> None:
+    """Stop a supervisor and its session (it made its own, so its group id is its pid)."""
+    process.join(timeout=5.0)
+    if process.exitcode is None:
+        try:
+            os.killpg(process.pid, signal.SIGKILL)
+        except OSError:
+            pass
+        process.join(timeout=5.0)
+
+
+def _result(job: Job, message: dict | None, process: multiprocessing.Process) -> JobResult:
+    if not isinstance(message, dict) or message.get("pictures") is None and not message.get("no_gl"):
+        why = f"exit code {process.exitcode}" if process.exitcode is not None else "no answer"
+        pictures = [Picture(status=CRASHED, error=f"its grading process ended without a result ({why})")
+                    for _ in job.renders]
+        return JobResult(job, pictures)
+    pictures = message.get("pictures") or [Picture(status=CRASHED, error="no GL") for _ in job.renders]
+    output = [str(line) for line in message.get("output", [])]
+    root = str(message.get("root") or "")
+    if root and job.source:  # the private copy's path, said as the submission's own
+        original = job.source if Path(job.source).is_dir() else str(Path(job.source).parent)
+        for picture in pictures:
+            picture.error = picture.error.replace(root, original)
+        output = [line.replace(root, original) for line in output]
+    return JobResult(job, pictures, output, str(message.get("no_gl", "")))
