@@ -326,7 +326,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     target = Path(args.lesson)
     if target.is_dir():
         if args.update:
-            raise SandboxError(f"--update writes references: give one lesson (the model answer), not the folder {target}")
+            raise SandboxError(f"--update writes references from the model answer: give one lesson, not the folder {target}")
 
         def progress(done: int, total: int, result) -> None:
             print(f"[{done}/{total}] {result.line()}", flush=True)

@@ -3,7 +3,7 @@
 The process tree of one grading run::
 
     grader (never opens a GL context; reads the reference, compares, writes every report)
-     └─ forkserver (Python's multiprocessing: imported glsandbox, numpy and moderngl once)
+     └─ zygote (imported glsandbox, numpy and moderngl once; forks on the grader's word)
          └─ supervisor, one per submission (own session; a "child subreaper": every process
             │  the submission leaves behind is re-parented to it, and it kills them all)
             └─ renderer (own session; stdin /dev/null, stdout and stderr into a file;
@@ -16,7 +16,10 @@ loads the submission and renders each requested picture, writing each as a
 framed message on a pipe: raw RGBA pixels, or an error line. It knows no
 reference. The supervisor reads the pipe against the clock, kills the
 renderer's whole tree when it is done, times out or dies, and sends the
-grader one plain result per picture. Nothing the submission does in its
+grader one plain result per picture (JSON and raw pixels on a pipe of its
+own: the grader never unpickles what a child sends). The zygote is
+Python's "forkserver" idea without its named socket: the grader talks to it
+over a socket pair no other process can find. Nothing the submission does in its
 own process (``os._exit``, a signal, ``atexit``, threads, ``fork``,
 replacing ``sys.stdout`` or glsandbox's functions) reaches the grader: the
 worst it can do is lose its own pictures.
@@ -26,8 +29,6 @@ from __future__ import annotations
 
 import ctypes
 import json
-import multiprocessing
-import multiprocessing.connection
 import os
 import resource
 import select
@@ -46,7 +47,7 @@ import numpy as np
 
 __all__ = ["Render", "Job", "Picture", "JobResult", "run_jobs", "PRELOAD"]
 
-#: What the forkserver imports once, so each submission starts warm (and no module
+#: What the zygote imports once, so each submission starts warm (and no module
 #: opens a GL context at import).
 PRELOAD = ["glsandbox.measure.isolate", "glsandbox.frame", "glsandbox.lesson", "glsandbox.scene_file",
            "glsandbox.measure.sandbox", "glsandbox.gl.context", "numpy", "moderngl", "PIL.Image"]
@@ -150,6 +151,9 @@ def _renderer(job: Job, root: str, target: str, work: str, out: int) -> None:
     os.dup2(log, 2)
     os.close(null)
     os.close(log)
+    os.dup2(out, 3)  # the result pipe; every other descriptor (the supervisor's, the zygote's) is closed
+    out = 3
+    os.closerange(4, resource.getrlimit(resource.RLIMIT_NOFILE)[0])
     sys.stdin = open(os.devnull)  # noqa: SIM115 - the submission's, for its life
     sys.argv = ["submission"]
     cwd = os.path.join(work, "cwd")
@@ -262,11 +266,6 @@ def kill_tree(pid: int, keep: Sequence[int] = ()) -> None:
         time.sleep(0.005)
     if pid == os.getpid():
         _reap()
-
-
-def _set_subreaper(on: bool = True) -> None:
-    if sys.platform == "linux":
-        ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_CHILD_SUBREAPER, int(on), 0, 0, 0)
 
 
 def _copy_submission(source: Path, into: Path) -> Path:
@@ -385,13 +384,26 @@ def _tail(path: str) -> list[str]:
     return [line[:TAIL_WIDTH] for line in lines[-TAIL_LINES:]]
 
 
-def _supervise(job: Job, conn: multiprocessing.connection.Connection) -> None:
-    """One submission, start to end (runs in a process forked by the forkserver)."""
+def _job_from(data: dict) -> Job:
+    renders = tuple(Render(tuple(r["settings"]), tuple(r["size"]), r["samples"]) for r in data.pop("renders"))
+    return Job(renders=renders, **data)
+
+
+def _job_data(job: Job) -> dict:
+    return {"index": job.index, "source": job.source, "target": job.target, "backend": job.backend,
+            "timeout": job.timeout, "memory_mb": job.memory_mb, "copy": job.copy,
+            "renders": [{"settings": list(r.settings), "size": list(r.size), "samples": r.samples}
+                        for r in job.renders]}
+
+
+def _supervise(job: Job, out: int) -> None:
+    """One submission, start to end, its result framed on ``out`` (runs in a process the zygote forked)."""
     os.setsid()
     _set_subreaper()
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the grader decides when a run stops
+    _send(out, {"kind": "pid", "pid": os.getpid()})
     work = tempfile.mkdtemp(prefix="glsandbox-grade-")
-    result: dict = {"pictures": None, "output": [], "no_gl": "", "root": ""}
+    result: dict = {"kind": "result", "pictures": None, "output": [], "no_gl": "", "root": ""}
+    pictures: list[Picture] | None = None
     try:
         os.mkdir(os.path.join(work, "cwd"))
         if job.source is None:
@@ -401,8 +413,8 @@ def _supervise(job: Job, conn: multiprocessing.connection.Connection) -> None:
                 root = str(_copy_submission(Path(job.source), Path(work) / "submission"))
             except (OSError, shutil.Error) as exc:
                 reason = getattr(exc, "strerror", None) or str(exc).splitlines()[0][:200]
-                conn.send({**result, "pictures": [Picture(status=BROKEN, error=f"{job.source}: cannot be copied "
-                                                          f"for grading ({reason})") for _ in job.renders]})
+                pictures = [Picture(status=BROKEN, error=f"{job.source}: cannot be copied for grading ({reason})")
+                            for _ in job.renders]
                 return
             target = job.target
             result["root"] = root
@@ -412,30 +424,127 @@ def _supervise(job: Job, conn: multiprocessing.connection.Connection) -> None:
         pid = os.fork()
         if pid == 0:  # the renderer: no GL context exists in this process yet, so forking is safe
             os.close(read_end)
-            conn.close()
             _renderer(job, root, target, work, write_end)
         os.close(write_end)
         try:
-            result["pictures"] = _collect(job, pid, read_end)
+            pictures = _collect(job, pid, read_end)
         except _NoGL as exc:
             result["no_gl"] = str(exc)
         kill_tree(os.getpid())
         os.close(read_end)
         result["output"] = _tail(os.path.join(work, "output.txt"))
-        conn.send(result)
     finally:
         kill_tree(os.getpid())
         shutil.rmtree(work, ignore_errors=True)
-        conn.close()
+        payload = b""
+        if pictures is not None:
+            result["pictures"] = []
+            for picture in pictures:
+                image = picture.image
+                result["pictures"].append({"status": picture.status, "error": picture.error,
+                                           "seconds": picture.seconds,
+                                           "shape": None if image is None else list(image.shape)})
+                payload += b"" if image is None else image.tobytes()
+        _send(out, result, payload)
+
+
+# --- the zygote: a warm process that forks a supervisor per job -------------------------------
+
+
+def zygote(channel_fd: int) -> None:
+    """Serve the grader on ``channel_fd`` (one end of a socket pair): each message is a job and
+    the pipe its result goes to; fork a supervisor for it. Ends when the grader closes its end.
+
+    A socket pair has no name in the file system, so no submission can find it
+    and ask for a process (multiprocessing's forkserver listens on a named socket).
+    """
+    import socket
+
+    channel = socket.socket(fileno=channel_fd)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the grader decides when a run stops
+    signal.signal(signal.SIGCHLD, signal.SIG_IGN)  # supervisors are reaped by the kernel
+    while True:
+        size_bytes = _recv_exact(channel, 4)
+        if size_bytes is None:
+            break
+        (size,) = struct.unpack("!I", size_bytes)
+        first, fds, _, _ = socket.recv_fds(channel, min(size, 1 << 16), 1)
+        data = first + (_recv_exact(channel, size - len(first)) or b"")
+        if not fds:
+            continue
+        pid = os.fork()
+        if pid == 0:
+            signal.signal(signal.SIGCHLD, signal.SIG_DFL)  # the supervisor waits for its renderer
+            channel.close()
+            code = 0
+            try:
+                _supervise(_job_from(json.loads(data)), fds[0])
+            except BaseException:  # noqa: BLE001 - the grader sees the pipe close without a result
+                code = 1
+            os._exit(code)
+        os.close(fds[0])
+    os._exit(0)
+
+
+def _recv_exact(channel, size: int) -> bytes | None:
+    data = b""
+    while len(data) < size:
+        chunk = channel.recv(size - len(data))
+        if not chunk:
+            return None
+        data += chunk
+    return data
+
+
+def _set_subreaper(on: bool = True) -> None:
+    if sys.platform == "linux":
+        ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_CHILD_SUBREAPER, int(on), 0, 0, 0)
 
 
 # --- the grader's side -----------------------------------------------------------------------
 
 
-def _context() -> multiprocessing.context.BaseContext:
-    context = multiprocessing.get_context("forkserver")
-    context.set_forkserver_preload(PRELOAD)
-    return context
+class _Zygote:
+    """The zygote process and the grader's end of its socket pair."""
+
+    def __init__(self) -> None:
+        import socket
+        import subprocess
+
+        self.channel, theirs = socket.socketpair()
+        code = ("import sys; from glsandbox.measure.isolate import zygote, PRELOAD; import importlib; "
+                "[importlib.import_module(m) for m in PRELOAD]; zygote(int(sys.argv[1]))")
+        self.process = subprocess.Popen([sys.executable, "-c", code, str(theirs.fileno())], pass_fds=[theirs.fileno()],
+                                        stdin=subprocess.DEVNULL)
+        theirs.close()
+
+    def start(self, job: Job) -> int:
+        """Ask for a supervisor for ``job``; the read end of its result pipe."""
+        import socket
+
+        read_end, write_end = os.pipe()
+        data = json.dumps(_job_data(job)).encode()
+        try:
+            self.channel.sendall(struct.pack("!I", len(data)))
+            socket.send_fds(self.channel, [data], [write_end])
+        finally:
+            os.close(write_end)
+        return read_end
+
+    def close(self) -> None:
+        self.channel.close()
+        try:
+            self.process.wait(timeout=10)
+        except Exception:  # noqa: BLE001 - it is killed with the rest of the run
+            pass
+
+
+@dataclass
+class _Running:
+    job: Job
+    reader: _Reader
+    deadline: float
+    pid: int = 0
 
 
 def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None]) -> list[JobResult]:
@@ -445,76 +554,85 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
     leaves behind whose supervisor was killed still comes back here, and is
     killed at the end with everything else the run started.
     """
-    context = _context()
     before = set(descendants(os.getpid()))
     _set_subreaper()
     pending = deque(jobs)
-    running: dict[multiprocessing.connection.Connection, tuple[Job, multiprocessing.Process, float]] = {}
+    running: dict[int, _Running] = {}
     results: dict[int, JobResult] = {}
+    zygote_process = _Zygote()
     try:
         while pending or running:
             while pending and len(running) < max(1, workers):
                 job = pending.popleft()
-                receive, send = context.Pipe(duplex=False)
-                process = context.Process(target=_supervise, args=(job, send), daemon=True)
-                process.start()
-                send.close()
+                fd = zygote_process.start(job)
                 # a supervisor that hangs (it should not) is given up after every picture's time and a margin
-                running[receive] = (job, process, time.monotonic() + job.timeout * len(job.renders) + 60)
-            ready = multiprocessing.connection.wait(list(running), timeout=1.0)
-            for receive in list(running):
-                job, process, deadline = running[receive]
-                if receive not in ready and time.monotonic() < deadline:
-                    continue
+                running[fd] = _Running(job, _Reader(fd), time.monotonic() + job.timeout * len(job.renders) + 60)
+            ready, _, _ = select.select(list(running), [], [], 1.0)
+            for fd in list(running):
+                entry = running[fd]
+                if fd in ready:
+                    entry.reader.pump(0.0)
                 message = None
-                if receive in ready:
-                    try:
-                        message = receive.recv()
-                    except (EOFError, OSError):
-                        message = None
-                del running[receive]
-                receive.close()
-                _end(process)
-                result = _result(job, message, process)
-                results[job.index] = result
+                try:
+                    for header, payload in entry.reader.messages(1 << 34):
+                        if header.get("kind") == "pid":
+                            entry.pid = int(header["pid"])
+                        elif header.get("kind") == "result":
+                            message = (header, payload)
+                except (ValueError, KeyError, TypeError):
+                    entry.reader.closed = True
+                late = time.monotonic() > entry.deadline
+                if message is None and not entry.reader.closed and not late:
+                    continue
+                if entry.pid and message is None:
+                    kill_tree(entry.pid)
+                    _killpg(entry.pid)
+                del running[fd]
+                os.close(fd)
+                result = _result(entry.job, message)
+                results[entry.job.index] = result
                 if result.no_gl:
                     return [results[j.index] for j in jobs if j.index in results]
                 done(result)
     finally:
-        for job, process, _ in running.values():
-            _end(process)
-        from multiprocessing import forkserver, resource_tracker
-
-        forkserver._forkserver._stop()  # the next run starts a fresh one
-        tracker = resource_tracker._resource_tracker._pid
-        kill_tree(os.getpid(), keep=sorted(before | ({tracker} if tracker else set())))
+        for fd, entry in running.items():
+            if entry.pid:
+                _killpg(entry.pid)
+            os.close(fd)
+        zygote_process.close()
+        kill_tree(os.getpid(), keep=sorted(before))
         _set_subreaper(False)
     return [results[j.index] for j in jobs]
 
 
-def _end(process: multiprocessing.Process) -> None:
-    """Stop a supervisor and its session (it made its own, so its group id is its pid)."""
-    process.join(timeout=5.0)
-    if process.exitcode is None:
-        try:
-            os.killpg(process.pid, signal.SIGKILL)
-        except OSError:
-            pass
-        process.join(timeout=5.0)
+def _killpg(group: int) -> None:
+    try:
+        os.killpg(group, signal.SIGKILL)
+    except OSError:
+        pass
 
 
-def _result(job: Job, message: dict | None, process: multiprocessing.Process) -> JobResult:
-    if not isinstance(message, dict) or message.get("pictures") is None and not message.get("no_gl"):
-        why = f"exit code {process.exitcode}" if process.exitcode is not None else "no answer"
-        pictures = [Picture(status=CRASHED, error=f"its grading process ended without a result ({why})")
-                    for _ in job.renders]
+def _result(job: Job, message: tuple[dict, bytes] | None) -> JobResult:
+    if message is None or (message[0].get("pictures") is None and not message[0].get("no_gl")):
+        pictures = [Picture(status=CRASHED, error="its grading process ended without a result") for _ in job.renders]
         return JobResult(job, pictures)
-    pictures = message.get("pictures") or [Picture(status=CRASHED, error="no GL") for _ in job.renders]
-    output = [str(line) for line in message.get("output", [])]
-    root = str(message.get("root") or "")
+    header, payload = message
+    if header.get("no_gl"):
+        return JobResult(job, [], no_gl=str(header["no_gl"]))
+    pictures, offset = [], 0
+    for entry in header["pictures"]:
+        image = None
+        if entry.get("shape"):
+            h, w, c = entry["shape"]
+            image = np.frombuffer(payload, dtype=np.uint8, count=h * w * c, offset=offset).reshape(h, w, c)
+            offset += h * w * c
+        pictures.append(Picture(image, str(entry.get("status", "")), str(entry.get("error", "")),
+                                float(entry.get("seconds", 0.0))))
+    output = [str(line) for line in header.get("output", [])]
+    root = str(header.get("root") or "")
     if root and job.source:  # the private copy's path, said as the submission's own
         original = job.source if Path(job.source).is_dir() else str(Path(job.source).parent)
         for picture in pictures:
             picture.error = picture.error.replace(root, original)
         output = [line.replace(root, original) for line in output]
-    return JobResult(job, pictures, output, str(message.get("no_gl", "")))
+    return JobResult(job, pictures, output)

@@ -227,7 +227,7 @@ def confine(submission: str | os.PathLike[str], private: Sequence[str | os.PathL
     reads = read_roots([root])
     from glsandbox.gl.shaders import shader_roots
 
-    files.set_sandbox_root(root, also=tuple(shader_roots()))
+    files.set_sandbox_root(root, also=(*writes, *shader_roots()))
     enforced = _landlock(reads, [*writes, "/dev/null"])
     _install_audit_hook(reads, writes)
     return enforced
