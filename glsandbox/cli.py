@@ -250,33 +250,47 @@ def cmd_tour(args: argparse.Namespace) -> int:
 
 def cmd_new(args: argparse.Namespace) -> int:
     """``glsandbox new NAME``: a commented starting lesson ``NAME.py``, scene file ``NAME.toml``
-    and shader ``NAME.glsl`` (the scene's ball is drawn with it)."""
+    and shader ``NAME.glsl`` (the scene's ball is drawn with it). ``new --assignment NAME``:
+    the lesson as a model answer and a starting grading file ``NAME.grading.toml`` beside it."""
     from importlib.resources import files as package_files
     from string import Template
 
-    name: str = args.name
+    from glsandbox.measure.rubric import STARTER
+
+    if (args.name is None) == (args.assignment is None):
+        raise SandboxError("new: give a NAME, or --assignment NAME (a model answer and its grading file)")
+    name: str = args.name if args.name is not None else args.assignment
     if not name.isidentifier() or name.startswith("_") or not name.isascii():
         raise SandboxError(f"new {name!r}: the name must be a Python identifier: letters, digits and _, "
                            "not starting with a digit or _ (e.g. my_lesson)")
     folder: Path = args.dir
     if not folder.is_dir():
         raise SandboxError(f"--dir {folder}: folder does not exist")
-    targets = {folder / f"{name}.py": "lesson.py.tmpl", folder / f"{name}.toml": "scene.toml.tmpl",
-               folder / f"{name}.glsl": "shader.glsl.tmpl"}
+    templates = package_files("glsandbox") / "templates"
+    if args.assignment is None:
+        targets = {folder / f"{name}.py": "lesson.py.tmpl", folder / f"{name}.toml": "scene.toml.tmpl",
+                   folder / f"{name}.glsl": "shader.glsl.tmpl"}
+    else:
+        targets = {folder / f"{name}.py": "lesson.py.tmpl", folder / f"{name}.grading.toml": STARTER}
     existing = [str(path) for path in targets if path.exists() or path.is_symlink()]
     if existing:  # all or none: never part of a starter
         verb = "exists" if len(existing) == 1 else "exist"
         raise SandboxError(f"{', '.join(existing)} already {verb}; not overwritten (pick another NAME or --dir)")
     # The class name: my_lesson -> MyLesson (a name of capitals only stays as it is).
     cls = "".join(part[:1].upper() + part[1:] for part in name.split("_")) or "MyLesson"
-    templates = package_files("glsandbox") / "templates"
     for path, template in targets.items():
-        text = Template(templates.joinpath(template).read_text(encoding="utf-8")).substitute(name=name, cls=cls)
+        source = template if "\n" in template else templates.joinpath(template).read_text(encoding="utf-8")
+        text = Template(source).substitute(name=name, cls=cls)
         try:
             write_text(path, text)
         except OSError as exc:
             raise SandboxError(f"{path}: cannot write ({exc.strerror or exc})") from None
         print(f"wrote {path}")
+    if args.assignment is not None:
+        rubric = folder / f"{name}.grading.toml"
+        print(f"next: glsandbox check {folder / name}.py --rubric {rubric} --update   (the goldens, from the model answer)")
+        print(f"then: glsandbox check SUBMISSIONS/ --rubric {rubric} --html report.html")
+        return 0
     print(f"next: glsandbox run {folder / name}.py   (or glsandbox render {folder / name}.py --out {name}.png)")
     return 0
 
@@ -444,7 +458,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_compare)
 
     p = sub.add_parser("new", help="write a small commented starting lesson NAME.py, scene file NAME.toml and shader NAME.glsl")
-    p.add_argument("name", metavar="NAME", help="the lesson's name, a Python identifier (e.g. my_lesson)")
+    p.add_argument("name", metavar="NAME", nargs="?", default=None,
+                   help="the lesson's name, a Python identifier (e.g. my_lesson)")
+    p.add_argument("--assignment", metavar="NAME", default=None,
+                   help="instead: a model answer NAME.py and a starting grading file NAME.grading.toml")
     p.add_argument("--dir", type=Path, default=Path("."), help="the folder to write into (default: here)")
     p.set_defaults(func=cmd_new)
 

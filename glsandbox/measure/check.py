@@ -52,7 +52,10 @@ THUMB_WIDTH = 160
 def shown(text: str) -> str:
     """A name as it may be printed or written anywhere: bytes that are not UTF-8 as ``\\xNN``,
     control and format characters (newlines, escape sequences) as ``\\n``, ``\\x1b``, ``\\u202e``."""
-    raw = os.fsencode(text) if isinstance(text, str) else bytes(text)
+    try:
+        raw = os.fsencode(text) if isinstance(text, str) else bytes(text)
+    except UnicodeEncodeError:  # a surrogate no file name gives
+        raw = text.encode("utf-8", "backslashreplace")
     decoded = raw.decode("utf-8", "backslashreplace")
     out = []
     for char in decoded:
@@ -117,7 +120,7 @@ class Outcome:
     def detail(self) -> str:
         """The figures of a comparison, or the error line."""
         if self.match is None:
-            return self.error
+            return shown(self.error)
         return self.match.summary().partition(": ")[2]
 
 
@@ -159,8 +162,12 @@ class CheckResult:
         """One line: the outcome, the name and (one check) the figures or error, (several) the score."""
         if len(self.outcomes) == 1:
             return f"{self.status:<6} {self.shown}: {self.outcomes[0].detail()}"
-        parts = "; ".join(f"{o.check.name} {o.status}" + ("" if o.status == PASS else f" ({o.detail()})")
-                          for o in self.outcomes)
+        first = self.outcomes[0]
+        if first.status != PASS and all((o.status, o.error) == (first.status, first.error) for o in self.outcomes):
+            parts = f"every check {first.status} ({first.detail()})"  # it did not load: said once
+        else:
+            parts = "; ".join(f"{o.check.name} {o.status}" + ("" if o.status == PASS else f" ({o.detail()})")
+                              for o in self.outcomes)
         return f"{self.status:<6} {self.shown}: {points(self.score)}/{points(self.total)} points: {parts}"
 
 
@@ -239,7 +246,7 @@ def _outcomes(result: JobResult, checks: Sequence[Check], references: dict[Path,
 
 def _outcome(check: Check, picture: Picture, expected: np.ndarray, name: str) -> Outcome:
     if picture.image is None:
-        return Outcome(check, picture.status or CRASHED, error=picture.error, seconds=picture.seconds)
+        return Outcome(check, picture.status or CRASHED, error=shown(picture.error), seconds=picture.seconds)
     stem = file_stem(name)
     match, paths = judge(picture.image, expected, check.tolerances, results_dir(check), stem)
     return Outcome(check, PASS if match.passed else FAIL, match, seconds=picture.seconds, artifacts=paths,
@@ -278,7 +285,7 @@ def check_folder(folder: Path, checks: Sequence[Check], backend: str | None = No
     def done(result: JobResult) -> None:
         name, path = by_index[result.job.index]
         finished[result.job.index] = CheckResult(name, path, _outcomes(result, checks, references, name),
-                                                 result.output)
+                                                 [shown(line) for line in result.output])
         progress(len(finished), len(entries), finished[result.job.index])
 
     results = run_jobs([job for _, _, job in entries], limits.jobs, done)
@@ -289,14 +296,17 @@ def check_folder(folder: Path, checks: Sequence[Check], backend: str | None = No
 
 
 def render_isolated(spec: str, checks: Sequence[Check], sizes: Sequence[tuple[int, int]],
-                    backend: str | None, limits: Limits) -> JobResult:
-    """One lesson (a name or a file) rendered once per check in an isolated child, its folder as its root."""
+                    backend: str | None, limits: Limits, model_answer: bool = False) -> JobResult:
+    """One lesson (a name or a file) rendered once per check in an isolated child, its folder as its root
+    (``model_answer``: its compiled shaders are kept in Mesa's cache, for the submissions)."""
     renders = tuple(Render(c.settings, size, c.samples) for c, size in zip(checks, sizes))
     path = Path(spec)
     if spec.endswith((".py", ".toml")):
-        job = Job(0, str(path.resolve()), path.name, renders, backend, limits.timeout, limits.memory, copy=False)
+        job = Job(0, str(path.resolve()), path.name, renders, backend, limits.timeout, limits.memory, copy=False,
+                  writes_cache=model_answer)
     else:
-        job = Job(0, None, spec, renders, backend, limits.timeout, limits.memory, copy=False)
+        job = Job(0, None, spec, renders, backend, limits.timeout, limits.memory, copy=False,
+                  writes_cache=model_answer)
     (result,) = run_jobs([job], 1, lambda r: None)
     if result.no_gl:
         raise SandboxError(result.no_gl)
@@ -332,10 +342,10 @@ def check_one(spec: str, checks: Sequence[Check], update: bool, backend: str | N
     existing = {c.golden: read_reference(c.golden) for c in checks if c.golden.exists()}
     sizes = [c.size or ((existing[c.golden].shape[1], existing[c.golden].shape[0]) if c.golden in existing
                         else DEFAULT_SIZE) for c in checks]
-    result = render_isolated(spec, checks, sizes, backend, limits)
+    result = render_isolated(spec, checks, sizes, backend, limits, model_answer=update)
     broken = next((p for p in result.pictures if p.status == BROKEN), None)
     if broken is not None:
-        raise SandboxError(broken.error)
+        raise SandboxError(shown(broken.error))
     if not update:
         missing = next((c for c in checks if c.golden not in existing), None)
         if missing is not None:
@@ -343,7 +353,7 @@ def check_one(spec: str, checks: Sequence[Check], update: bool, backend: str | N
     out = []
     for check, picture in zip(checks, result.pictures):
         if picture.image is None:
-            out.append(OneCheck(check, status=picture.status, error=picture.error))
+            out.append(OneCheck(check, status=picture.status, error=shown(picture.error)))
             continue
         expected = existing.get(check.golden)
         if expected is None:

@@ -21,7 +21,7 @@ from xml.sax.saxutils import escape as xml_escape
 
 from glsandbox import files
 from glsandbox.errors import SandboxError
-from glsandbox.measure.check import OUTCOMES, PASS, CheckResult, Outcome, counts, points, read_reference
+from glsandbox.measure.check import OUTCOMES, PASS, CheckResult, Outcome, counts, points, read_reference, shown
 
 __all__ = ["REPORTS", "write_reports"]
 
@@ -35,7 +35,7 @@ def _figures(o: Outcome) -> dict[str, object]:
             "rmse": None if m is None or math.isnan(m.rmse) else round(m.rmse, 6),
             "threshold": m.threshold if m else None,
             "max_bad_share": m.max_bad_share if m else None,
-            "seconds": round(o.seconds, 3), "error": o.error}
+            "seconds": round(o.seconds, 3), "error": shown(o.error)}
 
 
 def rows(results: Sequence[CheckResult]) -> list[dict[str, object]]:
@@ -51,9 +51,12 @@ def rows(results: Sequence[CheckResult]) -> list[dict[str, object]]:
 
 
 def _path(r: CheckResult) -> str:
-    from glsandbox.measure.check import shown
-
     return shown(str(r.path))
+
+
+def _output(r: CheckResult) -> list[str]:
+    """The submission's last printed lines, escaped as names are (its own text, any bytes)."""
+    return [shown(line) for line in r.output]
 
 
 def csv_text(results: Sequence[CheckResult], title: str) -> str:
@@ -69,7 +72,7 @@ def json_text(results: Sequence[CheckResult], title: str) -> str:
     submissions = []
     for r in results:
         entry: dict[str, object] = {"name": r.shown, "path": _path(r), "status": r.status,
-                                    "score": r.score, "total": r.total, "output": r.output}
+                                    "score": r.score, "total": r.total, "output": _output(r)}
         if len(r.outcomes) == 1:
             entry.update({k: v for k, v in _figures(r.outcomes[0]).items() if k != "status"})
         else:
@@ -92,7 +95,7 @@ def junit_text(results: Sequence[CheckResult], title: str) -> str:
             elif o.status != PASS:
                 body = f"<error message={quoteattr(o.detail())} type={quoteattr(o.status)}/>"
             if r.output:
-                body += f"<system-out>{xml_escape(chr(10).join(r.output))}</system-out>"
+                body += f"<system-out>{xml_escape(chr(10).join(_output(r)))}</system-out>"
             cases.append(f"  <testcase classname=\"glsandbox.check\" name={name} time=\"{o.seconds:.3f}\">"
                          f"{body}</testcase>")
     outcomes = [o for r in results for o in r.outcomes]
@@ -115,7 +118,7 @@ def gradescope_text(results: Sequence[CheckResult], title: str) -> str:
             name = o.check.name if len(results) == 1 else f"{r.shown}: {o.check.name}"
             output = f"{o.status}: {o.detail()}".rstrip(": ")
             if r.output and o.status != PASS:
-                output += "\nlast lines printed:\n" + "\n".join(r.output)
+                output += "\nlast lines printed:\n" + "\n".join(_output(r))
             tests.append({"name": name, "score": o.points, "max_score": o.check.points, "output": output,
                           "status": "passed" if o.status == PASS else "failed",
                           "visibility": "after_published" if o.check.hidden else "visible"})
@@ -162,7 +165,7 @@ def html_text(results: Sequence[CheckResult], title: str) -> str:
             cells.append(f'<td style="background:{_COLOURS.get(o.status, "#fff")}">'
                          f"{_img(ref, 'reference')}{_img(o.thumb, 'submission')}{_img(diff, 'difference')}"
                          f'<div class="detail">{text}</div></td>')
-        output = (f'<details><summary>output</summary><pre>{html.escape(chr(10).join(r.output))}</pre></details>'
+        output = (f'<details><summary>output</summary><pre>{html.escape(chr(10).join(_output(r)))}</pre></details>'
                   if r.output else "")
         body.append(f'<tr><td class="name">{html.escape(r.shown)}{output}</td>'
                     f'<td style="background:{_COLOURS.get(r.status, "#fff")}">{html.escape(r.status)}</td>'

@@ -90,6 +90,8 @@ def hostile_kinds(ref: Path, results: Path, subs: Path) -> dict[str, tuple[str, 
                                                   "'w').write('forged'))"), "FAIL"),
         "h_fake_line": ("h_fake_line.py", lesson(before="print('[1/1] PASS   h_fake_line: identical', flush=True)\n"
                                                        "sys.stdout = None"), "FAIL"),
+        "h_forge_error": ("h_forge_error.py", lesson(during="raise RuntimeError('\\n[1/1] PASS   z_forged: identical')"),
+                          "BROKEN RuntimeError at"),
         "h_pipe": ("h_pipe.py", lesson(during="for fd in os.listdir('/proc/self/fd'):\n"
                                               "    try: os.write(int(fd), b'GLSB' + bytes(100))\n"
                                               "    except OSError: pass"), "CRASHED"),
