@@ -53,21 +53,18 @@ _TWO_PATH_EVENTS = frozenset({"os.rename", "os.link", "os.symlink", "shutil.copy
 
 def read_roots(extra: Iterable[str | os.PathLike[str]] = ()) -> list[str]:
     """The folders a confined submission may read: Python's, glsandbox's, the system's and ``extra``."""
-    import glsandbox
+    import importlib.util
 
     roots = {sys.prefix, sys.base_prefix, sys.exec_prefix, *SYSTEM_READ,
-             str(Path(glsandbox.__file__).resolve().parent)}
+             str(Path(__file__).resolve().parents[1])}  # the glsandbox package
     for key in ("stdlib", "platstdlib", "purelib", "platlib"):
         path = sysconfig.get_paths().get(key)
         if path:
             roots.add(path)
     roots.update(p for p in sys.path if p.endswith(("site-packages", "dist-packages")))
-    try:  # the course's lessons, which a submission may subclass
-        import lessons
-
-        roots.update(str(Path(p).resolve()) for p in lessons.__path__)
-    except ImportError:
-        pass
+    spec = importlib.util.find_spec("lessons")  # the course's lessons, which a submission may subclass
+    if spec is not None and spec.submodule_search_locations:
+        roots.update(str(Path(p).resolve()) for p in spec.submodule_search_locations)
     from glsandbox.gl.shaders import shader_roots
 
     roots.update(str(p) for p in shader_roots())  # glsandbox's shaders, and GLSANDBOX_SHADER_DIR's
