@@ -604,7 +604,12 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
         while pending or running:
             while pending and len(running) < max(1, workers):
                 job = pending.popleft()
-                fd = zygote_process.start(job)
+                try:
+                    fd = zygote_process.start(job)
+                except OSError:  # the zygote is gone (it should not be): a fresh one, once
+                    zygote_process.close()
+                    zygote_process = _Zygote()
+                    fd = zygote_process.start(job)
                 # a supervisor that hangs (it should not) is given up after every picture's time and a margin
                 running[fd] = _Running(job, _Reader(fd), time.monotonic() + job.timeout * len(job.renders) + 60)
             ready, _, _ = select.select(list(running), [], [], 1.0)
