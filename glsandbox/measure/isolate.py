@@ -555,7 +555,7 @@ class _Zygote:
         self.channel, theirs = socket.socketpair()
         code = "import sys; from glsandbox.measure.isolate import zygote_main; zygote_main(int(sys.argv[1]))"
         self.process = subprocess.Popen([sys.executable, "-c", code, str(theirs.fileno())], pass_fds=[theirs.fileno()],
-                                        stdin=subprocess.DEVNULL)
+                                        stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL)  # never the grader's stdout
         theirs.close()
 
     def start(self, job: Job) -> int:
