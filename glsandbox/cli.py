@@ -103,14 +103,9 @@ def write_png(image: np.ndarray, out: Path) -> None:
 
 def parse_size(text: str) -> tuple[int, int]:
     """``WxH`` -> (W, H), refusing anything else with the value named."""
-    w, sep, h = text.lower().partition("x")
-    try:
-        size = (int(w), int(h))
-    except ValueError:
-        size = (0, 0)
-    if not sep or size[0] <= 0 or size[1] <= 0 or max(size) > 16384:
-        raise SandboxError(f"--size {text!r}: expected WIDTHxHEIGHT with positive integers, e.g. 640x480")
-    return size
+    from glsandbox.measure.rubric import parse_size_text
+
+    return parse_size_text(text, "--size")
 
 
 def add_render_options(parser: argparse.ArgumentParser) -> None:
