@@ -12,8 +12,7 @@ import pytest
 
 from glsandbox.files import load_png, save_png
 from glsandbox.measure.golden import compare_images
-from test_cli import assert_user_error, glsandbox
-from test_own_lessons import SPIN
+from support import SPIN, assert_user_error, glsandbox
 
 pytestmark = pytest.mark.slow
 

@@ -21,6 +21,7 @@ import uuid
 from pathlib import Path
 
 import pytest
+from support import REPO_ROOT
 
 from glsandbox.lesson import lesson_files
 from glsandbox.measure.check import shown
@@ -28,7 +29,6 @@ from glsandbox.measure.sandbox import landlock_abi
 
 pytestmark = pytest.mark.slow
 
-REPO = Path(__file__).resolve().parents[2]
 SIZE = "64x48"
 RIGHT = 'name = "cube"\n[camera]\neye = [2, 1.5, 3]\n[[nodes]]\nmesh = "cube"\n'
 WRONG = RIGHT.replace('"cube"\n', '"sphere"\n', 1).replace('mesh = "cube"', 'mesh = "sphere"')
@@ -167,7 +167,7 @@ def processes_with(marker: str) -> list[int]:
 def grade(*args: str, marker: str, timeout: float = 300) -> subprocess.CompletedProcess:
     env = {**os.environ, "GLSANDBOX_RUN_MARK": marker}
     return subprocess.run([sys.executable, "-m", "glsandbox.cli", *args], capture_output=True, env=env,
-                          cwd=REPO, timeout=timeout)
+                          cwd=REPO_ROOT, timeout=timeout)
 
 
 def no_process_left(marker: str) -> list[int]:

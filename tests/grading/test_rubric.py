@@ -3,24 +3,19 @@
 from __future__ import annotations
 
 import json
-import os
 import re
-import subprocess
-import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import pytest
+from support import glsandbox
 
 from glsandbox.errors import SandboxError
 from glsandbox.measure.rubric import load_rubric
 
-REPO = Path(__file__).resolve().parents[2]
 
-
-def run(*args: str, cwd: Path) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "glsandbox.cli", *args], capture_output=True, text=True, cwd=cwd,
-                          env={**os.environ, "PYTHONPATH": str(REPO)}, timeout=300)
+def run(*args: str, cwd: Path):
+    return glsandbox(*args, cwd=cwd)
 
 
 GOOD = '''timeout = 5
