@@ -179,7 +179,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
 
 def cmd_tour(args: argparse.Namespace) -> int:
-    from glsandbox.measure.check import file_stem, render_lesson, shown
+    from glsandbox.measure.check import render_lesson
 
     out: Path = args.out
     if args.settings:  # refused before the output folder exists
@@ -199,29 +199,27 @@ def cmd_tour(args: argparse.Namespace) -> int:
         found = lesson_files(args.lessons)
         if not found:
             raise SandboxError(f"--lessons {args.lessons}: no .py or .toml lesson files (nor subfolders holding one)")
-        # a file name may hold any bytes: shown escaped, and its picture named with safe characters
-        lessons = [(shown(name), lambda path=path: submission_lesson(path), file_stem(name)) for name, path in found]
-        commands = {shown(name): shown(f"glsandbox run {shlex.quote(str(path))}") for name, path in found}
+        lessons = [(name, lambda path=path: submission_lesson(path)) for name, path in found]
+        commands = {name: f"glsandbox run {shlex.quote(str(path))}" for name, path in found}
     else:
-        lessons = [(cls.name, lambda cls=cls: cls, cls.name) for cls in all_lessons()]
+        lessons = [(cls.name, lambda cls=cls: cls) for cls in all_lessons()]
         commands = {cls.name: f"glsandbox run {cls.name}" for cls in all_lessons()}
     results = []
     started = time.perf_counter()
     with HeadlessRenderer(args.backend) as renderer:
         print(f"tour: {len(lessons)} lessons at {size[0]}x{size[1]} on {renderer.host.backend} "
               f"({renderer.host.ctx.info['GL_RENDERER']}) -> {out}/", file=sys.stderr)
-        for number, (name, load, stem) in enumerate(lessons, start=1):
+        for number, (name, load) in enumerate(lessons, start=1):
             entry = {"lesson": name, "title": "", "course_section": "", "command": commands[name], "contrasts": []}
             prefix = f"[{number}/{len(lessons)}] {name}"
             try:
                 cls = load()
-                entry.update(title=shown(cls.title), course_section=shown(cls.course_section),
-                             description=lesson_description(cls))
+                entry.update(title=cls.title, course_section=cls.course_section, description=lesson_description(cls))
                 if args.lessons is None:
                     frame = renderer.render(cls(), size, args.samples)
                 else:  # a user's file: its own exceptions are one line, and a fresh context each
                     frame = render_lesson(cls(), size, args.samples, args.backend)
-                image_path = out / f"{stem}.png"
+                image_path = out / f"{name}.png"
                 write_png(frame.image, image_path)
                 entry.update(ok=True, image=image_path.name, render_ms=round(frame.seconds * 1000, 2),
                              plan=frame.plan.to_dict(), plan_text=frame.plan.describe())
@@ -229,7 +227,7 @@ def cmd_tour(args: argparse.Namespace) -> int:
                 if args.lessons is None:  # a user's lesson file runs only where its errors are caught
                     entry["contrasts"] = _tour_contrasts(cls, out, size, args.samples, renderer, prefix)
             except SandboxError as exc:  # one broken lesson must not stop the tour
-                entry.update(ok=False, error=shown(str(exc)))
+                entry.update(ok=False, error=str(exc))
                 print(f"{prefix}: FAILED: {exc}", file=sys.stderr, flush=True)
             results.append(entry)
         renderer_name = renderer.host.renderer

@@ -78,22 +78,3 @@ def test_a_report_that_cannot_be_written_is_one_line(tmp_path: Path, results: li
     with pytest.raises(SandboxError, match=r"^--junit .*cannot write"):
         write_reports(results, {"junit": blocker / "r.xml"}, "ref.png")
 
-
-@pytest.mark.slow
-def test_tour_lessons_with_names_of_any_bytes(tmp_path: Path, gl) -> None:
-    """``tour --lessons`` over the same folder a class is graded from: an odd name never stops it."""
-    import subprocess
-    import sys
-
-    lessons = tmp_path / "lessons"
-    lessons.mkdir()
-    scene = 'name = "c"\n[[nodes]]\nmesh = "cube"\n'
-    (lessons / "plain.toml").write_text(scene)
-    (lessons / (os.fsdecode(b"odd\xff\n\x1b[2J") + ".toml")).write_text(scene)
-    proc = subprocess.run([sys.executable, "-m", "glsandbox.cli", "tour", "--lessons", str(lessons), "--out",
-                           str(tmp_path / "out"), "--size", "32x24"], capture_output=True)
-    assert proc.returncode == 0, proc.stderr
-    summary = json.loads((tmp_path / "out" / "tour.json").read_text())
-    assert [r["lesson"] for r in summary["lessons"]] == ["odd\\xff\\n\\x1b[2J", "plain"]
-    assert all((tmp_path / "out" / r["image"]).is_file() for r in summary["lessons"])
-    assert b"\x1b" not in proc.stderr and "\x1b" not in (tmp_path / "out" / "index.html").read_text()
