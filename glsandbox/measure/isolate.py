@@ -30,7 +30,6 @@ from __future__ import annotations
 import ctypes
 import json
 import os
-import resource
 import select
 import shutil
 import signal
@@ -129,6 +128,8 @@ def _send(fd: int, header: dict, payload: bytes = b"") -> None:
 def _limit(job: Job) -> None:
     """Address space (--memory), CPU seconds (--timeout for each picture, plus start-up), no core
     files, and files no larger than 256 MB."""
+    import resource  # POSIX only, as the whole of this module's running side
+
     memory = job.memory_mb * 1024 * 1024
     cpu = int(job.timeout * len(job.renders)) + 10
     for limit, value in ((resource.RLIMIT_AS, memory), (resource.RLIMIT_CPU, cpu), (resource.RLIMIT_CORE, 0),
@@ -156,7 +157,7 @@ def _renderer(job: Job, root: str, target: str, work: str, out: int) -> None:
     os.close(log)
     os.dup2(out, 3)  # the result pipe; every other descriptor (the supervisor's, the zygote's) is closed
     out = 3
-    os.closerange(4, resource.getrlimit(resource.RLIMIT_NOFILE)[0])
+    os.closerange(4, os.sysconf("SC_OPEN_MAX"))
     sys.stdin = open(os.devnull)  # noqa: SIM115 - the submission's, for its life
     sys.argv = ["submission"]
     cwd = os.path.join(work, "cwd")
@@ -212,6 +213,8 @@ def _renderer(job: Job, root: str, target: str, work: str, out: int) -> None:
 def _children_map() -> dict[int, list[int]]:
     """Every live process's children, from /proc."""
     children: dict[int, list[int]] = {}
+    if not os.path.isdir("/proc"):  # not Linux: only the renderer's own session is killed (see _supervise)
+        return children
     for entry in os.listdir("/proc"):
         if not entry.isdigit():
             continue
@@ -433,6 +436,7 @@ def _supervise(job: Job, out: int) -> None:
             pictures = _collect(job, pid, read_end)
         except _NoGL as exc:
             result["no_gl"] = str(exc)
+        _killpg(pid)  # the renderer's session (all there is to kill where /proc is missing)
         kill_tree(os.getpid())
         os.close(read_end)
         result["output"] = _tail(os.path.join(work, "output.txt"))
@@ -594,6 +598,11 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
     leaves behind whose supervisor was killed still comes back here, and is
     killed at the end with everything else the run started.
     """
+    if not hasattr(os, "fork"):
+        from glsandbox.errors import SandboxError
+
+        raise SandboxError("glsandbox check runs each submission in a process of its own, which needs a POSIX "
+                           "system (Linux, macOS); on Windows run it in WSL or a container")
     before = set(descendants(os.getpid()))
     _set_subreaper()
     pending = deque(jobs)
