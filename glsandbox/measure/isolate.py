@@ -274,6 +274,19 @@ def kill_tree(pid: int, keep: Sequence[int] = ()) -> None:
         _reap()
 
 
+def _wait_briefly(pid: int, seconds: float = 0.05) -> None:
+    """Reap ``pid`` if it ends within ``seconds``."""
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        try:
+            done, _ = os.waitpid(pid, os.WNOHANG)
+        except ChildProcessError:
+            return
+        if done:
+            return
+        time.sleep(0.001)
+
+
 def _copy_submission(source: Path, into: Path) -> Path:
     """A private copy of a submission's file or folder; symbolic links are copied as links
     (one that points outside is refused when read, never followed while copying)."""
@@ -410,6 +423,7 @@ def _supervise(job: Job, out: int) -> None:
     work = tempfile.mkdtemp(prefix="glsandbox-grade-")
     result: dict = {"kind": "result", "pictures": None, "output": [], "no_gl": "", "root": ""}
     pictures: list[Picture] | None = None
+    cleaned = False
     try:
         os.mkdir(os.path.join(work, "cwd"))
         if job.source is None:
@@ -436,12 +450,15 @@ def _supervise(job: Job, out: int) -> None:
             pictures = _collect(job, pid, read_end)
         except _NoGL as exc:
             result["no_gl"] = str(exc)
+        _wait_briefly(pid)  # after its last picture it ends by itself: then one look finds nothing left
         _killpg(pid)  # the renderer's session (all there is to kill where /proc is missing)
         kill_tree(os.getpid())
+        cleaned = True
         os.close(read_end)
         result["output"] = _tail(os.path.join(work, "output.txt"))
     finally:
-        kill_tree(os.getpid())
+        if not cleaned:
+            kill_tree(os.getpid())
         shutil.rmtree(work, ignore_errors=True)
         payload = b""
         if pictures is not None:
@@ -493,6 +510,9 @@ def zygote_main(channel_fd: int) -> None:
         except ImportError:  # e.g. no lessons package beside an installed glsandbox
             pass
     preload_gl_libraries()
+    from glsandbox.measure.sandbox import read_roots
+
+    read_roots()  # worked out once, for every renderer
     zygote(channel_fd)
 
 

@@ -27,6 +27,7 @@ system's (``/usr``, ``/lib``, ``/etc``, ``/dev``, ``/proc``, ``/sys``).
 from __future__ import annotations
 
 import ctypes
+import functools
 import os
 import sys
 import sysconfig
@@ -53,6 +54,13 @@ _TWO_PATH_EVENTS = frozenset({"os.rename", "os.link", "os.symlink", "shutil.copy
 
 def read_roots(extra: Iterable[str | os.PathLike[str]] = ()) -> list[str]:
     """The folders a confined submission may read: Python's, glsandbox's, the system's and ``extra``."""
+    return sorted({*_base_roots(), *(os.path.realpath(p) for p in extra if os.path.isdir(p))})
+
+
+@functools.lru_cache(maxsize=1)
+def _base_roots() -> tuple[str, ...]:
+    """:func:`read_roots` without the extra folders: the same for every submission of a run, so
+    worked out once (in the zygote, before it forks)."""
     import importlib.util
 
     roots = {sys.prefix, sys.base_prefix, sys.exec_prefix, *SYSTEM_READ,
@@ -68,8 +76,7 @@ def read_roots(extra: Iterable[str | os.PathLike[str]] = ()) -> list[str]:
     from glsandbox.gl.shaders import shader_roots
 
     roots.update(str(p) for p in shader_roots())  # glsandbox's shaders, and GLSANDBOX_SHADER_DIR's
-    roots.update(os.fspath(p) for p in extra)
-    return sorted({os.path.realpath(r) for r in roots if os.path.isdir(r)})
+    return tuple(sorted({os.path.realpath(r) for r in roots if os.path.isdir(r)}))
 
 
 def shader_cache_dirs() -> list[str]:
