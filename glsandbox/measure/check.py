@@ -38,7 +38,7 @@ from glsandbox.frame import DEFAULT_SIZE, Frame, HeadlessRenderer
 from glsandbox.lesson import Lesson, lesson_files, user_code_error
 from glsandbox.measure.golden import DEFAULT_THRESHOLD, ImageMatch, compare_images, write_artifacts
 from glsandbox.measure.isolate import BROKEN, CRASHED, OOM, TIMEOUT, Job, JobResult, Picture, Render, run_jobs
-from glsandbox.measure.rubric import TOLERANCES, Check, parse_tolerances  # noqa: F401 - re-exported
+from glsandbox.measure.rubric import Check
 
 PASS, FAIL = "PASS", "FAIL"
 #: Every outcome, in the order the summary counts them.

@@ -628,6 +628,7 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
     pending = deque(jobs)
     running: dict[int, _Running] = {}
     results: dict[int, JobResult] = {}
+    retried: set[int] = set()
     zygote_process = _Zygote()
     try:
         while pending or running:
@@ -664,6 +665,10 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
                 del running[fd]
                 os.close(fd)
                 result = _result(entry.job, message)
+                if result.no_gl and entry.job.index not in retried:  # once more: a driver can fail now and then
+                    retried.add(entry.job.index)
+                    pending.appendleft(entry.job)
+                    continue
                 results[entry.job.index] = result
                 if result.no_gl:
                     return [results[j.index] for j in jobs if j.index in results]

@@ -20,9 +20,11 @@ import time
 import uuid
 from pathlib import Path
 
+import numpy as np
 import pytest
 from support import REPO_ROOT
 
+from glsandbox.files import save_png
 from glsandbox.lesson import lesson_files
 from glsandbox.measure.check import shown
 from glsandbox.measure.sandbox import landlock_abi
@@ -277,3 +279,17 @@ def test_one_lesson_is_isolated_too(tmp_path: Path, gl) -> None:
     assert proc.returncode == 0 and b"PASS: identical" in proc.stdout, proc.stdout + proc.stderr
     assert no_process_left(marker) == []
 
+
+
+def test_no_gl_for_the_renderers_is_the_graders_error_not_every_submissions(tmp_path: Path) -> None:
+    """A backend that cannot start in the renderer (a window without a display) is one line, exit 2."""
+    subs = tmp_path / "subs"
+    subs.mkdir()
+    (subs / "a.toml").write_text(RIGHT)
+    ref = tmp_path / "ref.png"
+    save_png(np.zeros((4, 4, 4), np.uint8), ref)
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    proc = subprocess.run([sys.executable, "-m", "glsandbox.cli", "check", str(subs), "--golden", str(ref),
+                           "--backend", "window"], capture_output=True, text=True, env=env, cwd=REPO_ROOT, timeout=120)
+    assert proc.returncode == 2 and proc.stdout == "", proc.stdout + proc.stderr
+    assert proc.stderr.startswith("error: no display for a window") and proc.stderr.count("\n") == 1
