@@ -57,6 +57,9 @@ BROKEN, TIMEOUT, CRASHED, OOM = "BROKEN", "TIMEOUT", "CRASHED", "OUT OF MEMORY"
 #: The renderer's output kept for the report: its last lines, each cut.
 TAIL_LINES, TAIL_WIDTH = 8, 200
 
+#: The environment a renderer keeps (by prefix): the drivers', the locale's and glsandbox's own.
+_ENV_KEPT = ("PATH", "HOME", "LANG", "LC_", "TZ", "DISPLAY", "WAYLAND_", "XDG_", "MESA_", "LIBGL_", "GALLIUM_",
+             "LP_", "EGL_", "__EGL_", "__GLX_", "GLCONTEXT_", "PYOPENGL_", "GLSANDBOX_", "PYTHONHASHSEED", "CI")
 _MAGIC = b"GLSB"
 _HEADER = struct.Struct("!4sIQ")  # magic, JSON header length, payload length
 _PR_SET_CHILD_SUBREAPER = 36
@@ -160,6 +163,9 @@ def _renderer(job: Job, root: str, target: str, work: str, out: int) -> None:
     os.closerange(4, os.sysconf("SC_OPEN_MAX"))
     sys.stdin = open(os.devnull)  # noqa: SIM115 - the submission's, for its life
     sys.argv = ["submission"]
+    for key in list(os.environ):  # only what rendering reads: no path of the teacher's (PWD, OLDPWD, ...)
+        if not key.startswith(_ENV_KEPT):
+            del os.environ[key]
     cwd = os.path.join(work, "cwd")
     os.chdir(root if job.copy else cwd)
     _limit(job)

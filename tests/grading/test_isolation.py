@@ -65,6 +65,9 @@ def hostile_kinds(ref: Path, results: Path, subs: Path) -> dict[str, tuple[str, 
         "h_argv": ("h_argv.py", lesson(during="refs = [a for a in sys.argv if a.endswith('.png')]\n"
                                               "assert refs, f'no reference in argv {sys.argv}'"),
                    "BROKEN AssertionError"),
+        "h_environ": ("h_environ.py", lesson(during="found = [v for v in os.environ.values() if '.png' in v]\n"
+                                                   "assert found, 'no reference in the environment'"),
+                      "BROKEN no reference in the environment"),
         "h_texture_up": ("h_texture_up.toml", RIGHT.replace('mesh = "cube"', 'mesh = "cube24"\ntexture = "../ref.png"'),
                          "BROKEN outside the submission"),
         "h_texture_abs": ("h_texture_abs.toml", RIGHT.replace('mesh = "cube"', f'mesh = "cube24"\ntexture = "{ref}"'),
@@ -166,8 +169,8 @@ def processes_with(marker: str) -> list[int]:
     return found
 
 
-def grade(*args: str, marker: str, timeout: float = 300) -> subprocess.CompletedProcess:
-    env = {**os.environ, "GLSANDBOX_RUN_MARK": marker}
+def grade(*args: str, marker: str, timeout: float = 300, **extra_env: str) -> subprocess.CompletedProcess:
+    env = {**os.environ, "GLSANDBOX_RUN_MARK": marker, **extra_env}
     return subprocess.run([sys.executable, "-m", "glsandbox.cli", *args], capture_output=True, env=env,
                           cwd=REPO_ROOT, timeout=timeout)
 
@@ -209,7 +212,8 @@ def test_hostile_submissions_cannot_touch_verdicts_references_reports_or_the_run
     (subs / f"{odd}.toml").write_text(RIGHT)
     reference_before, subs_before = ref.read_bytes(), digest(subs)
     flags = [f"--{kind}={path}" for kind, path in reports.items()]
-    proc = grade("check", str(subs), "--golden", str(ref), "--timeout", "3", "--jobs", "2", *flags, marker=marker)
+    proc = grade("check", str(subs), "--golden", str(ref), "--timeout", "3", "--jobs", "2", *flags, marker=marker,
+                 TEACHERS_REFERENCE=str(ref))  # the grader's environment names it: the renderers' must not
     stdout = proc.stdout.decode("utf-8")  # every name escaped: the output is plain UTF-8
 
     assert proc.returncode == 1, stdout + proc.stderr.decode()
