@@ -20,12 +20,13 @@ import numpy as np
 from glsandbox import transforms
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh, with_face_normals
-from glsandbox.gl import depth as gl_depth, planar as gl_planar
+from glsandbox.gl import depth as gl_depth, passes as gl_passes, planar as gl_planar, shadowmap as gl_shadowmap
 from glsandbox.gl.context import GLHost
 from glsandbox.gl.overlay import OverlayDrawer
 from glsandbox.gl.shaders import compile_with_sources, declared_uniforms, source_files
 from glsandbox.gl.textures import TextureCache
-from glsandbox.plan import PLANAR_PASS_KINDS, Draw, Pass, Plan, ProgramVariant, plan as make_plan
+from glsandbox.gl.passes import FrameState, PassRunner
+from glsandbox.plan import SHADOW_MAP_UNIT, Draw, Pass, Plan, ProgramVariant, plan as make_plan
 from glsandbox.scene import Light, Material, Node, Scene
 
 _MODES = {"triangles": moderngl.TRIANGLES, "triangle_strip": moderngl.TRIANGLE_STRIP,
@@ -187,6 +188,7 @@ class Executor:
         self._textures = TextureCache(host)
         self._lights: tuple[Light, ...] = ()  # the lights of the frame being drawn (draw_node's default)
         self._clear_depth = 1.0  # 0 with reverse-Z (glsandbox.gl.depth)
+        self.shadow_maps = gl_shadowmap.ShadowMaps(self.ctx)  # the lights' depth textures
 
     # --- resources ----------------------------------------------------------
 
@@ -342,30 +344,19 @@ class Executor:
             if not any(name in user.declared for user in users):
                 raise SandboxError(f"--set u.{name}: no shader of the scene declares uniform {name} "
                                    f"({', '.join(sorted(str(user.path) for user in users))})")
-        nodes = {node.name: node for node in scene.nodes}
+        frame = FrameState(scene, {node.name: node for node in scene.nodes}, framebuffer, size)
         self._lights = scene.lights
         self._clear_depth = gl_depth.clear_depth_value(scene)
         framebuffer.use()
         gl_depth.begin_depth_mode(self.ctx, self.raw, scene)
         for step in frame_plan.passes:
-            if step.kind == "overlay":
-                self._draw_overlays(scene, step, framebuffer, size)
-                continue
-            viewport = scene.viewports[step.viewport]
-            rect = viewport.pixels(*size)
-            if step.kind == "clear":
-                self._clear(framebuffer, step, rect)
-            else:
-                camera = viewport.camera or scene.camera
-                aspect = rect[2] / rect[3] if rect[3] else 1.0
-                pass_camera = PassCamera(camera.view(), gl_depth.projection_for(scene, camera.projection(aspect)))
-                framebuffer.viewport = rect
-                self._set_depth(step.depth_test)
-                if step.kind in PLANAR_PASS_KINDS:  # the stencil mirror and the planar shadow
-                    gl_planar.run_planar_pass(self, scene, step, nodes, pass_camera)
-                    continue
-                for draw in step.draws:
-                    self.draw_node(nodes[draw.node], draw, pass_camera)
+            runner = PASS_RUNNERS.get(step.kind)
+            if runner is None:
+                raise SandboxError(f"pass kind {step.kind!r} has no runner (gl.executor.PASS_RUNNERS)")
+            try:
+                runner(self, frame, step, self._frame_camera(frame, step))
+            finally:  # every pass starts from the same state, whatever the last one set
+                gl_passes.restore_state(self.ctx, self.raw)
         gl_depth.end_depth_mode(self.ctx, self.raw, scene)
         framebuffer.viewport = (0, 0, *size)
         self._set_depth(False)
@@ -373,7 +364,29 @@ class Executor:
         self._release_stale_meshes()
         return frame_plan
 
-    def _clear(self, framebuffer: moderngl.Framebuffer, step: Pass, rect: tuple[int, int, int, int]) -> None:
+    @staticmethod
+    def pass_camera(view: np.ndarray, proj: np.ndarray) -> PassCamera:
+        """A pass's camera from its matrices (for runners that look through their own, a light's)."""
+        return PassCamera(view, proj)
+
+    def _frame_camera(self, frame: FrameState, step: Pass) -> PassCamera | None:
+        """A frame pass with ``camera="viewport"``: its viewport set, its depth test
+        switched, and its camera (the viewport's or the scene's). Other passes set
+        their own target up (:data:`PASS_RUNNERS`)."""
+        if step.target != "frame" or step.camera != "viewport":
+            return None
+        scene = frame.scene
+        viewport = scene.viewports[step.viewport]
+        rect = viewport.pixels(*frame.size)
+        camera = viewport.camera or scene.camera
+        aspect = rect[2] / rect[3] if rect[3] else 1.0
+        frame.framebuffer.viewport = rect
+        self._set_depth(step.depth_test)
+        return PassCamera(camera.view(), gl_depth.projection_for(scene, camera.projection(aspect)))
+
+    def _clear(self, frame: FrameState, step: Pass, camera: PassCamera | None) -> None:
+        framebuffer = frame.framebuffer
+        rect = frame.scene.viewports[step.viewport].pixels(*frame.size)
         r, g, b, _ = step.clear_color or (0.0, 0.0, 0.0, 0.0)
         # moderngl scissors the clear to the viewport rectangle. Frames are opaque
         # whatever the clear colour's alpha: a target's alpha is 1 and its mask keeps
@@ -450,20 +463,28 @@ class Executor:
         for name, value in own.items():
             program[name].value = value
         texture = material.texture
-        if texture is not None:
+        if texture is not None:  # unit 0: the material's texture
             self._textures.bind(texture, 0)
             if "u_texture" in members:
                 program["u_texture"].value = 0
+        if draw.shadow_map is not None:  # unit 1: the light's shadow map (a depth texture, compared)
+            self.shadow_maps.bind(draw.shadow_map, SHADOW_MAP_UNIT, program, members)
         vao.render(gpu.mode, vertices=gpu.count)
         if texture is not None:
             self._textures.unbind(0)
 
-    def _draw_overlays(self, scene: Scene, step: Pass, framebuffer: moderngl.Framebuffer,
-                       size: tuple[int, int]) -> None:
+    def _draw(self, frame: FrameState, step: Pass, camera: PassCamera | None) -> None:
+        """A ``draw`` pass: each node with its program, through the viewport's camera."""
+        assert camera is not None
+        for draw in step.draws:
+            self.draw_node(frame.nodes[draw.node], draw, camera)
+
+    def _draw_overlays(self, frame: FrameState, step: Pass, camera: PassCamera | None) -> None:
         """An ``overlay`` pass: labels and figures, blended over the frame (:mod:`glsandbox.gl.overlay`)."""
         if self._overlays is None:
             self._overlays = OverlayDrawer(self.ctx)
-        self._overlays.draw(scene, step, framebuffer, size, self._programs[step.draws[0].program][1])
+        self._overlays.draw(frame.scene, step, frame.framebuffer, frame.size,
+                            self._programs[step.draws[0].program][1])
 
     def release(self) -> None:
         if self._overlays is not None:
@@ -479,6 +500,7 @@ class Executor:
         for _, program in self._programs.values():
             program.release()
         self._textures.release()
+        self.shadow_maps.release()
         self._vaos.clear()
         self._meshes.clear()
         self._mesh_last_frame.clear()
@@ -523,3 +545,19 @@ def write_material_uniforms(program: moderngl.Program, material: Material, membe
     for name, value in values.items():
         if name in members:  # a term the compiler removed has no uniform
             program[name].value = float(value)
+
+
+#: One runner per pass kind (:data:`glsandbox.plan.PASS_KINDS`); a new kind adds
+#: its entry here and its describer in :data:`glsandbox.plan.PASS_DESCRIBERS`.
+#: A runner gets the executor, the frame, the pass, and the pass's camera when it
+#: draws into the frame through a viewport's (None otherwise: it sets up its own).
+PASS_RUNNERS: dict[str, PassRunner] = {
+    "shadow_map": gl_shadowmap.run_shadow_map_pass,
+    "clear": Executor._clear,
+    "draw": Executor._draw,
+    "mark_mirror": gl_planar.mark_mirror,
+    "reflection": gl_planar.reflection,
+    "mirror_surface": gl_planar.mirror_surface,
+    "planar_shadow": gl_planar.planar_shadow,
+    "overlay": Executor._draw_overlays,
+}

@@ -26,7 +26,7 @@ from glsandbox.plan import Buffers
 #: leave the 1 alone: frames are opaque at no cost per frame. Blending reads the
 #: source's alpha only (``SRC_ALPHA, ONE_MINUS_SRC_ALPHA``), never the frame's.
 #: A pass that sets the mask itself puts this one back
-#: (:func:`glsandbox.gl.planar.restore_state`).
+#: (:func:`glsandbox.gl.passes.restore_state`).
 FRAME_COLOR_MASK = (True, True, True, False)
 
 
