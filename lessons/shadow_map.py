@@ -111,8 +111,9 @@ class ShadowMapLesson(Lesson):
             planar = PlanarShadow(f"{prefix}floor", FLOOR_PLANE, (*LIGHT, 1.0), (f"{prefix}cube", f"{prefix}sphere", f"{prefix}panel"),
                                   color=SHADOW_COLOR)
         light = Light(LIGHT, shadow=self.shadow_map() if "map" in techniques else None)
-        eye = (3.0, 5.0, 7.5) if several else (2.6, 3.6, 5.4)
-        camera = Camera(eye=eye, target=(0.0, 0.7, 0.0), fov_y=40.0, near=0.1, far=50.0)
+        # Tall narrow tiles side by side: from farther, at the middle of the objects.
+        eye, target = ((3.6, 6.5, 9.5), (0.5, 0.6, 0.4)) if several else ((2.6, 3.6, 5.4), (0.0, 0.7, 0.0))
+        camera = Camera(eye=eye, target=target, fov_y=40.0, near=0.1, far=50.0)
         return Scene(self.name, nodes=tuple(nodes), camera=camera, lights=(light,),
                      clear_color=(0.08, 0.08, 0.12, 1.0), viewports=tuple(viewports), planar_shadow=planar)
 
