@@ -44,7 +44,7 @@ def restore_state(ctx: moderngl.Context, raw: rawgl.RawGL) -> None:
     """The state every pass assumes: no stencil test, stencil and depth
     writes on, colour writes on but alpha (the frame's rule,
     :data:`~glsandbox.gl.target.FRAME_COLOR_MASK`: frames stay opaque), no
-    blending, no polygon offset, counter-clockwise front faces."""
+    blending, no polygon offset, no culling, counter-clockwise front faces."""
     raw.glDisable(rawgl.GL_STENCIL_TEST)
     raw.glStencilMask(0xFF)
     raw.glStencilFunc(rawgl.GL_ALWAYS, 0, 0xFF)
@@ -54,4 +54,5 @@ def restore_state(ctx: moderngl.Context, raw: rawgl.RawGL) -> None:
     ctx.disable(moderngl.BLEND)
     ctx.blend_func = moderngl.DEFAULT_BLENDING
     ctx.polygon_offset = (0.0, 0.0)
+    ctx.disable(moderngl.CULL_FACE)
     ctx.front_face = "ccw"
