@@ -35,12 +35,23 @@ from glsandbox import geometry, register, transforms
 FLOOR_PLANE = (0.0, 1.0, 0.0, 0.0)
 LIGHT = (-1.5, 4.0, 1.0)
 CUBE_HALF = 0.5
+CUBE_AT = (0.3, CUBE_HALF, -0.2)
+FLOOR_SIZE = 8.0
 #: Between the light and the cube's top: its shadow falls on the cube, which a planar shadow cannot show.
 SPHERE = ((-0.45, 2.2, 0.3), 0.3)
 #: A thin panel standing on the floor (centre, half extents): its shadow starts at
 #: its foot, so a bias larger than its thickness opens a gap there (peter-panning).
 PANEL = ((1.4, 0.4, 1.3), (0.04, 0.4, 0.6))
 SHADOW_COLOR = (0.0, 0.0, 0.0, 0.5)
+COLORS = {"floor": (0.75, 0.72, 0.65), "cube": (0.35, 0.55, 0.9), "sphere": (0.95, 0.45, 0.2),
+          "panel": (0.5, 0.8, 0.45)}
+#: The camera of one technique alone (eye, target); side by side it stands farther back.
+SINGLE_VIEW = ((2.6, 3.6, 5.4), (0.0, 0.7, 0.0))
+TILES_VIEW = ((3.6, 6.5, 9.5), (0.5, 0.6, 0.4))
+FOV, NEAR, FAR = 40.0, 0.1, 50.0
+CLEAR = (0.08, 0.08, 0.12, 1.0)
+#: The shadow map's frustum (degrees): wide enough for the floor around the objects.
+MAP_FOV = 80.0
 #: The tiles of show=all, left to right.
 TECHNIQUES = ("planar", "map", "ray")
 
@@ -74,7 +85,7 @@ class ShadowMapLesson(Lesson):
     def shadow_map(self) -> ShadowMap:
         v = self.values
         return ShadowMap(size=int(v["size"]), bias=float(v["bias"]), slope_bias=float(v["slope_bias"]),
-                         pcf=int(v["pcf"]), fov=80.0)
+                         pcf=int(v["pcf"]), fov=MAP_FOV)
 
     def objects(self, technique: str, viewport: int | None) -> list[Node]:
         """The floor, the turning cube and the sphere, as ``technique`` draws them in ``viewport``."""
@@ -82,17 +93,15 @@ class ShadowMapLesson(Lesson):
         mapped = technique != "planar"  # the planar tile neither casts nor receives the map
         turn = transforms.rotate_y(0.4 + float(self.values["speed"]) * self.time)
         models = {
-            "floor": transforms.scale(8.0, 1.0, 8.0),
-            "cube": transforms.translate(0.3, CUBE_HALF, -0.2) @ turn @ transforms.scale(*(CUBE_HALF,) * 3),
+            "floor": transforms.scale(FLOOR_SIZE, 1.0, FLOOR_SIZE),
+            "cube": transforms.translate(*CUBE_AT) @ turn @ transforms.scale(*(CUBE_HALF,) * 3),
             "sphere": transforms.translate(*SPHERE[0]) @ transforms.scale(*(SPHERE[1],) * 3),
             "panel": transforms.translate(*PANEL[0]) @ transforms.scale(*PANEL[1]),
         }
         meshes = {"floor": geometry.plane(1.0), "cube": geometry.cube24(), "sphere": geometry.sphere(),
                   "panel": geometry.cube24()}
-        colors = {"floor": (0.75, 0.72, 0.65), "cube": (0.35, 0.55, 0.9), "sphere": (0.95, 0.45, 0.2),
-                  "panel": (0.5, 0.8, 0.45)}
         prefix = "" if viewport is None else f"{technique}_"
-        return [Node(prefix + name, meshes[name], models[name], _lit(colors[name]), viewports=views,
+        return [Node(prefix + name, meshes[name], models[name], _lit(COLORS[name]), viewports=views,
                      casts_shadow=mapped, receives_shadow=mapped) for name in models]
 
     def build(self) -> Scene:
@@ -112,10 +121,10 @@ class ShadowMapLesson(Lesson):
                                   color=SHADOW_COLOR)
         light = Light(LIGHT, shadow=self.shadow_map() if "map" in techniques else None)
         # Tall narrow tiles side by side: from farther, at the middle of the objects.
-        eye, target = ((3.6, 6.5, 9.5), (0.5, 0.6, 0.4)) if several else ((2.6, 3.6, 5.4), (0.0, 0.7, 0.0))
-        camera = Camera(eye=eye, target=target, fov_y=40.0, near=0.1, far=50.0)
+        eye, target = TILES_VIEW if several else SINGLE_VIEW
+        camera = Camera(eye=eye, target=target, fov_y=FOV, near=NEAR, far=FAR)
         return Scene(self.name, nodes=tuple(nodes), camera=camera, lights=(light,),
-                     clear_color=(0.08, 0.08, 0.12, 1.0), viewports=tuple(viewports), planar_shadow=planar)
+                     clear_color=CLEAR, viewports=tuple(viewports), planar_shadow=planar)
 
 
 if __name__ == "__main__":

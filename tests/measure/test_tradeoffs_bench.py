@@ -277,7 +277,7 @@ def test_bench_unknown_case_is_one_line() -> None:
 
 # --- the raw-ModernGL baselines (benchmarks/lesson_frames.py) --------------------------------
 
-RAW_BASELINE_LESSONS = ("clear_and_swap", "triangle", "phong", "texture", "transform_order", "mirror")
+RAW_BASELINE_LESSONS = ("clear_and_swap", "triangle", "phong", "texture", "transform_order", "mirror", "shadow_map")
 
 
 def test_every_raw_baseline_is_checked_here() -> None:
@@ -297,8 +297,9 @@ def test_raw_baseline_draws_the_lessons_picture(gl, name: str) -> None:
         return {key: value for key, value in gl.host.raw.state_snapshot().items() if key != "depth_writemask"}
 
     size = (160, 120)
-    raw = _benchmark_module("lesson_frames.py").RAW_BASELINES[name](gl.host.ctx, size)
-    lesson = find_lesson(name)()
+    module = _benchmark_module("lesson_frames.py")
+    raw = module.RAW_BASELINES[name](gl.host.ctx, size)
+    lesson = find_lesson(name)(**module.RAW_SETTINGS.get(name, {}))
     for k in (0, 37, 150):
         expected = gl.render(lesson.at(0.01 * k), size).image.copy()
         before = state()
