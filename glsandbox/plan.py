@@ -235,18 +235,19 @@ class Plan:
         return result
 
 
-def program_for(node: Node, lights: int = 0, shadow_light: int | None = None) -> ProgramVariant:
+def program_for(node: Node, lights: int = 0, shadow_light: int | None = None, shadow_pcf: int = 1) -> ProgramVariant:
     """The shader variant a node needs: ``basic`` with its colour source, or
     ``phong`` (:func:`lit_program_for`) when its material is lit; ``TEXTURED``
     only when it has a texture. ``lights`` is the number of lights in the scene;
-    ``shadow_light`` the light whose shadow map a lit node receives (None: none).
+    ``shadow_light`` the light whose shadow map a lit node receives (None: none),
+    filtered ``shadow_pcf`` texels wide.
     A node with a shader of its own gets that file, with ``NUM_LIGHTS`` (and
     ``TEXTURED``) defined, whatever its material's shading."""
     material = node.material
     if node.shader is not None:
         return _user_variant(str(node.shader), lights, material.texture is not None)
     if material.lit:
-        return lit_program_for(node, lights, shadow_light)
+        return lit_program_for(node, lights, shadow_light, shadow_pcf)
     return _basic_variant(material.shading == "vertex_color", material.texture is not None)
 
 
@@ -279,22 +280,24 @@ def _basic_variant(vertex_color: bool, textured: bool) -> ProgramVariant:
     return ProgramVariant("basic", ((source, ""), *_texture_defines(textured)))
 
 
-def lit_program_for(node: Node, lights: int, shadow_light: int | None = None) -> ProgramVariant:
+def lit_program_for(node: Node, lights: int, shadow_light: int | None = None, shadow_pcf: int = 1) -> ProgramVariant:
     """The ``phong`` variant for a lit node (course section "Lighting").
 
     ``NUM_LIGHTS`` sizes the light loop to the lights present (no unused
     slots are looped over); ``PER_VERTEX`` evaluates the formula at the
     vertices (Gouraud), ``BLINN`` uses the half vector, ``NAIVE_NORMALS``
     the course's ``mul(Input.Norm, world)`` instead of the normal matrix;
-    ``SHADOW_LIGHT i`` looks light i's shadow map up (:mod:`glsandbox.shadowmap`).
+    ``SHADOW_LIGHT i`` looks light i's shadow map up (:mod:`glsandbox.shadowmap`) with a
+    ``SHADOW_PCF`` x ``SHADOW_PCF`` grid of comparisons (a constant: the loop unrolls).
     """
     material = node.material
-    return _lit_variant(lights, material.shading, material.normals, material.texture is not None, shadow_light)
+    return _lit_variant(lights, material.shading, material.normals, material.texture is not None, shadow_light,
+                        shadow_pcf)
 
 
 @functools.cache
 def _lit_variant(lights: int, shading: str, normals: str, textured: bool,
-                 shadow_light: int | None = None) -> ProgramVariant:
+                 shadow_light: int | None = None, shadow_pcf: int = 1) -> ProgramVariant:
     defines: list[tuple[str, str]] = [("NUM_LIGHTS", str(lights))]
     if shading == "gouraud":
         defines.append(("PER_VERTEX", ""))
@@ -304,7 +307,7 @@ def _lit_variant(lights: int, shading: str, normals: str, textured: bool,
         defines.append(("NAIVE_NORMALS", ""))
     defines.extend(_texture_defines(textured))
     if shadow_light is not None:
-        defines.append(("SHADOW_LIGHT", str(shadow_light)))
+        defines += [("SHADOW_LIGHT", str(shadow_light)), ("SHADOW_PCF", str(shadow_pcf))]
     return ProgramVariant("phong", tuple(defines))
 
 
@@ -358,6 +361,7 @@ def plan(scene: Scene) -> Plan:
     uses_depth = _needs_depth(scene) or (force and scene.depth_test) or _has_planar_effects(scene)
     programs: set[ProgramVariant] = set()
     passes, shadow_light = shadow_map_passes(scene, programs)
+    shadow_pcf = scene.lights[shadow_light].shadow.pcf if shadow_light is not None else 1  # type: ignore[union-attr]
     for index, viewport in enumerate(scene.viewports):
         color = viewport.clear_color if viewport.clear_color is not None else scene.clear_color
         passes.append(Pass("clear", index, clear_color=color, clear_depth=uses_depth,
@@ -369,7 +373,7 @@ def plan(scene: Scene) -> Plan:
             if scene.mirror is not None and node.name == scene.mirror.node:
                 continue  # the mirror's glass is drawn by the mirror passes
             receives = shadow_light if node.receives_shadow and viewport.renderer == "raster" else None
-            variant = program_for(node, len(scene.lights), receives)
+            variant = program_for(node, len(scene.lights), receives, shadow_pcf)
             programs.add(variant)
             texture = node.material.texture
             draws.append(Draw(node.name, variant.key, node.cull_back_faces,

@@ -53,7 +53,7 @@ class ShadowMaps:
         texture, matrix, settings = self._current[light]
         texture.use(unit)
         values = {"u_shadow_map": unit, "u_shadow_bias": settings.bias, "u_shadow_slope_bias": settings.slope_bias,
-                  "u_shadow_pcf": settings.pcf // 2, "u_shadow_texel": 1.0 / settings.size}
+                  "u_shadow_texel": 1.0 / settings.size}
         for name, value in values.items():
             if name in members:
                 program[name].value = value

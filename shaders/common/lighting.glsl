@@ -35,14 +35,13 @@ uniform vec3 u_light_color[NUM_LIGHTS];  // vLightColor[]
 // caster: lit). The bias is constant + slope · tan(angle between N and L)
 // world units: a surface at a grazing angle to the light spans more depth
 // per texel, so it needs more to stop shadowing itself (acne). Percentage-
-// closer filtering averages a (2·u_shadow_pcf + 1)² grid of comparisons,
-// one texel apart: edges get soft steps instead of stairs. Outside the
-// light's frustum a point counts as lit.
+// closer filtering averages a SHADOW_PCF x SHADOW_PCF grid of comparisons
+// (1, 3, 5 or 7), one texel apart: edges get soft steps instead of stairs.
+// Outside the light's frustum a point counts as lit.
 uniform sampler2DShadow u_shadow_map;
 uniform mat4 u_shadow_matrix;
 uniform float u_shadow_bias;
 uniform float u_shadow_slope_bias;
-uniform int u_shadow_pcf;       // the half width of the grid, 0..3
 uniform float u_shadow_texel;   // 1 / map size
 
 float shadow_visibility(vec3 position, vec3 normal, vec3 to_light) {
@@ -54,15 +53,15 @@ float shadow_visibility(vec3 position, vec3 normal, vec3 to_light) {
     vec3 ndc = clip.xyz / clip.w;
     vec3 coord = ndc * 0.5 + 0.5;
     if (any(lessThan(coord, vec3(0.0))) || any(greaterThan(coord, vec3(1.0)))) return 1.0;
+    // Constant bounds (a define, one variant per width): the compiler unrolls the loop.
+    const int half_width = SHADOW_PCF / 2;
     float lit = 0.0;
-    for (int y = -3; y <= 3; ++y) {
-        for (int x = -3; x <= 3; ++x) {
-            if (abs(x) <= u_shadow_pcf && abs(y) <= u_shadow_pcf) {
-                lit += texture(u_shadow_map, vec3(coord.xy + vec2(x, y) * u_shadow_texel, coord.z));
-            }
+    for (int y = -half_width; y <= half_width; ++y) {
+        for (int x = -half_width; x <= half_width; ++x) {
+            lit += texture(u_shadow_map, vec3(coord.xy + vec2(x, y) * u_shadow_texel, coord.z));
         }
     }
-    float side = float(2 * u_shadow_pcf + 1);
+    float side = float(2 * half_width + 1);
     return lit / (side * side);
 }
 #endif

@@ -35,10 +35,10 @@ def test_the_shadow_map_pass_comes_first_from_the_light_into_its_own_target():
     assert kinds(ShadowMapLesson(show="map").scene()) == ["shadow_map", "clear", "draw"]
     draw = frame_plan.passes[2]
     assert {d.shadow_map for d in draw.draws} == {0}
-    assert {d.program for d in draw.draws} == {"phong[NUM_LIGHTS=1,SHADOW_LIGHT=0]"}
+    assert {d.program for d in draw.draws} == {"phong[NUM_LIGHTS=1,SHADOW_LIGHT=0,SHADOW_PCF=3]"}
     text = frame_plan.describe()
     assert "1. shadow map from light 0 into shadow map 0 (1024x1024 depth 24, perspective 80°" in text
-    assert "floor with phong[NUM_LIGHTS=1,SHADOW_LIGHT=0] + texture unit 1: shadow map 0" in text
+    assert "floor with phong[NUM_LIGHTS=1,SHADOW_LIGHT=0,SHADOW_PCF=3] + texture unit 1: shadow map 0" in text
 
 
 def test_no_shadow_map_pass_when_no_node_receives_it():
