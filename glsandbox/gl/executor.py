@@ -334,6 +334,9 @@ class Executor:
     def render(self, scene: Scene, framebuffer: moderngl.Framebuffer, size: tuple[int, int],
                frame_plan: Plan | None = None) -> Plan:
         """Draw one frame of ``scene`` into ``framebuffer`` (``size`` pixels)."""
+        if any(vp.renderer != "raster" for vp in scene.viewports):
+            raise ValueError("the executor draws raster viewports only: trace the others first "
+                             "(glsandbox.frame.trace_viewports)")
         frame_plan = frame_plan or make_plan(scene)
         self._frame += 1
         for variant in frame_plan.programs:
@@ -462,6 +465,8 @@ class Executor:
             write_material_uniforms(program, material, members)
         for name, value in own.items():
             program[name].value = value
+        if "u_alpha_cutoff" in members:
+            program["u_alpha_cutoff"].value = float(material.alpha_cutoff)
         texture = material.texture
         if texture is not None:  # unit 0: the material's texture
             self._textures.bind(texture, 0)
@@ -469,9 +474,22 @@ class Executor:
                 program["u_texture"].value = 0
         if draw.shadow_map is not None:  # unit 1: the light's shadow map (a depth texture, compared)
             self.shadow_maps.bind(draw.shadow_map, SHADOW_MAP_UNIT, program, members)
+        if draw.blend:  # over what is drawn already; hidden by it where nearer, but not hiding
+            self.ctx.enable(moderngl.BLEND)
+            self.ctx.blend_func = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA)
+            self.raw.glDepthMask(0)
         vao.render(gpu.mode, vertices=gpu.count)
+        if draw.blend:
+            self.raw.glDepthMask(1)
+            self.ctx.disable(moderngl.BLEND)
+            self.ctx.blend_func = moderngl.DEFAULT_BLENDING
         if texture is not None:
             self._textures.unbind(0)
+
+    def _traced_before(self, frame: FrameState, step: Pass, camera: PassCamera | None) -> None:
+        """A ``trace`` pass is run before the executor, by :func:`glsandbox.frame.trace_viewports`
+        (its picture is an overlay by then); :meth:`render` refuses a scene that still has one."""
+        raise ValueError(f"trace viewport {step.viewport}: trace it first (glsandbox.frame.trace_viewports)")
 
     def _draw(self, frame: FrameState, step: Pass, camera: PassCamera | None) -> None:
         """A ``draw`` pass: each node with its program, through the viewport's camera."""
@@ -552,6 +570,7 @@ def write_material_uniforms(program: moderngl.Program, material: Material, membe
 #: A runner gets the executor, the frame, the pass, and the pass's camera when it
 #: draws into the frame through a viewport's (None otherwise: it sets up its own).
 PASS_RUNNERS: dict[str, PassRunner] = {
+    "trace": Executor._traced_before,
     "shadow_map": gl_shadowmap.run_shadow_map_pass,
     "clear": Executor._clear,
     "draw": Executor._draw,
