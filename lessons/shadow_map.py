@@ -90,7 +90,8 @@ class ShadowMapLesson(Lesson):
     def objects(self, technique: str, viewport: int | None) -> list[Node]:
         """The floor, the turning cube and the sphere, as ``technique`` draws them in ``viewport``."""
         views = None if viewport is None else (viewport,)
-        mapped = technique != "planar"  # the planar tile neither casts nor receives the map
+        # Only the map's own tile casts and receives it (a lone ray tile too: --set renderer=ray on show=map).
+        mapped = technique == "map" or viewport is None and technique == "ray"
         turn = transforms.rotate_y(0.4 + float(self.values["speed"]) * self.time)
         models = {
             "floor": transforms.scale(FLOOR_SIZE, 1.0, FLOOR_SIZE),
