@@ -19,10 +19,13 @@ frustum is treated as lit. Pure numpy: no GL in here.
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 
 from glsandbox import transforms
 from glsandbox.errors import SandboxError
+from glsandbox.geometry import Mesh
 from glsandbox.scene import Light, Node, Scene
 
 
@@ -53,15 +56,25 @@ def casters(scene: Scene) -> list[Node]:
     return [node for node in scene.nodes if node.casts_shadow and any(node.shown_in(i) for i in views)]
 
 
+#: Each mesh's 8 bounding-box corners (meshes are immutable: found once per mesh object).
+_CORNERS: weakref.WeakKeyDictionary[Mesh, np.ndarray] = weakref.WeakKeyDictionary()
+
+
+def _corners(mesh: Mesh) -> np.ndarray:
+    corners = _CORNERS.get(mesh)
+    if corners is None:
+        positions = np.asarray(mesh.positions, dtype=np.float64)
+        low, high = positions.min(axis=0), positions.max(axis=0)
+        corners = _CORNERS[mesh] = np.array([[(low, high)[i >> k & 1][k] for k in range(3)] for i in range(8)])
+    return corners
+
+
 def _world_corners(nodes: list[Node]) -> np.ndarray:
     """The corners of each node's mesh bounds in world space (8 per node)."""
-    corners = []
-    for node in nodes:
-        positions = np.asarray(node.mesh.positions, dtype=np.float64)
-        low, high = positions.min(axis=0), positions.max(axis=0)
-        box = np.array([[(low, high)[i >> k & 1][k] for k in range(3)] for i in range(8)])
-        corners.append(transforms.transform_points(np.asarray(node.model, dtype=np.float64), box))
-    return np.concatenate(corners) if corners else np.zeros((0, 3))
+    if not nodes:
+        return np.zeros((0, 3))
+    return np.concatenate([transforms.transform_points(np.asarray(node.model, dtype=np.float64), _corners(node.mesh))
+                           for node in nodes])
 
 
 def light_camera(scene: Scene, light: Light) -> tuple[np.ndarray, np.ndarray]:
