@@ -67,7 +67,8 @@ class ShadowMapLesson(Lesson):
     course_section = "after The stencil Test: shadow maps (depth from the light, compared per pixel)"
     order = 75
     animated = True
-    contrasts = (("acne, a sound bias, peter-panning", "bias=0,0.02,0.4"),
+    contrasts = (("each technique alone: planar (floor only), shadow map, ray-traced", "show=planar,map,ray"),
+                 ("acne, a sound bias, peter-panning", "bias=0,0.02,0.4"),
                  ("map size: blocky edges at 256, fine at 2048", "size=256,2048"))
     params = (
         Param("show", "all", "planar shadow, shadow map and ray-traced side by side, or one technique alone",
