@@ -26,7 +26,7 @@ from pathlib import Path
 import moderngl
 import numpy as np
 
-from _raw import VERTEX_COLOR_FS, VERTEX_COLOR_VS, opaque
+from _raw import VERTEX_COLOR_FS, VERTEX_COLOR_VS, clear, opaque
 
 SIZE = (800, 600)
 
@@ -68,7 +68,7 @@ class RawCube:
         c, s = np.cos(-t), np.sin(-t)
         model = np.array([[c, 0, s, 0], [0, 1, 0, 0], [-s, 0, c, 0], [0, 0, 0, 1]], dtype="f4")
         self.fbo.use()
-        self.fbo.clear(0.0, 0.125, 0.6, 1.0, depth=1.0)
+        clear(self.fbo, 0.0, 0.125, 0.6, depth=1.0)
         self.ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
         self.program["m_model"].write(model.T.tobytes())
         self.vao.render(moderngl.TRIANGLES)

@@ -24,7 +24,7 @@ import math
 import moderngl
 import numpy as np
 
-from _raw import (COLOR_MASK, GL_ALWAYS, GL_EQUAL, GL_INVERT, GL_KEEP, GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE,
+from _raw import (COLOR_MASK, clear, GL_ALWAYS, GL_EQUAL, GL_INVERT, GL_KEEP, GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE,
                   GL_REPLACE, GL_STENCIL_BUFFER_BIT, GL_STENCIL_TEST, GL_ZERO_TO_ONE, VERTEX_COLOR_FS, VERTEX_COLOR_VS,
                   depth_stencil_framebuffer, framebuffer, gl, gl_calls, look_at, perspective, read, reverse_z, rotate_x,
                   rotate_y, rotate_z, scale, translate)
@@ -120,7 +120,7 @@ class RawClear:
     def frame(self, k: int) -> np.ndarray:
         self.fbo.use()
         for rect, color in self.rects:
-            self.fbo.clear(*color, viewport=rect)
+            clear(self.fbo, *color[:3], viewport=rect)
         return read(self.fbo, self.size)
 
 
@@ -145,7 +145,7 @@ class RawTriangle:
         ctx.enable(moderngl.CULL_FACE)
         for rect, proj, vao, mode in zip(self.rects, self.projs, (self.strip, self.list),
                                          (moderngl.TRIANGLE_STRIP, moderngl.TRIANGLES)):
-            self.fbo.clear(0.0, 0.125, 0.6, 1.0, viewport=rect)
+            clear(self.fbo, 0.0, 0.125, 0.6, viewport=rect)
             self.fbo.viewport = rect
             p["m_model"].write(gl(np.eye(4)))
             p["m_view"].write(self.view)
@@ -181,7 +181,7 @@ class RawPhong:
         light_colors = np.array([(1, 1, 1), (1, 1, 0)], "f4")
         ctx, lit, solid = self.ctx, self.lit, self.solid
         self.fbo.use()
-        self.fbo.clear(0.0, 0.125, 0.6, 1.0, depth=1.0)
+        clear(self.fbo, 0.0, 0.125, 0.6, depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
         lit["m_view"].write(gl(self.view))
         lit["m_proj"].write(gl(self.proj))
@@ -231,7 +231,7 @@ class RawTexture:
         t = 0.01 * k
         ctx, p = self.ctx, self.program
         self.fbo.use()
-        self.fbo.clear(0.55, 0.7, 0.9, 1.0, depth=1.0)
+        clear(self.fbo, 0.55, 0.7, 0.9, depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
         p["m_view"].write(gl(self.view))
         p["m_proj"].write(gl(self.proj))
@@ -339,7 +339,7 @@ class RawTransformOrder:
             self.panel.write(pixels, alignment=1)
 
         self.fbo.use()
-        self.fbo.clear(0.0, 0.125, 0.6, 1.0, depth=1.0)
+        clear(self.fbo, 0.0, 0.125, 0.6, depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
         colored["m_view"].write(self.view)
         colored["m_proj"].write(self.proj)
@@ -486,7 +486,7 @@ class RawMirror:
         self.fbo.use()
         raw.ClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE)  # reverse-Z: depth 0..1 as is, near 1, far 0
         ctx.depth_func = ">"
-        self.fbo.clear(0.08, 0.08, 0.12, 1.0, depth=0.0)
+        clear(self.fbo, 0.08, 0.08, 0.12, depth=0.0)
         raw.ClearStencil(0)
         raw.Clear(GL_STENCIL_BUFFER_BIT)
         ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)

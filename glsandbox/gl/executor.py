@@ -24,6 +24,7 @@ from glsandbox.gl import depth as gl_depth, planar as gl_planar
 from glsandbox.gl.context import GLHost
 from glsandbox.gl.overlay import OverlayDrawer
 from glsandbox.gl.shaders import compile_with_sources, declared_uniforms, source_files
+from glsandbox.gl.target import clear_opaque
 from glsandbox.gl.textures import TextureCache
 from glsandbox.plan import PLANAR_PASS_KINDS, Draw, Pass, Plan, ProgramVariant, plan as make_plan
 from glsandbox.scene import Light, Material, Node, Scene
@@ -375,11 +376,8 @@ class Executor:
 
     def _clear(self, framebuffer: moderngl.Framebuffer, step: Pass, rect: tuple[int, int, int, int]) -> None:
         r, g, b, _ = step.clear_color or (0.0, 0.0, 0.0, 0.0)
-        # moderngl scissors the clear to the viewport rectangle. Frames are opaque
-        # whatever the clear colour's alpha: a target's alpha is 1 and its mask keeps
-        # this clear off it (glsandbox.gl.target.FRAME_COLOR_MASK); a framebuffer
-        # without that mask still gets an opaque clear.
-        framebuffer.clear(r, g, b, 1.0, depth=self._clear_depth, viewport=rect)
+        # Frames are opaque whatever the clear colour's alpha (glsandbox.gl.target).
+        clear_opaque(framebuffer, (r, g, b), self._clear_depth, rect)
         if step.clear_stencil:  # moderngl's clear leaves the stencil alone
             self.raw.clear_stencil(rect)
 
