@@ -14,7 +14,8 @@ panel is text whose numbers change), the raw side does that work too, with its
 own code; what never changes (a constant text panel) is made once, like a mesh.
 The table's last column says whether both draw the same picture; the tests
 (``tests/measure/test_tradeoffs_bench.py``) check each pixel for pixel at 160x120.
-Goal (issue 7): glsandbox <= 1.10x raw.
+Goals (issue 24): glsandbox <= 1.05x raw, and at most 50 us of extra main-thread
+CPU per frame (the bench's "extra CPU" column).
 """
 
 from __future__ import annotations
@@ -542,7 +543,7 @@ RAW_BASELINES = {"clear_and_swap": RawClear, "triangle": RawTriangle, "phong": R
 def cases(env) -> list:
     """One case per lesson with a raw baseline: the lesson's default frame, animated by ``time``."""
     from glsandbox.lesson import find_lesson
-    from glsandbox.measure.bench import Case, Side, same_pixels
+    from glsandbox.measure.bench import LESSON_FRAME_CPU_GOAL_US, LESSON_FRAME_GOAL, Case, Side, same_pixels
 
     renderer, size = env.renderer, env.size
     found = []
@@ -554,5 +555,6 @@ def cases(env) -> list:
             return renderer.render(lesson.at(0.01 * k), size).image
 
         found.append(Case("frame vs raw ModernGL", name, Side("raw ModernGL", raw.frame), Side("glsandbox", ours),
-                          repeat=30, goal=1.10, compare=same_pixels))
+                          repeat=30, goal=LESSON_FRAME_GOAL,
+                 cpu_goal_us=LESSON_FRAME_CPU_GOAL_US, compare=same_pixels))
     return found
