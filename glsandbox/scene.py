@@ -364,6 +364,12 @@ class Node:
     def __post_init__(self) -> None:
         if not isinstance(self.name, str):
             raise SandboxError(f"a node's name must be text, got {plain(self.name)}")
+        if not isinstance(self.mesh, Mesh):
+            hint = f" (a built-in mesh by name: glsandbox.geometry.builtin_mesh({self.mesh!r}))" \
+                if isinstance(self.mesh, str) else ""
+            raise SandboxError(f"node {self.name!r}: mesh must be a Mesh{hint}, got {plain(self.mesh)}")
+        if not isinstance(self.material, Material):
+            raise SandboxError(f"node {self.name!r}: material must be a Material, got {plain(self.material)}")
         if self.material.double_sided:
             _set(self, "cull_back_faces", False)  # both faces are the surface
         if self.shader is not None:
@@ -479,6 +485,7 @@ class Scene:
         for field_name in ("nodes", "lights", "viewports", "overlays"):
             if isinstance(getattr(self, field_name), list):
                 _set(self, field_name, tuple(getattr(self, field_name)))
+        self._check_parts()
         if self.uniform_overrides or type(self.uniform_overrides) is not MappingProxyType:
             _set(self, "uniform_overrides", check_uniforms(self.uniform_overrides, "--set u.{name}"))
         _set(self, "clear_color", check_numbers(self.clear_color, "scene clear colour", (4,), 0.0, 1.0))
@@ -486,3 +493,24 @@ class Scene:
             raise SandboxError(f"unknown depth mode {self.depth_mode!r}; use one of {', '.join(DEPTH_MODES)}")
         if self.plan_mode not in PLAN_MODES:
             raise SandboxError(f"unknown plan mode {self.plan_mode!r}; use one of {', '.join(PLAN_MODES)}")
+
+    def _check_parts(self) -> None:
+        """Each field holds what it names (``nodes=(1, 2)`` would fail deep in a renderer, naming nothing)."""
+        if not isinstance(self.name, str):
+            raise SandboxError(f"a scene's name must be text, got {plain(self.name)}")
+        for field_name, kind in (("nodes", Node), ("lights", Light), ("viewports", Viewport), ("overlays", Overlay)):
+            items = getattr(self, field_name)
+            if not isinstance(items, tuple):
+                lone = " (one alone needs a comma: (x,))" if isinstance(items, kind) else ""
+                raise SandboxError(f"scene {self.name!r}: {field_name} must be a tuple or list of {kind.__name__}"
+                                   f"{lone}, got {plain(items)}")
+            for i, item in enumerate(items):
+                if not isinstance(item, kind):
+                    raise SandboxError(f"scene {self.name!r}: {field_name}[{i}] must be a {kind.__name__}, "
+                                       f"got {plain(item)}")
+        for field_name, kind in (("camera", Camera), ("mirror", Mirror), ("shadow", PlanarShadow)):
+            value = getattr(self, field_name)
+            if not isinstance(value, kind) and (value is not None or field_name == "camera"):
+                raise SandboxError(f"scene {self.name!r}: {field_name} must be a {kind.__name__}, got {plain(value)}")
+        if isinstance(self.samples, bool) or not isinstance(self.samples, (int, np.integer)) or self.samples < 0:
+            raise SandboxError(f"scene {self.name!r}: samples must be a whole number >= 0, got {plain(self.samples)}")

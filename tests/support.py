@@ -94,20 +94,27 @@ def run_cli(*args: str, env: dict[str, str] | None = None, cwd: Path | None = No
     """``glsandbox ARGS`` in this process (``cli.main``), with the contract checked on every run:
     no warning is raised; exit 2 is one ``error:`` line and no traceback; and, given
     ``unchanged``, a failed run (exit not 0) leaves that folder's files as they were.
-    ``env`` entries are set for the run only; ``cwd`` is the working folder for the run."""
+    ``env`` entries are set for the run only; ``cwd`` is the working folder for the run
+    (the repository, as for :func:`glsandbox`, unless given)."""
     from glsandbox import cli
 
     before = sorted(unchanged.rglob("*")) if unchanged is not None else None
     stdout, stderr = io.StringIO(), io.StringIO()
-    with (_environment(env, cwd), warnings.catch_warnings(record=True) as caught,
+    with (_environment(env, cwd or REPO_ROOT), warnings.catch_warnings(record=True) as caught,
           contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr)):
         warnings.simplefilter("always")
+        # pyrr's docstring escapes warn when it is first compiled (pyproject.toml's filter, not ours);
+        # a ResourceWarning (never shown by Python by default) comes from whatever object the
+        # garbage collector finalises during the run, often one an earlier test made.
+        warnings.filterwarnings("ignore", "invalid escape sequence")
+        warnings.simplefilter("ignore", ResourceWarning)
         try:
             status = cli.main(list(args))
         except SystemExit as exc:  # argparse's own usage errors
             status = exc.code if isinstance(exc.code, int) else 2
     run = CliRun(list(args), status, stdout.getvalue(), stderr.getvalue())
-    assert [f"{w.category.__name__}: {w.message}" for w in caught] == [], run
+    raised = [f"{w.category.__name__}: {w.message} ({w.filename}:{w.lineno})" for w in caught]
+    assert raised == [], (raised, run)
     if status == 2:
         assert_user_error(run)
     if before is not None and status != 0:

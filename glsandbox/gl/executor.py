@@ -361,6 +361,9 @@ class Executor:
     def render(self, scene: Scene, framebuffer: moderngl.Framebuffer, size: tuple[int, int],
                frame_plan: Plan | None = None) -> Plan:
         """Draw one frame of ``scene`` into ``framebuffer`` (``size`` pixels)."""
+        if any(vp.renderer != "raster" for vp in scene.viewports):
+            raise ValueError("the executor draws raster viewports only: trace the others first "
+                             "(glsandbox.frame.trace_viewports)")
         frame_plan = frame_plan or make_plan(scene)
         self._frame += 1
         for variant in frame_plan.programs:

@@ -61,6 +61,7 @@ from numpy.typing import NDArray
 from glsandbox import transforms
 from glsandbox.geometry import Mesh
 from glsandbox.images import texture_levels
+from glsandbox.plan import traced_reflectivity
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.triangle import TriangleBatch
 from glsandbox.scene import MIN_SCALE, Camera, Node, Scene, Texture
@@ -232,19 +233,6 @@ def _texture_image(texture: Texture) -> NDArray[np.float64]:
     return np.asarray(texture_levels(texture)[0], dtype=np.float64) / 255.0
 
 
-def _reflectivity(scene: Scene, node: Node) -> float:
-    """The node's ``material.reflectivity``; for the glass of the scene's stencil
-    mirror (:class:`glsandbox.planar.Mirror`) at least ``1 - alpha``, the share
-    of the reflection the rasterizer blends under the glass. The ray tracer
-    reflects everything in front of the glass, not only the mirror's
-    ``reflected`` nodes: the answer the stencil approximation aims at."""
-    value = float(node.material.reflectivity)
-    mirror = getattr(scene, "mirror", None)
-    if mirror is not None and node.name == mirror.node:
-        value = max(value, 1.0 - float(node.material.color[3]))
-    return value
-
-
 def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = True) -> World:
     """The :class:`World` of ``scene`` as seen in viewport ``viewport``.
 
@@ -280,7 +268,7 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
             name=node.name, cull=bool(node.cull_back_faces),
             color=np.asarray(material.color[:3], dtype=np.float64), mode=MODES[material.shading],
             ka=float(material.ambient), kd=float(material.diffuse), ks=float(material.specular),
-            shininess=float(material.shininess), reflectivity=_reflectivity(scene, node),
+            shininess=float(material.shininess), reflectivity=traced_reflectivity(scene, node),
             texture=tex, alpha=float(material.color[3]), alpha_mode=ALPHA_CODES[material.alpha_mode],
             alpha_cutoff=float(material.alpha_cutoff), vertex_colors=bool(material.vertex_colors),
             two_sided=bool(material.double_sided),
