@@ -14,7 +14,8 @@ panel is text whose numbers change), the raw side does that work too, with its
 own code; what never changes (a constant text panel) is made once, like a mesh.
 The table's last column says whether both draw the same picture; the tests
 (``tests/measure/test_tradeoffs_bench.py``) check each pixel for pixel at 160x120.
-Goal (issue 7): glsandbox <= 1.10x raw.
+Goals (issue 24): glsandbox <= 1.05x raw, and at most 50 us of extra main-thread
+CPU per frame (the bench's "extra CPU" column).
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ import math
 import moderngl
 import numpy as np
 
-from _raw import (COLOR_MASK, GL_ALWAYS, GL_EQUAL, GL_INVERT, GL_KEEP, GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE,
+from _raw import (COLOR_MASK, clear, GL_ALWAYS, GL_EQUAL, GL_INVERT, GL_KEEP, GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE,
                   GL_REPLACE, GL_STENCIL_BUFFER_BIT, GL_STENCIL_TEST, GL_ZERO_TO_ONE, VERTEX_COLOR_FS, VERTEX_COLOR_VS,
                   depth_stencil_framebuffer, framebuffer, gl, gl_calls, look_at, perspective, read, reverse_z, rotate_x,
                   rotate_y, rotate_z, scale, translate)
@@ -120,7 +121,7 @@ class RawClear:
     def frame(self, k: int) -> np.ndarray:
         self.fbo.use()
         for rect, color in self.rects:
-            self.fbo.clear(*color, viewport=rect)
+            clear(self.fbo, *color[:3], viewport=rect)
         return read(self.fbo, self.size)
 
 
@@ -145,7 +146,7 @@ class RawTriangle:
         ctx.enable(moderngl.CULL_FACE)
         for rect, proj, vao, mode in zip(self.rects, self.projs, (self.strip, self.list),
                                          (moderngl.TRIANGLE_STRIP, moderngl.TRIANGLES)):
-            self.fbo.clear(0.0, 0.125, 0.6, 1.0, viewport=rect)
+            clear(self.fbo, 0.0, 0.125, 0.6, viewport=rect)
             self.fbo.viewport = rect
             p["m_model"].write(gl(np.eye(4)))
             p["m_view"].write(self.view)
@@ -181,7 +182,7 @@ class RawPhong:
         light_colors = np.array([(1, 1, 1), (1, 1, 0)], "f4")
         ctx, lit, solid = self.ctx, self.lit, self.solid
         self.fbo.use()
-        self.fbo.clear(0.0, 0.125, 0.6, 1.0, depth=1.0)
+        clear(self.fbo, 0.0, 0.125, 0.6, depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
         lit["m_view"].write(gl(self.view))
         lit["m_proj"].write(gl(self.proj))
@@ -231,7 +232,7 @@ class RawTexture:
         t = 0.01 * k
         ctx, p = self.ctx, self.program
         self.fbo.use()
-        self.fbo.clear(0.55, 0.7, 0.9, 1.0, depth=1.0)
+        clear(self.fbo, 0.55, 0.7, 0.9, depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
         p["m_view"].write(gl(self.view))
         p["m_proj"].write(gl(self.proj))
@@ -339,7 +340,7 @@ class RawTransformOrder:
             self.panel.write(pixels, alignment=1)
 
         self.fbo.use()
-        self.fbo.clear(0.0, 0.125, 0.6, 1.0, depth=1.0)
+        clear(self.fbo, 0.0, 0.125, 0.6, depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
         colored["m_view"].write(self.view)
         colored["m_proj"].write(self.proj)
@@ -486,7 +487,7 @@ class RawMirror:
         self.fbo.use()
         raw.ClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE)  # reverse-Z: depth 0..1 as is, near 1, far 0
         ctx.depth_func = ">"
-        self.fbo.clear(0.08, 0.08, 0.12, 1.0, depth=0.0)
+        clear(self.fbo, 0.08, 0.08, 0.12, depth=0.0)
         raw.ClearStencil(0)
         raw.Clear(GL_STENCIL_BUFFER_BIT)
         ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
@@ -654,7 +655,7 @@ RAW_SETTINGS: dict[str, dict[str, str]] = {"shadow_map": {"show": "map"}}
 def cases(env) -> list:
     """One case per lesson with a raw baseline: the lesson's default frame, animated by ``time``."""
     from glsandbox.lesson import find_lesson
-    from glsandbox.measure.bench import Case, Side, same_pixels
+    from glsandbox.measure.bench import LESSON_FRAME_CPU_GOAL_US, LESSON_FRAME_GOAL, Case, Side, same_pixels
 
     renderer, size = env.renderer, env.size
     found = []
@@ -666,5 +667,6 @@ def cases(env) -> list:
             return renderer.render(lesson.at(0.01 * k), size).image
 
         found.append(Case("frame vs raw ModernGL", name, Side("raw ModernGL", raw.frame), Side("glsandbox", ours),
-                          repeat=30, goal=1.10, compare=same_pixels))
+                          repeat=30, goal=LESSON_FRAME_GOAL,
+                 cpu_goal_us=LESSON_FRAME_CPU_GOAL_US, compare=same_pixels))
     return found

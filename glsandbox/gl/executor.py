@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import struct
 import weakref
-from collections.abc import Collection, Mapping
+from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -24,6 +25,7 @@ from glsandbox.gl import depth as gl_depth, passes as gl_passes, planar as gl_pl
 from glsandbox.gl.context import GLHost
 from glsandbox.gl.overlay import OverlayDrawer
 from glsandbox.gl.shaders import compile_with_sources, declared_uniforms, source_files
+from glsandbox.gl.target import clear_opaque
 from glsandbox.gl.textures import TextureCache
 from glsandbox.gl.passes import FrameState, PassRunner
 from glsandbox.plan import SHADOW_MAP_UNIT, Draw, Pass, Plan, ProgramVariant, plan as make_plan
@@ -66,18 +68,19 @@ class PassCamera:
     once per pass instead of once per draw: the uniform bytes, and the eye
     (only lit draws ask for it)."""
 
-    __slots__ = ("view", "proj", "view_bytes", "proj_bytes", "_eye")
+    __slots__ = ("view", "proj", "view_bytes", "proj_bytes", "_eye_bytes")
 
     def __init__(self, view: np.ndarray, proj: np.ndarray) -> None:
         self.view, self.proj = view, proj
         self.view_bytes, self.proj_bytes = transforms.gl_bytes(view), transforms.gl_bytes(proj)
-        self._eye: np.ndarray | None = None
+        self._eye_bytes: bytes | None = None
 
     @property
-    def eye(self) -> np.ndarray:
-        if self._eye is None:
-            self._eye = eye_position(self.view)
-        return self._eye
+    def eye_bytes(self) -> bytes:
+        """``u_eye``'s uniform bytes: a camera that does not move inverts its view once per run."""
+        if self._eye_bytes is None:
+            self._eye_bytes = _eye_bytes(np.asarray(self.view, dtype=np.float64).tobytes())
+        return self._eye_bytes
 
 
 #: Uniform bytes of material colours: a lesson rebuilding its scene each frame
@@ -90,6 +93,27 @@ def _color_bytes(color: tuple[float, ...]) -> bytes:
     if data is None:
         data = _COLOR_BYTES[color] = np.asarray(color, dtype="f4").tobytes()
     return data
+
+
+def _float_bytes(value: float) -> bytes:
+    return struct.pack("f", value)
+
+
+#: ``u_texture``'s value: the material texture is on unit 0.
+_UNIT_0 = struct.pack("i", 0)
+
+
+def _material_bytes(material: Material) -> tuple[tuple[str, bytes], ...]:
+    """The coefficients of the course's ``0.1*mesh + 0.4*diffuse + 0.3*specular`` and the
+    exponent (32) as uniform bytes; a zero coefficient switches its term off."""
+    return (("u_ambient", _float_bytes(material.ambient)), ("u_diffuse", _float_bytes(material.diffuse)),
+            ("u_specular", _float_bytes(material.specular)), ("u_shininess", _float_bytes(material.shininess)))
+
+
+@functools.lru_cache(maxsize=64)
+def _eye_bytes(view: bytes) -> bytes:
+    """The eye position's uniform bytes for a float64 view matrix given as bytes."""
+    return eye_position(np.frombuffer(view).reshape(4, 4)).astype("f4").tobytes()
 
 
 @functools.lru_cache(maxsize=1024)
@@ -187,6 +211,10 @@ class Executor:
         self._overlays: OverlayDrawer | None = None  # made on the first overlay pass
         self._textures = TextureCache(host)
         self._lights: tuple[Light, ...] = ()  # the lights of the frame being drawn (draw_node's default)
+        self._lights_cache: tuple[tuple[Light, ...], bytes, bytes] | None = None
+        # The uniform bytes last written into each program (by program key): see _uniform_writer.
+        self._written: dict[str, dict[str, bytes]] = {}
+        self._bound_texture: object | None = None  # the material texture on unit 0 in this frame
         self._clear_depth = 1.0  # 0 with reverse-Z (glsandbox.gl.depth)
         self.shadow_maps = gl_shadowmap.ShadowMaps(self.ctx)  # the lights' depth textures
 
@@ -234,6 +262,7 @@ class Executor:
         self._programs = fresh
         self._user = users
         self._member_names.clear()
+        self._written.clear()  # new programs hold no values yet
 
     def shader_files(self) -> frozenset[Path]:
         """The files the nodes' own shader programs were built from (with their includes)."""
@@ -361,6 +390,7 @@ class Executor:
             finally:  # every pass starts from the same state, whatever the last one set
                 gl_passes.restore_state(self.ctx, self.raw)
         gl_depth.end_depth_mode(self.ctx, self.raw, scene)
+        self._unbind_texture()
         framebuffer.viewport = (0, 0, *size)
         self._set_depth(False)
         self.ctx.disable(moderngl.CULL_FACE)
@@ -391,11 +421,8 @@ class Executor:
         framebuffer = frame.framebuffer
         rect = frame.scene.viewports[step.viewport].pixels(*frame.size)
         r, g, b, _ = step.clear_color or (0.0, 0.0, 0.0, 0.0)
-        # moderngl scissors the clear to the viewport rectangle. Frames are opaque
-        # whatever the clear colour's alpha: a target's alpha is 1 and its mask keeps
-        # this clear off it (glsandbox.gl.target.FRAME_COLOR_MASK); a framebuffer
-        # without that mask still gets an opaque clear.
-        framebuffer.clear(r, g, b, 1.0, depth=self._clear_depth, viewport=rect)
+        # Frames are opaque whatever the clear colour's alpha (glsandbox.gl.target).
+        clear_opaque(framebuffer, (r, g, b), self._clear_depth, rect)
         if step.clear_stencil:  # moderngl's clear leaves the stencil alone
             self.raw.clear_stencil(rect)
 
@@ -449,29 +476,31 @@ class Executor:
             self.ctx.front_face = front_face
         else:
             self.ctx.disable(moderngl.CULL_FACE)
-        uniforms = {
-            "m_model": transforms.gl_bytes(model),
-            "m_view": camera.view_bytes,
-            "m_proj": camera.proj_bytes,
-            "u_color": _color_bytes(material.color),
-        }
+        write = self._uniform_writer(draw.program, program, members)
+        write("m_model", transforms.gl_bytes(model))
+        write("m_view", camera.view_bytes)
+        write("m_proj", camera.proj_bytes)
+        write("u_color", _color_bytes(material.color))
         if "m_normal" in members:
-            uniforms["m_normal"] = _normal_matrix_bytes(np.asarray(model, dtype=np.float64).tobytes())
-        for name, data in uniforms.items():
-            if name in members:
-                program[name].write(data)
+            write("m_normal", _normal_matrix_bytes(np.asarray(model, dtype=np.float64).tobytes()))
         if material.lit or user is not None:  # a node's own shader may light itself whatever the shading
-            write_light_uniforms(program, self._lights if lights is None else lights, camera.eye, members)
-            write_material_uniforms(program, material, members)
+            write("u_eye", camera.eye_bytes)
+            frame_lights = self._lights if lights is None else lights
+            if frame_lights:  # with none, the shader's arrays do not exist (NUM_LIGHTS 0)
+                light_pos, light_color = self._light_bytes(frame_lights)
+                write("u_light_pos", light_pos)
+                write("u_light_color", light_color)
+            for name, data in _material_bytes(material):
+                write(name, data)
         for name, value in own.items():
             program[name].value = value
-        if "u_alpha_cutoff" in members:
-            program["u_alpha_cutoff"].value = float(material.alpha_cutoff)
+        write("u_alpha_cutoff", _float_bytes(material.alpha_cutoff))
         texture = material.texture
         if texture is not None:  # unit 0: the material's texture
-            self._textures.bind(texture, 0)
-            if "u_texture" in members:
-                program["u_texture"].value = 0
+            if self._bound_texture is not texture:  # consecutive draws of one texture bind it once
+                self._textures.bind(texture, 0)
+                self._bound_texture = texture
+            write("u_texture", _UNIT_0)
         if draw.shadow_map is not None:  # unit 1: the light's shadow map (a depth texture, compared)
             self.shadow_maps.bind(draw.shadow_map, SHADOW_MAP_UNIT, program, members)
         if draw.blend:  # over what is drawn already; hidden by it where nearer, but not hiding
@@ -483,8 +512,37 @@ class Executor:
             self.raw.glDepthMask(1)
             self.ctx.disable(moderngl.BLEND)
             self.ctx.blend_func = moderngl.DEFAULT_BLENDING
-        if texture is not None:
+
+    def _uniform_writer(self, program_key: str, program: moderngl.Program,
+                        members: Collection[str]) -> Callable[[str, bytes], None]:
+        """``write(name, data)`` for one program: the bytes go to GL only where the program has the
+        uniform (a term the compiler removed has none) and they differ from what was written last.
+        A program keeps its uniform values between draws and frames, so what does not change (the
+        view while the camera stands, lights, materials, a wall's model) is written once."""
+        written = self._written.setdefault(program_key, {})
+
+        def write(name: str, data: bytes) -> None:
+            if written.get(name) != data and name in members:
+                program[name].write(data)
+                written[name] = data
+
+        return write
+
+    def _light_bytes(self, lights: tuple[Light, ...]) -> tuple[bytes, bytes]:
+        """``u_light_pos`` and ``u_light_color`` bytes of ``lights``, made once per frame (and once
+        per pass that reflects them): every lit draw of the frame writes the same ones."""
+        cached = self._lights_cache
+        if cached is None or cached[0] is not lights:
+            cached = self._lights_cache = (lights, np.array([l.position for l in lights], dtype="f4").tobytes(),
+                                           np.array([l.color for l in lights], dtype="f4").tobytes())
+        return cached[1], cached[2]
+
+    def _unbind_texture(self) -> None:
+        """Leave texture unit 0 without the frame's sampler object (the overlays and the next user
+        of the context see plain texture state); once per frame, not per draw."""
+        if self._bound_texture is not None:
             self._textures.unbind(0)
+            self._bound_texture = None
 
     def _traced_before(self, frame: FrameState, step: Pass, camera: PassCamera | None) -> None:
         """A ``trace`` pass is run before the executor, by :func:`glsandbox.frame.trace_viewports`
@@ -499,6 +557,7 @@ class Executor:
 
     def _draw_overlays(self, frame: FrameState, step: Pass, camera: PassCamera | None) -> None:
         """An ``overlay`` pass: labels and figures, blended over the frame (:mod:`glsandbox.gl.overlay`)."""
+        self._unbind_texture()
         if self._overlays is None:
             self._overlays = OverlayDrawer(self.ctx)
         self._overlays.draw(frame.scene, step, frame.framebuffer, frame.size,
@@ -524,6 +583,7 @@ class Executor:
         self._mesh_last_frame.clear()
         self._programs.clear()
         self._member_names.clear()
+        self._written.clear()
         self._user.clear()
         self._user_nodes.clear()
 
@@ -536,33 +596,6 @@ def eye_position(view: np.ndarray) -> np.ndarray:
     origin, so it is the translation column of the inverse view matrix (the
     course's ``vEyePos``)."""
     return np.linalg.inv(np.asarray(view, dtype=np.float64))[:3, 3]
-
-
-def write_light_uniforms(program: moderngl.Program, lights: tuple[Light, ...], eye: np.ndarray,
-                         members: Collection[str]) -> None:
-    """The course's ``vLightPos[]``, ``vLightColor[]`` and ``vEyePos``, in world space.
-
-    The shader's arrays are sized by its ``NUM_LIGHTS`` define, which the plan
-    set to ``len(lights)``; with no lights they do not exist. ``eye`` is
-    :func:`eye_position` of the view; ``members`` are the program's uniform
-    names (see :meth:`Executor._members`).
-    """
-    if "u_eye" in members:
-        program["u_eye"].write(eye.astype("f4").tobytes())
-    if lights and "u_light_pos" in members:
-        program["u_light_pos"].write(np.array([l.position for l in lights], dtype="f4").tobytes())
-    if lights and "u_light_color" in members:
-        program["u_light_color"].write(np.array([l.color for l in lights], dtype="f4").tobytes())
-
-
-def write_material_uniforms(program: moderngl.Program, material: Material, members: Collection[str]) -> None:
-    """The coefficients of the course's ``0.1*mesh + 0.4*diffuse + 0.3*specular``
-    and the exponent (32); a zero coefficient switches its term off."""
-    values = {"u_ambient": material.ambient, "u_diffuse": material.diffuse,
-              "u_specular": material.specular, "u_shininess": material.shininess}
-    for name, value in values.items():
-        if name in members:  # a term the compiler removed has no uniform
-            program[name].value = float(value)
 
 
 #: One runner per pass kind (:data:`glsandbox.plan.PASS_KINDS`); a new kind adds
