@@ -116,10 +116,10 @@ def hostile_kinds(ref: Path, results: Path, subs: Path) -> dict[str, tuple[str, 
             during=f"{libc}\nr = libc.kill(os.getppid(), 9)\nraise RuntimeError(f'kill gave {{r}}')"),
             "BROKEN kill gave -1"),
         # it stops the run
-        "h_loop": ("h_loop.py", lesson(during="while True:\n    pass"), "TIMEOUT after 3 s"),
-        "h_sleep": ("h_sleep.py", lesson(before="import time\ntime.sleep(1000)"), "TIMEOUT after 3 s"),
+        "h_loop": ("h_loop.py", lesson(during="while True:\n    pass"), "TIMEOUT after 6 s"),
+        "h_sleep": ("h_sleep.py", lesson(before="import time\ntime.sleep(1000)"), "TIMEOUT after 6 s"),
         "h_stop": ("h_stop.py", lesson(during="import signal\nos.kill(os.getpid(), signal.SIGSTOP)"),
-                   "TIMEOUT after 3 s"),
+                   "TIMEOUT after 6 s"),
         "h_thread": ("h_thread.py", lesson(before="import threading, time\n"
                                                    "threading.Thread(target=time.sleep, args=(1000,)).start()"), "FAIL"),
         "h_fork": ("h_fork.py", lesson(before="import time\npid = os.fork()\nif pid == 0:\n    time.sleep(1000)\n"
@@ -212,7 +212,7 @@ def test_hostile_submissions_cannot_touch_verdicts_references_reports_or_the_run
     (subs / f"{odd}.toml").write_text(RIGHT)
     reference_before, subs_before = ref.read_bytes(), digest(subs)
     flags = [f"--{kind}={path}" for kind, path in reports.items()]
-    proc = grade("check", str(subs), "--golden", str(ref), "--timeout", "3", "--jobs", "2", *flags, marker=marker,
+    proc = grade("check", str(subs), "--golden", str(ref), "--timeout", "6", "--jobs", "2", *flags, marker=marker,
                  TEACHERS_REFERENCE=str(ref))  # the grader's environment names it: the renderers' must not
     stdout = proc.stdout.decode("utf-8")  # every name escaped: the output is plain UTF-8
 
