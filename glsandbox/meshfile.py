@@ -588,8 +588,8 @@ def _group_mesh(p: Path, file_type: str, parts: list[_Part], normals_mode: str, 
         notes.append(f"{_count(dropped, 'degenerate face')} dropped (zero area or a repeated vertex)")
     notes.append(f"normals {'from the file' if how == 'file' else how}")
     name = p.name if part_name is None else f"{p.name}#{part_name}"
-    mesh = Mesh(name, positions[chosen], index.astype(np.uint32), group_normals[group[first]],
-                None if uvs is None else uvs[chosen],
+    mesh = Mesh(name, positions.take(chosen, axis=0), index.astype(np.uint32),
+                group_normals.take(group[first], axis=0), None if uvs is None else uvs.take(chosen, axis=0),
                 None if corner_colors is None else corner_colors.reshape(-1, 3)[first], notes=tuple(notes))
     return mesh, int(faces.shape[0]), dropped, how
 
@@ -626,7 +626,7 @@ def _degenerate(positions: NDArray[np.float64], faces: NDArray[np.int64]) -> NDA
     flat = np.empty(faces.shape[0], dtype=bool)
     for lo in range(0, faces.shape[0], BLOCK_FACES):
         block = faces[lo:lo + BLOCK_FACES]
-        a, b, c = positions[block[:, 0]], positions[block[:, 1]], positions[block[:, 2]]
+        a, b, c = (positions.take(block[:, k], axis=0) for k in range(3))  # take: faster than positions[...]
         with np.errstate(all="ignore"):
             cross = face_cross(a, b, c)
             doubled_area_sq = np.einsum("ij,ij->i", cross, cross)

@@ -107,7 +107,7 @@ def _faces_and_angles(positions: NDArray[np.float64], tris: NDArray[np.intp],
     angles = np.empty((f, 3) if with_angles else (0, 3))
     for lo in range(0, f, BLOCK_FACES):
         block = tris[lo:lo + BLOCK_FACES]
-        p0, p1, p2 = (positions[block[:, k]] for k in range(3))
+        p0, p1, p2 = (positions.take(block[:, k], axis=0) for k in range(3))  # take: faster than positions[...]
         faces[lo:lo + BLOCK_FACES], doubled_area = _unit_rows(face_cross(p0, p1, p2))
         if with_angles:
             angles[lo:lo + BLOCK_FACES] = _corner_angles(p0, p1, p2, doubled_area)
@@ -252,9 +252,12 @@ def normal_groups(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: 
     mean = _unit_rows(np.stack([np.bincount(corner_pid, np.repeat(faces[:, j], 3), minlength=npos)
                                 for j in range(3)], axis=1))[0]
     half = max(0.0, math.radians(crease_angle) / 2.0 - _HALF_ANGLE_MARGIN)
-    spread = np.zeros(corner_pid.size)
-    for j in range(3):
-        spread += np.repeat(faces[:, j], 3) * mean[corner_pid, j]
+    # Each corner's face normal · its position's mean, one component at a time in (F, 3) corner
+    # layout: a 1-D gather per component (``mean[corner_pid, j]`` is several times slower).
+    spread = np.zeros((f, 3))
+    for j, mean_j in enumerate(np.ascontiguousarray(mean.T)):
+        spread += faces[:, j, None] * mean_j.take(corner_pid).reshape(f, 3)
+    spread = spread.reshape(-1)
     rough_pos = np.zeros(npos, dtype=bool)
     rough_pos[corner_pid[spread < math.cos(half)]] = True
     del spread

@@ -286,9 +286,10 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
         box_hi = np.where(bunched, centre_hi, box_hi)
         extent = box_hi - box_lo
         scale = np.where(extent > 0.0, bins * (1.0 - 1e-6) / np.where(extent > 0.0, extent, 1.0), 0.0)
-        rel = (rows[0:3] - np.repeat(box_lo.T.astype(np.float32), counts, axis=1)) * np.repeat(
-            scale.T.astype(np.float32), counts, axis=1)
+        rel = rows[0:3] - np.repeat(box_lo.T.astype(np.float32), counts, axis=1)
+        rel *= np.repeat(scale.T.astype(np.float32), counts, axis=1)
         bin_of = np.clip(rel, 0, bins - 1, out=rel).astype(np.int32)  # (3, width)
+        del rel
         node_key = np.repeat(np.arange(n, dtype=np.int64) * bins, counts)
         best_cost = np.full(n, np.inf)
         best_axis = np.zeros(n, dtype=np.int64)
@@ -378,9 +379,10 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
             child_lo = np.where(empty[:, :, None], box_lo[:, None, :], child_lo)
             child_hi = np.where(empty[:, :, None], box_hi[:, None, :], child_hi)
         # Each column's side (True: the right child) on its node's chosen axis.
-        axis_t = np.repeat(best_axis, counts)
-        chosen = np.where(axis_t == 0, bin_of[0], np.where(axis_t == 1, bin_of[1], bin_of[2]))
+        columns = np.arange(width)
+        chosen = np.take(bin_of.reshape(-1), np.repeat(best_axis * width, counts) + columns)
         right = chosen >= np.repeat(best_cut, counts)
+        del chosen
         stuck = np.flatnonzero(~np.isfinite(best_cost))
         if stuck.size:
             # No cut separates them (every centroid in one bin on every axis):
@@ -407,11 +409,18 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
         levels.append(child_ids)
         # Each column's rank within its child (lefts keep their order, rights
         # too): with the child's start, its place in the partition below.
-        r = right.astype(np.int64)
-        rights_before = np.cumsum(r) - r  # rights in columns [0, i)
-        node_start = np.cumsum(counts) - counts
-        rights_in_node = rights_before - np.repeat(rights_before[node_start], counts)
-        rank = np.where(right, rights_in_node, np.arange(width) - np.repeat(node_start, counts) - rights_in_node)
+        # A right column's rank is the rights before it less the rights before its node's first
+        # column; a left's, the lefts before it less the lefts before its node: one gather per
+        # column of a per-child offset, no per-column repeat of per-node values.
+        rights_before = np.cumsum(right)
+        rights_before -= right  # rights in columns [0, i)
+        at_start = rights_before[starts]
+        offset = np.empty(2 * n, dtype=np.int64)
+        offset[0::2] = starts - at_start  # lefts before each node's first column
+        offset[1::2] = at_start
+        rank = np.subtract(columns, rights_before, out=columns)  # lefts in columns [0, i)
+        np.copyto(rank, rights_before, where=right)
+        rank -= offset[child]
         tri_leaf = is_leaf[child]
         leaf_of[tris[tri_leaf]] = child_ids[child[tri_leaf]]
         leaf_rank[tris[tri_leaf]] = rank[tri_leaf]
