@@ -253,10 +253,13 @@ def normal_groups(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: 
                                 for j in range(3)], axis=1))[0]
     half = max(0.0, math.radians(crease_angle) / 2.0 - _HALF_ANGLE_MARGIN)
     # Each corner's face normal · its position's mean, one component at a time in (F, 3) corner
-    # layout: a 1-D gather per component (``mean[corner_pid, j]`` is several times slower).
+    # layout: the face's component broadcast over its three corners (no repeated copy of it).
     spread = np.zeros((f, 3))
-    for j, mean_j in enumerate(np.ascontiguousarray(mean.T)):
-        spread += faces[:, j, None] * mean_j.take(corner_pid).reshape(f, 3)
+    for j, face_j in enumerate(np.ascontiguousarray(faces.T)):
+        term = mean[corner_pid, j].reshape(f, 3)
+        term *= face_j[:, None]
+        spread += term
+    del term
     spread = spread.reshape(-1)
     rough_pos = np.zeros(npos, dtype=bool)
     rough_pos[corner_pid[spread < math.cos(half)]] = True
