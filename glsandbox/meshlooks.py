@@ -40,6 +40,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .meshnormals import BLOCK_FACES
+
 __all__ = ["Look", "file_warnings", "is_closed", "look_of"]
 
 Rgba = tuple[float, float, float, float]
@@ -159,11 +161,15 @@ def is_closed(positions: NDArray[np.float64], faces: NDArray[np.int64]) -> bool:
         return False
     bits = np.ascontiguousarray(positions + 0.0, dtype=np.float64).view(np.uint64).reshape(-1, 3)  # -0 is 0
     with np.errstate(over="ignore"):
-        key = _mix(_mix(_mix(bits[:, 0]) ^ bits[:, 1]) ^ bits[:, 2])[faces]
-        ends = key[:, [1, 2, 0]]
-        forward = _mix(key * _ODD ^ ends)
-        backward = _mix(ends * _ODD ^ key)
-        return bool(forward.sum(dtype=np.uint64) == backward.sum(dtype=np.uint64))
+        position_key = _mix(_mix(_mix(bits[:, 0]) ^ bits[:, 1]) ^ bits[:, 2])
+        # Sums mod 2⁶⁴ in blocks of faces (bounded temporaries; the order of a modular sum is free).
+        forward = backward = np.uint64(0)
+        for lo in range(0, faces.shape[0], BLOCK_FACES):
+            key = position_key[faces[lo:lo + BLOCK_FACES]]
+            ends = key[:, [1, 2, 0]]
+            forward += _mix(key * _ODD ^ ends).sum(dtype=np.uint64)
+            backward += _mix(ends * _ODD ^ key).sum(dtype=np.uint64)
+        return bool(forward == backward)
 
 
 #: An odd 64-bit constant: ``a * _ODD ^ b`` is not symmetric in a and b.

@@ -197,7 +197,9 @@ def split_vertices(attribute_ids: NDArray[np.intp], normal_ids: NDArray[np.intp]
     used = np.zeros(count, dtype=bool)
     used[vertex] = True
     renumber = np.cumsum(used, dtype=np.intp) - 1
-    vertex = renumber[vertex]
+    # In place (memory): each element reads its own index before it is overwritten; "clip"
+    # (no index is out of range) is what lets numpy write into its indices unbuffered.
+    np.take(renumber, vertex, out=vertex, mode="clip")
     first = np.empty(int(renumber[-1]) + 1, dtype=np.intp)
     first[vertex] = np.arange(c, dtype=np.intp)  # any corner of each vertex: they carry the same
     return vertex, first
@@ -249,25 +251,14 @@ def normal_groups(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: 
         return _finish(corner_pid, sums, faces)
     cos_limit = math.cos(math.radians(crease_angle))
     # Tier 1: positions whose normals all lie within half the crease angle of their mean direction.
-    mean = _unit_rows(np.stack([np.bincount(corner_pid, np.repeat(faces[:, j], 3), minlength=npos)
-                                for j in range(3)], axis=1))[0]
+    mean = _unit_rows(_sums(corner_pid, faces, None, npos))[0]
     half = max(0.0, math.radians(crease_angle) / 2.0 - _HALF_ANGLE_MARGIN)
-    # Each corner's face normal · its position's mean, one component at a time in (F, 3) corner
-    # layout: the face's component broadcast over its three corners (no repeated copy of it).
-    spread = np.zeros((f, 3))
-    for j, face_j in enumerate(np.ascontiguousarray(faces.T)):
-        term = mean[corner_pid, j].reshape(f, 3)
-        term *= face_j[:, None]
-        spread += term
-    del term
-    spread = spread.reshape(-1)
-    rough_pos = np.zeros(npos, dtype=bool)
-    rough_pos[corner_pid[spread < math.cos(half)]] = True
-    del spread
+    rough_pos = _rough_positions(corner_pid, faces, mean, math.cos(half))
     rough = rough_pos[corner_pid]
     del rough_pos
     which = np.flatnonzero(rough)
     if which.size == 0:
+        del mean, rough, which  # (memory: they go before the sums are made)
         return _finish(corner_pid, _sums(corner_pid, faces, angles, npos), faces)
     # Tiers 2 and 3: every rough corner gets a group of its own numbered after the positions;
     # corners of one smoothing group get the same sum, so they merge again by their normal.
@@ -291,14 +282,33 @@ def normal_groups(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: 
     return _finish(group, np.concatenate([smooth_sums, rough_sums]), faces)
 
 
-def _sums(corner_group: NDArray[np.intp], faces: NDArray[np.float64], angles: NDArray[np.float64],
+def _rough_positions(corner_pid: NDArray[np.intp], faces: NDArray[np.float64], mean: NDArray[np.float64],
+                     cos_half: float) -> NDArray[np.bool_]:
+    """Per position: whether a face normal there is further than the half angle from the
+    position's ``mean`` (``normal · mean < cos_half``: tier 1 does not apply). Worked out in
+    blocks of :data:`BLOCK_FACES` faces, in ``(faces, 3)`` corner layout, one component at a
+    time: no corner-sized float array at once."""
+    rough_pos = np.zeros(mean.shape[0], dtype=bool)
+    for lo in range(0, faces.shape[0], BLOCK_FACES):
+        block_pid = corner_pid[3 * lo:3 * (lo + BLOCK_FACES)].reshape(-1, 3)
+        spread = np.zeros(block_pid.shape)
+        for j in range(3):
+            term = mean[block_pid, j]
+            term *= faces[lo:lo + BLOCK_FACES, j, None]  # the face's component, for its three corners
+            spread += term
+        rough_pos[block_pid[spread < cos_half]] = True
+    return rough_pos
+
+
+def _sums(corner_group: NDArray[np.intp], faces: NDArray[np.float64], angles: NDArray[np.float64] | None,
           groups: int) -> NDArray[np.float64]:
     """The angle-weighted sum of face normals over the corners of each group, ``(groups, 3)``
-    (every corner given: corner ``c`` is of face ``c // 3``)."""
+    (every corner given: corner ``c`` is of face ``c // 3``); ``angles`` None: unweighted."""
     sums = np.empty((groups, 3))
     for j in range(3):
         weight = np.repeat(faces[:, j], 3)
-        weight *= angles
+        if angles is not None:
+            weight *= angles
         sums[:, j] = np.bincount(corner_group, weight, minlength=groups)
     return sums
 
