@@ -379,7 +379,7 @@ def test_model_cases_cover_every_size_mode_and_engine(monkeypatch) -> None:
 
     module = _models_module()
     monkeypatch.setattr(module, "embree_available", lambda: True)
-    monkeypatch.setattr(module, "_bunny_path", lambda: None)
+    monkeypatch.setattr(module, "bunny_path", lambda: None)
     found = module.cases(BenchEnv())  # nothing is built until a case runs
     assert found[0].name == "BVH build, 1,000,000 tris"
     assert [c.name for c in found[1:5]] == ["1,000 tris, primary, numpy", "1,000 tris, primary, gpu",
