@@ -105,8 +105,9 @@ from numpy.typing import NDArray
 
 from glsandbox.gl.shaders import compile_program
 from glsandbox.plan import ProgramVariant
-from glsandbox.raytrace.constants import SHADOW_OFFSET
+from glsandbox.raytrace.constants import NODE_BOX_PAD, OFFSETS, SIMPLE_OFFSET, glsl_defines
 from glsandbox.raytrace.errors import RayTraceError
+from glsandbox.raytrace.watertight import nondegenerate
 from glsandbox.raytrace.world import MODES, World, build_world, camera_basis
 from glsandbox.scene import Scene
 
@@ -224,17 +225,38 @@ def _records(rows: NDArray[np.float32]) -> tuple[tuple[int, int], bytes]:
     return (TEX_WIDTH, height), data.tobytes()
 
 
-def pack_triangles(world: World) -> NDArray[np.float32]:
-    """``TRI_RECORDS`` vec4 per triangle (layout in ``shaders/raytrace.glsl``)."""
+def world_anchor(world: World) -> NDArray[np.float64]:
+    """The point the gpu engine's coordinates are relative to: the centre of the
+    nodes' boxes (the origin for an empty world).
+
+    float32 has 24 bits: at 1e5 its spacing is 0.0078, at 1e6 0.0625, so a scene
+    traced in world coordinates there loses its shape (ids off on 2.9% and 15%
+    of the pixels, and BVH boxes padded in proportion to the coordinates). Every
+    position is therefore taken relative to this anchor in float64 on the CPU
+    (vertices, boxes, lights, the eye, spheres' inverse matrices) and only the
+    difference is rounded to float32: the picture at 1e6 is the one at the
+    origin. The anchor is the scene's own centre, not the eye, so a camera
+    moving around the scene keeps the upload (the eye is one uniform)."""
+    if not world.nodes:
+        return np.zeros(3)
+    lo = np.min([node.box_min for node in world.nodes], axis=0)
+    hi = np.max([node.box_max for node in world.nodes], axis=0)
+    return 0.5 * (lo + hi)
+
+
+def pack_triangles(world: World, anchor: NDArray[np.float64] | None = None) -> NDArray[np.float32]:
+    """``TRI_RECORDS`` vec4 per triangle (layout in ``shaders/raytrace.glsl``), positions
+    relative to ``anchor`` (see :func:`world_anchor`)."""
+    anchor = np.zeros(3) if anchor is None else anchor
     m = world.triangle_count
     rec = np.zeros((m, TRI_RECORDS, 4), dtype=np.float64)
-    e1 = world.v1 - world.v0
-    e2 = world.v2 - world.v0
-    area2 = np.linalg.norm(np.cross(e1, e2), axis=1)
-    ok = area2 > 1e-12 * np.linalg.norm(e1, axis=1) * np.linalg.norm(e2, axis=1)
-    rec[:, 0, :3] = world.v0
-    rec[:, 1, :3] = np.where(ok[:, None], e1, 0.0)  # degenerate: det = 0, never hit
-    rec[:, 2, :3] = np.where(ok[:, None], e2, 0.0)
+    # The corners themselves, not v0 and two edges: the watertight test needs a
+    # corner shared by two triangles to be the same three floats in both.
+    ok = nondegenerate(world.v0, world.v1, world.v2)  # the BVH's rule: a triangle without area is never hit
+    v0 = world.v0 - anchor
+    rec[:, 0, :3] = v0
+    rec[:, 1, :3] = np.where(ok[:, None], world.v1 - anchor, v0)  # degenerate: one point, det = 0
+    rec[:, 2, :3] = np.where(ok[:, None], world.v2 - anchor, v0)
     for k in range(3):
         rec[:, 3 + k, :3] = world.normals[:, k]
         rec[:, 6 + k, :3] = world.colors[:, k]
@@ -249,21 +271,26 @@ def node_order(world: World) -> list[int]:
     return meshes + [k for k, node in enumerate(world.nodes) if node.kind == "sphere"]
 
 
-def pack_nodes(world: World) -> NDArray[np.float32]:
-    """``NODE_RECORDS`` vec4 per node in :func:`node_order` (layout in ``shaders/raytrace.glsl``)."""
+def pack_nodes(world: World, anchor: NDArray[np.float64] | None = None) -> NDArray[np.float32]:
+    """``NODE_RECORDS`` vec4 per node in :func:`node_order` (layout in ``shaders/raytrace.glsl``),
+    positions relative to ``anchor`` (see :func:`world_anchor`)."""
+    anchor = np.zeros(3) if anchor is None else anchor
     rec = np.zeros((len(world.nodes), NODE_RECORDS, 4), dtype=np.float64)
     for slot, k in enumerate(node_order(world)):
         node = world.nodes[k]
+        lo, hi = node.box_min - anchor, node.box_max - anchor
         # Pad the box by a relative hair: float32 slab arithmetic must not
-        # reject a ray that Möller–Trumbore would accept at the box's face.
-        pad = 1e-5 * (1.0 + float(np.abs(np.concatenate([node.box_min, node.box_max])).max()))
-        rec[slot, 0] = (*(node.box_min - pad), 1.0 if node.kind == "sphere" else 0.0)
-        rec[slot, 1] = (*(node.box_max + pad), 1.0 if node.cull else 0.0)
+        # reject a ray that the triangle test would accept at the box's face.
+        pad = NODE_BOX_PAD * (1.0 + float(np.abs(np.concatenate([lo, hi])).max()))
+        rec[slot, 0] = (*(lo - pad), 1.0 if node.kind == "sphere" else 0.0)
+        rec[slot, 1] = (*(hi + pad), 1.0 if node.cull else 0.0)
         rec[slot, 2] = (node.start, node.count, k, 0.0)  # k: the scene order, for ties
         rec[slot, 3] = (*node.color, node.mode)
         rec[slot, 4] = (node.ka, node.kd, node.ks, node.shininess)
         rec[slot, 5] = (node.reflectivity, node.texture, node.lamp_of, 0.0)
-        rec[slot, 6:9] = node.inverse[:3, :4]
+        # world -> unit sphere for anchor-relative points: M⁻¹(p + anchor), in float64.
+        rec[slot, 6:9, :3] = node.inverse[:3, :3]
+        rec[slot, 6:9, 3] = node.inverse[:3, :3] @ anchor + node.inverse[:3, 3]
         rec[slot, 9:12, :3] = node.normal_matrix
     return rec.reshape(-1, 4).astype(np.float32)
 
@@ -301,8 +328,10 @@ class _Uploaded:
     def __init__(self, ctx: moderngl.Context, world: World, key: tuple[object, ...], block_records: int) -> None:
         self.key = key
         self.world = world
-        self.tris = pack_triangles(world)
-        self.nodes = pack_nodes(world)
+        #: Every uploaded position is relative to this point (:func:`world_anchor`).
+        self.anchor = world_anchor(world)
+        self.tris = pack_triangles(world, self.anchor)
+        self.nodes = pack_nodes(world, self.anchor)
         self.mesh_count = sum(1 for node in world.nodes if node.kind != "sphere")
         self.sphere_count = len(world.nodes) - self.mesh_count
         loops = sum(1 for node in world.nodes if node.kind != "sphere" and node.count > UNROLL_TRIS)
@@ -350,7 +379,9 @@ class _Uploaded:
         for k in node_order(world)[: self.mesh_count]:
             node = world.nodes[k]
             stop = node.start + node.count
-            bvh = bvh_for_triangles(world.v0[node.start:stop], world.v1[node.start:stop], world.v2[node.start:stop])
+            rows = slice(node.start, stop)
+            bvh = bvh_for_triangles(world.v0[rows] - self.anchor, world.v1[rows] - self.anchor,
+                                    world.v2[rows] - self.anchor)
             nodes, tris = pack_bvh(bvh)
             nodes = nodes.reshape(-1, 2, 4).copy()
             tris = tris.reshape(-1, 3, 4).copy()
@@ -406,7 +437,8 @@ class _Uploaded:
         return (len(world.textures) == len(self.world.textures)
                 and all(a is b or np.array_equal(a, b) for (a, _), (b, _) in zip(world.textures, self.world.textures))
                 and [w for _, w in world.textures] == [w for _, w in self.world.textures]
-                and np.array_equal(pack_triangles(world), self.tris) and np.array_equal(pack_nodes(world), self.nodes))
+                and np.array_equal(pack_triangles(world, world_anchor(world)), self.tris)
+                and np.array_equal(pack_nodes(world, world_anchor(world)), self.nodes))
 
     def release(self) -> None:
         for texture in self.textures.values():
@@ -442,7 +474,7 @@ class GpuTracer:
                  scene: tuple[tuple[str, str], ...] = ()) -> tuple[moderngl.Program, moderngl.VertexArray]:
         flags = (lights, textures, int(shadows and lights > 0), int(reflect), int(meshes), int(spheres))
         names = ("NUM_LIGHTS", "NUM_TEXTURES", "SHADOWS", "REFLECT", "HAS_MESHES", "HAS_SPHERES")
-        defines = tuple((name, str(value)) for name, value in zip(names, flags)) + scene
+        defines = tuple((name, str(value)) for name, value in zip(names, flags)) + glsl_defines() + scene
         if defines in self._programs:
             self._programs[defines] = self._programs.pop(defines)  # most recently used last
             self._vaos[defines] = self._vaos.pop(defines)
@@ -497,7 +529,7 @@ class GpuTracer:
 
     def render_viewport(self, scene: Scene, size: tuple[int, int], viewport: int = 0, *, max_depth: int = 2,
                         shadows: bool = True, cull_backfaces: bool | None = None, aabb: bool = True,
-                        analytic_spheres: bool = True) -> NDArray[np.uint8]:
+                        analytic_spheres: bool = True, offset: str = "bound") -> NDArray[np.uint8]:
         """Trace one viewport at ``size``: ``(H, W, 4)`` uint8, top row first (a read-only view)."""
         uploaded = self._upload(scene, viewport, analytic_spheres)
         world = uploaded.world
@@ -537,10 +569,10 @@ class GpuTracer:
         values = {
             "u_mesh_count": uploaded.mesh_count, "u_sphere_count": uploaded.sphere_count,
             "u_size": (float(width), float(height)),
-            "u_eye": tuple(eye), "u_half": (half_w, half_h), "u_background": tuple(world.background),
+            "u_eye": tuple(eye - uploaded.anchor), "u_half": (half_w, half_h), "u_background": tuple(world.background),
             "u_max_depth": int(max_depth),
             "u_cull": -1 if cull_backfaces is None else int(bool(cull_backfaces)), "u_aabb": bool(aabb),
-            "u_offset": SHADOW_OFFSET,
+            "u_offset": SIMPLE_OFFSET, "u_simple_offset": OFFSETS[offset],
         }
         for name, value in values.items():
             if name in program:
@@ -549,7 +581,7 @@ class GpuTracer:
             program["u_basis"].write(np.asarray(basis, dtype="f4").T.tobytes())  # column-major
         if lights:
             if "u_light_pos" in program:
-                program["u_light_pos"].write(world.light_positions.astype("f4").tobytes())
+                program["u_light_pos"].write((world.light_positions - uploaded.anchor).astype("f4").tobytes())
             if "u_light_color" in program:
                 program["u_light_color"].write(world.light_colors.astype("f4").tobytes())
         target = self._target((width, height))

@@ -49,7 +49,8 @@ from numpy.typing import NDArray
 from glsandbox.raytrace.aabb import AABB, reciprocals
 from glsandbox.raytrace.bvh_traverse import TraversalCounts, any_hit, closest_hit
 from glsandbox.raytrace.bvh_world import NodeBVH, WorldBVH
-from glsandbox.raytrace.constants import SHADOW_OFFSET
+from glsandbox.raytrace.constants import (BVH_BOX_PAD_F64, OFFSETS, SIMPLE_OFFSET, SPHERE_POINT_GAMMA,
+                                          TRIANGLE_POINT_GAMMA, UNIT_F64, gamma)
 from glsandbox.raytrace.sphere import Sphere
 from glsandbox.raytrace.vec import length
 from glsandbox.raytrace.world import World, build_world, camera_rays
@@ -172,7 +173,7 @@ def _box_candidates(entry: NodeBVH, o: NDArray[np.float64], inverse: NDArray[np.
     if stats is not None:
         stats.box_tests += inverse.shape[1]
     lo, hi = entry.bvh.node_min[0], entry.bvh.node_max[0]
-    pad = 2.0**-30 * (1.0 + max(np.abs(lo).max(), np.abs(hi).max(), float(np.abs(o).max(initial=0.0))))
+    pad = BVH_BOX_PAD_F64 * (1.0 + max(np.abs(lo).max(), np.abs(hi).max(), float(np.abs(o).max(initial=0.0))))
     near, far = AABB(lo - pad, hi + pad).slabs_reciprocal(o, inverse)
     return np.flatnonzero((near <= far) & (far >= 0.0) & (near <= limit))
 
@@ -312,11 +313,30 @@ def _sample(image: NDArray[np.float64], wrap: int, uv: NDArray[np.float64]) -> N
     return top * (1 - fy) + bottom * fy
 
 
+@dataclass
+class _Spawn:
+    """Where secondary rays start (pbrt-v4's robust spawned origins): the hit point
+    recomputed where its rounding error is bounded, that bound per component, and
+    the geometric normal. A triangle's point is ``b0·V0 + b1·V1 + b2·V2``, off its
+    plane by at most ``γ(7)·Σ|b_i·V_i|``; a sphere's is ``O + t·D`` with
+    ``γ(16)·(|O| + |t·D|)`` (:mod:`glsandbox.raytrace.constants`)."""
+
+    point: NDArray[np.float64]
+    error: NDArray[np.float64]
+    normal: NDArray[np.float64]
+
+    def subset(self, rows: NDArray[np.intp] | NDArray[np.bool_]) -> _Spawn:
+        return _Spawn(self.point[rows], self.error[rows], self.normal[rows])
+
+
 def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.float64]
-             ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """``(point, unit normal, base colour)`` for hit rays (all of ``hits`` must be hits)."""
+             ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], _Spawn]:
+    """``(point, unit normal, base colour, spawn)`` for hit rays (all of ``hits`` must be hits)."""
     n = d.shape[0]
     point = o + hits.t[:, None] * d
+    # Spheres' spawn points are the ray's point; triangles' are replaced below.
+    spawn = _Spawn(point.copy(), gamma(SPHERE_POINT_GAMMA, UNIT_F64) * (np.abs(o) + np.abs(hits.t[:, None] * d)),
+                   np.zeros((n, 3)))
     normal = np.zeros((n, 3))
     base = np.zeros((n, 3))
     uv = np.zeros((n, 2))
@@ -329,6 +349,7 @@ def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.fl
             q = point[sel] @ inv[:3, :3].T + inv[:3, 3]  # the hit on the unit sphere
             q /= length(q)[:, None]
             normal[sel] = q @ node.normal_matrix.T
+            spawn.normal[sel] = normal[sel]
             # geometry.sphere()'s uv: u = azimuth/2π from +z towards +x, v = polar angle/π from +y.
             uv[sel, 0] = np.mod(np.arctan2(q[:, 0], q[:, 2]), 2 * np.pi) / (2 * np.pi)
             uv[sel, 1] = np.arccos(np.clip(q[:, 1], -1.0, 1.0)) / np.pi
@@ -338,6 +359,11 @@ def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.fl
             u, v = _barycentric(world, tri, _rows(o, sel), d[sel])
             w = (1.0 - u - v)[:, None], u[:, None], v[:, None]  # weights of V0, V1, V2
             normal[sel] = _interpolate(world.normals[tri], w)
+            corners = world.v0[tri] * w[0], world.v1[tri] * w[1], world.v2[tri] * w[2]
+            spawn.point[sel] = corners[0] + corners[1] + corners[2]
+            spawn.error[sel] = gamma(TRIANGLE_POINT_GAMMA, UNIT_F64) * (
+                np.abs(corners[0]) + np.abs(corners[1]) + np.abs(corners[2]))
+            spawn.normal[sel] = np.cross(world.v1[tri] - world.v0[tri], world.v2[tri] - world.v0[tri])
             uv[sel] = _interpolate(world.uvs[tri], w)
             colors = _interpolate(world.colors[tri], w) if node.mode == 1 else None
         color = np.broadcast_to(node.color, (sel.size, 3)).copy()
@@ -348,7 +374,8 @@ def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.fl
             color *= _sample(image, wrap, uv[sel])[:, :3]
         base[sel] = color
     normal /= np.maximum(length(normal), 1e-300)[:, None]
-    return point, normal, base
+    spawn.normal /= np.maximum(length(spawn.normal), 1e-300)[:, None]
+    return point, normal, base, spawn
 
 
 def _interpolate(values: NDArray[np.float64], w: tuple[NDArray[np.float64], ...]) -> NDArray[np.float64]:
@@ -357,21 +384,31 @@ def _interpolate(values: NDArray[np.float64], w: tuple[NDArray[np.float64], ...]
     return values[:, 0] * w[0] + values[:, 1] * w[1] + values[:, 2] * w[2]
 
 
-def _offset(point: NDArray[np.float64], normal: NDArray[np.float64], side: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``point`` moved off its surface towards ``side`` by the relative :data:`SHADOW_OFFSET`."""
-    scale = SHADOW_OFFSET * np.maximum(1.0, np.abs(point).max(axis=1))
-    sign = np.where(np.einsum("ij,ij->i", normal, side) < 0.0, -1.0, 1.0)
-    return point + (scale * sign)[:, None] * normal
+def _offset(spawn: _Spawn, side: NDArray[np.float64], simple: bool = False) -> NDArray[np.float64]:
+    """Secondary-ray origins off their surface, on the side of ``side``: each spawn
+    point moved along its geometric normal by its error bound's reach along it,
+    ``Σ|n_i|·err_i``, then every moved component rounded one float further
+    (so the move cannot round back onto the surface). ``simple``: the teaching
+    variant, :data:`~glsandbox.raytrace.constants.SIMPLE_OFFSET`·max(1, max|P|)."""
+    p, n = spawn.point, spawn.normal
+    if simple:
+        reach = SIMPLE_OFFSET * np.maximum(1.0, np.abs(p).max(axis=1))
+    else:
+        reach = np.einsum("ij,ij->i", np.abs(n), spawn.error)
+    sign = np.where(np.einsum("ij,ij->i", n, side) < 0.0, -1.0, 1.0)
+    offset = (reach * sign)[:, None] * n
+    moved = p + offset
+    return np.where(offset > 0.0, np.nextafter(moved, np.inf), np.where(offset < 0.0, np.nextafter(moved, -np.inf), moved))
 
 
 # --- shading and bounces -------------------------------------------------------
 
 
 def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.float64], shadows: bool,
-           cull: bool | None, aabb: bool, stats: RenderStats, bvh: WorldBVH | None = None
-           ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """Local colour of hit rays (the raster's per-light formula), plus point and normal for bounces."""
-    point, normal, base = _surface(world, hits, o, d)
+           cull: bool | None, aabb: bool, stats: RenderStats, bvh: WorldBVH | None = None, simple: bool = False
+           ) -> tuple[NDArray[np.float64], NDArray[np.float64], _Spawn]:
+    """Local colour of hit rays (the raster's per-light formula), plus normal and spawn point for bounces."""
+    point, normal, base, spawn = _surface(world, hits, o, d)
     color = base.copy()  # unlit surfaces keep their colour
     table = world.materials
     lit = table.lit[hits.node]
@@ -384,6 +421,7 @@ def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.floa
         shin = table.shininess[nodes]
         blinn = table.blinn[nodes]
         p, nrm, mesh = point[idx], normal[idx], base[idx]
+        lit_spawn = spawn.subset(idx)
         to_eye = -d[idx] / length(d[idx])[:, None]
         total = np.zeros_like(mesh)
         for index, (light, light_color) in enumerate(zip(world.light_positions, world.light_colors)):
@@ -403,17 +441,18 @@ def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.floa
             specular = highlight[:, None] * light_color
             lighting = kd * diffuse + ks * specular
             if shadows:
-                start = _offset(p, nrm, light - p)
+                start = _offset(lit_spawn, light - p, simple)
                 stats.shadow += idx.size
                 blocked = _occluded(world, start, light - start, index, cull, aabb, stats, bvh)
                 lighting *= np.where(blocked, 0.0, 1.0)[:, None]  # in shadow only the ambient term stays
             total += np.minimum(ka * mesh + lighting, 1.0)
         color[idx] = total
-    return color, point, normal
+    return color, normal, spawn
 
 
 def _trace(world: World, o: NDArray[np.float64], d: NDArray[np.float64], max_depth: int, shadows: bool,
-           cull: bool | None, aabb: bool, stats: RenderStats, bvh: WorldBVH | None = None) -> NDArray[np.float64]:
+           cull: bool | None, aabb: bool, stats: RenderStats, bvh: WorldBVH | None = None,
+           simple: bool = False) -> NDArray[np.float64]:
     """Colour of each ray, reflections followed iteratively: ``(1−r)·local + r·reflected``."""
     n = d.shape[0]
     out = np.zeros((n, 3))
@@ -427,7 +466,7 @@ def _trace(world: World, o: NDArray[np.float64], d: NDArray[np.float64], max_dep
         if not hit.any():
             break
         sub = _Hits(hits.t[hit], hits.node[hit], hits.tri[hit])
-        local, point, normal = _shade(world, sub, _rows(o, hit), d[hit], shadows, cull, aabb, stats, bvh)
+        local, normal, spawn = _shade(world, sub, _rows(o, hit), d[hit], shadows, cull, aabb, stats, bvh, simple)
         r = world.materials.reflectivity[sub.node] if depth < max_depth else np.zeros(sub.node.size)
         w = weight[hit]
         out[alive[hit]] += (w * (1.0 - r))[:, None] * local
@@ -437,7 +476,7 @@ def _trace(world: World, o: NDArray[np.float64], d: NDArray[np.float64], max_dep
         dh = d[hit][bounce]
         nh = normal[bounce]
         reflected = dh - 2.0 * np.einsum("ij,ij->i", dh, nh)[:, None] * nh  # Yansıma vektörü
-        o = _offset(point[bounce], nh, -dh)
+        o = _offset(spawn.subset(bounce), -dh, simple)
         d = reflected
         weight = (w * r)[bounce]
         alive = alive[hit][bounce]
@@ -471,7 +510,7 @@ def _world_of(scene: Scene, viewport: int, analytic_spheres: bool, bvh: bool) ->
 def render_viewport(scene: Scene, size: tuple[int, int], viewport: int = 0, *, max_depth: int = 2,
                     shadows: bool = True, cull_backfaces: bool | None = None, aabb: bool = True,
                     bvh: bool = True, analytic_spheres: bool = True,
-                    stats: RenderStats | None = None) -> NDArray[np.uint8]:
+                    stats: RenderStats | None = None, offset: str = "bound") -> NDArray[np.uint8]:
     """Trace one viewport at ``size``: ``(H, W, 4)`` uint8, top row first (see :func:`to_rgba8`).
 
     The options are :func:`glsandbox.raytrace.render`'s; ``stats`` counts the rays cast.
@@ -485,5 +524,6 @@ def render_viewport(scene: Scene, size: tuple[int, int], viewport: int = 0, *, m
     rgb = np.empty((dirs.shape[0], 3))
     for lo in range(0, dirs.shape[0], RAY_BLOCK):
         rays = slice(lo, lo + RAY_BLOCK)
-        rgb[rays] = _trace(world, eye, dirs[rays], max_depth, shadows, cull_backfaces, aabb, stats, accel)
+        rgb[rays] = _trace(world, eye, dirs[rays], max_depth, shadows, cull_backfaces, aabb, stats, accel,
+                           OFFSETS[offset])
     return to_rgba8(rgb.reshape(height, width, 3))
