@@ -31,8 +31,8 @@ earlier node, then the lower triangle). Spheres stay analytic
 (:func:`_hit_node`). Shadow rays are an any-hit query
 (:func:`~glsandbox.raytrace.bvh_traverse.any_hit`): a ray leaves at its first
 occluder. With ``bvh=False``, :func:`_scan_nodes` tests every triangle of a
-node whose box a ray enters (Möller–Trumbore,
-``world.batches[k].nearest_many``), and :func:`_occluded` is that scan cut at
+node whose box a ray enters (the watertight test too,
+:func:`~glsandbox.raytrace.watertight.nearest_watertight`), and :func:`_occluded` is that scan cut at
 ``t = 1``: what ``ray_acceleration`` compares the BVH with.
 :class:`RenderStats` counts the ray-shape tests and the ray-box tests either
 way.
@@ -53,6 +53,7 @@ from glsandbox.raytrace.constants import (BVH_BOX_PAD_F64, OFFSETS, SIMPLE_OFFSE
                                           TRIANGLE_POINT_GAMMA, UNIT_F64, gamma)
 from glsandbox.raytrace.sphere import Sphere
 from glsandbox.raytrace.vec import length
+from glsandbox.raytrace.watertight import nearest_watertight
 from glsandbox.raytrace.world import World, build_world, camera_rays
 from glsandbox.scene import Scene
 
@@ -250,9 +251,9 @@ def _hit_node(world: World, k: int, o: NDArray[np.float64], d: NDArray[np.float6
 
     A sphere node is the unit sphere under its model matrix: the ray is taken
     into the sphere's own space (Işın-Küre kesim testi there; ``t`` is kept by
-    the affine map). A mesh node's triangles are tested with Möller–Trumbore
-    (:meth:`~glsandbox.raytrace.triangle.TriangleBatch.nearest_many`), the lowest
-    index winning a tie. ``one_sided``: backface culling (course "Hızlandırma:
+    the affine map). A mesh node's triangles are tested with the watertight test
+    (:func:`~glsandbox.raytrace.watertight.nearest_watertight`, as the BVH does), the
+    lowest index winning a tie. ``one_sided``: backface culling (course "Hızlandırma:
     backface culling").
     """
     node = world.nodes[k]
@@ -264,9 +265,8 @@ def _hit_node(world: World, k: int, o: NDArray[np.float64], d: NDArray[np.float6
         if one_sided:  # from inside, the sphere's front faces all face away
             t = np.where(np.einsum("...j,...j->...", oo, oo) < 1.0, np.inf, t)
         return t, np.full(d.shape[0], -1, dtype=np.intp)
-    batch = world.batches[k]
-    assert batch is not None
-    t, j = batch.nearest_many(o, d, cull_backfaces=one_sided)
+    rows = slice(node.start, node.start + node.count)
+    t, j = nearest_watertight(world.v0[rows], world.v1[rows], world.v2[rows], o, d, cull_backfaces=one_sided)
     return t, np.where(j >= 0, j + node.start, -1)
 
 

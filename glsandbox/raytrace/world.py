@@ -62,7 +62,6 @@ from glsandbox import transforms
 from glsandbox.geometry import Mesh
 from glsandbox.images import texture_levels
 from glsandbox.raytrace.errors import RayTraceError
-from glsandbox.raytrace.triangle import TriangleBatch
 from glsandbox.scene import MIN_SCALE, Camera, Node, Scene, Texture
 
 __all__ = [
@@ -135,7 +134,6 @@ class World:
     light_colors: NDArray[np.float64]  # (L, 3)
     background: NDArray[np.float64]  # rgb of the viewport's clear colour
     textures: list[tuple[NDArray[np.float64], int]]  # (image (H, W, 4) in 0..1, wrap code)
-    batches: list[TriangleBatch | None] = field(default_factory=list)
 
     @property
     def triangle_count(self) -> int:
@@ -229,7 +227,6 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
     v0s, v1s, v2s, ns, uvs, cols, owners = [], [], [], [], [], [], []
     textures: list[tuple[NDArray[np.float64], int]] = []
     texture_index: dict[tuple[str, str, str], int] = {}
-    batches: list[TriangleBatch | None] = []
     start = 0
     for node in scene.nodes:
         if not node.shown_in(viewport):
@@ -261,7 +258,6 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
             nodes.append(NodeInfo(kind="sphere", start=start, count=0, box_min=world_corners.min(axis=0),
                                   box_max=world_corners.max(axis=0), inverse=np.linalg.inv(model),
                                   normal_matrix=transforms.normal_matrix(model), **common))
-            batches.append(None)
             continue
         order = mesh.indices if mesh.indices is not None else np.arange(mesh.vertex_count)
         if mesh.mode == "triangles":
@@ -286,7 +282,6 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
         owners.append(np.full(len(tri), len(nodes), dtype=np.intp))
         nodes.append(NodeInfo(kind="mesh", start=start, count=len(tri), box_min=world.min(axis=0),
                               box_max=world.max(axis=0), **common))
-        batches.append(TriangleBatch(a, b, c))
         start += len(tri)
     lights = scene.lights
     for info in nodes:
@@ -304,7 +299,7 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
         tri_node=np.concatenate(owners) if owners else np.zeros(0, dtype=np.intp),
         light_positions=np.array([l.position for l in lights], dtype=np.float64).reshape(-1, 3),
         light_colors=np.array([l.color for l in lights], dtype=np.float64).reshape(-1, 3),
-        background=np.asarray(clear[:3], dtype=np.float64), textures=textures, batches=batches,
+        background=np.asarray(clear[:3], dtype=np.float64), textures=textures,
     )
 
 
