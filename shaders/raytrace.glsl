@@ -456,17 +456,18 @@ float next_float(float x, float dir) {
     return intBitsToFloat((x > 0.0) == (dir > 0.0) ? bits + 1 : bits - 1);
 }
 
-// A secondary ray's origin, on the side of `towards`: the point moved along
-// the geometric normal by the error bound's reach along it, then rounded away
-// (so the move itself cannot round back onto the surface).
-vec3 offset_point(Spawn s, vec3 towards) {
+// A secondary ray's origin: the point moved along the geometric normal by the
+// error bound's reach along it, then rounded away (so the move itself cannot
+// round back onto the surface), to the side the shading normal `n` puts
+// `towards` on (as the numpy engine's _offset, which says why).
+vec3 offset_point(Spawn s, vec3 n, vec3 towards) {
     vec3 offset;
     if (u_simple_offset) {
         offset = u_offset * max(1.0, max(max(abs(s.p.x), abs(s.p.y)), abs(s.p.z))) * s.ng;
     } else {
         offset = dot(abs(s.ng), s.err) * s.ng;
     }
-    if (dot(s.ng, towards) < 0.0) offset = -offset;
+    if ((dot(n, towards) < 0.0) != (dot(s.ng, n) < 0.0)) offset = -offset;
     vec3 q = s.p + offset;
     return vec3(next_float(q.x, offset.x), next_float(q.y, offset.y), next_float(q.z, offset.z));
 }
@@ -487,7 +488,7 @@ vec3 shade(int k, vec3 p, vec3 n, vec3 mesh, vec3 d, Spawn at) {
                      diffuse, specular);
         float visible = 1.0;
 #if SHADOWS
-        vec3 start = offset_point(at, u_light_pos[i] - at.p);
+        vec3 start = offset_point(at, n, u_light_pos[i] - at.p);
         if (occluded(start, u_light_pos[i] - start, i)) visible = 0.0;
 #endif
         color += min(coef.x * mesh + visible * (coef.y * diffuse + coef.z * specular), vec3(1.0));
@@ -519,7 +520,7 @@ void main() {
         color += weight * (1.0 - r) * local;
         if (r <= 0.0) break;
         vec3 reflected = d - 2.0 * dot(d, n) * n;  // Yansıma vektörü
-        o = offset_point(at, -d);
+        o = offset_point(at, n, -d);
         d = reflected;
         weight *= r;
     }

@@ -384,18 +384,23 @@ def _interpolate(values: NDArray[np.float64], w: tuple[NDArray[np.float64], ...]
     return values[:, 0] * w[0] + values[:, 1] * w[1] + values[:, 2] * w[2]
 
 
-def _offset(spawn: _Spawn, side: NDArray[np.float64], simple: bool = False) -> NDArray[np.float64]:
-    """Secondary-ray origins off their surface, on the side of ``side``: each spawn
-    point moved along its geometric normal by its error bound's reach along it,
-    ``Σ|n_i|·err_i``, then every moved component rounded one float further
-    (so the move cannot round back onto the surface). ``simple``: the teaching
-    variant, :data:`~glsandbox.raytrace.constants.SIMPLE_OFFSET`·max(1, max|P|)."""
+def _offset(spawn: _Spawn, normal: NDArray[np.float64], side: NDArray[np.float64],
+            simple: bool = False) -> NDArray[np.float64]:
+    """Secondary-ray origins off their surface: each spawn point moved along its
+    geometric normal by its error bound's reach along it, ``Σ|n_i|·err_i``, then
+    every moved component rounded one float further (so the move cannot round back
+    onto the surface). The side is the one the shading ``normal`` puts ``side``
+    on, as the shading decides whether a point faces its light (on a tessellated
+    sphere's terminator the facet may face away while the normal does not: the ray
+    then starts outside and the facet shadows it). ``simple``: the teaching variant,
+    :data:`~glsandbox.raytrace.constants.SIMPLE_OFFSET`·max(1, max|P|)."""
     p, n = spawn.point, spawn.normal
     if simple:
         reach = SIMPLE_OFFSET * np.maximum(1.0, np.abs(p).max(axis=1))
     else:
         reach = np.einsum("ij,ij->i", np.abs(n), spawn.error)
-    sign = np.where(np.einsum("ij,ij->i", n, side) < 0.0, -1.0, 1.0)
+    sign = np.where(np.einsum("ij,ij->i", normal, side) < 0.0, -1.0, 1.0)
+    sign *= np.where(np.einsum("ij,ij->i", n, normal) < 0.0, -1.0, 1.0)  # a geometric normal against the shading one
     offset = (reach * sign)[:, None] * n
     moved = p + offset
     return np.where(offset > 0.0, np.nextafter(moved, np.inf), np.where(offset < 0.0, np.nextafter(moved, -np.inf), moved))
@@ -441,7 +446,7 @@ def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.floa
             specular = highlight[:, None] * light_color
             lighting = kd * diffuse + ks * specular
             if shadows:
-                start = _offset(lit_spawn, light - p, simple)
+                start = _offset(lit_spawn, nrm, light - p, simple)
                 stats.shadow += idx.size
                 blocked = _occluded(world, start, light - start, index, cull, aabb, stats, bvh)
                 lighting *= np.where(blocked, 0.0, 1.0)[:, None]  # in shadow only the ambient term stays
@@ -476,7 +481,7 @@ def _trace(world: World, o: NDArray[np.float64], d: NDArray[np.float64], max_dep
         dh = d[hit][bounce]
         nh = normal[bounce]
         reflected = dh - 2.0 * np.einsum("ij,ij->i", dh, nh)[:, None] * nh  # Yansıma vektörü
-        o = _offset(spawn.subset(bounce), -dh, simple)
+        o = _offset(spawn.subset(bounce), nh, -dh, simple)
         d = reflected
         weight = (w * r)[bounce]
         alive = alive[hit][bounce]
