@@ -28,7 +28,7 @@ __all__ = [
     "NODE_BOX_PAD",
     "OFFSETS",
     "SIMPLE_OFFSET",
-    "SPHERE_POINT_GAMMA",
+    "RAY_POINT_GAMMA",
     "TRIANGLE_POINT_GAMMA",
     "UNIT_F32",
     "UNIT_F64",
@@ -45,11 +45,12 @@ UNIT_F32: float = 2.0**-24
 #: (three products, two sums, and ``b_i`` itself a quotient off by two more):
 #: pbrt-v4's bound for its watertight triangle, ``γ(7)·Σ|b_i·V_i|``.
 TRIANGLE_POINT_GAMMA: int = 7
-#: Operations behind a sphere hit ``O + t·D``: the stable quadratic's ``t`` is
+#: Operations behind a point ``O + t·D`` (a sphere hit in the engines, any hit in
+#: the course API's :class:`~glsandbox.raytrace.trace.Hit`): the stable quadratic's ``t`` is
 #: off by a few ulps (Ray Tracing Gems ch. 7), and the point by that times
 #: ``|t·D|`` plus the two operations of the sum; 16 covers it with room
 #: (the bound is ``γ(16)·(|O| + |t·D|)`` per component).
-SPHERE_POINT_GAMMA: int = 16
+RAY_POINT_GAMMA: int = 16
 #: How secondary rays leave a surface, as the engines' ``offset`` option names
 #: it (the value: whether it is the simple relative offset).
 #: ``"bound"``: by the hit point's rounding-error bound (the default, above);
@@ -85,7 +86,7 @@ def glsl_defines() -> tuple[tuple[str, str], ...]:
     """The numbers above as the shaders' ``#define``s (float32 values)."""
     return (
         ("TRIANGLE_POINT_ERROR", repr(gamma(TRIANGLE_POINT_GAMMA, UNIT_F32))),
-        ("SPHERE_POINT_ERROR", repr(gamma(SPHERE_POINT_GAMMA, UNIT_F32))),
+        ("SPHERE_POINT_ERROR", repr(gamma(RAY_POINT_GAMMA, UNIT_F32))),
         ("GAMMA2", repr(gamma(2, UNIT_F32))),
         ("GAMMA3", repr(gamma(3, UNIT_F32))),
         ("GAMMA5", repr(gamma(5, UNIT_F32))),

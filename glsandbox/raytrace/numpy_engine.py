@@ -49,7 +49,7 @@ from numpy.typing import NDArray
 from glsandbox.raytrace.aabb import AABB, reciprocals
 from glsandbox.raytrace.bvh_traverse import TraversalCounts, any_hit, closest_hit
 from glsandbox.raytrace.bvh_world import NodeBVH, WorldBVH
-from glsandbox.raytrace.constants import (BVH_BOX_PAD_F64, OFFSETS, SIMPLE_OFFSET, SPHERE_POINT_GAMMA,
+from glsandbox.raytrace.constants import (BVH_BOX_PAD_F64, OFFSETS, SIMPLE_OFFSET, RAY_POINT_GAMMA,
                                           TRIANGLE_POINT_GAMMA, UNIT_F64, gamma)
 from glsandbox.raytrace.sphere import Sphere
 from glsandbox.raytrace.vec import length
@@ -335,7 +335,7 @@ def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.fl
     n = d.shape[0]
     point = o + hits.t[:, None] * d
     # Spheres' spawn points are the ray's point; triangles' are replaced below.
-    spawn = _Spawn(point.copy(), gamma(SPHERE_POINT_GAMMA, UNIT_F64) * (np.abs(o) + np.abs(hits.t[:, None] * d)),
+    spawn = _Spawn(point.copy(), gamma(RAY_POINT_GAMMA, UNIT_F64) * (np.abs(o) + np.abs(hits.t[:, None] * d)),
                    np.zeros((n, 3)))
     normal = np.zeros((n, 3))
     base = np.zeros((n, 3))
