@@ -114,3 +114,41 @@ def test_the_gpu_engine_draws_lesson_scenes_at_1e5_as_the_numpy_engine(gl, name)
     assert np.count_nonzero(far) <= 0.0005 * far.size, np.count_nonzero(far)
     interior = far & ~grown(~far)
     assert not interior.any(), f"{np.count_nonzero(interior)} pixels inside a patch of differences"
+
+
+def rock_scene() -> Scene:
+    """A 5,120-triangle rock (the gpu engine's BVH program), lit and half a mirror."""
+    from glsandbox import meshgen
+
+    material = Material(color=(0.8, 0.7, 0.6, 1.0), shading="phong", reflectivity=0.3)
+    return Scene("rock", nodes=(Node("rock", meshgen.rock(4, seed=4, roughness=0.3), np.eye(4), material),),
+                 camera=Camera(eye=(0.0, 0.5, 3.0), target=(0.0, 0.0, 0.0)), lights=(Light((3.0, 3.0, 3.0)),),
+                 clear_color=(0.0, 0.0, 0.0, 1.0))
+
+
+@pytest.mark.parametrize("cap", [128, 192])
+def test_the_gpu_bvh_takes_the_same_steps_at_1e6_as_at_the_origin(gl, monkeypatch, cap) -> None:
+    # Steps per ray, seen through the step bound: at 128 the same pixels run out of steps
+    # wherever the rock sits, at 192 none does and the pictures are the same. (In world
+    # space the boxes' padding grew with the coordinates: 22 steps a ray at the origin,
+    # 479 at 1e5, the 8,192 cap at 1e6, where a frame with a bounce raised.)
+    from glsandbox.raytrace import RayTraceError
+    from glsandbox.raytrace import gpu as gpu_engine
+
+    monkeypatch.setattr(gpu_engine, "BVH_STEP_CAP", cap)
+    tracer = gpu_engine.gpu_tracer(gl.host.ctx)
+    outcomes = []
+    for at in (0.0, 1e5, 1e6):
+        tracer.forget_scenes()
+        try:
+            outcomes.append(render(moved(rock_scene(), at * DIRECTION), (80, 60), "gpu", ctx=gl.host.ctx,
+                                   max_depth=1).copy())
+        except RayTraceError as exc:
+            outcomes.append(str(exc))
+    tracer.forget_scenes()
+    if cap == 128:
+        assert all(isinstance(o, str) and "steps a ray on" in o for o in outcomes)
+        assert outcomes[1] == outcomes[0] and outcomes[2] == outcomes[0]  # the same count of pixels
+    else:
+        assert all(isinstance(o, np.ndarray) for o in outcomes)
+        assert np.array_equal(outcomes[1], outcomes[0]) and np.array_equal(outcomes[2], outcomes[0])
