@@ -33,6 +33,10 @@ class Mesh:
     ``name`` identifies the mesh (GPU buffers are cached by it). ``notes``
     says where a loaded mesh came from and what loading did to it (dropped
     faces, how its normals were made): ``glsandbox plan`` prints them.
+    ``analytic`` names the exact shape the triangles tessellate, for the ray
+    tracer (``"sphere"``: :func:`sphere`, the unit sphere; None: the
+    triangles are the shape); :mod:`glsandbox.raytrace.world` traces that
+    shape instead of the triangles.
     """
 
     name: str
@@ -43,6 +47,7 @@ class Mesh:
     colors: np.ndarray | None = None
     mode: str = "triangles"
     notes: tuple[str, ...] = ()
+    analytic: str | None = None
 
     def __post_init__(self) -> None:
         # Meshes are shared, immutable data (renderers cache per mesh object).
@@ -243,7 +248,7 @@ def sphere(stacks: int = 24, slices: int = 48) -> Mesh:
                 indices += [a, b, a + 1]
             if i < stacks - 1:
                 indices += [a + 1, b, b + 1]
-    return Mesh("sphere", positions, np.array(indices, dtype=np.uint32), positions.copy(), uvs)
+    return Mesh("sphere", positions, np.array(indices, dtype=np.uint32), positions.copy(), uvs, analytic="sphere")
 
 
 #: Built-in meshes by name, for scene files.

@@ -108,7 +108,7 @@ from glsandbox.plan import ProgramVariant
 from glsandbox.raytrace.constants import NODE_BOX_PAD, OFFSETS, SIMPLE_OFFSET, glsl_defines
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.watertight import nondegenerate
-from glsandbox.raytrace.world import MODES, World, build_world, camera_basis
+from glsandbox.raytrace.world import MODES, World, build_world, camera_basis, kind_defines
 from glsandbox.scene import Scene
 
 __all__ = ["LOOP_LIMIT", "GpuTracer", "MAX_TEXTURES", "check_loop_budget", "gpu_tracer"]
@@ -130,7 +130,7 @@ def check_loop_budget(world: World, lights: int, shadows: bool, reflect: bool, m
     where llvmpipe would silently stop testing (a wrong picture): a conservative bound,
     never a guess."""
     rays = (1 + (lights if shadows else 0)) * (1 + (max_depth if reflect else 0))
-    meshes = [node for node in world.nodes if node.kind != "sphere"]
+    meshes = [node for node in world.nodes if node.kind.triangles]
     worst = rays * (sum(node.count for node in meshes) + len(world.nodes))
     if worst > LOOP_LIMIT:
         largest = max(meshes, key=lambda node: node.count)
@@ -163,7 +163,7 @@ def bvh_step_cap(world: World, lights: int, shadows: bool, reflect: bool, max_de
     raises. Raises :class:`RayTraceError` when the budget leaves too few steps."""
     bounces = 1 + (max_depth if reflect else 0)
     rays = (1 + (lights if shadows else 0)) * bounces
-    meshes = sum(1 for node in world.nodes if node.kind != "sphere")
+    meshes = sum(1 for node in world.nodes if node.kind.triangles)
     other = rays * (len(world.nodes) + 1) + bounces * (lights + 1) + 64
     cap = (LOOP_LIMIT - other) // max(1, rays * meshes)
     if BVH_STEP_CAP is not None:
@@ -267,8 +267,8 @@ def pack_triangles(world: World, anchor: NDArray[np.float64] | None = None) -> N
 
 def node_order(world: World) -> list[int]:
     """The nodes as the shader stores them: mesh nodes first, then sphere nodes (scene order within)."""
-    meshes = [k for k, node in enumerate(world.nodes) if node.kind != "sphere"]
-    return meshes + [k for k, node in enumerate(world.nodes) if node.kind == "sphere"]
+    meshes = [k for k, node in enumerate(world.nodes) if node.kind.triangles]
+    return meshes + [k for k, node in enumerate(world.nodes) if not node.kind.triangles]
 
 
 def pack_nodes(world: World, anchor: NDArray[np.float64] | None = None) -> NDArray[np.float32]:
@@ -282,7 +282,7 @@ def pack_nodes(world: World, anchor: NDArray[np.float64] | None = None) -> NDArr
         # Pad the box by a relative hair: float32 slab arithmetic must not
         # reject a ray that the triangle test would accept at the box's face.
         pad = NODE_BOX_PAD * (1.0 + float(np.abs(np.concatenate([lo, hi])).max()))
-        rec[slot, 0] = (*(lo - pad), 1.0 if node.kind == "sphere" else 0.0)
+        rec[slot, 0] = (*(lo - pad), float(node.kind.code))
         rec[slot, 1] = (*(hi + pad), 1.0 if node.cull else 0.0)
         rec[slot, 2] = (node.start, node.count, k, 0.0)  # k: the scene order, for ties
         rec[slot, 3] = (*node.color, node.mode)
@@ -325,18 +325,20 @@ class _Uploaded:
     RGBA32F textures and the shader's general loops.
     """
 
-    def __init__(self, ctx: moderngl.Context, world: World, key: tuple[object, ...], block_records: int) -> None:
+    def __init__(self, ctx: moderngl.Context, world: World, key: tuple[object, ...], block_records: int,
+                 relative: bool = True) -> None:
         self.key = key
         self.world = world
-        #: Every uploaded position is relative to this point (:func:`world_anchor`).
-        self.anchor = world_anchor(world)
+        #: Every uploaded position is relative to this point (:func:`world_anchor`; the
+        #: origin for ``relative=False``, world-space float32, what the tradeoffs knob shows).
+        self.anchor = world_anchor(world) if relative else np.zeros(3)
         self.tris = pack_triangles(world, self.anchor)
         self.nodes = pack_nodes(world, self.anchor)
-        self.mesh_count = sum(1 for node in world.nodes if node.kind != "sphere")
+        self.mesh_count = sum(1 for node in world.nodes if node.kind.triangles)
         self.sphere_count = len(world.nodes) - self.mesh_count
-        loops = sum(1 for node in world.nodes if node.kind != "sphere" and node.count > UNROLL_TRIS)
+        loops = sum(1 for node in world.nodes if node.kind.triangles and node.count > UNROLL_TRIS)
         #: Some mesh node is large enough that its BVH beats the scan (:data:`BVH_TRIANGLES`).
-        self.large_mesh = max((node.count for node in world.nodes if node.kind != "sphere"),
+        self.large_mesh = max((node.count for node in world.nodes if node.kind.triangles),
                               default=0) > BVH_TRIANGLES
         self.unrolled = (not self.large_mesh and len(world.nodes) <= UNROLL_NODES and loops <= UNROLL_LOOPS
                          and max(1, self.tris.shape[0]) + max(1, self.nodes.shape[0]) <= block_records)
@@ -420,7 +422,7 @@ class _Uploaded:
         parts = []
         for k, node in enumerate(self.world.nodes):
             one_sided = int(node.cull if cull is None else cull)
-            if node.kind == "sphere":
+            if not node.kind.triangles:
                 parts.append(f"SPHERE({slots[k]},{one_sided},{node.lamp_of})")
             elif node.count <= UNROLL_TRIS:
                 parts += [f"TRI({slots[k]},{j},{one_sided},{node.lamp_of})" for j in range(node.start, node.start + node.count)]
@@ -437,8 +439,12 @@ class _Uploaded:
         return (len(world.textures) == len(self.world.textures)
                 and all(a is b or np.array_equal(a, b) for (a, _), (b, _) in zip(world.textures, self.world.textures))
                 and [w for _, w in world.textures] == [w for _, w in self.world.textures]
-                and np.array_equal(pack_triangles(world, world_anchor(world)), self.tris)
-                and np.array_equal(pack_nodes(world, world_anchor(world)), self.nodes))
+                and np.array_equal(pack_triangles(world, self.anchor_of(world)), self.tris)
+                and np.array_equal(pack_nodes(world, self.anchor_of(world)), self.nodes))
+
+    def anchor_of(self, world: World) -> NDArray[np.float64]:
+        """Where ``world`` would be anchored in an upload like this one."""
+        return world_anchor(world) if self.key[-1] else np.zeros(3)
 
     def release(self) -> None:
         for texture in self.textures.values():
@@ -474,7 +480,7 @@ class GpuTracer:
                  scene: tuple[tuple[str, str], ...] = ()) -> tuple[moderngl.Program, moderngl.VertexArray]:
         flags = (lights, textures, int(shadows and lights > 0), int(reflect), int(meshes), int(spheres))
         names = ("NUM_LIGHTS", "NUM_TEXTURES", "SHADOWS", "REFLECT", "HAS_MESHES", "HAS_SPHERES")
-        defines = tuple((name, str(value)) for name, value in zip(names, flags)) + glsl_defines() + scene
+        defines = tuple((name, str(value)) for name, value in zip(names, flags)) + glsl_defines() + kind_defines() + scene
         if defines in self._programs:
             self._programs[defines] = self._programs.pop(defines)  # most recently used last
             self._vaos[defines] = self._vaos.pop(defines)
@@ -496,9 +502,9 @@ class GpuTracer:
             self._targets[size] = (color, self.ctx.framebuffer(color_attachments=[color]))
         return self._targets[size][1]
 
-    def _upload(self, scene: Scene, viewport: int, analytic_spheres: bool) -> _Uploaded:
+    def _upload(self, scene: Scene, viewport: int, analytic_spheres: bool, relative: bool = True) -> _Uploaded:
         """The scene's upload: kept from an earlier render when its World cannot have changed."""
-        key = _scene_key(scene, viewport, analytic_spheres)
+        key = (*_scene_key(scene, viewport, analytic_spheres), relative)
         for i, entry in enumerate(self._scenes):
             if _same_key(entry.key, key):
                 self._scenes.insert(0, self._scenes.pop(i))
@@ -509,12 +515,12 @@ class GpuTracer:
             raise RayTraceError(f"the gpu engine samples at most {MAX_TEXTURES} textures per viewport, "
                                 f"scene {scene.name!r} has {len(world.textures)}")
         for i, entry in enumerate(self._scenes):  # new objects, same data (glsandbox.frame.trace_viewports rebuilds nodes)
-            if entry.same_data(world):
+            if entry.key[-1] == relative and entry.same_data(world):
                 entry.key = key
                 self._scenes.insert(0, self._scenes.pop(i))
                 self.reuses += 1
                 return entry
-        entry = _Uploaded(self.ctx, world, key, self.block_records)
+        entry = _Uploaded(self.ctx, world, key, self.block_records, relative)
         self.uploads += 1
         self._scenes.insert(0, entry)
         while len(self._scenes) > self.KEEP_SCENES:
@@ -529,9 +535,12 @@ class GpuTracer:
 
     def render_viewport(self, scene: Scene, size: tuple[int, int], viewport: int = 0, *, max_depth: int = 2,
                         shadows: bool = True, cull_backfaces: bool | None = None, aabb: bool = True,
-                        analytic_spheres: bool = True, offset: str = "bound") -> NDArray[np.uint8]:
-        """Trace one viewport at ``size``: ``(H, W, 4)`` uint8, top row first (a read-only view)."""
-        uploaded = self._upload(scene, viewport, analytic_spheres)
+                        analytic_spheres: bool = True, offset: str = "bound",
+                        relative: bool = True) -> NDArray[np.uint8]:
+        """Trace one viewport at ``size``: ``(H, W, 4)`` uint8, top row first (a read-only view).
+        ``relative=False`` traces world coordinates in float32 (the tradeoffs knob's
+        bad example; see :func:`world_anchor`)."""
+        uploaded = self._upload(scene, viewport, analytic_spheres, relative)
         world = uploaded.world
         width, height = size
         vp = scene.viewports[viewport]

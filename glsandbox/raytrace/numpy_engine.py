@@ -54,7 +54,7 @@ from glsandbox.raytrace.constants import (BVH_BOX_PAD_F64, OFFSETS, SIMPLE_OFFSE
 from glsandbox.raytrace.sphere import Sphere
 from glsandbox.raytrace.vec import length
 from glsandbox.raytrace.watertight import nearest_watertight
-from glsandbox.raytrace.world import World, build_world, camera_rays
+from glsandbox.raytrace.world import NodeInfo, NodeKind, World, build_world, camera_rays
 from glsandbox.scene import Scene
 
 __all__ = ["RAY_BLOCK", "RenderStats", "render_viewport", "to_rgba8"]
@@ -138,7 +138,7 @@ def _occluded(world: World, o: NDArray[np.float64], d: NDArray[np.float64], ligh
     for k, node in enumerate(world.nodes):
         if light >= 0 and node.lamp_of >> light & 1:
             continue
-        if node.kind == "sphere":
+        if not node.kind.triangles:  # an analytic shape: its box, then its own test
             idx = np.flatnonzero(~found)
             if aabb:
                 if stats is not None:
@@ -205,7 +205,7 @@ def _scan_nodes(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_
         if light >= 0 and node.lamp_of >> light & 1:
             continue
         one_sided = node.cull if cull is None else cull
-        if bvh is not None and node.kind != "sphere":
+        if bvh is not None and node.kind.triangles:
             entry = bvh.by_node.get(k)
             if entry is None:  # no triangle of non-zero area
                 continue
@@ -257,14 +257,22 @@ def _hit_node(world: World, k: int, o: NDArray[np.float64], d: NDArray[np.float6
     backface culling").
     """
     node = world.nodes[k]
-    if node.kind == "sphere":
-        inv = node.inverse
-        oo = o @ inv[:3, :3].T + inv[:3, 3]  # the ray in the unit sphere's own space
-        dd = d @ inv[:3, :3].T
-        t = _UNIT_SPHERE.intersect_many(oo, dd)
-        if one_sided:  # from inside, the sphere's front faces all face away
-            t = np.where(np.einsum("...j,...j->...", oo, oo) < 1.0, np.inf, t)
-        return t, np.full(d.shape[0], -1, dtype=np.intp)
+    return _HIT[node.kind](world, node, o, d, one_sided)
+
+
+def _hit_sphere(world: World, node: NodeInfo, o: NDArray[np.float64], d: NDArray[np.float64], one_sided: bool
+                ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
+    inv = node.inverse
+    oo = o @ inv[:3, :3].T + inv[:3, 3]  # the ray in the unit sphere's own space
+    dd = d @ inv[:3, :3].T
+    t = _UNIT_SPHERE.intersect_many(oo, dd)
+    if one_sided:  # from inside, the sphere's front faces all face away
+        t = np.where(np.einsum("...j,...j->...", oo, oo) < 1.0, np.inf, t)
+    return t, np.full(d.shape[0], -1, dtype=np.intp)
+
+
+def _hit_triangles(world: World, node: NodeInfo, o: NDArray[np.float64], d: NDArray[np.float64], one_sided: bool
+                   ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
     rows = slice(node.start, node.start + node.count)
     t, j = nearest_watertight(world.v0[rows], world.v1[rows], world.v2[rows], o, d, cull_backfaces=one_sided)
     return t, np.where(j >= 0, j + node.start, -1)
@@ -344,28 +352,8 @@ def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.fl
         sel = np.nonzero(hits.node == k)[0]
         if sel.size == 0:
             continue
-        if node.kind == "sphere":
-            inv = node.inverse
-            q = point[sel] @ inv[:3, :3].T + inv[:3, 3]  # the hit on the unit sphere
-            q /= length(q)[:, None]
-            normal[sel] = q @ node.normal_matrix.T
-            spawn.normal[sel] = normal[sel]
-            # geometry.sphere()'s uv: u = azimuth/2π from +z towards +x, v = polar angle/π from +y.
-            uv[sel, 0] = np.mod(np.arctan2(q[:, 0], q[:, 2]), 2 * np.pi) / (2 * np.pi)
-            uv[sel, 1] = np.arccos(np.clip(q[:, 1], -1.0, 1.0)) / np.pi
-            colors = np.ones((sel.size, 3)) if node.mode == 1 else None
-        else:
-            tri = hits.tri[sel]
-            u, v = _barycentric(world, tri, _rows(o, sel), d[sel])
-            w = (1.0 - u - v)[:, None], u[:, None], v[:, None]  # weights of V0, V1, V2
-            normal[sel] = _interpolate(world.normals[tri], w)
-            corners = world.v0[tri] * w[0], world.v1[tri] * w[1], world.v2[tri] * w[2]
-            spawn.point[sel] = corners[0] + corners[1] + corners[2]
-            spawn.error[sel] = gamma(TRIANGLE_POINT_GAMMA, UNIT_F64) * (
-                np.abs(corners[0]) + np.abs(corners[1]) + np.abs(corners[2]))
-            spawn.normal[sel] = np.cross(world.v1[tri] - world.v0[tri], world.v2[tri] - world.v0[tri])
-            uv[sel] = _interpolate(world.uvs[tri], w)
-            colors = _interpolate(world.colors[tri], w) if node.mode == 1 else None
+        normal[sel], uv[sel], colors = _SURFACE[node.kind](world, node, hits, sel, o, d, point, spawn)
+        colors = colors if node.mode == 1 else None
         color = np.broadcast_to(node.color, (sel.size, 3)).copy()
         if colors is not None:  # vertex colours, times the material colour (basic.glsl)
             color *= colors
@@ -376,6 +364,45 @@ def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.fl
     normal /= np.maximum(length(normal), 1e-300)[:, None]
     spawn.normal /= np.maximum(length(spawn.normal), 1e-300)[:, None]
     return point, normal, base, spawn
+
+
+def _surface_sphere(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[np.intp], o: NDArray[np.float64],
+                    d: NDArray[np.float64], point: NDArray[np.float64], spawn: _Spawn
+                    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """A sphere node's (normal, uv, vertex colour) at its hits; its spawn points stay ``O + t·D``."""
+    inv = node.inverse
+    q = point[sel] @ inv[:3, :3].T + inv[:3, 3]  # the hit on the unit sphere
+    q /= length(q)[:, None]
+    normal = q @ node.normal_matrix.T
+    spawn.normal[sel] = normal
+    # geometry.sphere()'s uv: u = azimuth/2π from +z towards +x, v = polar angle/π from +y.
+    uv = np.stack([np.mod(np.arctan2(q[:, 0], q[:, 2]), 2 * np.pi) / (2 * np.pi),
+                   np.arccos(np.clip(q[:, 1], -1.0, 1.0)) / np.pi], axis=1)
+    return normal, uv, np.ones((sel.size, 3))
+
+
+def _surface_triangles(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[np.intp], o: NDArray[np.float64],
+                       d: NDArray[np.float64], point: NDArray[np.float64], spawn: _Spawn
+                       ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """A mesh node's (normal, uv, vertex colour) at its hits, barycentric; its spawn
+    points are the barycentric points with their error bound and the face normal."""
+    tri = hits.tri[sel]
+    u, v = _barycentric(world, tri, _rows(o, sel), d[sel])
+    w = (1.0 - u - v)[:, None], u[:, None], v[:, None]  # weights of V0, V1, V2
+    corners = world.v0[tri] * w[0], world.v1[tri] * w[1], world.v2[tri] * w[2]
+    spawn.point[sel] = corners[0] + corners[1] + corners[2]
+    spawn.error[sel] = gamma(TRIANGLE_POINT_GAMMA, UNIT_F64) * (
+        np.abs(corners[0]) + np.abs(corners[1]) + np.abs(corners[2]))
+    spawn.normal[sel] = np.cross(world.v1[tri] - world.v0[tri], world.v2[tri] - world.v0[tri])
+    return _interpolate(world.normals[tri], w), _interpolate(world.uvs[tri], w), _interpolate(world.colors[tri], w)
+
+
+#: The node table's per-kind code (:class:`~glsandbox.raytrace.world.NodeKind`): a hit
+#: test ``(world, node, o, d, one_sided) -> (t, world triangle or −1)`` in the node's
+#: own space, and a surface ``-> (normal, uv, vertex colour)`` that also fills the
+#: spawn points. A new kind is one entry in each.
+_HIT = {NodeKind.MESH: _hit_triangles, NodeKind.SPHERE: _hit_sphere}
+_SURFACE = {NodeKind.MESH: _surface_triangles, NodeKind.SPHERE: _surface_sphere}
 
 
 def _interpolate(values: NDArray[np.float64], w: tuple[NDArray[np.float64], ...]) -> NDArray[np.float64]:

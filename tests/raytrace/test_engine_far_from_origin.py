@@ -7,42 +7,21 @@ scene's centre) draws the lesson scenes moved to 1e5 as the numpy engine does.""
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 import pytest
 
-from glsandbox import Camera, Light, Material, Node, Scene, geometry, transforms
+from glsandbox import Camera, Light, Material, Node, Scene
 from glsandbox.lesson import find_lesson
+from glsandbox.measure.knobs._far import contact_shadow, grown, moved
 from glsandbox.raytrace import render
 
 OFFSETS = (1.0, 1e3, 1e5, 1e6)
-DIRECTION = np.array([0.99, 0.7, -0.4])  # the largest stays within the API's 1e6
 SIZE = (96, 72)
 
 
-def cube_on_floor(offset: float) -> Scene:
-    """A unit cube resting exactly on a 12x12 floor (touching it along its base),
-    a light up and to the side: the cube's shadow starts at its base."""
-    at = offset * DIRECTION
-    lit = dict(shading="phong", ambient=0.1, diffuse=0.9, specular=0.0)
-    floor = Node("floor", geometry.plane(12.0), transforms.translate(*at),
-                 Material(color=(0.8, 0.8, 0.8, 1.0), **lit))
-    cube = Node("cube", geometry.cube(), transforms.translate(*(at + (0.0, 0.5, 0.0))) @ transforms.scale(0.5, 0.5, 0.5),
-                Material(color=(0.9, 0.3, 0.2, 1.0), **lit))
-    camera = Camera(eye=tuple(at + (1.5, 3.0, 3.5)), target=tuple(at + (-1.0, 0.0, -0.5)), near=0.01, far=100.0)
-    return Scene("contact", nodes=(floor, cube), camera=camera, lights=(Light(tuple(at + (2.5, 1.8, 1.2))),),
-                 clear_color=(0.0, 0.0, 0.0, 1.0))
-
-
 def shadow_mask(trace, at: float, **options) -> tuple[np.ndarray, np.ndarray]:
-    """``(floor, shadowed)``: the floor's pixels, and those of them a shadow ray darkens,
-    with the scene moved ``at`` along :data:`DIRECTION`."""
-    scene = cube_on_floor(at)
-    lit = trace(scene, SIZE, shadows=False, max_depth=0, **options)[..., :3].astype(int)
-    shaded = trace(scene, SIZE, shadows=True, max_depth=0, **options)[..., :3].astype(int)
-    floor = (np.abs(lit[..., 0] - lit[..., 2]) <= 2) & (lit[..., 0] > 0)  # grey: the floor, not the red cube
-    return floor, floor & (np.abs(lit - shaded).max(axis=-1) > 8)
+    """``(floor, shadowed)`` of the cube on its floor moved ``at`` along DIRECTION."""
+    return contact_shadow(trace, at, SIZE, **options)
 
 
 @pytest.fixture(scope="module")
@@ -51,16 +30,6 @@ def reference_shadow() -> np.ndarray:
     floor, shadowed = shadow_mask(lambda *a, **k: render(*a, **k), 0.0)
     assert 150 < np.count_nonzero(shadowed) < 0.5 * np.count_nonzero(floor)
     return shadowed
-
-
-def grown(mask: np.ndarray) -> np.ndarray:
-    """``mask`` and its 8 neighbours: a shadow boundary may move by a pixel."""
-    padded = np.pad(mask, 1)
-    out = np.zeros_like(mask)
-    for dy in (0, 1, 2):
-        for dx in (0, 1, 2):
-            out |= padded[dy:dy + mask.shape[0], dx:dx + mask.shape[1]]
-    return out
 
 
 @pytest.mark.parametrize("offset", OFFSETS, ids=lambda o: f"at{o:g}")
@@ -80,27 +49,10 @@ def test_the_simple_offset_loses_the_contact_shadow_far_away(reference_shadow, o
     assert np.count_nonzero(shadowed & reference_shadow) < 0.5 * np.count_nonzero(reference_shadow)
 
 
-def moved(scene: Scene, offset: np.ndarray) -> Scene:
-    """``scene`` with every node, light and camera translated by ``offset``."""
-    shift = transforms.translate(*offset)
-    nodes = tuple(dataclasses.replace(node, model=shift @ np.asarray(node.model)) for node in scene.nodes)
-    lights = tuple(dataclasses.replace(light, position=tuple(np.asarray(light.position) + offset))
-                   for light in scene.lights)
-
-    def cam(camera: Camera | None) -> Camera | None:
-        if camera is None:
-            return None
-        return dataclasses.replace(camera, eye=tuple(np.asarray(camera.eye) + offset),
-                                   target=tuple(np.asarray(camera.target) + offset))
-
-    viewports = tuple(dataclasses.replace(vp, camera=cam(vp.camera)) for vp in scene.viewports)
-    return dataclasses.replace(scene, nodes=nodes, lights=lights, camera=cam(scene.camera), viewports=viewports)
-
-
 @pytest.mark.parametrize("name", ["ray_phong", "ray_spheres", "indexed_cube", "phong", "ray_acceleration", "mirror",
                                   "model", "texture"])
 def test_the_gpu_engine_draws_lesson_scenes_at_1e5_as_the_numpy_engine(gl, name) -> None:
-    scene = moved(find_lesson(name)().scene(), 1e5 * DIRECTION)
+    scene = moved(find_lesson(name)().scene(), 1e5)
     size = (160, 120)
     cpu = render(scene, size).astype(int)
     gpu = render(scene, size, "gpu", ctx=gl.host.ctx).astype(int)
@@ -141,7 +93,7 @@ def test_the_gpu_bvh_takes_the_same_steps_at_1e6_as_at_the_origin(gl, monkeypatc
     for at in (0.0, 1e5, 1e6):
         tracer.forget_scenes()
         try:
-            outcomes.append(render(moved(rock_scene(), at * DIRECTION), (80, 60), "gpu", ctx=gl.host.ctx,
+            outcomes.append(render(moved(rock_scene(), at), (80, 60), "gpu", ctx=gl.host.ctx,
                                    max_depth=1).copy())
         except RayTraceError as exc:
             outcomes.append(str(exc))

@@ -13,11 +13,9 @@ import numpy as np
 import pytest
 
 from glsandbox import Camera, Material, Node, Scene, geometry, meshgen, transforms
+from glsandbox.measure.knobs._far import DIRECTION
 
 OFFSETS = (0.0, 1e3, 1e5, 1e6)
-#: Where the scene moves: along a direction with three different components, so
-#: no coordinate stays small.
-DIRECTION = np.array([0.99, 0.7, -0.4])  # the largest stays within the API's 1e6
 RED = (1.0, 0.0, 0.0, 1.0)
 
 
