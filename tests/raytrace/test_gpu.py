@@ -13,7 +13,7 @@ from glsandbox.raytrace import RayTraceError, render
 from glsandbox.raytrace import gpu as gpu_engine
 from glsandbox.raytrace.world import build_world
 
-from test_engine_bvh import far_triangle_scene
+from support import far_triangle_scene
 
 
 def rock_scene(subdivisions: int = 5) -> Scene:

@@ -16,7 +16,8 @@ from glsandbox.files import load_png
 from glsandbox.raytrace.render import render
 from glsandbox.raytrace.world import build_world
 from glsandbox.scene import Camera, Material, Node, Scene, Texture
-from test_cli import REPO, glsandbox
+from support import REPO_ROOT as REPO
+from support import glsandbox
 
 FLAT = """\
 [camera]
@@ -88,7 +89,7 @@ def test_a_tracer_is_freed_with_its_renderer() -> None:
     proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=REPO, timeout=180)
     assert proc.returncode == 0, proc.stderr
     if proc.stdout.startswith("no-gl"):
-        from conftest import need
+        from support import need
 
         need("headless OpenGL", proc.stdout)
     # Each tracer (programs, targets, uploads: about 0.1 MB) went with its context; a module-level

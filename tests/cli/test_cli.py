@@ -11,24 +11,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from support import REPO_ROOT as REPO
+from support import assert_user_error, glsandbox
+
 from glsandbox.files import load_png
-
-REPO = Path(__file__).resolve().parent.parent
-
-
-def glsandbox(*args: str, env: dict | None = None, cwd: Path | None = None) -> subprocess.CompletedProcess:
-    full_env = {**os.environ, **(env or {})}
-    return subprocess.run([sys.executable, "-m", "glsandbox.cli", *args], capture_output=True, text=True,
-                          env=full_env, cwd=cwd or REPO, timeout=180)
-
-
-def assert_user_error(proc: subprocess.CompletedProcess, *fragments: str) -> None:
-    assert proc.returncode == 2, proc.stderr
-    lines = proc.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: "), proc.stderr
-    assert "Traceback" not in proc.stderr
-    for fragment in fragments:
-        assert fragment in lines[0], lines[0]
 
 
 def test_list_shows_the_lessons() -> None:
@@ -135,6 +121,7 @@ def test_no_gl_available_says_what_to_install(tmp_path: Path) -> None:
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_tour_writes_images_gallery_and_json(tmp_path: Path, gl) -> None:
     out = tmp_path / "tour"
     proc = glsandbox("tour", "--out", str(out), "--size", "128x96")
@@ -151,6 +138,7 @@ def test_tour_writes_images_gallery_and_json(tmp_path: Path, gl) -> None:
     assert f"[1/{len(names)}] clear_and_swap: ok" in proc.stderr  # progress
 
 
+@pytest.mark.slow
 def test_tour_goes_on_when_a_lesson_fails_and_exits_non_zero(tmp_path: Path, gl) -> None:
     shaders = tmp_path / "shaders"
     shaders.mkdir()

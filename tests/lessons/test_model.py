@@ -17,8 +17,8 @@ from glsandbox.errors import SandboxError
 from glsandbox.files import load_png
 from glsandbox.lesson import scene_file_lesson
 from glsandbox.scene_file import load_scene
-from test_cli import REPO, assert_user_error, glsandbox
-from test_meshfile import CUBE_OBJ, textured_quad_glb
+from support import CUBE_OBJ, assert_user_error, glsandbox, textured_quad_glb
+from support import REPO_ROOT as REPO
 
 LIT = """\
 [camera]

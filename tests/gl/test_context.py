@@ -9,10 +9,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import backend_available, need
+from support import backend_available, need
 
 from glsandbox.files import load_png
 from glsandbox.lesson import all_lessons
+
+pytestmark = pytest.mark.slow  # every lesson on both backends, in subprocesses
 
 LESSONS = [cls.name for cls in all_lessons()]
 

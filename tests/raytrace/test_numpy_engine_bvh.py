@@ -7,7 +7,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from glsandbox import Camera, Light, Material, Mesh, Node, Scene, meshgen, transforms
+from support import far_triangle_scene
+
+from glsandbox import Camera, Light, Material, Node, Scene, meshgen, transforms
 from glsandbox.raytrace import RenderStats, render
 from glsandbox.raytrace.bvh_world import WorldBVH
 from glsandbox.raytrace.numpy_engine import _nearest, _occluded
@@ -71,20 +73,6 @@ def test_the_model_lesson_shows_the_bvh_figures() -> None:
 
     line = bvh_figures(generated("rock"))
     assert line.startswith("BVH: ") and " nodes, " in line and " ms" in line and "not built" not in line
-
-
-def far_triangle_scene(count: int = 70_000) -> Scene:
-    """One mesh node of ``count`` triangles whose only visible one is the last (index
-    ``count − 1``, past llvmpipe's 65,535 loop iterations): the others are tiny and behind the camera."""
-    base = np.array([[0.0, 0.0, 0.0], [1e-3, 0.0, 0.0], [0.0, 1e-3, 0.0]])
-    hidden = base[None] + np.array([0.0, 0.0, 50.0]) + (np.arange(count - 1) * 1e-3)[:, None, None] * [1.0, 0, 0]
-    visible = np.array([[[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, 0.0]]])
-    positions = np.concatenate([hidden, visible]).reshape(-1, 3)
-    mesh = Mesh("far_triangle", positions, normals=np.tile([0.0, 0.0, 1.0], (positions.shape[0], 1)))
-    material = Material(color=(0.9, 0.2, 0.2, 1.0), shading="solid")
-    return Scene("far_triangle", nodes=(Node("big", mesh, np.eye(4), material),),
-                 camera=Camera(eye=(0.0, 0.0, 5.0), target=(0.0, 0.0, 0.0)), lights=(Light((0.0, 3.0, 3.0)),),
-                 clear_color=(0.0, 0.0, 0.0, 1.0))
 
 
 def test_the_numpy_engine_finds_a_triangle_past_65535() -> None:

@@ -12,12 +12,16 @@ import time
 from pathlib import Path
 
 import numpy as np
-from test_window import REPO, LessonWindow, wait_for, window_env  # noqa: F401 (the fixture: Xvfb and xdotool via need())
+import pytest
+from support import REPO_ROOT as REPO
+from support import LessonWindow, wait_for
 
 from glsandbox.cli import parse_size
 from glsandbox.files import load_png
 from glsandbox.lesson import find_lesson
 from glsandbox.measure.compare import build_variants, compare_variants, difference_image
+
+pytestmark = pytest.mark.slow  # windows under Xvfb
 
 SIZE = (640, 480)
 

@@ -11,60 +11,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 import trimesh
-from PIL import Image
 
 import glsandbox
+from support import CUBE_OBJ, quadrant_image, textured_quad_glb
+
 from glsandbox import geometry
 from glsandbox.errors import SandboxError
 from glsandbox.meshfile import fit_mesh, is_model_path, load_mesh, load_model
 
-# A unit cube as an OBJ: 8 vertices, 12 counter-clockwise triangles (outward fronts).
-CUBE_OBJ = """\
-v -1 -1 -1
-v 1 -1 -1
-v 1 1 -1
-v -1 1 -1
-v -1 -1 1
-v 1 -1 1
-v 1 1 1
-v -1 1 1
-f 1 4 3
-f 1 3 2
-f 5 6 7
-f 5 7 8
-f 1 5 8
-f 1 8 4
-f 2 3 7
-f 2 7 6
-f 4 8 7
-f 4 7 3
-f 1 2 6
-f 1 6 5
-"""
-
-
 def write(path: Path, text: str) -> Path:
     path.write_text(text)
-    return path
-
-
-def quadrant_image() -> Image.Image:
-    """Red top-left, green top-right, blue bottom-left, yellow bottom-right: 16x16 pixels, so that
-    bilinear sampling (the ray tracer's) reads pure colours inside each quadrant."""
-    quadrants = np.array([[(255, 0, 0), (0, 255, 0)], [(0, 0, 255), (255, 255, 0)]], dtype=np.uint8)
-    return Image.fromarray(np.repeat(np.repeat(quadrants, 8, axis=0), 8, axis=1))
-
-
-def textured_quad_glb(path: Path) -> Path:
-    """A unit quad in the xy plane facing +z, with the quadrant image as its glTF base colour texture
-    (white factor), uv laid so the image shows upright seen from +z."""
-    quad = trimesh.Trimesh(vertices=[[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], faces=[[0, 1, 2], [0, 2, 3]],
-                           process=False)
-    material = trimesh.visual.material.PBRMaterial(baseColorTexture=quadrant_image(),
-                                                   baseColorFactor=[255, 255, 255, 255])
-    # trimesh's uv: v up (OpenGL); it writes glTF's v-down uv itself.
-    quad.visual = trimesh.visual.TextureVisuals(uv=[[0, 0], [1, 0], [1, 1], [0, 1]], material=material)
-    quad.export(path)
     return path
 
 

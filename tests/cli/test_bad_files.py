@@ -15,8 +15,8 @@ from PIL import Image
 
 from glsandbox.errors import SandboxError
 from glsandbox.images import load_image
-from conftest import need
-from test_cli import REPO, assert_user_error, glsandbox
+from support import REPO_ROOT as REPO
+from support import assert_user_error, glsandbox, need
 
 @pytest.fixture
 def needs_fifo() -> None:

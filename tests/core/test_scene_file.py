@@ -7,6 +7,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from support import EXAMPLES_DIR
+
 from glsandbox.errors import SandboxError
 from glsandbox.plan import plan
 from glsandbox.scene_file import load_scene
@@ -137,7 +139,7 @@ def test_a_lit_scene_file_renders_lit(tmp_path: Path, gl) -> None:
 
 # --- the mirror and the shadow in a scene file ([mirror], [shadow], depth_mode) ---
 
-ROOM = (Path(__file__).resolve().parent.parent / "examples" / "mirror_room.toml").read_text()
+ROOM = (EXAMPLES_DIR / "mirror_room.toml").read_text()
 
 
 def without_table(text: str, table: str) -> str:

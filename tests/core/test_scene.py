@@ -18,9 +18,9 @@ from glsandbox import geometry, transforms
 from glsandbox.errors import NUMBER_LIMIT, SandboxError
 from glsandbox.scene import Camera, Light, Material, Node, Scene, Texture, Viewport
 from glsandbox.scene_file import load_scene
-from test_cli import assert_user_error, glsandbox
+from support import EXAMPLES_DIR, assert_user_error, glsandbox
 
-ROOM = (Path(__file__).resolve().parent.parent / "examples" / "mirror_room.toml").read_text()
+ROOM = (EXAMPLES_DIR / "mirror_room.toml").read_text()
 
 
 def write(tmp_path: Path, text: str) -> Path:

@@ -30,6 +30,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from PIL import Image
 
+from support import REPO_ROOT as REPO
+
 from glsandbox import cli
 from glsandbox.files import load_png
 
@@ -40,7 +42,6 @@ settings.register_profile("long", max_examples=400, deadline=None,
 PROFILE = "long" if os.environ.get("GLSANDBOX_FUZZ") == "long" else "ci"
 
 SIZE = (24, 18)
-REPO = Path(__file__).resolve().parent.parent
 
 # --- values, from ordinary to hostile ---------------------------------------
 

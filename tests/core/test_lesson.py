@@ -12,23 +12,7 @@ from glsandbox.errors import SandboxError
 from glsandbox.files import load_png
 from glsandbox.lesson import all_lessons, find_lesson, lesson_files
 from glsandbox.measure.golden import compare_images
-from test_cli import assert_user_error, glsandbox
-from test_window import LessonWindow, wait_for, window_env  # noqa: F401 (window_env: a fixture)
-
-SPIN = '''
-import glsandbox
-from glsandbox import Lesson, Node, Param, Scene, geometry, register, transforms
-
-@register
-class Spin(Lesson):
-    name = "phong"          # the same name as a built-in lesson: it must not shadow it
-    animated = True
-    params = (Param("speed", 1.0, "radians per second"),)
-
-    def build(self) -> Scene:
-        turn = transforms.rotate_y(self.values["speed"] * self.time)
-        return Scene(self.name, nodes=(Node("cube", geometry.cube(), turn),))
-'''
+from support import EXAMPLES_DIR, SPIN, LessonWindow, assert_user_error, glsandbox, wait_for
 
 NAMELESS = '''
 from glsandbox import Lesson, Node, Scene, geometry
@@ -181,7 +165,7 @@ def test_tour_lessons_dir_renders_each_file_and_goes_on_past_a_broken_one(tmp_pa
     mine = tmp_path / "mine"
     mine.mkdir()
     (mine / "spin.py").write_text(SPIN)
-    (mine / "room.toml").write_text((Path(__file__).parents[1] / "examples" / "mirror_room.toml").read_text())
+    (mine / "room.toml").write_text((EXAMPLES_DIR / "mirror_room.toml").read_text())
     (mine / "broken.py").write_text("def oops(:\n")
     out = tmp_path / "tour"
     proc = glsandbox("tour", "--lessons", str(mine), "--out", str(out), "--size", "64x48")
@@ -196,6 +180,7 @@ def test_tour_lessons_dir_renders_each_file_and_goes_on_past_a_broken_one(tmp_pa
     assert_user_error(glsandbox("tour", "--lessons", str(tmp_path / "none"), "--out", str(out)), "not a folder")
 
 
+@pytest.mark.slow
 def test_a_lesson_file_in_a_window_with_the_window_keys(window_env: str, tmp_path: Path, gl) -> None:
     assert glsandbox("new", "mine", "--dir", str(tmp_path)).returncode == 0
     win = LessonWindow(window_env, tmp_path, "glsandbox.cli", "run", "mine.py", "--size", "320x240",
@@ -235,6 +220,7 @@ class Flat(Lesson):
 '''
 
 
+@pytest.mark.slow
 def test_saving_a_lesson_file_reloads_it_in_the_window(window_env: str, tmp_path: Path) -> None:
     """Saving the lesson file redraws the window with the new code; a mistake saved (a syntax
     error, an exception in build()) keeps the last good lesson drawing and shows the error

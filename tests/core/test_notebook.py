@@ -71,11 +71,12 @@ def test_widget_text_fields_report_a_bad_value_and_keep_the_picture(gl) -> None:
     assert box.error.value == "" and box.image.value != before
 
 
-def test_without_ipywidgets_widget_says_what_to_install() -> None:
-    code = ("import sys; sys.modules['ipywidgets'] = None\n"
+@pytest.mark.parametrize("helper, module", [("widget", "ipywidgets"), ("view", "jupyter_rfb")])
+def test_without_the_notebook_extra_the_helpers_say_what_to_install(helper: str, module: str) -> None:
+    code = (f"import sys; sys.modules[{module!r}] = None\n"
             "import glsandbox\n"
-            "try:\n    glsandbox.widget('phong')\n"
+            f"try:\n    glsandbox.{helper}('phong')\n"
             "except glsandbox.SandboxError as exc:\n    print(exc)\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
-    assert out.stdout.strip().startswith("glsandbox.widget needs ipywidgets: install the notebook extra")
-    assert len(out.stdout.strip().splitlines()) == 1
+    assert out.stdout.strip() == (f"glsandbox.{helper} needs {module}: install the notebook extra "
+                                  "(pip install 'glsandbox[notebook]', or uv sync --extra notebook)")

@@ -2,95 +2,20 @@
 
 from __future__ import annotations
 
-import os
 import shutil
-import subprocess
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import need
+from support import COURSE_BLUE, LessonWindow, wait_for
+from support import REPO_ROOT as REPO
 
 from glsandbox.files import load_png
 from glsandbox.lesson import find_lesson
 from glsandbox.measure.golden import compare_images
 
-REPO = Path(__file__).resolve().parent.parent
-COURSE_BLUE = (0, 32, 153)
-
-
-class LessonWindow:
-    """A lesson running in its own process on the test's X server."""
-
-    def __init__(self, display: str, cwd: Path, *args: str, env: dict | None = None) -> None:
-        self.env = {**os.environ, "DISPLAY": display, **(env or {})}
-        self.display = display
-        self.proc = subprocess.Popen([sys.executable, "-m", *args], cwd=cwd, env=self.env,
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        self.window = self._wait(lambda: self._xdotool("search", "--name", "glsandbox").split()[:1])[0]
-
-    def _xdotool(self, *args: str) -> str:
-        proc = subprocess.run(["xdotool", *args], capture_output=True, text=True, env=self.env, timeout=20)
-        return proc.stdout.strip()
-
-    def _wait(self, probe, timeout: float = 30.0):
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            if self.proc.poll() is not None:
-                raise AssertionError(f"lesson exited early with code {self.proc.returncode}: "
-                                     f"{self.proc.stdout.read()} {self.proc.stderr.read()}")
-            value = probe()
-            if value:
-                return value
-            time.sleep(0.1)
-        raise AssertionError("timed out waiting for the lesson window")
-
-    def title(self) -> str:
-        return self._xdotool("getwindowname", self.window)
-
-    def wait_title(self, predicate) -> str:
-        return self._wait(lambda: (t := self.title()) and predicate(t) and t)
-
-    def key(self, name: str) -> None:
-        self._xdotool("windowfocus", "--sync", self.window)
-        self._xdotool("key", "--window", self.window, name)
-
-    def screen(self) -> np.ndarray:
-        from PIL import ImageGrab
-
-        return np.asarray(ImageGrab.grab(xdisplay=self.display).convert("RGB"))
-
-    def close(self) -> int:
-        # Escape through XTEST to the focused window, not XSendEvent to our
-        # window: the lesson destroys its window on the press, the release
-        # sent to that window then fails, and xdotool leaves Escape held in
-        # the server, where autorepeat closes the next test's window.
-        self._xdotool("windowfocus", "--sync", self.window)
-        self._xdotool("key", "Escape")
-        try:
-            return self.proc.wait(timeout=20)
-        finally:
-            if self.proc.poll() is None:
-                self.proc.kill()
-
-
-@pytest.fixture
-def window_env(xvfb_display: str) -> str:
-    if shutil.which("xdotool") is None:
-        need("xdotool", "not installed (apt-get install xdotool)")
-    return xvfb_display
-
-
-def wait_for(path: Path, timeout: float = 20.0) -> Path:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if path.exists():
-            time.sleep(0.2)  # the file is written atomically; give the rename a moment
-            return path
-        time.sleep(0.1)
-    raise AssertionError(f"{path} was not written")
+pytestmark = pytest.mark.slow  # windows under Xvfb
 
 
 def test_window_shows_the_lesson_saves_screenshots_resizes_and_quits(window_env: str, tmp_path: Path,

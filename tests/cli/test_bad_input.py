@@ -13,7 +13,8 @@ from pathlib import Path
 import pytest
 
 from glsandbox import cli
-from test_cli import REPO, assert_user_error, glsandbox
+from support import REPO_ROOT as REPO
+from support import assert_user_error, glsandbox
 
 
 @pytest.mark.parametrize("args, fragment", [

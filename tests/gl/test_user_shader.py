@@ -13,7 +13,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import need
+from support import REPO_ROOT as REPO
+from support import need
 
 from glsandbox import cli
 from glsandbox.errors import SandboxError
@@ -26,7 +27,6 @@ from glsandbox.plan import plan
 from glsandbox.scene import SHADER_INPUTS, Node, Scene
 from glsandbox.scene_file import load_scene
 
-REPO = Path(__file__).resolve().parent.parent
 TOON = REPO / "examples" / "toon" / "toon.toml"
 
 TINT = """#version 330 core
@@ -406,8 +406,9 @@ def test_a_save_reloads_the_users_shader_and_a_broken_one_keeps_the_last_good(fo
     assert tuple(gl.render_scene(scene, (32, 32)).image[16, 16]) == (255, 0, 0, 255)
 
 
+@pytest.mark.slow
 def test_saving_the_shader_reloads_it_in_the_window(folder: Path, xvfb_display: str) -> None:
-    from test_window import LessonWindow
+    from support import LessonWindow
 
     if shutil.which("xdotool") is None:
         need("xdotool", "not installed (apt-get install xdotool)")
