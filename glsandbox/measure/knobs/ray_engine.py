@@ -20,7 +20,7 @@ def world_space(c: RenderContext, at: float):  # type: ignore[no-untyped-def]
 
 KNOB = register_knob(Knob(
     name="ray_engine",
-    title="Ray tracer engine: float32 against float64, near and far from the origin",
+    title="Ray tracer engine",
     order=30,
     scene="phong at time 1.0, ray-traced with shadow rays; moved along (0.99, 0.7, -0.4) by the distance given",
     settings=(
