@@ -92,6 +92,7 @@ vec4 node_rec(int k, int r) { return record(u_nodes, k * NODE_RECORDS + r); }
 vec4 tri_rec(int k, int r) { return record(u_tris, k * TRI_RECORDS + r); }
 #endif
 
+#define WT_DOUBLE_EDGES 0  // see common/watertight.glsl: watertight without, and cheaper
 #include "common/watertight.glsl"
 
 #ifndef BVH

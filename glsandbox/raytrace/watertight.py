@@ -166,9 +166,15 @@ def watertight_pairs(setup: RaySetup, rays: NDArray[np.intp], v0: NDArray[np.flo
         inside &= det != 0.0
         # Step 5: the sheared z interpolated with the scaled barycentrics is t along d.
         t = (u * (sz * az) + v * (sz * bz) + w * (sz * cz)) / det
-        # Step 6: only a t above its rounding-error bound counts (pbrt-v4), as in the scalar test.
-        bound = watertight_t_bound((ax, bx, cx), (ay, by, cy), (sz * az, sz * bz, sz * cz), (u, v, w), det)
-        hit = inside & (t > bound)
+        # Step 6: only a t above its rounding-error bound counts (pbrt-v4), as in the scalar test;
+        # formed for the pairs that could hit only (most pairs a traversal tests miss).
+        hit = inside & (t > 0.0)
+        near = np.flatnonzero(hit)
+        if near.size:
+            z = (sz * az)[near], (sz * bz)[near], (sz * cz)[near]
+            bound = watertight_t_bound((ax[near], bx[near], cx[near]), (ay[near], by[near], cy[near]), z,
+                                       (u[near], v[near], w[near]), det[near])
+            hit[near] = t[near] > bound
         return np.where(hit, t, np.inf), v / det, w / det
 
 

@@ -8,7 +8,11 @@
 //
 // `precise` (GLSL 4.00) keeps the compiler from fusing a*b - c*d into an fma,
 // which would break the exact antisymmetry; an edge function that rounds to 0
-// is recomputed in double (exact for float inputs) where doubles exist.
+// is recomputed in double (exact for float inputs) where doubles exist and
+// WT_DOUBLE_EDGES is not defined to 0. That only decides the side of a ray
+// passing exactly through an edge; a 0 counts on both sides, so the test is
+// watertight without it. The ray tracer leaves it out: llvmpipe runs a branch
+// for all 8 lanes whenever one takes it, and the doubles cost per triangle.
 //
 // t is accepted only above its own rounding-error bound (pbrt-v4's deltaT):
 // a shadow ray that starts a bounded distance off its surface (see
@@ -31,9 +35,12 @@
 #endif
 #if __VERSION__ >= 400
 #define WT_PRECISE precise
+#ifndef WT_DOUBLE_EDGES
 #define WT_DOUBLE_EDGES 1
+#endif
 #else
 #define WT_PRECISE
+#undef WT_DOUBLE_EDGES
 #define WT_DOUBLE_EDGES 0
 #endif
 
