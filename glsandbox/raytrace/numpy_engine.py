@@ -52,7 +52,7 @@ from glsandbox.raytrace.bvh_world import NodeBVH, WorldBVH
 from glsandbox.raytrace.constants import (BVH_BOX_PAD_F64, OFFSETS, SIMPLE_OFFSET, RAY_POINT_GAMMA,
                                           TRIANGLE_POINT_GAMMA, UNIT_F64, gamma)
 from glsandbox.raytrace.sphere import Sphere
-from glsandbox.raytrace.vec import length
+from glsandbox.raytrace.vec import length, moved_off
 from glsandbox.raytrace.watertight import nearest_watertight
 from glsandbox.raytrace.world import NodeInfo, NodeKind, World, build_world, camera_rays
 from glsandbox.scene import Scene
@@ -428,9 +428,7 @@ def _offset(spawn: _Spawn, normal: NDArray[np.float64], side: NDArray[np.float64
         reach = np.einsum("ij,ij->i", np.abs(n), spawn.error)
     sign = np.where(np.einsum("ij,ij->i", normal, side) < 0.0, -1.0, 1.0)
     sign *= np.where(np.einsum("ij,ij->i", n, normal) < 0.0, -1.0, 1.0)  # a geometric normal against the shading one
-    offset = (reach * sign)[:, None] * n
-    moved = p + offset
-    return np.where(offset > 0.0, np.nextafter(moved, np.inf), np.where(offset < 0.0, np.nextafter(moved, -np.inf), moved))
+    return moved_off(p, (reach * sign)[:, None] * n)
 
 
 # --- shading and bounces -------------------------------------------------------

@@ -66,7 +66,7 @@ from numpy.typing import ArrayLike, NDArray
 from glsandbox.raytrace.base import Shape, broadcast_rays
 from glsandbox.raytrace.constants import RAY_POINT_GAMMA, UNIT_F64, gamma
 from glsandbox.raytrace.ray import Ray
-from glsandbox.raytrace.vec import Vec3, as_vec3, dot, length, normalize
+from glsandbox.raytrace.vec import Vec3, as_vec3, dot, length, moved_off, normalize
 
 __all__ = [
     "SHADOW_EPSILON",
@@ -183,9 +183,7 @@ def shadow_ray(
         step = float(epsilon) * max(1.0, float(np.max(np.abs(p)))) * n
     else:
         step = float(np.dot(np.abs(n), np.abs(as_vec3(error, "error")))) * n
-    moved = p + step
-    # One float further in each moved coordinate: the move itself cannot round back.
-    origin = np.where(step > 0.0, np.nextafter(moved, np.inf), np.where(step < 0.0, np.nextafter(moved, -np.inf), moved))
+    origin = moved_off(p, step)  # one float further in each moved coordinate
     to_light = light - origin
     distance = float(length(to_light))
     return Ray(origin, to_light / distance), distance
