@@ -337,14 +337,15 @@ class _Spawn:
         return _Spawn(self.point[rows], self.error[rows], self.normal[rows])
 
 
-def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.float64]
-             ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], _Spawn]:
-    """``(point, unit normal, base colour, spawn)`` for hit rays (all of ``hits`` must be hits)."""
+def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.float64], need_spawn: bool = True
+             ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], _Spawn | None]:
+    """``(point, unit normal, base colour, spawn)`` for hit rays (all of ``hits`` must be hits);
+    ``spawn`` None unless ``need_spawn`` (no shadow ray or bounce leaves these hits)."""
     n = d.shape[0]
     point = o + hits.t[:, None] * d
     # Spheres' spawn points are the ray's point; triangles' are replaced below.
     spawn = _Spawn(point.copy(), gamma(RAY_POINT_GAMMA, UNIT_F64) * (np.abs(o) + np.abs(hits.t[:, None] * d)),
-                   np.zeros((n, 3)))
+                   np.zeros((n, 3))) if need_spawn else None
     normal = np.zeros((n, 3))
     base = np.zeros((n, 3))
     uv = np.zeros((n, 2))
@@ -362,19 +363,21 @@ def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.fl
             color *= _sample(image, wrap, uv[sel])[:, :3]
         base[sel] = color
     normal /= np.maximum(length(normal), 1e-300)[:, None]
-    spawn.normal /= np.maximum(length(spawn.normal), 1e-300)[:, None]
+    if spawn is not None:
+        spawn.normal /= np.maximum(length(spawn.normal), 1e-300)[:, None]
     return point, normal, base, spawn
 
 
 def _surface_sphere(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[np.intp], o: NDArray[np.float64],
-                    d: NDArray[np.float64], point: NDArray[np.float64], spawn: _Spawn
+                    d: NDArray[np.float64], point: NDArray[np.float64], spawn: _Spawn | None
                     ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """A sphere node's (normal, uv, vertex colour) at its hits; its spawn points stay ``O + t·D``."""
     inv = node.inverse
     q = point[sel] @ inv[:3, :3].T + inv[:3, 3]  # the hit on the unit sphere
     q /= length(q)[:, None]
     normal = q @ node.normal_matrix.T
-    spawn.normal[sel] = normal
+    if spawn is not None:
+        spawn.normal[sel] = normal
     # geometry.sphere()'s uv: u = azimuth/2π from +z towards +x, v = polar angle/π from +y.
     uv = np.stack([np.mod(np.arctan2(q[:, 0], q[:, 2]), 2 * np.pi) / (2 * np.pi),
                    np.arccos(np.clip(q[:, 1], -1.0, 1.0)) / np.pi], axis=1)
@@ -382,18 +385,19 @@ def _surface_sphere(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[np.i
 
 
 def _surface_triangles(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[np.intp], o: NDArray[np.float64],
-                       d: NDArray[np.float64], point: NDArray[np.float64], spawn: _Spawn
+                       d: NDArray[np.float64], point: NDArray[np.float64], spawn: _Spawn | None
                        ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """A mesh node's (normal, uv, vertex colour) at its hits, barycentric; its spawn
     points are the barycentric points with their error bound and the face normal."""
     tri = hits.tri[sel]
     u, v = _barycentric(world, tri, _rows(o, sel), d[sel])
     w = (1.0 - u - v)[:, None], u[:, None], v[:, None]  # weights of V0, V1, V2
-    corners = world.v0[tri] * w[0], world.v1[tri] * w[1], world.v2[tri] * w[2]
-    spawn.point[sel] = corners[0] + corners[1] + corners[2]
-    spawn.error[sel] = gamma(TRIANGLE_POINT_GAMMA, UNIT_F64) * (
-        np.abs(corners[0]) + np.abs(corners[1]) + np.abs(corners[2]))
-    spawn.normal[sel] = np.cross(world.v1[tri] - world.v0[tri], world.v2[tri] - world.v0[tri])
+    if spawn is not None:
+        corners = world.v0[tri] * w[0], world.v1[tri] * w[1], world.v2[tri] * w[2]
+        spawn.point[sel] = corners[0] + corners[1] + corners[2]
+        spawn.error[sel] = gamma(TRIANGLE_POINT_GAMMA, UNIT_F64) * (
+            np.abs(corners[0]) + np.abs(corners[1]) + np.abs(corners[2]))
+        spawn.normal[sel] = np.cross(world.v1[tri] - world.v0[tri], world.v2[tri] - world.v0[tri])
     return _interpolate(world.normals[tri], w), _interpolate(world.uvs[tri], w), _interpolate(world.colors[tri], w)
 
 
@@ -435,10 +439,11 @@ def _offset(spawn: _Spawn, normal: NDArray[np.float64], side: NDArray[np.float64
 
 
 def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.float64], shadows: bool,
-           cull: bool | None, aabb: bool, stats: RenderStats, bvh: WorldBVH | None = None, simple: bool = False
-           ) -> tuple[NDArray[np.float64], NDArray[np.float64], _Spawn]:
-    """Local colour of hit rays (the raster's per-light formula), plus normal and spawn point for bounces."""
-    point, normal, base, spawn = _surface(world, hits, o, d)
+           cull: bool | None, aabb: bool, stats: RenderStats, bvh: WorldBVH | None = None, simple: bool = False,
+           bounce: bool = True) -> tuple[NDArray[np.float64], NDArray[np.float64], _Spawn | None]:
+    """Local colour of hit rays (the raster's per-light formula), plus normal and spawn
+    point for bounces (``bounce``: some may follow; else the spawn is None)."""
+    point, normal, base, spawn = _surface(world, hits, o, d, need_spawn=shadows or bounce)
     color = base.copy()  # unlit surfaces keep their colour
     table = world.materials
     lit = table.lit[hits.node]
@@ -451,7 +456,7 @@ def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.floa
         shin = table.shininess[nodes]
         blinn = table.blinn[nodes]
         p, nrm, mesh = point[idx], normal[idx], base[idx]
-        lit_spawn = spawn.subset(idx)
+        lit_spawn = spawn.subset(idx) if spawn is not None else None
         to_eye = -d[idx] / length(d[idx])[:, None]
         total = np.zeros_like(mesh)
         for index, (light, light_color) in enumerate(zip(world.light_positions, world.light_colors)):
@@ -471,6 +476,7 @@ def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.floa
             specular = highlight[:, None] * light_color
             lighting = kd * diffuse + ks * specular
             if shadows:
+                assert lit_spawn is not None
                 start = _offset(lit_spawn, nrm, light - p, simple)
                 stats.shadow += idx.size
                 blocked = _occluded(world, start, light - start, index, cull, aabb, stats, bvh)
@@ -496,8 +502,9 @@ def _trace(world: World, o: NDArray[np.float64], d: NDArray[np.float64], max_dep
         if not hit.any():
             break
         sub = _Hits(hits.t[hit], hits.node[hit], hits.tri[hit])
-        local, normal, spawn = _shade(world, sub, _rows(o, hit), d[hit], shadows, cull, aabb, stats, bvh, simple)
         r = world.materials.reflectivity[sub.node] if depth < max_depth else np.zeros(sub.node.size)
+        local, normal, spawn = _shade(world, sub, _rows(o, hit), d[hit], shadows, cull, aabb, stats, bvh, simple,
+                                      bounce=bool((r > 0.0).any()))
         w = weight[hit]
         out[alive[hit]] += (w * (1.0 - r))[:, None] * local
         bounce = r > 0.0
@@ -506,6 +513,7 @@ def _trace(world: World, o: NDArray[np.float64], d: NDArray[np.float64], max_dep
         dh = d[hit][bounce]
         nh = normal[bounce]
         reflected = dh - 2.0 * np.einsum("ij,ij->i", dh, nh)[:, None] * nh  # Yansıma vektörü
+        assert spawn is not None  # some hit reflects: _shade made it
         o = _offset(spawn.subset(bounce), nh, -dh, simple)
         d = reflected
         weight = (w * r)[bounce]
