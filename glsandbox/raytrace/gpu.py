@@ -87,7 +87,22 @@ leaves after the other loops, shared by every ray of a pixel and every mesh
 node). A ray that reaches the bound writes alpha 0, and the render raises
 :class:`RayTraceError` instead of returning the picture. Scenes whose mesh
 nodes all have at most :data:`BVH_TRIANGLES` triangles (the cubes, quads and
-floors of most lessons) keep the scan.
+floors of most lessons) keep the scan, which tests its triangles with the
+same watertight test (``shaders/common/watertight.glsl``; the triangle
+records hold the three corners, so a corner shared by two triangles is the
+same three floats in both).
+
+Precision far from the origin
+-----------------------------
+Every position is uploaded relative to :func:`world_anchor`, the scene's
+centre, the difference taken in float64 before the float32 rounding: the
+picture, and the BVH's steps per ray, do not depend on where the scene
+sits (``tests/raytrace/test_engine_far_from_origin.py``). Shadow and
+reflected rays leave a surface by a bound on the hit point's rounding
+error (``shaders/raytrace.glsl``'s ``offset_point``, the bounds in
+:mod:`glsandbox.raytrace.constants`), and the triangle test accepts ``t``
+only above its own error bound, so no surface shadows itself and contact
+shadows stay.
 
 Float32 differs from float64 in the last bits of ``t`` and of the shading;
 the image agrees with the numpy engine's to within a couple of 8-bit levels

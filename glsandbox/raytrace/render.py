@@ -19,7 +19,10 @@ The algorithm, in the course's order (first half of the notes):
 1. **Primary rays** through the image plane (:func:`~glsandbox.raytrace.world.camera_rays`).
 2. **Nearest hit** (``tDistances``/``min_indis``): for each node, the AABB
    slab test first (course "Hızlandırma: AABB"; ``aabb=False`` skips it),
-   then Möller–Trumbore against its triangles, or the exact sphere test.
+   then the watertight triangle test (Woop, Benthin & Wald; the course's
+   Işın-Üçgen kesim testi ends with it) against its triangles, or the exact
+   sphere test: a ray through a shared edge or vertex never slips through,
+   in either engine, on any path.
    The numpy engine's ``bvh=True`` (the default) traces each mesh node's rays
    through a BVH over its triangles instead (:mod:`glsandbox.raytrace.bvh`,
    built once per mesh and cached), with the watertight triangle test
@@ -32,7 +35,7 @@ The algorithm, in the course's order (first half of the notes):
    the option.
    **Backface culling** (course "Hızlandırma: backface culling"): a node the
    rasterizer culls (``cull_back_faces``) is one-sided for *every* ray, as
-   ``det > 0`` in Möller–Trumbore; ``cull_backfaces=True``/``False``
+   the front faces only (``N·d < 0``); ``cull_backfaces=True``/``False``
    overrides all nodes.
 3. **Shading**, the rasterizer's formula (``shaders/common/lighting.glsl``,
    course "Lighting"), so the two renderers differ only where the raster
