@@ -354,7 +354,6 @@ def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.fl
         if sel.size == 0:
             continue
         normal[sel], uv[sel], colors = _SURFACE[node.kind](world, node, hits, sel, o, d, point, spawn)
-        colors = colors if node.mode == 1 else None
         color = np.broadcast_to(node.color, (sel.size, 3)).copy()
         if colors is not None:  # vertex colours, times the material colour (basic.glsl)
             color *= colors
@@ -370,7 +369,7 @@ def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.fl
 
 def _surface_sphere(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[np.intp], o: NDArray[np.float64],
                     d: NDArray[np.float64], point: NDArray[np.float64], spawn: _Spawn | None
-                    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+                    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64] | None]:
     """A sphere node's (normal, uv, vertex colour) at its hits; its spawn points stay ``O + t·D``."""
     inv = node.inverse
     q = point[sel] @ inv[:3, :3].T + inv[:3, 3]  # the hit on the unit sphere
@@ -381,12 +380,12 @@ def _surface_sphere(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[np.i
     # geometry.sphere()'s uv: u = azimuth/2π from +z towards +x, v = polar angle/π from +y.
     uv = np.stack([np.mod(np.arctan2(q[:, 0], q[:, 2]), 2 * np.pi) / (2 * np.pi),
                    np.arccos(np.clip(q[:, 1], -1.0, 1.0)) / np.pi], axis=1)
-    return normal, uv, np.ones((sel.size, 3))
+    return normal, uv, np.ones((sel.size, 3)) if node.mode == 1 else None
 
 
 def _surface_triangles(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[np.intp], o: NDArray[np.float64],
                        d: NDArray[np.float64], point: NDArray[np.float64], spawn: _Spawn | None
-                       ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+                       ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64] | None]:
     """A mesh node's (normal, uv, vertex colour) at its hits, barycentric; its spawn
     points are the barycentric points with their error bound and the face normal."""
     tri = hits.tri[sel]
@@ -398,13 +397,14 @@ def _surface_triangles(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[n
         spawn.error[sel] = gamma(TRIANGLE_POINT_GAMMA, UNIT_F64) * (
             np.abs(corners[0]) + np.abs(corners[1]) + np.abs(corners[2]))
         spawn.normal[sel] = np.cross(world.v1[tri] - world.v0[tri], world.v2[tri] - world.v0[tri])
-    return _interpolate(world.normals[tri], w), _interpolate(world.uvs[tri], w), _interpolate(world.colors[tri], w)
+    colors = _interpolate(world.colors[tri], w) if node.mode == 1 else None  # vertex colours, when shown
+    return _interpolate(world.normals[tri], w), _interpolate(world.uvs[tri], w), colors
 
 
 #: The node table's per-kind code (:class:`~glsandbox.raytrace.world.NodeKind`): a hit
 #: test ``(world, node, o, d, one_sided) -> (t, world triangle or −1)`` in the node's
-#: own space, and a surface ``-> (normal, uv, vertex colour)`` that also fills the
-#: spawn points. A new kind is one entry in each.
+#: own space, and a surface ``-> (normal, uv, vertex colour or None unless the node
+#: shows vertex colours)`` that also fills the spawn points (when given). A new kind is one entry in each.
 _HIT = {NodeKind.MESH: _hit_triangles, NodeKind.SPHERE: _hit_sphere}
 _SURFACE = {NodeKind.MESH: _surface_triangles, NodeKind.SPHERE: _surface_sphere}
 
