@@ -29,6 +29,7 @@ from glsandbox import camera, geometry, meshgen, transforms
 from glsandbox.planar import Mirror, PlanarShadow
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh
+from glsandbox.images import check_texture_source
 from glsandbox.lesson import Lesson, Param, register
 from glsandbox.meshfile import Model, fit_mesh, load_mesh, load_model
 from glsandbox.overlay import Overlay, text_image
@@ -53,7 +54,7 @@ __all__ = [
     "COURSE_BLUE", "DEPTH_MODES", "LIT_SHADINGS", "NORMAL_MODES", "TEXTURE_FILTERS", "TEXTURE_WRAPS",
     "Camera", "Lesson", "Light", "Material", "Mesh", "Mirror", "Model", "Node", "Overlay", "Param", "PlanarShadow",
     "SandboxError", "Scene", "Texture", "Viewport",
-    "__version__", "camera", "fit_mesh", "geometry", "load_mesh", "load_model", "meshgen", "register", "run",
+    "__version__", "camera", "check_texture_source", "fit_mesh", "geometry", "load_mesh", "load_model", "meshgen", "register", "run",
     "show", "text_image", "transforms", "view", "widget",
 ]
 

@@ -17,7 +17,8 @@ ROOT = Path(__file__).resolve().parents[1]
 
 #: Lowest first. A module may import its own layer and the ones above it in this list.
 LAYERS: list[tuple[str, tuple[str, ...]]] = [
-    ("core", ("glsandbox.errors", "glsandbox.transforms", "glsandbox.meshnormals", "glsandbox.geometry",
+    ("core", ("glsandbox.errors", "glsandbox.transforms", "glsandbox.meshnormals", "glsandbox.meshlooks",
+              "glsandbox.geometry",
               "glsandbox.meshgen", "glsandbox.files", "glsandbox.file_watch")),
     ("scene data", ("glsandbox.scene", "glsandbox.planar", "glsandbox.images",
                     "glsandbox.overlay", "glsandbox.meshfile")),

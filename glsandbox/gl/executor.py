@@ -332,6 +332,9 @@ class Executor:
     def render(self, scene: Scene, framebuffer: moderngl.Framebuffer, size: tuple[int, int],
                frame_plan: Plan | None = None) -> Plan:
         """Draw one frame of ``scene`` into ``framebuffer`` (``size`` pixels)."""
+        if any(vp.renderer != "raster" for vp in scene.viewports):
+            raise ValueError("the executor draws raster viewports only: trace the others first "
+                             "(glsandbox.frame.trace_viewports)")
         frame_plan = frame_plan or make_plan(scene)
         self._frame += 1
         for variant in frame_plan.programs:
@@ -449,12 +452,22 @@ class Executor:
             write_material_uniforms(program, material, members)
         for name, value in own.items():
             program[name].value = value
+        if "u_alpha_cutoff" in members:
+            program["u_alpha_cutoff"].value = float(material.alpha_cutoff)
         texture = material.texture
         if texture is not None:
             self._textures.bind(texture, 0)
             if "u_texture" in members:
                 program["u_texture"].value = 0
+        if draw.blend:  # over what is drawn already; hidden by it where nearer, but not hiding
+            self.ctx.enable(moderngl.BLEND)
+            self.ctx.blend_func = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA)
+            self.raw.glDepthMask(0)
         vao.render(gpu.mode, vertices=gpu.count)
+        if draw.blend:
+            self.raw.glDepthMask(1)
+            self.ctx.disable(moderngl.BLEND)
+            self.ctx.blend_func = moderngl.DEFAULT_BLENDING
         if texture is not None:
             self._textures.unbind(0)
 

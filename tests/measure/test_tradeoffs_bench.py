@@ -1,7 +1,8 @@
 """``glsandbox tradeoffs``, ``glsandbox bench`` and ``--set effects=all``.
 
-The two commands run in subprocesses (a second GL context must not be opened
-in the test process); their content is checked, never their timings.
+The two commands' measuring runs are in subprocesses (a second GL context must not be
+opened in the test process); their content is checked, never their timings. Their
+refusals, made before any context opens, run in this process.
 """
 
 from __future__ import annotations
@@ -15,6 +16,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from support import REPO_ROOT as REPO
+from support import run_cli
 
 from glsandbox.frame import LazyRenderer
 from glsandbox.lesson import all_lessons
@@ -22,7 +25,6 @@ from glsandbox.measure.render_context import downsample
 from glsandbox.measure.tradeoffs_report import CSV_COLUMNS
 from glsandbox.plan import plan
 
-REPO = Path(__file__).resolve().parents[2]
 
 
 def _run(*args: str, timeout: int = 240) -> subprocess.CompletedProcess:
@@ -74,13 +76,15 @@ def test_effects_all_renders_the_same_picture(gl, cls) -> None:
         forced_frame = gl.render(cls(time=time, effects="all"), (96, 72))
         assert forced_frame.plan.buffers.stencil
         assert np.array_equal(needed, forced_frame.image), f"{cls.name} at time {time}"
+        # Opaque (tests/gl/test_target.py): alpha 255 everywhere, as the window shows the frame.
+        assert (needed[..., 3] == 255).all(), f"{cls.name} at time {time}: alpha below 255"
 
 
 def test_effects_is_a_parameter_of_every_lesson() -> None:
-    proc = _run("plan", "indexed_cube", "--set", "effects=all")
+    proc = run_cli("plan", "indexed_cube", "--set", "effects=all")
     assert proc.returncode == 0, proc.stderr
     assert "stencil 8" in proc.stdout
-    proc = _run("plan", "indexed_cube", "--set", "effects=some")
+    proc = run_cli("plan", "indexed_cube", "--set", "effects=some")
     assert proc.returncode == 2 and proc.stderr.startswith("error: --set effects=some: expected one of needed, all")
 
 
@@ -159,7 +163,7 @@ def test_tradeoffs_errors_fall_where_they_must(quick_report: Path) -> None:
 
 @pytest.mark.slow
 def test_depth_knob_counts_z_fighting_pixels(quick_report: Path) -> None:
-    # Seen from 90 units (tests/test_mirror.py pins it): a 24-bit buffer with no polygon offset
+    # Seen from 90 units (tests/lessons/test_mirror.py pins it): a 24-bit buffer with no polygon offset
     # fights with or without the course's lift, and so does reverse-Z without any lift; each
     # remedy alone (nearer plane, reverse-Z with the lift, polygon offset) has no fighting pixel.
     rows = {r["setting"]: r for r in _rows(quick_report) if r["knob"] == "depth"}
@@ -242,7 +246,7 @@ def test_the_measure_extra_is_imported_only_by_tradeoffs_at_work() -> None:
 
 
 def test_tradeoffs_bad_runs_is_one_line() -> None:
-    proc = _run("tradeoffs", "--quick", "--runs", "3", "--out", "/nonexistent/x")
+    proc = run_cli("tradeoffs", "--quick", "--runs", "3", "--out", "/nonexistent/x")
     assert proc.returncode == 2 and proc.stderr.strip() == "error: --runs 3: the timing needs at least 5 runs"
 
 
@@ -269,7 +273,7 @@ def test_bench_prints_one_table_and_writes_json(tmp_path: Path) -> None:
 
 
 def test_bench_unknown_case_is_one_line() -> None:
-    proc = _run("bench", "--quick", "--only", "no_such_benchmark")
+    proc = run_cli("bench", "--quick", "--only", "no_such_benchmark")
     assert proc.returncode == 2
     assert proc.stderr.strip().splitlines() == [
         "error: --only no_such_benchmark: no benchmark case matched (see glsandbox bench)"]  # no progress first
