@@ -474,6 +474,11 @@ def watertight_t_bound(x, y, z, e, det):  # type: ignore[no-untyped-def]
     the edge functions ``2·(γ(2)·max|x|·max|y| + δy·max|x| + δx·max|y|)``, and ``t``
     three times the error of ``Σ e_i·z_i`` over ``|det|``."""
     g2, g3, g5 = (gamma(n, UNIT_F64) for n in (2, 3, 5))
+    with np.errstate(over="ignore", invalid="ignore"):  # coordinates near 1e154 and up: an inf bound, a miss
+        return _t_bound(x, y, z, e, det, g2, g3, g5)
+
+
+def _t_bound(x, y, z, e, det, g2, g3, g5):  # type: ignore[no-untyped-def]
     max_x = np.maximum(np.maximum(np.abs(x[0]), np.abs(x[1])), np.abs(x[2]))
     max_y = np.maximum(np.maximum(np.abs(y[0]), np.abs(y[1])), np.abs(y[2]))
     max_z = np.maximum(np.maximum(np.abs(z[0]), np.abs(z[1])), np.abs(z[2]))

@@ -1,4 +1,5 @@
-"""Fixtures of the ray tracer's tests: ``engine``, every path a render can take."""
+"""Fixtures of the ray tracer's tests: ``engine_path``, every path a render can take
+(tests/conftest.py's ``engine`` is the two engines; this splits each into scan and BVH)."""
 
 from __future__ import annotations
 
@@ -14,8 +15,8 @@ ENGINE_PATHS = ("numpy-scan", "numpy-bvh", "gpu-scan", "gpu-bvh")
 
 
 @pytest.fixture(params=ENGINE_PATHS)
-def engine(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> Callable[..., np.ndarray]:
-    """``engine(scene, size, **options)``: the scene rendered through one engine path
+def engine_path(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> Callable[..., np.ndarray]:
+    """``engine_path(scene, size, **options)``: the scene rendered through one engine path
     (the fixture's id names it); gpu paths need a GL backend (skip without one)."""
     from glsandbox.raytrace import render
 

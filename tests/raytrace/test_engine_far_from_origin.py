@@ -33,12 +33,12 @@ def reference_shadow() -> np.ndarray:
 
 
 @pytest.mark.parametrize("offset", OFFSETS, ids=lambda o: f"at{o:g}")
-def test_a_cube_on_a_floor_keeps_its_contact_shadow_far_from_the_origin(engine, reference_shadow, offset) -> None:
-    floor, shadowed = shadow_mask(engine, offset)
+def test_a_cube_on_a_floor_keeps_its_contact_shadow_far_from_the_origin(engine_path, reference_shadow, offset) -> None:
+    floor, shadowed = shadow_mask(engine_path, offset)
     kept = np.count_nonzero(shadowed & reference_shadow) / np.count_nonzero(reference_shadow)
     false = np.count_nonzero(shadowed & ~grown(reference_shadow))
-    assert kept >= 0.95, f"{engine.path} at {offset:g}: {kept:.1%} of the contact shadow kept"
-    assert false == 0, f"{engine.path} at {offset:g}: {false} floor pixels wrongly in shadow"
+    assert kept >= 0.95, f"{engine_path.path} at {offset:g}: {kept:.1%} of the contact shadow kept"
+    assert false == 0, f"{engine_path.path} at {offset:g}: {false} floor pixels wrongly in shadow"
 
 
 @pytest.mark.parametrize("offset", [1e5, 1e6], ids=lambda o: f"at{o:g}")

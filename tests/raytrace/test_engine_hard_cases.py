@@ -69,16 +69,16 @@ def aimed_scenes(name: str, offset: float):
 
 @pytest.mark.parametrize("offset", OFFSETS, ids=lambda o: f"at{o:g}")
 @pytest.mark.parametrize("name", ["cube", "icosahedron", "icosphere1"])
-def test_rays_aimed_at_vertices_and_edges_never_miss(engine, name, offset) -> None:
+def test_rays_aimed_at_vertices_and_edges_never_miss(engine_path, name, offset) -> None:
     scenes = aimed_scenes(name, offset)
     assert len(scenes) >= 2 * (8 + 18)
     missed = [i for i, scene in enumerate(scenes)
-              if not engine(scene, (1, 1), shadows=False, max_depth=0)[0, 0, :3].any()]
-    assert missed == [], f"{engine.path}: {len(missed)} of {len(scenes)} rays through vertices and edges missed"
+              if not engine_path(scene, (1, 1), shadows=False, max_depth=0)[0, 0, :3].any()]
+    assert missed == [], f"{engine_path.path}: {len(missed)} of {len(scenes)} rays through vertices and edges missed"
 
 
 @pytest.mark.parametrize("offset", OFFSETS, ids=lambda o: f"at{o:g}")
-def test_a_view_from_inside_a_closed_mesh_has_no_hole(engine, offset) -> None:
+def test_a_view_from_inside_a_closed_mesh_has_no_hole(engine_path, offset) -> None:
     # Every primary ray from inside a closed mesh crosses it: a background pixel is a
     # ray that slipped between two triangles (the gpu scan had 30-45 at 1e3 before).
     centre = offset * DIRECTION
@@ -87,6 +87,6 @@ def test_a_view_from_inside_a_closed_mesh_has_no_hole(engine, offset) -> None:
     camera = Camera(eye=tuple(centre + (0.31, 0.17, 0.4)), target=tuple(centre + (-1.0, -0.3, -2.0)),
                     fov_y=100.0, near=0.01, far=100.0)
     scene = Scene("inside", nodes=(node,), camera=camera, clear_color=(0.0, 0.0, 0.0, 1.0))
-    image = engine(scene, (121, 91), shadows=False, max_depth=0)
+    image = engine_path(scene, (121, 91), shadows=False, max_depth=0)
     holes = int(np.count_nonzero(~image[..., :3].any(axis=-1)))
-    assert holes == 0, f"{engine.path}: {holes} holes at offset {offset:g}"
+    assert holes == 0, f"{engine_path.path}: {holes} holes at offset {offset:g}"
