@@ -12,7 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 import functools
 import weakref
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -21,6 +21,7 @@ from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh
 from glsandbox.overlay import Overlay
 from glsandbox.scene import Camera, Node, Scene
+from glsandbox.shadowmap import casters, casting_light, receivers
 
 
 @dataclass(frozen=True, order=True)
@@ -72,11 +73,15 @@ class Draw:
     texture: str | None = None  # what texture unit 0 holds, only for textured nodes
     #: Alpha blending on and depth writes off (a material's ``alpha_mode = "blend"``).
     blend: bool = False
+    #: The light whose shadow map texture unit 1 holds (:data:`SHADOW_MAP_UNIT`), for receivers.
+    shadow_map: int | None = None
 
     def describe(self) -> str:
         return (f"{self.node} with {self.program}" + ("" if self.cull_back_faces else " (no culling)")
                 + (" (blended, no depth writes)" if self.blend else "")
-                + (f" + texture unit 0: {self.texture}" if self.texture else ""))
+                + (f" + texture unit 0: {self.texture}" if self.texture else "")
+                + (f" + texture unit {SHADOW_MAP_UNIT}: shadow map {self.shadow_map}"
+                   if self.shadow_map is not None else ""))
 
 
 #: Stencil comparisons a pass may use (``glStencilFunc``).
@@ -134,10 +139,20 @@ class StencilState:
 
 @dataclass(frozen=True)
 class Pass:
-    """One step of the frame, restricted to one viewport."""
+    """One step of the frame, restricted to one viewport.
 
-    kind: str  # "trace", "clear", "draw" or "overlay" (viewport -1: the whole frame)
-    viewport: int
+    ``kind`` is one of :data:`PASS_KINDS`: each has a describer here
+    (:data:`PASS_DESCRIBERS`) and a runner in the executor
+    (:data:`glsandbox.gl.executor.PASS_RUNNERS`). ``target`` is what the pass
+    draws into: ``"frame"``, or a named offscreen (``"shadow map 0"``: light
+    0's depth texture). ``camera`` is what it looks through: ``"viewport"``
+    (the viewport's camera, or the scene's), ``"light N"`` (light N's shadow
+    camera, :func:`glsandbox.shadowmap.light_camera`), or None for passes
+    that draw no 3D content (clears, overlays).
+    """
+
+    kind: str
+    viewport: int  # -1: the whole target
     clear_color: tuple[float, float, float, float] | None = None
     clear_depth: bool = False
     clear_stencil: bool = False
@@ -149,28 +164,41 @@ class Pass:
     #: :func:`planar_passes`).
     stencil: StencilState | None = None
     detail: str = ""
+    target: str = "frame"
+    camera: str | None = "viewport"
 
     def describe(self) -> str:
-        if self.kind == "overlay":
-            return describe_overlay_pass(self)
-        if self.kind == "trace":
-            nodes = "; ".join(f"{d.node} ({d.program}" + (f", texture {d.texture}" if d.texture else "") + ")"
-                              for d in self.draws) or "nothing"
-            return f"trace viewport {self.viewport} ({self.detail}): {nodes}"
-        if self.kind in PLANAR_PASS_KINDS:
-            return describe_planar_pass(self)
-        if self.kind == "clear":
-            what = []
-            if self.clear_color is not None:
-                what.append("colour (" + ", ".join(f"{c:g}" for c in self.clear_color) + ")")
-            if self.clear_depth:
-                what.append("depth")
-            if self.clear_stencil:
-                what.append("stencil")
-            return f"clear viewport {self.viewport}: " + " + ".join(what)
-        items = "; ".join(d.describe() for d in self.draws)
-        depth = "depth test" if self.depth_test else "no depth test"
-        return f"draw viewport {self.viewport} ({depth}): {items}"
+        describer = PASS_DESCRIBERS.get(self.kind)
+        if describer is None:
+            raise SandboxError(f"pass kind {self.kind!r} has no describer (plan.PASS_DESCRIBERS)")
+        return describer(self)
+
+
+def describe_clear_pass(step: Pass) -> str:
+    what = []
+    if step.clear_color is not None:
+        what.append("colour (" + ", ".join(f"{c:g}" for c in step.clear_color) + ")")
+    if step.clear_depth:
+        what.append("depth")
+    if step.clear_stencil:
+        what.append("stencil")
+    return f"clear viewport {step.viewport}: " + " + ".join(what)
+
+
+def describe_draws(step: Pass) -> str:
+    """Each draw as :meth:`Draw.describe` says it, or ``nothing``."""
+    return "; ".join(d.describe() for d in step.draws) or "nothing"
+
+
+def describe_draw_pass(step: Pass) -> str:
+    depth = "depth test" if step.depth_test else "no depth test"
+    return f"draw viewport {step.viewport} ({depth}): {describe_draws(step)}"
+
+
+def describe_trace_pass(step: Pass) -> str:
+    nodes = "; ".join(f"{d.node} ({d.program}" + (f", texture {d.texture}" if d.texture else "") + ")"
+                      for d in step.draws) or "nothing"
+    return f"trace viewport {step.viewport} ({step.detail}): {nodes}"
 
 
 @dataclass(frozen=True)
@@ -225,17 +253,19 @@ class Plan:
         return result
 
 
-def program_for(node: Node, lights: int = 0) -> ProgramVariant:
+def program_for(node: Node, lights: int = 0, shadow_light: int | None = None, shadow_pcf: int = 1) -> ProgramVariant:
     """The shader variant a node needs: ``basic`` with its colour source, or
     ``phong`` (:func:`lit_program_for`) when its material is lit; ``TEXTURED``
-    only when it has a texture. ``lights`` is the number of lights in the scene.
+    only when it has a texture. ``lights`` is the number of lights in the scene;
+    ``shadow_light`` the light whose shadow map a lit node receives (None: none),
+    filtered ``shadow_pcf`` texels wide.
     A node with a shader of its own gets that file, with ``NUM_LIGHTS`` (and
     ``TEXTURED``) defined, whatever its material's shading."""
     material = node.material
     if node.shader is not None:
         return _user_variant(str(node.shader), lights, material.texture is not None)
     if material.lit:
-        return lit_program_for(node, lights)
+        return lit_program_for(node, lights, shadow_light, shadow_pcf)
     return _basic_variant(material.shading == "vertex_color", material.texture is not None,
                           material.alpha_mode == "mask")
 
@@ -274,7 +304,7 @@ def _basic_variant(vertex_color: bool, textured: bool, mask: bool = False) -> Pr
     return ProgramVariant("basic", ((source, ""), *_texture_defines(textured), *_mask_defines(mask)))
 
 
-def lit_program_for(node: Node, lights: int) -> ProgramVariant:
+def lit_program_for(node: Node, lights: int, shadow_light: int | None = None, shadow_pcf: int = 1) -> ProgramVariant:
     """The ``phong`` variant for a lit node (course section "Lighting").
 
     ``NUM_LIGHTS`` sizes the light loop to the lights present (no unused
@@ -284,15 +314,19 @@ def lit_program_for(node: Node, lights: int) -> ProgramVariant:
     A model file's materials add ``VERTEX_COLOR`` (the mesh colour times the
     vertex colours), ``TWO_SIDED`` (back faces lit with the normal reversed)
     and ``ALPHA_MASK`` (cut-outs), each only for a material that asks.
+    ``SHADOW_LIGHT i`` looks light i's shadow map up (:mod:`glsandbox.shadowmap`) with a
+    ``SHADOW_PCF`` x ``SHADOW_PCF`` grid of comparisons (a constant: the loop unrolls).
     """
     material = node.material
     return _lit_variant(lights, material.shading, material.normals, material.texture is not None,
-                        material.vertex_colors, material.double_sided, material.alpha_mode == "mask")
+                        material.vertex_colors, material.double_sided, material.alpha_mode == "mask",
+                        shadow_light, shadow_pcf)
 
 
 @functools.cache
 def _lit_variant(lights: int, shading: str, normals: str, textured: bool, vertex_colors: bool = False,
-                 two_sided: bool = False, mask: bool = False) -> ProgramVariant:
+                 two_sided: bool = False, mask: bool = False, shadow_light: int | None = None,
+                 shadow_pcf: int = 1) -> ProgramVariant:
     defines: list[tuple[str, str]] = [("NUM_LIGHTS", str(lights))]
     if shading == "gouraud":
         defines.append(("PER_VERTEX", ""))
@@ -306,6 +340,8 @@ def _lit_variant(lights: int, shading: str, normals: str, textured: bool, vertex
     if two_sided:
         defines.append(("TWO_SIDED", ""))
     defines.extend(_mask_defines(mask))
+    if shadow_light is not None:
+        defines += [("SHADOW_LIGHT", str(shadow_light)), ("SHADOW_PCF", str(shadow_pcf))]
     return ProgramVariant("phong", tuple(defines))
 
 
@@ -479,9 +515,14 @@ def ignored_settings_notes(scene: Scene) -> tuple[str, ...]:
         how = "through the stencil" if scene.mirror.stencil else "without the stencil (it leaks)"
         notes.append(f"{where} ray-traced: the planar mirror {scene.mirror.node!r} drawn {how} is a raster "
                      "technique; the ray tracer traces reflection rays off the glass instead")
-    if scene.shadow is not None and any(node.name == scene.shadow.receiver for node in shown):
-        notes.append(f"{where} ray-traced: the planar shadow on {scene.shadow.receiver!r} is a raster technique; "
+    planar = scene.planar_shadow
+    if planar is not None and any(node.name == planar.receiver for node in shown):
+        notes.append(f"{where} ray-traced: the planar shadow on {planar.receiver!r} is a raster technique; "
                      "the ray tracer casts shadow rays to the lights instead")
+    mapped = [i for i, light in enumerate(scene.lights) if light.shadow is not None]
+    if mapped and any(node.receives_shadow and node.material.lit for node in shown):
+        notes.append(f"{where} ray-traced: light {mapped[0]}'s shadow map is a raster technique; the ray tracer "
+                     "casts shadow rays to the lights instead (exact: no resolution, bias or filter)")
     if scene.samples > 1:
         every = "every viewport is" if len(ray) == len(scene.viewports) else f"{where}"
         notes.append(f"--samples {scene.samples}: MSAA smooths rasterized edges only and {every} ray-traced "
@@ -524,25 +565,28 @@ def plan(scene: Scene) -> Plan:
     # (unless the scene turned depth testing off, which would change the picture).
     force = scene.plan_mode == "all"
     uses_depth = _needs_depth(scene) or (force and scene.depth_test) or _has_planar_effects(scene)
-    passes: list[Pass] = []
     programs: set[ProgramVariant] = set()
+    passes, shadow_light = shadow_map_passes(scene, programs)
+    shadow_pcf = scene.lights[shadow_light].shadow.pcf if shadow_light is not None else 1  # type: ignore[union-attr]
     for index, viewport in enumerate(scene.viewports):
         color = viewport.clear_color if viewport.clear_color is not None else scene.clear_color
         passes.append(Pass("clear", index, clear_color=color, clear_depth=uses_depth,
-                           clear_stencil=force or _needs_stencil(scene)))
+                           clear_stencil=force or _needs_stencil(scene), camera=None))
         draws, blended = [], []
         for node in scene.nodes:
             if not node.shown_in(index):
                 continue
             if scene.mirror is not None and node.name == scene.mirror.node:
                 continue  # the mirror's glass is drawn by the mirror passes
-            variant = program_for(node, len(scene.lights))
+            receives = shadow_light if node.receives_shadow and viewport.renderer == "raster" else None
+            variant = program_for(node, len(scene.lights), receives, shadow_pcf)
             programs.add(variant)
             texture = node.material.texture
             blend = node.material.alpha_mode == "blend"
             (blended if blend else draws).append(
                 (node, Draw(node.name, variant.key, node.cull_back_faces,
-                            texture=texture.describe() if texture is not None else None, blend=blend)))
+                            texture=texture.describe() if texture is not None else None, blend=blend,
+                            shadow_map=receives if "SHADOW_LIGHT" in dict(variant.defines) else None)))
         camera = viewport.camera or scene.camera
         draws = [d for _, d in draws] + [d for _, d in sorted(blended, key=lambda nd: -_distance(nd[0], camera))]
         if draws:
@@ -591,7 +635,7 @@ def overlay_passes(scene: Scene) -> list[Pass]:
         regions.setdefault(region, []).append(Draw(overlay.name, OVERLAY_PROGRAM.key, False))
     # Viewport regions in order, then the frame-wide ones, which may lie across several viewports.
     order = sorted(regions, key=lambda region: (region < 0, region))
-    return [Pass("overlay", region, draws=tuple(regions[region])) for region in order]
+    return [Pass("overlay", region, draws=tuple(regions[region]), camera=None) for region in order]
 
 
 def describe_overlay_pass(step: Pass) -> str:
@@ -602,11 +646,11 @@ def describe_overlay_pass(step: Pass) -> str:
 # --- planar effects: the stencil mirror and the planar shadow (course "The stencil Test") ---
 
 #: Pass kinds that only a scene with a mirror or a shadow receiver gets, in frame order.
-PLANAR_PASS_KINDS = ("mark_mirror", "reflection", "mirror_surface", "shadow")
+PLANAR_PASS_KINDS = ("mark_mirror", "reflection", "mirror_surface", "planar_shadow")
 #: The stencil bit of the mirror's pixels, and the bit of pixels already shadowed.
 #: Separate bits (with write and compare masks) let both effects share one buffer.
 MIRROR_STENCIL_BIT = 0x1
-SHADOW_STENCIL_BIT = 0x2
+PLANAR_SHADOW_STENCIL_BIT = 0x2
 #: ``MarkMirrorDSS``: every fragment of the glass that passes the depth test
 #: sets the mirror bit.
 MARK_MIRROR_STENCIL = StencilState("always", MIRROR_STENCIL_BIT, write_mask=MIRROR_STENCIL_BIT, on_pass="replace")
@@ -614,19 +658,19 @@ MARK_MIRROR_STENCIL = StencilState("always", MIRROR_STENCIL_BIT, write_mask=MIRR
 REFLECTION_STENCIL = StencilState("equal", MIRROR_STENCIL_BIT, mask=MIRROR_STENCIL_BIT)
 #: A pixel is darkened only while its shadow bit is clear, and the bit is then set
 #: (flipped from 0), so overlapping shadow triangles darken it once.
-SHADOW_STENCIL = StencilState("equal", 0, mask=SHADOW_STENCIL_BIT, write_mask=SHADOW_STENCIL_BIT, on_pass="invert")
+PLANAR_SHADOW_STENCIL = StencilState("equal", 0, mask=PLANAR_SHADOW_STENCIL_BIT, write_mask=PLANAR_SHADOW_STENCIL_BIT, on_pass="invert")
 #: Shadows are drawn in one flat colour.
-SHADOW_PROGRAM = ProgramVariant("basic", (("SOLID_COLOR", ""),))
+PLANAR_SHADOW_PROGRAM = ProgramVariant("basic", (("SOLID_COLOR", ""),))
 
 
 def _has_planar_effects(scene: Scene) -> bool:
-    return scene.mirror is not None or scene.shadow is not None
+    return scene.mirror is not None or scene.planar_shadow is not None
 
 
 def _needs_stencil(scene: Scene) -> bool:
     """The stencil buffer exists only for a stencil mirror or a stencil shadow."""
     return bool((scene.mirror is not None and scene.mirror.stencil)
-                or (scene.shadow is not None and scene.shadow.stencil))
+                or (scene.planar_shadow is not None and scene.planar_shadow.stencil))
 
 
 def planar_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> list[Pass]:
@@ -672,7 +716,7 @@ def planar_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
                            stencil=REFLECTION_STENCIL if mirror.stencil else None,
                            detail="front faces clockwise, lights reflected"))
         passes.append(Pass("mirror_surface", index, draws=(glass_draw,), depth_test=True, detail="blended"))
-    shadow = scene.shadow
+    shadow = scene.planar_shadow
     if shadow is not None and shadow.receiver in nodes and nodes[shadow.receiver].shown_in(index):
         models = {name: (nodes[name].model, nodes[name].mesh.positions) for name in shadow.casters if name in nodes}
         casting = shadow_casters(shadow, models)
@@ -683,17 +727,17 @@ def planar_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
         culled = [f"{name} culled ({why})" for name, why in casting.culled]
         if casting.reason:
             culled.append(f"culled: {casting.reason}")
-        draws = tuple(Draw(name, SHADOW_PROGRAM.key, False) for name in casting.kept if nodes[name].shown_in(index))
+        draws = tuple(Draw(name, PLANAR_SHADOW_PROGRAM.key, False) for name in casting.kept if nodes[name].shown_in(index))
         if draws:
-            programs.add(SHADOW_PROGRAM)
-        passes.append(Pass("shadow", index, draws=draws, depth_test=True,
-                           stencil=SHADOW_STENCIL if shadow.stencil else None,
+            programs.add(PLANAR_SHADOW_PROGRAM)
+        passes.append(Pass("planar_shadow", index, draws=draws, depth_test=True,
+                           stencil=PLANAR_SHADOW_STENCIL if shadow.stencil else None,
                            detail="; ".join([", ".join(how), *culled])))
     return passes
 
 
 _PLANAR_TITLES = {"mark_mirror": "mark mirror", "reflection": "reflection", "mirror_surface": "mirror surface",
-                  "shadow": "shadow"}
+                  "planar_shadow": "planar shadow"}
 
 
 def describe_planar_pass(step: Pass) -> str:
@@ -702,10 +746,52 @@ def describe_planar_pass(step: Pass) -> str:
         what.append("no colour or depth writes")
     if step.stencil is not None:
         what.append(f"stencil {step.stencil.describe()}")
-    elif step.kind in ("reflection", "shadow"):
+    elif step.kind in ("reflection", "planar_shadow"):
         what.append("no stencil")
     if step.detail:
         what.append(step.detail)
-    items = "; ".join(f"{d.node} with {d.program}" + ("" if d.cull_back_faces else " (no culling)")
-                      for d in step.draws) or "nothing"
-    return f"{_PLANAR_TITLES[step.kind]} viewport {step.viewport} ({', '.join(what)}): {items}"
+    return f"{_PLANAR_TITLES[step.kind]} viewport {step.viewport} ({', '.join(what)}): {describe_draws(step)}"
+
+
+# --- shadow maps (glsandbox.shadowmap) ----------------------------------------
+
+#: The texture unit a receiver's shadow map is bound to (unit 0 is the material's texture).
+SHADOW_MAP_UNIT = 1
+#: Casters are drawn into the map with the flat program; only their depth is kept.
+DEPTH_PROGRAM = ProgramVariant("basic", (("SOLID_COLOR", ""),))
+
+
+def shadow_map_passes(scene: Scene, programs: set[ProgramVariant]) -> tuple[list[Pass], int | None]:
+    """The depth-only pass of the shadow-casting light, before every viewport,
+    and that light's index; none (and None) when no light casts a shadow map or
+    no visible lit node receives it: the map would be drawn for nobody."""
+    light = casting_light(scene)
+    if light is None or not receivers(scene):
+        return [], None
+    shadow = scene.lights[light].shadow
+    assert shadow is not None
+    draws = tuple(Draw(node.name, DEPTH_PROGRAM.key, node.cull_back_faces) for node in casters(scene))
+    if draws:
+        programs.add(DEPTH_PROGRAM)
+    detail = f"{shadow.size}x{shadow.size} depth 24, perspective {shadow.fov:g}°"
+    return [Pass("shadow_map", -1, clear_depth=True, draws=draws, depth_test=True, detail=detail,
+                 target=f"shadow map {light}", camera=f"light {light}")], light
+
+
+def describe_shadow_map_pass(step: Pass) -> str:
+    return (f"shadow map from {step.camera} into {step.target} ({step.detail}, cleared, depth test, "
+            f"no colour): {describe_draws(step)}")
+
+
+#: One describer per pass kind; a new kind adds its entry here and its runner in
+#: :data:`glsandbox.gl.executor.PASS_RUNNERS` (a test checks both registries agree).
+PASS_DESCRIBERS: dict[str, Callable[[Pass], str]] = {
+    "trace": describe_trace_pass,
+    "shadow_map": describe_shadow_map_pass,
+    "clear": describe_clear_pass,
+    "draw": describe_draw_pass,
+    **{kind: describe_planar_pass for kind in PLANAR_PASS_KINDS},
+    "overlay": describe_overlay_pass,
+}
+#: Every pass kind, in frame order.
+PASS_KINDS = tuple(PASS_DESCRIBERS)

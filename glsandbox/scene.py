@@ -126,17 +126,63 @@ class Camera:
         return transforms.perspective(self.fov_y, aspect, self.near, self.far)
 
 
+#: Shadow-map sizes a light may ask for (texels per side).
+SHADOW_MAP_SIZES = (64, 128, 256, 512, 1024, 2048, 4096)
+#: The widest percentage-closer filter (texels per side of the kernel).
+MAX_PCF = 7
+
+
+@dataclass(frozen=True)
+class ShadowMap:
+    """A light's shadow map (:mod:`glsandbox.shadowmap`): the depth of the
+    nearest caster seen from the light, ``size`` x ``size`` texels, which a
+    lit receiver compares its own distance with.
+
+    ``bias`` (world units) and ``slope_bias`` (world units per unit of
+    ``tan`` of the angle between the surface normal and the light) move the
+    receiver's point towards the light before the comparison: too little and a
+    surface shadows itself in stripes (acne), too much and shadows come loose
+    from their casters (peter-panning). ``pcf`` is the width in texels of the
+    percentage-closer filter (1: one comparison, hard aliased edges; 3: a 3x3
+    grid of comparisons averaged). ``fov`` is the light frustum's field of view
+    in degrees: a point light gets one perspective frustum looking from it at
+    the centre of the shadow casters, not a cube map (what lies outside the
+    frustum is lit).
+    """
+
+    size: int = 1024
+    bias: float = 0.02
+    slope_bias: float = 0.02
+    pcf: int = 3
+    fov: float = 90.0
+
+    def __post_init__(self) -> None:
+        if isinstance(self.size, bool) or self.size not in SHADOW_MAP_SIZES:
+            raise SandboxError(f"shadow map size must be one of {', '.join(map(str, SHADOW_MAP_SIZES))}, "
+                               f"got {plain(self.size)}")
+        for name in ("bias", "slope_bias"):
+            _set(self, name, check_number(getattr(self, name), f"shadow map {name}", low=0.0))
+        if isinstance(self.pcf, bool) or self.pcf not in range(1, MAX_PCF + 1, 2):
+            raise SandboxError(f"shadow map pcf must be an odd width from 1 to {MAX_PCF} texels, got {plain(self.pcf)}")
+        _set(self, "fov", check_number(self.fov, "shadow map fov"))
+        if not 1.0 <= self.fov <= 150.0:
+            raise SandboxError(f"shadow map fov must lie in 1..150 degrees, got {plain(self.fov)}")
+
+
 @dataclass(frozen=True)
 class Light:
-    """A point light."""
+    """A point light; with ``shadow`` it casts a shadow map (:class:`ShadowMap`)."""
 
     position: tuple[float, float, float]
     #: Its colour (intensity per channel, >= 0; above 1 is a brighter light).
     color: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    shadow: ShadowMap | None = None
 
     def __post_init__(self) -> None:
         _set(self, "position", check_numbers(self.position, "light position"))
         _set(self, "color", check_numbers(self.color, "light colour", low=0.0))
+        if self.shadow is not None and not isinstance(self.shadow, ShadowMap):
+            raise SandboxError(f"a light's shadow must be a ShadowMap, got {plain(self.shadow)}")
 
 
 #: Digests of in-memory texture images by array identity (the arrays are read-only), so that
@@ -360,6 +406,10 @@ class Node:
     viewports: tuple[int, ...] | None = None
     shader: str | os.PathLike[str] | None = None
     uniforms: Mapping[str, Any] = field(default_factory=lambda: _NO_UNIFORMS)
+    #: Shadow maps: whether the node is drawn into them (casts), and whether a
+    #: lit node looks them up (receives). The planar shadow names its own.
+    casts_shadow: bool = True
+    receives_shadow: bool = True
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str):
@@ -468,7 +518,7 @@ class Scene:
     #: A planar mirror drawn through the stencil buffer (:mod:`glsandbox.planar`).
     mirror: Mirror | None = None
     #: A planar shadow projected onto a receiver (:mod:`glsandbox.planar`).
-    shadow: PlanarShadow | None = None
+    planar_shadow: PlanarShadow | None = None
     #: How depth is stored and compared (:data:`DEPTH_MODES`).
     depth_mode: str = "standard"
     #: ``"needed"``: the plan lists only what the scene calls for; ``"all"``:
@@ -508,7 +558,7 @@ class Scene:
                 if not isinstance(item, kind):
                     raise SandboxError(f"scene {self.name!r}: {field_name}[{i}] must be a {kind.__name__}, "
                                        f"got {plain(item)}")
-        for field_name, kind in (("camera", Camera), ("mirror", Mirror), ("shadow", PlanarShadow)):
+        for field_name, kind in (("camera", Camera), ("mirror", Mirror), ("planar_shadow", PlanarShadow)):
             value = getattr(self, field_name)
             if not isinstance(value, kind) and (value is not None or field_name == "camera"):
                 raise SandboxError(f"scene {self.name!r}: {field_name} must be a {kind.__name__}, got {plain(value)}")

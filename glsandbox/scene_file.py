@@ -4,7 +4,9 @@ The format is the README's "Scene files" section: top-level ``name``,
 ``clear_color``, ``depth_test`` and ``depth_mode``, a ``[camera]`` table,
 ``[[nodes]]``, ``[[lights]]`` and ``[[viewports]]`` arrays, and the optional
 ``[mirror]`` and ``[shadow]`` tables that tie the planar effects to nodes by
-name. Every value is checked here; a mistake is one :class:`SandboxError`
+name (``[shadow]`` is the planar shadow, kept under its old name; a light's
+shadow map is its ``shadow_map = {size = 1024, ...}``, and a node opts out of
+it with ``casts_shadow``/``receives_shadow = false``). Every value is checked here; a mistake is one :class:`SandboxError`
 naming the file, the line and the key (``scene.toml:7: nodes[0].mesh: ...``),
 once: a value of the wrong type (a number where a table, list or text is
 expected), a number that is not finite or lies beyond
@@ -37,7 +39,7 @@ from glsandbox.geometry import Mesh, builtin_mesh
 from glsandbox.meshfile import CREASE_ANGLE, NORMALS as MESH_NORMALS, Model, ModelPart, is_model_path, load_model
 from glsandbox.planar import Mirror, PlanarShadow
 from glsandbox.scene import (BUILTIN_TEXTURES, COURSE_BLUE, DEPTH_MODES, SHADINGS, Camera, Color, Light, Material,
-                             Node, Scene, Texture, Viewport, check_uniforms)
+                             Node, Scene, ShadowMap, Texture, Viewport, check_uniforms)
 
 #: Lighting coefficients a scene file may set on a node (see :class:`~glsandbox.scene.Material`).
 _MATERIAL_NUMBERS = ("ambient", "diffuse", "specular", "shininess")
@@ -207,7 +209,7 @@ class _SceneReader:
         allowed = {"name", "mesh", "order", "scale", "translate", "rotate", "color", "shading",
                    "cull_back_faces", "viewports", *_MATERIAL_NUMBERS, *_MATERIAL_LOOKS, "normals", "texture",
                    "filter", "wrap",
-                   *_MODEL_FILE_KEYS, "shader", "uniforms"}
+                   *_MODEL_FILE_KEYS, "shader", "uniforms", "casts_shadow", "receives_shadow"}
         self.check_keys(data, allowed, "nodes", i)
         mesh_name = data.get("mesh")
         if not isinstance(mesh_name, str):
@@ -255,7 +257,10 @@ class _SceneReader:
         try:
             return tuple(Node(name=label, mesh=part_mesh, model=model, material=material, cull_back_faces=cull,
                               viewports=tuple(views) if views is not None else None, shader=shader,
-                              uniforms=uniforms) for label, part_mesh, material in looks)
+                              uniforms=uniforms,
+                              casts_shadow=self.flag(data, "casts_shadow", "nodes", i),
+                              receives_shadow=self.flag(data, "receives_shadow", "nodes", i))
+                         for label, part_mesh, material in looks)
         except SandboxError as exc:  # the mesh lacks what the material reads, or the model is out of bounds
             message = str(exc)
             if "which a texture needs" in message:
@@ -406,15 +411,36 @@ class _SceneReader:
 
     def light(self, data: Any, i: int) -> Light:
         data = self.table(data, "lights", i)
-        self.check_keys(data, {"position", "color"}, "lights", i)
+        self.check_keys(data, {"position", "color", "shadow_map"}, "lights", i)
         pos = self.numbers(data, "position", (3,), "lights", i)
         if pos is None:
             raise self.fail("lights", i, None, "every light needs position = [x, y, z]")
         col = self.numbers(data, "color", (3,), "lights", i, default=(1.0, 1.0, 1.0))
+        shadow = self.shadow_map(data["shadow_map"], i) if "shadow_map" in data else None
         try:
-            return Light(position=pos, color=col)  # type: ignore[arg-type]
+            return Light(position=pos, color=col, shadow=shadow)  # type: ignore[arg-type]
         except SandboxError as exc:
             raise self.fail("lights", i, "color" if "colour" in str(exc) else "position", str(exc)) from None
+
+    def shadow_map(self, data: Any, i: int) -> ShadowMap:
+        """A light's ``shadow_map = {size, bias, slope_bias, pcf, fov}`` (every key optional)."""
+        if not isinstance(data, dict):
+            raise self.fail("lights", i, "shadow_map", f"expected a table such as {{size = 1024}}, got {plain(data)}")
+        allowed = ("size", "bias", "slope_bias", "pcf", "fov")
+        unknown = sorted(set(data) - set(allowed))
+        if unknown:
+            raise self.fail("lights", i, "shadow_map", f"unknown key {unknown[0]!r}; use {', '.join(allowed)}")
+        values = {}
+        for key in allowed:
+            if key in data:
+                value = data[key]
+                if isinstance(value, bool) or not isinstance(value, (int, float)):
+                    raise self.fail("lights", i, "shadow_map", f"{key} must be a number, got {plain(value)}")
+                values[key] = value
+        try:
+            return ShadowMap(**values)
+        except SandboxError as exc:
+            raise self.fail("lights", i, "shadow_map", str(exc)) from None
 
     def mirror(self, data: Any, known: set[str]) -> Mirror:
         """``[mirror]``: the glass node, its plane (a, b, c, d with ax + by + cz + d = 0), what it reflects."""
@@ -431,7 +457,7 @@ class _SceneReader:
         except SandboxError as exc:
             raise self.fail("mirror", 0, "reflected" if "reflect" in str(exc) else "plane", str(exc)) from None
 
-    def shadow(self, data: Any, known: set[str], lights: tuple[Light, ...]) -> PlanarShadow:
+    def planar_shadow(self, data: Any, known: set[str], lights: tuple[Light, ...]) -> PlanarShadow:
         """``[shadow]``: casters flattened onto the receiver's plane along the light (one of ``lights``)."""
         data = self.table(data, "shadow")
         self.check_keys(data, {"receiver", "plane", "light", "casters", "lift", "polygon_offset", "stencil", "color"},
@@ -502,7 +528,7 @@ class _SceneReader:
             viewports=viewports,
             depth_test=depth,
             mirror=self.mirror(data["mirror"], known) if "mirror" in data else None,
-            shadow=self.shadow(data["shadow"], known, lights) if "shadow" in data else None,
+            planar_shadow=self.planar_shadow(data["shadow"], known, lights) if "shadow" in data else None,
             depth_mode=depth_mode,
         )
 

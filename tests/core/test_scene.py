@@ -142,14 +142,14 @@ def test_a_shadow_light_that_is_none_of_the_lights_is_refused_with_its_line(tmp_
 
 
 def test_a_shadow_light_may_be_a_light_or_a_direction_towards_one(tmp_path: Path) -> None:
-    assert load_scene(write(tmp_path, ROOM)).shadow.light == (-2.0, 5.0, 2.0, 1.0)
+    assert load_scene(write(tmp_path, ROOM)).planar_shadow.light == (-2.0, 5.0, 2.0, 1.0)
     # Left out with exactly one light: that light.
     only = load_scene(write(tmp_path, ROOM.replace("light = [-2, 5, 2, 1] ", "# light")))
-    assert only.shadow.light == (-2.0, 5.0, 2.0, 1.0)
+    assert only.planar_shadow.light == (-2.0, 5.0, 2.0, 1.0)
     # A directional shadow light pointing at a light far away (the mirror lesson's far light).
     far = ROOM.replace("position = [-2, 5, 2]", "position = [-2000, 5000, 2000]").replace(
         "light = [-2, 5, 2, 1]", "light = [-2, 5, 2, 0]")
-    assert load_scene(write(tmp_path, far)).shadow.light[3] == 0.0
+    assert load_scene(write(tmp_path, far)).planar_shadow.light[3] == 0.0
     # Left out with two lights: which one is not guessed.
     two = ROOM.replace("light = [-2, 5, 2, 1] ", "# light").replace(
         "[[lights]]\nposition = [-2, 5, 2]\n", "[[lights]]\nposition = [-2, 5, 2]\n\n[[lights]]\nposition = [1, 1, 1]\n")

@@ -1,7 +1,7 @@
 """Frames are opaque (issue 12): every pixel's alpha is 255, as the window shows it.
 
-The rule is :data:`glsandbox.gl.target.FRAME_COLOR_MASK`: a target's alpha is
-made 1 once and never written, so the mirror's blended glass and shadow, an
+The rule is :data:`glsandbox.gl.target.FRAME_COLOR_MASK`: every clear writes a
+target's alpha as 1 (:func:`glsandbox.gl.target.clear_opaque`) and no draw writes it, so the mirror's blended glass and shadow, an
 unblended translucent node and a translucent clear colour all leave it 1.
 Checked on every lesson (raster and ray-traced), with MSAA, on a scene made
 to write alpha, and on the PNG ``glsandbox render`` writes. Every lesson's

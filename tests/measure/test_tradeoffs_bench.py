@@ -134,7 +134,7 @@ def test_tradeoffs_report_has_a_table_per_knob(quick_report: Path) -> None:
     rows = _rows(quick_report)
     knobs = {row["knob"] for row in rows}
     assert knobs == {"antialiasing", "lighting", "ray_engine", "texture_filter", "depth", "shadows_mirror",
-                     "shadow_offset"}
+                     "shadow_map", "shadow_offset"}
     for knob in knobs:  # one reference per knob, at zero error
         refs = [r for r in rows if r["knob"] == knob and r["reference"] == "1"]
         assert len(refs) == 1 and float(refs[0]["rmse"]) == 0.0 and refs[0]["psnr_db"] == "inf"
@@ -180,8 +180,8 @@ def test_depth_knob_counts_z_fighting_pixels(quick_report: Path) -> None:
     for label in ("standard 24-bit, lift 0.005, near 0.1", "standard 24-bit, lift 0.005, polygon offset",
                   "reverse-Z float, lift 0.005, no offset"):
         assert rows[label]["count_px"] == "0", label
-    others = [r for r in _rows(quick_report) if r["knob"] not in ("depth", "shadow_offset")]
-    assert all(r["count_px"] == "" for r in others)  # only the depth and shadow-offset knobs count pixels
+    others = [r for r in _rows(quick_report) if r["knob"] not in ("depth", "shadow_map", "shadow_offset")]
+    assert all(r["count_px"] == "" for r in others)  # only the depth, shadow-map and shadow-offset knobs count
     report = (quick_report / "report.md").read_text(encoding="utf-8")
     assert "## Depth precision (`depth`)" in report
     fights = int(rows["standard 24-bit, lift 0, no offset"]["count_px"])
@@ -281,7 +281,7 @@ def test_bench_unknown_case_is_one_line() -> None:
 
 # --- the raw-ModernGL baselines (benchmarks/lesson_frames.py) --------------------------------
 
-RAW_BASELINE_LESSONS = ("clear_and_swap", "triangle", "phong", "texture", "transform_order", "mirror")
+RAW_BASELINE_LESSONS = ("clear_and_swap", "triangle", "phong", "texture", "transform_order", "mirror", "shadow_map")
 
 
 def test_every_raw_baseline_is_checked_here() -> None:
@@ -301,8 +301,9 @@ def test_raw_baseline_draws_the_lessons_picture(gl, name: str) -> None:
         return {key: value for key, value in gl.host.raw.state_snapshot().items() if key != "depth_writemask"}
 
     size = (160, 120)
-    raw = _benchmark_module("lesson_frames.py").RAW_BASELINES[name](gl.host.ctx, size)
-    lesson = find_lesson(name)()
+    module = _benchmark_module("lesson_frames.py")
+    raw = module.RAW_BASELINES[name](gl.host.ctx, size)
+    lesson = find_lesson(name)(**module.RAW_SETTINGS.get(name, {}))
     for k in (0, 37, 150):
         expected = gl.render(lesson.at(0.01 * k), size).image.copy()
         before = state()
