@@ -128,12 +128,23 @@ def test_no_window_on_windows_or_macos_offers_no_linux_fix(monkeypatch, platform
                        "or use a headless backend: --backend standalone")
 
 
-def test_standalone_on_linux_without_an_x_server_says_to_use_egl(monkeypatch) -> None:
-    monkeypatch.delenv("DISPLAY", raising=False)
+@pytest.mark.parametrize(("platform", "hint"), [
+    ("linux", "on Linux it is GLX and needs an X display: use --backend egl or osmesa"),
+    ("win32", "update the graphics driver"), ("darwin", "macOS 10.9 or later gives OpenGL 4.1 core"),
+])
+def test_a_standalone_context_that_fails_is_one_line_with_this_systems_fix(monkeypatch, platform, hint) -> None:
+    import moderngl
+
+    def refuse(**kwargs):
+        assert kwargs == {"require": context.REQUIRED_GL}  # OpenGL 3.3 core, as every backend asks
+        raise Exception("(standalone) XOpenDisplay:\n cannot open display")
+
+    monkeypatch.setattr(moderngl, "create_standalone_context", refuse)
+    monkeypatch.setattr(sys, "platform", platform)
     with pytest.raises(SandboxError) as error:
         context.open_context("standalone")
-    assert str(error.value).startswith("standalone backend unavailable (")
-    assert "--backend egl or osmesa" in str(error.value)
+    assert str(error.value).startswith("standalone backend unavailable ((standalone) XOpenDisplay: cannot open "
+                                       "display); " + hint)
 
 
 def _render(backend: str, out: Path, env: dict[str, str]) -> subprocess.CompletedProcess:
