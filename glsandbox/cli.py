@@ -377,7 +377,11 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from glsandbox import __version__
+
     parser = ArgumentParser(prog="glsandbox", description="A graphics course as runnable ModernGL lessons.")
+    parser.add_argument("--version", action="version", version=f"glsandbox {__version__}",
+                        help="print glsandbox's version and exit")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     p = sub.add_parser("list", help="list the lessons")
