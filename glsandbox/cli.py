@@ -29,6 +29,7 @@ from glsandbox.frame import DEFAULT_SIZE, Frame, HeadlessRenderer, with_samples
 from glsandbox.gl.context import BACKENDS
 from glsandbox.lesson import Lesson, all_lessons, find_lesson, lesson_files, submission_lesson
 from glsandbox.plan import plan
+from glsandbox.progress import progress, say
 from glsandbox.scene import Scene
 from glsandbox.window import run_window
 
@@ -170,8 +171,9 @@ def cmd_compare(args: argparse.Namespace) -> int:
     # Everything is parsed and every scene built before a context opens.
     variants, columns = build_variants(lesson_cls, args.vary, args.settings)
     variants = [replace(v, scene=with_samples(v.scene, args.samples)) for v in variants]
-    with HeadlessRenderer(args.backend) as renderer:
-        result = compare_variants(variants, columns, size, renderer)
+    # Each variant is drawn twice: in the composed frame, and alone for the figures.
+    with HeadlessRenderer(args.backend) as renderer, progress(2 * len(variants), "compare", "tile") as bar:
+        result = compare_variants(variants, columns, size, renderer, advance=bar.update)
     write_png(result.image, out)
     print(result.report())
     if result.difference is not None:  # the first two distinct pictures, amplified
@@ -208,9 +210,9 @@ def cmd_tour(args: argparse.Namespace) -> int:
         lessons = [(cls.name, lambda cls=cls: cls) for cls in all_lessons()]
     results = []
     started = time.perf_counter()
-    with HeadlessRenderer(args.backend) as renderer:
-        print(f"tour: {len(lessons)} lessons at {size[0]}x{size[1]} on {renderer.host.backend} "
-              f"({renderer.host.ctx.info['GL_RENDERER']}) -> {out}/", file=sys.stderr)
+    with HeadlessRenderer(args.backend) as renderer, progress(len(lessons), "tour", "lesson") as bar:
+        say(f"tour: {len(lessons)} lessons at {size[0]}x{size[1]} on {renderer.host.backend} "
+            f"({renderer.host.ctx.info['GL_RENDERER']}) -> {out}/")
         for number, (name, load) in enumerate(lessons, start=1):
             entry = {"lesson": name, "title": "", "course_section": ""}
             prefix = f"[{number}/{len(lessons)}] {name}"
@@ -225,11 +227,12 @@ def cmd_tour(args: argparse.Namespace) -> int:
                 write_png(frame.image, image_path)
                 entry.update(ok=True, image=image_path.name, render_ms=round(frame.seconds * 1000, 2),
                              plan=frame.plan.to_dict(), plan_text=frame.plan.describe())
-                print(f"{prefix}: ok, {frame.seconds * 1000:.1f} ms", file=sys.stderr, flush=True)
+                say(f"{prefix}: ok, {frame.seconds * 1000:.1f} ms")
             except SandboxError as exc:  # one broken lesson must not stop the tour
                 entry.update(ok=False, error=str(exc))
-                print(f"{prefix}: FAILED: {exc}", file=sys.stderr, flush=True)
+                say(f"{prefix}: FAILED: {exc}")
             results.append(entry)
+            bar.update(1)
         renderer_name = renderer.host.renderer
         backend = renderer.host.backend
     summary = {"size": list(size), "samples": args.samples, "backend": backend, "renderer": renderer_name,

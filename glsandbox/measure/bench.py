@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from glsandbox.errors import SandboxError
+from glsandbox.progress import progress, say
 from glsandbox.files import write_text
 from glsandbox.frame import HeadlessRenderer, LazyRenderer
 
@@ -147,14 +148,20 @@ def _sample(side: Side, repeat: int, start: int) -> float:
     return (time.perf_counter() - t0) / repeat
 
 
-def measure(cases: Sequence[Case], rounds: int, log: Callable[[str], None] = lambda s: None) -> list[Result]:
-    """Alternating rounds over every case; the first call of each side is a warm-up and the picture check."""
+def measure(cases: Sequence[Case], rounds: int, log: Callable[[str], None] = lambda s: None,
+            advance: Callable[[int], object] = lambda n: None) -> list[Result]:
+    """Alternating rounds over every case; the first call of each side is a warm-up and the picture check.
+
+    ``advance(1)`` follows each case's warm-up and each case in each round:
+    ``len(cases) * (rounds + 1)`` steps (a progress bar's ``update``).
+    """
     results = []
     for case in cases:
         first_base = case.baseline.run(0) if case.baseline else None
         first_subject = case.subject.run(0)
         same = case.compare(first_base, first_subject) if case.compare and case.baseline else ""
         results.append(Result(case, [], [], same))
+        advance(1)
     for r in range(rounds):
         log(f"bench: round {r + 1}/{rounds}")
         for result in results:
@@ -165,6 +172,7 @@ def measure(cases: Sequence[Case], rounds: int, log: Callable[[str], None] = lam
             for side, samples in sides:
                 if side is not None:
                     samples.append(_sample(side, case.repeat, r * case.repeat))
+            advance(1)
     return results
 
 
@@ -252,7 +260,7 @@ def run_all(json_path: Path | None = None, quick: bool = False, only: Sequence[s
         raise SandboxError(f"--json {json_path}: not a file in an existing folder")
     folder = benchmarks_dir()
     env = BenchEnv(quick=quick, root=folder.parent)
-    log = lambda text: print(text, file=sys.stderr, flush=True)  # noqa: E731
+    log = say  # lines above the progress bar (only a terminal gets the bar)
     try:
         cases: list[Case] = []
         found_lines = []
@@ -281,7 +289,8 @@ def run_all(json_path: Path | None = None, quick: bool = False, only: Sequence[s
         if quick:
             cases = [_quick(c) for c in cases]
         started = time.perf_counter()
-        results = measure(cases, rounds, log)
+        with progress(len(cases) * (rounds + 1), "bench", "case") as bar:
+            results = measure(cases, rounds, log, bar.update)
         for summarize in summaries:
             for line in summarize(results):
                 env.note(line)
