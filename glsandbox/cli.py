@@ -114,14 +114,16 @@ def parse_size(text: str) -> tuple[int, int]:
     return size
 
 
-def add_render_options(parser: argparse.ArgumentParser) -> None:
-    """The options shared by every command that renders."""
-    parser.add_argument("--size", default=None, help="frame size WxH (default 640x480)")
+def add_render_options(parser: argparse.ArgumentParser, settings: bool = True,
+                       size_default: str = f"{DEFAULT_SIZE[0]}x{DEFAULT_SIZE[1]}") -> None:
+    """The options shared by every command that renders (``settings``: ``--set``, for one lesson)."""
+    parser.add_argument("--size", default=None, help=f"frame size WxH (default {size_default})")
     parser.add_argument("--samples", type=int, default=0, help="MSAA samples (0: none)")
     parser.add_argument("--backend", default=None, help=f"one of {', '.join(BACKENDS)} "
                         "(default: GLSANDBOX_BACKEND or auto)")
-    parser.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
-                        help="a lesson parameter (repeatable); every lesson has time=SECONDS")
+    if settings:
+        parser.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
+                            help="a lesson parameter (repeatable); every lesson has time=SECONDS")
 
 
 def _lesson(args: argparse.Namespace) -> Lesson:
@@ -188,8 +190,6 @@ def cmd_tour(args: argparse.Namespace) -> int:
     from glsandbox.measure.check import render_lesson
 
     out: Path = args.out
-    if args.settings:  # refused before the output folder exists
-        raise SandboxError("--set is per lesson; use glsandbox render LESSON --set ... instead of tour")
     if args.lessons is not None and not args.lessons.is_dir():
         raise SandboxError(f"--lessons {args.lessons}: not a folder")
     size = _size(args)
@@ -379,36 +379,74 @@ def cmd_bench(args: argparse.Namespace) -> int:
     return run_all(json_path=args.json, quick=args.quick, only=args.only)
 
 
+#: Each command: (what it does, in one line; examples). ``glsandbox COMMAND --help`` shows both.
+COMMANDS: dict[str, tuple[str, tuple[str, ...]]] = {
+    "list": ("list the course's lessons in course order, with -v each one's parameters",
+             ("glsandbox list", "glsandbox list -v")),
+    "run": ("open a lesson in a window (ESC quits, F1 the panel, F12 a screenshot, R reloads)",
+            ("glsandbox run phong", "glsandbox run phong --set shading=gouraud --samples 4",
+             "glsandbox run my_lesson.py")),
+    "render": ("render a lesson headless to a PNG file",
+               ("glsandbox render indexed_cube --out cube.png",
+                "glsandbox render phong --set time=1.5 --size 800x600 --out phong.png")),
+    "plan": ("print the passes, buffers and shader variants a lesson's frame needs",
+             ("glsandbox plan mirror", "glsandbox plan scene.toml")),
+    "tour": ("render every lesson headless into a folder, with a gallery page (index.html) and tour.json",
+             ("glsandbox tour", "glsandbox tour --out gallery --size 320x240",
+              "glsandbox tour --lessons submissions/ --out checked")),
+    "compare": ("render one lesson with several parameter values side by side, and say which pictures differ",
+                ("glsandbox compare phong --vary shading=phong,gouraud,blinn_phong",
+                 "glsandbox compare phong --vary shading=phong,gouraud --vary normals=correct,naive")),
+    "new": ("write a small commented starting lesson NAME.py, scene file NAME.toml and shader NAME.glsl",
+            ("glsandbox new my_lesson", "glsandbox new my_lesson --dir lessons_of_mine")),
+    "check": ("render a lesson (or each one in a folder) and compare it with a reference PNG: exit 0 match, 1 differs",
+              ("glsandbox check my_lesson.py --golden expected.png",
+               "glsandbox check submissions/ --golden expected.png --csv marks.csv",
+               "glsandbox check phong --golden phong.png --update")),
+    "tradeoffs": ("time each accuracy knob and compare it with a reference (FLIP, RMSE): report.md, CSV and plot",
+                  ("glsandbox tradeoffs --quick", "glsandbox tradeoffs --knob antialiasing --out out/aa")),
+    "bench": ("run every benchmark in benchmarks/ and print one table of side-by-side ratios",
+              ("glsandbox bench --quick", "glsandbox bench --only clear_and_swap --json bench.json")),
+}
+
+
+def add_command(sub: argparse._SubParsersAction, name: str) -> argparse.ArgumentParser:
+    """A subcommand whose ``--help`` starts with what it does and ends with examples."""
+    summary, examples = COMMANDS[name]
+    epilog = "examples:\n" + "\n".join(f"  {example}" for example in examples)
+    return sub.add_parser(name, help=summary, description=summary[:1].upper() + summary[1:] + ".", epilog=epilog,
+                          formatter_class=argparse.RawDescriptionHelpFormatter)
+
+
 def build_parser() -> argparse.ArgumentParser:
     from glsandbox import __version__
 
-    parser = ArgumentParser(prog="glsandbox", description="A graphics course as runnable ModernGL lessons.")
+    parser = ArgumentParser(prog="glsandbox", description="A graphics course as runnable ModernGL lessons.",
+                            epilog="glsandbox COMMAND --help says what a command does, with examples.")
     parser.add_argument("--version", action="version", version=f"glsandbox {__version__}",
                         help="print glsandbox's version and exit")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    p = sub.add_parser("list", help="list the lessons")
+    p = add_command(sub, "list")
     p.add_argument("-v", "--verbose", action="store_true", help="also list each lesson's parameters")
     p.set_defaults(func=cmd_list)
 
-    for name, func, help_text in (("run", cmd_run, "open a lesson in a window"),
-                                  ("render", cmd_render, "render a lesson headless to a PNG"),
-                                  ("plan", cmd_plan, "print the passes a lesson's scene needs")):
-        p = sub.add_parser(name, help=help_text)
+    for name, func in (("run", cmd_run), ("render", cmd_render), ("plan", cmd_plan)):
+        p = add_command(sub, name)
         p.add_argument("lesson", metavar="LESSON", help="a lesson name, a lesson .py file or a scene .toml file")
         add_render_options(p)
         if name == "render":
             p.add_argument("--out", type=Path, required=True, help="the PNG file to write")
         p.set_defaults(func=func)
 
-    p = sub.add_parser("tour", help="render every lesson headless, with a gallery page")
-    add_render_options(p)
+    p = add_command(sub, "tour")
+    add_render_options(p, settings=False)  # --set is per lesson: tour refuses it
     p.add_argument("--lessons", type=Path, default=None, metavar="DIR",
                    help="the lesson files (.py, .toml) in DIR instead of the course's lessons")
     p.add_argument("--out", type=Path, default=Path("out"), help="output folder (default out/)")
-    p.set_defaults(func=cmd_tour)
+    p.set_defaults(func=cmd_tour, settings=[])
 
-    p = sub.add_parser("compare", help="render one lesson with several parameter values side by side")
+    p = add_command(sub, "compare")
     p.add_argument("lesson", metavar="LESSON", help="a lesson name, a lesson .py file or a scene .toml file")
     p.add_argument("--vary", action="append", default=[], metavar="KEY=V1,V2,...",
                    help="a parameter and its values, one tile each (twice: a grid)")
@@ -416,12 +454,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", type=Path, default=None, help="the PNG to write (default compare_LESSON.png)")
     p.set_defaults(func=cmd_compare)
 
-    p = sub.add_parser("new", help="write a small commented starting lesson NAME.py, scene file NAME.toml and shader NAME.glsl")
+    p = add_command(sub, "new")
     p.add_argument("name", metavar="NAME", help="the lesson's name, a Python identifier (e.g. my_lesson)")
     p.add_argument("--dir", type=Path, default=Path("."), help="the folder to write into (default: here)")
     p.set_defaults(func=cmd_new)
 
-    p = sub.add_parser("check", help="render a lesson and compare it with a reference PNG (0 match, 1 differs)")
+    p = add_command(sub, "check")
     p.add_argument("lesson", metavar="LESSON_OR_DIR",
                    help="a lesson name, .py or .toml file, or a folder of them (one line each, and a table)")
     p.add_argument("--golden", type=Path, required=True, metavar="REF.png", help="the reference image")
@@ -431,10 +469,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="threshold=LEVELS (default 2) or max_bad_share=FRACTION (default 0.0005); repeatable")
     p.add_argument("--csv", type=Path, default=None, metavar="FILE", help="folder mode: the figures as CSV")
     p.add_argument("--json", type=Path, default=None, metavar="FILE", help="folder mode: the figures as JSON")
-    add_render_options(p)
+    add_render_options(p, size_default="the reference's size")
     p.set_defaults(func=cmd_check)
 
-    p = sub.add_parser("tradeoffs", help="what accuracy costs in time: each knob timed and compared with a reference")
+    p = add_command(sub, "tradeoffs")
     p.add_argument("--out", type=Path, default=Path("out/tradeoffs"), help="output folder (default out/tradeoffs)")
     p.add_argument("--quick", action="store_true", help="a reduced set at a small size (for CI)")
     p.add_argument("--runs", type=int, default=5, help="timed runs per setting (at least 5, default 5)")
@@ -442,7 +480,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--backend", default=None, help="GL backend (default: GLSANDBOX_BACKEND or auto)")
     p.set_defaults(func=cmd_tradeoffs)
 
-    p = sub.add_parser("bench", help="run every benchmark in benchmarks/ and print one table of ratios")
+    p = add_command(sub, "bench")
     p.add_argument("--json", type=Path, default=None, metavar="FILE", help="also write the figures as JSON")
     p.add_argument("--quick", action="store_true", help="fewer frames and rounds (a smoke run)")
     p.add_argument("--only", action="append", default=[], metavar="NAME",
@@ -458,8 +496,11 @@ def main(argv: list[str] | None = None) -> int:
 
 def lesson_main(lesson_cls: type[Lesson], argv: list[str] | None = None) -> int:
     """Entry point of a lesson module: a window, or ``--headless --out FILE.png``."""
-    parser = ArgumentParser(prog=f"python -m lessons.{lesson_cls.name}",
-                                     description=f"{lesson_cls.title} ({lesson_cls.course_section})")
+    prog = f"python -m lessons.{lesson_cls.name}"
+    parser = ArgumentParser(prog=prog, description=f"{lesson_cls.title} ({lesson_cls.course_section}): "
+                            "opens it in a window, or renders it headless to a PNG.",
+                            epilog=f"examples:\n  {prog}\n  {prog} --headless --out {lesson_cls.name}.png",
+                            formatter_class=argparse.RawDescriptionHelpFormatter)
     add_render_options(parser)
     parser.add_argument("--headless", action="store_true", help="render offscreen instead of opening a window")
     parser.add_argument("--out", type=Path, default=None, help="with --headless: the PNG to write")
