@@ -13,7 +13,7 @@ picture needs more than GL every frame (the transform-order lesson's matrix
 panel is text whose numbers change), the raw side does that work too, with its
 own code; what never changes (a constant text panel) is made once, like a mesh.
 The table's last column says whether both draw the same picture; the tests
-(``tests/test_tradeoffs_bench.py``) check each pixel for pixel at 160x120.
+(``tests/measure/test_tradeoffs_bench.py``) check each pixel for pixel at 160x120.
 Goal (issue 7): glsandbox <= 1.10x raw.
 """
 

@@ -54,7 +54,7 @@ __all__ = [
     "Camera", "Lesson", "Light", "Material", "Mesh", "Mirror", "Model", "Node", "Overlay", "Param", "PlanarShadow",
     "SandboxError", "Scene", "Texture", "Viewport",
     "__version__", "camera", "fit_mesh", "geometry", "load_mesh", "load_model", "meshgen", "register", "run",
-    "show", "text_image", "transforms", "widget",
+    "show", "text_image", "transforms", "view", "widget",
 ]
 
 
@@ -83,3 +83,11 @@ def widget(lesson: object, *args: object, **params: object) -> object:
     from glsandbox.notebook import widget as _widget
 
     return _widget(lesson, *args, **params)
+
+
+def view(lesson: object, *args: object, **params: object) -> object:
+    """A live view of the lesson in Jupyter (the ``notebook`` extra): drag to orbit, wheel to zoom,
+    a play button and a time slider (:func:`glsandbox.notebook.view`)."""
+    from glsandbox.notebook import view as _view
+
+    return _view(lesson, *args, **params)

@@ -11,9 +11,9 @@ print ``error: <one line>`` and exit with status 2.
 from __future__ import annotations
 
 import argparse
-import html
 import json
 import os
+import shlex
 import sys
 import time
 from collections.abc import Callable
@@ -23,11 +23,12 @@ from pathlib import Path
 
 import numpy as np
 
+from glsandbox.course_page import course_page
 from glsandbox.errors import SandboxError
 from glsandbox.files import save_png, write_text
 from glsandbox.frame import DEFAULT_SIZE, Frame, HeadlessRenderer, with_samples
 from glsandbox.gl.context import BACKENDS
-from glsandbox.lesson import Lesson, all_lessons, find_lesson, lesson_files, submission_lesson
+from glsandbox.lesson import Lesson, all_lessons, find_lesson, lesson_description, lesson_files, submission_lesson
 from glsandbox.plan import plan
 from glsandbox.progress import progress, say
 from glsandbox.scene import Scene
@@ -206,19 +207,21 @@ def cmd_tour(args: argparse.Namespace) -> int:
         if not found:
             raise SandboxError(f"--lessons {args.lessons}: no .py or .toml lesson files (nor subfolders holding one)")
         lessons = [(name, lambda path=path: submission_lesson(path)) for name, path in found]
+        commands = {name: f"glsandbox run {shlex.quote(str(path))}" for name, path in found}
     else:
         lessons = [(cls.name, lambda cls=cls: cls) for cls in all_lessons()]
+        commands = {cls.name: f"glsandbox run {cls.name}" for cls in all_lessons()}
     results = []
     started = time.perf_counter()
     with HeadlessRenderer(args.backend) as renderer, progress(len(lessons), "tour", "lesson") as bar:
         say(f"tour: {len(lessons)} lessons at {size[0]}x{size[1]} on {renderer.host.backend} "
             f"({renderer.host.ctx.info['GL_RENDERER']}) -> {out}/")
         for number, (name, load) in enumerate(lessons, start=1):
-            entry = {"lesson": name, "title": "", "course_section": ""}
+            entry = {"lesson": name, "title": "", "course_section": "", "command": commands[name], "contrasts": []}
             prefix = f"[{number}/{len(lessons)}] {name}"
             try:
                 cls = load()
-                entry.update(title=cls.title, course_section=cls.course_section)
+                entry.update(title=cls.title, course_section=cls.course_section, description=lesson_description(cls))
                 if args.lessons is None:
                     frame = renderer.render(cls(), size, args.samples)
                 else:  # a user's file: its own exceptions are one line, and a fresh context each
@@ -228,6 +231,8 @@ def cmd_tour(args: argparse.Namespace) -> int:
                 entry.update(ok=True, image=image_path.name, render_ms=round(frame.seconds * 1000, 2),
                              plan=frame.plan.to_dict(), plan_text=frame.plan.describe())
                 say(f"{prefix}: ok, {frame.seconds * 1000:.1f} ms")
+                if args.lessons is None:  # a user's lesson file runs only where its errors are caught
+                    entry["contrasts"] = _tour_contrasts(cls, out, size, args.samples, renderer, prefix)
             except SandboxError as exc:  # one broken lesson must not stop the tour
                 entry.update(ok=False, error=str(exc))
                 say(f"{prefix}: FAILED: {exc}")
@@ -236,19 +241,55 @@ def cmd_tour(args: argparse.Namespace) -> int:
         renderer_name = renderer.host.renderer
         backend = renderer.host.backend
     summary = {"size": list(size), "samples": args.samples, "backend": backend, "renderer": renderer_name,
+               "folder": None if args.lessons is None else str(args.lessons),
                "seconds": round(time.perf_counter() - started, 3), "lessons": results}
-    for name, text in (("tour.json", json.dumps(summary, indent=2) + "\n"), ("index.html", _gallery(summary))):
+    for name, text in (("tour.json", json.dumps(summary, indent=2) + "\n"), ("index.html", course_page(summary))):
         try:
             write_text(out / name, text)
         except OSError as exc:
             raise SandboxError(f"--out {out / name}: cannot write ({exc.strerror or exc})") from None
-    failed = [r["lesson"] for r in results if not r["ok"]]
-    print(f"tour: {len(results) - len(failed)} of {len(results)} rendered; gallery {out / 'index.html'}",
+    failed = [r["lesson"] for r in results if not r["ok"] or any("error" in c for c in r["contrasts"])]
+    print(f"tour: {len(results) - len(failed)} of {len(results)} rendered; course page {out / 'index.html'}",
           file=sys.stderr)
     if failed:
         print(f"tour: failed: {', '.join(failed)}", file=sys.stderr)
         return 1
     return 0
+
+
+#: A contrast grid's columns on the course page: three tiles side by side still read on a card.
+CONTRAST_COLUMNS = 3
+
+
+def _tour_contrasts(cls: type[Lesson], out: Path, size: tuple[int, int], samples: int,
+                    renderer: HeadlessRenderer, prefix: str) -> list[dict]:
+    """The lesson's contrasts (``Lesson.contrasts``) as tile grids beside its picture: each tile
+    half the tour's frame each way, the grid as ``glsandbox compare`` lays it out."""
+    from glsandbox.measure.compare import build_variants, render_grid
+
+    found = []
+    for number, (caption, vary) in enumerate(cls.contrasts, start=1):
+        entry: dict = {"caption": caption, "vary": vary,
+                       "command": f"glsandbox compare {cls.name} --vary {shlex.quote(vary)}"}
+        try:
+            variants, _ = build_variants(cls, [vary], [])
+            variants = [replace(v, scene=with_samples(v.scene, samples)) for v in variants]
+            columns = min(len(variants), CONTRAST_COLUMNS)
+            rows = -(-len(variants) // columns)
+            grid_size = (columns * max(1, size[0] // 2), rows * max(1, size[1] // 2))
+            image_path = out / f"{cls.name}.contrast{number}.png"
+            grid = render_grid(variants, columns, grid_size, renderer).copy()
+            tile = (grid_size[0] // columns, grid_size[1] // rows)
+            for slot in range(len(variants), rows * columns):  # the last row's empty tiles: transparent
+                x, y = (slot % columns) * tile[0], (slot // columns) * tile[1]
+                grid[y:y + tile[1], x:x + tile[0]] = 0
+            write_png(grid, image_path)
+            entry.update(image=image_path.name, size=list(grid_size), labels=[v.label for v in variants])
+        except SandboxError as exc:
+            entry["error"] = str(exc)
+            say(f"{prefix}: contrast {vary} FAILED: {exc}")
+        found.append(entry)
+    return found
 
 
 def cmd_new(args: argparse.Namespace) -> int:
@@ -333,34 +374,6 @@ def cmd_check(args: argparse.Namespace) -> int:
     for kind, path in paths.items():
         print(f"  {kind:<8}: {path}")
     return 0 if match.passed else 1
-
-
-def _gallery(summary: dict) -> str:
-    cards = []
-    for r in summary["lessons"]:
-        title = html.escape(f"{r['lesson']}: {r['title']}")
-        section = html.escape(r["course_section"])
-        if r["ok"]:
-            body = (f'<img src="{html.escape(r["image"])}" alt="{title}">'
-                    f"<p>render {r['render_ms']:.1f} ms</p><pre>{html.escape(r['plan_text'])}</pre>")
-        else:
-            body = f'<p class="error">failed: {html.escape(r["error"])}</p>'
-        cards.append(f"<section><h2>{title}</h2><p class=\"section\">course: {section}</p>{body}</section>")
-    return f"""<!doctype html>
-<html lang="en"><head><meta charset="utf-8"><title>glsandbox tour</title>
-<style>
-body {{ font-family: sans-serif; margin: 2em; background: #f4f4f4; }}
-section {{ background: white; padding: 1em; margin-bottom: 1.5em; border-radius: 6px; }}
-img {{ image-rendering: pixelated; border: 1px solid #ccc; }}
-pre {{ background: #eee; padding: 0.5em; }}
-.section {{ color: #555; }} .error {{ color: #b00; }}
-</style></head><body>
-<h1>glsandbox tour</h1>
-<p>{html.escape(summary['renderer'])} ({html.escape(summary['backend'])}),
-{summary['size'][0]}x{summary['size'][1]}, {summary['seconds']:.2f} s in all</p>
-{''.join(cards)}
-</body></html>
-"""
 
 
 def cmd_tradeoffs(args: argparse.Namespace) -> int:

@@ -44,9 +44,13 @@ STALE_SECONDS = 600.0
 
 
 def _tmp_prefix(name: str) -> str:
-    """``.<name>.``, cut so that the temporary name fits where ``name`` fits."""
+    """``.<name>.``, cut so that the temporary name fits where ``name`` fits.
+
+    The name's bytes as the file system has them (a name that is not UTF-8
+    arrives with surrogate escapes), cut to whole UTF-8 characters: bytes that
+    are not UTF-8 are left out of the prefix."""
     room = _NAME_MAX - len(".") - len(".") - 8 - len(_TMP_SUFFIX)
-    encoded = name.encode("utf-8")[:room].decode("utf-8", errors="ignore")
+    encoded = os.fsencode(name)[:room].decode("utf-8", errors="ignore")
     return f".{encoded}."
 
 

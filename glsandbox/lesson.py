@@ -12,6 +12,7 @@ import copy
 import difflib
 import importlib
 import importlib.util
+import inspect
 import itertools
 import math
 import pkgutil
@@ -181,6 +182,11 @@ class Lesson:
     #: Defaults of the shared parameters this lesson changes (the ray-tracing
     #: lessons set ``{"renderer": "ray"}``).
     defaults: ClassVar[dict[str, Any]] = {}
+    #: The comparisons the lesson is about, as (caption, ``--vary`` text): the
+    #: tour's course page shows each as a grid of labelled tiles, the picture
+    #: ``glsandbox compare NAME --vary TEXT`` writes (e.g. the mirror's
+    #: ``("stencil against leak", "mirror=stencil,no_stencil")``).
+    contrasts: ClassVar[tuple[tuple[str, str], ...]] = ()
 
     def __init__(self, **values: Any) -> None:
         known = {p.name: p for p in self.all_params()}
@@ -516,6 +522,16 @@ def submission_lesson(path: Path) -> type[Lesson]:
 
 
 # --- reading a lesson's file again (the window's reload on save) --------------
+
+
+def lesson_description(cls: type[Lesson]) -> str:
+    """What the lesson shows, in its author's words: the docstring of the module that
+    defines it (a lesson file's own), else of the class; "" for a scene file or none."""
+    if issubclass(cls, SceneFileLesson):
+        return ""
+    module = sys.modules.get(cls.__module__)
+    doc = (module.__doc__ if module is not None else None) or cls.__dict__.get("__doc__") or ""
+    return inspect.cleandoc(doc) if isinstance(doc, str) else ""
 
 
 def lesson_source(cls: type[Lesson]) -> Path | None:

@@ -5,17 +5,27 @@ In Jupyter::
     import glsandbox
     glsandbox.show("phong", specular=False)      # a picture, shown inline
     glsandbox.widget("transform_order")           # the parameters as ipywidgets, re-rendering on change
+    glsandbox.view("phong")                       # drag to orbit, wheel to zoom, play/slide the time
 
-Both render headless on one shared :class:`~glsandbox.frame.HeadlessRenderer`
+All render headless on one shared :class:`~glsandbox.frame.HeadlessRenderer`
 (EGL, else OSMesa), opened on first use: the pictures are exactly what
-``glsandbox render`` writes. :func:`widget` needs the optional ``notebook``
-extra (ipywidgets); without it, it raises one :class:`SandboxError` line.
-The widgets are the window panel's (:mod:`glsandbox.controls`): a combo
-becomes a dropdown, a checkbox a checkbox, a number a slider with the same range.
+``glsandbox render`` writes. :func:`widget` and :func:`view` need the optional
+``notebook`` extra (ipywidgets, jupyter_rfb); without it, they raise one
+:class:`SandboxError` line. The widgets are the window panel's
+(:mod:`glsandbox.controls`): a combo becomes a dropdown, a checkbox a
+checkbox, a number a slider with the same range.
+
+A widget lives only while its kernel runs: a saved notebook shown on a web
+site, or converted by nbconvert, has no kernel to draw it. So the boxes that
+:func:`widget` and :func:`view` return put their picture beside the widget in
+the cell's output (``image/png``, what the cell showed when it ran): a live
+notebook draws the widget, a static viewer shows the picture.
 """
 
 from __future__ import annotations
 
+import base64
+import functools
 from typing import Any
 
 import numpy as np
@@ -29,7 +39,7 @@ from glsandbox.scene import Scene
 
 #: The renderer every helper shares (a context opens once per kernel).
 _RENDERER = LazyRenderer()
-NOTEBOOK_MISSING = ("glsandbox.widget needs ipywidgets: install the notebook extra "
+NOTEBOOK_MISSING = ("glsandbox.{helper} needs {module}: install the notebook extra "
                     "(pip install 'glsandbox[notebook]', or uv sync --extra notebook)")
 
 
@@ -86,12 +96,37 @@ def show(lesson_or_scene: Any, size: tuple[int, int] = DEFAULT_SIZE, samples: in
     return render(lesson_or_scene, size, samples, **params)
 
 
-def _ipywidgets() -> Any:
+def _ipywidgets(helper: str = "widget") -> Any:
     try:
         import ipywidgets
     except ImportError:
-        raise SandboxError(NOTEBOOK_MISSING) from None
+        raise SandboxError(NOTEBOOK_MISSING.format(helper=helper, module="ipywidgets")) from None
     return ipywidgets
+
+
+@functools.cache
+def _picture_box_class(widgets: Any) -> type:
+    """``widgets.VBox`` whose output bundle also carries its picture (see the module's docstring)."""
+
+    class PictureBox(widgets.VBox):  # type: ignore[misc, name-defined]
+        #: () -> PNG bytes: the picture a static viewer shows
+        picture_source: Any = None
+        title: str = ""
+
+        def _repr_mimebundle_(self, **kwargs: Any) -> Any:
+            data = super()._repr_mimebundle_(**kwargs)
+            if isinstance(data, dict) and self.picture_source is not None:
+                data["image/png"] = base64.b64encode(self.picture_source()).decode("ascii")
+                data["text/plain"] = f"<glsandbox {self.title}>"
+            return data
+
+    return PictureBox
+
+
+def _picture_box(widgets: Any, children: list[Any], title: str, picture_source: Any) -> Any:
+    box = _picture_box_class(widgets)(children)
+    box.picture_source, box.title = picture_source, title
+    return box
 
 
 def _widget_for(widgets: Any, control: Control, value: Any) -> Any:
@@ -140,6 +175,33 @@ def widget(lesson: str | type[Lesson] | Lesson, size: tuple[int, int] = (480, 36
 
     for w in made.values():
         w.observe(changed, names="value")
-    box = widgets.VBox([*made.values(), error, image])
+    box = _picture_box(widgets, [*made.values(), error, image], f"widget {current.name}", lambda: image.value)
     box.controls, box.image, box.lesson, box.error = made, image, current, error
+    return box
+
+
+def view(lesson: str | type[Lesson] | Lesson, size: tuple[int, int] = (480, 360), **params: Any) -> Any:
+    """A live view of the lesson you can orbit: drag to orbit, the wheel to zoom, a double click
+    for the lesson's own camera, a play button and a slider for ``time``.
+
+    Returns an ``ipywidgets.VBox`` with ``.canvas`` (a jupyter_rfb widget: its
+    ``camera``, ``last_image`` and ``frame_ms``, the render time of each frame),
+    ``.time`` (the slider) and ``.play``. Needs the ``notebook`` extra."""
+    widgets = _ipywidgets("view")
+    try:
+        from glsandbox.notebook_view import make_view
+    except ImportError:
+        raise SandboxError(NOTEBOOK_MISSING.format(helper="view", module="jupyter_rfb")) from None
+    current = make_lesson(lesson, **params)
+    size = (int(size[0]), int(size[1]))
+    if min(size) <= 0:
+        raise SandboxError(f"view: size must be two positive integers, got {size}")
+    parts = make_view(current, lambda: _RENDERER.renderer, size)
+    canvas = parts.canvas
+
+    def picture() -> bytes:  # what the view shows now (drawn now if it has not drawn yet)
+        return png_bytes(canvas.last_image if canvas.last_image is not None else canvas.draw())
+
+    box = _picture_box(widgets, parts.children, f"view {current.name}", picture)
+    box.canvas, box.time, box.play = canvas, parts.time, parts.play
     return box

@@ -149,6 +149,8 @@ class MirrorLesson(Lesson):
     title = "A stencil mirror, a planar shadow, and depth precision"
     course_section = "The stencil Test: MarkMirrorDSS, DrawReflectionDSS, XMMatrixReflect, XMMatrixShadow"
     order = 70
+    contrasts = (("stencil against leak: the reflection through the stencil, and without it",
+                  "mirror=stencil,no_stencil"),)
     animated = True
     params = (
         Param("mirror", "stencil", "the mirror: through the stencil, without it (leaks), or none",

@@ -80,6 +80,8 @@ class PhongLesson(Lesson):
     title = "Two orbiting lights: Phong, Gouraud, Blinn-Phong, and the normal matrix"
     course_section = "Phong boyama modeli; Lighting"
     order = 50
+    contrasts = (("per-pixel Phong, per-vertex Gouraud, Blinn-Phong", "shading=phong,gouraud,blinn_phong"),
+                 ("the normal matrix against the course's mul(Norm, world)", "normals=correct,naive"))
     animated = True
     params = (
         Param("shading", "phong", "per-pixel Phong, per-vertex Gouraud, or Blinn-Phong", choices=LIT_SHADINGS),

@@ -102,6 +102,7 @@ class RayPhong(Lesson):
     title = "Phong, shadow rays and reflections; the 2013 and 2012 exam scenes"
     course_section = "Phong boyama modeli; Yansıma vektörü; Gölge testi"
     order = 140
+    contrasts = (("raster against ray: the same Scene rasterized and ray traced", "renderer=raster,ray"),)
     defaults = {"renderer": "ray"}
     params = (Param("scene", "demo", "which scene", choices=SCENES),)
 

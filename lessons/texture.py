@@ -63,6 +63,8 @@ class TextureLesson(Lesson):
     title = "Texture mapping: the 24-vertex cube, filters, mipmaps and wrap modes"
     course_section = "Texture Mapping (Doku Kaplama)"
     order = 60
+    contrasts = (("the filter grid: minification on the grazing ground",
+                  "filter=nearest,linear,mip_nearest,mip_linear,anisotropic"),)
     animated = True
     params = (
         Param("filter", "mip_linear", "sampler filter", choices=TEXTURE_FILTERS),

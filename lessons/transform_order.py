@@ -157,6 +157,7 @@ class TransformOrder(Lesson):
     title = "Transform order: two cubes, six orders of S, T, R"
     course_section = "Rotation, two cubes, transform order"
     order = 35
+    contrasts = (("the six orders of S, T and R", "order=STR,SRT,TSR,TRS,RST,RTS"),)
     animated = True
     params = (
         Param("order", "STR", "the order S, T, R act on the second cube (STR = mScale*mTranslate*mRotate)",

@@ -28,6 +28,7 @@ class Triangle(Lesson):
     title = "Quad as strip and as list; winding and culling"
     course_section = "Triangle; vertex buffer; TRIANGLESTRIP vs TRIANGLELIST"
     order = 20
+    contrasts = (("strip against list", "topology=strip,list"),)
     params = (
         Param("topology", "both", "draw the quad as a strip, a list, or both side by side",
               choices=("both", "strip", "list")),

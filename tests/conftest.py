@@ -3,25 +3,23 @@
 from __future__ import annotations
 
 import os
+import shutil
 from collections.abc import Callable
-from pathlib import Path
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 import pytest
+from support import GOLDENS_DIR, RESULTS_DIR, backend_available, need
 
 from glsandbox.measure.golden import ImageMatch, check_golden
-
-REPO_ROOT = Path(__file__).resolve().parent.parent  # the folder with pyproject.toml
 
 
 # --- golden images ---------------------------------------------------------
 # The rule is glsandbox.measure.golden's (README, "Tests and golden images").
-# Goldens live in tests/goldens/<name>.png, failure artefacts go to the
-# ignored test-results/ folder.
+# A lesson's goldens live in tests/goldens/<lesson>/<variant>.png (support.GOLDENS_DIR),
+# failure artefacts go to the ignored test-results/ folder.
 
-GOLDENS_DIR = REPO_ROOT / "tests" / "goldens"
-RESULTS_DIR = REPO_ROOT / "test-results"
 UPDATE_GOLDENS = "--update-goldens"
 
 
@@ -76,14 +74,6 @@ def golden(request: pytest.FixtureRequest) -> GoldenCheck:
 # reason to pass.
 
 
-def need(resource: str, reason: str) -> None:
-    """Skip (locally) or fail (CI) because ``resource`` is unavailable."""
-    message = f"{resource} unavailable: {reason}"
-    if os.environ.get("CI"):
-        pytest.fail(f"{message} (CI is set, so this fails instead of skipping)", pytrace=False)
-    pytest.skip(message)
-
-
 @pytest.fixture(scope="session")
 def gl_renderer():
     """A headless renderer on the default backend (EGL, else OSMesa), shared by the session."""
@@ -104,22 +94,9 @@ def gl(gl_renderer):
     return gl_renderer
 
 
-def backend_available(name: str) -> str | None:
-    """None when the backend starts here, else the reason (in a subprocess,
-    so a failed start cannot disturb this process's contexts)."""
-    import subprocess
-    import sys
-
-    code = ("from glsandbox.gl.context import open_context; import sys; "
-            f"h = open_context({name!r}); h.release()")
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
-    return None if proc.returncode == 0 else (proc.stderr.strip().splitlines() or ["failed"])[-1]
-
-
 @pytest.fixture(scope="session")
 def xvfb_display():
     """A private Xvfb server for window tests; yields its DISPLAY (e.g. ':5')."""
-    import shutil
     import subprocess
 
     if shutil.which("Xvfb") is None:
@@ -140,3 +117,58 @@ def xvfb_display():
     yield f":{number}"
     proc.terminate()
     proc.wait(timeout=10)
+
+
+@pytest.fixture
+def window_env(xvfb_display: str) -> str:
+    """The DISPLAY of the test X server, with xdotool to drive windows on it (support.LessonWindow)."""
+    if shutil.which("xdotool") is None:
+        need("xdotool", "not installed (apt-get install xdotool)")
+    return xvfb_display
+
+
+# --- headless backends and ray engines -----------------------------------------
+
+
+@pytest.fixture(scope="session", params=["egl", "osmesa"])
+def backend(request: pytest.FixtureRequest) -> str:
+    """Each headless backend by name (``--backend NAME``), skipped (failed on CI) where it does not start."""
+    reason = backend_available(request.param)
+    if reason:
+        need(f"the {request.param} backend", reason)
+    return request.param
+
+
+@dataclass(frozen=True)
+class Engine:
+    """A ray engine bound to what it needs: ``engine.render(scene, size, **options)``."""
+
+    name: str
+    ctx: Any = None
+
+    def render(self, scene, size: tuple[int, int], **options: Any) -> np.ndarray:
+        from glsandbox.raytrace import render
+
+        return render(scene, size, self.name, ctx=self.ctx, **options)
+
+
+@pytest.fixture(params=["numpy", "gpu"])
+def engine(request: pytest.FixtureRequest) -> Engine:
+    """Each ray engine: numpy (float64), and gpu (GLSL, float32) on the shared GL context."""
+    if request.param == "gpu":
+        return Engine("gpu", request.getfixturevalue("gl").host.ctx)
+    return Engine("numpy")
+
+
+# --- a browser ---------------------------------------------------------------
+
+
+@pytest.fixture(scope="session")
+def chromium() -> str:
+    """The path of a headless-capable Chromium (Debian's ``chromium`` package; .ci/run installs it)."""
+    for name in ("chromium", "chromium-browser", "google-chrome"):
+        found = shutil.which(name)
+        if found:
+            return found
+    need("Chromium", "no chromium binary on PATH (apt-get install chromium)")
+    raise AssertionError("unreachable")  # need() skips or fails

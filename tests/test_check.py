@@ -10,8 +10,7 @@ import numpy as np
 
 from glsandbox.files import load_png, save_png
 from glsandbox.measure.golden import compare_images
-from test_cli import assert_user_error, glsandbox
-from test_own_lessons import SPIN
+from support import SPIN, assert_user_error, glsandbox
 
 SIZE = "64x48"
 

@@ -25,7 +25,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("renderers", ("glsandbox.gl", "glsandbox.raytrace")),
     ("one frame", ("glsandbox.frame",)),
     ("window and measuring", ("glsandbox.window", "glsandbox.panel", "glsandbox.controls", "glsandbox.notebook",
-                              "glsandbox.measure")),
+                              "glsandbox.notebook_view", "glsandbox.course_page", "glsandbox.measure")),
     ("command line", ("glsandbox.cli", "glsandbox.pytest_plugin")),
 ]
 
@@ -178,7 +178,7 @@ def test_a_raster_frame_never_loads_the_ray_tracer_and_import_glsandbox_loads_no
     result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=ROOT)
     assert result.returncode == 0, result.stderr
     if result.stdout.startswith("no-gl"):
-        from conftest import need
+        from support import need
 
         need("a GL backend", result.stdout)
     assert result.stdout.strip() == "ok"

@@ -12,11 +12,11 @@ from email.parser import Parser
 from pathlib import Path
 
 import pytest
+from support import REPO_ROOT as REPO
 
 import glsandbox
 from glsandbox import cli
 
-REPO = Path(__file__).resolve().parent.parent
 
 
 @pytest.fixture(scope="module")

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from glsandbox.files import load_png, save_png
-from test_own_lessons import SPIN
+from support import SPIN
 
 pytest_plugins = ["pytester"]
 

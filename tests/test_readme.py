@@ -7,9 +7,10 @@ import subprocess
 import sys
 from pathlib import Path
 
-from glsandbox.files import load_png
+import pytest
+from support import REPO_ROOT as ROOT
 
-ROOT = Path(__file__).resolve().parents[1]
+from glsandbox.files import load_png
 
 
 def test_the_readme_lesson_of_your_own_renders(tmp_path: Path, gl) -> None:
@@ -31,6 +32,7 @@ def tutorial_section() -> str:
     return re.search(r"## Your own lesson, step by step\n(.*?)\n## ", text, re.S).group(1)
 
 
+@pytest.mark.slow
 def test_the_readme_tutorial_works_step_by_step(tmp_path: Path, gl) -> None:
     """Every command of "Your own lesson, step by step", as written, in a fresh folder
     (``uv run glsandbox`` / ``uv run pytest`` become this interpreter's ``-m glsandbox.cli`` /

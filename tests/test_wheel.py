@@ -8,11 +8,13 @@ import subprocess
 import zipfile
 from pathlib import Path
 
-from conftest import need
+import pytest
+from support import REPO_ROOT as REPO
+from support import need
 
 from glsandbox.files import load_png
 
-REPO = Path(__file__).resolve().parent.parent
+pytestmark = pytest.mark.slow  # builds a wheel and installs it in a fresh venv
 
 
 def run(*args: str, cwd: Path) -> subprocess.CompletedProcess:

@@ -289,6 +289,14 @@ def compare(lesson_cls: type[Lesson], varies: list[str], settings: list[str], si
     return compare_variants(variants, columns, size, renderer)
 
 
+def render_grid(variants: list[Variant], columns: int, size: tuple[int, int], renderer) -> np.ndarray:
+    """The labelled tiles in one frame of ``size``: composed as viewports of one scene
+    where the variants can share a frame, else rendered one by one and stitched."""
+    if composable(variants) is None:
+        return renderer.render_scene(compose(variants, columns, size), size).image
+    return stitch(variants, columns, size, renderer)
+
+
 def compare_variants(variants: list[Variant], columns: int, size: tuple[int, int], renderer,
                      advance: Callable[[int], object] = lambda n: None) -> CompareResult:
     """Render already built variants: the composed frame, then each alone for the figures.
@@ -298,10 +306,7 @@ def compare_variants(variants: list[Variant], columns: int, size: tuple[int, int
     """
     rows = math.ceil(len(variants) / columns)
     tile = (max(1, size[0] // columns), max(1, size[1] // rows))
-    if composable(variants) is None:
-        image = renderer.render_scene(compose(variants, columns, size), size).image
-    else:
-        image = stitch(variants, columns, size, renderer)
+    image = render_grid(variants, columns, size, renderer)
     advance(len(variants))
     alone = []
     for v in variants:

@@ -1,6 +1,6 @@
 """The course's first half: a ray tracer from scratch, in numpy float64 (and in GLSL, float32).
 
-Public API, in the course's words (``tests/raytrace/test_raytrace_worked_examples.py``
+Public API, in the course's words (``tests/raytrace/test_worked_examples.py``
 checks that these reproduce every worked example of the notes):
 
 - Vektörel işlemler: :func:`normalize`, :func:`dot`, :func:`cross`, :func:`length`;

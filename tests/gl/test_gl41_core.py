@@ -14,8 +14,8 @@ import sys
 from pathlib import Path
 
 import pytest
+from support import REPO_ROOT as REPO
 
-REPO = Path(__file__).resolve().parents[2]
 MACOS_GL = {"MESA_GL_VERSION_OVERRIDE": "4.1", "MESA_GLSL_VERSION_OVERRIDE": "410"}
 
 #: Run pytest on exactly the tests that compare with a golden image (wherever they live).

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import REPO_ROOT as REPO
-from conftest import need
+from support import REPO_ROOT as REPO
+from support import need
 
 from glsandbox.cli import main
 from glsandbox.errors import SandboxError

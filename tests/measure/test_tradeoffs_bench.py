@@ -101,6 +101,7 @@ def _rows(out: Path) -> list[dict[str, str]]:
         return list(csv.DictReader(handle))
 
 
+@pytest.mark.slow
 def test_tradeoffs_writes_every_file(quick_report: Path) -> None:
     for name in ("report.md", "tradeoffs.csv", "tradeoffs.png"):
         assert (quick_report / name).is_file(), name
@@ -113,6 +114,7 @@ def test_tradeoffs_writes_every_file(quick_report: Path) -> None:
         assert 0 < float(row["time_min_ms"]) <= float(row["time_median_ms"]) <= float(row["time_max_ms"])
 
 
+@pytest.mark.slow
 def test_tradeoffs_report_has_a_table_per_knob(quick_report: Path) -> None:
     report = (quick_report / "report.md").read_text(encoding="utf-8")
     header = "| setting | time median (ms) | spread min-max (ms) | RMSE | PSNR (dB) | FLIP | error map |"
@@ -134,6 +136,7 @@ def test_tradeoffs_report_has_a_table_per_knob(quick_report: Path) -> None:
         assert float(refs[0]["flip"]) == 0.0
 
 
+@pytest.mark.slow
 def test_tradeoffs_errors_fall_where_they_must(quick_report: Path) -> None:
     rows = {(r["knob"], r["setting"]): r for r in _rows(quick_report)}
 
@@ -153,6 +156,7 @@ def test_tradeoffs_errors_fall_where_they_must(quick_report: Path) -> None:
     assert "DOES NOT HOLD" not in report and report.count("(RMSE): holds") == 2
 
 
+@pytest.mark.slow
 def test_depth_knob_counts_z_fighting_pixels(quick_report: Path) -> None:
     # Seen from 90 units (tests/test_mirror.py pins it): a 24-bit buffer with no polygon offset
     # fights with or without the course's lift, and so does reverse-Z without any lift; each
@@ -180,6 +184,7 @@ def test_depth_knob_counts_z_fighting_pixels(quick_report: Path) -> None:
     assert "| default: reverse-Z float, lift 0.005, polygon offset (reference) | " in report
 
 
+@pytest.mark.slow
 def test_shadows_mirror_knob_against_the_ray_tracer(quick_report: Path) -> None:
     rows = {r["setting"]: r for r in _rows(quick_report) if r["knob"] == "shadows_mirror"}
     reference = rows["ray tracer, numpy (float64)"]
@@ -195,6 +200,7 @@ def test_shadows_mirror_knob_against_the_ray_tracer(quick_report: Path) -> None:
     assert "The two renderers model different things" in report  # the honest notes
 
 
+@pytest.mark.slow
 def test_tradeoffs_lists_what_is_not_measured_yet(quick_report: Path) -> None:
     from glsandbox.measure.knob import all_knobs
 
@@ -242,6 +248,7 @@ def test_tradeoffs_bad_runs_is_one_line() -> None:
 # --- glsandbox bench -----------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_bench_prints_one_table_and_writes_json(tmp_path: Path) -> None:
     out = tmp_path / "bench.json"
     proc = _run("bench", "--quick", "--only", "clear_and_swap", "--json", str(out))

@@ -53,7 +53,7 @@ KNOB = register_knob(Knob(
     reference=setting("default: reverse-Z float, lift 0.005, polygon offset", depth="reverse_z", offset=True),
     reference_note=("the lesson's default, reverse-Z (32-bit float depth, glClipControl 0..1) with polygon "
                     "offset and the course's 0.005 lift, which has no z-fighting pixel at any distance "
-                    "(tests/test_mirror.py)"),
+                    "(tests/lessons/test_mirror.py)"),
     count_label="z-fighting px",
     count_of="shadow px",
     notes=(

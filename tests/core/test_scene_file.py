@@ -1,0 +1,214 @@
+"""TOML scene files: a valid one loads; each mistake names the file and line."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from support import EXAMPLES_DIR
+
+from glsandbox.errors import SandboxError
+from glsandbox.plan import plan
+from glsandbox.scene_file import load_scene
+
+GOOD = """\
+name = "two boxes"
+clear_color = [0.1, 0.1, 0.1]
+
+[camera]
+eye = [0, 3, 10]
+fov_y = 45
+
+[[nodes]]
+name = "left"
+mesh = "cube"
+translate = [-2, 0, 0]
+
+[[nodes]]
+name = "right"
+mesh = "cube"
+order = "TRS"
+scale = [0.5, 1, 0.5]
+translate = [2, 0, 0]
+rotate = [0, 90, 0]
+color = [1, 0, 0]
+shading = "solid"
+"""
+
+
+def write(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "scene.toml"
+    path.write_text(text)
+    return path
+
+
+def test_a_valid_scene_loads_with_its_transforms(tmp_path: Path) -> None:
+    scene = load_scene(write(tmp_path, GOOD))
+    assert scene.name == "two boxes"
+    assert [n.name for n in scene.nodes] == ["left", "right"]
+    assert scene.clear_color == (0.1, 0.1, 0.1, 1.0)
+    # TRS: translate, then rotate about y by 90°, then scale: (2,0,0) -> (0,0,-2) -> (0,0,-1).
+    np.testing.assert_allclose(scene.nodes[1].model[:3, 3], (0, 0, -1), atol=1e-12)
+    assert scene.nodes[0].material.shading == "vertex_color"
+    assert plan(scene).buffers.depth
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        ("name = \n", r"scene.toml:1: malformed TOML"),
+        ("[[nodes]]\nmesh = \"cbe\"\n", r"scene.toml:2: nodes\[0\].mesh: unknown mesh 'cbe'"),
+        ("[[nodes]]\nmesh = \"cube\"\n\n[[nodes]]\nmesh = \"cube\"\norder = \"SST\"\n",
+         r"scene.toml:6: nodes\[1\].order: .*valid orders"),
+        ("[[nodes]]\nmesh = \"cube\"\ncolor = [2, 0, 0]\n", r"scene.toml:3: nodes\[0\].color: colour channels"),
+        ("[[nodes]]\nmesh = \"cube\"\nscale = [1, 1]\n", r"scene.toml:3: nodes\[0\].scale: expected a list of 3"),
+        ("[[nodes]]\nmesh = \"cube\"\nspin = 3\n", r"scene.toml:3: nodes\[0\].spin: unknown key"),
+        ("[camera]\neye = [0, 0, 0]\ntarget = [0, 5, 0]\n", r"scene.toml:1: camera: .*parallel"),
+        ("[[nodes]]\nname = \"x\"\n", r"scene.toml:1: nodes\[0\]: every node needs mesh"),
+        ("[[nodes]]\nmesh = \"triangle\"\nshading = \"vertex_color\"\n",
+         r"scene.toml:3: nodes\[0\].shading: mesh 'triangle' has no vertex colours"),
+    ],
+)
+def test_scene_errors_name_file_and_line(tmp_path: Path, text: str, expected: str) -> None:
+    with pytest.raises(SandboxError, match=expected) as info:
+        load_scene(write(tmp_path, text))
+    assert "\n" not in str(info.value)
+
+
+def test_missing_scene_file_is_named(tmp_path: Path) -> None:
+    with pytest.raises(SandboxError, match="scene file .*nothere.toml not found"):
+        load_scene(tmp_path / "nothere.toml")
+
+
+LIT = """\
+[[lights]]
+position = [2, 4, 3]
+
+[[nodes]]
+mesh = "cube24"
+shading = "blinn_phong"
+ambient = 0.2
+specular = 0.0
+shininess = 8
+normals = "naive"
+texture = "images/wood.png"
+filter = "nearest"
+wrap = "clamp"
+"""
+
+
+def test_lit_textured_nodes_load_with_paths_relative_to_the_scene_file(tmp_path: Path) -> None:
+    node = load_scene(write(tmp_path, LIT)).nodes[0]
+    m = node.material
+    assert (m.shading, m.ambient, m.diffuse, m.specular, m.shininess, m.normals) == (
+        "blinn_phong", 0.2, 0.4, 0.0, 8.0, "naive")
+    assert m.texture is not None
+    assert (m.texture.source, m.texture.filter, m.texture.wrap) == (str(tmp_path / "images/wood.png"), "nearest",
+                                                                     "clamp")
+    plan_text = plan(load_scene(write(tmp_path, LIT))).describe()
+    assert "NUM_LIGHTS=1" in plan_text and "texture unit 0" in plan_text
+
+
+@pytest.mark.parametrize(
+    ("change", "expected"),
+    [
+        (("filter = \"nearest\"", "filter = \"bicubic\""), r"scene.toml:12: nodes\[0\].filter: unknown texture filter"),
+        (("wrap = \"clamp\"", "wrap = \"tile\""), r"scene.toml:13: nodes\[0\].wrap: unknown texture wrap"),
+        (("ambient = 0.2", "ambient = -1"), r"scene.toml:7: nodes\[0\].ambient: material ambient must be"),
+        (("normals = \"naive\"", "normals = \"bent\""), r"scene.toml:10: nodes\[0\].normals: unknown normals"),
+        (("texture = \"images/wood.png\"\n", ""), r"scene.toml:11: nodes\[0\].filter: needs texture"),
+    ],
+)
+def test_material_errors_name_the_line(tmp_path: Path, change: tuple[str, str], expected: str) -> None:
+    with pytest.raises(SandboxError, match=expected):
+        load_scene(write(tmp_path, LIT.replace(*change)))
+
+
+def test_a_lit_scene_file_renders_lit(tmp_path: Path, gl) -> None:
+    from glsandbox.lesson import scene_file_lesson
+
+    path = write(tmp_path, '[[lights]]\nposition = [0, 0, 5]\n\n[[nodes]]\nmesh = "cube24"\nshading = "phong"\n'
+                           'color = [1, 0, 0]\n\n[camera]\neye = [0, 0, 6]\n')
+    image = gl.render(scene_file_lesson(path)(), (64, 64)).image
+    # Facing the light head on: 0.1 ambient + 0.4 diffuse + specular on red, clamped.
+    r, g, b, _ = image[32, 32]
+    assert r > 150 and g < r and b < r
+
+
+# --- the mirror and the shadow in a scene file ([mirror], [shadow], depth_mode) ---
+
+ROOM = (EXAMPLES_DIR / "mirror_room.toml").read_text()
+
+
+def without_table(text: str, table: str) -> str:
+    """The file with one ``[table]`` (its header up to the next blank line or the end) removed."""
+    start = text.index(f"[{table}]")
+    end = text.find("\n\n", start)
+    return text[:start] + (text[end:] if end >= 0 else "")
+
+
+def test_the_example_room_loads_its_mirror_shadow_and_depth_mode(tmp_path: Path) -> None:
+    scene = load_scene(write(tmp_path, ROOM))
+    assert scene.depth_mode == "reverse_z"
+    assert scene.mirror is not None and scene.shadow is not None
+    assert (scene.mirror.node, scene.mirror.reflected, scene.mirror.stencil) == ("glass", ("box", "floor"), True)
+    assert scene.mirror.plane == (0.0, 0.0, 1.0, 4.0)
+    assert (scene.shadow.receiver, scene.shadow.casters, scene.shadow.light) == ("floor", ("box",), (-2, 5, 2, 1))
+    assert (scene.shadow.lift, scene.shadow.polygon_offset, scene.shadow.stencil) == (0.005, True, True)
+    frame_plan = plan(scene)
+    assert [p.kind for p in frame_plan.passes] == ["clear", "draw", "mark_mirror", "reflection", "mirror_surface",
+                                                   "shadow"]
+    assert frame_plan.buffers.stencil and frame_plan.buffers.float_depth
+    # Without the two tables the plan has neither their passes nor the stencil.
+    plain = plan(load_scene(write(tmp_path, without_table(without_table(ROOM, "mirror"), "shadow"))))
+    assert [p.kind for p in plain.passes] == ["clear", "draw"] and not plain.buffers.stencil
+
+
+def test_the_example_room_shows_its_reflection_and_shadow(tmp_path: Path, gl) -> None:
+    from glsandbox.lesson import scene_file_lesson
+
+    def render(text: str, name: str) -> np.ndarray:
+        path = tmp_path / f"{name}.toml"
+        path.write_text(text)
+        return gl.render(scene_file_lesson(path)(), (160, 120)).image[..., :3].astype(int)
+
+    room = render(ROOM, "room")
+    no_mirror = render(without_table(ROOM, "mirror"), "no_mirror")
+    no_shadow = render(without_table(ROOM, "shadow"), "no_shadow")
+    # The mirror changes only the glass (the reflected box and floor appear in it) ...
+    changed = np.any(room != no_mirror, axis=-1)
+    assert changed.sum() > 300
+    rows, cols = np.nonzero(changed)
+    assert rows.min() > 15 and rows.max() < 55 and cols.min() > 80 and cols.max() < 120  # the glass, top middle
+    # ... and the shadow only darkens the floor beside the box.
+    darker = np.all(room <= no_shadow, axis=-1) & np.any(room < no_shadow, axis=-1)
+    assert darker.sum() > 50 and np.array_equal(darker, np.any(room != no_shadow, axis=-1))
+
+
+def line_of(text: str, fragment: str) -> int:
+    return next(i for i, line in enumerate(text.splitlines(), start=1) if fragment in line)
+
+
+@pytest.mark.parametrize(
+    ("change", "expected"),
+    [
+        (('reflected = ["box", "floor"]', 'reflected = ["box", "ghost"]'),
+         r"mirror.reflected: no node is named 'ghost'"),
+        (('reflected = ["box", "floor"]', 'reflected = ["box", "glass"]'), r"mirror.reflected: .*cannot reflect itself"),
+        (('node = "glass"', 'node = 3'), r"mirror.node: needs node"),
+        (('plane = [0, 0, 1, 4] ', 'tilt = 1 '), r"mirror.tilt: unknown key"),
+        (('light = [-2, 5, 2, 1]', 'light = [1, 0, 0, 0]'), r"shadow.light: .*parallel"),
+        (('casters = ["box"]', 'casters = "box"'), r"shadow.casters: expected a list of node names"),
+        (('depth_mode = "reverse_z"', 'depth_mode = "inverse"'), r"depth_mode: unknown depth mode 'inverse'"),
+    ],
+)
+def test_mirror_and_shadow_errors_name_the_line(tmp_path: Path, change: tuple[str, str], expected: str) -> None:
+    old, new = change
+    assert old in ROOM
+    text = ROOM.replace(old, new)
+    key_line = line_of(text, new.split("=")[0].strip() + " =")
+    with pytest.raises(SandboxError, match=rf"scene.toml:{key_line}: {expected}") as info:
+        load_scene(write(tmp_path, text))
+    assert "\n" not in str(info.value)

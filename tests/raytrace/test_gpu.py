@@ -1,0 +1,55 @@
+"""The gpu engine traces large mesh nodes through their BVHs (general program): a
+triangle past llvmpipe's 65,535 loop iterations appears, a ~20k-triangle rock agrees
+with the numpy engine pixel for pixel but for float32 edge grazes, and a ray that runs
+out of its step bound raises instead of drawing a wrong picture."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from glsandbox import Camera, Light, Material, Node, Scene, meshgen
+from glsandbox.raytrace import RayTraceError, render
+from glsandbox.raytrace import gpu as gpu_engine
+from glsandbox.raytrace.world import build_world
+
+from support import far_triangle_scene
+
+
+def rock_scene(subdivisions: int = 5) -> Scene:
+    mesh = meshgen.rock(subdivisions, seed=4, roughness=0.3)
+    material = Material(color=(0.8, 0.7, 0.6, 1.0))
+    return Scene("rock", nodes=(Node("rock", mesh, np.eye(4), material),),
+                 camera=Camera(eye=(0.0, 0.5, 3.0), target=(0.0, 0.0, 0.0)), lights=(Light((3.0, 3.0, 3.0)),),
+                 clear_color=(0.0, 0.0, 0.0, 1.0))
+
+
+def test_the_gpu_engine_finds_a_triangle_past_65535_through_the_bvh(gl) -> None:
+    image = render(far_triangle_scene(), (32, 24), "gpu", ctx=gl.host.ctx)
+    assert tuple(image[12, 16, :3]) == (230, 51, 51)  # the last triangle (index 69,999), its solid colour
+    assert tuple(image[0, 0, :3]) == (0, 0, 0)
+    assert (image[..., 3] == 255).all()
+
+
+def test_a_large_rock_hits_where_the_numpy_engine_hits(gl) -> None:
+    scene = rock_scene()
+    assert build_world(scene, 0).triangle_count == 20_480  # past gpu.BVH_TRIANGLES: the BVH program
+    size = (160, 120)
+    cpu = render(scene, size)
+    gpu = render(scene, size, "gpu", ctx=gl.host.ctx)
+    hit_cpu = cpu[..., :3].any(axis=-1)
+    hit_gpu = gpu[..., :3].any(axis=-1)
+    assert 0.2 < hit_cpu.mean() < 0.9
+    differing = np.count_nonzero(hit_cpu != hit_gpu)
+    assert differing < 0.01 * hit_cpu.size, differing
+    both = hit_cpu & hit_gpu
+    close = np.abs(cpu[..., :3].astype(int) - gpu[..., :3].astype(int)).max(axis=-1) <= 3
+    assert close[both].mean() > 0.97
+
+
+def test_a_ray_out_of_steps_raises(gl, monkeypatch) -> None:
+    monkeypatch.setattr(gpu_engine, "BVH_STEP_CAP", 4)
+    with pytest.raises(RayTraceError) as info:
+        render(rock_scene(), (40, 30), "gpu", ctx=gl.host.ctx)
+    message = str(info.value)
+    assert "\n" not in message and "4 steps" in message and "renderer=ray_numpy" in message

@@ -1,0 +1,306 @@
+"""What several test modules share: paths, the command line's error contract (in this process
+and in a subprocess), the window driver, and a few test scenes and files.
+
+Fixtures live in ``conftest.py`` only; test modules import helpers from here and never from
+another test module or from ``conftest.py`` (``tests/test_suite.py`` checks that).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import os
+import subprocess
+import sys
+import time
+import warnings
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+REPO_ROOT = Path(__file__).resolve().parent.parent  # the folder with pyproject.toml
+TESTS_DIR = REPO_ROOT / "tests"
+GOLDENS_DIR = TESTS_DIR / "goldens"  # one folder per lesson: goldens/<lesson>/<variant>.png
+RESULTS_DIR = REPO_ROOT / "test-results"  # failure artefacts (ignored by git)
+EXAMPLES_DIR = REPO_ROOT / "examples"
+
+COURSE_BLUE = (0, 32, 153)  # round(255 * (0, 0.125, 0.6)): the course's clear colour as RGB8
+COURSE_BLUE_RGBA8 = (*COURSE_BLUE, 255)
+
+
+# --- missing resources: skip locally, fail on CI ----------------------------------------------
+
+
+def need(resource: str, reason: str) -> None:
+    """Skip (locally) or fail (CI) because ``resource`` is unavailable: on CI a missing
+    backend or X server is a broken set-up, never a reason to pass."""
+    message = f"{resource} unavailable: {reason}"
+    if os.environ.get("CI"):
+        pytest.fail(f"{message} (CI is set, so this fails instead of skipping)", pytrace=False)
+    pytest.skip(message)
+
+
+def backend_available(name: str) -> str | None:
+    """None when the headless backend ``name`` starts here, else the reason (asked in a
+    subprocess, so a failed start cannot disturb this process's contexts)."""
+    code = ("from glsandbox.gl.context import open_context; import sys; "
+            f"h = open_context({name!r}); h.release()")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    return None if proc.returncode == 0 else (proc.stderr.strip().splitlines() or ["failed"])[-1]
+
+
+# --- the command line ------------------------------------------------------------------------
+# The contract for everything a user hands glsandbox: success, or exit 2 with exactly one
+# `error: ...` line on stderr, no traceback, no warning, and no file left behind.
+
+
+@dataclass
+class CliRun:
+    """One run of ``glsandbox``: the fields of :class:`subprocess.CompletedProcess` that tests read."""
+
+    args: list[str]
+    returncode: int
+    stdout: str
+    stderr: str
+
+
+def glsandbox(*args: str, env: dict | None = None, cwd: Path | None = None) -> subprocess.CompletedProcess:
+    """``python -m glsandbox.cli ARGS`` in a subprocess: for tests where the process is the point
+    (exit by signal, no display, a library path read at start-up, the installed entry point)."""
+    full_env = {**os.environ, **(env or {})}
+    return subprocess.run([sys.executable, "-m", "glsandbox.cli", *args], capture_output=True, text=True,
+                          env=full_env, cwd=cwd or REPO_ROOT, timeout=180)
+
+
+@contextlib.contextmanager
+def _environment(env: dict[str, str] | None, cwd: Path | None) -> Iterator[None]:
+    saved_env, saved_cwd = dict(os.environ), Path.cwd()
+    os.environ.update(env or {})
+    if cwd is not None:
+        os.chdir(cwd)
+    try:
+        yield
+    finally:
+        os.chdir(saved_cwd)
+        os.environ.clear()
+        os.environ.update(saved_env)
+
+
+def run_cli(*args: str, env: dict[str, str] | None = None, cwd: Path | None = None,
+            unchanged: Path | None = None) -> CliRun:
+    """``glsandbox ARGS`` in this process (``cli.main``), with the contract checked on every run:
+    no warning is raised; exit 2 is one ``error:`` line and no traceback; and, given
+    ``unchanged``, a failed run (exit not 0) leaves that folder's files as they were.
+    ``env`` entries are set for the run only; ``cwd`` is the working folder for the run."""
+    from glsandbox import cli
+
+    before = sorted(unchanged.rglob("*")) if unchanged is not None else None
+    stdout, stderr = io.StringIO(), io.StringIO()
+    with (_environment(env, cwd), warnings.catch_warnings(record=True) as caught,
+          contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr)):
+        warnings.simplefilter("always")
+        try:
+            status = cli.main(list(args))
+        except SystemExit as exc:  # argparse's own usage errors
+            status = exc.code if isinstance(exc.code, int) else 2
+    run = CliRun(list(args), status, stdout.getvalue(), stderr.getvalue())
+    assert [f"{w.category.__name__}: {w.message}" for w in caught] == [], run
+    if status == 2:
+        assert_user_error(run)
+    if before is not None and status != 0:
+        left = sorted(set(unchanged.rglob("*")) - set(before))
+        assert left == [], f"files left behind: {[str(p) for p in left]}"
+    return run
+
+
+def assert_user_error(proc: CliRun | subprocess.CompletedProcess, *fragments: str) -> None:
+    """Exit 2, exactly one ``error: ...`` line on stderr holding every fragment, no traceback."""
+    assert proc.returncode == 2, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), proc.stderr
+    assert "Traceback" not in proc.stderr
+    for fragment in fragments:
+        assert fragment in lines[0], lines[0]
+
+
+# --- the window under Xvfb ---------------------------------------------------------------------
+
+
+class LessonWindow:
+    """A lesson running in its own process on the test's X server (``python -m ARGS``)."""
+
+    def __init__(self, display: str, cwd: Path, *args: str, env: dict | None = None) -> None:
+        self.env = {**os.environ, "DISPLAY": display, **(env or {})}
+        self.display = display
+        self.proc = subprocess.Popen([sys.executable, "-m", *args], cwd=cwd, env=self.env,
+                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.window = self._wait(lambda: self._xdotool("search", "--name", "glsandbox").split()[:1])[0]
+
+    def _xdotool(self, *args: str) -> str:
+        proc = subprocess.run(["xdotool", *args], capture_output=True, text=True, env=self.env, timeout=20)
+        return proc.stdout.strip()
+
+    def _wait(self, probe, timeout: float = 30.0):
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if self.proc.poll() is not None:
+                raise AssertionError(f"lesson exited early with code {self.proc.returncode}: "
+                                     f"{self.proc.stdout.read()} {self.proc.stderr.read()}")
+            value = probe()
+            if value:
+                return value
+            time.sleep(0.1)
+        raise AssertionError("timed out waiting for the lesson window")
+
+    def title(self) -> str:
+        return self._xdotool("getwindowname", self.window)
+
+    def wait_title(self, predicate) -> str:
+        return self._wait(lambda: (t := self.title()) and predicate(t) and t)
+
+    def key(self, name: str) -> None:
+        self._xdotool("windowfocus", "--sync", self.window)
+        self._xdotool("key", "--window", self.window, name)
+
+    def screen(self) -> np.ndarray:
+        from PIL import ImageGrab
+
+        return np.asarray(ImageGrab.grab(xdisplay=self.display).convert("RGB"))
+
+    def close(self) -> int:
+        # Escape through XTEST to the focused window, not XSendEvent to our
+        # window: the lesson destroys its window on the press, the release
+        # sent to that window then fails, and xdotool leaves Escape held in
+        # the server, where autorepeat closes the next test's window.
+        self._xdotool("windowfocus", "--sync", self.window)
+        self._xdotool("key", "Escape")
+        try:
+            return self.proc.wait(timeout=20)
+        finally:
+            if self.proc.poll() is None:
+                self.proc.kill()
+
+
+def wait_for(path: Path, timeout: float = 20.0) -> Path:
+    """``path`` once it exists (a screenshot the window writes), or an AssertionError."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if path.exists():
+            time.sleep(0.2)  # the file is written atomically; give the rename a moment
+            return path
+        time.sleep(0.1)
+    raise AssertionError(f"{path} was not written")
+
+
+# --- files and scenes several modules use ------------------------------------------------------
+
+#: A lesson file: a spinning cube whose name clashes with a built-in lesson (which it must not shadow).
+SPIN = '''
+import glsandbox
+from glsandbox import Lesson, Node, Param, Scene, geometry, register, transforms
+
+@register
+class Spin(Lesson):
+    name = "phong"          # the same name as a built-in lesson: it must not shadow it
+    animated = True
+    params = (Param("speed", 1.0, "radians per second"),)
+
+    def build(self) -> Scene:
+        turn = transforms.rotate_y(self.values["speed"] * self.time)
+        return Scene(self.name, nodes=(Node("cube", geometry.cube(), turn),))
+'''
+
+# A unit cube as an OBJ: 8 vertices, 12 counter-clockwise triangles (outward fronts).
+CUBE_OBJ = """\
+v -1 -1 -1
+v 1 -1 -1
+v 1 1 -1
+v -1 1 -1
+v -1 -1 1
+v 1 -1 1
+v 1 1 1
+v -1 1 1
+f 1 4 3
+f 1 3 2
+f 5 6 7
+f 5 7 8
+f 1 5 8
+f 1 8 4
+f 2 3 7
+f 2 7 6
+f 4 8 7
+f 4 7 3
+f 1 2 6
+f 1 6 5
+"""
+
+
+def quadrant_image():
+    """Red top-left, green top-right, blue bottom-left, yellow bottom-right: 16x16 pixels, so that
+    bilinear sampling (the ray tracer's) reads pure colours inside each quadrant."""
+    from PIL import Image
+
+    quadrants = np.array([[(255, 0, 0), (0, 255, 0)], [(0, 0, 255), (255, 255, 0)]], dtype=np.uint8)
+    return Image.fromarray(np.repeat(np.repeat(quadrants, 8, axis=0), 8, axis=1))
+
+
+def textured_quad_glb(path: Path) -> Path:
+    """A unit quad in the xy plane facing +z, with the quadrant image as its glTF base colour texture
+    (white factor), uv laid so the image shows upright seen from +z."""
+    import trimesh
+
+    quad = trimesh.Trimesh(vertices=[[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], faces=[[0, 1, 2], [0, 2, 3]],
+                           process=False)
+    material = trimesh.visual.material.PBRMaterial(baseColorTexture=quadrant_image(),
+                                                   baseColorFactor=[255, 255, 255, 255])
+    # trimesh's uv: v up (OpenGL); it writes glTF's v-down uv itself.
+    quad.visual = trimesh.visual.TextureVisuals(uv=[[0, 0], [1, 0], [1, 1], [0, 1]], material=material)
+    quad.export(path)
+    return path
+
+
+def far_triangle_scene(count: int = 70_000):
+    """One mesh node of ``count`` triangles whose only visible one is the last (index
+    ``count − 1``, past llvmpipe's 65,535 loop iterations): the others are tiny and behind the camera."""
+    from glsandbox import Camera, Light, Material, Mesh, Node, Scene
+
+    base = np.array([[0.0, 0.0, 0.0], [1e-3, 0.0, 0.0], [0.0, 1e-3, 0.0]])
+    hidden = base[None] + np.array([0.0, 0.0, 50.0]) + (np.arange(count - 1) * 1e-3)[:, None, None] * [1.0, 0, 0]
+    visible = np.array([[[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, 0.0]]])
+    positions = np.concatenate([hidden, visible]).reshape(-1, 3)
+    mesh = Mesh("far_triangle", positions, normals=np.tile([0.0, 0.0, 1.0], (positions.shape[0], 1)))
+    material = Material(color=(0.9, 0.2, 0.2, 1.0), shading="solid")
+    return Scene("far_triangle", nodes=(Node("big", mesh, np.eye(4), material),),
+                 camera=Camera(eye=(0.0, 0.0, 5.0), target=(0.0, 0.0, 0.0)), lights=(Light((0.0, 3.0, 3.0)),),
+                 clear_color=(0.0, 0.0, 0.0, 1.0))
+
+
+# --- lessons and their goldens -------------------------------------------------------------------
+
+
+def variant_name(settings: tuple[str, ...] | list[str]) -> str:
+    """A golden's file stem for a lesson's ``--set`` values: ``default``, or ``scene_exam2012``."""
+    return "-".join(s.replace("=", "_") for s in settings) or "default"
+
+
+def lesson_image(gl, name: str, *settings: str, size: tuple[int, int] = (256, 256), samples: int = 0) -> np.ndarray:
+    """Built-in lesson ``name`` with ``--set`` values ``settings``, rendered headless by ``gl``."""
+    from glsandbox.lesson import find_lesson
+
+    return gl.render(find_lesson(name).from_settings(list(settings)), size, samples).image
+
+
+def count_color(image: np.ndarray, rgba) -> int:
+    """How many pixels of ``image`` are exactly ``rgba``."""
+    return int(np.all(image == np.array(rgba, dtype=np.uint8), axis=-1).sum())
+
+
+def check_lesson_golden(gl, golden, name: str, *settings: str, size: tuple[int, int] = (256, 256)) -> np.ndarray:
+    """Render lesson ``name`` with ``settings`` headless and check it against
+    ``tests/goldens/<name>/<variant>.png``; the image, for further checks."""
+    image = lesson_image(gl, name, *settings, size=size)
+    golden(image, f"{name}/{variant_name(settings)}")
+    return image
