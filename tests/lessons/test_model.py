@@ -123,7 +123,9 @@ def bad_files(folder: Path) -> dict[str, str]:
         "truncated.ply": "not a readable PLY file", "garbage.stl": "not a readable STL file",
         "garbage.obj": "garbage.obj", "points.obj": "has no faces", "degenerate.obj": "all 2 are degenerate",
         "nan.obj": "NaN or infinite", "inf.ply": "NaN or infinite", "range.obj": "out of range",
-        "range.off": ("face index outside the range", "refers to vertex 5"),  # trimesh >= 4.6 refuses it, older: we do "folder.obj": "is a folder", "model.xyz": "unknown format",
+        # trimesh >= 4.6 refuses an out-of-range OFF face itself; older ones load it and glsandbox refuses it
+        "range.off": ("face index outside the range", "refers to vertex 5"), "folder.obj": "is a folder",
+        "model.xyz": "unknown format",
     }
 
 
