@@ -36,6 +36,7 @@ from glsandbox.errors import SandboxError
 from glsandbox.progress import progress, say
 from glsandbox.files import write_text
 from glsandbox.frame import HeadlessRenderer, LazyRenderer
+from glsandbox.gl.context import headless_order
 
 #: The frame size of the frame benchmarks (the course's 800x600 window).
 FRAME_SIZE = (800, 600)
@@ -84,8 +85,9 @@ class BenchEnv:
     root: Path = field(default_factory=lambda: Path.cwd())
     #: Lines printed under the table (and written to the JSON): what a module skipped and why.
     notes: list[str] = field(default_factory=list)
-    #: The one EGL context every case draws on, opened by the first case that asks for it.
-    gl: LazyRenderer = field(default_factory=lambda: LazyRenderer("egl"))
+    #: The one headless context every case draws on (EGL on Linux, the standalone WGL/CGL one on
+    #: Windows and macOS), opened by the first case that asks for it.
+    gl: LazyRenderer = field(default_factory=lambda: LazyRenderer(headless_order()[0]))
 
     def note(self, text: str) -> None:
         """Print ``text`` under the table, e.g. ``skipped: embreex not installed``."""
@@ -94,7 +96,7 @@ class BenchEnv:
 
     @property
     def renderer(self) -> HeadlessRenderer:
-        """One :class:`~glsandbox.frame.HeadlessRenderer` on EGL for every case (one context)."""
+        """One :class:`~glsandbox.frame.HeadlessRenderer` for every case (one context)."""
         return self.gl.renderer
 
     def renderer_name(self) -> str:
