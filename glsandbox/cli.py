@@ -432,7 +432,7 @@ def add_command(sub: argparse._SubParsersAction, name: str) -> argparse.Argument
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from glsandbox import __version__
+    from glsandbox.version import __version__
 
     parser = ArgumentParser(prog="glsandbox", description="A graphics course as runnable ModernGL lessons.",
                             epilog="glsandbox COMMAND --help says what a command does, with examples.")

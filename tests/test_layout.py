@@ -18,7 +18,8 @@ ROOT = Path(__file__).resolve().parents[1]
 #: Lowest first. A module may import its own layer and the ones above it in this list.
 LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("core", ("glsandbox.errors", "glsandbox.transforms", "glsandbox.meshnormals", "glsandbox.geometry",
-              "glsandbox.meshgen", "glsandbox.files", "glsandbox.file_watch")),
+              "glsandbox.meshgen", "glsandbox.files", "glsandbox.file_watch", "glsandbox.progress",
+              "glsandbox.version")),
     ("scene data", ("glsandbox.scene", "glsandbox.planar", "glsandbox.images",
                     "glsandbox.overlay", "glsandbox.meshfile")),
     ("scene logic", ("glsandbox.scene_file", "glsandbox.plan", "glsandbox.camera", "glsandbox.lesson")),
@@ -26,7 +27,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("one frame", ("glsandbox.frame",)),
     ("window and measuring", ("glsandbox.window", "glsandbox.panel", "glsandbox.controls", "glsandbox.notebook",
                               "glsandbox.notebook_view", "glsandbox.course_page", "glsandbox.measure")),
-    ("command line", ("glsandbox.cli", "glsandbox.pytest_plugin")),
+    ("command line", ("glsandbox.cli", "glsandbox.pytest_plugin", "glsandbox.__main__")),
 ]
 
 #: The two doors up, each opened only when called: lesson discovery
