@@ -14,7 +14,8 @@ panel is text whose numbers change), the raw side does that work too, with its
 own code; what never changes (a constant text panel) is made once, like a mesh.
 The table's last column says whether both draw the same picture; the tests
 (``tests/measure/test_tradeoffs_bench.py``) check each pixel for pixel at 160x120.
-Goal (issue 7): glsandbox <= 1.10x raw.
+Goals (issue 24): glsandbox <= 1.05x raw, and at most 50 us of extra main-thread
+CPU per frame (the bench's "extra CPU" column).
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ import math
 import moderngl
 import numpy as np
 
-from _raw import (COLOR_MASK, GL_ALWAYS, GL_EQUAL, GL_INVERT, GL_KEEP, GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE,
+from _raw import (COLOR_MASK, clear, GL_ALWAYS, GL_EQUAL, GL_INVERT, GL_KEEP, GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE,
                   GL_REPLACE, GL_STENCIL_BUFFER_BIT, GL_STENCIL_TEST, GL_ZERO_TO_ONE, VERTEX_COLOR_FS, VERTEX_COLOR_VS,
                   depth_stencil_framebuffer, framebuffer, gl, gl_calls, look_at, perspective, read, reverse_z, rotate_x,
                   rotate_y, rotate_z, scale, translate)
@@ -120,7 +121,7 @@ class RawClear:
     def frame(self, k: int) -> np.ndarray:
         self.fbo.use()
         for rect, color in self.rects:
-            self.fbo.clear(*color, viewport=rect)
+            clear(self.fbo, *color[:3], viewport=rect)
         return read(self.fbo, self.size)
 
 
@@ -145,7 +146,7 @@ class RawTriangle:
         ctx.enable(moderngl.CULL_FACE)
         for rect, proj, vao, mode in zip(self.rects, self.projs, (self.strip, self.list),
                                          (moderngl.TRIANGLE_STRIP, moderngl.TRIANGLES)):
-            self.fbo.clear(0.0, 0.125, 0.6, 1.0, viewport=rect)
+            clear(self.fbo, 0.0, 0.125, 0.6, viewport=rect)
             self.fbo.viewport = rect
             p["m_model"].write(gl(np.eye(4)))
             p["m_view"].write(self.view)
@@ -181,7 +182,7 @@ class RawPhong:
         light_colors = np.array([(1, 1, 1), (1, 1, 0)], "f4")
         ctx, lit, solid = self.ctx, self.lit, self.solid
         self.fbo.use()
-        self.fbo.clear(0.0, 0.125, 0.6, 1.0, depth=1.0)
+        clear(self.fbo, 0.0, 0.125, 0.6, depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
         lit["m_view"].write(gl(self.view))
         lit["m_proj"].write(gl(self.proj))
@@ -231,7 +232,7 @@ class RawTexture:
         t = 0.01 * k
         ctx, p = self.ctx, self.program
         self.fbo.use()
-        self.fbo.clear(0.55, 0.7, 0.9, 1.0, depth=1.0)
+        clear(self.fbo, 0.55, 0.7, 0.9, depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
         p["m_view"].write(gl(self.view))
         p["m_proj"].write(gl(self.proj))
@@ -339,7 +340,7 @@ class RawTransformOrder:
             self.panel.write(pixels, alignment=1)
 
         self.fbo.use()
-        self.fbo.clear(0.0, 0.125, 0.6, 1.0, depth=1.0)
+        clear(self.fbo, 0.0, 0.125, 0.6, depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
         colored["m_view"].write(self.view)
         colored["m_proj"].write(self.proj)
@@ -486,7 +487,7 @@ class RawMirror:
         self.fbo.use()
         raw.ClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE)  # reverse-Z: depth 0..1 as is, near 1, far 0
         ctx.depth_func = ">"
-        self.fbo.clear(0.08, 0.08, 0.12, 1.0, depth=0.0)
+        clear(self.fbo, 0.08, 0.08, 0.12, depth=0.0)
         raw.ClearStencil(0)
         raw.Clear(GL_STENCIL_BUFFER_BIT)
         ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
@@ -535,24 +536,137 @@ class RawMirror:
         return read(self.fbo, self.size)
 
 
+# The lit pass of the shadow-map lesson: one light, its map sampled with a comparison sampler.
+SHADOW_PHONG_FS = """#version 330 core
+uniform vec4 u_color; uniform vec3 u_eye; uniform vec3 u_light_pos; uniform vec3 u_light_color;
+uniform sampler2DShadow u_map; uniform mat4 u_light_matrix; uniform float u_texel;
+in vec3 v_world; in vec3 v_normal; out vec4 frag_color;
+float lit_share(vec3 p, vec3 n, vec3 l) {
+    float c = clamp(dot(n, l), 0.05, 1.0);
+    vec4 clip = u_light_matrix * vec4(p + l * (0.02 + 0.02 * sqrt(1.0 - c * c) / c), 1.0);
+    if (clip.w <= 0.0) return 1.0;
+    vec3 q = clip.xyz / clip.w * 0.5 + 0.5;
+    if (any(lessThan(q, vec3(0.0))) || any(greaterThan(q, vec3(1.0)))) return 1.0;
+    float sum = 0.0;
+    for (int y = -1; y <= 1; ++y)
+        for (int x = -1; x <= 1; ++x) sum += texture(u_map, vec3(q.xy + vec2(x, y) * u_texel, q.z));
+    return sum / 9.0;
+}
+void main() {
+    vec3 n = normalize(v_normal), mesh = u_color.rgb;
+    vec3 to_eye = normalize(u_eye - v_world), l = normalize(u_light_pos - v_world);
+    float nl = dot(n, l), s = 0.0;
+    if (nl > 0.0) { s = pow(max(dot(to_eye, 2.0 * nl * n - l), 0.0), 32.0); }
+    float visible = lit_share(v_world, n, l);
+    frag_color = vec4(min(0.1 * mesh + visible * (0.4 * (max(nl, 0.0) * mesh * u_light_color)
+                                                  + 0.3 * (s * u_light_color)), vec3(1.0)), u_color.a);
+}
+"""
+
+
+class RawShadowMap:
+    """shadow_map (show=map): the two passes by hand. The casters' depth from the light into a
+    1024² depth texture (a perspective frustum from the light at the centre of the casters' bounds,
+    near and far around every corner), then the lit pass comparing each pixel with it, 3x3 PCF."""
+
+    def __init__(self, ctx: moderngl.Context, size: tuple[int, int]) -> None:
+        from glsandbox import geometry
+        from lessons import shadow_map as lesson
+
+        self.ctx, self.size, self.fbo, self.lesson = ctx, size, framebuffer(ctx, size), lesson
+        self.depth = ctx.program(vertex_shader=SOLID_VS, fragment_shader=SOLID_FS)
+        self.lit = ctx.program(vertex_shader=PHONG_VS, fragment_shader=SHADOW_PHONG_FS)
+        self.map = ctx.depth_texture((1024, 1024))
+        self.map.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        self.map.repeat_x = self.map.repeat_y = False
+        self.map.compare_func = "<="
+        self.map_fbo = ctx.framebuffer(depth_attachment=self.map)
+        meshes = {"floor": geometry.plane(1.0), "cube": geometry.cube24(), "sphere": geometry.sphere(),
+                  "panel": geometry.cube24()}
+        self.names = tuple(meshes)
+        self.lit_vaos = {k: _vao(ctx, self.lit, m, with_normals=True) for k, m in meshes.items()}
+        self.depth_vaos = {k: _vao(ctx, self.depth, m) for k, m in meshes.items()}
+        # Each mesh's bounding box corners (model space), for the light's frustum.
+        self.corners = {k: np.array([[(m.positions.min(0), m.positions.max(0))[i >> a & 1][a] for a in range(3)]
+                                     for i in range(8)]) for k, m in meshes.items()}
+        eye, target = lesson.SINGLE_VIEW
+        self.eye, self.view = eye, look_at(eye, target)
+        self.proj = perspective(lesson.FOV, size[0] / size[1], lesson.NEAR, lesson.FAR)
+
+    def models(self, t: float) -> dict[str, np.ndarray]:
+        les = self.lesson
+        h = les.CUBE_HALF
+        return {"floor": scale(les.FLOOR_SIZE, 1.0, les.FLOOR_SIZE),
+                "cube": translate(*les.CUBE_AT) @ rotate_y(0.4 + 0.5 * t) @ scale(h, h, h),
+                "sphere": translate(*les.SPHERE[0]) @ scale(*(les.SPHERE[1],) * 3),
+                "panel": translate(*les.PANEL[0]) @ scale(*les.PANEL[1])}
+
+    def light_matrix(self, models: dict[str, np.ndarray]) -> np.ndarray:
+        light = np.asarray(self.lesson.LIGHT, dtype=np.float64)
+        points = np.concatenate([(np.c_[self.corners[k], np.ones(8)] @ models[k].T)[:, :3] for k in self.names])
+        target = points.mean(axis=0)
+        forward = (target - light) / np.linalg.norm(target - light)
+        view = look_at(light, target, (0.0, 0.0, 1.0) if abs(forward[1]) > 0.9 else (0.0, 1.0, 0.0))
+        depths = -(np.c_[points, np.ones(len(points))] @ view.T)[:, 2]
+        far = max(float(depths.max()), 1e-3) * 1.01
+        near = max(float(depths.min()) * 0.99, far * 1e-3)
+        return perspective(self.lesson.MAP_FOV, 1.0, near, far) @ view
+
+    def frame(self, k: int) -> np.ndarray:
+        ctx, depth, lit = self.ctx, self.depth, self.lit
+        models = self.models(0.01 * k)
+        light_matrix = self.light_matrix(models)
+        ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
+        self.map_fbo.use()  # pass 1: depth only, from the light
+        self.map_fbo.clear(depth=1.0)
+        depth["m_view"].write(gl(np.eye(4)))
+        depth["m_proj"].write(gl(light_matrix))
+        for name in self.names:
+            depth["m_model"].write(gl(models[name]))
+            self.depth_vaos[name].render(moderngl.TRIANGLES)
+        self.fbo.use()  # pass 2: lit, each pixel compared with the map
+        self.fbo.clear(*self.lesson.CLEAR, depth=1.0)
+        self.map.use(1)
+        lit["u_map"].value = 1
+        lit["u_texel"].value = 1.0 / 1024
+        lit["u_light_matrix"].write(gl(light_matrix))
+        lit["m_view"].write(gl(self.view))
+        lit["m_proj"].write(gl(self.proj))
+        lit["u_eye"].value = self.eye
+        lit["u_light_pos"].value = self.lesson.LIGHT
+        lit["u_light_color"].value = (1.0, 1.0, 1.0)
+        for name in self.names:
+            model = models[name]
+            lit["m_model"].write(gl(model))
+            lit["m_normal"].write(np.linalg.inv(model[:3, :3]).astype("f4").tobytes())
+            lit["u_color"].value = (*self.lesson.COLORS[name], 1.0)
+            self.lit_vaos[name].render(moderngl.TRIANGLES)
+        ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
+        return read(self.fbo, self.size)
+
+
 RAW_BASELINES = {"clear_and_swap": RawClear, "triangle": RawTriangle, "phong": RawPhong, "texture": RawTexture,
-                 "transform_order": RawTransformOrder, "mirror": RawMirror}
+                 "transform_order": RawTransformOrder, "mirror": RawMirror, "shadow_map": RawShadowMap}
+#: The lesson settings a baseline draws (the default where not listed): the shadow-map lesson's
+#: technique alone, its two passes (the side-by-side default also ray-traces a tile).
+RAW_SETTINGS: dict[str, dict[str, str]] = {"shadow_map": {"show": "map"}}
 
 
 def cases(env) -> list:
     """One case per lesson with a raw baseline: the lesson's default frame, animated by ``time``."""
     from glsandbox.lesson import find_lesson
-    from glsandbox.measure.bench import Case, Side, same_pixels
+    from glsandbox.measure.bench import LESSON_FRAME_CPU_GOAL_US, LESSON_FRAME_GOAL, Case, Side, same_pixels
 
     renderer, size = env.renderer, env.size
     found = []
     for name, raw_class in RAW_BASELINES.items():
         raw = raw_class(renderer.host.ctx, size)
-        lesson = find_lesson(name)()
+        lesson = find_lesson(name)(**RAW_SETTINGS.get(name, {}))
 
         def ours(k: int, lesson=lesson) -> np.ndarray:
             return renderer.render(lesson.at(0.01 * k), size).image
 
         found.append(Case("frame vs raw ModernGL", name, Side("raw ModernGL", raw.frame), Side("glsandbox", ours),
-                          repeat=30, goal=1.10, compare=same_pixels))
+                          repeat=30, goal=LESSON_FRAME_GOAL,
+                 cpu_goal_us=LESSON_FRAME_CPU_GOAL_US, compare=same_pixels))
     return found

@@ -30,6 +30,7 @@ from glsandbox.planar import Mirror, PlanarShadow
 from glsandbox.errors import SandboxError
 from glsandbox.version import __version__
 from glsandbox.geometry import Mesh
+from glsandbox.images import check_texture_source
 from glsandbox.lesson import Lesson, Param, register
 from glsandbox.meshfile import Model, fit_mesh, load_mesh, load_model
 from glsandbox.overlay import Overlay, text_image
@@ -45,6 +46,7 @@ from glsandbox.scene import (
     Material,
     Node,
     Scene,
+    ShadowMap,
     Texture,
     Viewport,
 )
@@ -52,8 +54,8 @@ from glsandbox.scene import (
 __all__ = [
     "COURSE_BLUE", "DEPTH_MODES", "LIT_SHADINGS", "NORMAL_MODES", "TEXTURE_FILTERS", "TEXTURE_WRAPS",
     "Camera", "Lesson", "Light", "Material", "Mesh", "Mirror", "Model", "Node", "Overlay", "Param", "PlanarShadow",
-    "SandboxError", "Scene", "Texture", "Viewport",
-    "__version__", "camera", "fit_mesh", "geometry", "load_mesh", "load_model", "meshgen", "register", "run",
+    "SandboxError", "Scene", "ShadowMap", "Texture", "Viewport",
+    "__version__", "camera", "check_texture_source", "fit_mesh", "geometry", "load_mesh", "load_model", "meshgen", "register", "run",
     "show", "text_image", "transforms", "view", "widget",
 ]
 

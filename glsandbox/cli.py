@@ -139,8 +139,9 @@ def cmd_list(args: argparse.Namespace) -> int:
     for cls in all_lessons():
         print(f"{cls.name:<18} {cls.title}  [{cls.course_section}]")
         if args.verbose:
-            for param in cls.all_params():
-                print(f"{'':<20}--set {param.describe()}")
+            for param in cls.all_params():  # with the lesson's own defaults (the ray lessons: renderer=ray)
+                own = replace(param, default=cls.defaults[param.name]) if param.name in cls.defaults else param
+                print(f"{'':<20}--set {own.describe()}")
     return 0
 
 

@@ -11,6 +11,10 @@ Every frame, headless or in a window, goes through :class:`FrameRenderer`:
 3. the raster executor draws them into an offscreen target with exactly the
    depth, stencil and MSAA the plan lists.
 
+The plan a frame returns (and ``glsandbox plan`` prints) is the whole frame's:
+a ``trace`` pass per ray-traced viewport first, saying who traces it and how,
+then the raster passes, and as notes what the ray tracer ignores of the scene.
+
 :class:`HeadlessRenderer` opens a context of its own and reads frames back;
 the window (:mod:`glsandbox.window`) copies the target onto the screen.
 """
@@ -30,7 +34,7 @@ from glsandbox.gl.executor import Executor
 from glsandbox.gl.target import OffscreenTarget
 from glsandbox.lesson import Lesson
 from glsandbox.overlay import Overlay
-from glsandbox.plan import Buffers, Plan, plan, user_shader_notes
+from glsandbox.plan import TRACE_OPTIONS, Buffers, Plan, plan, traced_image_name, traced_scene
 from glsandbox.scene import Scene
 
 __all__ = ["DEFAULT_SIZE", "Frame", "FrameRenderer", "HeadlessRenderer", "InteractiveResolution",
@@ -79,7 +83,7 @@ def trace_viewports(scene: Scene, size: tuple[int, int], ctx: object | None = No
     from glsandbox.raytrace.render import render  # only frames that trace pay for the import
 
     width, height = size
-    images = []
+    images = {}
     for i in sorted(ray):
         vp = scene.viewports[i]
         w, h = vp.pixels(width, height)[2:]
@@ -91,29 +95,21 @@ def trace_viewports(scene: Scene, size: tuple[int, int], ctx: object | None = No
         engine = "gpu" if vp.renderer == "ray" and ctx is not None else "numpy"
         if resolution < 1.0:
             small = (max(1, math.ceil(w * resolution)), max(1, math.ceil(h * resolution)))
-            image = render(single, small, engine, ctx=ctx)
+            image = render(single, small, engine, ctx=ctx, **TRACE_OPTIONS)
             rows = np.minimum((np.arange(h) * small[1]) // h, small[1] - 1)
             cols = np.minimum((np.arange(w) * small[0]) // w, small[0] - 1)
             image = np.ascontiguousarray(image[rows][:, cols])
         else:
-            image = render(single, (w, h), engine, ctx=ctx)
-        images.append(Overlay(f"raytrace/{i}", image, viewport=i, position=(0, 0)))
-    everywhere = tuple(range(len(scene.viewports)))
-    nodes = []
-    for node in scene.nodes:
-        shown = tuple(v for v in (node.viewports if node.viewports is not None else everywhere) if v not in ray)
-        if shown:
-            nodes.append(node if shown == node.viewports or (node.viewports is None and shown == everywhere)
-                         else replace(node, viewports=shown))
-    viewports = tuple(replace(vp, renderer="raster") for vp in scene.viewports)
-    return replace(scene, nodes=tuple(nodes), viewports=viewports, overlays=(*images, *scene.overlays))
+            image = render(single, (w, h), engine, ctx=ctx, **TRACE_OPTIONS)
+        images[i] = Overlay(traced_image_name(i), image, viewport=i, position=(0, 0))
+    return traced_scene(scene, images)
 
 
 class InteractiveResolution:
     """The interactive ray tracer's rule: coarse while the camera moves, full when still.
 
     :meth:`resolution` is called once per window frame with the scene about
-    to be drawn; while its camera differs from the last frame's (or did
+    to be drawn; while its camera or a node's model matrix differs from the last frame's (or did
     within ``settle`` seconds) it answers ``moving`` (a quarter of the
     pixels each way by default: 16 times fewer rays), then 1.
     """
@@ -126,7 +122,10 @@ class InteractiveResolution:
 
     def resolution(self, scene: Scene, now: float | None = None) -> float:
         now = time.perf_counter() if now is None else now
-        cameras = tuple(vp.camera or scene.camera for vp in scene.viewports)
+        # The picture moves when a camera does or a node does (the model lesson's turning
+        # model): a big model is then traced coarse, and the window keeps answering.
+        cameras = (tuple(vp.camera or scene.camera for vp in scene.viewports),
+                   tuple(np.asarray(node.model).tobytes() for node in scene.nodes))
         if self._last is not None and cameras != self._last:
             self._moved_at = now
         self._last = cameras
@@ -165,15 +164,20 @@ class FrameRenderer:
 
     def draw(self, scene: Scene, size: tuple[int, int],
              ray_resolution: float = 1.0) -> tuple[Plan, OffscreenTarget]:
-        """Draw one frame; returns its plan and the target holding it.
-        ``ray_resolution`` < 1 traces ray-traced viewports coarser (the window while moving)."""
+        """Draw one frame; returns its plan (with a ``trace`` pass per ray-traced viewport)
+        and the target holding it. ``ray_resolution`` < 1 traces ray-traced viewports
+        coarser (the window while moving). What a ray-traced viewport ignores of the
+        scene, and what a model file holds that is not drawn, is one ``warning:`` line
+        each on stderr, once per run."""
         self.host.make_current()
-        notes = user_shader_notes(scene)  # a node's own shader in a ray-traced viewport
-        scene = trace_viewports(scene, size, self.host.ctx, ray_resolution)
-        frame_plan = plan(scene)
-        target = self.target(size, frame_plan.buffers)
-        self.executor.render(scene, target.framebuffer, size, frame_plan)
-        for note in notes:  # once per run, after a frame that worked (a failed one says only its error)
+        traced = trace_viewports(scene, size, self.host.ctx, ray_resolution)
+        raster_plan = plan(traced)
+        target = self.target(size, raster_plan.buffers)
+        self.executor.render(traced, target.framebuffer, size, raster_plan)
+        # The whole frame's plan: the same raster passes after the trace passes, with the
+        # notes and warnings of the scene as given (a traced viewport's nodes are an image now).
+        frame_plan = raster_plan if traced is scene else plan(scene)
+        for note in (*frame_plan.notes, *frame_plan.warnings):  # once per run, after a frame that worked
             if note not in self._noted:
                 self._noted.add(note)
                 print(f"warning: {note}", file=sys.stderr, flush=True)

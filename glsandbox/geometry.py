@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from glsandbox.errors import SandboxError
+from glsandbox.errors import SandboxError, plain
 from glsandbox.meshnormals import face_normals
 from glsandbox.transforms import from_directx_mesh
 
@@ -33,6 +33,9 @@ class Mesh:
     ``name`` identifies the mesh (GPU buffers are cached by it). ``notes``
     says where a loaded mesh came from and what loading did to it (dropped
     faces, how its normals were made): ``glsandbox plan`` prints them.
+    ``warnings`` says what of its file is not drawn (a normal map, an
+    animation, a missing texture): ``plan`` lists them and ``render``, ``run``
+    and ``tour`` print each once as a ``warning:`` line.
     """
 
     name: str
@@ -43,14 +46,16 @@ class Mesh:
     colors: np.ndarray | None = None
     mode: str = "triangles"
     notes: tuple[str, ...] = ()
+    warnings: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
+        if self.mode not in MODES:
+            raise SandboxError(f"mesh {self.name!r}: unknown mode {self.mode!r}; use one of {', '.join(MODES)}")
+        check_mesh_arrays(self)
         # Meshes are shared, immutable data (renderers cache per mesh object).
         for array in (self.positions, self.indices, self.normals, self.uvs, self.colors):
             if isinstance(array, np.ndarray):
                 array.flags.writeable = False
-        if self.mode not in MODES:
-            raise SandboxError(f"mesh {self.name!r}: unknown mode {self.mode!r}; use one of {', '.join(MODES)}")
 
     @property
     def vertex_count(self) -> int:
@@ -84,6 +89,80 @@ class Mesh:
         return self.positions[self.triangle_indices()]
 
 
+#: The columns of each per-vertex array (None: any of these counts).
+_VERTEX_COLUMNS = {"positions": (3,), "normals": (3,), "uvs": (2,), "colors": (3, 4)}
+#: How many indices make one primitive, per topology (strips take any count).
+_PER_PRIMITIVE = {"triangles": 3, "lines": 2}
+
+
+def check_mesh_arrays(mesh: Mesh) -> None:
+    """Refuse a mesh the renderers would draw torn or fail on, with one line naming the array and value.
+
+    Per-vertex arrays are (N, columns) finite numbers, one row per position;
+    an index names a vertex that exists (``0 <= i < N``: the rasterizer would
+    read past the vertex buffer and draw a torn picture, the ray tracers
+    raise); a list topology gets whole primitives. Checked once, where the
+    Mesh is made: one ``isfinite`` pass per array and one ``min``/``max`` of the
+    indices, so a cached mesh costs nothing per frame. Lists are taken as
+    arrays (kept as numpy arrays).
+    """
+    count = None
+    for field_name, columns in _VERTEX_COLUMNS.items():
+        value = getattr(mesh, field_name)
+        if value is None and field_name != "positions":
+            continue
+        array = value if isinstance(value, np.ndarray) else _as_array(mesh, field_name, value)
+        if array.ndim != 2 or array.shape[1] not in columns or array.dtype.kind not in "iuf":
+            want = " or ".join(f"(N, {c})" for c in columns)
+            raise SandboxError(f"mesh {mesh.name!r}: {field_name} must be an {want} array of numbers, "
+                               f"got shape {array.shape} of {array.dtype}")
+        if count is not None and len(array) != count:
+            raise SandboxError(f"mesh {mesh.name!r}: {len(array)} {field_name} for {count} positions; "
+                               "every vertex array has one row per position")
+        count = len(array)
+        if array.dtype.kind == "f" and not np.isfinite(array).all():
+            row = int(np.argwhere(~np.isfinite(array))[0][0])
+            raise SandboxError(f"mesh {mesh.name!r}: {field_name}[{row}] is not finite: {plain(array[row])}")
+        if array is not value:
+            object.__setattr__(mesh, field_name, array)  # a frozen dataclass keeping its own array
+    if mesh.indices is not None:
+        _check_indices(mesh, count or 0)
+    per = _PER_PRIMITIVE.get(mesh.mode)
+    if per is not None and mesh.element_count % per:
+        what = "indices" if mesh.indices is not None else "vertices"
+        raise SandboxError(f"mesh {mesh.name!r}: {mesh.element_count} {what} do not make whole {mesh.mode} "
+                           f"({per} per {mesh.mode[:-1]})")
+
+
+def _as_array(mesh: Mesh, field_name: str, value: object) -> np.ndarray:
+    try:
+        return np.array(value, dtype=np.float64 if field_name != "indices" else None)
+    except (TypeError, ValueError):
+        raise SandboxError(f"mesh {mesh.name!r}: {field_name} must be an array of numbers, "
+                           f"got {plain(value)}") from None
+
+
+def _check_indices(mesh: Mesh, count: int) -> None:
+    """An index buffer of whole numbers, each naming one of the ``count`` vertices."""
+    indices = mesh.indices if isinstance(mesh.indices, np.ndarray) else _as_array(mesh, "indices", mesh.indices)
+    if indices.dtype.kind not in "iu" or indices.ndim not in (1, 2):
+        raise SandboxError(f"mesh {mesh.name!r}: indices must be a flat array of integers, "
+                           f"got shape {indices.shape} of {indices.dtype}")
+    if indices.ndim == 2:  # (T, 3) triangles: the flat buffer the GPU reads, three per row
+        indices = indices.reshape(-1)
+    if indices is not mesh.indices:
+        object.__setattr__(mesh, "indices", indices)
+    if not len(indices):
+        return
+    low, high = int(indices.min()), int(indices.max())
+    if low < 0 or high >= count:
+        bad = low if low < 0 else high
+        at = int(np.argmax(indices == bad))
+        raise SandboxError(f"mesh {mesh.name!r}: indices[{at}] = {bad} names no vertex; it has {count} "
+                           f"(indices 0..{count - 1})" if count else
+                           f"mesh {mesh.name!r}: indices[{at}] = {bad} names no vertex; it has none")
+
+
 _FACE_NORMALS: weakref.WeakKeyDictionary[Mesh, Mesh] = weakref.WeakKeyDictionary()
 
 
@@ -111,7 +190,8 @@ def with_face_normals(mesh: Mesh) -> Mesh:
             return None if array is None else np.asarray(array)[corners]
 
         flat = _FACE_NORMALS[mesh] = Mesh(f"{mesh.name}/face_normals", positions[corners], None, normals,
-                                          per_corner(mesh.uvs), per_corner(mesh.colors), notes=mesh.notes)
+                                          per_corner(mesh.uvs), per_corner(mesh.colors), notes=mesh.notes,
+                                          warnings=mesh.warnings)
     return flat
 
 

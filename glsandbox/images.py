@@ -119,6 +119,16 @@ def texture_levels(texture: Texture, max_size: int | None = None) -> list[np.nda
     return [load_image(texture.source, max_size)]
 
 
+def check_texture_source(text: str) -> str:
+    """A lesson parameter's texture (``Param(..., convert=check_texture_source)``): a built-in
+    image's name, or an image file that loads, else the :class:`SandboxError` naming it.
+    Checked when the value is given (``--set``, the window's panel, where a refused value
+    shows in red and the frame keeps the last one), not when a frame draws."""
+    if text not in BUILTIN_TEXTURES:
+        load_image(text)
+    return text
+
+
 def load_image(path: str | Path, max_size: int | None = None) -> np.ndarray:
     """Read an image file as RGBA ``uint8`` (row 0 at the top).
 

@@ -21,13 +21,16 @@ import types
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any, ClassVar, NoReturn
 
 from glsandbox.errors import NUMBER_LIMIT, SandboxError, plain
 from glsandbox.files import read_user_file
 from glsandbox.scene import RENDERERS
 from glsandbox.scene import PLAN_MODES, Camera, Scene, check_uniform_name, check_uniform_value
 from glsandbox.scene_file import load_scene
+
+#: The module name prefix of lesson files loaded from outside the package.
+_FILE_MODULE = "_glsandbox_lesson_"
 
 # NUMBER_LIMIT (glsandbox.errors) is the largest magnitude a number parameter
 # takes unless it says otherwise: the same bound the scene's dataclasses keep.
@@ -46,6 +49,25 @@ class Param:
     #: A parser of its own for text values (e.g. :func:`glsandbox.transforms.parse_order`);
     #: its :class:`SandboxError` is reported with the parameter and value.
     convert: Callable[[str], Any] | None = None
+
+    def __post_init__(self) -> None:
+        # A lesson's own mistakes, refused where the lesson is defined (the loader adds file and line).
+        if not isinstance(self.name, str) or not self.name or any(c.isspace() or c == "=" for c in self.name):
+            raise SandboxError(f"Param name must be a word (no spaces or =), got {plain(self.name)}")
+        if self.choices is not None:
+            if isinstance(self.choices, str) or not isinstance(self.choices, (tuple, list)) \
+                    or not all(isinstance(c, str) for c in self.choices) or not self.choices:
+                raise SandboxError(f"Param {self.name!r}: choices must be a tuple of texts, got {plain(self.choices)}")
+            object.__setattr__(self, "choices", tuple(self.choices))  # a frozen dataclass keeping its own tuple
+            if self.default not in self.choices:
+                raise SandboxError(f"Param {self.name!r}: default {plain(self.default)} is not one of its choices "
+                                   f"({', '.join(self.choices)})")
+        if isinstance(self.default, (int, float)) and not isinstance(self.default, bool):
+            low = -math.inf if self.minimum is None else self.minimum
+            high = math.inf if self.maximum is None else self.maximum
+            if not low <= self.default <= high:
+                raise SandboxError(f"Param {self.name!r}: default {plain(self.default)} is outside its range "
+                                   f"{plain(self.minimum)}..{plain(self.maximum)}")
 
     @property
     def kind(self) -> type:
@@ -188,6 +210,10 @@ class Lesson:
     #: ``("stencil against leak", "mirror=stencil,no_stencil")``).
     contrasts: ClassVar[tuple[tuple[str, str], ...]] = ()
 
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        check_lesson_class(cls)
+
     def __init__(self, **values: Any) -> None:
         known = {p.name: p for p in self.all_params()}
         self.values: dict[str, Any] = {p.name: self.defaults.get(p.name, p.default) for p in known.values()}
@@ -200,7 +226,7 @@ class Lesson:
 
     @classmethod
     def all_params(cls) -> tuple[Param, ...]:
-        return (TIME, RENDERER, EFFECTS_PARAM, CAMERA, *cls.params)
+        return (*SHARED_PARAMS, *cls.params)
 
     @classmethod
     def setting(cls, item: str, flag: str = "--set", expected: str = "key=value") -> tuple[Param, str]:
@@ -240,7 +266,7 @@ class Lesson:
 
     def scene(self) -> Scene:
         """The Scene for the current values (``renderer`` marks its viewports)."""
-        scene = self.build()
+        scene = built_scene(self)
         renderer = self.values.get("renderer", "raster")
         if renderer != "raster":  # traced by glsandbox.frame.trace_viewports
             scene = replace(scene, viewports=tuple(replace(vp, renderer=renderer) for vp in scene.viewports))
@@ -261,6 +287,77 @@ class Lesson:
     def on_key(self, key: str) -> bool:
         """Window key hook (glfw key name, e.g. ``"1"``); return True when handled."""
         return False
+
+
+#: The parameters every lesson has; a lesson's own may not reuse their names.
+SHARED_PARAMS = (TIME, RENDERER, EFFECTS_PARAM, CAMERA)
+
+
+def check_lesson_class(cls: type[Lesson]) -> None:
+    """Refuse a lesson class's own mistakes when it is defined: ``params`` not a tuple of
+    :class:`Param`, two parameters with one name (or one of :data:`SHARED_PARAMS`'s), a
+    ``defaults`` entry that names no parameter or is not among its choices. The message
+    names the class; a lesson file's loader adds the file and line of the class."""
+    def refuse(what: str) -> NoReturn:
+        raise SandboxError(f"{_definition_site(cls)}class {cls.__name__}: {what}")
+
+    params = cls.__dict__.get("params", cls.params)
+    if isinstance(params, list):
+        params = tuple(params)
+        cls.params = params
+    if not isinstance(params, tuple) or not all(isinstance(p, Param) for p in params):
+        bad = next((p for p in params if not isinstance(p, Param)), params) if isinstance(params, tuple) else params
+        refuse(f"params must be a tuple of Param(...), got {plain(bad)}{'' if bad is params else ' in it'}")
+    shared = {p.name for p in SHARED_PARAMS}
+    seen = set(shared)
+    for param in params:
+        if param.name in seen:
+            reason = "every lesson has it already" if param.name in shared else "two parameters have that name"
+            refuse(f"parameter {param.name!r} defined again ({reason})")
+        seen.add(param.name)
+    if not isinstance(cls.defaults, dict):
+        refuse(f"defaults must be a dict of name: value, got {plain(cls.defaults)}")
+    known = {p.name: p for p in (*SHARED_PARAMS, *params)}
+    for key, value in cls.defaults.items():
+        if key not in known:
+            refuse(f"defaults names {plain(key)}, which is no parameter (parameters: {', '.join(known)})")
+        choices = known[key].choices
+        if choices is not None and value not in choices:
+            refuse(f"defaults {key}={plain(value)} is not one of {', '.join(choices)}")
+
+
+def _definition_site(cls: type) -> str:
+    """``file:line: `` of a class statement running now, for a class outside a lesson file
+    (whose loader names the file and line itself); empty when not found."""
+    if cls.__module__.startswith(_FILE_MODULE):
+        return ""
+    filename = getattr(sys.modules.get(cls.__module__), "__file__", None)
+    frame = sys._getframe(1)
+    while frame is not None and frame.f_code.co_filename != filename:
+        frame = frame.f_back
+    return f"{filename}:{frame.f_lineno}: " if frame is not None else ""
+
+
+def built_scene(lesson: Lesson) -> Scene:
+    """``lesson.build()``, checked to be a Scene. A :class:`SandboxError` raised in a lesson
+    file's ``build()`` (a Scene, Node or Mesh refusing a value) gets the file and line
+    it came from in front. (Any other exception is the lesson's own code: its traceback
+    is shown, see README "The rule for a lesson file".)"""
+    try:
+        scene = lesson.build()
+    except SandboxError as exc:
+        source = lesson_source(type(lesson))
+        line = _user_line(exc, str(source)) if source is not None else 0
+        if line and not str(exc).startswith(str(source)):
+            raise SandboxError(f"{source}:{line}: {exc}") from None
+        raise
+    if not isinstance(scene, Scene):
+        code = getattr(type(lesson).build, "__code__", None)
+        where = f"{code.co_filename}:{code.co_firstlineno}: " if code is not None else ""
+        hint = " (a forgotten return?)" if scene is None else f" (type {type(scene).__name__})"
+        raise SandboxError(f"{where}{type(lesson).__name__}.build() returned {plain(scene)}{hint}; "
+                           "it must return a glsandbox.Scene")
+    return scene
 
 
 def unknown_param_message(lesson: type[Lesson] | Lesson, key: str, flag: str = "--set") -> str:
@@ -381,8 +478,6 @@ def find_lesson(name_or_path: str) -> type[Lesson]:
 # --- lesson files outside the package -----------------------------------------
 
 _loaded_files = itertools.count()
-#: The module name prefix of lesson files loaded from outside the package.
-_FILE_MODULE = "_glsandbox_lesson_"
 
 
 def lesson_file_lesson(path: Path) -> type[Lesson]:
@@ -416,6 +511,8 @@ def lesson_file_lesson(path: Path) -> type[Lesson]:
     except SystemExit as exc:
         raise SandboxError(f"{path}: exited while importing (SystemExit {exc.code}); "
                            "keep glsandbox.run(...) under if __name__ == \"__main__\"") from None
+    except SandboxError as exc:  # a glsandbox call of the file's, or its lesson class refused where defined
+        raise SandboxError(f"{path}:{_user_line(exc, str(path))}: {exc}") from None
     except Exception as exc:
         raise SandboxError(f"{path}:{_user_line(exc, str(path))}: {type(exc).__name__} while importing: "
                            f"{_cut(str(exc))}") from None

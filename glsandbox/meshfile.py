@@ -1,17 +1,20 @@
 """Model files: triangle meshes from OBJ, PLY, STL, OFF and glTF/GLB, read by trimesh.
 
-:func:`load_model` reads a file into a :class:`Model`: a
+:func:`load_model` reads a file into a :class:`Model`: one
+:class:`ModelPart` per material of the file, each a
 :class:`~glsandbox.geometry.Mesh` (positions, normals, uvs and vertex colours
-where the file has them), the base colour texture of a glTF material (or of
-an OBJ's ``map_Kd``) as an in-memory :class:`~glsandbox.scene.Texture`, and
-what loading did. :func:`load_mesh` is the mesh alone. No format is parsed
-here: trimesh reads them (``process=False``: the file's vertices and faces as
-written, nothing merged); this module turns what it read into the course's
+where the file has them) with its material as the file gives it (base
+colour, base colour texture in memory as a :class:`~glsandbox.scene.Texture`,
+alpha mode and cutoff, sidedness: :mod:`glsandbox.meshlooks`), and what
+loading did. :meth:`Model.nodes` makes one scene node per part;
+:func:`load_mesh` is all parts as one mesh. No format is parsed here: trimesh
+reads them (``process=False``: the file's vertices and faces as written,
+nothing merged); this module turns what it read into the course's
 conventions and checks it.
 
-- **Positions** as written; a glTF's node transforms are applied (its parts
-  become one mesh); a mirroring transform gets its triangles' winding swapped
-  so fronts stay counter-clockwise.
+- **Positions** as written; a glTF's node transforms are applied (its meshes
+  that share a material become one part); a mirroring transform gets its
+  triangles' winding swapped so fronts stay counter-clockwise.
 - **Normals** (``normals=``): ``"auto"`` takes the file's vertex normals when
   it has usable ones (OBJ ``vn``, PLY ``nx ny nz``, glTF ``NORMAL``) and
   otherwise makes them with the crease angle (:mod:`glsandbox.meshnormals`,
@@ -43,6 +46,7 @@ file changes. trimesh's log messages and warnings are kept off stderr.
 from __future__ import annotations
 
 import contextlib
+import functools
 import io
 import logging
 import math
@@ -60,10 +64,12 @@ from numpy.typing import NDArray
 from glsandbox.errors import SandboxError
 from glsandbox.files import open_user_file
 from glsandbox.geometry import Mesh
+from glsandbox.meshlooks import Look, file_warnings, is_closed, look_of
 from glsandbox.meshnormals import corner_normals, unique_vertices
-from glsandbox.scene import Material, Texture
+from glsandbox.scene import Material, Node, Texture
 
-__all__ = ["CREASE_ANGLE", "FORMATS", "NORMALS", "Model", "fit_mesh", "is_model_path", "load_mesh", "load_model"]
+__all__ = ["CREASE_ANGLE", "FORMATS", "NORMALS", "Model", "ModelPart", "fit_mesh", "is_model_path", "load_mesh",
+           "load_model"]
 
 #: File extensions (lower case) and the trimesh file type each is read as.
 FORMATS: dict[str, str] = {".obj": "obj", ".ply": "ply", ".stl": "stl", ".off": "off", ".gltf": "gltf",
@@ -84,34 +90,108 @@ DEGENERATE_SHARE = 1e-12
 CACHE_SIZE = 16
 
 
+Rgba = tuple[float, float, float, float]
+
+
+@dataclass(frozen=True, eq=False)
+class ModelPart:
+    """The triangles of a model file that share one material, and that material:
+    base colour (glTF ``baseColorFactor``, OBJ ``Kd``; None: the file gives none),
+    base colour texture (glTF ``baseColorTexture``, OBJ ``map_Kd``: in memory, the
+    default sampler), alpha mode and cutoff, and sidedness (glTF ``doubleSided``;
+    for the other formats, double-sided unless the model is closed)."""
+
+    name: str
+    mesh: Mesh
+    texture: Texture | None
+    color: Rgba | None
+    alpha_mode: str
+    alpha_cutoff: float
+    double_sided: bool
+    triangles: int
+
+    def material(self, **fields: Any) -> Material:
+        """A :class:`~glsandbox.scene.Material` drawing this part as the file describes it
+        (white when it gives no colour), other fields as given (``shading="phong"``, ...).
+        A mesh with vertex colours gets them multiplied in (``vertex_colors``)."""
+        fields.setdefault("color", self.color or (1.0, 1.0, 1.0, 1.0))
+        fields.setdefault("texture", self.texture)
+        fields.setdefault("alpha_mode", self.alpha_mode)
+        fields.setdefault("alpha_cutoff", self.alpha_cutoff)
+        fields.setdefault("double_sided", self.double_sided)
+        unlit_colours = fields.get("shading", "solid") == "vertex_color"  # they are the colour already
+        fields.setdefault("vertex_colors", self.mesh.colors is not None and not unlit_colours)
+        return Material(**fields)
+
+
 @dataclass(frozen=True, eq=False)
 class Model:
-    """A model file, loaded: its mesh, its base colour texture and colour, and what loading did.
+    """A model file, loaded: one :class:`ModelPart` per material, and what loading did.
 
-    ``texture`` is the material's base colour image where the file has one
-    (glTF ``baseColorTexture``, OBJ ``map_Kd``), in memory, with the default
-    sampler (replace ``filter``/``wrap`` with :func:`dataclasses.replace`);
-    ``color`` is a glTF material's ``baseColorFactor`` (rgba, 0..1), which
-    multiplies the texture as the course's textured shaders do. Put both on
-    a node with :meth:`material`.
+    Draw it as one node per part (:meth:`nodes`), each with its part's
+    material; ``mesh`` is all parts as one mesh (built on first use), for a
+    single node that ignores the materials.
     """
 
     path: Path
-    mesh: Mesh
-    texture: Texture | None
-    color: tuple[float, float, float, float] | None
+    parts: tuple[ModelPart, ...]
     #: Triangles kept, and degenerate ones dropped on loading.
     triangles: int
     dropped_faces: int
     #: Where the normals came from: ``"file"``, ``"crease 30°"``, ``"smooth"`` or ``"flat"``.
     normals: str
+    #: Whether the triangles close a volume (:func:`glsandbox.meshlooks.is_closed`; True for glTF,
+    #: which says per material whether back faces are seen).
+    closed: bool = True
+
+    @property
+    def texture(self) -> Texture | None:
+        """The first part's base colour texture."""
+        return next((part.texture for part in self.parts if part.texture is not None), None)
+
+    @property
+    def color(self) -> Rgba | None:
+        """The first part's base colour (None: the file gives none)."""
+        return next((part.color for part in self.parts if part.color is not None), None)
+
+    @property
+    def warnings(self) -> tuple[str, ...]:
+        """What of the file is not drawn, one line each (also on the parts' meshes)."""
+        return tuple(line for part in self.parts for line in part.mesh.warnings)
+
+    @functools.cached_property
+    def mesh(self) -> Mesh:
+        """Every part in one mesh (the first part's mesh when there is one part)."""
+        return _joined(self.path.name, [part.mesh for part in self.parts])
 
     def material(self, **fields: Any) -> Material:
-        """A :class:`~glsandbox.scene.Material` with this model's texture and colour
-        (white when it has none), other fields as given (``shading="phong"``, ...)."""
-        fields.setdefault("color", self.color or (1.0, 1.0, 1.0, 1.0))
-        fields.setdefault("texture", self.texture)
-        return Material(**fields)
+        """The first part's material (:meth:`ModelPart.material`)."""
+        return self.parts[0].material(**fields)
+
+    def nodes(self, name: str, model: np.ndarray | None = None, **fields: Any) -> tuple[Node, ...]:
+        """One :class:`~glsandbox.scene.Node` per part, named ``name`` (one part) or
+        ``name/part``, each with its part's material (``fields`` as :meth:`ModelPart.material`)."""
+        matrix = np.eye(4) if model is None else model
+        return tuple(Node(name if len(self.parts) == 1 else f"{name}/{part.name}", part.mesh, matrix,
+                          part.material(**fields)) for part in self.parts)
+
+
+def _joined(name: str, meshes: list[Mesh]) -> Mesh:
+    """Meshes as one (indices offset; an attribute some lack gets neutral values)."""
+    if len(meshes) == 1:
+        return meshes[0]
+    offsets = np.cumsum([0] + [m.vertex_count for m in meshes])
+
+    def stack(field: str, width: int, fill: float) -> NDArray[np.float64] | None:
+        if all(getattr(m, field) is None for m in meshes):
+            return None
+        return np.concatenate([getattr(m, field) if getattr(m, field) is not None
+                               else np.full((m.vertex_count, width), fill) for m in meshes])
+
+    return Mesh(name, np.concatenate([m.positions for m in meshes]),
+                np.concatenate([np.asarray(m.indices) + o for m, o in zip(meshes, offsets)]).astype(np.uint32),
+                stack("normals", 3, 0.0), stack("uvs", 2, 0.0), stack("colors", 3, 1.0),
+                notes=tuple(n for m in meshes for n in m.notes), warnings=tuple(w for m in meshes for w in m.warnings))
 
 
 def is_model_path(name: str) -> bool:
@@ -158,7 +238,7 @@ def load_model(path: str | os.PathLike[str], *, fit: bool = False, normals: str 
         except OSError as exc:
             raise SandboxError(f"model file {p} cannot be read ({exc.strerror or exc})") from None
     parts = _parts(p, _trimesh_scene(p, data, file_type))
-    model = _model(p, file_type, parts, bool(fit), normals, float(crease_angle))
+    model = _model(p, file_type, parts, bool(fit), normals, float(crease_angle), data)
     _CACHE[key] = model
     while len(_CACHE) > CACHE_SIZE:
         _CACHE.popitem(last=False)
@@ -171,12 +251,18 @@ def fit_mesh(mesh: Mesh) -> Mesh:
     positions = np.asarray(mesh.positions, dtype=np.float64)
     if positions.size == 0:
         return mesh
+    centre, scale = _fit_transform(positions, mesh.name)
+    return replace(mesh, positions=(positions - centre) * scale)
+
+
+def _fit_transform(positions: NDArray[np.float64], name: str = "model") -> tuple[NDArray[np.float64], float]:
+    """``(centre, scale)``: ``(p - centre) * scale`` puts the points' bounding box
+    centred on the origin with its longest side spanning -1..1."""
     low, high = positions.min(axis=0), positions.max(axis=0)
     extent = float((high - low).max())
     if not (math.isfinite(extent) and extent > 0.0):
-        raise SandboxError(f"mesh {mesh.name!r} has no extent to fit (all its vertices are one point)")
-    centre = (low + high) / 2.0
-    return replace(mesh, positions=(positions - centre) * (2.0 / extent))
+        raise SandboxError(f"mesh {name!r} has no extent to fit (all its vertices are one point)")
+    return (low + high) / 2.0, 2.0 / extent
 
 
 _CACHE: OrderedDict[tuple[Any, ...], Model] = OrderedDict()
@@ -255,8 +341,7 @@ class _Part:
     normals: NDArray[np.float64] | None
     uvs: NDArray[np.float64] | None
     colors: NDArray[np.float64] | None  # per vertex (N, 3), or per corner (F, 3, 3) from face colours
-    image: NDArray[np.uint8] | None
-    color: tuple[float, float, float, float] | None
+    look: Look
 
 
 def _parts(p: Path, scene: Any) -> list[_Part]:
@@ -264,13 +349,14 @@ def _parts(p: Path, scene: Any) -> list[_Part]:
     import trimesh
 
     parts = []
+    looks: dict[int, Look] = {}  # by material object: many meshes may share one (and its big image)
     with _quiet():
         try:
             for node in scene.graph.nodes_geometry:
                 transform, name = scene.graph[node]
                 geometry = scene.geometry.get(name)
                 if isinstance(geometry, trimesh.Trimesh):
-                    parts.append(_part(geometry, np.asarray(transform, dtype=np.float64)))
+                    parts.append(_part(geometry, np.asarray(transform, dtype=np.float64), len(parts), looks))
         except SandboxError:
             raise
         except Exception as exc:
@@ -278,7 +364,7 @@ def _parts(p: Path, scene: Any) -> list[_Part]:
     return parts
 
 
-def _part(mesh: Any, transform: NDArray[np.float64]) -> _Part:
+def _part(mesh: Any, transform: NDArray[np.float64], index: int, looks: dict[int, Look]) -> _Part:
     positions = np.array(mesh.vertices, dtype=np.float64).reshape(-1, 3)
     faces = np.array(mesh.faces, dtype=np.int64).reshape(-1, 3)
     normals = _file_normals(mesh, positions.shape[0])
@@ -290,22 +376,26 @@ def _part(mesh: Any, transform: NDArray[np.float64]) -> _Part:
                 normals = normals @ np.linalg.inv(linear)  # (M⁻¹)ᵀ applied to row vectors
         if np.linalg.det(linear) < 0.0:  # a mirror turns the winding: swap to keep fronts counter-clockwise
             faces = faces[:, [0, 2, 1]]
-    uvs = colors = image = None
-    color = None
+    uvs = colors = None
     visual = getattr(mesh, "visual", None)
     kind = getattr(visual, "kind", None)
+    material = getattr(visual, "material", None)
+    look = looks.get(id(material)) if material is not None else None
+    if look is None:
+        look = look_of(material, index)
+        if material is not None:
+            looks[id(material)] = look
     if kind == "texture":
         uv = getattr(visual, "uv", None)
         if uv is not None and len(uv) == positions.shape[0]:
             uvs = np.array(uv, dtype=np.float64).reshape(-1, 2)
             uvs[:, 1] = 1.0 - uvs[:, 1]  # trimesh's v up -> the course's v down
-        image, color = _material(getattr(visual, "material", None))
     elif kind == "vertex":
         colors = np.asarray(visual.vertex_colors, dtype=np.float64)[:, :3] / 255.0
     elif kind == "face":
         face_colors = np.asarray(visual.face_colors, dtype=np.float64)[:, :3] / 255.0
         colors = np.repeat(face_colors[:, None, :], 3, axis=1)
-    return _Part(positions, faces, normals, uvs, colors, image, color)
+    return _Part(positions, faces, normals, uvs, colors, look)
 
 
 def _file_normals(mesh: Any, count: int) -> NDArray[np.float64] | None:
@@ -323,45 +413,16 @@ def _file_normals(mesh: Any, count: int) -> NDArray[np.float64] | None:
     return normals if normals.shape == (count, 3) else None
 
 
-def _material(material: Any) -> tuple[NDArray[np.uint8] | None, tuple[float, float, float, float] | None]:
-    """The base colour image (RGBA, row 0 at the top) and glTF base colour factor of a trimesh material."""
-    if material is None:
-        return None, None
-    picture = getattr(material, "baseColorTexture", None)
-    if picture is None:
-        # An OBJ material's map_Kd: an image decoded from a file has a format; the 2x2 grey
-        # placeholder trimesh gives an OBJ with uvs but no material file has none.
-        picture = getattr(material, "image", None)
-        if getattr(picture, "format", None) is None:
-            picture = None
-    image = None
-    if picture is not None:
-        try:
-            image = np.ascontiguousarray(np.asarray(picture.convert("RGBA"), dtype=np.uint8))
-        except Exception:
-            image = None
-        if image is not None and (image.ndim != 3 or 0 in image.shape):
-            image = None
-    factor = getattr(material, "baseColorFactor", None)
-    color = None
-    if factor is not None:
-        f = np.asarray(factor, dtype=np.float64).reshape(-1)
-        if f.size >= 3:
-            f = f / 255.0 if f.dtype.kind in "iu" or f.max() > 1.0 else f
-            rgb = np.clip(np.nan_to_num(f[:3], nan=1.0), 0.0, 1.0)
-            color = (float(rgb[0]), float(rgb[1]), float(rgb[2]), 1.0)
-    return image, color
-
-
 # --- from parts to one mesh ------------------------------------------------
 
 
-def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode: str, crease: float) -> Model:
+def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode: str, crease: float,
+           data: bytes) -> Model:
     vertex_total = sum(part.positions.shape[0] for part in parts)
     if not parts or sum(part.faces.shape[0] for part in parts) == 0:
         what = f" (only {vertex_total:,} vertices)" if vertex_total else ""
         raise SandboxError(f"model file {p} has no faces{what}")
-    # One vertex and face list for all parts.
+    # One vertex and face list for all parts, to check them as the file numbers them.
     offsets = np.cumsum([0] + [part.positions.shape[0] for part in parts])
     positions = np.concatenate([part.positions for part in parts])
     faces = np.concatenate([part.faces + offset for part, offset in zip(parts, offsets)])
@@ -375,12 +436,65 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
         index = int(faces[f][outside[f]][0])
         raise SandboxError(f"model file {p}: face {f} refers to vertex {index}, but the file has "
                            f"{positions.shape[0]:,} vertices (index out of range)")
+    if any(part.uvs is not None and not np.isfinite(part.uvs).all() for part in parts):
+        raise SandboxError(f"model file {p}: texture coordinates are NaN or infinite")
+    # Parts that look alike (one material) become one mesh, one node when drawn.
+    groups: dict[tuple[Any, ...], list[_Part]] = {}
+    for part in parts:
+        groups.setdefault(part.look.key, []).append(part)
+    # Sidedness: glTF says per material; otherwise one-sided only when the model is closed.
+    closed = file_type in ("gltf", "glb") or is_closed(positions, faces)
+    undrawn = file_warnings(p, data, file_type, [part.look for part in parts])
+    built = []
+    dropped = 0
+    for members in groups.values():
+        look = members[0].look
+        mesh, kept, lost, how = _group_mesh(p, file_type, members, normals_mode, crease,
+                                            look.name if len(groups) > 1 else None)
+        dropped += lost
+        if mesh is not None:
+            built.append((look, mesh, kept, how))
+    if not built:
+        raise SandboxError(f"model file {p} has no faces: all {faces.shape[0]:,} are degenerate "
+                           "(zero area or a repeated vertex)")
+    transform = _fit_transform(np.concatenate([mesh.positions for _, mesh, _, _ in built])) if fit else None
+    model_parts = []
+    for i, (look, mesh, kept, how) in enumerate(built):
+        said = [f"model file {p}: {', '.join(undrawn[''])} not drawn"] if i == 0 and undrawn.get("") else []
+        if look.name in undrawn:
+            said.append(f"model file {p}, part {look.name!r}: {', '.join(undrawn[look.name])} not drawn")
+        texture = None
+        notes = list(mesh.notes)
+        if look.image is not None:
+            if mesh.uvs is None:
+                notes.append("its texture is not used: the mesh has no texture coordinates")
+                said.append(f"model file {p}, part {look.name!r}: its texture not drawn "
+                                "(the mesh has no texture coordinates)")
+            else:
+                where = "" if len(built) == 1 else f"{look.name}/"
+                texture = Texture(f"{p}#{where}base_color", image=look.image)
+        if transform is not None:
+            notes.append("fitted into -1..1")
+            mesh = replace(mesh, positions=(np.asarray(mesh.positions) - transform[0]) * transform[1])
+        mesh = replace(mesh, notes=tuple(notes), warnings=tuple(said))
+        sided = look.double_sided if look.double_sided is not None else not closed
+        model_parts.append(ModelPart(look.name, mesh, texture, look.color, look.alpha_mode, look.alpha_cutoff,
+                                     sided, kept))
+    total = sum(part.triangles for part in model_parts)
+    return Model(p, tuple(model_parts), total, dropped, built[0][3], closed)
+
+
+def _group_mesh(p: Path, file_type: str, parts: list[_Part], normals_mode: str, crease: float,
+                part_name: str | None) -> tuple[Mesh | None, int, int, str]:
+    """One mesh for parts that share a material: ``(mesh, triangles, degenerate faces
+    dropped, how its normals were made)``; no mesh when every face was degenerate."""
+    offsets = np.cumsum([0] + [part.positions.shape[0] for part in parts])
+    positions = np.concatenate([part.positions for part in parts])
+    faces = np.concatenate([part.faces + offset for part, offset in zip(parts, offsets)])
     # Optional attributes: a part without them gets neutral values when another has them.
     has_uvs = any(part.uvs is not None for part in parts)
     uvs = np.concatenate([part.uvs if part.uvs is not None else np.zeros((part.positions.shape[0], 2))
                           for part in parts]) if has_uvs else None
-    if uvs is not None and not np.isfinite(uvs).all():
-        raise SandboxError(f"model file {p}: texture coordinates are NaN or infinite")
     corner_colors = _corner_colors(parts) if any(part.colors is not None for part in parts) else None
     file_normals = None
     if all(part.normals is not None for part in parts):
@@ -389,8 +503,7 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
     keep = ~_degenerate(positions, faces)
     dropped = int(faces.shape[0] - keep.sum())
     if not keep.any():
-        raise SandboxError(f"model file {p} has no faces: all {faces.shape[0]:,} are degenerate "
-                           "(zero area or a repeated vertex)")
+        return None, 0, dropped, ""
     faces = faces[keep]
     if corner_colors is not None:
         corner_colors = corner_colors[keep]
@@ -404,28 +517,16 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
         rows.append(corner_colors.reshape(-1, 3))
     index, first = unique_vertices(np.concatenate(rows, axis=1))
     chosen = corners[first]
-    notes = [f"{p.name}: {_count(faces.shape[0], 'triangle')} ({file_type.upper()})"]
+    where = p.name if part_name is None else f"{p.name}, part {part_name!r}"
+    notes = [f"{where}: {_count(faces.shape[0], 'triangle')} ({file_type.upper()})"]
     if dropped:
         notes.append(f"{_count(dropped, 'degenerate face')} dropped (zero area or a repeated vertex)")
     notes.append(f"normals {'from the file' if how == 'file' else how}")
-    image, color, textures = _texture(parts)
-    if textures > 1:
-        notes.append(f"{textures} textures in the file, only the first is used")
-    if fit:
-        notes.append("fitted into -1..1")
-    mesh = Mesh(p.name, positions[chosen], index.astype(np.uint32), normals.reshape(-1, 3)[first],
+    name = p.name if part_name is None else f"{p.name}#{part_name}"
+    mesh = Mesh(name, positions[chosen], index.astype(np.uint32), normals.reshape(-1, 3)[first],
                 None if uvs is None else uvs[chosen],
                 None if corner_colors is None else corner_colors.reshape(-1, 3)[first], notes=tuple(notes))
-    if fit:
-        mesh = fit_mesh(mesh)
-    texture = None
-    if image is not None:
-        if uvs is None:
-            notes_without = (*mesh.notes, "its texture is not used: the mesh has no texture coordinates")
-            mesh = replace(mesh, notes=notes_without)
-        else:
-            texture = Texture(f"{p}#base_color", image=image)
-    return Model(p, mesh, texture, color, int(faces.shape[0]), dropped, how)
+    return mesh, int(faces.shape[0]), dropped, how
 
 
 def _count(n: int, one: str, many: str | None = None) -> str:
@@ -477,14 +578,3 @@ def _corner_normals(p: Path, positions: NDArray[np.float64], faces: NDArray[np.i
         mode = "crease"
     normals = corner_normals(positions, faces.astype(np.intp), mode, crease)
     return normals, f"crease {crease:g}°" if mode == "crease" else mode
-
-
-def _texture(parts: list[_Part]) -> tuple[NDArray[np.uint8] | None, tuple[float, float, float, float] | None, int]:
-    """The first part's base colour image and factor, and how many distinct images the parts have."""
-    images = [part.image for part in parts if part.image is not None]
-    distinct: list[NDArray[np.uint8]] = []
-    for image in images:
-        if not any(image.shape == d.shape and np.array_equal(image, d) for d in distinct):
-            distinct.append(image)
-    color = next((part.color for part in parts if part.color is not None), None)
-    return (distinct[0] if distinct else None), color, len(distinct)

@@ -288,8 +288,9 @@ class Panel:
             if entered:
                 try:
                     new, changed = parse_value(param, self.texts.pop(name)), True
-                except SandboxError as exc:
+                except SandboxError as exc:  # refused: shown in red, the value and the window stay
                     self.message = f"error: {exc}"
+                    print(self.message, file=sys.stderr, flush=True)
         self._item(name)
         if imgui.is_item_hovered():
             imgui.set_item_tooltip(param.help)

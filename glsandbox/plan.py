@@ -9,17 +9,19 @@ buffers the plan lists.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 import functools
 import weakref
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
 from glsandbox.planar import shadow_casters
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh
-from glsandbox.scene import Node, Scene
+from glsandbox.overlay import Overlay
+from glsandbox.scene import Camera, Node, Scene
+from glsandbox.shadowmap import casters, casting_light, receivers
 
 
 @dataclass(frozen=True, order=True)
@@ -63,12 +65,23 @@ class Buffers:
 
 @dataclass(frozen=True)
 class Draw:
-    """One node drawn with one program variant."""
+    """One node drawn with one program variant (in a ``trace`` pass: traced, shaded as ``program`` says)."""
 
     node: str
-    program: str  # a ProgramVariant key
+    program: str  # a ProgramVariant key; in a trace pass, the shading the ray tracer gives the node
     cull_back_faces: bool
     texture: str | None = None  # what texture unit 0 holds, only for textured nodes
+    #: Alpha blending on and depth writes off (a material's ``alpha_mode = "blend"``).
+    blend: bool = False
+    #: The light whose shadow map texture unit 1 holds (:data:`SHADOW_MAP_UNIT`), for receivers.
+    shadow_map: int | None = None
+
+    def describe(self) -> str:
+        return (f"{self.node} with {self.program}" + ("" if self.cull_back_faces else " (no culling)")
+                + (" (blended, no depth writes)" if self.blend else "")
+                + (f" + texture unit 0: {self.texture}" if self.texture else "")
+                + (f" + texture unit {SHADOW_MAP_UNIT}: shadow map {self.shadow_map}"
+                   if self.shadow_map is not None else ""))
 
 
 #: Stencil comparisons a pass may use (``glStencilFunc``).
@@ -126,10 +139,20 @@ class StencilState:
 
 @dataclass(frozen=True)
 class Pass:
-    """One step of the frame, restricted to one viewport."""
+    """One step of the frame, restricted to one viewport.
 
-    kind: str  # "clear", "draw" or "overlay" (viewport -1: the whole frame)
-    viewport: int
+    ``kind`` is one of :data:`PASS_KINDS`: each has a describer here
+    (:data:`PASS_DESCRIBERS`) and a runner in the executor
+    (:data:`glsandbox.gl.executor.PASS_RUNNERS`). ``target`` is what the pass
+    draws into: ``"frame"``, or a named offscreen (``"shadow map 0"``: light
+    0's depth texture). ``camera`` is what it looks through: ``"viewport"``
+    (the viewport's camera, or the scene's), ``"light N"`` (light N's shadow
+    camera, :func:`glsandbox.shadowmap.light_camera`), or None for passes
+    that draw no 3D content (clears, overlays).
+    """
+
+    kind: str
+    viewport: int  # -1: the whole target
     clear_color: tuple[float, float, float, float] | None = None
     clear_depth: bool = False
     clear_stencil: bool = False
@@ -141,27 +164,41 @@ class Pass:
     #: :func:`planar_passes`).
     stencil: StencilState | None = None
     detail: str = ""
+    target: str = "frame"
+    camera: str | None = "viewport"
 
     def describe(self) -> str:
-        if self.kind == "overlay":
-            return describe_overlay_pass(self)
-        if self.kind in PLANAR_PASS_KINDS:
-            return describe_planar_pass(self)
-        if self.kind == "clear":
-            what = []
-            if self.clear_color is not None:
-                what.append("colour (" + ", ".join(f"{c:g}" for c in self.clear_color) + ")")
-            if self.clear_depth:
-                what.append("depth")
-            if self.clear_stencil:
-                what.append("stencil")
-            return f"clear viewport {self.viewport}: " + " + ".join(what)
-        items = "; ".join(
-            f"{d.node} with {d.program}" + ("" if d.cull_back_faces else " (no culling)")
-            + (f" + texture unit 0: {d.texture}" if d.texture else "") for d in self.draws
-        )
-        depth = "depth test" if self.depth_test else "no depth test"
-        return f"draw viewport {self.viewport} ({depth}): {items}"
+        describer = PASS_DESCRIBERS.get(self.kind)
+        if describer is None:
+            raise SandboxError(f"pass kind {self.kind!r} has no describer (plan.PASS_DESCRIBERS)")
+        return describer(self)
+
+
+def describe_clear_pass(step: Pass) -> str:
+    what = []
+    if step.clear_color is not None:
+        what.append("colour (" + ", ".join(f"{c:g}" for c in step.clear_color) + ")")
+    if step.clear_depth:
+        what.append("depth")
+    if step.clear_stencil:
+        what.append("stencil")
+    return f"clear viewport {step.viewport}: " + " + ".join(what)
+
+
+def describe_draws(step: Pass) -> str:
+    """Each draw as :meth:`Draw.describe` says it, or ``nothing``."""
+    return "; ".join(d.describe() for d in step.draws) or "nothing"
+
+
+def describe_draw_pass(step: Pass) -> str:
+    depth = "depth test" if step.depth_test else "no depth test"
+    return f"draw viewport {step.viewport} ({depth}): {describe_draws(step)}"
+
+
+def describe_trace_pass(step: Pass) -> str:
+    nodes = "; ".join(f"{d.node} ({d.program}" + (f", texture {d.texture}" if d.texture else "") + ")"
+                      for d in step.draws) or "nothing"
+    return f"trace viewport {step.viewport} ({step.detail}): {nodes}"
 
 
 @dataclass(frozen=True)
@@ -179,6 +216,10 @@ class Plan:
     #: What the frame does differently from what the scene asks (a node's own
     #: shader in a ray-traced viewport: :func:`user_shader_note`).
     notes: tuple[str, ...] = ()
+    #: What of the nodes' model files is not drawn (each mesh's
+    #: :attr:`~glsandbox.geometry.Mesh.warnings`, once each): ``render``, ``run``
+    #: and ``tour`` print them as ``warning:`` lines.
+    warnings: tuple[str, ...] = ()
 
     def describe(self) -> str:
         """A readable listing, as ``glsandbox plan`` prints it."""
@@ -192,6 +233,7 @@ class Plan:
         if self.notes:
             lines.append("notes:")
             lines += [f"  {line}" for line in self.notes]
+        lines += [f"warning: {line}" for line in self.warnings]
         return "\n".join(lines)
 
     def to_dict(self) -> dict[str, Any]:
@@ -206,21 +248,26 @@ class Plan:
             result["meshes"] = list(self.meshes)
         if self.notes:
             result["notes"] = list(self.notes)
+        if self.warnings:
+            result["warnings"] = list(self.warnings)
         return result
 
 
-def program_for(node: Node, lights: int = 0) -> ProgramVariant:
+def program_for(node: Node, lights: int = 0, shadow_light: int | None = None, shadow_pcf: int = 1) -> ProgramVariant:
     """The shader variant a node needs: ``basic`` with its colour source, or
     ``phong`` (:func:`lit_program_for`) when its material is lit; ``TEXTURED``
-    only when it has a texture. ``lights`` is the number of lights in the scene.
+    only when it has a texture. ``lights`` is the number of lights in the scene;
+    ``shadow_light`` the light whose shadow map a lit node receives (None: none),
+    filtered ``shadow_pcf`` texels wide.
     A node with a shader of its own gets that file, with ``NUM_LIGHTS`` (and
     ``TEXTURED``) defined, whatever its material's shading."""
     material = node.material
     if node.shader is not None:
         return _user_variant(str(node.shader), lights, material.texture is not None)
     if material.lit:
-        return lit_program_for(node, lights)
-    return _basic_variant(material.shading == "vertex_color", material.texture is not None)
+        return lit_program_for(node, lights, shadow_light, shadow_pcf)
+    return _basic_variant(material.shading == "vertex_color", material.texture is not None,
+                          material.alpha_mode == "mask")
 
 
 @functools.cache
@@ -245,27 +292,41 @@ def _texture_defines(textured: bool) -> tuple[tuple[str, str], ...]:
     return (("TEXTURED", ""),) if textured else ()
 
 
+def _mask_defines(mask: bool) -> tuple[tuple[str, str], ...]:
+    """``ALPHA_MASK``: fragments whose alpha is below the material's cutoff are discarded."""
+    return (("ALPHA_MASK", ""),) if mask else ()
+
+
 # One ProgramVariant object per combination: planning runs every frame.
 @functools.cache
-def _basic_variant(vertex_color: bool, textured: bool) -> ProgramVariant:
+def _basic_variant(vertex_color: bool, textured: bool, mask: bool = False) -> ProgramVariant:
     source = "VERTEX_COLOR" if vertex_color else "SOLID_COLOR"
-    return ProgramVariant("basic", ((source, ""), *_texture_defines(textured)))
+    return ProgramVariant("basic", ((source, ""), *_texture_defines(textured), *_mask_defines(mask)))
 
 
-def lit_program_for(node: Node, lights: int) -> ProgramVariant:
+def lit_program_for(node: Node, lights: int, shadow_light: int | None = None, shadow_pcf: int = 1) -> ProgramVariant:
     """The ``phong`` variant for a lit node (course section "Lighting").
 
     ``NUM_LIGHTS`` sizes the light loop to the lights present (no unused
     slots are looped over); ``PER_VERTEX`` evaluates the formula at the
     vertices (Gouraud), ``BLINN`` uses the half vector, ``NAIVE_NORMALS``
     the course's ``mul(Input.Norm, world)`` instead of the normal matrix.
+    A model file's materials add ``VERTEX_COLOR`` (the mesh colour times the
+    vertex colours), ``TWO_SIDED`` (back faces lit with the normal reversed)
+    and ``ALPHA_MASK`` (cut-outs), each only for a material that asks.
+    ``SHADOW_LIGHT i`` looks light i's shadow map up (:mod:`glsandbox.shadowmap`) with a
+    ``SHADOW_PCF`` x ``SHADOW_PCF`` grid of comparisons (a constant: the loop unrolls).
     """
     material = node.material
-    return _lit_variant(lights, material.shading, material.normals, material.texture is not None)
+    return _lit_variant(lights, material.shading, material.normals, material.texture is not None,
+                        material.vertex_colors, material.double_sided, material.alpha_mode == "mask",
+                        shadow_light, shadow_pcf)
 
 
 @functools.cache
-def _lit_variant(lights: int, shading: str, normals: str, textured: bool) -> ProgramVariant:
+def _lit_variant(lights: int, shading: str, normals: str, textured: bool, vertex_colors: bool = False,
+                 two_sided: bool = False, mask: bool = False, shadow_light: int | None = None,
+                 shadow_pcf: int = 1) -> ProgramVariant:
     defines: list[tuple[str, str]] = [("NUM_LIGHTS", str(lights))]
     if shading == "gouraud":
         defines.append(("PER_VERTEX", ""))
@@ -274,6 +335,13 @@ def _lit_variant(lights: int, shading: str, normals: str, textured: bool) -> Pro
     if normals == "naive":
         defines.append(("NAIVE_NORMALS", ""))
     defines.extend(_texture_defines(textured))
+    if vertex_colors:
+        defines.append(("VERTEX_COLOR", ""))
+    if two_sided:
+        defines.append(("TWO_SIDED", ""))
+    defines.extend(_mask_defines(mask))
+    if shadow_light is not None:
+        defines += [("SHADOW_LIGHT", str(shadow_light)), ("SHADOW_PCF", str(shadow_pcf))]
     return ProgramVariant("phong", tuple(defines))
 
 
@@ -296,6 +364,23 @@ def _coplanar(positions: np.ndarray) -> bool:
     return len(singular) < 3 or singular[2] <= 1e-9 * max(singular[0], 1e-300)
 
 
+_CENTRES: weakref.WeakKeyDictionary[Mesh, np.ndarray] = weakref.WeakKeyDictionary()
+
+
+def _distance(node: Node, camera: Camera) -> float:
+    """How far the centre of a node's bounding box lies from the eye, in world space:
+    blended nodes are drawn farthest first, so each blends over what lies behind it
+    (sorted by part, not by triangle: a part that wraps round another can still be
+    wrong, as in any rasterizer that sorts objects)."""
+    centre = _CENTRES.get(node.mesh)
+    if centre is None:  # meshes are immutable: once per mesh, not per frame
+        points = np.asarray(node.mesh.positions, dtype=np.float64)
+        centre = (points.min(axis=0) + points.max(axis=0)) / 2.0 if points.size else np.zeros(3)
+        _CENTRES[node.mesh] = centre
+    world = np.asarray(node.model, dtype=np.float64) @ np.append(centre, 1.0)
+    return float(np.linalg.norm(world[:3] - np.asarray(camera.eye, dtype=np.float64)))
+
+
 def _needs_depth(scene: Scene) -> bool:
     """A depth buffer is needed only where something can hide something else:
     two nodes in one viewport, or one mesh that is not flat."""
@@ -311,8 +396,155 @@ def _needs_depth(scene: Scene) -> bool:
     return False
 
 
+# --- ray-traced viewports (renderer=ray, ray_numpy) -----------------------------
+
+#: The options every ray-traced viewport is traced with (:func:`glsandbox.frame.trace_viewports`
+#: passes them to :func:`glsandbox.raytrace.render.render`; the plan's trace passes say them).
+TRACE_OPTIONS: dict[str, Any] = {"max_depth": 2, "shadows": True}
+
+#: Who traces a viewport of each ray renderer.
+TRACERS = {"ray": "GLSL ray tracer, float32", "ray_numpy": "numpy ray tracer, float64"}
+
+#: Shadings the ray tracer gives another name: Gouraud is a raster approximation
+#: (the ray tracer shades every pixel with the Phong formula).
+TRACED_SHADING = {"gouraud": "phong"}
+
+
+def traced_scene(scene: Scene, images: dict[int, Overlay]) -> Scene:
+    """The scene the rasterizer draws once the ray-traced viewports are traced.
+
+    Each viewport in ``images`` (by index) is traced: it keeps its clear, loses
+    its nodes, and shows its traced image as its first overlay (so the
+    scene's own overlays still land on top); its renderer becomes ``raster``.
+    Viewports without an image (a ray viewport too small to hold a pixel)
+    keep their nodes away too. A pure function: :func:`plan` uses it with
+    placeholder images to print the frame that will be drawn.
+    """
+    ray = {i for i, vp in enumerate(scene.viewports) if vp.renderer != "raster"}
+    everywhere = tuple(range(len(scene.viewports)))
+    nodes = []
+    for node in scene.nodes:
+        shown = tuple(v for v in (node.viewports if node.viewports is not None else everywhere) if v not in ray)
+        if shown:
+            nodes.append(node if shown == node.viewports or (node.viewports is None and shown == everywhere)
+                         else replace(node, viewports=shown))
+    viewports = tuple(replace(vp, renderer="raster") for vp in scene.viewports)
+    traced = tuple(images[i] for i in sorted(images))
+    return replace(scene, nodes=tuple(nodes), viewports=viewports, overlays=(*traced, *scene.overlays))
+
+
+def traced_image_name(viewport: int) -> str:
+    """The overlay name of a viewport's traced image."""
+    return f"raytrace/{viewport}"
+
+
+_PLACEHOLDER = np.zeros((1, 1, 4), dtype=np.uint8)
+
+
+def traced_reflectivity(scene: Scene, node: Node) -> float:
+    """The share of a node's colour the ray tracer takes from the reflected ray: its
+    ``material.reflectivity``; for the glass of the scene's stencil mirror
+    (:class:`glsandbox.planar.Mirror`) at least ``1 - alpha``, the share of the
+    reflection the rasterizer blends under the glass. The ray tracer reflects
+    everything in front of the glass, not only the mirror's ``reflected`` nodes:
+    the answer the stencil approximation aims at."""
+    value = float(node.material.reflectivity)
+    if scene.mirror is not None and node.name == scene.mirror.node:
+        value = max(value, 1.0 - float(node.material.color[3]))
+    return value
+
+
+def _trace_pass(scene: Scene, index: int) -> Pass:
+    """What tracing viewport ``index`` does: the tracer, its options, and each node as it is shaded."""
+    viewport = scene.viewports[index]
+    lights = len(scene.lights)
+    draws = []
+    for node in scene.nodes:
+        if not node.shown_in(index):
+            continue
+        material = node.material
+        shading = TRACED_SHADING.get(material.shading, material.shading)
+        reflects = traced_reflectivity(scene, node)
+        texture = material.texture
+        draws.append(Draw(node.name, shading + (f", reflects {reflects:g}" if reflects > 0 else ""),
+                          node.cull_back_faces, texture=texture.describe() if texture is not None else None))
+    how = [TRACERS[viewport.renderer], "1 primary ray per pixel"]
+    if lights:
+        how.append(f"shadow rays to {lights} light{'s' if lights != 1 else ''}" if TRACE_OPTIONS["shadows"]
+                   else "no shadow rays")
+    if any(", reflects" in d.program for d in draws):
+        how.append(f"reflections up to {TRACE_OPTIONS['max_depth']} bounces")
+    if any(d.texture for d in draws):
+        how.append("textures sampled bilinearly in their base level")
+    how.append(f"shown as overlay {traced_image_name(index)}")
+    return Pass("trace", index, draws=tuple(draws), detail=", ".join(how))
+
+
+def ignored_settings_notes(scene: Scene) -> tuple[str, ...]:
+    """What a ray-traced viewport ignores of what the scene asks, one note each: Gouraud
+    shading and naive normals (raster approximations: the ray tracer shades every pixel
+    with the normal matrix), texture filters other than ``linear`` (a ray samples the
+    base level bilinearly), the planar mirror and shadow (raster techniques: the ray
+    tracer traces reflection and shadow rays), MSAA (one ray per pixel), reverse-Z
+    (a depth buffer)."""
+    ray = [i for i, vp in enumerate(scene.viewports) if vp.renderer != "raster"]
+    if not ray:
+        return ()
+    where = f"viewport {ray[0]} is" if len(ray) == 1 else f"viewports {', '.join(map(str, ray))} are"
+    shown = [node for node in scene.nodes if any(node.shown_in(i) for i in ray)]
+    notes = []
+    for what, picked, instead in (
+            ("shading=gouraud", [n.name for n in shown if n.material.shading == "gouraud"],
+             "shaded per pixel (Phong), the picture of shading=phong"),
+            ("normals=naive", [n.name for n in shown if n.material.normals == "naive"],
+             "shaded with the normal matrix, the picture of normals=correct")):
+        if picked:
+            notes.append(f"{where} ray-traced: {what} (node{'s' if len(picked) > 1 else ''} "
+                         f"{', '.join(repr(name) for name in picked)}) is a raster approximation; "
+                         f"the ray tracer ignores it: {instead}")
+    filtered = {}
+    for node in shown:
+        texture = node.material.texture
+        if texture is not None and texture.filter != "linear":
+            filtered.setdefault(texture.filter, []).append(node.name)
+    for name, nodes in filtered.items():
+        notes.append(f"{where} ray-traced: texture filter {name} (node{'s' if len(nodes) > 1 else ''} "
+                     f"{', '.join(repr(n) for n in nodes)}) is the rasterizer's sampler; the ray tracer samples "
+                     "the base level bilinearly (filter=linear, no mipmaps: a ray has no footprint)")
+    if scene.mirror is not None and any(node.name == scene.mirror.node for node in shown):
+        how = "through the stencil" if scene.mirror.stencil else "without the stencil (it leaks)"
+        notes.append(f"{where} ray-traced: the planar mirror {scene.mirror.node!r} drawn {how} is a raster "
+                     "technique; the ray tracer traces reflection rays off the glass instead")
+    planar = scene.planar_shadow
+    if planar is not None and any(node.name == planar.receiver for node in shown):
+        notes.append(f"{where} ray-traced: the planar shadow on {planar.receiver!r} is a raster technique; "
+                     "the ray tracer casts shadow rays to the lights instead")
+    mapped = [i for i, light in enumerate(scene.lights) if light.shadow is not None]
+    if mapped and any(node.receives_shadow and node.material.lit for node in shown):
+        notes.append(f"{where} ray-traced: light {mapped[0]}'s shadow map is a raster technique; the ray tracer "
+                     "casts shadow rays to the lights instead (exact: no resolution, bias or filter)")
+    if scene.samples > 1:
+        every = "every viewport is" if len(ray) == len(scene.viewports) else f"{where}"
+        notes.append(f"--samples {scene.samples}: MSAA smooths rasterized edges only and {every} ray-traced "
+                     "with 1 ray per pixel, so its picture does not change")
+    if scene.depth_mode != "standard":
+        notes.append(f"{where} ray-traced: depth mode {scene.depth_mode} is the rasterizer's depth buffer; "
+                     "the ray tracer compares hit distances in float64/float32 and ignores it")
+    return tuple(notes)
+
+
+def renderer_notes(scene: Scene) -> tuple[str, ...]:
+    """Everything a frame does differently from what the scene asks, because of who renders
+    it: a node's own shader traced with its material, settings the ray tracer ignores."""
+    return (*user_shader_notes(scene), *ignored_settings_notes(scene))
+
+
 def plan(scene: Scene) -> Plan:
     """Plan a frame: per viewport a clear, then a draw of the nodes it shows.
+
+    Ray-traced viewports are traced first (a ``trace`` pass each, saying
+    with what); then the frame is planned as the rasterizer draws it, each
+    traced image an overlay of its viewport (:func:`traced_scene`).
 
     Depth is allocated, cleared and tested only when something can hide
     something else (see :func:`_needs_depth`); MSAA only when asked for; the
@@ -320,28 +552,43 @@ def plan(scene: Scene) -> Plan:
     With ``scene.plan_mode == "all"`` every buffer and test that leaves the
     picture unchanged is forced on: the plan is a superset of the needed one.
     """
+    ray = [i for i, vp in enumerate(scene.viewports) if vp.renderer != "raster"]
+    if ray:
+        images = {i: Overlay(traced_image_name(i), _PLACEHOLDER, viewport=i, position=(0, 0)) for i in ray}
+        drawn = plan(traced_scene(scene, images))
+        return replace(drawn, passes=(*(_trace_pass(scene, i) for i in ray), *drawn.passes),
+                       meshes=tuple(f"{node.name}: {', '.join(node.mesh.notes)}" for node in scene.nodes
+                                    if node.mesh.notes),
+                       notes=renderer_notes(scene), warnings=mesh_warnings(scene))
     # plan_mode "all": the everything-on baseline. Depth and stencil are allocated
     # and cleared in every viewport, and the depth test runs in every draw pass
     # (unless the scene turned depth testing off, which would change the picture).
     force = scene.plan_mode == "all"
     uses_depth = _needs_depth(scene) or (force and scene.depth_test) or _has_planar_effects(scene)
-    passes: list[Pass] = []
     programs: set[ProgramVariant] = set()
+    passes, shadow_light = shadow_map_passes(scene, programs)
+    shadow_pcf = scene.lights[shadow_light].shadow.pcf if shadow_light is not None else 1  # type: ignore[union-attr]
     for index, viewport in enumerate(scene.viewports):
         color = viewport.clear_color if viewport.clear_color is not None else scene.clear_color
         passes.append(Pass("clear", index, clear_color=color, clear_depth=uses_depth,
-                           clear_stencil=force or _needs_stencil(scene)))
-        draws = []
+                           clear_stencil=force or _needs_stencil(scene), camera=None))
+        draws, blended = [], []
         for node in scene.nodes:
             if not node.shown_in(index):
                 continue
             if scene.mirror is not None and node.name == scene.mirror.node:
                 continue  # the mirror's glass is drawn by the mirror passes
-            variant = program_for(node, len(scene.lights))
+            receives = shadow_light if node.receives_shadow and viewport.renderer == "raster" else None
+            variant = program_for(node, len(scene.lights), receives, shadow_pcf)
             programs.add(variant)
             texture = node.material.texture
-            draws.append(Draw(node.name, variant.key, node.cull_back_faces,
-                              texture=texture.describe() if texture is not None else None))
+            blend = node.material.alpha_mode == "blend"
+            (blended if blend else draws).append(
+                (node, Draw(node.name, variant.key, node.cull_back_faces,
+                            texture=texture.describe() if texture is not None else None, blend=blend,
+                            shadow_map=receives if "SHADOW_LIGHT" in dict(variant.defines) else None)))
+        camera = viewport.camera or scene.camera
+        draws = [d for _, d in draws] + [d for _, d in sorted(blended, key=lambda nd: -_distance(nd[0], camera))]
         if draws:
             passes.append(Pass("draw", index, draws=tuple(draws), depth_test=uses_depth))
         passes.extend(planar_passes(scene, index, programs))
@@ -358,7 +605,13 @@ def plan(scene: Scene) -> Plan:
         passes=tuple(passes),
         meshes=tuple(f"{node.name}: {', '.join(node.mesh.notes)}" for node in scene.nodes if node.mesh.notes),
         notes=user_shader_notes(scene),
+        warnings=mesh_warnings(scene),
     )
+
+
+def mesh_warnings(scene: Scene) -> tuple[str, ...]:
+    """What the scene's model files hold that is not drawn, each line once."""
+    return tuple(dict.fromkeys(line for node in scene.nodes for line in node.mesh.warnings))
 
 
 # --- overlays (labels and figures over the frame) ----------------------------
@@ -382,7 +635,7 @@ def overlay_passes(scene: Scene) -> list[Pass]:
         regions.setdefault(region, []).append(Draw(overlay.name, OVERLAY_PROGRAM.key, False))
     # Viewport regions in order, then the frame-wide ones, which may lie across several viewports.
     order = sorted(regions, key=lambda region: (region < 0, region))
-    return [Pass("overlay", region, draws=tuple(regions[region])) for region in order]
+    return [Pass("overlay", region, draws=tuple(regions[region]), camera=None) for region in order]
 
 
 def describe_overlay_pass(step: Pass) -> str:
@@ -393,11 +646,11 @@ def describe_overlay_pass(step: Pass) -> str:
 # --- planar effects: the stencil mirror and the planar shadow (course "The stencil Test") ---
 
 #: Pass kinds that only a scene with a mirror or a shadow receiver gets, in frame order.
-PLANAR_PASS_KINDS = ("mark_mirror", "reflection", "mirror_surface", "shadow")
+PLANAR_PASS_KINDS = ("mark_mirror", "reflection", "mirror_surface", "planar_shadow")
 #: The stencil bit of the mirror's pixels, and the bit of pixels already shadowed.
 #: Separate bits (with write and compare masks) let both effects share one buffer.
 MIRROR_STENCIL_BIT = 0x1
-SHADOW_STENCIL_BIT = 0x2
+PLANAR_SHADOW_STENCIL_BIT = 0x2
 #: ``MarkMirrorDSS``: every fragment of the glass that passes the depth test
 #: sets the mirror bit.
 MARK_MIRROR_STENCIL = StencilState("always", MIRROR_STENCIL_BIT, write_mask=MIRROR_STENCIL_BIT, on_pass="replace")
@@ -405,19 +658,19 @@ MARK_MIRROR_STENCIL = StencilState("always", MIRROR_STENCIL_BIT, write_mask=MIRR
 REFLECTION_STENCIL = StencilState("equal", MIRROR_STENCIL_BIT, mask=MIRROR_STENCIL_BIT)
 #: A pixel is darkened only while its shadow bit is clear, and the bit is then set
 #: (flipped from 0), so overlapping shadow triangles darken it once.
-SHADOW_STENCIL = StencilState("equal", 0, mask=SHADOW_STENCIL_BIT, write_mask=SHADOW_STENCIL_BIT, on_pass="invert")
+PLANAR_SHADOW_STENCIL = StencilState("equal", 0, mask=PLANAR_SHADOW_STENCIL_BIT, write_mask=PLANAR_SHADOW_STENCIL_BIT, on_pass="invert")
 #: Shadows are drawn in one flat colour.
-SHADOW_PROGRAM = ProgramVariant("basic", (("SOLID_COLOR", ""),))
+PLANAR_SHADOW_PROGRAM = ProgramVariant("basic", (("SOLID_COLOR", ""),))
 
 
 def _has_planar_effects(scene: Scene) -> bool:
-    return scene.mirror is not None or scene.shadow is not None
+    return scene.mirror is not None or scene.planar_shadow is not None
 
 
 def _needs_stencil(scene: Scene) -> bool:
     """The stencil buffer exists only for a stencil mirror or a stencil shadow."""
     return bool((scene.mirror is not None and scene.mirror.stencil)
-                or (scene.shadow is not None and scene.shadow.stencil))
+                or (scene.planar_shadow is not None and scene.planar_shadow.stencil))
 
 
 def planar_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> list[Pass]:
@@ -463,7 +716,7 @@ def planar_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
                            stencil=REFLECTION_STENCIL if mirror.stencil else None,
                            detail="front faces clockwise, lights reflected"))
         passes.append(Pass("mirror_surface", index, draws=(glass_draw,), depth_test=True, detail="blended"))
-    shadow = scene.shadow
+    shadow = scene.planar_shadow
     if shadow is not None and shadow.receiver in nodes and nodes[shadow.receiver].shown_in(index):
         models = {name: (nodes[name].model, nodes[name].mesh.positions) for name in shadow.casters if name in nodes}
         casting = shadow_casters(shadow, models)
@@ -474,17 +727,17 @@ def planar_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
         culled = [f"{name} culled ({why})" for name, why in casting.culled]
         if casting.reason:
             culled.append(f"culled: {casting.reason}")
-        draws = tuple(Draw(name, SHADOW_PROGRAM.key, False) for name in casting.kept if nodes[name].shown_in(index))
+        draws = tuple(Draw(name, PLANAR_SHADOW_PROGRAM.key, False) for name in casting.kept if nodes[name].shown_in(index))
         if draws:
-            programs.add(SHADOW_PROGRAM)
-        passes.append(Pass("shadow", index, draws=draws, depth_test=True,
-                           stencil=SHADOW_STENCIL if shadow.stencil else None,
+            programs.add(PLANAR_SHADOW_PROGRAM)
+        passes.append(Pass("planar_shadow", index, draws=draws, depth_test=True,
+                           stencil=PLANAR_SHADOW_STENCIL if shadow.stencil else None,
                            detail="; ".join([", ".join(how), *culled])))
     return passes
 
 
 _PLANAR_TITLES = {"mark_mirror": "mark mirror", "reflection": "reflection", "mirror_surface": "mirror surface",
-                  "shadow": "shadow"}
+                  "planar_shadow": "planar shadow"}
 
 
 def describe_planar_pass(step: Pass) -> str:
@@ -493,10 +746,52 @@ def describe_planar_pass(step: Pass) -> str:
         what.append("no colour or depth writes")
     if step.stencil is not None:
         what.append(f"stencil {step.stencil.describe()}")
-    elif step.kind in ("reflection", "shadow"):
+    elif step.kind in ("reflection", "planar_shadow"):
         what.append("no stencil")
     if step.detail:
         what.append(step.detail)
-    items = "; ".join(f"{d.node} with {d.program}" + ("" if d.cull_back_faces else " (no culling)")
-                      for d in step.draws) or "nothing"
-    return f"{_PLANAR_TITLES[step.kind]} viewport {step.viewport} ({', '.join(what)}): {items}"
+    return f"{_PLANAR_TITLES[step.kind]} viewport {step.viewport} ({', '.join(what)}): {describe_draws(step)}"
+
+
+# --- shadow maps (glsandbox.shadowmap) ----------------------------------------
+
+#: The texture unit a receiver's shadow map is bound to (unit 0 is the material's texture).
+SHADOW_MAP_UNIT = 1
+#: Casters are drawn into the map with the flat program; only their depth is kept.
+DEPTH_PROGRAM = ProgramVariant("basic", (("SOLID_COLOR", ""),))
+
+
+def shadow_map_passes(scene: Scene, programs: set[ProgramVariant]) -> tuple[list[Pass], int | None]:
+    """The depth-only pass of the shadow-casting light, before every viewport,
+    and that light's index; none (and None) when no light casts a shadow map or
+    no visible lit node receives it: the map would be drawn for nobody."""
+    light = casting_light(scene)
+    if light is None or not receivers(scene):
+        return [], None
+    shadow = scene.lights[light].shadow
+    assert shadow is not None
+    draws = tuple(Draw(node.name, DEPTH_PROGRAM.key, node.cull_back_faces) for node in casters(scene))
+    if draws:
+        programs.add(DEPTH_PROGRAM)
+    detail = f"{shadow.size}x{shadow.size} depth 24, perspective {shadow.fov:g}°"
+    return [Pass("shadow_map", -1, clear_depth=True, draws=draws, depth_test=True, detail=detail,
+                 target=f"shadow map {light}", camera=f"light {light}")], light
+
+
+def describe_shadow_map_pass(step: Pass) -> str:
+    return (f"shadow map from {step.camera} into {step.target} ({step.detail}, cleared, depth test, "
+            f"no colour): {describe_draws(step)}")
+
+
+#: One describer per pass kind; a new kind adds its entry here and its runner in
+#: :data:`glsandbox.gl.executor.PASS_RUNNERS` (a test checks both registries agree).
+PASS_DESCRIBERS: dict[str, Callable[[Pass], str]] = {
+    "trace": describe_trace_pass,
+    "shadow_map": describe_shadow_map_pass,
+    "clear": describe_clear_pass,
+    "draw": describe_draw_pass,
+    **{kind: describe_planar_pass for kind in PLANAR_PASS_KINDS},
+    "overlay": describe_overlay_pass,
+}
+#: Every pass kind, in frame order.
+PASS_KINDS = tuple(PASS_DESCRIBERS)

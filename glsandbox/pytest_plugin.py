@@ -4,7 +4,7 @@ Installed with glsandbox (the ``pytest11`` entry point), it adds the fixture
 ``glsandbox_golden``::
 
     def test_my_lesson(glsandbox_golden):
-        glsandbox_golden("my_lesson.py", "my_lesson", settings=["time=1"])
+        glsandbox_golden("my_lesson.py", "my_lesson", settings=["time=1"])  # or settings={"time": 1}
 
 which renders the subject headless and checks it against
 ``goldens/<name>.png`` beside the test file with the project's golden rule
@@ -64,6 +64,11 @@ def glsandbox_renderer() -> Iterator[Any]:
 def glsandbox_golden(request: pytest.FixtureRequest, glsandbox_renderer: Any) -> Callable[..., Any]:
     """``glsandbox_golden(subject, name, settings=(), size=None, samples=0, threshold=2, max_bad_share=0.0005)``.
 
+    ``settings`` is a list of ``"key=value"`` texts (as ``--set`` takes them)
+    or a dict ``{"time": 1.0, "shading": "phong"}``. A mistake in the call (an
+    unknown setting, a threshold that is not a number, a golden that is a
+    folder, a lesson that does not load) fails the test with one line.
+
     Renders ``subject`` (see the module's docstring), checks it against
     ``<goldens>/<name>.png`` and returns the :class:`~glsandbox.measure.golden.ImageMatch`;
     a mismatch or a missing golden fails the test with the figures and the
@@ -78,25 +83,104 @@ def glsandbox_golden(request: pytest.FixtureRequest, glsandbox_renderer: Any) ->
     here = Path(request.path).parent
     goldens = (root / configured) if configured else here / "goldens"
 
-    def check(subject: Any, name: str, *, settings: Sequence[str] = (), size: Any = None, samples: int = 0,
+    def check(subject: Any, name: str, *, settings: Any = (), size: Any = None, samples: int = 0,
               **tolerances: Any) -> Any:
-        golden = goldens / f"{name}.png"
-        image = _image_of(subject, here, settings, _size(size, golden), samples, glsandbox_renderer)
-        return check_golden(image, golden, update=update, results_dir=root / "test-results", name=name,
-                            hint=f"run pytest {UPDATE_FLAG}", **tolerances)
+        from glsandbox.errors import SandboxError
+
+        try:
+            golden = _golden_path(goldens, name)
+            texts = _settings(settings)
+            checked = _tolerances(tolerances)
+            frame_size = _size(size, golden)
+            image = _image_of(subject, here, texts, frame_size, _samples(samples), glsandbox_renderer)
+        except SandboxError as exc:
+            mistake = str(exc)
+        else:
+            return check_golden(image, golden, update=update, results_dir=root / "test-results", name=name,
+                                hint=f"run pytest {UPDATE_FLAG}", **checked)
+        # A mistake in the call (or the lesson): one line, not a traceback from inside glsandbox.
+        pytest.fail(f"glsandbox_golden: {mistake}", pytrace=False)
 
     return check
 
 
+def _golden_path(goldens: Path, name: Any) -> Path:
+    """``<goldens>/<name>.png``; a name that leaves the folder, or a golden that is a folder, is refused."""
+    from glsandbox.errors import SandboxError, plain
+
+    if not isinstance(name, str) or not name.strip() or Path(name).is_absolute() or ".." in Path(name).parts:
+        raise SandboxError(f"name must be a relative name without '..' (the golden's file stem), got {plain(name)}")
+    golden = goldens / f"{name}.png"
+    if golden.is_dir():  # also under --glsandbox-update: a folder is never replaced by an image
+        raise SandboxError(f"golden {golden} is a folder, not a .png file; move it away or pick another name")
+    return golden
+
+
+def _settings(settings: Any) -> list[str]:
+    """``settings`` as ``--set`` texts: a list or tuple of ``"key=value"`` texts, one such text,
+    or a dict ``{"key": value}`` (on/off for bools, commas between the numbers of a list)."""
+    from collections.abc import Mapping
+
+    from glsandbox.errors import SandboxError, plain
+
+    if settings is None:
+        return []
+    if isinstance(settings, str):
+        return [settings]
+    if isinstance(settings, Mapping):
+        def text(value: Any) -> str:
+            if isinstance(value, bool):
+                return "on" if value else "off"
+            if isinstance(value, (list, tuple)):
+                return ",".join(str(v) for v in value)
+            return str(value)
+
+        return [f"{key}={text(value)}" for key, value in settings.items()]
+    if isinstance(settings, (list, tuple)) and all(isinstance(item, str) for item in settings):
+        return list(settings)
+    raise SandboxError('settings must be a list of "key=value" texts or a dict {"key": value}, '
+                       f"got {plain(settings)}")
+
+
+def _tolerances(tolerances: dict[str, Any]) -> dict[str, Any]:
+    """``threshold`` (0..255 levels) and ``max_bad_share`` (0..1), checked; nothing else is taken."""
+    from glsandbox.errors import SandboxError, check_number
+
+    unknown = sorted(set(tolerances) - {"threshold", "max_bad_share"})
+    if unknown:
+        raise SandboxError(f"unknown argument {unknown[0]!r}; the tolerances are threshold and max_bad_share")
+    checked = {}
+    if "threshold" in tolerances:
+        value = check_number(tolerances["threshold"], "threshold", 0, 255)
+        if value != int(value):
+            raise SandboxError(f"threshold must be a whole number of levels (0..255), got {value:g}")
+        checked["threshold"] = int(value)
+    if "max_bad_share" in tolerances:
+        checked["max_bad_share"] = check_number(tolerances["max_bad_share"], "max_bad_share", 0.0, 1.0)
+    return checked
+
+
+def _samples(samples: Any) -> int:
+    from glsandbox.errors import SandboxError, plain
+
+    if isinstance(samples, bool) or not isinstance(samples, int) or samples < 0:
+        raise SandboxError(f"samples must be a whole number >= 0, got {plain(samples)}")
+    return samples
+
+
 def _size(size: Any, golden: Path) -> tuple[int, int]:
     from glsandbox.cli import parse_size
+    from glsandbox.errors import SandboxError, plain
     from glsandbox.frame import DEFAULT_SIZE
     from glsandbox.files import load_png
 
     if isinstance(size, str):
         return parse_size(size)
     if size is not None:
-        return int(size[0]), int(size[1])
+        if isinstance(size, (list, tuple)) and len(size) == 2 \
+                and all(isinstance(v, int) and not isinstance(v, bool) for v in size):
+            return parse_size(f"{size[0]}x{size[1]}")
+        raise SandboxError(f'size must be (width, height) or "WxH", got {plain(size)}')
     try:
         height, width = load_png(golden).shape[:2]
     except OSError:  # none yet, or unreadable: check_golden reports it
@@ -109,6 +193,7 @@ def _image_of(subject: Any, here: Path, settings: Sequence[str], size: tuple[int
     """The RGBA image a subject stands for, rendered on the shared context when it is a scene or lesson."""
     import numpy as np
 
+    from glsandbox.errors import SandboxError
     from glsandbox.files import load_png
     from glsandbox.frame import with_samples
     from glsandbox.lesson import Lesson, find_lesson
@@ -129,8 +214,8 @@ def _image_of(subject: Any, here: Path, settings: Sequence[str], size: tuple[int
     if isinstance(subject, type) and issubclass(subject, Lesson):
         subject = subject.from_settings(settings)
     elif settings:
-        raise TypeError("settings= applies to a lesson given by name, file or class")
+        raise SandboxError("settings= applies to a lesson given by name, file or class")
     if isinstance(subject, Lesson):
         return lazy.renderer.render(subject, size, samples).image
-    raise TypeError(f"glsandbox_golden: cannot check a {type(subject).__name__}; give a lesson name or file, "
-                    "a .png, a Lesson, a Scene or an RGBA image array")
+    raise SandboxError(f"cannot check a {type(subject).__name__}; give a lesson name or file, "
+                       "a .png, a Lesson, a Scene or an RGBA image array")

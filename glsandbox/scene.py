@@ -66,6 +66,11 @@ PLAN_MODES = ("needed", "all")
 DEPTH_MODES = ("standard", "reverse_z")
 
 
+#: How a material's alpha is used (glTF ``alphaMode``): ignored (the surface is opaque); a
+#: cut-out, where an alpha below ``alpha_cutoff`` leaves no fragment; or blended over what lies
+#: behind (drawn after the opaque nodes, farthest first, without depth writes).
+ALPHA_MODES = ("opaque", "mask", "blend")
+
 #: Images the project draws itself (:mod:`glsandbox.images`); any other
 #: texture source is an image file path.
 BUILTIN_TEXTURES = ("checker", "labels", "mip_levels")
@@ -121,17 +126,63 @@ class Camera:
         return transforms.perspective(self.fov_y, aspect, self.near, self.far)
 
 
+#: Shadow-map sizes a light may ask for (texels per side).
+SHADOW_MAP_SIZES = (64, 128, 256, 512, 1024, 2048, 4096)
+#: The widest percentage-closer filter (texels per side of the kernel).
+MAX_PCF = 7
+
+
+@dataclass(frozen=True)
+class ShadowMap:
+    """A light's shadow map (:mod:`glsandbox.shadowmap`): the depth of the
+    nearest caster seen from the light, ``size`` x ``size`` texels, which a
+    lit receiver compares its own distance with.
+
+    ``bias`` (world units) and ``slope_bias`` (world units per unit of
+    ``tan`` of the angle between the surface normal and the light) move the
+    receiver's point towards the light before the comparison: too little and a
+    surface shadows itself in stripes (acne), too much and shadows come loose
+    from their casters (peter-panning). ``pcf`` is the width in texels of the
+    percentage-closer filter (1: one comparison, hard aliased edges; 3: a 3x3
+    grid of comparisons averaged). ``fov`` is the light frustum's field of view
+    in degrees: a point light gets one perspective frustum looking from it at
+    the centre of the shadow casters, not a cube map (what lies outside the
+    frustum is lit).
+    """
+
+    size: int = 1024
+    bias: float = 0.02
+    slope_bias: float = 0.02
+    pcf: int = 3
+    fov: float = 90.0
+
+    def __post_init__(self) -> None:
+        if isinstance(self.size, bool) or self.size not in SHADOW_MAP_SIZES:
+            raise SandboxError(f"shadow map size must be one of {', '.join(map(str, SHADOW_MAP_SIZES))}, "
+                               f"got {plain(self.size)}")
+        for name in ("bias", "slope_bias"):
+            _set(self, name, check_number(getattr(self, name), f"shadow map {name}", low=0.0))
+        if isinstance(self.pcf, bool) or self.pcf not in range(1, MAX_PCF + 1, 2):
+            raise SandboxError(f"shadow map pcf must be an odd width from 1 to {MAX_PCF} texels, got {plain(self.pcf)}")
+        _set(self, "fov", check_number(self.fov, "shadow map fov"))
+        if not 1.0 <= self.fov <= 150.0:
+            raise SandboxError(f"shadow map fov must lie in 1..150 degrees, got {plain(self.fov)}")
+
+
 @dataclass(frozen=True)
 class Light:
-    """A point light."""
+    """A point light; with ``shadow`` it casts a shadow map (:class:`ShadowMap`)."""
 
     position: tuple[float, float, float]
     #: Its colour (intensity per channel, >= 0; above 1 is a brighter light).
     color: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    shadow: ShadowMap | None = None
 
     def __post_init__(self) -> None:
         _set(self, "position", check_numbers(self.position, "light position"))
         _set(self, "color", check_numbers(self.color, "light colour", low=0.0))
+        if self.shadow is not None and not isinstance(self.shadow, ShadowMap):
+            raise SandboxError(f"a light's shadow must be a ShadowMap, got {plain(self.shadow)}")
 
 
 #: Digests of in-memory texture images by array identity (the arrays are read-only), so that
@@ -220,9 +271,23 @@ class Material:
     #: ray (course section "Yansıma vektörü"): ``(1-r)·local + r·reflected``.
     #: Only the ray tracer follows reflection rays; the rasterizer ignores it.
     reflectivity: float = 0.0
+    #: Lit shadings multiply the mesh colour by the mesh's vertex colours (a PLY's
+    #: ``red green blue``), as ``vertex_color`` shading does unlit.
+    vertex_colors: bool = False
+    #: :data:`ALPHA_MODES`; alpha is the colour's times the texture's.
+    alpha_mode: str = "opaque"
+    alpha_cutoff: float = 0.5
+    #: Both faces are drawn and lit, a back face with its normal reversed (glTF
+    #: ``doubleSided``): the node's back-face culling is off whatever it says.
+    double_sided: bool = False
 
     def __post_init__(self) -> None:
         _set(self, "color", check_numbers(self.color, "material colour", (4,), low=0.0, high=1.0))
+        if self.alpha_mode not in ALPHA_MODES:
+            raise SandboxError(f"unknown alpha mode {self.alpha_mode!r}; use one of {', '.join(ALPHA_MODES)}")
+        if not (isinstance(self.alpha_cutoff, (int, float)) and math.isfinite(self.alpha_cutoff)
+                and 0.0 <= self.alpha_cutoff <= 1.0):
+            raise SandboxError(f"material alpha cutoff must lie in 0..1, got {plain(self.alpha_cutoff)}")
         if not (isinstance(self.reflectivity, (int, float)) and math.isfinite(self.reflectivity)
                 and 0.0 <= self.reflectivity <= 1.0):
             raise SandboxError(f"material reflectivity must lie in 0..1, got {plain(self.reflectivity)}")
@@ -270,6 +335,7 @@ SHADER_INPUTS: tuple[tuple[str, str, str, str], ...] = (
     ("u_specular", "uniform float", "-", "material coefficient (0.3)"),
     ("u_shininess", "uniform float", "-", "specular exponent (32)"),
     ("u_texture", "uniform sampler2D", "texture", "the material's texture on unit 0 (with TEXTURED)"),
+    ("u_alpha_cutoff", "uniform float", "-", "material alpha cutoff (0.5; alpha_mode \"mask\" discards below it)"),
 )
 
 #: The names the renderer sets; a node's own uniforms may not use them.
@@ -321,7 +387,7 @@ class Node:
     """A mesh placed in the world with a model matrix and a material.
 
     ``cull_back_faces`` is the rasterizer state (on by default, as in the
-    course); ``viewports`` limits the node to some viewports (None: all).
+    course; off for a double-sided material); ``viewports`` limits the node to some viewports (None: all).
 
     ``shader`` names a GLSL file of the user's (a path, relative to the
     working folder or absolute, kept absolute; a scene file's is relative to
@@ -340,10 +406,22 @@ class Node:
     viewports: tuple[int, ...] | None = None
     shader: str | os.PathLike[str] | None = None
     uniforms: Mapping[str, Any] = field(default_factory=lambda: _NO_UNIFORMS)
+    #: Shadow maps: whether the node is drawn into them (casts), and whether a
+    #: lit node looks them up (receives). The planar shadow names its own.
+    casts_shadow: bool = True
+    receives_shadow: bool = True
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str):
             raise SandboxError(f"a node's name must be text, got {plain(self.name)}")
+        if not isinstance(self.mesh, Mesh):
+            hint = f" (a built-in mesh by name: glsandbox.geometry.builtin_mesh({self.mesh!r}))" \
+                if isinstance(self.mesh, str) else ""
+            raise SandboxError(f"node {self.name!r}: mesh must be a Mesh{hint}, got {plain(self.mesh)}")
+        if not isinstance(self.material, Material):
+            raise SandboxError(f"node {self.name!r}: material must be a Material, got {plain(self.material)}")
+        if self.material.double_sided:
+            _set(self, "cull_back_faces", False)  # both faces are the surface
         if self.shader is not None:
             if not isinstance(self.shader, (str, os.PathLike)) or not str(self.shader).strip():
                 raise SandboxError(f"node {self.name!r}: shader must be a GLSL file path, got {plain(self.shader)}")
@@ -367,7 +445,8 @@ class Node:
         # Normals are not among them: a lit mesh without normals is shaded flat by both
         # renderers (glsandbox.geometry.with_face_normals).
         for needed, data, attribute in (("a texture", self.material.texture is not None, "uvs"),
-                                        ("vertex_color shading", self.material.shading == "vertex_color", "colors")):
+                                        ("vertex_color shading", self.material.shading == "vertex_color", "colors"),
+                                        ("vertex_colors = true", self.material.vertex_colors, "colors")):
             if data and getattr(self.mesh, attribute, None) is None:
                 raise SandboxError(f"node {self.name!r}: mesh {self.mesh.name!r} has no {attribute[:-1]} data, "
                                    f"which {needed} needs")
@@ -439,7 +518,7 @@ class Scene:
     #: A planar mirror drawn through the stencil buffer (:mod:`glsandbox.planar`).
     mirror: Mirror | None = None
     #: A planar shadow projected onto a receiver (:mod:`glsandbox.planar`).
-    shadow: PlanarShadow | None = None
+    planar_shadow: PlanarShadow | None = None
     #: How depth is stored and compared (:data:`DEPTH_MODES`).
     depth_mode: str = "standard"
     #: ``"needed"``: the plan lists only what the scene calls for; ``"all"``:
@@ -456,6 +535,7 @@ class Scene:
         for field_name in ("nodes", "lights", "viewports", "overlays"):
             if isinstance(getattr(self, field_name), list):
                 _set(self, field_name, tuple(getattr(self, field_name)))
+        self._check_parts()
         if self.uniform_overrides or type(self.uniform_overrides) is not MappingProxyType:
             _set(self, "uniform_overrides", check_uniforms(self.uniform_overrides, "--set u.{name}"))
         _set(self, "clear_color", check_numbers(self.clear_color, "scene clear colour", (4,), 0.0, 1.0))
@@ -463,3 +543,24 @@ class Scene:
             raise SandboxError(f"unknown depth mode {self.depth_mode!r}; use one of {', '.join(DEPTH_MODES)}")
         if self.plan_mode not in PLAN_MODES:
             raise SandboxError(f"unknown plan mode {self.plan_mode!r}; use one of {', '.join(PLAN_MODES)}")
+
+    def _check_parts(self) -> None:
+        """Each field holds what it names (``nodes=(1, 2)`` would fail deep in a renderer, naming nothing)."""
+        if not isinstance(self.name, str):
+            raise SandboxError(f"a scene's name must be text, got {plain(self.name)}")
+        for field_name, kind in (("nodes", Node), ("lights", Light), ("viewports", Viewport), ("overlays", Overlay)):
+            items = getattr(self, field_name)
+            if not isinstance(items, tuple):
+                lone = " (one alone needs a comma: (x,))" if isinstance(items, kind) else ""
+                raise SandboxError(f"scene {self.name!r}: {field_name} must be a tuple or list of {kind.__name__}"
+                                   f"{lone}, got {plain(items)}")
+            for i, item in enumerate(items):
+                if not isinstance(item, kind):
+                    raise SandboxError(f"scene {self.name!r}: {field_name}[{i}] must be a {kind.__name__}, "
+                                       f"got {plain(item)}")
+        for field_name, kind in (("camera", Camera), ("mirror", Mirror), ("planar_shadow", PlanarShadow)):
+            value = getattr(self, field_name)
+            if not isinstance(value, kind) and (value is not None or field_name == "camera"):
+                raise SandboxError(f"scene {self.name!r}: {field_name} must be a {kind.__name__}, got {plain(value)}")
+        if isinstance(self.samples, bool) or not isinstance(self.samples, (int, np.integer)) or self.samples < 0:
+            raise SandboxError(f"scene {self.name!r}: samples must be a whole number >= 0, got {plain(self.samples)}")

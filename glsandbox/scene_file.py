@@ -4,7 +4,9 @@ The format is the README's "Scene files" section: top-level ``name``,
 ``clear_color``, ``depth_test`` and ``depth_mode``, a ``[camera]`` table,
 ``[[nodes]]``, ``[[lights]]`` and ``[[viewports]]`` arrays, and the optional
 ``[mirror]`` and ``[shadow]`` tables that tie the planar effects to nodes by
-name. Every value is checked here; a mistake is one :class:`SandboxError`
+name (``[shadow]`` is the planar shadow, kept under its old name; a light's
+shadow map is its ``shadow_map = {size = 1024, ...}``, and a node opts out of
+it with ``casts_shadow``/``receives_shadow = false``). Every value is checked here; a mistake is one :class:`SandboxError`
 naming the file, the line and the key (``scene.toml:7: nodes[0].mesh: ...``),
 once: a value of the wrong type (a number where a table, list or text is
 expected), a number that is not finite or lies beyond
@@ -33,17 +35,21 @@ import numpy as np
 from glsandbox import transforms
 from glsandbox.errors import NUMBER_LIMIT, SandboxError, plain
 from glsandbox.files import read_user_file
-from glsandbox.geometry import builtin_mesh
-from glsandbox.meshfile import CREASE_ANGLE, NORMALS as MESH_NORMALS, Model, is_model_path, load_model
+from glsandbox.geometry import Mesh, builtin_mesh
+from glsandbox.meshfile import CREASE_ANGLE, NORMALS as MESH_NORMALS, Model, ModelPart, is_model_path, load_model
 from glsandbox.planar import Mirror, PlanarShadow
 from glsandbox.scene import (BUILTIN_TEXTURES, COURSE_BLUE, DEPTH_MODES, SHADINGS, Camera, Color, Light, Material,
-                             Node, Scene, Texture, Viewport, check_uniforms)
+                             Node, Scene, ShadowMap, Texture, Viewport, check_uniforms)
 
 #: Lighting coefficients a scene file may set on a node (see :class:`~glsandbox.scene.Material`).
 _MATERIAL_NUMBERS = ("ambient", "diffuse", "specular", "shininess")
+#: A material's alpha and sides (glsandbox.scene.Material; a model file's parts bring their own).
+_MATERIAL_LOOKS = ("alpha_mode", "alpha_cutoff", "double_sided", "vertex_colors")
 
 #: Keys only a node whose mesh is a model file takes (:mod:`glsandbox.meshfile`).
-_MODEL_FILE_KEYS = ("fit", "mesh_normals", "crease_angle")
+_MODEL_FILE_KEYS = ("fit", "mesh_normals", "crease_angle", "up")
+#: A model file's up axis (``up = "z"`` stands a Z-up scan upright: z becomes y).
+_UP_AXES = ("y", "z")
 
 
 class _Locator:
@@ -196,20 +202,25 @@ class _SceneReader:
             key = _guess_key(str(exc).split(":")[0], ("fov_y", "near", "far"))
             raise self.fail("camera", 0, key, str(exc)) from None
 
-    def node(self, data: Any, i: int) -> Node:
+    def node(self, data: Any, i: int) -> tuple[Node, ...]:
+        """The node of ``[[nodes]]`` table ``i``; a model file with several materials gives one
+        node per material, named ``name/material``, unless the table sets its own colour or texture."""
         data = self.table(data, "nodes", i)
         allowed = {"name", "mesh", "order", "scale", "translate", "rotate", "color", "shading",
-                   "cull_back_faces", "viewports", *_MATERIAL_NUMBERS, "normals", "texture", "filter", "wrap",
-                   *_MODEL_FILE_KEYS, "shader", "uniforms"}
+                   "cull_back_faces", "viewports", *_MATERIAL_NUMBERS, *_MATERIAL_LOOKS, "normals", "texture",
+                   "filter", "wrap",
+                   *_MODEL_FILE_KEYS, "shader", "uniforms", "casts_shadow", "receives_shadow"}
         self.check_keys(data, allowed, "nodes", i)
         mesh_name = data.get("mesh")
         if not isinstance(mesh_name, str):
             raise self.fail("nodes", i, "mesh" if "mesh" in data else None, "every node needs mesh = \"<name>\"")
         loaded = self.model_file(data, i, mesh_name)
         try:
-            mesh = loaded.mesh if loaded is not None else builtin_mesh(mesh_name)
+            # A model file's first part (its only one, mostly): the parts are drawn, never joined.
+            mesh = loaded.parts[0].mesh if loaded is not None else builtin_mesh(mesh_name)
         except SandboxError as exc:
             raise self.fail("nodes", i, "mesh", str(exc)) from None
+        coloured = mesh.colors is not None if loaded is None else all(p.mesh.colors is not None for p in loaded.parts)
         order = self.text(data, "order", "nodes", i, default="STR")
         try:
             order = transforms.parse_order(order)
@@ -222,10 +233,12 @@ class _SceneReader:
         rx, ry, rz = (math.radians(a) for a in r)
         rotation = transforms.rotate_z(rz) @ transforms.rotate_y(ry) @ transforms.rotate_x(rx)
         model = transforms.compose(order, S=transforms.scale(*s), T=transforms.translate(*t), R=rotation)
-        shading = self.text(data, "shading", "nodes", i, default="vertex_color" if mesh.colors is not None else "solid")
+        if loaded is not None and data.get("up", "y") == "z":
+            model = model @ transforms.rotate_x(-math.pi / 2)  # the file's z becomes y, before the node's own transform
+        shading = self.text(data, "shading", "nodes", i, default="vertex_color" if coloured else "solid")
         if shading not in SHADINGS:
             raise self.fail("nodes", i, "shading", f"unknown shading {shading!r}; use one of {', '.join(SHADINGS)}")
-        if shading == "vertex_color" and mesh.colors is None:
+        if shading == "vertex_color" and not coloured:
             raise self.fail("nodes", i, "shading", f"mesh {mesh_name!r} has no vertex colours")
         cull = self.flag(data, "cull_back_faces", "nodes", i)
         views = data.get("viewports")
@@ -233,18 +246,29 @@ class _SceneReader:
                                                                       for v in views)):
             raise self.fail("nodes", i, "viewports", f"expected a list of viewport indices, got {plain(views)}")
         name = self.text(data, "name", "nodes", i, default=f"node{i}")
-        material = self.material(data, i, shading) if loaded is None else self.model_material(data, i, shading,
-                                                                                             loaded)
+        if loaded is None:
+            looks = [(name, mesh, self.material(data, i, shading))]
+        elif len(loaded.parts) == 1 or "color" in data or "texture" in data:  # one look: one node, all parts
+            looks = [(name, loaded.mesh, self.model_material(data, i, shading, loaded.parts[0], loaded.mesh))]
+        else:
+            looks = [(f"{name}/{part.name}", part.mesh, self.model_material(data, i, shading, part, part.mesh))
+                     for part in loaded.parts]
         shader, uniforms = self.shader(data, i)
         try:
-            return Node(name=name, mesh=mesh, model=model, material=material, cull_back_faces=cull,
-                        viewports=tuple(views) if views is not None else None, shader=shader, uniforms=uniforms)
+            return tuple(Node(name=label, mesh=part_mesh, model=model, material=material, cull_back_faces=cull,
+                              viewports=tuple(views) if views is not None else None, shader=shader,
+                              uniforms=uniforms,
+                              casts_shadow=self.flag(data, "casts_shadow", "nodes", i),
+                              receives_shadow=self.flag(data, "receives_shadow", "nodes", i))
+                         for label, part_mesh, material in looks)
         except SandboxError as exc:  # the mesh lacks what the material reads, or the model is out of bounds
             message = str(exc)
             if "which a texture needs" in message:
                 key: str | None = "texture"
             elif "shading needs" in message:
                 key = "shading"
+            elif "vertex_colors = true needs" in message:
+                key = "vertex_colors"
             else:
                 key = next((k for k in ("scale", "translate") if k in data), None)
             raise self.fail("nodes", i, key, message) from None
@@ -292,6 +316,8 @@ class _SceneReader:
                     raise self.fail("nodes", i, key, f"only for a mesh loaded from a file; {mesh_name!r} is built in")
             return None
         fit = self.flag(data, "fit", "nodes", i, default=False)
+        if data.get("up", "y") not in _UP_AXES:
+            raise self.fail("nodes", i, "up", f"unknown up axis {plain(data['up'])}; use one of {', '.join(_UP_AXES)}")
         normals = data.get("mesh_normals", "auto")
         if normals not in MESH_NORMALS:
             raise self.fail("nodes", i, "mesh_normals", f"unknown mesh normals {normals!r}; "
@@ -309,9 +335,11 @@ class _SceneReader:
             key = "mesh_normals" if "normals = " in str(exc) else "mesh"
             raise self.fail("nodes", i, key, str(exc)) from None
 
-    def model_material(self, data: dict[str, Any], i: int, shading: str, model: Model) -> Material:
-        """:meth:`material` for a model file's node: the file's base colour texture and
-        colour unless the node gives its own (``filter`` and ``wrap`` apply to the file's texture)."""
+    def model_material(self, data: dict[str, Any], i: int, shading: str, model: ModelPart, mesh: Mesh) -> Material:
+        """:meth:`material` for a model file's part drawn as ``mesh``: the file's base colour
+        texture and colour unless the node gives its own (``filter`` and ``wrap`` apply to the
+        file's texture), its alpha mode and sidedness (``cull_back_faces``, when given, wins),
+        and its vertex colours tinting a lit shading."""
         own = model.texture is None or "texture" in data
         material = self.material(data if own else {k: v for k, v in data.items() if k not in ("filter", "wrap")},
                                  i, shading)
@@ -324,9 +352,13 @@ class _SceneReader:
             material = replace(material, texture=texture)
         if model.color is not None and "color" not in data:
             material = replace(material, color=model.color)
-        if material.texture is not None and model.mesh.uvs is None:
-            raise self.fail("nodes", i, "texture", f"{model.path.name} has no texture coordinates to map it with")
-        return material
+        if material.texture is not None and mesh.uvs is None:
+            raise self.fail("nodes", i, "texture", f"{mesh.name} has no texture coordinates to map it with")
+        # The file's alpha and sides, unless the node says (cull_back_faces = true makes it one-sided).
+        sided = model.double_sided if "cull_back_faces" not in data else not data["cull_back_faces"]
+        file_look = dict(alpha_mode=model.alpha_mode, alpha_cutoff=model.alpha_cutoff, double_sided=sided,
+                         vertex_colors=mesh.colors is not None and material.lit)
+        return replace(material, **{k: v for k, v in file_look.items() if k not in data})
 
     def material(self, data: dict[str, Any], i: int, shading: str) -> Material:
         """A node's material: colour, shading, the lighting coefficients, a texture."""
@@ -353,11 +385,17 @@ class _SceneReader:
             raise self.fail("nodes", i, "filter" if "filter" in data else "wrap", "needs texture = \"<image>\"")
         color = self.color(data, "color", "nodes", i, default=(1.0, 1.0, 1.0, 1.0))
         normals = self.text(data, "normals", "nodes", i, default="correct")
+        looks = dict(alpha_mode=self.text(data, "alpha_mode", "nodes", i, default="opaque"),
+                     alpha_cutoff=self.number(data, "alpha_cutoff", "nodes", i, default=0.5),
+                     double_sided=self.flag(data, "double_sided", "nodes", i, default=False),
+                     vertex_colors=self.flag(data, "vertex_colors", "nodes", i, default=False))
         try:
             return Material(color=color, shading=shading, normals=normals, texture=texture,  # type: ignore[arg-type]
-                            **numbers)
+                            **numbers, **looks)
         except SandboxError as exc:
-            key = next((k for k in (*_MATERIAL_NUMBERS, "normals") if k in data and k in str(exc)), None)
+            words = str(exc).replace(" ", "_")
+            key = next((k for k in (*_MATERIAL_NUMBERS, "normals", *_MATERIAL_LOOKS) if k in data and k in words),
+                       None)
             raise self.fail("nodes", i, key, str(exc)) from None
 
     def viewport(self, data: Any, i: int) -> Viewport:
@@ -373,15 +411,36 @@ class _SceneReader:
 
     def light(self, data: Any, i: int) -> Light:
         data = self.table(data, "lights", i)
-        self.check_keys(data, {"position", "color"}, "lights", i)
+        self.check_keys(data, {"position", "color", "shadow_map"}, "lights", i)
         pos = self.numbers(data, "position", (3,), "lights", i)
         if pos is None:
             raise self.fail("lights", i, None, "every light needs position = [x, y, z]")
         col = self.numbers(data, "color", (3,), "lights", i, default=(1.0, 1.0, 1.0))
+        shadow = self.shadow_map(data["shadow_map"], i) if "shadow_map" in data else None
         try:
-            return Light(position=pos, color=col)  # type: ignore[arg-type]
+            return Light(position=pos, color=col, shadow=shadow)  # type: ignore[arg-type]
         except SandboxError as exc:
             raise self.fail("lights", i, "color" if "colour" in str(exc) else "position", str(exc)) from None
+
+    def shadow_map(self, data: Any, i: int) -> ShadowMap:
+        """A light's ``shadow_map = {size, bias, slope_bias, pcf, fov}`` (every key optional)."""
+        if not isinstance(data, dict):
+            raise self.fail("lights", i, "shadow_map", f"expected a table such as {{size = 1024}}, got {plain(data)}")
+        allowed = ("size", "bias", "slope_bias", "pcf", "fov")
+        unknown = sorted(set(data) - set(allowed))
+        if unknown:
+            raise self.fail("lights", i, "shadow_map", f"unknown key {unknown[0]!r}; use {', '.join(allowed)}")
+        values = {}
+        for key in allowed:
+            if key in data:
+                value = data[key]
+                if isinstance(value, bool) or not isinstance(value, (int, float)):
+                    raise self.fail("lights", i, "shadow_map", f"{key} must be a number, got {plain(value)}")
+                values[key] = value
+        try:
+            return ShadowMap(**values)
+        except SandboxError as exc:
+            raise self.fail("lights", i, "shadow_map", str(exc)) from None
 
     def mirror(self, data: Any, known: set[str]) -> Mirror:
         """``[mirror]``: the glass node, its plane (a, b, c, d with ax + by + cz + d = 0), what it reflects."""
@@ -398,7 +457,7 @@ class _SceneReader:
         except SandboxError as exc:
             raise self.fail("mirror", 0, "reflected" if "reflect" in str(exc) else "plane", str(exc)) from None
 
-    def shadow(self, data: Any, known: set[str], lights: tuple[Light, ...]) -> PlanarShadow:
+    def planar_shadow(self, data: Any, known: set[str], lights: tuple[Light, ...]) -> PlanarShadow:
         """``[shadow]``: casters flattened onto the receiver's plane along the light (one of ``lights``)."""
         data = self.table(data, "shadow")
         self.check_keys(data, {"receiver", "plane", "light", "casters", "lift", "polygon_offset", "stencil", "color"},
@@ -445,8 +504,10 @@ class _SceneReader:
                 shape = f"[{key}]" if kind is dict else f"[[{key}]]"
                 raise self.fail("", 0, key, f"expected a {shape} table, got {plain(data[key])}")
         viewports = tuple(self.viewport(v, i) for i, v in enumerate(data.get("viewports", []))) or (Viewport(),)
-        nodes = tuple(self.node(n, i) for i, n in enumerate(data.get("nodes", [])))
-        for i, n in enumerate(nodes):
+        # A model file with several materials is one node per material (a table's index i for errors).
+        indexed = [(i, node) for i, n in enumerate(data.get("nodes", [])) for node in self.node(n, i)]
+        nodes = tuple(node for _, node in indexed)
+        for i, n in indexed:
             for v in n.viewports or ():
                 if not 0 <= v < len(viewports):
                     raise self.fail("nodes", i, "viewports", f"viewport {v} does not exist ({len(viewports)} defined)")
@@ -467,7 +528,7 @@ class _SceneReader:
             viewports=viewports,
             depth_test=depth,
             mirror=self.mirror(data["mirror"], known) if "mirror" in data else None,
-            shadow=self.shadow(data["shadow"], known, lights) if "shadow" in data else None,
+            planar_shadow=self.planar_shadow(data["shadow"], known, lights) if "shadow" in data else None,
             depth_mode=depth_mode,
         )
 

@@ -80,15 +80,31 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
     source = lesson_source(type(lesson))  # a lesson .py or scene .toml file: saving it reloads the lesson
     last_good: dict[str, Scene] = {}
 
-    # Two kinds of lesson error: reading its file again failed (kept until a read
-    # succeeds), or building a frame failed (kept until a frame builds).
-    lesson_errors = {"file": "", "frame": ""}
+    # Three kinds of lesson error: reading its file again failed (kept until a read
+    # succeeds), building a frame failed (kept until a frame builds), or drawing the
+    # built frame failed (a value the renderer refuses: kept until a frame draws).
+    lesson_errors = {"file": "", "frame": "", "draw": ""}
 
     def report_lesson_error(kind: str, error: str) -> None:
         if error and error != lesson_errors[kind]:
             print(f"error: {error}", file=sys.stderr, flush=True)
         lesson_errors[kind] = error
-        state["lesson_error"] = session.lesson_error = lesson_errors["file"] or lesson_errors["frame"]
+        state["lesson_error"] = session.lesson_error = next((e for e in lesson_errors.values() if e), "")
+
+    def draw(scene: Scene, size: tuple[int, int]) -> tuple[Any, Any]:
+        """Draw ``scene``; when the renderer refuses it after a good frame (a value set in
+        the panel that only drawing finds wrong), draw the last good scene, the error on screen."""
+        try:
+            drawn = renderer.draw(scene, size, motion.resolution(scene))
+        except SandboxError as exc:
+            if "drawn" not in last_good:
+                raise
+            report_lesson_error("draw", str(exc))
+            return renderer.draw(last_good["drawn"], size, motion.resolution(last_good["drawn"]))
+        last_good["drawn"] = scene
+        if lesson_errors["draw"]:
+            report_lesson_error("draw", "")
+        return drawn
 
     def lesson_scene() -> Scene:
         """The lesson's scene; while its file (or a value) has a mistake, the last good one,
@@ -173,7 +189,7 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
                 # The camera keys' camera, once moved, replaces the scene's.
                 scene = camera_input.apply(with_samples(lesson_scene(), session.samples))
                 scene = _live_compare(session, renderer, (width, height)) or scene
-                frame_plan, target = renderer.draw(scene, (width, height), motion.resolution(scene))
+                frame_plan, target = draw(scene, (width, height))
                 if state["shoot"]:
                     state["shoot"] = False
                     screenshot(target.read(), next_numbered(screenshot_dir, lesson.name))

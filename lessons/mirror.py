@@ -214,7 +214,7 @@ class MirrorLesson(Lesson):
         camera = Camera(eye=tuple(float(c) for c in eye), target=TARGET, fov_y=float(v["fov"]),
                         near=float(v["near"]), far=float(v["far"]))
         return Scene(self.name, nodes=tuple(nodes), camera=camera, lights=(shading_light,),
-                     clear_color=(0.08, 0.08, 0.12, 1.0), mirror=mirror, shadow=shadow, depth_mode=v["depth"])
+                     clear_color=(0.08, 0.08, 0.12, 1.0), mirror=mirror, planar_shadow=shadow, depth_mode=v["depth"])
 
     def on_key(self, key: str) -> bool:
         """1: cycle the mirror mode; 2: the shadow mode; 3: the depth mode; 4: the light type."""

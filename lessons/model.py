@@ -9,10 +9,15 @@ count, and the ray side the BVH's figures once the ray tracer builds one
 
 ``--set mesh=PATH`` loads any OBJ, PLY, STL, OFF, glTF or GLB file
 (``glsandbox.load_model``: normals from the file or made with a 30° crease
-angle, a glTF's base colour texture); the default is a generated rock
-(``glsandbox.meshgen``: no file, no download, the same every run).
-``--set fit=off`` keeps the file's own size and place; ``on`` centres it and
-scales it into the box -1..1.
+angle), one node per material of the file with its colour, texture, alpha
+mode and sidedness, vertex colours tinting the lit colour; the default is a
+generated rock (``glsandbox.meshgen``: no file, no download, the same every
+run). ``--set fit=off`` keeps the file's own size and place; ``on`` (the
+default) centres it and scales it into the box -1..1. ``--set up=z`` stands a
+Z-up file (a scan, CAD) upright; glTF is +Y up, as OpenGL, and stands as
+written. In the window the ray-traced side is traced coarse while the model
+turns or the camera moves (:class:`glsandbox.frame.InteractiveResolution`),
+so a big model keeps the window answering.
 
 Both ray engines trace a mesh through its BVH (the GLSL engine for a mesh
 node of more than 64 triangles, where the BVH measured faster than testing
@@ -29,6 +34,8 @@ import functools
 import math
 import sys
 from pathlib import Path
+
+import numpy as np
 
 import glsandbox
 from glsandbox import (
@@ -65,6 +72,8 @@ MATERIAL = dict(shading="phong", ambient=0.1, diffuse=0.4, specular=0.3, shinine
 MODEL_COLOR = (0.75, 0.7, 0.65, 1.0)
 FLOOR_COLOR = (0.55, 0.55, 0.6, 1.0)
 VIEWS = ("split", "raster", "ray")
+#: A file's up axis: y (glTF's +Y up, OpenGL's) or z (many scans and CAD files).
+UP_AXES = ("y", "z")
 #: What each renderer is called in the overlay.
 RENDERER_TITLES = {"raster": "rasterizer", "ray": "ray tracer (GLSL)", "ray_numpy": "ray tracer (numpy, float64)"}
 
@@ -111,30 +120,42 @@ class ModelLesson(Lesson):
         Param("mesh", "rock", "a model file (OBJ, PLY, STL, OFF, glTF, GLB), or a generated model: "
               + ", ".join(GENERATED), convert=check_mesh),
         Param("fit", True, "centre the model and scale it into the box -1..1"),
+        Param("up", "y", "the file's up axis: y (glTF, most OBJ) or z (scans, CAD: stood upright)",
+              choices=UP_AXES),
         Param("view", "split", "rasterizer left and ray tracer right, or one of them alone", choices=VIEWS),
         Param("speed", 0.3, "the model's turn about y, radians per second"),
     )
 
-    def model(self) -> tuple[str, Mesh, Material]:
-        """The model's label, mesh and material (a file's texture and colour where it has them)."""
+    def model(self) -> tuple[str, tuple[tuple[str, Mesh, Material], ...]]:
+        """The model's label and its parts: one ``(name, mesh, material)`` per material of
+        the file (colour, texture, alpha, sidedness and vertex colours as the file gives them)."""
         source = self.values["mesh"]
         fit = bool(self.values["fit"])
         if source in GENERATED:
             mesh = generated(source)
-            return source, glsandbox.fit_mesh(mesh) if fit else mesh, Material(color=MODEL_COLOR, **MATERIAL)
+            shown = glsandbox.fit_mesh(mesh) if fit else mesh
+            return source, (("model", shown, Material(color=MODEL_COLOR, **MATERIAL)),)
         loaded = glsandbox.load_model(source, fit=fit)
-        material = loaded.material(**MATERIAL) if loaded.texture or loaded.color else Material(color=MODEL_COLOR,
-                                                                                                **MATERIAL)
-        return Path(source).name, loaded.mesh, material
+        parts = []
+        for part in loaded.parts:
+            # A part the file gives no colour or texture: the lesson's stone colour.
+            plain = part.color is None and part.texture is None
+            material = part.material(**MATERIAL, **({"color": MODEL_COLOR} if plain else {}))
+            name = "model" if len(loaded.parts) == 1 else f"model/{part.name}"
+            parts.append((name, part.mesh, material))
+        return Path(source).name, tuple(parts)
 
     def build(self) -> Scene:
-        label, mesh, material = self.model()
-        turn = transforms.rotate_y(float(self.values["speed"]) * self.time)
-        low = float(transforms.transform_points(turn, mesh.positions)[:, 1].min()) if mesh.vertex_count else -1.0
+        label, parts = self.model()
+        # --set up=z: a Z-up file (a scan, CAD) stood upright: z becomes y (a -90° turn about x).
+        upright = transforms.rotate_x(-math.pi / 2) if self.values["up"] == "z" else np.eye(4)
+        turn = transforms.rotate_y(float(self.values["speed"]) * self.time) @ upright
+        low = min((float(transforms.transform_points(turn, mesh.positions)[:, 1].min())
+                   for _, mesh, _ in parts if mesh.vertex_count), default=-1.0)
         nodes = [
             Node("floor", geometry.plane(12.0), transforms.translate(0.0, min(low, -1.0) - 0.01, 0.0),
                  Material(color=FLOOR_COLOR, **MATERIAL)),
-            Node("model", mesh, turn, material),
+            *(Node(name, mesh, turn, material) for name, mesh, material in parts),
         ]
         view = self.values["view"]
         sides = ["raster", "ray"] if view == "split" else [view]
@@ -144,9 +165,11 @@ class ModelLesson(Lesson):
         viewports = tuple(Viewport(rect=(i * width, 0.0, width, 1.0), renderer=renderer,
                                    label=RENDERER_TITLES[renderer if everywhere == "raster" else everywhere])
                           for i, renderer in enumerate(sides))
-        count = f"{label}: {triangle_count(mesh):,} triangles"
+        count = f"{label}: {sum(triangle_count(mesh) for _, mesh, _ in parts):,} triangles" + (
+            f", {len(parts)} materials" if len(parts) > 1 else "")
+        biggest = max((mesh for _, mesh, _ in parts), key=triangle_count)
         overlays = tuple(
-            Overlay(f"label{i}", text_image([vp.label, count] + ([bvh_figures(mesh)] if "ray " in vp.label else [])),
+            Overlay(f"label{i}", text_image([vp.label, count] + ([bvh_figures(biggest)] if "ray " in vp.label else [])),
                     viewport=i, position=(4, 4))
             for i, vp in enumerate(viewports))
         camera = Camera(eye=(0.0, 1.6, 5.2), target=(0.0, -0.1, 0.0), fov_y=45.0)

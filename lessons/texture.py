@@ -37,6 +37,7 @@ from glsandbox import (
     Param,
     Scene,
     Texture,
+    check_texture_source,
     geometry,
     register,
     transforms,
@@ -69,8 +70,10 @@ class TextureLesson(Lesson):
     params = (
         Param("filter", "mip_linear", "sampler filter", choices=TEXTURE_FILTERS),
         Param("wrap", "repeat", "what uv outside 0..1 reads", choices=TEXTURE_WRAPS),
-        Param("image", "labels", "the cube's image: labels, checker, mip_levels, or an image file path"),
-        Param("ground", "checker", "the ground's image (labels shows mirrored and clamped uv best)"),
+        Param("image", "labels", "the cube's image: labels, checker, mip_levels, or an image file path",
+              convert=check_texture_source),
+        Param("ground", "checker", "the ground's image (labels shows mirrored and clamped uv best)",
+              convert=check_texture_source),
         Param("tile", 3.0, "ground units per texture repeat", minimum=0.01),
         Param("speed", 0.5, "the cube's turn rate in radians per second"),
     )

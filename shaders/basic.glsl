@@ -2,7 +2,8 @@
 // Unlit geometry: a flat colour (SOLID_COLOR) or the mesh's per-vertex
 // colours interpolated across each triangle (VERTEX_COLOR, the course's
 // Tutorial 04 cube). TEXTURED multiplies by the texture on unit 0 at the
-// mesh's uv (course section "Texture Mapping").
+// mesh's uv (course section "Texture Mapping"). ALPHA_MASK discards a
+// fragment whose alpha is below u_alpha_cutoff (a model file's cut-outs).
 
 #if defined(VERTEX_SHADER)
 #include "common/transform.glsl"
@@ -41,6 +42,9 @@ uniform vec4 u_color;
 uniform sampler2D u_texture;
 in vec2 v_uv;
 #endif
+#ifdef ALPHA_MASK
+uniform float u_alpha_cutoff;
+#endif
 out vec4 frag_color;
 
 void main() {
@@ -51,6 +55,9 @@ void main() {
 #endif
 #ifdef TEXTURED
     frag_color *= texture(u_texture, v_uv);
+#endif
+#ifdef ALPHA_MASK
+    if (frag_color.a < u_alpha_cutoff) discard;
 #endif
 }
 #endif

@@ -12,14 +12,17 @@
 //   nodes      NODE_RECORDS per node: box min,kind | box max,cull |
 //              start,count,scene order,0 | colour,mode | ka,kd,ks,n |
 //              reflectivity,texture,lamp bits | inverse model (3 rows) |
-//              normal matrix (3 rows); mesh nodes first (u_mesh_count of
+//              normal matrix (3 rows) | alpha,alpha mode,cutoff,flags
+//              (flags: 1 vertex colours tint a lit colour, 2 two-sided);
+//              mesh nodes first (u_mesh_count of
 //              them), then sphere nodes (u_sphere_count).
 // A small scene has them in a uniform block (SceneData: u_node, u_tri), a
 // larger one in RGBA32F textures read with texelFetch (u_nodes, u_tris).
 //
 // Variants: NUM_LIGHTS (the light loop), NUM_TEXTURES (0..4 samplers),
-// SHADOWS (shadow rays), REFLECT (reflection bounces: some node reflects
-// and max_depth > 0), HAS_MESHES, HAS_SPHERES, VERTEX_COLORS (a node uses
+// SHADOWS (shadow rays), REFLECT (reflection bounces and passes through
+// see-through surfaces: some node reflects, is a cut-out or is blended, and
+// max_depth > 0), HAS_MESHES, HAS_SPHERES, VERTEX_COLORS (a node uses
 // them); SCENE_NODES (the scene's node list, see nearest()) with
 // NODE_COUNT and TRI_COUNT for a small scene, whose records are in the
 // uniform block.
@@ -39,7 +42,7 @@
 
 #define TEX_WIDTH 1024
 #define TRI_RECORDS 9
-#define NODE_RECORDS 12
+#define NODE_RECORDS 13
 #define INF 1e30
 
 #if defined(VERTEX_SHADER)
@@ -365,7 +368,7 @@ ivec2 texture_size(int slot) {
 }
 
 // Bilinear in the base level, the wrap mode done by hand (as the numpy engine).
-vec3 sample_texture(int slot, vec2 uv) {
+vec4 sample_texture(int slot, vec2 uv) {
     ivec2 size = texture_size(slot);
     int mode = u_wrap[slot];
     vec2 xy = uv * vec2(size) - 0.5;
@@ -374,15 +377,18 @@ vec3 sample_texture(int slot, vec2 uv) {
     int x0 = int(base.x), y0 = int(base.y);
     int xa = wrap_index(x0, size.x, mode), xb = wrap_index(x0 + 1, size.x, mode);
     int ya = wrap_index(y0, size.y, mode), yb = wrap_index(y0 + 1, size.y, mode);
-    vec3 top = mix(fetch_texel(slot, ivec2(xa, ya)).rgb, fetch_texel(slot, ivec2(xb, ya)).rgb, f.x);
-    vec3 bottom = mix(fetch_texel(slot, ivec2(xa, yb)).rgb, fetch_texel(slot, ivec2(xb, yb)).rgb, f.x);
+    vec4 top = mix(fetch_texel(slot, ivec2(xa, ya)), fetch_texel(slot, ivec2(xb, ya)), f.x);
+    vec4 bottom = mix(fetch_texel(slot, ivec2(xa, yb)), fetch_texel(slot, ivec2(xb, yb)), f.x);
     return mix(top, bottom, f.y);
 }
 #endif
 
-// Point, unit normal and base colour of a hit; `bary` is the (u, v) the
-// triangle test found.
-void surface(int k, int j, float t, vec2 bary, vec3 o, vec3 d, out vec3 p, out vec3 n, out vec3 base) {
+// Point, unit normal, base colour and alpha (the colour's times the
+// texture's) of a hit; `bary` is the (u, v) the triangle test found.
+void surface(int k, int j, float t, vec2 bary, vec3 o, vec3 d, out vec3 p, out vec3 n, out vec3 base,
+             out float alpha) {
+    vec4 look = node_rec(k, 12);  // alpha, alpha mode, cutoff, flags
+    int flags = int(look.w);
     p = o + t * d;
     vec2 uv = vec2(0.0);
     vec3 colors = vec3(1.0);
@@ -404,6 +410,9 @@ void surface(int k, int j, float t, vec2 bary, vec3 o, vec3 d, out vec3 p, out v
         vec3 w = vec3(1.0 - bary.x - bary.y, bary.x, bary.y);
         vec4 a = tri_rec(j, 3), b = tri_rec(j, 4), c = tri_rec(j, 5);
         n = w.x * a.xyz + w.y * b.xyz + w.z * c.xyz;
+        // Two-sided: a back face seen (the ray along the face normal e1 x e2, the
+        // rasterizer's !gl_FrontFacing) is lit as its other side.
+        if ((flags & 2) != 0 && dot(cross(tri_rec(j, 1).xyz, tri_rec(j, 2).xyz), d) > 0.0) n = -n;
 #if VERTEX_COLORS || NUM_TEXTURES > 0
         vec4 ca = tri_rec(j, 6), cb = tri_rec(j, 7), cc = tri_rec(j, 8);
         uv = w.x * vec2(a.w, b.w) + w.y * vec2(c.w, ca.w) + w.z * vec2(cb.w, cc.w);
@@ -417,12 +426,25 @@ void surface(int k, int j, float t, vec2 bary, vec3 o, vec3 d, out vec3 p, out v
     vec4 m = node_rec(k, 3);
     base = m.rgb;
 #if VERTEX_COLORS
-    if (int(m.w) == 1) base *= colors;  // vertex colours
+    if (int(m.w) == 1 || (flags & 1) != 0) base *= colors;  // vertex colours (unlit, or tinting a lit colour)
 #endif
+    alpha = look.x;
 #if NUM_TEXTURES > 0
     int slot = int(node_rec(k, 5).y);
-    if (slot >= 0) base *= sample_texture(slot, uv);
+    if (slot >= 0) {
+        vec4 texel = sample_texture(slot, uv);
+        base *= texel.rgb;
+        alpha *= texel.a;
+    }
 #endif
+}
+
+// How much of a hit surface covers what lies behind it (numpy_engine's coverage):
+// opaque 1, a cut-out 1 or 0 by its cutoff, a blended surface its alpha.
+float coverage(int k, float alpha) {
+    vec4 look = node_rec(k, 12);
+    int mode = int(look.y);
+    return mode == 1 ? (alpha >= look.z ? 1.0 : 0.0) : mode == 2 ? alpha : 1.0;
 }
 
 // Secondary rays start off the surface, on the side of `towards`.
@@ -472,10 +494,20 @@ void main() {
             break;
         }
         vec3 p, n, base;
-        surface(k, j, t, bary, o, d, p, n, base);
+        float alpha;
+        surface(k, j, t, bary, o, d, p, n, base, alpha);
         vec3 local = shade(k, p, n, base, d);
-        float r = depth < u_max_depth ? node_rec(k, 5).x : 0.0;
-        color += weight * (1.0 - r) * local;
+        bool last = depth >= u_max_depth;
+        // A see-through surface passes the ray on straight, weighted 1 - a; it does not
+        // also reflect (numpy_engine._trace). At the last bounce its own colour stands in.
+        float a = last ? 1.0 : coverage(k, alpha);
+        float r = (last || a < 1.0) ? 0.0 : node_rec(k, 5).x;
+        color += weight * a * (1.0 - r) * local;
+        if (a < 1.0) {
+            o = offset_point(p, n, d);
+            weight *= 1.0 - a;
+            continue;
+        }
         if (r <= 0.0) break;
         vec3 reflected = d - 2.0 * dot(d, n) * n;  // Yansıma vektörü
         o = offset_point(p, n, -d);
@@ -490,7 +522,8 @@ void main() {
         color = u_background;
     } else {
         vec3 p, n, base;
-        surface(k, j, t, bary, o, d, p, n, base);
+        float alpha;
+        surface(k, j, t, bary, o, d, p, n, base, alpha);
         color = shade(k, p, n, base, d);
     }
 #endif

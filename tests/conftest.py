@@ -3,14 +3,16 @@
 from __future__ import annotations
 
 import os
+import py_compile
 import shutil
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 import pytest
-from support import GOLDENS_DIR, RESULTS_DIR, backend_available, need
+from support import GOLDENS_DIR, RESULTS_DIR, TESTS_DIR, backend_available, need
 
 from glsandbox.measure.golden import ImageMatch, check_golden
 
@@ -68,6 +70,33 @@ def golden(request: pytest.FixtureRequest) -> GoldenCheck:
     return check
 
 
+# --- bytecode for subprocesses ----------------------------------------------------
+# Where bytecode writing is off (PYTHONDONTWRITEBYTECODE=1) and nothing compiled the
+# installed packages (`uv sync --compile-bytecode`, README "Tests"), every `glsandbox`
+# subprocess compiles numpy, moderngl, Pillow and glsandbox again (issue 24: `glsandbox
+# render` started in 0.63 s instead of 0.23 s on a quiet machine). The modules this process
+# imported while collecting (the same ones) are compiled once here, and again only when
+# their source is newer.
+
+
+def pytest_collection_finish(session: pytest.Session) -> None:
+    if sys.dont_write_bytecode:
+        compile_imported_modules()
+
+
+def compile_imported_modules() -> None:
+    for module in list(sys.modules.values()):
+        source, cached = getattr(module, "__file__", None), getattr(module, "__cached__", None)
+        if not (source and cached and source.endswith(".py")) or source.startswith(str(TESTS_DIR)):
+            continue  # test modules: pytest rewrites and caches them itself
+        try:
+            if os.path.exists(cached) and os.stat(cached).st_mtime >= os.stat(source).st_mtime:
+                continue
+            py_compile.compile(source, cfile=cached, doraise=True)
+        except (OSError, py_compile.PyCompileError):
+            continue  # a read-only install or an odd file: that module is compiled at import, as before
+
+
 # --- GL backends and displays ------------------------------------------------
 # Tests that need a GL backend or an X server skip locally when it is missing,
 # and fail when CI is set: on CI a missing backend is a broken set-up, never a
@@ -90,7 +119,10 @@ def gl_renderer():
 
 @pytest.fixture
 def gl(gl_renderer):
-    """The shared :class:`~glsandbox.frame.HeadlessRenderer` (``gl.render(lesson, size)``)."""
+    """The shared :class:`~glsandbox.frame.HeadlessRenderer` (``gl.render(lesson, size)``), its
+    context current: a command run in this process (support.run_cli) opens and closes a context
+    of its own and leaves that one current, and ``gl.host.ctx`` used directly must not see it."""
+    gl_renderer.host.make_current()
     return gl_renderer
 
 

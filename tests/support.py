@@ -94,20 +94,27 @@ def run_cli(*args: str, env: dict[str, str] | None = None, cwd: Path | None = No
     """``glsandbox ARGS`` in this process (``cli.main``), with the contract checked on every run:
     no warning is raised; exit 2 is one ``error:`` line and no traceback; and, given
     ``unchanged``, a failed run (exit not 0) leaves that folder's files as they were.
-    ``env`` entries are set for the run only; ``cwd`` is the working folder for the run."""
+    ``env`` entries are set for the run only; ``cwd`` is the working folder for the run
+    (the repository, as for :func:`glsandbox`, unless given)."""
     from glsandbox import cli
 
     before = sorted(unchanged.rglob("*")) if unchanged is not None else None
     stdout, stderr = io.StringIO(), io.StringIO()
-    with (_environment(env, cwd), warnings.catch_warnings(record=True) as caught,
+    with (_environment(env, cwd or REPO_ROOT), warnings.catch_warnings(record=True) as caught,
           contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr)):
         warnings.simplefilter("always")
+        # pyrr's docstring escapes warn when it is first compiled (pyproject.toml's filter, not ours);
+        # a ResourceWarning (never shown by Python by default) comes from whatever object the
+        # garbage collector finalises during the run, often one an earlier test made.
+        warnings.filterwarnings("ignore", "invalid escape sequence")
+        warnings.simplefilter("ignore", ResourceWarning)
         try:
             status = cli.main(list(args))
         except SystemExit as exc:  # argparse's own usage errors
             status = exc.code if isinstance(exc.code, int) else 2
     run = CliRun(list(args), status, stdout.getvalue(), stderr.getvalue())
-    assert [f"{w.category.__name__}: {w.message}" for w in caught] == [], run
+    raised = [f"{w.category.__name__}: {w.message} ({w.filename}:{w.lineno})" for w in caught]
+    assert raised == [], (raised, run)
     if status == 2:
         assert_user_error(run)
     if before is not None and status != 0:
@@ -304,3 +311,118 @@ def check_lesson_golden(gl, golden, name: str, *settings: str, size: tuple[int, 
     image = lesson_image(gl, name, *settings, size=size)
     golden(image, f"{name}/{variant_name(settings)}")
     return image
+
+
+# --- model files with materials (tests/core/test_meshfile_materials.py, tests/lessons/test_model_materials.py) ---
+# Each is small, lies in the box -1..1 (so the model lesson's fit leaves it as it is, up to a
+# shift in z), and has its parts at known places, so a test can read each part's colour from a frame.
+
+QUAD_FACES = np.array([[0, 1, 2], [0, 2, 3]])
+
+
+def quad(x0: float, x1: float, z: float = 0.0, facing: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """A square from x0 to x1, y -1..1 at depth z; facing +z (counter-clockwise seen from +z) or -z."""
+    vertices = np.array([[x0, -1, z], [x1, -1, z], [x1, 1, z], [x0, 1, z]], dtype=np.float64)
+    return vertices, QUAD_FACES if facing > 0 else QUAD_FACES[:, ::-1]
+
+
+def gltf_part(vertices: np.ndarray, faces: np.ndarray, **material: object):
+    """A trimesh mesh with a glTF (PBR) material, for a trimesh.Scene to export."""
+    import trimesh
+
+    mesh = trimesh.Trimesh(vertices, faces, process=False)
+    mesh.visual = trimesh.visual.TextureVisuals(material=trimesh.visual.material.PBRMaterial(**material))
+    return mesh
+
+
+def two_material_glb(path: Path) -> Path:
+    """An opaque red square on the left and a half-transparent blue one in front, on the right."""
+    import trimesh
+
+    red = gltf_part(*quad(-1.0, 0.2), name="paint", baseColorFactor=[255, 0, 0, 255])
+    glass = gltf_part(*quad(-0.2, 1.0, z=0.4), name="glass", baseColorFactor=[0, 0, 255, 128], alphaMode="BLEND")
+    trimesh.Scene([red, glass]).export(path)
+    return path
+
+
+def two_usemtl_obj(folder: Path, extra_mtl: str = "") -> Path:
+    """Two squares side by side, one usemtl group each: red on the left, blue on the right (Kd)."""
+    (folder / "two.mtl").write_text("newmtl red\nKd 1 0 0\nnewmtl blue\nKd 0 0 1\n" + extra_mtl)
+    (folder / "two.obj").write_text(
+        "mtllib two.mtl\n"
+        "v -1 -1 0\nv 0 -1 0\nv 0 1 0\nv -1 1 0\n"
+        "v 0.05 -1 0\nv 1 -1 0\nv 1 1 0\nv 0.05 1 0\n"
+        "usemtl red\nf 1 2 3\nf 1 3 4\n"
+        "usemtl blue\nf 5 6 7\nf 5 7 8\n")
+    return folder / "two.obj"
+
+
+def coloured_ply(path: Path) -> Path:
+    """Two squares with vertex colours, red on the left and blue on the right (ASCII PLY)."""
+    rows = [(-1, -1, 255, 0, 0), (0, -1, 255, 0, 0), (0, 1, 255, 0, 0), (-1, 1, 255, 0, 0),
+            (0.05, -1, 0, 0, 255), (1, -1, 0, 0, 255), (1, 1, 0, 0, 255), (0.05, 1, 0, 0, 255)]
+    header = ("ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
+              "property uchar red\nproperty uchar green\nproperty uchar blue\nelement face 4\n"
+              "property list uchar int vertex_indices\nend_header\n")
+    body = "".join(f"{x} {y} 0 {r} {g} {b}\n" for x, y, r, g, b in rows)
+    path.write_text(header + body + "3 0 1 2\n3 0 2 3\n3 4 5 6\n3 4 6 7\n")
+    return path
+
+
+def reversed_obj(folder: Path) -> Path:
+    """An open square wound clockwise as seen from +z (its front faces -z: a scan the wrong way
+    round), green."""
+    (folder / "back.mtl").write_text("newmtl green\nKd 0 1 0\n")
+    (folder / "back.obj").write_text("mtllib back.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n"
+                                     "usemtl green\nf 1 3 2\nf 1 4 3\n")
+    return folder / "back.obj"
+
+
+
+def double_sided_glb(path: Path, double_sided: bool = True) -> Path:
+    """A green square whose front faces away from +z (where the model lesson's camera is):
+    seen only from behind, so drawn only when the material is double-sided."""
+    import trimesh
+
+    plane = gltf_part(*quad(-1, 1, facing=-1), name="leaf", baseColorFactor=[0, 255, 0, 255],
+                      doubleSided=double_sided)
+    trimesh.Scene([plane]).export(path)
+    return path
+
+
+def masked_glb(path: Path) -> Path:
+    """A red square behind a white one cut out by a texture's alpha (glTF MASK): the white
+    square's left half (alpha 0) is cut away, its right half (alpha 255) is drawn."""
+    import trimesh
+    from PIL import Image
+
+    red = gltf_part(*quad(-1, 1, z=-0.2), name="wall", baseColorFactor=[255, 0, 0, 255])
+    vertices, faces = quad(-1, 1, z=0.2)
+    pixels = np.full((1, 4, 4), 255, dtype=np.uint8)
+    pixels[0, :2, 3] = 0  # the left half transparent
+    uv = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=np.float64)
+    stencil = trimesh.Trimesh(vertices, faces, process=False)
+    image = Image.fromarray(pixels.repeat(4, axis=0), "RGBA")  # 4x4: each column's alpha as above
+    material = trimesh.visual.material.PBRMaterial(name="stencil", baseColorTexture=image, alphaMode="MASK",
+                                                   alphaCutoff=0.5)
+    stencil.visual = trimesh.visual.TextureVisuals(uv=uv, material=material)
+    trimesh.Scene([red, stencil]).export(path)
+    return path
+
+
+def two_textures_glb(path: Path) -> Path:
+    """Two squares side by side with a texture each (white factor): red pixels on the left
+    part, blue on the right (the boat of issue 20: several textures, each part its own)."""
+    import trimesh
+    from PIL import Image
+
+    parts = []
+    for name, x0, x1, rgb in (("hull", -1.0, 0.0, (255, 0, 0)), ("sail", 0.05, 1.0, (0, 0, 255))):
+        vertices, faces = quad(x0, x1)
+        square = trimesh.Trimesh(vertices, faces, process=False)
+        square.visual = trimesh.visual.TextureVisuals(
+            uv=[[0, 0], [1, 0], [1, 1], [0, 1]],
+            material=trimesh.visual.material.PBRMaterial(name=name, baseColorTexture=Image.new("RGB", (4, 4), rgb)))
+        parts.append(square)
+    trimesh.Scene(parts).export(path)
+    return path

@@ -17,12 +17,14 @@ ROOT = Path(__file__).resolve().parents[1]
 
 #: Lowest first. A module may import its own layer and the ones above it in this list.
 LAYERS: list[tuple[str, tuple[str, ...]]] = [
-    ("core", ("glsandbox.errors", "glsandbox.transforms", "glsandbox.meshnormals", "glsandbox.geometry",
+    ("core", ("glsandbox.errors", "glsandbox.transforms", "glsandbox.meshnormals", "glsandbox.meshlooks",
+              "glsandbox.geometry",
               "glsandbox.meshgen", "glsandbox.files", "glsandbox.file_watch", "glsandbox.progress",
               "glsandbox.version")),
     ("scene data", ("glsandbox.scene", "glsandbox.planar", "glsandbox.images",
                     "glsandbox.overlay", "glsandbox.meshfile")),
-    ("scene logic", ("glsandbox.scene_file", "glsandbox.plan", "glsandbox.camera", "glsandbox.lesson")),
+    ("scene logic", ("glsandbox.scene_file", "glsandbox.shadowmap", "glsandbox.plan", "glsandbox.camera",
+                     "glsandbox.lesson")),
     ("renderers", ("glsandbox.gl", "glsandbox.raytrace")),
     ("one frame", ("glsandbox.frame",)),
     ("window and measuring", ("glsandbox.window", "glsandbox.panel", "glsandbox.controls", "glsandbox.notebook",

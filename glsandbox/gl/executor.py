@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import struct
 import weakref
-from collections.abc import Collection, Mapping
+from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -20,12 +21,14 @@ import numpy as np
 from glsandbox import transforms
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh, with_face_normals
-from glsandbox.gl import depth as gl_depth, planar as gl_planar
+from glsandbox.gl import depth as gl_depth, passes as gl_passes, planar as gl_planar, shadowmap as gl_shadowmap
 from glsandbox.gl.context import GLHost
 from glsandbox.gl.overlay import OverlayDrawer
 from glsandbox.gl.shaders import compile_with_sources, declared_uniforms, source_files
+from glsandbox.gl.target import clear_opaque
 from glsandbox.gl.textures import TextureCache
-from glsandbox.plan import PLANAR_PASS_KINDS, Draw, Pass, Plan, ProgramVariant, plan as make_plan
+from glsandbox.gl.passes import FrameState, PassRunner
+from glsandbox.plan import SHADOW_MAP_UNIT, Draw, Pass, Plan, ProgramVariant, plan as make_plan
 from glsandbox.scene import Light, Material, Node, Scene
 
 _MODES = {"triangles": moderngl.TRIANGLES, "triangle_strip": moderngl.TRIANGLE_STRIP,
@@ -65,18 +68,19 @@ class PassCamera:
     once per pass instead of once per draw: the uniform bytes, and the eye
     (only lit draws ask for it)."""
 
-    __slots__ = ("view", "proj", "view_bytes", "proj_bytes", "_eye")
+    __slots__ = ("view", "proj", "view_bytes", "proj_bytes", "_eye_bytes")
 
     def __init__(self, view: np.ndarray, proj: np.ndarray) -> None:
         self.view, self.proj = view, proj
         self.view_bytes, self.proj_bytes = transforms.gl_bytes(view), transforms.gl_bytes(proj)
-        self._eye: np.ndarray | None = None
+        self._eye_bytes: bytes | None = None
 
     @property
-    def eye(self) -> np.ndarray:
-        if self._eye is None:
-            self._eye = eye_position(self.view)
-        return self._eye
+    def eye_bytes(self) -> bytes:
+        """``u_eye``'s uniform bytes: a camera that does not move inverts its view once per run."""
+        if self._eye_bytes is None:
+            self._eye_bytes = _eye_bytes(np.asarray(self.view, dtype=np.float64).tobytes())
+        return self._eye_bytes
 
 
 #: Uniform bytes of material colours: a lesson rebuilding its scene each frame
@@ -89,6 +93,27 @@ def _color_bytes(color: tuple[float, ...]) -> bytes:
     if data is None:
         data = _COLOR_BYTES[color] = np.asarray(color, dtype="f4").tobytes()
     return data
+
+
+def _float_bytes(value: float) -> bytes:
+    return struct.pack("f", value)
+
+
+#: ``u_texture``'s value: the material texture is on unit 0.
+_UNIT_0 = struct.pack("i", 0)
+
+
+def _material_bytes(material: Material) -> tuple[tuple[str, bytes], ...]:
+    """The coefficients of the course's ``0.1*mesh + 0.4*diffuse + 0.3*specular`` and the
+    exponent (32) as uniform bytes; a zero coefficient switches its term off."""
+    return (("u_ambient", _float_bytes(material.ambient)), ("u_diffuse", _float_bytes(material.diffuse)),
+            ("u_specular", _float_bytes(material.specular)), ("u_shininess", _float_bytes(material.shininess)))
+
+
+@functools.lru_cache(maxsize=64)
+def _eye_bytes(view: bytes) -> bytes:
+    """The eye position's uniform bytes for a float64 view matrix given as bytes."""
+    return eye_position(np.frombuffer(view).reshape(4, 4)).astype("f4").tobytes()
 
 
 @functools.lru_cache(maxsize=1024)
@@ -186,7 +211,12 @@ class Executor:
         self._overlays: OverlayDrawer | None = None  # made on the first overlay pass
         self._textures = TextureCache(host)
         self._lights: tuple[Light, ...] = ()  # the lights of the frame being drawn (draw_node's default)
+        self._lights_cache: tuple[tuple[Light, ...], bytes, bytes] | None = None
+        # The uniform bytes last written into each program (by program key): see _uniform_writer.
+        self._written: dict[str, dict[str, bytes]] = {}
+        self._bound_texture: object | None = None  # the material texture on unit 0 in this frame
         self._clear_depth = 1.0  # 0 with reverse-Z (glsandbox.gl.depth)
+        self.shadow_maps = gl_shadowmap.ShadowMaps(self.ctx)  # the lights' depth textures
 
     # --- resources ----------------------------------------------------------
 
@@ -232,6 +262,7 @@ class Executor:
         self._programs = fresh
         self._user = users
         self._member_names.clear()
+        self._written.clear()  # new programs hold no values yet
 
     def shader_files(self) -> frozenset[Path]:
         """The files the nodes' own shader programs were built from (with their includes)."""
@@ -332,6 +363,9 @@ class Executor:
     def render(self, scene: Scene, framebuffer: moderngl.Framebuffer, size: tuple[int, int],
                frame_plan: Plan | None = None) -> Plan:
         """Draw one frame of ``scene`` into ``framebuffer`` (``size`` pixels)."""
+        if any(vp.renderer != "raster" for vp in scene.viewports):
+            raise ValueError("the executor draws raster viewports only: trace the others first "
+                             "(glsandbox.frame.trace_viewports)")
         frame_plan = frame_plan or make_plan(scene)
         self._frame += 1
         for variant in frame_plan.programs:
@@ -342,44 +376,53 @@ class Executor:
             if not any(name in user.declared for user in users):
                 raise SandboxError(f"--set u.{name}: no shader of the scene declares uniform {name} "
                                    f"({', '.join(sorted(str(user.path) for user in users))})")
-        nodes = {node.name: node for node in scene.nodes}
+        frame = FrameState(scene, {node.name: node for node in scene.nodes}, framebuffer, size)
         self._lights = scene.lights
         self._clear_depth = gl_depth.clear_depth_value(scene)
         framebuffer.use()
         gl_depth.begin_depth_mode(self.ctx, self.raw, scene)
         for step in frame_plan.passes:
-            if step.kind == "overlay":
-                self._draw_overlays(scene, step, framebuffer, size)
-                continue
-            viewport = scene.viewports[step.viewport]
-            rect = viewport.pixels(*size)
-            if step.kind == "clear":
-                self._clear(framebuffer, step, rect)
-            else:
-                camera = viewport.camera or scene.camera
-                aspect = rect[2] / rect[3] if rect[3] else 1.0
-                pass_camera = PassCamera(camera.view(), gl_depth.projection_for(scene, camera.projection(aspect)))
-                framebuffer.viewport = rect
-                self._set_depth(step.depth_test)
-                if step.kind in PLANAR_PASS_KINDS:  # the stencil mirror and the planar shadow
-                    gl_planar.run_planar_pass(self, scene, step, nodes, pass_camera)
-                    continue
-                for draw in step.draws:
-                    self.draw_node(nodes[draw.node], draw, pass_camera)
+            runner = PASS_RUNNERS.get(step.kind)
+            if runner is None:
+                raise SandboxError(f"pass kind {step.kind!r} has no runner (gl.executor.PASS_RUNNERS)")
+            try:
+                runner(self, frame, step, self._frame_camera(frame, step))
+            finally:  # every pass starts from the same state, whatever the last one set
+                gl_passes.restore_state(self.ctx, self.raw)
         gl_depth.end_depth_mode(self.ctx, self.raw, scene)
+        self._unbind_texture()
         framebuffer.viewport = (0, 0, *size)
         self._set_depth(False)
         self.ctx.disable(moderngl.CULL_FACE)
         self._release_stale_meshes()
         return frame_plan
 
-    def _clear(self, framebuffer: moderngl.Framebuffer, step: Pass, rect: tuple[int, int, int, int]) -> None:
+    @staticmethod
+    def pass_camera(view: np.ndarray, proj: np.ndarray) -> PassCamera:
+        """A pass's camera from its matrices (for runners that look through their own, a light's)."""
+        return PassCamera(view, proj)
+
+    def _frame_camera(self, frame: FrameState, step: Pass) -> PassCamera | None:
+        """A frame pass with ``camera="viewport"``: its viewport set, its depth test
+        switched, and its camera (the viewport's or the scene's). Other passes set
+        their own target up (:data:`PASS_RUNNERS`)."""
+        if step.target != "frame" or step.camera != "viewport":
+            return None
+        scene = frame.scene
+        viewport = scene.viewports[step.viewport]
+        rect = viewport.pixels(*frame.size)
+        camera = viewport.camera or scene.camera
+        aspect = rect[2] / rect[3] if rect[3] else 1.0
+        frame.framebuffer.viewport = rect
+        self._set_depth(step.depth_test)
+        return PassCamera(camera.view(), gl_depth.projection_for(scene, camera.projection(aspect)))
+
+    def _clear(self, frame: FrameState, step: Pass, camera: PassCamera | None) -> None:
+        framebuffer = frame.framebuffer
+        rect = frame.scene.viewports[step.viewport].pixels(*frame.size)
         r, g, b, _ = step.clear_color or (0.0, 0.0, 0.0, 0.0)
-        # moderngl scissors the clear to the viewport rectangle. Frames are opaque
-        # whatever the clear colour's alpha: a target's alpha is 1 and its mask keeps
-        # this clear off it (glsandbox.gl.target.FRAME_COLOR_MASK); a framebuffer
-        # without that mask still gets an opaque clear.
-        framebuffer.clear(r, g, b, 1.0, depth=self._clear_depth, viewport=rect)
+        # Frames are opaque whatever the clear colour's alpha (glsandbox.gl.target).
+        clear_opaque(framebuffer, (r, g, b), self._clear_depth, rect)
         if step.clear_stencil:  # moderngl's clear leaves the stencil alone
             self.raw.clear_stencil(rect)
 
@@ -433,37 +476,92 @@ class Executor:
             self.ctx.front_face = front_face
         else:
             self.ctx.disable(moderngl.CULL_FACE)
-        uniforms = {
-            "m_model": transforms.gl_bytes(model),
-            "m_view": camera.view_bytes,
-            "m_proj": camera.proj_bytes,
-            "u_color": _color_bytes(material.color),
-        }
+        write = self._uniform_writer(draw.program, program, members)
+        write("m_model", transforms.gl_bytes(model))
+        write("m_view", camera.view_bytes)
+        write("m_proj", camera.proj_bytes)
+        write("u_color", _color_bytes(material.color))
         if "m_normal" in members:
-            uniforms["m_normal"] = _normal_matrix_bytes(np.asarray(model, dtype=np.float64).tobytes())
-        for name, data in uniforms.items():
-            if name in members:
-                program[name].write(data)
+            write("m_normal", _normal_matrix_bytes(np.asarray(model, dtype=np.float64).tobytes()))
         if material.lit or user is not None:  # a node's own shader may light itself whatever the shading
-            write_light_uniforms(program, self._lights if lights is None else lights, camera.eye, members)
-            write_material_uniforms(program, material, members)
+            write("u_eye", camera.eye_bytes)
+            frame_lights = self._lights if lights is None else lights
+            if frame_lights:  # with none, the shader's arrays do not exist (NUM_LIGHTS 0)
+                light_pos, light_color = self._light_bytes(frame_lights)
+                write("u_light_pos", light_pos)
+                write("u_light_color", light_color)
+            for name, data in _material_bytes(material):
+                write(name, data)
         for name, value in own.items():
             program[name].value = value
+        write("u_alpha_cutoff", _float_bytes(material.alpha_cutoff))
         texture = material.texture
-        if texture is not None:
-            self._textures.bind(texture, 0)
-            if "u_texture" in members:
-                program["u_texture"].value = 0
+        if texture is not None:  # unit 0: the material's texture
+            if self._bound_texture is not texture:  # consecutive draws of one texture bind it once
+                self._textures.bind(texture, 0)
+                self._bound_texture = texture
+            write("u_texture", _UNIT_0)
+        if draw.shadow_map is not None:  # unit 1: the light's shadow map (a depth texture, compared)
+            self.shadow_maps.bind(draw.shadow_map, SHADOW_MAP_UNIT, program, members)
+        if draw.blend:  # over what is drawn already; hidden by it where nearer, but not hiding
+            self.ctx.enable(moderngl.BLEND)
+            self.ctx.blend_func = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA)
+            self.raw.glDepthMask(0)
         vao.render(gpu.mode, vertices=gpu.count)
-        if texture is not None:
-            self._textures.unbind(0)
+        if draw.blend:
+            self.raw.glDepthMask(1)
+            self.ctx.disable(moderngl.BLEND)
+            self.ctx.blend_func = moderngl.DEFAULT_BLENDING
 
-    def _draw_overlays(self, scene: Scene, step: Pass, framebuffer: moderngl.Framebuffer,
-                       size: tuple[int, int]) -> None:
+    def _uniform_writer(self, program_key: str, program: moderngl.Program,
+                        members: Collection[str]) -> Callable[[str, bytes], None]:
+        """``write(name, data)`` for one program: the bytes go to GL only where the program has the
+        uniform (a term the compiler removed has none) and they differ from what was written last.
+        A program keeps its uniform values between draws and frames, so what does not change (the
+        view while the camera stands, lights, materials, a wall's model) is written once."""
+        written = self._written.setdefault(program_key, {})
+
+        def write(name: str, data: bytes) -> None:
+            if written.get(name) != data and name in members:
+                program[name].write(data)
+                written[name] = data
+
+        return write
+
+    def _light_bytes(self, lights: tuple[Light, ...]) -> tuple[bytes, bytes]:
+        """``u_light_pos`` and ``u_light_color`` bytes of ``lights``, made once per frame (and once
+        per pass that reflects them): every lit draw of the frame writes the same ones."""
+        cached = self._lights_cache
+        if cached is None or cached[0] is not lights:
+            cached = self._lights_cache = (lights, np.array([l.position for l in lights], dtype="f4").tobytes(),
+                                           np.array([l.color for l in lights], dtype="f4").tobytes())
+        return cached[1], cached[2]
+
+    def _unbind_texture(self) -> None:
+        """Leave texture unit 0 without the frame's sampler object (the overlays and the next user
+        of the context see plain texture state); once per frame, not per draw."""
+        if self._bound_texture is not None:
+            self._textures.unbind(0)
+            self._bound_texture = None
+
+    def _traced_before(self, frame: FrameState, step: Pass, camera: PassCamera | None) -> None:
+        """A ``trace`` pass is run before the executor, by :func:`glsandbox.frame.trace_viewports`
+        (its picture is an overlay by then); :meth:`render` refuses a scene that still has one."""
+        raise ValueError(f"trace viewport {step.viewport}: trace it first (glsandbox.frame.trace_viewports)")
+
+    def _draw(self, frame: FrameState, step: Pass, camera: PassCamera | None) -> None:
+        """A ``draw`` pass: each node with its program, through the viewport's camera."""
+        assert camera is not None
+        for draw in step.draws:
+            self.draw_node(frame.nodes[draw.node], draw, camera)
+
+    def _draw_overlays(self, frame: FrameState, step: Pass, camera: PassCamera | None) -> None:
         """An ``overlay`` pass: labels and figures, blended over the frame (:mod:`glsandbox.gl.overlay`)."""
+        self._unbind_texture()
         if self._overlays is None:
             self._overlays = OverlayDrawer(self.ctx)
-        self._overlays.draw(scene, step, framebuffer, size, self._programs[step.draws[0].program][1])
+        self._overlays.draw(frame.scene, step, frame.framebuffer, frame.size,
+                            self._programs[step.draws[0].program][1])
 
     def release(self) -> None:
         if self._overlays is not None:
@@ -479,11 +577,13 @@ class Executor:
         for _, program in self._programs.values():
             program.release()
         self._textures.release()
+        self.shadow_maps.release()
         self._vaos.clear()
         self._meshes.clear()
         self._mesh_last_frame.clear()
         self._programs.clear()
         self._member_names.clear()
+        self._written.clear()
         self._user.clear()
         self._user_nodes.clear()
 
@@ -498,28 +598,18 @@ def eye_position(view: np.ndarray) -> np.ndarray:
     return np.linalg.inv(np.asarray(view, dtype=np.float64))[:3, 3]
 
 
-def write_light_uniforms(program: moderngl.Program, lights: tuple[Light, ...], eye: np.ndarray,
-                         members: Collection[str]) -> None:
-    """The course's ``vLightPos[]``, ``vLightColor[]`` and ``vEyePos``, in world space.
-
-    The shader's arrays are sized by its ``NUM_LIGHTS`` define, which the plan
-    set to ``len(lights)``; with no lights they do not exist. ``eye`` is
-    :func:`eye_position` of the view; ``members`` are the program's uniform
-    names (see :meth:`Executor._members`).
-    """
-    if "u_eye" in members:
-        program["u_eye"].write(eye.astype("f4").tobytes())
-    if lights and "u_light_pos" in members:
-        program["u_light_pos"].write(np.array([l.position for l in lights], dtype="f4").tobytes())
-    if lights and "u_light_color" in members:
-        program["u_light_color"].write(np.array([l.color for l in lights], dtype="f4").tobytes())
-
-
-def write_material_uniforms(program: moderngl.Program, material: Material, members: Collection[str]) -> None:
-    """The coefficients of the course's ``0.1*mesh + 0.4*diffuse + 0.3*specular``
-    and the exponent (32); a zero coefficient switches its term off."""
-    values = {"u_ambient": material.ambient, "u_diffuse": material.diffuse,
-              "u_specular": material.specular, "u_shininess": material.shininess}
-    for name, value in values.items():
-        if name in members:  # a term the compiler removed has no uniform
-            program[name].value = float(value)
+#: One runner per pass kind (:data:`glsandbox.plan.PASS_KINDS`); a new kind adds
+#: its entry here and its describer in :data:`glsandbox.plan.PASS_DESCRIBERS`.
+#: A runner gets the executor, the frame, the pass, and the pass's camera when it
+#: draws into the frame through a viewport's (None otherwise: it sets up its own).
+PASS_RUNNERS: dict[str, PassRunner] = {
+    "trace": Executor._traced_before,
+    "shadow_map": gl_shadowmap.run_shadow_map_pass,
+    "clear": Executor._clear,
+    "draw": Executor._draw,
+    "mark_mirror": gl_planar.mark_mirror,
+    "reflection": gl_planar.reflection,
+    "mirror_surface": gl_planar.mirror_surface,
+    "planar_shadow": gl_planar.planar_shadow,
+    "overlay": Executor._draw_overlays,
+}

@@ -3,8 +3,9 @@
 Course section "The stencil Test". Direct3D 11 bundles this state into
 objects (``MarkMirrorDSS``, ``DrawReflectionDSS``, ``CullClockwiseRS``) set
 per draw; OpenGL keeps it as loose global switches, so every pass here sets
-what it needs and :func:`restore_state` puts back the defaults the other
-passes assume, whatever happened (``finally``). The raw calls moderngl lacks
+what it needs and the executor puts back the defaults the other passes
+assume after each one, whatever happened
+(:func:`glsandbox.gl.passes.restore_state`). The raw calls moderngl lacks
 (stencil, colour and depth write masks) go through
 :mod:`glsandbox.gl.rawgl`.
 
@@ -23,9 +24,9 @@ import numpy as np
 
 from glsandbox import transforms
 from glsandbox.gl import rawgl
-from glsandbox.gl.target import FRAME_COLOR_MASK
+from glsandbox.gl.passes import FrameState
 from glsandbox.plan import Draw, Pass, StencilState
-from glsandbox.scene import Light, Material, Node, Scene
+from glsandbox.scene import Light, Material, Node
 
 
 class NodeDrawer(Protocol):
@@ -63,34 +64,7 @@ def set_stencil(raw: rawgl.RawGL, stencil: StencilState) -> None:
 # --- the passes ------------------------------------------------------------------
 
 
-def run_planar_pass(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, Node], camera: Any) -> None:
-    """Run one ``mark_mirror``, ``reflection``, ``mirror_surface`` or ``shadow`` pass."""
-    runners = {"mark_mirror": _mark_mirror, "reflection": _reflection,
-               "mirror_surface": _mirror_surface, "shadow": _shadow}
-    try:
-        runners[step.kind](drawer, scene, step, nodes, camera)
-    finally:
-        restore_state(drawer.ctx, drawer.raw)
-
-
-def restore_state(ctx: moderngl.Context, raw: rawgl.RawGL) -> None:
-    """The state every other pass assumes: no stencil test, stencil and depth
-    writes on, colour writes on but alpha (the frame's rule,
-    :data:`~glsandbox.gl.target.FRAME_COLOR_MASK`: frames stay opaque), no
-    blending, no polygon offset, counter-clockwise front faces."""
-    raw.glDisable(rawgl.GL_STENCIL_TEST)
-    raw.glStencilMask(0xFF)
-    raw.glStencilFunc(rawgl.GL_ALWAYS, 0, 0xFF)
-    raw.glStencilOp(rawgl.GL_KEEP, rawgl.GL_KEEP, rawgl.GL_KEEP)
-    raw.glColorMask(*FRAME_COLOR_MASK)
-    raw.glDepthMask(1)
-    ctx.disable(moderngl.BLEND)
-    ctx.blend_func = moderngl.DEFAULT_BLENDING
-    ctx.polygon_offset = (0.0, 0.0)
-    ctx.front_face = "ccw"
-
-
-def _mark_mirror(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, Node], camera: Any) -> None:
+def mark_mirror(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any) -> None:
     """``MarkMirrorDSS``: the glass's visible pixels get the mirror bit.
 
     The stencil test always passes; where the depth test passes too (nothing
@@ -99,7 +73,7 @@ def _mark_mirror(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, 
     are off: this pass changes nothing but the stencil.
     """
     assert step.stencil is not None
-    raw = drawer.raw
+    raw, nodes = drawer.raw, frame.nodes
     set_stencil(raw, step.stencil)
     raw.glColorMask(0, 0, 0, 0)
     raw.glDepthMask(0)
@@ -115,7 +89,7 @@ def reflected_lights(lights: tuple[Light, ...], reflection: np.ndarray) -> tuple
                  for l in lights)
 
 
-def _reflection(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, Node], camera: Any) -> None:
+def reflection(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any) -> None:
     """``DrawReflectionDSS``: the reflected nodes, only where the mirror bit is set.
 
     Each node is drawn with ``R @ model``. R has determinant -1, so a triangle
@@ -124,6 +98,7 @@ def _reflection(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, N
     Without the stencil (``mirror=no_stencil``) nothing stops the reflection
     outside the glass.
     """
+    scene, nodes = frame.scene, frame.nodes
     assert scene.mirror is not None
     if step.stencil is not None:  # read only: write mask 0
         set_stencil(drawer.raw, step.stencil)
@@ -134,17 +109,17 @@ def _reflection(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, N
         drawer.draw_node(node, draw, camera, model=reflection @ node.model, front_face="cw", lights=lights)
 
 
-def _mirror_surface(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, Node], camera: Any) -> None:
+def mirror_surface(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any) -> None:
     """The glass over its reflection, blended by its colour's alpha (the
     frame's own alpha is neither read nor written: it stays 1)."""
     ctx = drawer.ctx
     ctx.enable(moderngl.BLEND)
     ctx.blend_func = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA)
     for draw in step.draws:
-        drawer.draw_node(nodes[draw.node], draw, camera)
+        drawer.draw_node(frame.nodes[draw.node], draw, camera)
 
 
-def _shadow(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, Node], camera: Any) -> None:
+def planar_shadow(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any) -> None:
     """The casters flattened by the lifted shadow matrix, dark and blended.
 
     Depth test on (the shadow must hide behind what stands in front of the
@@ -155,7 +130,8 @@ def _shadow(drawer: NodeDrawer, scene: Scene, step: Pass, nodes: dict[str, Node]
     and the bit is then set (``GL_INVERT`` under write mask 2), so the
     flattened cube's overlapping front and back faces darken it once.
     """
-    shadow = scene.shadow
+    scene, nodes = frame.scene, frame.nodes
+    shadow = scene.planar_shadow
     assert shadow is not None
     raw, ctx = drawer.raw, drawer.ctx
     if step.stencil is not None:

@@ -36,7 +36,17 @@ import moderngl
 
 from glsandbox.errors import SandboxError
 from glsandbox.files import read_user_file
+from glsandbox.gl.shader_limits import check_array_sizes
 from glsandbox.plan import ProgramVariant
+
+#: How deep ``#include`` may nest (the top file is depth 0); deeper is a mistake, most
+#: likely a chain that never ends, and is refused before Python's own recursion limit.
+MAX_INCLUDE_DEPTH = 32
+#: The most ``#include`` lines one stage may follow, and the most lines it may
+#: assemble to: a file included many times over (10 includes each including 10
+#: ...) grows as a power without a cycle or a deep chain.
+MAX_INCLUDES = 1_000
+MAX_SHADER_LINES = 100_000
 
 _INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"\s*(?://.*)?$')
 _ANY_INCLUDE = re.compile(r"^\s*#\s*include\b")
@@ -109,14 +119,22 @@ def assemble(name: str, stage: str, defines: tuple[tuple[str, str], ...] = (), r
     out: list[str] = []
     origins: list[tuple[Path, int]] = []
     stages_seen: set[str] = set()  # the stage macros the files mention
+    followed = [0]  # #include lines followed so far
+    injected: set[int] = set()  # the loader's own lines (the stage and variant defines), by index
 
     def emit(text: str, path: Path, line_no: int) -> None:
+        if len(out) >= MAX_SHADER_LINES:
+            raise SandboxError(f"{path}:{line_no}: the shader, with its includes, has more than "
+                               f"{MAX_SHADER_LINES:,} lines (a file included over and over?)")
         out.append(text)
         origins.append((path, line_no))
 
     def read(path: Path, included_from: str | None, stack: tuple[Path, ...]) -> None:
         if path in stack:
             raise SandboxError(f"{included_from}: #include cycle through {path.name}")
+        if len(stack) > MAX_INCLUDE_DEPTH:
+            raise SandboxError(f"{included_from}: #include nested more than {MAX_INCLUDE_DEPTH} files deep "
+                               f"(from {stack[0]}); a chain of includes that never ends?")
         lines = _read_lines(path, included_from)
         for line_no, line in enumerate(lines, start=1):
             if _VERSION.match(line):
@@ -124,14 +142,20 @@ def assemble(name: str, stage: str, defines: tuple[tuple[str, str], ...] = (), r
                     raise SandboxError(f"{path}:{line_no}: #version is only allowed in the top file")
                 emit(line, path, line_no)
                 # Injected lines are attributed to the #version line.
+                injected.add(len(out))
                 emit(f"#define {_STAGES[stage]}", path, line_no)
                 for key, value in defines:
+                    injected.add(len(out))
                     emit(f"#define {key} {value}".rstrip(), path, line_no)
                 continue
             include = _INCLUDE.match(line)
             if include is None and _ANY_INCLUDE.match(line):
                 raise SandboxError(f"{path}:{line_no}: expected #include \"file.glsl\", got {line.strip()!r}")
             if include:
+                followed[0] += 1
+                if followed[0] > MAX_INCLUDES:
+                    raise SandboxError(f"{path}:{line_no}: more than {MAX_INCLUDES:,} #include lines followed "
+                                       "for one shader (a file included over and over?)")
                 read(_include(include.group(1), path, roots, f"{path}:{line_no}"), f"{path}:{line_no}",
                      (*stack, path))
                 continue
@@ -153,7 +177,9 @@ def assemble(name: str, stage: str, defines: tuple[tuple[str, str], ...] = (), r
         # (A built-in file without one fails to compile, at the line the compiler names.)
         raise SandboxError(f"{top}: no {_STAGES[stage]} section; a shader file holds both stages: "
                            "#if defined(VERTEX_SHADER) ... #elif defined(FRAGMENT_SHADER) ... #endif")
-    return Source("\n".join(out) + "\n", origins)
+    text = "\n".join(out) + "\n"
+    check_array_sizes(text, origins, shader_root(), injected)
+    return Source(text, origins)
 
 
 def _include(relative: str, including: Path, roots: list[Path], where: str) -> Path:

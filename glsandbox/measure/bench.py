@@ -9,7 +9,10 @@ on-demand plan vs ``effects=all``). All cases run together in alternating
 rounds, in one process and on one GL context: every round times each
 case's two sides back to back, the order swapped every other round, so the
 noise of a shared machine hits both alike. The figure per case is the ratio
-of the two medians (subject / baseline). Speed goals are printed, never
+of the two medians (subject / baseline). Each sample also records the main
+thread's CPU time (``time.thread_time``): the subject's extra CPU per
+repetition is a column of its own, steadier than wall time on a shared
+machine (GL drivers' worker threads are not in it). Speed goals are printed, never
 asserted: no test depends on a timing, which a busy machine would fail
 (README, "Benchmarks").
 
@@ -40,6 +43,10 @@ from glsandbox.gl.context import headless_order
 
 #: The frame size of the frame benchmarks (the course's 800x600 window).
 FRAME_SIZE = (800, 600)
+#: Goals of a lesson frame against its raw-ModernGL baseline (issue 24): at most this ratio
+#: of the raw frame's wall time, and at most this much extra main-thread CPU (µs) per frame.
+LESSON_FRAME_GOAL = 1.05
+LESSON_FRAME_CPU_GOAL_US = 50.0
 
 
 @dataclass(frozen=True)
@@ -61,7 +68,8 @@ class Case:
     ``repeat`` is how many repetitions make one timed sample (many cheap
     frames, one process start); ``unit`` is how the per-repetition time is
     printed ("ms" or "s"); ``goal`` is the ratio aimed for (printed, never
-    asserted); ``compare`` decides whether the two sides show the same
+    asserted); ``cpu_goal_us`` the most extra main-thread CPU per repetition
+    aimed for, in microseconds (printed likewise); ``compare`` decides whether the two sides show the same
     picture from their first results (None: nothing to compare).
     """
 
@@ -72,6 +80,7 @@ class Case:
     repeat: int = 30
     unit: str = "ms"
     goal: float | None = None
+    cpu_goal_us: float | None = None
     note: str = ""
     compare: Callable[[Any, Any], str] | None = None
 
@@ -115,12 +124,22 @@ class Result:
     baseline_s: list[float]
     subject_s: list[float]
     same: str = ""
+    #: Main-thread CPU seconds per repetition, sample for sample with the wall times.
+    baseline_cpu_s: list[float] = field(default_factory=list)
+    subject_cpu_s: list[float] = field(default_factory=list)
 
     @property
     def ratio(self) -> float | None:
         if not self.baseline_s:
             return None
         return statistics.median(self.subject_s) / statistics.median(self.baseline_s)
+
+    @property
+    def extra_cpu_us(self) -> float | None:
+        """The subject's main-thread CPU per repetition beyond the baseline's (medians), in µs."""
+        if not self.baseline_cpu_s or not self.subject_cpu_s:
+            return None
+        return (statistics.median(self.subject_cpu_s) - statistics.median(self.baseline_cpu_s)) * 1e6
 
     def to_dict(self) -> dict[str, Any]:
         c = self.case
@@ -137,17 +156,22 @@ class Result:
                 "baseline_time": summary(self.baseline_s), "subject_time": summary(self.subject_s),
                 "ratio": None if self.ratio is None else round(self.ratio, 4), "goal": c.goal,
                 "goal_met": None if c.goal is None or self.ratio is None else self.ratio <= c.goal,
+                "extra_cpu_us": None if self.extra_cpu_us is None else round(self.extra_cpu_us, 1),
+                "cpu_goal_us": c.cpu_goal_us,
+                "cpu_goal_met": None if c.cpu_goal_us is None or self.extra_cpu_us is None
+                else self.extra_cpu_us <= c.cpu_goal_us,
                 "same_picture": self.same or None, "note": c.note or None}
 
 
 # --- measuring ----------------------------------------------------------------
 
 
-def _sample(side: Side, repeat: int, start: int) -> float:
-    t0 = time.perf_counter()
+def _sample(side: Side, repeat: int, start: int) -> tuple[float, float]:
+    """Wall and main-thread CPU seconds per repetition."""
+    cpu0, t0 = time.thread_time(), time.perf_counter()
     for k in range(repeat):
         side.run(start + k)
-    return (time.perf_counter() - t0) / repeat
+    return (time.perf_counter() - t0) / repeat, (time.thread_time() - cpu0) / repeat
 
 
 def measure(cases: Sequence[Case], rounds: int, log: Callable[[str], None] = lambda s: None,
@@ -168,12 +192,15 @@ def measure(cases: Sequence[Case], rounds: int, log: Callable[[str], None] = lam
         log(f"bench: round {r + 1}/{rounds}")
         for result in results:
             case = result.case
-            sides = [(case.baseline, result.baseline_s), (case.subject, result.subject_s)]
+            sides = [(case.baseline, result.baseline_s, result.baseline_cpu_s),
+                     (case.subject, result.subject_s, result.subject_cpu_s)]
             if r % 2:
                 sides.reverse()
-            for side, samples in sides:
+            for side, samples, cpu_samples in sides:
                 if side is not None:
-                    samples.append(_sample(side, case.repeat, r * case.repeat))
+                    wall, cpu = _sample(side, case.repeat, r * case.repeat)
+                    samples.append(wall)
+                    cpu_samples.append(cpu)
             advance(1)
     return results
 
@@ -230,8 +257,10 @@ def load_modules(folder: Path) -> list[ModuleType]:
 
 
 def format_table(results: Sequence[Result]) -> str:
-    """One table: every case, both medians with spread, the ratio, the goal and the picture check."""
-    header = ("benchmark", "baseline", "subject", "baseline", "subject", "ratio", "goal", "same picture")
+    """One table: every case, both medians with spread, the ratio, the goal, the subject's extra
+    main-thread CPU per repetition with its goal, and the picture check."""
+    header = ("benchmark", "baseline", "subject", "baseline", "subject", "ratio", "goal", "extra CPU",
+              "CPU goal", "same picture")
     rows = []
     for res in results:
         c = res.case
@@ -245,14 +274,22 @@ def format_table(results: Sequence[Result]) -> str:
 
         ratio = res.ratio
         goal = "-" if c.goal is None or ratio is None else f"<={c.goal:.2f}x {'met' if ratio <= c.goal else 'NOT met'}"
+        extra = res.extra_cpu_us
+        cpu_goal = "-" if c.cpu_goal_us is None or extra is None else \
+            f"<={c.cpu_goal_us:g} us {'met' if extra <= c.cpu_goal_us else 'NOT met'}"
         rows.append((f"{c.group}: {c.name}", c.baseline.label if c.baseline else "-", c.subject.label,
                      cell(res.baseline_s), cell(res.subject_s), "-" if ratio is None else f"{ratio:.2f}x",
-                     goal, res.same or "-"))
+                     goal, "-" if extra is None else _cpu_cell(extra, c.unit), cpu_goal, res.same or "-"))
     widths = [max(len(str(r[i])) for r in (header, *rows)) for i in range(len(header))]
     lines = ["  ".join(str(v).ljust(w) for v, w in zip(header, widths)).rstrip(),
              "  ".join("-" * w for w in widths)]
     lines += ["  ".join(str(v).ljust(w) for v, w in zip(r, widths)).rstrip() for r in rows]
     return "\n".join(lines)
+
+
+def _cpu_cell(extra_us: float, unit: str) -> str:
+    """Extra CPU per repetition: microseconds for frames, seconds for whole runs."""
+    return f"{extra_us:+.0f} us" if unit == "ms" else f"{extra_us / 1e6:+.3f} s"
 
 
 def run_all(json_path: Path | None = None, quick: bool = False, only: Sequence[str] = (),

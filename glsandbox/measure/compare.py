@@ -210,7 +210,7 @@ def whole_frame_reason(scene: Scene) -> str | None:
     """
     if scene.mirror is not None:
         return "it has a stencil mirror"
-    if scene.shadow is not None:
+    if scene.planar_shadow is not None:
         return "it has a planar shadow"
     if scene.depth_mode != "standard":
         return f"it uses {scene.depth_mode} depth"

@@ -49,9 +49,9 @@ class ZFighting:
 
 def flat_receiver(scene: Scene, drop: float = 0.0, grey: float = RECEIVER_GREY) -> Scene:
     """``scene`` with its shadow's receiver unlit and flat ``grey``, moved ``drop`` below its plane."""
-    if scene.shadow is None:
+    if scene.planar_shadow is None:
         raise SandboxError(f"scene {scene.name!r} has no planar shadow: nothing can z-fight")
-    shadow = scene.shadow
+    shadow = scene.planar_shadow
     down = -drop * np.asarray(shadow.plane[:3], dtype=np.float64)  # the plane's normal is unit length
     move = transforms.translate(*(float(c) for c in down))
     nodes = tuple(replace(n, model=move @ n.model, material=Material(color=(grey, grey, grey, 1.0)))
@@ -63,8 +63,8 @@ def flat_receiver(scene: Scene, drop: float = 0.0, grey: float = RECEIVER_GREY) 
 
 def shadow_level(scene: Scene, grey: float = RECEIVER_GREY) -> int:
     """The 8-bit level of a shadowed pixel of the flat receiver: the shadow colour blended once over ``grey``."""
-    assert scene.shadow is not None
-    r, _, _, alpha = scene.shadow.color
+    assert scene.planar_shadow is not None
+    r, _, _, alpha = scene.planar_shadow.color
     return int(round(255.0 * (alpha * r + (1.0 - alpha) * grey)))
 
 

@@ -18,9 +18,11 @@ flatten it into ``vec4`` records, :data:`TRI_RECORDS` per triangle and
 shader). A small scene (see the program variants below) has its records in
 one uniform block, the shader's ``SceneData``; a larger one in two RGBA32F
 textures :data:`TEX_WIDTH` wide, read with ``texelFetch``. The materials'
-images become RGBA8 textures (at most :data:`MAX_TEXTURES` a viewport)
+images become RGBA8 textures (at most :data:`MAX_TEXTURES` a viewport),
 sampled by hand, bilinear in the base level with the wrap mode done in the
-shader, exactly as the numpy engine samples them. Uploads are kept (the
+shader, exactly as the numpy engine samples them; the nodes of any more
+textures (a model file with many materials) are traced with their colour
+alone, and a ``warning:`` line says so. Uploads are kept (the
 last :attr:`GpuTracer.KEEP_SCENES`): a render of the same node objects,
 lights and viewport, or of new objects that pack to the same records, only
 moves the camera.
@@ -98,6 +100,7 @@ except on a few pixels where a ray grazes an edge or a shadow boundary
 from __future__ import annotations
 
 import math
+import sys
 
 import moderngl
 import numpy as np
@@ -115,7 +118,7 @@ __all__ = ["LOOP_LIMIT", "GpuTracer", "MAX_TEXTURES", "check_loop_budget", "gpu_
 #: Width of the record textures (must match TEX_WIDTH in the shader).
 TEX_WIDTH = 1024
 TRI_RECORDS = 9
-NODE_RECORDS = 12
+NODE_RECORDS = 13
 #: Samplers the shader declares at most.
 MAX_TEXTURES = 4
 #: llvmpipe's loop iterations per shader invocation, all loops together (see the module docstring).
@@ -224,6 +227,27 @@ def _records(rows: NDArray[np.float32]) -> tuple[tuple[int, int], bytes]:
     return (TEX_WIDTH, height), data.tobytes()
 
 
+#: The warnings already printed by this process (once per run, not per frame).
+_WARNED: set[str] = set()
+
+
+def _keep_first_textures(scene: Scene, world: World) -> None:
+    """A viewport with more textures than the shader's samplers (a model file with many
+    materials): the nodes of the textures beyond :data:`MAX_TEXTURES` are traced with their
+    colour alone, and one ``warning:`` line says so (the numpy engine samples them all)."""
+    untextured = [node.name for node in world.nodes if node.texture >= MAX_TEXTURES]
+    for node in world.nodes:
+        if node.texture >= MAX_TEXTURES:
+            node.texture = -1
+    del world.textures[MAX_TEXTURES:]
+    shown = ", ".join(untextured[:3]) + (f" and {len(untextured) - 3} more" if len(untextured) > 3 else "")
+    line = (f"warning: scene {scene.name!r}: the GLSL ray tracer samples at most {MAX_TEXTURES} textures per "
+            f"viewport; {shown} traced without their textures (renderer=ray_numpy samples them all)")
+    if line not in _WARNED:
+        _WARNED.add(line)
+        print(line, file=sys.stderr, flush=True)
+
+
 def pack_triangles(world: World) -> NDArray[np.float32]:
     """``TRI_RECORDS`` vec4 per triangle (layout in ``shaders/raytrace.glsl``)."""
     m = world.triangle_count
@@ -265,6 +289,8 @@ def pack_nodes(world: World) -> NDArray[np.float32]:
         rec[slot, 5] = (node.reflectivity, node.texture, node.lamp_of, 0.0)
         rec[slot, 6:9] = node.inverse[:3, :4]
         rec[slot, 9:12, :3] = node.normal_matrix
+        rec[slot, 12] = (node.alpha, node.alpha_mode, node.alpha_cutoff,
+                         int(node.vertex_colors) | 2 * int(node.two_sided))
     return rec.reshape(-1, 4).astype(np.float32)
 
 
@@ -375,7 +401,8 @@ class _Uploaded:
 
     def defines(self, cull: bool | None) -> tuple[tuple[str, str], ...]:
         """The program variant's scene-shaped defines (see ``shaders/raytrace.glsl``)."""
-        found = [("VERTEX_COLORS", str(int(any(node.mode == MODES["vertex_color"] for node in self.world.nodes))))]
+        found = [("VERTEX_COLORS", str(int(any(node.mode == MODES["vertex_color"] or node.vertex_colors
+                                               for node in self.world.nodes))))]
         if self.unrolled:
             found += [("SCENE_NODES", self.scene_nodes(cull)), ("NODE_COUNT", str(max(1, len(self.world.nodes)))),
                       ("TRI_COUNT", str(max(1, self.world.triangle_count)))]
@@ -474,8 +501,7 @@ class GpuTracer:
                 return entry
         world = build_world(scene, viewport, analytic_spheres=analytic_spheres)
         if len(world.textures) > MAX_TEXTURES:
-            raise RayTraceError(f"the gpu engine samples at most {MAX_TEXTURES} textures per viewport, "
-                                f"scene {scene.name!r} has {len(world.textures)}")
+            _keep_first_textures(scene, world)
         for i, entry in enumerate(self._scenes):  # new objects, same data (glsandbox.frame.trace_viewports rebuilds nodes)
             if entry.same_data(world):
                 entry.key = key
@@ -505,8 +531,8 @@ class GpuTracer:
         vp = scene.viewports[viewport]
         eye, basis, half_w, half_h = camera_basis(vp.camera or scene.camera, width / height)
         lights = world.light_positions.shape[0]
-        # The bounce loop only where some node reflects.
-        reflect = max_depth > 0 and any(node.reflectivity > 0.0 for node in world.nodes)
+        # The bounce loop only where some node reflects or lets rays through (a cut-out, a blend).
+        reflect = max_depth > 0 and any(node.reflectivity > 0.0 or node.see_through for node in world.nodes)
         scene_defines = uploaded.defines(cull_backfaces)
         use_bvh = False
         try:

@@ -9,10 +9,13 @@ of rays at once:
   ray over the :class:`~glsandbox.raytrace.world.World`'s nodes;
 - :func:`_occluded`: the shadow query (Gölge testi), whether anything but the
   light's lamp lies at ``0 < s < 1`` along each shadow ray;
-- :func:`_surface`: point, normal and base colour at the hits (barycentric
-  normals, uv and vertex colours; textures sampled bilinearly by hand);
+- :func:`_surface`: point, normal, base colour and alpha at the hits
+  (barycentric normals, uv and vertex colours; textures sampled bilinearly by
+  hand; a two-sided node's back face lit with its normal reversed);
 - :func:`_shade`: the rasterizer's per-light Phong with a shadow ray per light;
-- :func:`_trace`: reflections followed iteratively, ``(1 − r)·local + r·reflected``.
+- :func:`_trace`: reflections followed iteratively, ``(1 − r)·local + r·reflected``,
+  and rays passed on straight through cut-outs and blended surfaces,
+  ``a·local + (1 − a)·behind``.
 
 Primary rays are traced :data:`RAY_BLOCK` at a time, each block through every
 step before the next.
@@ -52,7 +55,7 @@ from glsandbox.raytrace.bvh_world import NodeBVH, WorldBVH
 from glsandbox.raytrace.constants import SHADOW_OFFSET
 from glsandbox.raytrace.sphere import Sphere
 from glsandbox.raytrace.vec import length
-from glsandbox.raytrace.world import World, build_world, camera_rays
+from glsandbox.raytrace.world import World, build_world, camera_rays, coverage
 from glsandbox.scene import Scene
 
 __all__ = ["RAY_BLOCK", "RenderStats", "render_viewport", "to_rgba8"]
@@ -313,12 +316,14 @@ def _sample(image: NDArray[np.float64], wrap: int, uv: NDArray[np.float64]) -> N
 
 
 def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.float64]
-             ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """``(point, unit normal, base colour)`` for hit rays (all of ``hits`` must be hits)."""
+             ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """``(point, unit normal, base colour, alpha)`` for hit rays (all of ``hits`` must be hits).
+    ``alpha`` is the material colour's times the texture's (what a cut-out or a blend reads)."""
     n = d.shape[0]
     point = o + hits.t[:, None] * d
     normal = np.zeros((n, 3))
     base = np.zeros((n, 3))
+    alpha = np.ones(n)
     uv = np.zeros((n, 2))
     for k, node in enumerate(world.nodes):
         sel = np.nonzero(hits.node == k)[0]
@@ -338,17 +343,26 @@ def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.fl
             u, v = _barycentric(world, tri, _rows(o, sel), d[sel])
             w = (1.0 - u - v)[:, None], u[:, None], v[:, None]  # weights of V0, V1, V2
             normal[sel] = _interpolate(world.normals[tri], w)
+            if node.two_sided:
+                # A back face seen (the ray runs along the face normal: clockwise from the eye,
+                # the rasterizer's !gl_FrontFacing) is lit as its other side: the normal reversed.
+                face = np.cross(world.v1[tri] - world.v0[tri], world.v2[tri] - world.v0[tri])
+                back = np.einsum("ij,ij->i", face, d[sel]) > 0.0
+                normal[sel[back]] *= -1.0
             uv[sel] = _interpolate(world.uvs[tri], w)
-            colors = _interpolate(world.colors[tri], w) if node.mode == 1 else None
+            colors = _interpolate(world.colors[tri], w) if node.mode == 1 or node.vertex_colors else None
         color = np.broadcast_to(node.color, (sel.size, 3)).copy()
-        if colors is not None:  # vertex colours, times the material colour (basic.glsl)
+        if colors is not None:  # vertex colours, times the material colour (basic.glsl, phong.glsl)
             color *= colors
+        alpha[sel] = node.alpha
         if node.texture >= 0:
             image, wrap = world.textures[node.texture]
-            color *= _sample(image, wrap, uv[sel])[:, :3]
+            texel = _sample(image, wrap, uv[sel])
+            color *= texel[:, :3]
+            alpha[sel] *= texel[:, 3]
         base[sel] = color
     normal /= np.maximum(length(normal), 1e-300)[:, None]
-    return point, normal, base
+    return point, normal, base, alpha
 
 
 def _interpolate(values: NDArray[np.float64], w: tuple[NDArray[np.float64], ...]) -> NDArray[np.float64]:
@@ -369,9 +383,10 @@ def _offset(point: NDArray[np.float64], normal: NDArray[np.float64], side: NDArr
 
 def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.float64], shadows: bool,
            cull: bool | None, aabb: bool, stats: RenderStats, bvh: WorldBVH | None = None
-           ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """Local colour of hit rays (the raster's per-light formula), plus point and normal for bounces."""
-    point, normal, base = _surface(world, hits, o, d)
+           ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Local colour of hit rays (the raster's per-light formula), plus point, normal and alpha
+    for bounces."""
+    point, normal, base, alpha = _surface(world, hits, o, d)
     color = base.copy()  # unlit surfaces keep their colour
     table = world.materials
     lit = table.lit[hits.node]
@@ -409,12 +424,18 @@ def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.floa
                 lighting *= np.where(blocked, 0.0, 1.0)[:, None]  # in shadow only the ambient term stays
             total += np.minimum(ka * mesh + lighting, 1.0)
         color[idx] = total
-    return color, point, normal
+    return color, point, normal, alpha
 
 
 def _trace(world: World, o: NDArray[np.float64], d: NDArray[np.float64], max_depth: int, shadows: bool,
            cull: bool | None, aabb: bool, stats: RenderStats, bvh: WorldBVH | None = None) -> NDArray[np.float64]:
-    """Colour of each ray, reflections followed iteratively: ``(1−r)·local + r·reflected``."""
+    """Colour of each ray, reflections followed iteratively: ``(1−r)·local + r·reflected``.
+
+    A see-through surface (a cut-out, a blended one) covers a share ``a`` of what lies
+    behind it (:func:`~glsandbox.raytrace.world.coverage`): ``a·local + (1−a)·behind``,
+    the ray going on straight through it. Such a pass is one of the ``max_depth`` bounces
+    (at the last one the surface's own colour stands in), and a see-through surface does
+    not also reflect: one ray per pixel, as in the GLSL engine's loop."""
     n = d.shape[0]
     out = np.zeros((n, 3))
     weight = np.ones(n)
@@ -427,19 +448,26 @@ def _trace(world: World, o: NDArray[np.float64], d: NDArray[np.float64], max_dep
         if not hit.any():
             break
         sub = _Hits(hits.t[hit], hits.node[hit], hits.tri[hit])
-        local, point, normal = _shade(world, sub, _rows(o, hit), d[hit], shadows, cull, aabb, stats, bvh)
-        r = world.materials.reflectivity[sub.node] if depth < max_depth else np.zeros(sub.node.size)
+        local, point, normal, alpha = _shade(world, sub, _rows(o, hit), d[hit], shadows, cull, aabb, stats, bvh)
+        table = world.materials
+        last = depth >= max_depth
+        r = table.reflectivity[sub.node] if not last else np.zeros(sub.node.size)
+        a = np.ones(sub.node.size) if last else coverage(table.alpha_mode[sub.node], alpha,
+                                                          table.alpha_cutoff[sub.node])
+        through = a < 1.0
+        r = np.where(through, 0.0, r)
         w = weight[hit]
-        out[alive[hit]] += (w * (1.0 - r))[:, None] * local
-        bounce = r > 0.0
+        out[alive[hit]] += (w * a * (1.0 - r))[:, None] * local
+        bounce = (r > 0.0) | through
         if not bounce.any():
             break
         dh = d[hit][bounce]
         nh = normal[bounce]
+        on = through[bounce][:, None]
         reflected = dh - 2.0 * np.einsum("ij,ij->i", dh, nh)[:, None] * nh  # Yansıma vektörü
-        o = _offset(point[bounce], nh, -dh)
-        d = reflected
-        weight = (w * r)[bounce]
+        o = _offset(point[bounce], nh, np.where(on, dh, -dh))  # behind the surface, or back in front
+        d = np.where(on, dh, reflected)
+        weight = np.where(through, w * (1.0 - a), w * r)[bounce]
         alive = alive[hit][bounce]
         stats.reflection += alive.size
     return out

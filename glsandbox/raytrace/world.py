@@ -61,6 +61,7 @@ from numpy.typing import NDArray
 from glsandbox import transforms
 from glsandbox.geometry import Mesh
 from glsandbox.images import texture_levels
+from glsandbox.plan import traced_reflectivity
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.triangle import TriangleBatch
 from glsandbox.scene import MIN_SCALE, Camera, Node, Scene, Texture
@@ -77,6 +78,8 @@ __all__ = [
 
 #: How a node's surface is coloured, as the engines number it.
 MODES = {"solid": 0, "vertex_color": 1, "phong": 2, "gouraud": 2, "blinn_phong": 3}
+#: Alpha modes (:data:`glsandbox.scene.ALPHA_MODES`) as the engines number them.
+ALPHA_CODES = {"opaque": 0, "mask": 1, "blend": 2}
 #: Texture wrap modes as the engines number them.
 WRAPS = {"repeat": 0, "mirrored": 1, "clamp": 2}
 
@@ -108,10 +111,24 @@ class NodeInfo:
     #: that light's lamp (the lessons draw each light as a small cube around
     #: it) and casts no shadow for it.
     lamp_of: int = 0
+    #: A model file's material (:class:`glsandbox.scene.Material`): the colour's alpha, the
+    #: alpha mode (:data:`ALPHA_CODES`) and cutoff; the lit colour times the vertex colours;
+    #: back faces lit with the normal reversed.
+    alpha: float = 1.0
+    alpha_mode: int = 0
+    alpha_cutoff: float = 0.5
+    vertex_colors: bool = False
+    two_sided: bool = False
 
     @property
     def lit(self) -> bool:
         return self.mode >= 2
+
+    @property
+    def see_through(self) -> bool:
+        """Whether rays may pass it (a cut-out or a blended surface): the engines
+        continue such a ray behind it (:func:`coverage`)."""
+        return self.alpha_mode != ALPHA_CODES["opaque"]
 
 
 @dataclass
@@ -162,6 +179,8 @@ class NodeMaterials:
     shininess: NDArray[np.float64]
     blinn: NDArray[np.bool_]  # Blinn-Phong: N·H instead of R·E
     reflectivity: NDArray[np.float64]
+    alpha_mode: NDArray[np.intp]  # ALPHA_CODES
+    alpha_cutoff: NDArray[np.float64]
 
     @classmethod
     def of(cls, nodes: list[NodeInfo]) -> NodeMaterials:
@@ -171,7 +190,19 @@ class NodeMaterials:
         return cls(lit=np.array([n.lit for n in nodes], dtype=bool), ka=floats("ka"), kd=floats("kd"),
                    ks=floats("ks"), shininess=floats("shininess"),
                    blinn=np.array([n.mode == MODES["blinn_phong"] for n in nodes], dtype=bool),
-                   reflectivity=floats("reflectivity"))
+                   reflectivity=floats("reflectivity"),
+                   alpha_mode=np.array([n.alpha_mode for n in nodes], dtype=np.intp),
+                   alpha_cutoff=floats("alpha_cutoff"))
+
+
+def coverage(alpha_mode: NDArray[np.intp], alpha: NDArray[np.float64],
+             cutoff: NDArray[np.float64]) -> NDArray[np.float64]:
+    """How much of a hit surface covers what lies behind it, 0..1, as the rasterizer
+    draws it: opaque 1; a cut-out 1 where its alpha reaches the cutoff and 0 (discarded)
+    below; blended its alpha (``a·surface + (1−a)·behind``)."""
+    mask = np.where(alpha >= cutoff, 1.0, 0.0)
+    return np.where(alpha_mode == ALPHA_CODES["mask"], mask,
+                    np.where(alpha_mode == ALPHA_CODES["blend"], alpha, 1.0))
 
 
 def is_unit_sphere(mesh: Mesh) -> bool:
@@ -200,19 +231,6 @@ def _unit_rows(v: NDArray[np.float64]) -> NDArray[np.float64]:
 def _texture_image(texture: Texture) -> NDArray[np.float64]:
     """The base level of a texture as float rgba in 0..1 (the ray tracer samples level 0 only)."""
     return np.asarray(texture_levels(texture)[0], dtype=np.float64) / 255.0
-
-
-def _reflectivity(scene: Scene, node: Node) -> float:
-    """The node's ``material.reflectivity``; for the glass of the scene's stencil
-    mirror (:class:`glsandbox.planar.Mirror`) at least ``1 - alpha``, the share
-    of the reflection the rasterizer blends under the glass. The ray tracer
-    reflects everything in front of the glass, not only the mirror's
-    ``reflected`` nodes: the answer the stencil approximation aims at."""
-    value = float(node.material.reflectivity)
-    mirror = getattr(scene, "mirror", None)
-    if mirror is not None and node.name == mirror.node:
-        value = max(value, 1.0 - float(node.material.color[3]))
-    return value
 
 
 def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = True) -> World:
@@ -250,8 +268,10 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
             name=node.name, cull=bool(node.cull_back_faces),
             color=np.asarray(material.color[:3], dtype=np.float64), mode=MODES[material.shading],
             ka=float(material.ambient), kd=float(material.diffuse), ks=float(material.specular),
-            shininess=float(material.shininess), reflectivity=_reflectivity(scene, node),
-            texture=tex,
+            shininess=float(material.shininess), reflectivity=traced_reflectivity(scene, node),
+            texture=tex, alpha=float(material.color[3]), alpha_mode=ALPHA_CODES[material.alpha_mode],
+            alpha_cutoff=float(material.alpha_cutoff), vertex_colors=bool(material.vertex_colors),
+            two_sided=bool(material.double_sided),
         )
         # A model that flattens the node (a scale of 0, or below MIN_SCALE) has no usable inverse.
         invertible = transforms.smallest_scale(model) >= MIN_SCALE
@@ -290,6 +310,9 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
         start += len(tri)
     lights = scene.lights
     for info in nodes:
+        if info.see_through:  # cut-outs and glass cast no shadow (the rasterizer draws none)
+            info.lamp_of = (1 << len(lights)) - 1
+            continue
         for i, light in enumerate(lights):
             inside = np.all(info.box_min <= light.position) and np.all(np.asarray(light.position) <= info.box_max)
             if inside and not info.lit:

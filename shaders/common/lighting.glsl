@@ -27,6 +27,45 @@ uniform vec3 u_light_color[NUM_LIGHTS];  // vLightColor[]
 
 #include "common/course_light.glsl"
 
+#ifdef SHADOW_LIGHT
+// Shadow map of light SHADOW_LIGHT (glsandbox/shadowmap.py). The receiver
+// point p, moved towards the light by the bias, is projected by the light's
+// projection @ view: its depth in 0..1 is compared with the map's (the
+// comparison sampler returns 1 where p is at most as far as the nearest
+// caster: lit). The bias is constant + slope · tan(angle between N and L)
+// world units: a surface at a grazing angle to the light spans more depth
+// per texel, so it needs more to stop shadowing itself (acne). Percentage-
+// closer filtering averages a SHADOW_PCF x SHADOW_PCF grid of comparisons
+// (1, 3, 5 or 7), one texel apart: edges get soft steps instead of stairs.
+// Outside the light's frustum a point counts as lit.
+uniform sampler2DShadow u_shadow_map;
+uniform mat4 u_shadow_matrix;
+uniform float u_shadow_bias;
+uniform float u_shadow_slope_bias;
+uniform float u_shadow_texel;   // 1 / map size
+
+float shadow_visibility(vec3 position, vec3 normal, vec3 to_light) {
+    float cosine = clamp(dot(normal, to_light), 0.05, 1.0);
+    float slope = sqrt(1.0 - cosine * cosine) / cosine;  // tan of the angle, at most about 20
+    vec3 moved = position + to_light * (u_shadow_bias + u_shadow_slope_bias * slope);
+    vec4 clip = u_shadow_matrix * vec4(moved, 1.0);
+    if (clip.w <= 0.0) return 1.0;
+    vec3 ndc = clip.xyz / clip.w;
+    vec3 coord = ndc * 0.5 + 0.5;
+    if (any(lessThan(coord, vec3(0.0))) || any(greaterThan(coord, vec3(1.0)))) return 1.0;
+    // Constant bounds (a define, one variant per width): the compiler unrolls the loop.
+    const int half_width = SHADOW_PCF / 2;
+    float lit = 0.0;
+    for (int y = -half_width; y <= half_width; ++y) {
+        for (int x = -half_width; x <= half_width; ++x) {
+            lit += texture(u_shadow_map, vec3(coord.xy + vec2(x, y) * u_shadow_texel, coord.z));
+        }
+    }
+    float side = float(2 * half_width + 1);
+    return lit / (side * side);
+}
+#endif
+
 vec3 shade(vec3 position, vec3 normal, vec3 mesh) {
     vec3 color = vec3(0.0);
 #if NUM_LIGHTS > 0
@@ -38,9 +77,14 @@ vec3 shade(vec3 position, vec3 normal, vec3 mesh) {
 #endif
     for (int i = 0; i < NUM_LIGHTS; ++i) {
         vec3 diffuse, specular;
-        course_light(normal, normalize(u_light_pos[i] - position), to_eye, mesh, u_light_color[i], u_shininess,
-                     blinn, diffuse, specular);
-        color += min(u_ambient * mesh + u_diffuse * diffuse + u_specular * specular, vec3(1.0));
+        vec3 to_light = normalize(u_light_pos[i] - position);
+        course_light(normal, to_light, to_eye, mesh, u_light_color[i], u_shininess, blinn, diffuse, specular);
+        float visible = 1.0;
+#ifdef SHADOW_LIGHT
+        // In shadow only the ambient term stays (the ray tracer's rule).
+        if (i == SHADOW_LIGHT) visible = shadow_visibility(position, normal, to_light);
+#endif
+        color += min(u_ambient * mesh + visible * (u_diffuse * diffuse + u_specular * specular), vec3(1.0));
     }
 #endif
     return color;

@@ -16,7 +16,7 @@ from PIL import Image
 from glsandbox.errors import SandboxError
 from glsandbox.images import load_image
 from support import REPO_ROOT as REPO
-from support import assert_user_error, glsandbox, need
+from support import assert_user_error, need, run_cli
 
 @pytest.fixture
 def needs_fifo() -> None:
@@ -39,8 +39,8 @@ def textured_scene(tmp_path: Path, texture: str) -> Path:
 def test_a_named_pipe_as_a_texture_is_refused_not_waited_on(tmp_path: Path, renderer: str) -> None:
     os.mkfifo(tmp_path / "pipe.png")  # opening it for reading blocked forever: no writer ever comes
     out = tmp_path / "x.png"
-    proc = glsandbox("render", str(textured_scene(tmp_path, "pipe.png")), "--size", "16x16", "--set",
-                     f"renderer={renderer}", "--out", str(out))
+    proc = run_cli("render", str(textured_scene(tmp_path, "pipe.png")), "--size", "16x16", "--set",
+                   f"renderer={renderer}", "--out", str(out))
     assert_user_error(proc, f"texture file {tmp_path / 'pipe.png'} is a named pipe (FIFO), expected an image file")
     assert not out.exists()
 
@@ -49,10 +49,10 @@ def test_a_named_pipe_as_a_texture_is_refused_not_waited_on(tmp_path: Path, rend
 def test_a_named_pipe_as_the_lesson_image_or_the_scene_file_is_refused(tmp_path: Path) -> None:
     os.mkfifo(tmp_path / "pipe")
     out = tmp_path / "x.png"
-    assert_user_error(glsandbox("render", "texture", "--size", "16x16", "--set", f"image={tmp_path / 'pipe'}",
-                                "--out", str(out)), "is a named pipe (FIFO)")
+    assert_user_error(run_cli("render", "texture", "--size", "16x16", "--set", f"image={tmp_path / 'pipe'}",
+                              "--out", str(out)), "is a named pipe (FIFO)")
     os.mkfifo(tmp_path / "pipe.toml")
-    assert_user_error(glsandbox("render", str(tmp_path / "pipe.toml"), "--out", str(out)),
+    assert_user_error(run_cli("render", str(tmp_path / "pipe.toml"), "--out", str(out)),
                       f"scene file {tmp_path / 'pipe.toml'} is a named pipe (FIFO), expected a scene .toml file")
     assert not out.exists()
 
@@ -62,7 +62,7 @@ def test_a_folder_as_a_texture_or_scene_is_refused(tmp_path: Path) -> None:
     with pytest.raises(SandboxError, match="is a folder, expected an image file"):
         load_image(tmp_path / "folder.png")
     (tmp_path / "folder.toml").mkdir()
-    assert_user_error(glsandbox("render", str(tmp_path / "folder.toml"), "--out", str(tmp_path / "x.png")),
+    assert_user_error(run_cli("render", str(tmp_path / "folder.toml"), "--out", str(tmp_path / "x.png")),
                       "is a folder, expected a scene .toml file")
 
 
@@ -89,7 +89,7 @@ def test_a_16_bit_texture_renders_its_grey_through_the_cli(tmp_path: Path, gl) -
     scene.write_text('[camera]\neye = [0, 0, 4]\n\n[[nodes]]\nmesh = "cube24"\ntexture = "grey16.png"\n'
                      'filter = "nearest"\n')
     out = tmp_path / "x.png"
-    proc = glsandbox("render", str(scene), "--size", "16x16", "--out", str(out))
+    proc = run_cli("render", str(scene), "--size", "16x16", "--out", str(out))
     assert proc.returncode == 0 and proc.stderr == "", proc.stderr
     from glsandbox.files import load_png
 
@@ -102,8 +102,8 @@ def test_a_decompression_bomb_is_one_error_line_and_no_warning(tmp_path: Path) -
     Image.new("1", (9500, 9500)).save(tmp_path / "bomb.png")
     out = tmp_path / "x.png"
     for renderer in ("raster", "ray_numpy"):
-        proc = glsandbox("render", str(textured_scene(tmp_path, "bomb.png")), "--size", "16x16", "--set",
-                         f"renderer={renderer}", "--out", str(out))
+        proc = run_cli("render", str(textured_scene(tmp_path, "bomb.png")), "--size", "16x16", "--set",
+                       f"renderer={renderer}", "--out", str(out))
         assert_user_error(proc, f"texture file {tmp_path / 'bomb.png'}", "too large")
         assert "DecompressionBombWarning" not in proc.stderr
     assert not out.exists()
@@ -130,6 +130,6 @@ def test_a_shader_file_that_is_not_utf8_is_one_line_naming_it(tmp_path: Path, br
     (shaders / broken).write_bytes(text + b"// caf\xe9 in Latin-1\n")
     line = text.count(b"\n") + 1
     out = tmp_path / "x.png"
-    proc = glsandbox("render", "phong", "--size", "16x16", "--out", str(out), env={"GLSANDBOX_SHADER_DIR": str(shaders)})
+    proc = run_cli("render", "phong", "--size", "16x16", "--out", str(out), env={"GLSANDBOX_SHADER_DIR": str(shaders)})
     assert_user_error(proc, f"{shaders / broken}:{line}: shader file is not UTF-8 text (byte 0xe9)")
     assert not out.exists()

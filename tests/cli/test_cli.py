@@ -1,4 +1,5 @@
-"""The glsandbox command, run as a user would: output files, and every bad input."""
+"""The glsandbox command: output files, and every bad input (in this process, where the contract is
+checked on each run; in a subprocess where the process is the point: no GL library, no display)."""
 
 from __future__ import annotations
 
@@ -12,27 +13,27 @@ import numpy as np
 import pytest
 
 from support import REPO_ROOT as REPO
-from support import assert_user_error, glsandbox
+from support import assert_user_error, glsandbox, run_cli
 
 from glsandbox.files import load_png
 
 
 def test_list_shows_the_lessons() -> None:
-    proc = glsandbox("list")
+    proc = run_cli("list")
     assert proc.returncode == 0
     names = [line.split()[0] for line in proc.stdout.splitlines()]
     assert names[:3] == ["clear_and_swap", "triangle", "indexed_cube"]
 
 
 def test_plan_prints_the_lessons_plan() -> None:
-    proc = glsandbox("plan", "indexed_cube", "--samples", "4")
+    proc = run_cli("plan", "indexed_cube", "--samples", "4")
     assert proc.returncode == 0
     assert "buffers: colour RGBA8, depth 24, MSAA 4x" in proc.stdout
 
 
 def test_render_writes_the_png(tmp_path: Path, gl) -> None:
     out = tmp_path / "cube.png"
-    proc = glsandbox("render", "indexed_cube", "--out", str(out), "--size", "256x256", "--set", "time=0.5")
+    proc = run_cli("render", "indexed_cube", "--out", str(out), "--size", "256x256", "--set", "time=0.5")
     assert proc.returncode == 0, proc.stderr
     image = load_png(out)
     np.testing.assert_array_equal(image, gl.render(__import__("glsandbox.lesson", fromlist=["x"])
@@ -43,7 +44,7 @@ def test_render_a_scene_file(tmp_path: Path, gl) -> None:
     scene = tmp_path / "box.toml"
     scene.write_text('[[nodes]]\nmesh = "cube"\ncolor = [1, 0, 0]\nshading = "solid"\n')
     out = tmp_path / "box.png"
-    proc = glsandbox("render", str(scene), "--out", str(out), "--size", "64x64")
+    proc = run_cli("render", str(scene), "--out", str(out), "--size", "64x64")
     assert proc.returncode == 0, proc.stderr
     image = load_png(out)
     assert tuple(image[32, 32]) == (255, 0, 0, 255)
@@ -72,13 +73,13 @@ def test_bad_input_is_one_line_exit_2_and_writes_nothing(tmp_path: Path, args: l
                                                          gl) -> None:
     out = tmp_path / "out.png"
     filled = [a.replace("{out}", str(out)).replace("{tmp}", str(tmp_path)) for a in args]
-    proc = glsandbox(*filled)
+    proc = run_cli(*filled, unchanged=tmp_path)
     assert_user_error(proc, *fragments)
     assert list(tmp_path.iterdir()) == []  # nothing written, not even a temporary file
 
 
 def test_backend_from_environment_is_validated(tmp_path: Path) -> None:
-    proc = glsandbox("render", "triangle", "--out", str(tmp_path / "x.png"), env={"GLSANDBOX_BACKEND": "dx11"})
+    proc = run_cli("render", "triangle", "--out", str(tmp_path / "x.png"), env={"GLSANDBOX_BACKEND": "dx11"})
     assert_user_error(proc, "unknown backend 'dx11' (from GLSANDBOX_BACKEND)")
 
 
@@ -86,9 +87,9 @@ def test_malformed_scene_file_names_file_and_line(tmp_path: Path) -> None:
     scene = tmp_path / "bad.toml"
     scene.write_text('[camera]\neye = [0, 3, 10]\n\n[[nodes]]\nmesh = "cube"\ncolor = [1, 0,, 0]\n')
     out = tmp_path / "x.png"
-    assert_user_error(glsandbox("render", str(scene), "--out", str(out)), f"{scene}:6: malformed TOML")
+    assert_user_error(run_cli("render", str(scene), "--out", str(out)), f"{scene}:6: malformed TOML")
     scene.write_text('[[nodes]]\nmesh = "sphere9"\n')
-    assert_user_error(glsandbox("render", str(scene), "--out", str(out)), f"{scene}:2: nodes[0].mesh")
+    assert_user_error(run_cli("render", str(scene), "--out", str(out)), f"{scene}:2: nodes[0].mesh")
     assert not out.exists()
 
 
@@ -100,11 +101,12 @@ def test_shader_that_does_not_compile_names_file_and_line(tmp_path: Path, gl) ->
     source[line - 1] = source[line - 1].replace("u_color", "u_colour")
     (shaders / "basic.glsl").write_text("\n".join(source) + "\n")
     out = tmp_path / "x.png"
-    proc = glsandbox("render", "triangle", "--out", str(out), env={"GLSANDBOX_SHADER_DIR": str(shaders)})
+    proc = run_cli("render", "triangle", "--out", str(out), env={"GLSANDBOX_SHADER_DIR": str(shaders)})
     assert_user_error(proc, f"{shaders / 'basic.glsl'}:{line}:", "u_colour")
     assert not out.exists()
 
 
+@pytest.mark.slow  # several subprocesses: the process is the point
 def test_no_gl_available_says_what_to_install(tmp_path: Path) -> None:
     broken = {"__EGL_VENDOR_LIBRARY_FILENAMES": str(tmp_path / "none.json"), "EGL_PLATFORM": "surfaceless",
               "GLSANDBOX_OSMESA": str(tmp_path / "libOSMesa-missing.so")}
@@ -124,7 +126,7 @@ def test_no_gl_available_says_what_to_install(tmp_path: Path) -> None:
 @pytest.mark.slow
 def test_tour_writes_images_gallery_and_json(tmp_path: Path, gl) -> None:
     out = tmp_path / "tour"
-    proc = glsandbox("tour", "--out", str(out), "--size", "128x96")
+    proc = run_cli("tour", "--out", str(out), "--size", "128x96")
     assert proc.returncode == 0, proc.stderr
     summary = json.loads((out / "tour.json").read_text())
     names = [r["lesson"] for r in summary["lessons"]]
@@ -144,7 +146,7 @@ def test_tour_goes_on_when_a_lesson_fails_and_exits_non_zero(tmp_path: Path, gl)
     shaders.mkdir()
     (shaders / "basic.glsl").write_text("#version 330 core\nthis is not glsl\n")
     out = tmp_path / "tour"
-    proc = glsandbox("tour", "--out", str(out), "--size", "64x64", env={"GLSANDBOX_SHADER_DIR": str(shaders)})
+    proc = run_cli("tour", "--out", str(out), "--size", "64x64", env={"GLSANDBOX_SHADER_DIR": str(shaders)})
     assert proc.returncode == 1
     summary = json.loads((out / "tour.json").read_text())
     by_name = {r["lesson"]: r for r in summary["lessons"]}

@@ -20,7 +20,6 @@ from __future__ import annotations
 import io
 import math
 import os
-import warnings
 from pathlib import Path
 from typing import Any
 
@@ -31,8 +30,8 @@ from hypothesis import strategies as st
 from PIL import Image
 
 from support import REPO_ROOT as REPO
+from support import run_cli
 
-from glsandbox import cli
 from glsandbox.files import load_png
 
 settings.register_profile("ci", max_examples=100, deadline=None, derandomize=True,
@@ -135,27 +134,18 @@ images = st.one_of(
 # --- the contract -----------------------------------------------------------
 
 
-def run_cli(args: list[str], out_dir: Path, capsys) -> tuple[int, str]:
-    before = set(out_dir.iterdir())
-    capsys.readouterr()
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        status = cli.main(args)
-    err = capsys.readouterr().err
-    assert [f"{w.category.__name__}: {w.message}" for w in caught] == []
-    after = set(out_dir.iterdir())
-    if status == 0:
+def check_contract(args: list[str], out_dir: Path, cwd: Path) -> int:
+    """One run in this process (support.run_cli checks exit 2's one line, no warning and no file
+    left in ``out_dir``): exit 0 and a PNG of the asked size, or exit 2."""
+    run = run_cli(*args, cwd=cwd, unchanged=out_dir)
+    if run.returncode == 0:
         out = Path(args[args.index("--out") + 1])
         image = load_png(out)
         assert image.shape == (SIZE[1], SIZE[0], 4)
         out.unlink()
     else:
-        assert status == 2, (status, err)
-        lines = err.strip().splitlines()
-        assert len(lines) == 1 and lines[0].startswith("error: "), err
-        assert "Traceback" not in err
-        assert after == before, f"files left behind: {sorted(p.name for p in after - before)}"
-    return status, err
+        assert run.returncode == 2, run
+    return run.returncode
 
 
 @pytest.fixture
@@ -168,15 +158,15 @@ def workdir(tmp_path: Path, gl) -> Path:  # `gl`: a GL backend, or a skip (fail 
 
 @settings(settings.get_profile(PROFILE))
 @given(text=st.one_of(scenes, hostile_text), image=images)
-def test_generated_scene_files_keep_the_contract(workdir: Path, capsys, text: str, image: bytes) -> None:
+def test_generated_scene_files_keep_the_contract(workdir: Path, text: str, image: bytes) -> None:
     scene = workdir / "scene.toml"
     scene.write_text(text, encoding="utf-8", errors="surrogateescape")
     (workdir / "img.png").write_bytes(image)
     out_dir = workdir / "out"
     out_dir.mkdir(exist_ok=True)
     for renderer in ("raster", "ray_numpy"):
-        run_cli(["render", str(scene), "--size", f"{SIZE[0]}x{SIZE[1]}", "--set", f"renderer={renderer}",
-                 "--out", str(out_dir / "x.png")], out_dir, capsys)
+        check_contract(["render", str(scene), "--size", f"{SIZE[0]}x{SIZE[1]}", "--set", f"renderer={renderer}",
+                        "--out", str(out_dir / "x.png")], out_dir, workdir)
 
 
 SET_LESSONS = ["indexed_cube", "transform_order", "phong", "texture", "mirror", "ray_spheres"]
@@ -188,7 +178,7 @@ set_texts = st.one_of(st.sampled_from(["1e308", "-1e308", "nan", "inf", "-0", "0
 
 @settings(settings.get_profile(PROFILE))
 @given(lesson=st.sampled_from(SET_LESSONS), data=st.data())
-def test_generated_set_values_keep_the_contract(workdir: Path, capsys, lesson: str, data: st.DataObject) -> None:
+def test_generated_set_values_keep_the_contract(workdir: Path, lesson: str, data: st.DataObject) -> None:
     from glsandbox.lesson import find_lesson
 
     names = [p.name for p in find_lesson(lesson).all_params() if p.name != "effects"]
@@ -197,10 +187,6 @@ def test_generated_set_values_keep_the_contract(workdir: Path, capsys, lesson: s
     out_dir = workdir / "out"
     out_dir.mkdir(exist_ok=True)
     settings_args = [a for key, text in chosen for a in ("--set", f"{key}={text}")]
-    cwd = Path.cwd()
-    os.chdir(workdir)  # `image=img.png` is read relative to the working folder
-    try:
-        run_cli(["render", lesson, "--size", f"{SIZE[0]}x{SIZE[1]}", *settings_args, "--out", str(out_dir / "x.png")],
-                out_dir, capsys)
-    finally:
-        os.chdir(cwd)
+    # In the work folder: `image=img.png` is read relative to the working folder.
+    check_contract(["render", lesson, "--size", f"{SIZE[0]}x{SIZE[1]}", *settings_args, "--out", str(out_dir / "x.png")],
+                   out_dir, workdir)

@@ -12,7 +12,7 @@ from glsandbox.errors import SandboxError
 from glsandbox.files import load_png
 from glsandbox.lesson import all_lessons, find_lesson, lesson_files
 from glsandbox.measure.golden import compare_images
-from support import EXAMPLES_DIR, SPIN, LessonWindow, assert_user_error, glsandbox, wait_for
+from support import EXAMPLES_DIR, SPIN, LessonWindow, assert_user_error, run_cli, wait_for
 
 NAMELESS = '''
 from glsandbox import Lesson, Node, Scene, geometry
@@ -53,6 +53,11 @@ def test_a_nameless_lesson_takes_the_file_stem_and_a_helper_module_beside_it_imp
     assert str(tmp_path) not in __import__("sys").path  # the folder was on sys.path only while importing
 
 
+def test_unknown_lesson_suggests_the_closest_name() -> None:
+    with pytest.raises(SandboxError, match="did you mean 'indexed_cube'"):
+        find_lesson("indexed_cub")
+
+
 def test_lesson_picks_one_of_several(tmp_path: Path) -> None:
     path = tmp_path / "two.py"
     path.write_text(NAMELESS + NAMELESS.replace("class Box", "class Other").split("\n", 3)[3] + "\nLESSON = Other\n")
@@ -86,11 +91,11 @@ def test_bad_lesson_files_end_to_end(tmp_path: Path) -> None:
     out = tmp_path / "x.png"
     for command in ("render", "plan", "compare", "run"):
         extra = ["--out", str(out)] if command == "render" else []
-        assert_user_error(glsandbox(command, str(tmp_path / "bad.py"), *extra), "bad.py:3: ZeroDivisionError")
-    assert_user_error(glsandbox("render", str(tmp_path / "notes.txt"), "--out", str(out)),
+        assert_user_error(run_cli(command, str(tmp_path / "bad.py"), *extra), "bad.py:3: ZeroDivisionError")
+    assert_user_error(run_cli("render", str(tmp_path / "notes.txt"), "--out", str(out)),
                       "notes.txt: expected a lesson name, a lesson .py file or a scene .toml file")
-    assert_user_error(glsandbox("render", str(tmp_path), "--out", str(out)), "expected a lesson name")
-    assert_user_error(glsandbox("render", str(tmp_path / "nope.py"), "--out", str(out)), "nope.py not found")
+    assert_user_error(run_cli("render", str(tmp_path), "--out", str(out)), "expected a lesson name")
+    assert_user_error(run_cli("render", str(tmp_path / "nope.py"), "--out", str(out)), "nope.py not found")
     assert not out.exists()
 
 
@@ -98,26 +103,26 @@ def test_render_plan_and_compare_a_lesson_file(tmp_path: Path, gl) -> None:
     path = tmp_path / "spin.py"
     path.write_text(SPIN)
     out = tmp_path / "spin.png"
-    proc = glsandbox("render", str(path), "--out", str(out), "--size", "64x48", "--set", "speed=2")
+    proc = run_cli("render", str(path), "--out", str(out), "--size", "64x48", "--set", "speed=2")
     assert proc.returncode == 0, proc.stderr
     image = load_png(out)
     assert image.shape == (48, 64, 4) and (image[24, 32, :3] > 200).all()  # the white cube in the middle
-    assert "plan for phong" in glsandbox("plan", str(path)).stdout
-    proc = glsandbox("compare", str(path), "--vary", "time=0,1", "--size", "128x48", "--out", str(tmp_path / "c.png"))
+    assert "plan for phong" in run_cli("plan", str(path)).stdout
+    proc = run_cli("compare", str(path), "--vary", "time=0,1", "--size", "128x48", "--out", str(tmp_path / "c.png"))
     assert proc.returncode == 0, proc.stderr
     assert "distinct pictures: 2" in proc.stdout
-    assert_user_error(glsandbox("render", str(path), "--out", str(out), "--set", "sped=2"),
+    assert_user_error(run_cli("render", str(path), "--out", str(out), "--set", "sped=2"),
                       "has no parameter 'sped'", "did you mean 'speed'")
 
 
 def test_new_writes_a_lesson_and_a_scene_that_render_as_they_are(tmp_path: Path, gl) -> None:
-    proc = glsandbox("new", "my_lesson", "--dir", str(tmp_path))
+    proc = run_cli("new", "my_lesson", "--dir", str(tmp_path))
     assert proc.returncode == 0, proc.stderr
     lesson, scene = tmp_path / "my_lesson.py", tmp_path / "my_lesson.toml"
     assert "class MyLesson(Lesson)" in lesson.read_text() and 'name = "my_lesson"' in scene.read_text()
     for source in (lesson, scene):
         out = tmp_path / f"{source.suffix[1:]}.png"
-        proc = glsandbox("render", str(source), "--out", str(out), "--size", "96x72", "--set", "time=1")
+        proc = run_cli("render", str(source), "--out", str(out), "--size", "96x72", "--set", "time=1")
         assert proc.returncode == 0, proc.stderr
         assert not_blank(load_png(out)), source
     # its parameters are real: a slower turn is another picture, each shading another
@@ -132,7 +137,7 @@ def test_new_writes_a_lesson_and_a_scene_that_render_as_they_are(tmp_path: Path,
     rims = []
     for power in ("3", "1"):
         out = tmp_path / f"rim{power}.png"
-        proc = glsandbox("render", str(scene), "--out", str(out), "--size", "96x72", "--set", f"u.rim_power={power}")
+        proc = run_cli("render", str(scene), "--out", str(out), "--size", "96x72", "--set", f"u.rim_power={power}")
         assert proc.returncode == 0, proc.stderr
         rims.append(load_png(out).astype(int))
     changed = np.any(rims[0] != rims[1], axis=-1)
@@ -142,12 +147,12 @@ def test_new_writes_a_lesson_and_a_scene_that_render_as_they_are(tmp_path: Path,
 
 def test_new_refuses_to_overwrite_and_bad_names(tmp_path: Path) -> None:
     (tmp_path / "taken.toml").write_text("# mine\n")
-    assert_user_error(glsandbox("new", "taken", "--dir", str(tmp_path)), "taken.toml already exists", "not overwritten")
+    assert_user_error(run_cli("new", "taken", "--dir", str(tmp_path)), "taken.toml already exists", "not overwritten")
     assert (tmp_path / "taken.toml").read_text() == "# mine\n" and not (tmp_path / "taken.py").exists()
     assert not (tmp_path / "taken.glsl").exists()
     for name in ("9lives", "my-lesson", "_hidden", "a b", "../up"):
-        assert_user_error(glsandbox("new", name, "--dir", str(tmp_path)), "must be a Python identifier")
-    assert_user_error(glsandbox("new", "fine", "--dir", str(tmp_path / "nowhere")), "does not exist")
+        assert_user_error(run_cli("new", name, "--dir", str(tmp_path)), "must be a Python identifier")
+    assert_user_error(run_cli("new", "fine", "--dir", str(tmp_path / "nowhere")), "does not exist")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["taken.toml"]
 
 
@@ -168,7 +173,7 @@ def test_tour_lessons_dir_renders_each_file_and_goes_on_past_a_broken_one(tmp_pa
     (mine / "room.toml").write_text((EXAMPLES_DIR / "mirror_room.toml").read_text())
     (mine / "broken.py").write_text("def oops(:\n")
     out = tmp_path / "tour"
-    proc = glsandbox("tour", "--lessons", str(mine), "--out", str(out), "--size", "64x48")
+    proc = run_cli("tour", "--lessons", str(mine), "--out", str(out), "--size", "64x48")
     assert proc.returncode == 1
     summary = json.loads((out / "tour.json").read_text())
     by_name = {r["lesson"]: r for r in summary["lessons"]}
@@ -177,12 +182,12 @@ def test_tour_lessons_dir_renders_each_file_and_goes_on_past_a_broken_one(tmp_pa
     assert "broken.py:1: syntax error" in by_name["broken"]["error"]
     assert not_blank(load_png(out / "room.png")) and load_png(out / "spin.png").shape == (48, 64, 4)
     assert "[1/3] broken: FAILED" in proc.stderr and "[3/3] spin: ok" in proc.stderr
-    assert_user_error(glsandbox("tour", "--lessons", str(tmp_path / "none"), "--out", str(out)), "not a folder")
+    assert_user_error(run_cli("tour", "--lessons", str(tmp_path / "none"), "--out", str(out)), "not a folder")
 
 
 @pytest.mark.slow
 def test_a_lesson_file_in_a_window_with_the_window_keys(window_env: str, tmp_path: Path, gl) -> None:
-    assert glsandbox("new", "mine", "--dir", str(tmp_path)).returncode == 0
+    assert run_cli("new", "mine", "--dir", str(tmp_path)).returncode == 0
     win = LessonWindow(window_env, tmp_path, "glsandbox.cli", "run", "mine.py", "--size", "320x240",
                        "--set", "speed=0")
     try:

@@ -18,7 +18,7 @@ from glsandbox import geometry, transforms
 from glsandbox.errors import NUMBER_LIMIT, SandboxError
 from glsandbox.scene import Camera, Light, Material, Node, Scene, Texture, Viewport
 from glsandbox.scene_file import load_scene
-from support import EXAMPLES_DIR, assert_user_error, glsandbox
+from support import EXAMPLES_DIR, assert_user_error, run_cli
 
 ROOM = (EXAMPLES_DIR / "mirror_room.toml").read_text()
 
@@ -44,7 +44,7 @@ def test_a_deeply_nested_file_is_one_error_line_through_the_cli(tmp_path: Path) 
     scene = tmp_path / "deep.toml"
     scene.write_text("a = " + "[" * 2000 + "]" * 2000 + "\n")  # 4 KB: tomllib recursed into a RecursionError
     out = tmp_path / "x.png"
-    assert_user_error(glsandbox("render", str(scene), "--out", str(out)), f"{scene}:1: malformed TOML",
+    assert_user_error(run_cli("render", str(scene), "--out", str(out)), f"{scene}:1: malformed TOML",
                       "nested too deeply")
     assert not out.exists()
 
@@ -52,7 +52,7 @@ def test_a_deeply_nested_file_is_one_error_line_through_the_cli(tmp_path: Path) 
 def test_a_number_where_a_table_belongs_names_file_line_and_key_through_the_cli(tmp_path: Path) -> None:
     scene = tmp_path / "nodes.toml"
     scene.write_text('name = "x"\nnodes = [1, 2]\n')  # was a TypeError traceback
-    assert_user_error(glsandbox("render", str(scene), "--out", str(tmp_path / "x.png")),
+    assert_user_error(run_cli("render", str(scene), "--out", str(tmp_path / "x.png")),
                       f"{scene}:2: nodes[0]: expected a table")
 
 
@@ -121,7 +121,7 @@ def test_a_mesh_without_what_its_material_reads_is_named_in_the_file(tmp_path: P
     # The executor refused it while drawing, naming neither the file nor the node.
     assert error_of(tmp_path, '[[nodes]]\nmesh = "quad_list"\ntexture = "checker"\n').startswith(
         "scene.toml:3: nodes[0].texture: node 'node0': mesh 'quad_list' has no uv data, which a texture needs")
-    # A lit mesh without normals is no mistake: both renderers shade it flat (tests/test_flat_normals.py).
+    # A lit mesh without normals is no mistake: both renderers shade it flat (tests/core/test_meshnormals.py).
 
 
 def test_a_flattened_lit_node_names_the_file_and_the_node(tmp_path: Path) -> None:
@@ -142,14 +142,14 @@ def test_a_shadow_light_that_is_none_of_the_lights_is_refused_with_its_line(tmp_
 
 
 def test_a_shadow_light_may_be_a_light_or_a_direction_towards_one(tmp_path: Path) -> None:
-    assert load_scene(write(tmp_path, ROOM)).shadow.light == (-2.0, 5.0, 2.0, 1.0)
+    assert load_scene(write(tmp_path, ROOM)).planar_shadow.light == (-2.0, 5.0, 2.0, 1.0)
     # Left out with exactly one light: that light.
     only = load_scene(write(tmp_path, ROOM.replace("light = [-2, 5, 2, 1] ", "# light")))
-    assert only.shadow.light == (-2.0, 5.0, 2.0, 1.0)
+    assert only.planar_shadow.light == (-2.0, 5.0, 2.0, 1.0)
     # A directional shadow light pointing at a light far away (the mirror lesson's far light).
     far = ROOM.replace("position = [-2, 5, 2]", "position = [-2000, 5000, 2000]").replace(
         "light = [-2, 5, 2, 1]", "light = [-2, 5, 2, 0]")
-    assert load_scene(write(tmp_path, far)).shadow.light[3] == 0.0
+    assert load_scene(write(tmp_path, far)).planar_shadow.light[3] == 0.0
     # Left out with two lights: which one is not guessed.
     two = ROOM.replace("light = [-2, 5, 2, 1] ", "# light").replace(
         "[[lights]]\nposition = [-2, 5, 2]\n", "[[lights]]\nposition = [-2, 5, 2]\n\n[[lights]]\nposition = [1, 1, 1]\n")

@@ -152,14 +152,15 @@ def without_table(text: str, table: str) -> str:
 def test_the_example_room_loads_its_mirror_shadow_and_depth_mode(tmp_path: Path) -> None:
     scene = load_scene(write(tmp_path, ROOM))
     assert scene.depth_mode == "reverse_z"
-    assert scene.mirror is not None and scene.shadow is not None
+    assert scene.mirror is not None and scene.planar_shadow is not None
     assert (scene.mirror.node, scene.mirror.reflected, scene.mirror.stencil) == ("glass", ("box", "floor"), True)
     assert scene.mirror.plane == (0.0, 0.0, 1.0, 4.0)
-    assert (scene.shadow.receiver, scene.shadow.casters, scene.shadow.light) == ("floor", ("box",), (-2, 5, 2, 1))
-    assert (scene.shadow.lift, scene.shadow.polygon_offset, scene.shadow.stencil) == (0.005, True, True)
+    shadow = scene.planar_shadow
+    assert (shadow.receiver, shadow.casters, shadow.light) == ("floor", ("box",), (-2, 5, 2, 1))
+    assert (shadow.lift, shadow.polygon_offset, shadow.stencil) == (0.005, True, True)
     frame_plan = plan(scene)
     assert [p.kind for p in frame_plan.passes] == ["clear", "draw", "mark_mirror", "reflection", "mirror_surface",
-                                                   "shadow"]
+                                                   "planar_shadow"]
     assert frame_plan.buffers.stencil and frame_plan.buffers.float_depth
     # Without the two tables the plan has neither their passes nor the stencil.
     plain = plan(load_scene(write(tmp_path, without_table(without_table(ROOM, "mirror"), "shadow"))))

@@ -1,20 +1,22 @@
 """Frames are opaque (issue 12): every pixel's alpha is 255, as the window shows it.
 
-The rule is :data:`glsandbox.gl.target.FRAME_COLOR_MASK`: a target's alpha is
-made 1 once and never written, so the mirror's blended glass and shadow, an
+The rule is :data:`glsandbox.gl.target.FRAME_COLOR_MASK`: every clear writes a
+target's alpha as 1 (:func:`glsandbox.gl.target.clear_opaque`) and no draw writes it, so the mirror's blended glass and shadow, an
 unblended translucent node and a translucent clear colour all leave it 1.
 Checked on every lesson (raster and ray-traced), with MSAA, on a scene made
-to write alpha, and on the PNG ``glsandbox render`` writes.
+to write alpha, and on the PNG ``glsandbox render`` writes. Every lesson's
+default frame and its ``effects=all`` frame are checked where they are rendered
+already (tests/measure/test_tradeoffs_bench.py, ``effects=all``); here, each
+lesson with its other renderer, and the mirror's other settings.
 """
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from support import run_cli
 
 from glsandbox import geometry
 from glsandbox.files import load_png
@@ -22,13 +24,13 @@ from glsandbox.lesson import all_lessons, find_lesson
 from glsandbox.scene import Material, Node, Scene, Viewport
 
 SIZE = (96, 72)
-#: Settings every lesson is rendered at, then the mirror's own: its default
-#: (stencil glass and shadow) is the first case.
-EVERY_LESSON = ([], ["time=0.7", "effects=all"], ["renderer=ray"], ["renderer=raster"])
-MIRROR = ([], ["mirror=off"], ["mirror=no_stencil", "shadow=double_blend"],
+#: Each lesson with the renderer it does not use by default (its default frame is checked
+#: with effects=all), then the mirror's own settings.
+OTHER_RENDERER = {"ray": "raster", "raster": "ray"}
+MIRROR = (["mirror=off"], ["mirror=no_stencil", "shadow=double_blend"],
           ["depth=standard", "offset=off", "light=directional", "lx=-0.5", "ly=1", "lz=0.4"])
-CASES = [(cls.name, settings) for cls in all_lessons() for settings in EVERY_LESSON]
-CASES += [("mirror", settings) for settings in MIRROR[1:]]
+CASES = [(cls.name, [f"renderer={OTHER_RENDERER[cls().values['renderer']]}"]) for cls in all_lessons()]
+CASES += [("mirror", settings) for settings in MIRROR]
 
 
 def assert_opaque(image: np.ndarray, what: str) -> None:
@@ -62,8 +64,7 @@ def test_translucent_clear_colours_and_unblended_translucent_draws_leave_alpha_a
 
 def test_render_writes_an_opaque_png_of_the_mirror(gl, tmp_path: Path) -> None:
     out = tmp_path / "mirror.png"
-    proc = subprocess.run([sys.executable, "-m", "glsandbox.cli", "render", "mirror", "--size", "160x120",
-                           "--out", str(out)], capture_output=True, text=True, timeout=180)
+    proc = run_cli("render", "mirror", "--size", "160x120", "--out", str(out))
     assert proc.returncode == 0, proc.stderr
     png = load_png(out)
     assert_opaque(png, "glsandbox render mirror")

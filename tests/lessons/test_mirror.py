@@ -122,13 +122,13 @@ def test_light_parallel_to_the_plane_or_in_it_is_refused():
 
 
 def test_light_below_the_plane_culls_the_shadow_pass():
-    step = [p for p in plan(MirrorLesson(ly=-1.0).scene()).passes if p.kind == "shadow"][0]
+    step = [p for p in plan(MirrorLesson(ly=-1.0).scene()).passes if p.kind == "planar_shadow"][0]
     assert step.draws == () and "light is below the receiver plane" in step.describe()
 
 
 def test_caster_above_a_point_light_is_culled():
     # The cube's top is at 0.6 + 0.6 = 1.2; a light at 1.0 has vertices above it.
-    step = [p for p in plan(MirrorLesson(ly=1.0).scene()).passes if p.kind == "shadow"][0]
+    step = [p for p in plan(MirrorLesson(ly=1.0).scene()).passes if p.kind == "planar_shadow"][0]
     assert step.draws == () and "cube culled" in step.describe()
     shadow = PlanarShadow("floor", (0, 1, 0, 0), (0, 2, 0, 1), ("box",))
     box = (np.eye(4), np.array([[0, 1.9, 0], [0, 2.0, 0], [1, 0.5, 0]]))
@@ -159,7 +159,7 @@ phong[NUM_LIGHTS=1]; wall_back_high with phong[NUM_LIGHTS=1]; cube with phong[NU
   4. reflection viewport 0 (depth test, stencil equal 1, keep, front faces clockwise, lights reflected): \
 floor with phong[NUM_LIGHTS=1]; wall_left with phong[NUM_LIGHTS=1]; cube with phong[NUM_LIGHTS=1]; light with basic[SOLID_COLOR]
   5. mirror surface viewport 0 (depth test, blended): glass with basic[SOLID_COLOR]
-  6. shadow viewport 0 (depth test, stencil equal 0 on bit 2, set it, lift 0.005, polygon offset, blended, \
+  6. planar shadow viewport 0 (depth test, stencil equal 0 on bit 2, set it, lift 0.005, polygon offset, blended, \
 no depth writes): cube with basic[SOLID_COLOR] (no culling)"""
 
 
@@ -171,9 +171,9 @@ def test_mirror_plan_is_pinned():
     ("off", "off", ["clear", "draw"], False),
     ("stencil", "off", ["clear", "draw", "mark_mirror", "reflection", "mirror_surface"], True),
     ("no_stencil", "off", ["clear", "draw", "reflection", "mirror_surface"], False),
-    ("off", "on", ["clear", "draw", "shadow"], True),
-    ("off", "double_blend", ["clear", "draw", "shadow"], False),
-    ("no_stencil", "double_blend", ["clear", "draw", "reflection", "mirror_surface", "shadow"], False),
+    ("off", "on", ["clear", "draw", "planar_shadow"], True),
+    ("off", "double_blend", ["clear", "draw", "planar_shadow"], False),
+    ("no_stencil", "double_blend", ["clear", "draw", "reflection", "mirror_surface", "planar_shadow"], False),
 ])
 def test_effect_passes_and_stencil_exist_only_when_asked_for(mirror, shadow, kinds, stencil):
     p = plan(MirrorLesson(mirror=mirror, shadow=shadow).scene())
@@ -198,10 +198,10 @@ def test_planar_passes_carry_their_stencil_state_as_structure():
     stencils = {s.kind: s.stencil for s in plan(MirrorLesson().scene()).passes}
     assert stencils["mark_mirror"] == StencilState("always", 1, 0xFF, write_mask=1, on_pass="replace")
     assert stencils["reflection"] == StencilState("equal", 1, 1, write_mask=0, on_pass="keep")
-    assert stencils["shadow"] == StencilState("equal", 0, 2, write_mask=2, on_pass="invert")
+    assert stencils["planar_shadow"] == StencilState("equal", 0, 2, write_mask=2, on_pass="invert")
     assert stencils["mirror_surface"] is None and stencils["draw"] is None
     leaky = {s.kind: s.stencil for s in plan(MirrorLesson(mirror="no_stencil", shadow="double_blend").scene()).passes}
-    assert leaky["reflection"] is None and leaky["shadow"] is None
+    assert leaky["reflection"] is None and leaky["planar_shadow"] is None
     with pytest.raises(SandboxError, match="stencil test 'less'"):
         StencilState("less", 0)
 

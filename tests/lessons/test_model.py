@@ -17,7 +17,7 @@ from glsandbox.errors import SandboxError
 from glsandbox.files import load_png
 from glsandbox.lesson import scene_file_lesson
 from glsandbox.scene_file import load_scene
-from support import CUBE_OBJ, assert_user_error, glsandbox, textured_quad_glb
+from support import CUBE_OBJ, assert_user_error, run_cli, textured_quad_glb
 from support import REPO_ROOT as REPO
 
 LIT = """\
@@ -146,14 +146,14 @@ def test_a_fifo_is_refused_without_opening_it(tmp_path: Path) -> None:
     os.mkfifo(models(tmp_path) / "pipe.obj")  # nobody writes: opening it for reading would block forever
     scene = scene_with(tmp_path, "models/pipe.obj")
     out = tmp_path / "x.png"
-    proc = glsandbox("render", str(scene), "--out", str(out), "--size", "32x32")  # the helper's timeout applies
+    proc = run_cli("render", str(scene), "--out", str(out), "--size", "32x32")
     assert_user_error(proc, f"{scene}:9: nodes[0].mesh: model file {tmp_path / 'models' / 'pipe.obj'} is a named pipe (FIFO)")
     assert not out.exists()
 
 
 def test_plan_shows_the_dropped_faces_of_a_node(tmp_path: Path) -> None:
     (models(tmp_path) / "cube.obj").write_text(CUBE_OBJ + "v 0 9 0\nv 1 9 0\nv 2 9 0\nf 9 10 11\nf 1 2 2\n")
-    proc = glsandbox("plan", str(scene_with(tmp_path, "models/cube.obj")))
+    proc = run_cli("plan", str(scene_with(tmp_path, "models/cube.obj")))
     assert proc.returncode == 0, proc.stderr
     assert "meshes:\n  model: cube.obj: 12 triangles (OBJ), 2 degenerate faces dropped (zero area or a repeated " \
            "vertex), normals crease 30°" in proc.stdout
@@ -184,12 +184,12 @@ def test_a_model_scene_renders_and_compares_raster_with_ray(tmp_path: Path, gl) 
     trimesh.creation.icosphere(subdivisions=2).export(models(tmp_path) / "ball.stl")
     scene = scene_with(tmp_path, "models/ball.stl", extra="fit = true\ncolor = [0.9, 0.5, 0.2]\n")
     out = tmp_path / "ball.png"
-    proc = glsandbox("render", str(scene), "--out", str(out), "--size", "96x96")
+    proc = run_cli("render", str(scene), "--out", str(out), "--size", "96x96")
     assert proc.returncode == 0, proc.stderr
     image = load_png(out)
     assert image[48, 48, 0] > 60 and image[2, 2, 0] < 20  # the lit ball in the middle, the course's blue around
     both = tmp_path / "both.png"
-    proc = glsandbox("compare", str(scene), "--vary", "renderer=raster,ray", "--out", str(both), "--size", "192x96")
+    proc = run_cli("compare", str(scene), "--vary", "renderer=raster,ray", "--out", str(both), "--size", "192x96")
     assert proc.returncode == 0, proc.stderr
     assert load_png(both).shape == (96, 192, 4) and (tmp_path / "both-diff.png").exists()
     # The two renderers draw the same lit ball: few pixels differ (the silhouette's edge, shading in float32).
@@ -216,11 +216,11 @@ def test_the_model_lesson_shows_both_renderers_side_by_side(gl) -> None:
 def test_the_model_lesson_loads_a_file_and_refuses_a_missing_one(tmp_path: Path) -> None:
     (tmp_path / "cube.obj").write_text(CUBE_OBJ)
     out = tmp_path / "cube.png"
-    proc = glsandbox("render", "model", "--set", f"mesh={tmp_path / 'cube.obj'}", "--set", "fit=off",
-                     "--set", "view=raster", "--out", str(out), "--size", "64x48")
+    proc = run_cli("render", "model", "--set", f"mesh={tmp_path / 'cube.obj'}", "--set", "fit=off",
+                   "--set", "view=raster", "--out", str(out), "--size", "64x48")
     assert proc.returncode == 0, proc.stderr
     assert load_png(out).shape == (48, 64, 4)
-    proc = glsandbox("render", "model", "--set", f"mesh={tmp_path / 'nope.obj'}", "--out", str(out))
+    proc = run_cli("render", "model", "--set", f"mesh={tmp_path / 'nope.obj'}", "--out", str(out))
     assert_user_error(proc, f"--set mesh={tmp_path / 'nope.obj'}: model file {tmp_path / 'nope.obj'} not found")
 
 
@@ -253,11 +253,12 @@ def test_model_lesson_plan_is_pinned() -> None:
         "programs:",
         "  overlay",
         "  phong[NUM_LIGHTS=2]",
-        "passes:",
-        "  1. clear viewport 0: colour (0.12, 0.14, 0.2, 1) + depth",
-        f"  2. draw viewport 0 (depth test): {draw}",
-        "  3. clear viewport 1: colour (0.12, 0.14, 0.2, 1) + depth",
-        f"  4. draw viewport 1 (depth test): {draw}",
+        "passes:",  # viewport 1 is ray-traced (issue 22: the plan says so, and draws nothing there)
+        "  1. trace viewport 1 (GLSL ray tracer, float32, 1 primary ray per pixel, shadow rays to 2 lights, "
+        "shown as overlay raytrace/1): floor (phong); model (phong)",
+        "  2. clear viewport 0: colour (0.12, 0.14, 0.2, 1) + depth",
+        f"  3. draw viewport 0 (depth test): {draw}",
+        "  4. clear viewport 1: colour (0.12, 0.14, 0.2, 1) + depth",
         "  5. overlay viewport 0 (blended, no depth test): label0",
-        "  6. overlay viewport 1 (blended, no depth test): label1",
+        "  6. overlay viewport 1 (blended, no depth test): raytrace/1, label1",
     ])

@@ -10,13 +10,12 @@ log2(4k).
 from __future__ import annotations
 
 import math
-import subprocess
-import sys
 from dataclasses import replace
 
 import numpy as np
 import pytest
 from PIL import Image
+from support import assert_user_error, run_cli
 
 from glsandbox import geometry, transforms
 from glsandbox.errors import SandboxError
@@ -301,15 +300,11 @@ def test_bad_texture_files_raise_one_line_naming_the_file(gl, tmp_path, case):
 
 
 def test_cli_bad_texture_file_exits_2_and_writes_nothing(tmp_path):
-    # A subprocess: the CLI opens and releases its own context.
     out = tmp_path / "out.png"
     missing = tmp_path / "nope.png"
-    proc = subprocess.run([sys.executable, "-m", "glsandbox.cli", "render", "texture", "--set", f"image={missing}",
-                           "--size", "32x32", "--out", str(out)], capture_output=True, text=True, timeout=120)
-    assert proc.returncode == 2
-    err = proc.stderr.strip()
-    assert err.startswith("error: ") and "\n" not in err and str(missing) in err and "not found" in err
-    assert not out.exists()  # nothing half-written
+    proc = run_cli("render", "texture", "--set", f"image={missing}", "--size", "32x32", "--out", str(out),
+                   unchanged=tmp_path)  # nothing half-written
+    assert_user_error(proc, str(missing), "not found")
 
 
 def test_unknown_sampler_and_wrap_names():
@@ -322,7 +317,5 @@ def test_unknown_sampler_and_wrap_names():
 
 
 def test_cli_unknown_filter_is_a_one_line_error(tmp_path):
-    proc = subprocess.run([sys.executable, "-m", "glsandbox.cli", "render", "texture", "--set", "filter=bilinear",
-                           "--out", str(tmp_path / "x.png")], capture_output=True, text=True, timeout=120)
-    assert proc.returncode == 2
-    assert proc.stderr.strip().count("\n") == 0 and "bilinear" in proc.stderr
+    proc = run_cli("render", "texture", "--set", "filter=bilinear", "--out", str(tmp_path / "x.png"))
+    assert_user_error(proc, "bilinear")

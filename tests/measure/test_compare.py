@@ -2,14 +2,11 @@
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
-from support import REPO_ROOT as REPO
-from support import need
+from support import run_cli
 
 from glsandbox.cli import main
 from glsandbox.errors import SandboxError
@@ -62,17 +59,7 @@ def test_six_orders_compare_into_four_classes(gl) -> None:
     assert result.image.shape == (256, 384, 4)
 
 
-def run_cli(*args: str) -> subprocess.CompletedProcess:
-    """The command in its own process: it opens its own GL context, which must not
-    replace the test session's current one."""
-    proc = subprocess.run([sys.executable, "-m", "glsandbox.cli", *args], capture_output=True, text=True,
-                          cwd=REPO, timeout=120)
-    if proc.returncode != 0 and "no OpenGL available" in proc.stderr:
-        need("headless OpenGL", proc.stderr.strip())
-    return proc
-
-
-def test_cli_writes_the_labelled_image_and_the_table(tmp_path: Path) -> None:
+def test_cli_writes_the_labelled_image_and_the_table(tmp_path: Path, gl) -> None:  # gl: a backend, or a skip
     out = tmp_path / "orders.png"
     proc = run_cli("compare", "transform_order", "--vary", ORDERS, "--set", "time=0", "--set", "overlay=off",
                    "--size", "384x256", "--out", str(out))
@@ -87,7 +74,7 @@ def test_cli_writes_the_labelled_image_and_the_table(tmp_path: Path) -> None:
     assert np.any((corner[..., 0] > 200) & (corner[..., 1] > 180) & (corner[..., 2] < 120))
 
 
-def test_cli_works_for_other_lessons_and_a_grid(tmp_path: Path) -> None:
+def test_cli_works_for_other_lessons_and_a_grid(tmp_path: Path, gl) -> None:
     out = tmp_path / "grid.png"
     proc = run_cli("compare", "triangle", "--vary", "topology=strip,list", "--vary", "cull=on,off",
                    "--size", "128x128", "--out", str(out))

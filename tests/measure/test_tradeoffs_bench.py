@@ -1,7 +1,8 @@
 """``glsandbox tradeoffs``, ``glsandbox bench`` and ``--set effects=all``.
 
-The two commands run in subprocesses (a second GL context must not be opened
-in the test process); their content is checked, never their timings.
+The two commands' measuring runs are in subprocesses (a second GL context must not be
+opened in the test process); their content is checked, never their timings. Their
+refusals, made before any context opens, run in this process.
 """
 
 from __future__ import annotations
@@ -15,6 +16,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from support import REPO_ROOT as REPO
+from support import run_cli
 
 from glsandbox.frame import LazyRenderer
 from glsandbox.lesson import all_lessons
@@ -22,7 +25,6 @@ from glsandbox.measure.render_context import downsample
 from glsandbox.measure.tradeoffs_report import CSV_COLUMNS
 from glsandbox.plan import plan
 
-REPO = Path(__file__).resolve().parents[2]
 
 
 def _run(*args: str, timeout: int = 240) -> subprocess.CompletedProcess:
@@ -74,13 +76,15 @@ def test_effects_all_renders_the_same_picture(gl, cls) -> None:
         forced_frame = gl.render(cls(time=time, effects="all"), (96, 72))
         assert forced_frame.plan.buffers.stencil
         assert np.array_equal(needed, forced_frame.image), f"{cls.name} at time {time}"
+        # Opaque (tests/gl/test_target.py): alpha 255 everywhere, as the window shows the frame.
+        assert (needed[..., 3] == 255).all(), f"{cls.name} at time {time}: alpha below 255"
 
 
 def test_effects_is_a_parameter_of_every_lesson() -> None:
-    proc = _run("plan", "indexed_cube", "--set", "effects=all")
+    proc = run_cli("plan", "indexed_cube", "--set", "effects=all")
     assert proc.returncode == 0, proc.stderr
     assert "stencil 8" in proc.stdout
-    proc = _run("plan", "indexed_cube", "--set", "effects=some")
+    proc = run_cli("plan", "indexed_cube", "--set", "effects=some")
     assert proc.returncode == 2 and proc.stderr.startswith("error: --set effects=some: expected one of needed, all")
 
 
@@ -129,7 +133,8 @@ def test_tradeoffs_report_has_a_table_per_knob(quick_report: Path) -> None:
     assert "## Ray tracer engine (`ray_engine`)" in report
     rows = _rows(quick_report)
     knobs = {row["knob"] for row in rows}
-    assert knobs == {"antialiasing", "lighting", "ray_engine", "texture_filter", "depth", "shadows_mirror"}
+    assert knobs == {"antialiasing", "lighting", "ray_engine", "texture_filter", "depth", "shadows_mirror",
+                     "shadow_map"}
     for knob in knobs:  # one reference per knob, at zero error
         refs = [r for r in rows if r["knob"] == knob and r["reference"] == "1"]
         assert len(refs) == 1 and float(refs[0]["rmse"]) == 0.0 and refs[0]["psnr_db"] == "inf"
@@ -158,7 +163,7 @@ def test_tradeoffs_errors_fall_where_they_must(quick_report: Path) -> None:
 
 @pytest.mark.slow
 def test_depth_knob_counts_z_fighting_pixels(quick_report: Path) -> None:
-    # Seen from 90 units (tests/test_mirror.py pins it): a 24-bit buffer with no polygon offset
+    # Seen from 90 units (tests/lessons/test_mirror.py pins it): a 24-bit buffer with no polygon offset
     # fights with or without the course's lift, and so does reverse-Z without any lift; each
     # remedy alone (nearer plane, reverse-Z with the lift, polygon offset) has no fighting pixel.
     rows = {r["setting"]: r for r in _rows(quick_report) if r["knob"] == "depth"}
@@ -175,8 +180,8 @@ def test_depth_knob_counts_z_fighting_pixels(quick_report: Path) -> None:
     for label in ("standard 24-bit, lift 0.005, near 0.1", "standard 24-bit, lift 0.005, polygon offset",
                   "reverse-Z float, lift 0.005, no offset"):
         assert rows[label]["count_px"] == "0", label
-    others = [r for r in _rows(quick_report) if r["knob"] != "depth"]
-    assert all(r["count_px"] == "" for r in others)  # only the depth knob counts pixels
+    others = [r for r in _rows(quick_report) if r["knob"] not in ("depth", "shadow_map")]
+    assert all(r["count_px"] == "" for r in others)  # only the depth and shadow-map knobs count pixels
     report = (quick_report / "report.md").read_text(encoding="utf-8")
     assert "## Depth precision (`depth`)" in report
     fights = int(rows["standard 24-bit, lift 0, no offset"]["count_px"])
@@ -241,7 +246,7 @@ def test_the_measure_extra_is_imported_only_by_tradeoffs_at_work() -> None:
 
 
 def test_tradeoffs_bad_runs_is_one_line() -> None:
-    proc = _run("tradeoffs", "--quick", "--runs", "3", "--out", "/nonexistent/x")
+    proc = run_cli("tradeoffs", "--quick", "--runs", "3", "--out", "/nonexistent/x")
     assert proc.returncode == 2 and proc.stderr.strip() == "error: --runs 3: the timing needs at least 5 runs"
 
 
@@ -268,7 +273,7 @@ def test_bench_prints_one_table_and_writes_json(tmp_path: Path) -> None:
 
 
 def test_bench_unknown_case_is_one_line() -> None:
-    proc = _run("bench", "--quick", "--only", "no_such_benchmark")
+    proc = run_cli("bench", "--quick", "--only", "no_such_benchmark")
     assert proc.returncode == 2
     assert proc.stderr.strip().splitlines() == [
         "error: --only no_such_benchmark: no benchmark case matched (see glsandbox bench)"]  # no progress first
@@ -276,7 +281,7 @@ def test_bench_unknown_case_is_one_line() -> None:
 
 # --- the raw-ModernGL baselines (benchmarks/lesson_frames.py) --------------------------------
 
-RAW_BASELINE_LESSONS = ("clear_and_swap", "triangle", "phong", "texture", "transform_order", "mirror")
+RAW_BASELINE_LESSONS = ("clear_and_swap", "triangle", "phong", "texture", "transform_order", "mirror", "shadow_map")
 
 
 def test_every_raw_baseline_is_checked_here() -> None:
@@ -296,8 +301,9 @@ def test_raw_baseline_draws_the_lessons_picture(gl, name: str) -> None:
         return {key: value for key, value in gl.host.raw.state_snapshot().items() if key != "depth_writemask"}
 
     size = (160, 120)
-    raw = _benchmark_module("lesson_frames.py").RAW_BASELINES[name](gl.host.ctx, size)
-    lesson = find_lesson(name)()
+    module = _benchmark_module("lesson_frames.py")
+    raw = module.RAW_BASELINES[name](gl.host.ctx, size)
+    lesson = find_lesson(name)(**module.RAW_SETTINGS.get(name, {}))
     for k in (0, 37, 150):
         expected = gl.render(lesson.at(0.01 * k), size).image.copy()
         before = state()

@@ -17,7 +17,7 @@ from glsandbox.raytrace.render import render
 from glsandbox.raytrace.world import build_world
 from glsandbox.scene import Camera, Material, Node, Scene, Texture
 from support import REPO_ROOT as REPO
-from support import glsandbox
+from support import run_cli
 
 FLAT = """\
 [camera]
@@ -51,7 +51,7 @@ def test_flattened_spheres_trace_their_triangles_on_both_engines(tmp_path: Path,
     images = {}
     for renderer in ("raster", "ray", "ray_numpy"):  # the ray engines raised numpy's LinAlgError
         out = tmp_path / f"{renderer}.png"
-        proc = glsandbox("render", str(scene), "--size", "96x64", "--set", f"renderer={renderer}", "--out", str(out))
+        proc = run_cli("render", str(scene), "--size", "96x64", "--set", f"renderer={renderer}", "--out", str(out))
         assert proc.returncode == 0 and proc.stderr == "", proc.stderr
         images[renderer] = load_png(out)[..., :3].astype(int)
     background = images["raster"][0, 0]

@@ -1,7 +1,13 @@
 """The BVH top level over a World's mesh nodes: the same nearest hit as testing every
-triangle, and, on lesson scenes, the node the numpy engine's own loop finds."""
+triangle, and, on lesson scenes, the node the numpy engine's own loop finds.
+
+``WorldBVH.closest_hit`` is public, but renders trace through the numpy engine's own loop
+(tests/raytrace/test_numpy_engine_bvh.py), so these checks use a small grid of rays: the
+brute force they compare with tests every ray against every triangle."""
 
 from __future__ import annotations
+
+import functools
 
 import numpy as np
 import pytest
@@ -13,12 +19,16 @@ from glsandbox.raytrace.numpy_engine import _nearest
 from glsandbox.raytrace.world import World, build_world, camera_rays
 
 LESSONS = ("phong", "ray_phong", "ray_acceleration")
+#: The camera's rays, as a grid of this size: 768 rays over the whole view (the brute force tests each
+#: against every triangle: 6,662 of them in ray_phong).
+RAYS = (32, 24)
 
 
+@functools.cache
 def world_of(lesson: str) -> tuple[World, np.ndarray, np.ndarray]:
     scene = find_lesson(lesson)().scene()
     world = build_world(scene, 0, analytic_spheres=False)  # every node a mesh
-    eye, dirs = camera_rays(scene.viewports[0].camera or scene.camera, 96, 72)
+    eye, dirs = camera_rays(scene.viewports[0].camera or scene.camera, *RAYS)
     return world, eye, dirs
 
 

@@ -75,15 +75,9 @@ def test_the_model_lesson_shows_the_bvh_figures() -> None:
     assert line.startswith("BVH: ") and " nodes, " in line and " ms" in line and "not built" not in line
 
 
-def test_the_numpy_engine_finds_a_triangle_past_65535() -> None:
-    image = render(far_triangle_scene(), (32, 24))
-    assert tuple(image[12, 16, :3]) == (230, 51, 51)  # the last triangle, its solid colour
-    assert tuple(image[0, 0, :3]) == (0, 0, 0)
-
-
 def test_the_gpu_engine_refuses_where_its_bvh_budget_is_too_small(gl, monkeypatch) -> None:
     """This test used to expect the gpu engine to refuse the 70,000-triangle node outright;
-    the engine now traces it through a BVH (tests/raytrace/test_gpu_engine_bvh.py checks it
+    the engine now traces it through a BVH (tests/raytrace/test_render.py checks it
     appears). What is left of the refusal: when the loop budget leaves a ray too few
     traversal steps, one line naming the cause and the numpy engine."""
     from glsandbox.raytrace import RayTraceError

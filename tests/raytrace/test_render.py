@@ -12,6 +12,7 @@ import math
 
 import numpy as np
 import pytest
+from support import far_triangle_scene
 
 from glsandbox import geometry, transforms
 from glsandbox.errors import SandboxError
@@ -44,6 +45,15 @@ def mirror_scene() -> Scene:
     ball = sphere_node("ball", (0, 0, 0), 1.0, lit((1.0, 0.2, 0.1)))
     return Scene("mirror", nodes=(ground, ball), camera=Camera(eye=(0, 2, 6)),
                  lights=(Light((2.0, 5.0, 2.0)),), clear_color=(0.2, 0.3, 0.6, 1.0))
+
+
+def test_each_engine_finds_a_triangle_past_65535(engine):
+    """One node of 70,000 triangles whose only visible one is the last (index 69,999): past
+    llvmpipe's 65,535 loop iterations, which the gpu engine passes through the node's BVH."""
+    image = engine.render(far_triangle_scene(), (32, 24))
+    assert tuple(image[12, 16, :3]) == (230, 51, 51)  # the last triangle, its solid colour
+    assert tuple(image[0, 0, :3]) == (0, 0, 0)
+    assert (image[..., 3] == 255).all()
 
 
 def test_course_image_plane_gd_mapping():

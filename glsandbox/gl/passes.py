@@ -1,0 +1,58 @@
+"""What every pass runner shares: the frame it draws in, its signature, and the
+GL state every pass starts from.
+
+The runners themselves are registered in one place,
+:data:`glsandbox.gl.executor.PASS_RUNNERS` (their describers in
+:data:`glsandbox.plan.PASS_DESCRIBERS`). OpenGL keeps its state as loose
+global switches, so after every pass the executor calls
+:func:`restore_state`, whatever the pass did or raised: a pass sets what it
+needs and never has to undo it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import moderngl
+
+from glsandbox.gl import rawgl
+from glsandbox.gl.target import FRAME_COLOR_MASK
+from glsandbox.plan import Pass
+from glsandbox.scene import Node, Scene
+
+
+@dataclass(frozen=True)
+class FrameState:
+    """The frame being drawn: its scene, its nodes by name, and its target."""
+
+    scene: Scene
+    nodes: dict[str, Node]
+    framebuffer: moderngl.Framebuffer
+    size: tuple[int, int]
+
+
+class PassRunner(Protocol):
+    """``runner(executor, frame, step, camera)``: run one pass. ``camera`` is the
+    executor's pass camera for a pass drawn into the frame through a viewport
+    (its viewport and depth test already set), None for any other."""
+
+    def __call__(self, executor: Any, frame: FrameState, step: Pass, camera: Any) -> None: ...
+
+
+def restore_state(ctx: moderngl.Context, raw: rawgl.RawGL) -> None:
+    """The state every pass assumes: no stencil test, stencil and depth
+    writes on, colour writes on but alpha (the frame's rule,
+    :data:`~glsandbox.gl.target.FRAME_COLOR_MASK`: frames stay opaque), no
+    blending, no polygon offset, no culling, counter-clockwise front faces."""
+    raw.glDisable(rawgl.GL_STENCIL_TEST)
+    raw.glStencilMask(0xFF)
+    raw.glStencilFunc(rawgl.GL_ALWAYS, 0, 0xFF)
+    raw.glStencilOp(rawgl.GL_KEEP, rawgl.GL_KEEP, rawgl.GL_KEEP)
+    raw.glColorMask(*FRAME_COLOR_MASK)
+    raw.glDepthMask(1)
+    ctx.disable(moderngl.BLEND)
+    ctx.blend_func = moderngl.DEFAULT_BLENDING
+    ctx.polygon_offset = (0.0, 0.0)
+    ctx.disable(moderngl.CULL_FACE)
+    ctx.front_face = "ccw"

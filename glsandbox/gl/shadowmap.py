@@ -1,0 +1,98 @@
+"""Shadow maps on the GPU: the depth textures, the pass that fills one, and
+what a receiver's draw binds (the maths: :mod:`glsandbox.shadowmap`).
+
+A map is a ``DEPTH_COMPONENT24`` texture attached alone to a framebuffer (no
+colour: the pass writes depth only). It is sampled with a comparison sampler
+(``compare_func='<='``: GLSL's ``sampler2DShadow``), which returns 1 where
+the receiver's depth is at most the stored depth (lit) and 0 where a caster
+is nearer (shadowed); nearest filtering, so that each comparison is one
+texel and the percentage-closer filter's grid is the phong shader's own.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Collection
+from typing import Any
+
+import moderngl
+import numpy as np
+
+from glsandbox import transforms
+from glsandbox.gl import depth as gl_depth
+from glsandbox.gl.passes import FrameState
+from glsandbox.plan import Pass
+from glsandbox.scene import ShadowMap
+from glsandbox.shadowmap import light_camera
+
+
+class ShadowMaps:
+    """The depth textures of the lights' shadow maps, kept between frames by
+    (light, size), with the light matrix and settings of the frame's last pass."""
+
+    def __init__(self, ctx: moderngl.Context) -> None:
+        self.ctx = ctx
+        self._maps: dict[tuple[int, int], tuple[moderngl.Texture, moderngl.Framebuffer]] = {}
+        #: light -> (its map's texture, light projection @ view as uniform bytes, its ShadowMap)
+        self._current: dict[int, tuple[moderngl.Texture, bytes, ShadowMap]] = {}
+
+    def target(self, light: int, size: int) -> tuple[moderngl.Texture, moderngl.Framebuffer]:
+        key = (light, size)
+        if key not in self._maps:
+            texture = self.ctx.depth_texture((size, size))
+            texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            texture.repeat_x = texture.repeat_y = False
+            texture.compare_func = "<="
+            self._maps[key] = (texture, self.ctx.framebuffer(depth_attachment=texture))
+        return self._maps[key]
+
+    def drawn(self, light: int, texture: moderngl.Texture, matrix: np.ndarray, settings: ShadowMap) -> None:
+        self._current[light] = (texture, transforms.gl_bytes(matrix), settings)
+
+    def bind(self, light: int, unit: int, program: moderngl.Program, members: Collection[str]) -> None:
+        """Light ``light``'s map on texture unit ``unit``, and the receiver's uniforms."""
+        texture, matrix, settings = self._current[light]
+        texture.use(unit)
+        values = {"u_shadow_map": unit, "u_shadow_bias": settings.bias, "u_shadow_slope_bias": settings.slope_bias,
+                  "u_shadow_texel": 1.0 / settings.size}
+        for name, value in values.items():
+            if name in members:
+                program[name].value = value
+        if "u_shadow_matrix" in members:
+            program["u_shadow_matrix"].write(matrix)
+
+    def release(self) -> None:
+        for texture, framebuffer in self._maps.values():
+            framebuffer.release()
+            texture.release()
+        self._maps.clear()
+        self._current.clear()
+
+
+def run_shadow_map_pass(executor: Any, frame: FrameState, step: Pass, camera: Any) -> None:
+    """Fill light N's map (``step.camera == "light N"``): clear its depth to 1,
+    draw the casters' depth from the light, then give the frame back its target.
+
+    The map always uses OpenGL's standard depth (clip -1..1, test LESS), also
+    in a reverse-Z frame: its depth is compared only with depths made by the
+    same light matrix in the phong shader.
+    """
+    assert step.camera is not None and step.camera.startswith("light ")
+    scene, ctx = frame.scene, executor.ctx
+    light_index = int(step.camera.split()[1])
+    light = scene.lights[light_index]
+    assert light.shadow is not None
+    texture, framebuffer = executor.shadow_maps.target(light_index, light.shadow.size)
+    view, proj = light_camera(scene, light)
+    gl_depth.end_depth_mode(ctx, executor.raw, scene)
+    try:
+        framebuffer.use()
+        framebuffer.viewport = (0, 0, light.shadow.size, light.shadow.size)
+        framebuffer.clear(depth=1.0)
+        ctx.enable(moderngl.DEPTH_TEST)
+        pass_camera = executor.pass_camera(view, proj)
+        for draw in step.draws:
+            executor.draw_node(frame.nodes[draw.node], draw, pass_camera)
+    finally:
+        gl_depth.begin_depth_mode(ctx, executor.raw, scene)
+        frame.framebuffer.use()
+    executor.shadow_maps.drawn(light_index, texture, proj @ view, light.shadow)

@@ -1,0 +1,103 @@
+"""Shadow maps: which lights need one, and the camera each is drawn from.
+
+A shadow map is a depth picture of the scene taken from a light: a texel
+holds how far the nearest caster is along that texel's ray. A lit receiver
+point p is in shadow when something nearer than p lies on its ray to the
+light: project p with the light's camera and compare its depth with the
+texel's (OpenGL's comparison sampler does the compare, and percentage-closer
+filtering averages several). Unlike the planar shadow (``XMMatrixShadow``,
+one receiving plane), any surface receives and any shape casts, at the price
+of a resolution (aliased edges), a depth bias (acne below it, peter-panning
+above it) and a second pass.
+
+The light's camera here is one perspective frustum (a point light has no
+direction of its own): from the light towards the centre of the casters'
+bounds, :attr:`ShadowMap.fov` wide. A cube map (six frusta) would cover every
+direction; this covers what the lessons need, and a point outside the
+frustum is treated as lit. Pure numpy: no GL in here.
+"""
+
+from __future__ import annotations
+
+import weakref
+
+import numpy as np
+
+from glsandbox import transforms
+from glsandbox.errors import SandboxError
+from glsandbox.geometry import Mesh
+from glsandbox.scene import Light, Node, Scene
+
+
+def casting_light(scene: Scene) -> int | None:
+    """The index of the light with a shadow map, or None. One light at most:
+    the phong shader samples one map (a second would need a sampler array)."""
+    lights = [i for i, light in enumerate(scene.lights) if light.shadow is not None]
+    if len(lights) > 1:
+        raise SandboxError(f"lights {', '.join(map(str, lights))} all cast shadow maps; at most one light may "
+                           "(ShadowMap on one light, the others without)")
+    return lights[0] if lights else None
+
+
+def raster_viewports(scene: Scene) -> list[int]:
+    return [i for i, viewport in enumerate(scene.viewports) if viewport.renderer == "raster"]
+
+
+def receivers(scene: Scene) -> list[Node]:
+    """Lit nodes that look the shadow map up and are drawn by the rasterizer somewhere."""
+    views = raster_viewports(scene)
+    return [node for node in scene.nodes if node.receives_shadow and node.material.lit and node.shader is None
+            and any(node.shown_in(i) for i in views)]
+
+
+def casters(scene: Scene) -> list[Node]:
+    """Nodes drawn into the shadow map: casting, shown in some rasterized viewport."""
+    views = raster_viewports(scene)
+    return [node for node in scene.nodes if node.casts_shadow and any(node.shown_in(i) for i in views)]
+
+
+#: Each mesh's 8 bounding-box corners (meshes are immutable: found once per mesh object).
+_CORNERS: weakref.WeakKeyDictionary[Mesh, np.ndarray] = weakref.WeakKeyDictionary()
+
+
+def _corners(mesh: Mesh) -> np.ndarray:
+    corners = _CORNERS.get(mesh)
+    if corners is None:
+        positions = np.asarray(mesh.positions, dtype=np.float64)
+        low, high = positions.min(axis=0), positions.max(axis=0)
+        corners = _CORNERS[mesh] = np.array([[(low, high)[i >> k & 1][k] for k in range(3)] for i in range(8)])
+    return corners
+
+
+def _world_corners(nodes: list[Node]) -> np.ndarray:
+    """The corners of each node's mesh bounds in world space (8 per node)."""
+    if not nodes:
+        return np.zeros((0, 3))
+    return np.concatenate([transforms.transform_points(np.asarray(node.model, dtype=np.float64), _corners(node.mesh))
+                           for node in nodes])
+
+
+def light_camera(scene: Scene, light: Light) -> tuple[np.ndarray, np.ndarray]:
+    """The shadow map's view and projection for ``light`` (which has a ShadowMap).
+
+    The view looks from the light at the centre of the casters' bounds. Near
+    and far enclose every caster and receiver corner in front of the light, so
+    the 24-bit map spends its precision on the scene and not on empty space.
+    """
+    assert light.shadow is not None
+    eye = np.asarray(light.position, dtype=np.float64)
+    cast = _world_corners(casters(scene))
+    target = cast.mean(axis=0) if len(cast) else eye - np.array([0.0, 1.0, 0.0])
+    forward = target - eye
+    if np.linalg.norm(forward) < 1e-9:
+        forward = np.array([0.0, -1.0, 0.0])
+        target = eye + forward
+    forward = forward / np.linalg.norm(forward)
+    # Any up not along the view works (the map's rotation about its axis does not matter).
+    up = (0.0, 0.0, 1.0) if abs(forward[1]) > 0.9 else (0.0, 1.0, 0.0)
+    view = transforms.look_at(tuple(eye), tuple(target), up)
+    points = np.concatenate([cast, _world_corners(receivers(scene))])
+    depths = -(transforms.transform_points(view, points)[:, 2]) if len(points) else np.array([1.0])
+    far = max(float(depths.max()), 1e-3) * 1.01
+    near = max(float(depths.min()) * 0.99, far * 1e-3)
+    return view, transforms.perspective(light.shadow.fov, 1.0, near, far)

@@ -1,0 +1,254 @@
+"""A model file's materials as loaded (glsandbox.meshfile, glsandbox.meshlooks): one part per
+material with its colour, texture, alpha mode and sidedness; what the file holds that is not
+drawn, one warning line each; and the plan, which shows blending and two-sided lighting only
+for a part that asks. Every model is written by the test (trimesh or by hand)."""
+
+from __future__ import annotations
+
+import json
+import struct
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+
+import glsandbox
+from glsandbox.meshlooks import is_closed
+from support import CUBE_OBJ, coloured_ply, gltf_part, quad, reversed_obj, two_material_glb, two_usemtl_obj
+from glsandbox.plan import plan
+from glsandbox.scene import Material, Node, Scene
+from glsandbox.scene_file import load_scene
+
+# --- parts and their materials -------------------------------------------------------
+
+
+def test_a_gltf_with_two_materials_is_two_parts_each_with_its_colour_and_alpha_mode(tmp_path: Path) -> None:
+    model = glsandbox.load_model(two_material_glb(tmp_path / "two.glb"))
+    parts = {part.name: part for part in model.parts}
+    assert sorted(parts) == ["glass", "paint"] and model.triangles == 4
+    assert parts["paint"].color == (1.0, 0.0, 0.0, 1.0) and parts["paint"].alpha_mode == "opaque"
+    glass = parts["glass"]
+    assert glass.color is not None and glass.color[:3] == (0.0, 0.0, 1.0) and glass.color[3] == pytest.approx(128 / 255)
+    assert glass.alpha_mode == "blend" and not glass.double_sided
+    material = glass.material(shading="phong")
+    assert (material.alpha_mode, material.color, material.shading) == ("blend", glass.color, "phong")
+    # Node names: the part's name after the model's; the whole model as one mesh still exists.
+    assert sorted(node.name for node in model.nodes("duck")) == ["duck/glass", "duck/paint"]
+    assert model.mesh.vertex_count == sum(part.mesh.vertex_count for part in model.parts)
+
+
+def test_gltf_double_sided_and_mask_cutoff_are_read(tmp_path: Path) -> None:
+    plane = gltf_part(*quad(-1, 1, facing=-1), name="leaf", baseColorFactor=[0, 255, 0, 255], doubleSided=True,
+                      alphaMode="MASK", alphaCutoff=0.25)
+    path = tmp_path / "leaf.glb"
+    trimesh.Scene([plane]).export(path)
+    (part,) = glsandbox.load_model(path).parts
+    assert (part.double_sided, part.alpha_mode, part.alpha_cutoff) == (True, "mask", 0.25)
+    node = Node("leaf", part.mesh, material=part.material(shading="phong"))
+    assert node.cull_back_faces is False  # a double-sided material turns culling off
+
+
+def test_an_obj_with_two_usemtl_groups_is_two_parts_with_their_kd(tmp_path: Path) -> None:
+    model = glsandbox.load_model(two_usemtl_obj(tmp_path))
+    colours = {part.name: part.color for part in model.parts}
+    assert colours == {"red": (1.0, 0.0, 0.0, 1.0), "blue": (0.0, 0.0, 1.0, 1.0)}
+    assert not model.closed and all(part.double_sided for part in model.parts)  # open: seen from both sides
+    assert model.warnings == ()
+
+
+def test_an_obj_material_with_dissolve_below_one_is_blended(tmp_path: Path) -> None:
+    path = two_usemtl_obj(tmp_path, extra_mtl="d 0.25\n")  # on the blue material
+    parts = {part.name: part for part in glsandbox.load_model(path).parts}
+    assert (parts["blue"].alpha_mode, parts["blue"].color) == ("blend", (0.0, 0.0, 1.0, 0.25))
+    assert (parts["red"].alpha_mode, parts["red"].color) == ("opaque", (1.0, 0.0, 0.0, 1.0))
+
+
+def test_a_ply_with_vertex_colours_tints_a_lit_material(tmp_path: Path) -> None:
+    (part,) = glsandbox.load_model(coloured_ply(tmp_path / "c.ply")).parts
+    assert part.mesh.colors is not None and part.color is None
+    assert part.material(shading="phong").vertex_colors
+    assert not part.material(shading="vertex_color").vertex_colors  # unlit vertex colours: as before
+
+
+def test_sidedness_of_formats_without_materials_follows_closedness(tmp_path: Path) -> None:
+    (tmp_path / "cube.obj").write_text(CUBE_OBJ)
+    cube = glsandbox.load_model(tmp_path / "cube.obj")
+    assert cube.closed and not cube.parts[0].double_sided  # a closed cube: back faces culled
+    scan = glsandbox.load_model(reversed_obj(tmp_path))
+    assert not scan.closed and scan.parts[0].double_sided
+
+
+def test_closedness_welds_equal_positions_and_needs_opposite_windings() -> None:
+    box = trimesh.creation.box()
+    assert is_closed(np.asarray(box.vertices), np.asarray(box.faces))
+    # Split into per-face vertices (as uvs or normals split them): still closed.
+    corners = np.asarray(box.vertices)[np.asarray(box.faces).reshape(-1)]
+    assert is_closed(corners, np.arange(corners.shape[0]).reshape(-1, 3))
+    flipped = np.asarray(box.faces).copy()
+    flipped[0] = flipped[0][::-1]  # one face wound the other way: not consistently closed
+    assert not is_closed(np.asarray(box.vertices), flipped)
+    assert not is_closed(np.asarray(box.vertices), np.asarray(box.faces)[:-1])  # a hole
+
+
+# --- what is not drawn -----------------------------------------------------------
+
+
+def glb_with(doc_extra: dict, material_extra: dict) -> bytes:
+    """A one-triangle GLB written by hand, with extra top-level keys and material keys."""
+    positions = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=np.float32).tobytes()
+    doc = {
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]}],
+        "materials": [{"name": "skin", "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1]}, **material_extra}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                       "min": [0, 0, 0], "max": [1, 1, 0]}],
+        "bufferViews": [{"buffer": 0, "byteLength": len(positions)}],
+        "buffers": [{"byteLength": len(positions)}], **doc_extra}
+    text = json.dumps(doc).encode()
+    text += b" " * (-len(text) % 4)
+    chunks = (struct.pack("<I4s", len(text), b"JSON") + text
+              + struct.pack("<I4s", len(positions), b"BIN\x00") + positions)
+    return struct.pack("<4sII", b"glTF", 2, 12 + len(chunks)) + chunks
+
+
+def test_what_a_gltf_holds_that_is_not_drawn_is_one_warning_per_part(tmp_path: Path) -> None:
+    path = tmp_path / "robot.glb"
+    path.write_bytes(glb_with({"cameras": [{"type": "perspective", "perspective": {"yfov": 1, "znear": 0.1}}],
+                               "animations": [{"channels": [], "samplers": []}] * 2},
+                              {"normalTexture": {"index": 0}, "emissiveFactor": [1, 0, 0]}))
+    model = glsandbox.load_model(path)
+    assert model.warnings == (f"model file {path}: 2 animations, a camera not drawn",
+                              f"model file {path}, part 'skin': normal map, emissive colour not drawn")
+    scene = Scene("s", nodes=model.nodes("robot"))
+    described = plan(scene).describe().splitlines()
+    assert [line for line in described if line.startswith("warning:")] == [f"warning: {w}" for w in model.warnings]
+
+
+def test_a_missing_obj_texture_and_a_normal_map_are_warned_about(tmp_path: Path) -> None:
+    path = two_usemtl_obj(tmp_path, extra_mtl="map_Kd nowhere.png\nmap_Bump bumps.png\n")
+    model = glsandbox.load_model(path)
+    assert model.warnings == (f"model file {path}, part 'blue': its texture nowhere.png (missing or unreadable), "
+                              "bump map not drawn",)
+
+
+def test_render_prints_each_warning_once(tmp_path: Path, gl, capsys) -> None:
+    path = two_usemtl_obj(tmp_path, extra_mtl="map_Kd nowhere.png\n")
+    from lessons.model import ModelLesson
+
+    gl.render(ModelLesson(mesh=str(path), view="raster"), (32, 24))
+    gl.render(ModelLesson(mesh=str(path), view="raster"), (32, 24))
+    err = capsys.readouterr().err
+    assert err.count(f"warning: model file {path}, part 'blue': its texture nowhere.png") == 1
+
+
+# --- the plan --------------------------------------------------------------------
+
+
+def test_blending_and_two_sided_lighting_appear_in_the_plan_only_when_a_part_needs_them(tmp_path: Path) -> None:
+    from lessons.model import ModelLesson
+
+    rock = plan(ModelLesson(view="raster").scene()).describe()
+    assert not any(word in rock for word in ("no depth writes", "TWO_SIDED", "ALPHA_MASK", "VERTEX_COLOR"))
+    two = plan(ModelLesson(view="raster", mesh=str(two_material_glb(tmp_path / "two.glb"))).scene())
+    (draw_pass,) = [p for p in two.passes if p.kind == "draw"]
+    assert [d.node for d in draw_pass.draws] == ["floor", "model/paint", "model/glass"]  # blended last
+    assert [d.blend for d in draw_pass.draws] == [False, False, True]
+    assert "model/glass with phong[NUM_LIGHTS=2] (blended, no depth writes)" in two.describe()
+    scan = plan(ModelLesson(view="raster", mesh=str(reversed_obj(tmp_path))).scene()).describe()
+    assert "model with phong[NUM_LIGHTS=2,TWO_SIDED] (no culling)" in scan
+    ply = plan(ModelLesson(view="raster", mesh=str(coloured_ply(tmp_path / "c.ply"))).scene()).describe()
+    assert "phong[NUM_LIGHTS=2,VERTEX_COLOR,TWO_SIDED]" in ply
+
+
+def test_blended_nodes_are_drawn_farthest_first() -> None:
+    square = glsandbox.geometry.quad_list()
+    glass = Material(color=(0, 0, 1, 0.5), alpha_mode="blend")
+    near = Node("near", square, glsandbox.transforms.translate(0, 0, 2), glass)
+    far = Node("far", square, glsandbox.transforms.translate(0, 0, -2), glass)
+    solid = Node("solid", square, np.eye(4), Material())
+    (draw_pass,) = [p for p in plan(Scene("s", nodes=(near, solid, far))).passes if p.kind == "draw"]
+    assert [d.node for d in draw_pass.draws] == ["solid", "far", "near"]
+
+
+def test_material_refuses_an_unknown_alpha_mode_or_cutoff() -> None:
+    with pytest.raises(glsandbox.SandboxError, match="unknown alpha mode 'glass'"):
+        Material(alpha_mode="glass")
+    with pytest.raises(glsandbox.SandboxError, match="alpha cutoff must lie in 0..1"):
+        Material(alpha_cutoff=2.0)
+
+
+# --- scene files -------------------------------------------------------------------
+
+
+def test_a_scene_file_node_becomes_one_node_per_material_and_up_z_stands_it_upright(tmp_path: Path) -> None:
+    two_usemtl_obj(tmp_path)
+    scene_path = tmp_path / "scene.toml"
+    scene_path.write_text('[[lights]]\nposition = [0, 2, 3]\n\n[[nodes]]\nname = "sign"\nmesh = "two.obj"\n'
+                          'shading = "phong"\nup = "z"\n')
+    nodes = load_scene(scene_path).nodes
+    assert sorted((n.name, n.material.color) for n in nodes) == [("sign/blue", (0.0, 0.0, 1.0, 1.0)),
+                                                                 ("sign/red", (1.0, 0.0, 0.0, 1.0))]
+    # up = "z": the file's +z turns to +y (and its +y to -z).
+    assert np.allclose(nodes[0].model[:3, :3] @ [0, 0, 1], [0, 1, 0])
+    assert np.allclose(nodes[0].model[:3, :3] @ [0, 1, 0], [0, 0, -1])
+    scene_path.write_text('[[nodes]]\nmesh = "two.obj"\nup = "x"\n')
+    with pytest.raises(glsandbox.SandboxError, match=r"scene.toml:3: nodes\[0\].up: unknown up axis 'x'"):
+        load_scene(scene_path)
+
+
+def test_a_gltf_whose_texture_image_is_missing_or_garbage_loads_and_says_so(tmp_path: Path) -> None:
+    from PIL import Image
+
+    square = trimesh.Trimesh(*quad(-1, 1), process=False)
+    square.visual = trimesh.visual.TextureVisuals(
+        uv=[[0, 0], [1, 0], [1, 1], [0, 1]],
+        material=trimesh.visual.material.PBRMaterial(name="skin", baseColorTexture=Image.new("RGB", (4, 4))))
+    for case, content in (("missing", None), ("garbage", b"not a png")):
+        folder = tmp_path / case  # a folder each: loads are cached by the model file
+        folder.mkdir()
+        for name, data in trimesh.Scene([square]).export(file_type="gltf").items():
+            (folder / name).write_bytes(data)
+        doc = json.loads((folder / "model.gltf").read_text())
+        doc["images"] = [{"uri": "skin.png"}]  # an image file next to it, instead of the embedded one
+        (folder / "model.gltf").write_text(json.dumps(doc))
+        if content is not None:
+            (folder / "skin.png").write_bytes(content)
+        model = glsandbox.load_model(folder / "model.gltf")
+        assert model.parts[0].texture is None
+        assert model.warnings == (f"model file {folder / 'model.gltf'}, part 'skin': its base colour texture "
+                                  "skin.png (missing or unreadable) not drawn",)
+
+
+def test_a_scene_file_node_with_its_own_colour_stays_one_node_with_every_part(tmp_path: Path) -> None:
+    two_usemtl_obj(tmp_path)
+    scene_path = tmp_path / "scene.toml"
+    scene_path.write_text('[[nodes]]\nname = "sign"\nmesh = "two.obj"\ncolor = [1, 1, 0]\n')
+    (node,) = load_scene(scene_path).nodes
+    assert node.name == "sign" and node.material.color == (1.0, 1.0, 0.0, 1.0)
+    assert node.mesh.triangle_indices().shape[0] == 4  # both parts' squares
+
+
+
+def test_scene_file_material_keys_for_alpha_and_sides(tmp_path: Path) -> None:
+    scene_path = tmp_path / "scene.toml"
+    scene_path.write_text('[[nodes]]\nmesh = "cube24"\ncolor = [0, 0, 1, 0.5]\nalpha_mode = "blend"\n'
+                          'double_sided = true\n\n[[nodes]]\nmesh = "quad_list"\nalpha_mode = "mask"\n'
+                          'alpha_cutoff = 0.3\n')
+    glass, leaf = load_scene(scene_path).nodes
+    assert (glass.material.alpha_mode, glass.material.double_sided, glass.cull_back_faces) == ("blend", True, False)
+    assert (leaf.material.alpha_mode, leaf.material.alpha_cutoff) == ("mask", 0.3)
+    for text, where in (('alpha_mode = "glass"', r"scene.toml:3: nodes\[0\].alpha_mode: unknown alpha mode 'glass'"),
+                        ("alpha_cutoff = 1.5", r"scene.toml:3: nodes\[0\].alpha_cutoff: material alpha cutoff"),
+                        ("vertex_colors = true", r"scene.toml:3: nodes\[0\].vertex_colors: .* no color data")):
+        scene_path.write_text(f'[[nodes]]\nmesh = "cube24"\n{text}\n')
+        with pytest.raises(glsandbox.SandboxError, match=where):
+            load_scene(scene_path)
+
+
+def test_a_scene_file_node_s_own_alpha_mode_wins_over_its_model_file_s(tmp_path: Path) -> None:
+    two_material_glb(tmp_path / "two.glb")
+    scene_path = tmp_path / "scene.toml"
+    scene_path.write_text('[[nodes]]\nname = "m"\nmesh = "two.glb"\nalpha_mode = "opaque"\n')
+    assert {n.name: n.material.alpha_mode for n in load_scene(scene_path).nodes} == {"m/paint": "opaque",
+                                                                                     "m/glass": "opaque"}

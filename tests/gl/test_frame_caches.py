@@ -1,0 +1,76 @@
+"""What the executor keeps between draws and frames (issue 24) never changes a picture.
+
+A program keeps its uniform values, so the executor writes a uniform only when its
+bytes differ from the last ones written into that program; the lights' bytes are
+made once per frame, the eye's once per view, a material texture is bound once per
+run of draws that use it. Each check compares frames drawn by one long-lived
+renderer (every cache warm, lessons and times interleaved) with the same frames
+drawn by a fresh renderer on the same context (every cache empty).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from glsandbox.frame import FrameRenderer
+from glsandbox.lesson import find_lesson
+
+SIZE = (80, 60)
+#: Lessons with lights (reflected ones too: the mirror), textures, overlays and split viewports.
+LESSONS = ("phong", "mirror", "texture", "transform_order", "triangle", "indexed_cube")
+
+
+def fresh_frame(gl, scene) -> np.ndarray:
+    renderer = FrameRenderer(gl.host)
+    try:
+        return renderer.render_scene(scene, SIZE).image.copy()
+    finally:
+        renderer.close()
+
+
+def test_frames_with_warm_caches_equal_frames_drawn_from_scratch(gl) -> None:
+    # Interleaved, so every lesson's programs are entered with another lesson's values cached.
+    for t in (0.0, 0.45, 1.3):
+        for name in LESSONS:
+            scene = find_lesson(name)().at(t).scene()
+            warm = gl.render_scene(scene, SIZE).image
+            assert np.array_equal(warm, fresh_frame(gl, scene)), f"{name} at time {t}"
+
+
+@pytest.fixture
+def uniform_writes(monkeypatch):
+    """Every uniform write of the executor, by uniform name (moderngl's ``Uniform.write``)."""
+    import moderngl
+
+    writes: list[str] = []
+    original = moderngl.Uniform.write
+
+    def counted(self, data):
+        writes.append(self.name)
+        return original(self, data)
+
+    monkeypatch.setattr(moderngl.Uniform, "write", counted)
+    return writes
+
+
+#: What differs from one draw to the next when draws share a program (a node's own matrix and colour).
+PER_DRAW = {"m_model", "m_normal", "u_color"}
+
+
+def test_a_frame_writes_only_the_uniforms_that_changed(gl, uniform_writes) -> None:
+    lesson = find_lesson("phong")()
+    gl.render(lesson.at(0.2), SIZE)  # every program has its values now
+    uniform_writes.clear()
+    gl.render(lesson.at(0.2), SIZE)
+    # The same frame again: the camera, the lights and the materials are not written again.
+    assert set(uniform_writes) <= PER_DRAW
+    uniform_writes.clear()
+    scene = lesson.at(0.7).scene()
+    frame = gl.render_scene(scene, SIZE)  # the lights turn: their positions change
+    nodes = {node.name: node for node in scene.nodes}
+    lit = [draw for step in frame.plan.passes for draw in step.draws
+           if draw.node in nodes and nodes[draw.node].material.lit]
+    assert set(uniform_writes) - PER_DRAW == {"u_light_pos"}
+    # Once per program that draws lit nodes, not once per lit draw.
+    assert uniform_writes.count("u_light_pos") == len({draw.program for draw in lit}) < len(lit)

@@ -1,0 +1,43 @@
+"""glsandbox.measure.bench: the extra main-thread CPU column and its goal (issue 24)."""
+
+from __future__ import annotations
+
+import time
+
+from glsandbox.measure.bench import Case, Result, Side, format_table, measure
+
+
+def spin(seconds: float) -> None:
+    """Busy main-thread CPU for ``seconds``."""
+    end = time.thread_time() + seconds
+    while time.thread_time() < end:
+        pass
+
+
+def test_measure_records_the_main_threads_cpu_of_each_side() -> None:
+    case = Case("g", "busy vs idle", Side("idle", lambda k: time.sleep(0.002)), Side("busy", lambda k: spin(0.002)),
+                repeat=2)
+    (result,) = measure([case], rounds=2)
+    assert len(result.baseline_cpu_s) == len(result.subject_cpu_s) == 2
+    # Sleeping takes wall time but no CPU; spinning takes both.
+    assert max(result.baseline_cpu_s) < 0.001 <= min(result.subject_cpu_s)
+    assert result.extra_cpu_us is not None and result.extra_cpu_us >= 1000
+
+
+def test_the_table_prints_the_extra_cpu_and_its_goal() -> None:
+    case = Case("frame vs raw ModernGL", "phong", Side("raw", print), Side("glsandbox", print), goal=1.05,
+                cpu_goal_us=50.0)
+    met = Result(case, [0.010], [0.0104], "identical", baseline_cpu_s=[0.001], subject_cpu_s=[0.00103])
+    missed = Result(case, [0.010], [0.011], "identical", baseline_cpu_s=[0.001], subject_cpu_s=[0.0012])
+    header, _, first, second = format_table([met, missed]).splitlines()
+    assert "extra CPU" in header and "CPU goal" in header
+    assert "+30 us" in first and "<=50 us met" in first and "<=1.05x met" in first
+    assert "+200 us" in second and "<=50 us NOT met" in second and "<=1.05x NOT met" in second
+    assert met.to_dict()["extra_cpu_us"] == 30.0 and met.to_dict()["cpu_goal_met"] is True
+
+
+def test_a_case_without_a_baseline_has_no_cpu_difference() -> None:
+    case = Case("g", "alone", None, Side("one", lambda k: None))
+    (result,) = measure([case], rounds=1)
+    assert result.extra_cpu_us is None
+    assert result.to_dict()["extra_cpu_us"] is None

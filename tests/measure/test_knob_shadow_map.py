@@ -1,0 +1,32 @@
+"""The shadow-map knob of ``glsandbox tradeoffs`` (glsandbox/measure/knobs/shadow_map.py):
+its settings and its wrong-state count, measured at a small size against the ray tracer."""
+
+from __future__ import annotations
+
+from glsandbox.frame import LazyRenderer
+from glsandbox.measure.knob import all_knobs
+from glsandbox.measure.render_context import RenderContext
+
+
+def knob():
+    return next(k for k in all_knobs() if k.name == "shadow_map")
+
+
+def test_the_knob_lists_planar_and_every_map_size_with_and_without_pcf():
+    labels = [s.label for s in knob().settings]
+    assert labels[0] == "planar shadow (stencil)"
+    assert labels[1:] == [f"shadow map {size}, PCF {pcf}" for size in (256, 512, 1024, 2048) for pcf in (1, 3)]
+    assert set(knob().quick) <= set(labels) and knob().count_label == "wrong-state px"
+
+
+def test_wrong_state_pixels_fall_with_the_map_size_and_the_planar_shadow_misses_most(gl):
+    context = RenderContext((192, 144))
+    context.gl = LazyRenderer(renderer=gl)  # the session's renderer, shared (not closed here)
+    settings = {s.label: s for s in knob().settings}
+    counts = {label: settings[label].count(context) for label in
+              ("planar shadow (stencil)", "shadow map 256, PCF 1", "shadow map 2048, PCF 1")}
+    planar, coarse, fine = (counts[k].pixels for k in counts)
+    # The planar shadow misses the sphere's shadow on the cube; a small map's stairs
+    # stray further from the exact edge than a large map's.
+    assert planar > coarse > fine > 0, counts
+    assert all(c.of == 192 * 144 for c in counts.values())
