@@ -42,11 +42,11 @@ import math
 import statistics
 from collections.abc import Callable, Sequence
 from functools import cache
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from _bunny import bunny_path
 from raytrace import EMBREE_MISSING, MODES, embree_available, embree_side
 
 from glsandbox import Camera, Light, Material, Mesh, Node, Scene, load_model, meshgen
@@ -71,21 +71,11 @@ BUILD_GOAL_S = 2.0
 EDGE_SAMPLE = 400
 
 
-def _bunny_path() -> Path | None:
-    """pymeshlab's copy of the Stanford bunny, or None when pymeshlab is not installed."""
-    try:
-        import pymeshlab
-    except ImportError:
-        return None
-    path = Path(pymeshlab.__file__).parent / "tests" / "sample_meshes" / "bunny.obj"
-    return path if path.is_file() else None
-
-
 @cache
 def model_scene(label: str) -> Scene:
     """The scene for one model: the mesh lit by one light, seen from above and in front."""
     if label == "bunny":
-        path = _bunny_path()
+        path = bunny_path()
         assert path is not None
         mesh: Mesh = load_model(path, fit=True).mesh
         camera = Camera(eye=(0.0, 0.8, 4.0))
@@ -164,9 +154,9 @@ def cases(env: Any) -> list:
         return []
     size: tuple[int, int] = env.size
     labels = [str(n) for n in (SIZES[:2] if env.quick else SIZES)]
-    if _bunny_path() is not None and not env.quick:
+    if bunny_path() is not None and not env.quick:
         labels.insert(2, "bunny")
-    elif _bunny_path() is None:
+    elif bunny_path() is None:
         env.note(f"{GROUP}: the bunny skipped: pymeshlab not installed (uv run --group bench glsandbox bench)")
     references: dict[str, HitMiss] = {}
 

@@ -105,14 +105,9 @@ def write_png(image: np.ndarray, out: Path) -> None:
 
 def parse_size(text: str) -> tuple[int, int]:
     """``WxH`` -> (W, H), refusing anything else with the value named."""
-    w, sep, h = text.lower().partition("x")
-    try:
-        size = (int(w), int(h))
-    except ValueError:
-        size = (0, 0)
-    if not sep or size[0] <= 0 or size[1] <= 0 or max(size) > 16384:
-        raise SandboxError(f"--size {text!r}: expected WIDTHxHEIGHT with positive integers, e.g. 640x480")
-    return size
+    from glsandbox.measure.rubric import parse_size_text
+
+    return parse_size_text(text, "--size")
 
 
 def add_render_options(parser: argparse.ArgumentParser, settings: bool = True,
@@ -295,86 +290,144 @@ def _tour_contrasts(cls: type[Lesson], out: Path, size: tuple[int, int], samples
 
 def cmd_new(args: argparse.Namespace) -> int:
     """``glsandbox new NAME``: a commented starting lesson ``NAME.py``, scene file ``NAME.toml``
-    and shader ``NAME.glsl`` (the scene's ball is drawn with it)."""
+    and shader ``NAME.glsl`` (the scene's ball is drawn with it). ``new --assignment NAME``:
+    the lesson as a model answer and a starting grading file ``NAME.grading.toml`` beside it."""
     from importlib.resources import files as package_files
     from string import Template
 
-    name: str = args.name
+    from glsandbox.measure.rubric import STARTER
+
+    if (args.name is None) == (args.assignment is None):
+        raise SandboxError("new: give a NAME, or --assignment NAME (a model answer and its grading file)")
+    name: str = args.name if args.name is not None else args.assignment
     if not name.isidentifier() or name.startswith("_") or not name.isascii():
         raise SandboxError(f"new {name!r}: the name must be a Python identifier: letters, digits and _, "
                            "not starting with a digit or _ (e.g. my_lesson)")
     folder: Path = args.dir
     if not folder.is_dir():
         raise SandboxError(f"--dir {folder}: folder does not exist")
-    targets = {folder / f"{name}.py": "lesson.py.tmpl", folder / f"{name}.toml": "scene.toml.tmpl",
-               folder / f"{name}.glsl": "shader.glsl.tmpl"}
+    templates = package_files("glsandbox") / "templates"
+    if args.assignment is None:
+        targets = {folder / f"{name}.py": "lesson.py.tmpl", folder / f"{name}.toml": "scene.toml.tmpl",
+                   folder / f"{name}.glsl": "shader.glsl.tmpl"}
+    else:
+        targets = {folder / f"{name}.py": "lesson.py.tmpl", folder / f"{name}.grading.toml": STARTER}
     existing = [str(path) for path in targets if path.exists() or path.is_symlink()]
     if existing:  # all or none: never part of a starter
         verb = "exists" if len(existing) == 1 else "exist"
         raise SandboxError(f"{', '.join(existing)} already {verb}; not overwritten (pick another NAME or --dir)")
     # The class name: my_lesson -> MyLesson (a name of capitals only stays as it is).
     cls = "".join(part[:1].upper() + part[1:] for part in name.split("_")) or "MyLesson"
-    templates = package_files("glsandbox") / "templates"
     for path, template in targets.items():
-        text = Template(templates.joinpath(template).read_text(encoding="utf-8")).substitute(name=name, cls=cls)
+        source = template if "\n" in template else templates.joinpath(template).read_text(encoding="utf-8")
+        text = Template(source).substitute(name=name, cls=cls)
         try:
             write_text(path, text)
         except OSError as exc:
             raise SandboxError(f"{path}: cannot write ({exc.strerror or exc})") from None
         print(f"wrote {path}")
+    if args.assignment is not None:
+        rubric = folder / f"{name}.grading.toml"
+        print(f"next: glsandbox check {folder / name}.py --rubric {rubric} --update   (the goldens, from the model answer)")
+        print(f"then: glsandbox check SUBMISSIONS/ --rubric {rubric} --html report.html")
+        return 0
     print(f"next: glsandbox run {folder / name}.py   (or glsandbox render {folder / name}.py --out {name}.png)")
     return 0
 
 
-def cmd_check(args: argparse.Namespace) -> int:
-    """``glsandbox check``: render, compare with a reference PNG by the golden rule; 0 match, 1 differs."""
-    from glsandbox.measure.check import (
-        check_folder,
-        check_one,
-        parse_tolerances,
-        summary_table,
-        write_reports,
-    )
+def _checks(args: argparse.Namespace) -> tuple[list, float | None, int | None]:
+    """The checks of ``check``: a rubric's, or one from --golden, --set, --size and --tolerance."""
+    from glsandbox.measure.rubric import Check, load_rubric, parse_tolerances
 
+    if (args.golden is None) == (args.rubric is None):
+        raise SandboxError("check: give the reference with --golden REF.png or a grading file with --rubric FILE "
+                           "(one of the two)")
+    if args.rubric is not None:
+        if args.settings or args.tolerance or args.size or args.samples:
+            raise SandboxError(f"--rubric {args.rubric}: each check's settings, size and tolerance are in the "
+                               "grading file; drop --set, --size, --samples and --tolerance")
+        rubric = load_rubric(args.rubric)
+        return list(rubric.checks), rubric.timeout, rubric.memory
     reference: Path = args.golden
     if reference.suffix.lower() != ".png":
         raise SandboxError(f"--golden {reference}: the reference must be a .png file")
     tolerances = parse_tolerances(args.tolerance)
     size = parse_size(args.size) if args.size else None
-    for flag, path in (("--csv", args.csv), ("--json", args.json)):
+    with_samples(Scene("samples"), args.samples)  # a bad --samples is refused before any work
+    return [Check(reference.stem, reference, tuple(args.settings), size, args.samples, tolerances)], None, None
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    """``glsandbox check``: render, compare with reference PNGs by the golden rule; 0 all pass, 1 not."""
+    from glsandbox.measure.check import Limits, check_folder, check_one, default_jobs, summary_table
+    from glsandbox.measure.reports import REPORTS, write_reports
+
+    checks, rubric_timeout, rubric_memory = _checks(args)
+    timeout = args.timeout if args.timeout is not None else rubric_timeout or 30.0
+    memory = args.memory if args.memory is not None else rubric_memory or 2048
+    if not 0 < timeout <= 3600:
+        raise SandboxError(f"--timeout {timeout:g}: expected seconds, more than 0 and at most 3600")
+    if not 64 <= memory <= 1 << 20:
+        raise SandboxError(f"--memory {memory}: expected MB, at least 64")
+    jobs = args.jobs if args.jobs is not None else default_jobs()
+    if not 1 <= jobs <= 256:
+        raise SandboxError(f"--jobs {jobs}: expected 1 to 256 submissions at once")
+    limits = Limits(float(timeout), int(memory), jobs)
+    reports = {kind: getattr(args, kind) for kind in REPORTS}
+    for kind, path in reports.items():
         if path is not None and path.is_dir():
-            raise SandboxError(f"{flag} {path}: is a folder, expected a file name")
+            raise SandboxError(f"--{kind} {path}: is a folder, expected a file name")
     target = Path(args.lesson)
     if target.is_dir():
         if args.update:
-            raise SandboxError(f"--update writes one reference: give one lesson, not the folder {target}")
-        results = check_folder(target, reference, args.settings, size, tolerances, args.samples, args.backend,
-                               progress=lambda text: print(text, file=sys.stderr, flush=True))
-        for result in results:
-            print(result.line())
-            for kind, path in result.artifacts.items():
-                print(f"       {kind:<8}: {path}")
+            raise SandboxError(f"--update writes references from the model answer: give one lesson, not the folder {target}")
+
+        bars = []  # the progress bar, made when the first submission reports (the total known then)
+
+        def report(done: int, total: int, result) -> None:
+            if not bars:
+                bars.append(progress(total, "check", "submission"))
+            # Lines on stdout above the bar on stderr (only a terminal gets the bar).
+            say(f"[{done}/{total}] {result.line()}", file=sys.stdout)
+            for outcome in result.outcomes:
+                for kind, path in outcome.artifacts.items():
+                    say(f"       {kind:<8}: {path}", file=sys.stdout)
+            bars[0].update(1)
+
+        try:
+            results = check_folder(target, checks, args.backend, limits, report)
+        finally:
+            for bar in bars:
+                bar.close()
         print()
         print(summary_table(results))
-        for path in write_reports(results, args.csv, args.json, reference):
+        title = str(args.rubric or args.golden)
+        for path in write_reports(results, reports, title):
             print(f"wrote {path}")
         return 0 if all(r.status == "PASS" for r in results) else 1
-    if args.csv or args.json:
-        raise SandboxError("--csv and --json report a folder of submissions; give a folder")
-    match, paths, updated = check_one(args.lesson, reference, args.settings, size, tolerances, args.update,
-                                      args.samples, args.backend)
-    if updated == "written":
-        print(f"wrote reference {reference}")
-        return 0
-    print(f"{args.lesson}: {match.summary()}")
-    if updated == "rewritten":
-        print(f"rewrote reference {reference}")
-        return 0
-    if updated == "unchanged":
-        print(f"reference {reference} unchanged (it passes)")
-    for kind, path in paths.items():
-        print(f"  {kind:<8}: {path}")
-    return 0 if match.passed else 1
+    if any(path is not None for path in reports.values()):
+        raise SandboxError(f"--{', --'.join(REPORTS)} report a folder of submissions; give a folder")
+    failed = False
+    for one in check_one(args.lesson, checks, args.update, args.backend, limits):
+        reference = one.check.golden
+        if one.status:
+            print(f"{args.lesson}: {one.status}: {one.error}")
+            failed = True
+            continue
+        if one.updated == "written":
+            print(f"wrote reference {reference}")
+            continue
+        print(f"{args.lesson}: {one.match.summary()}")
+        if one.updated == "rewritten":
+            print(f"rewrote reference {reference}")
+            continue
+        if one.updated == "unchanged":
+            print(f"reference {reference} unchanged (it passes)")
+            continue
+        for kind, path in one.artifacts.items():
+            print(f"  {kind:<8}: {path}")
+        failed = failed or not one.match.passed
+    return 1 if failed else 0
 
 
 def cmd_tradeoffs(args: argparse.Namespace) -> int:
@@ -411,11 +464,15 @@ COMMANDS: dict[str, tuple[str, tuple[str, ...]]] = {
     "compare": ("render one lesson with several parameter values side by side, and say which pictures differ",
                 ("glsandbox compare phong --vary shading=phong,gouraud,blinn_phong",
                  "glsandbox compare phong --vary shading=phong,gouraud --vary normals=correct,naive")),
-    "new": ("write a small commented starting lesson NAME.py, scene file NAME.toml and shader NAME.glsl",
-            ("glsandbox new my_lesson", "glsandbox new my_lesson --dir lessons_of_mine")),
-    "check": ("render a lesson (or each one in a folder) and compare it with a reference PNG: exit 0 match, 1 differs",
+    "new": ("write a small commented starting lesson NAME.py, scene file NAME.toml and shader NAME.glsl "
+            "(or, with --assignment, a model answer and a grading file)",
+            ("glsandbox new my_lesson", "glsandbox new my_lesson --dir lessons_of_mine",
+             "glsandbox new --assignment shading")),
+    "check": ("render a lesson (or each one in a folder) and compare it with a reference PNG or a grading "
+              "file's checks: exit 0 match, 1 differs",
               ("glsandbox check my_lesson.py --golden expected.png",
                "glsandbox check submissions/ --golden expected.png --csv marks.csv",
+               "glsandbox check submissions/ --rubric shading.grading.toml --html marks.html",
                "glsandbox check phong --golden phong.png --update")),
     "tradeoffs": ("time each accuracy knob and compare it with a reference (FLIP, RMSE): report.md, CSV and plot",
                   ("glsandbox tradeoffs --quick", "glsandbox tradeoffs --knob antialiasing --out out/aa")),
@@ -469,20 +526,34 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_compare)
 
     p = add_command(sub, "new")
-    p.add_argument("name", metavar="NAME", help="the lesson's name, a Python identifier (e.g. my_lesson)")
+    p.add_argument("name", metavar="NAME", nargs="?", default=None,
+                   help="the lesson's name, a Python identifier (e.g. my_lesson)")
+    p.add_argument("--assignment", metavar="NAME", default=None,
+                   help="instead: a model answer NAME.py and a starting grading file NAME.grading.toml")
     p.add_argument("--dir", type=Path, default=Path("."), help="the folder to write into (default: here)")
     p.set_defaults(func=cmd_new)
 
     p = add_command(sub, "check")
     p.add_argument("lesson", metavar="LESSON_OR_DIR",
                    help="a lesson name, .py or .toml file, or a folder of them (one line each, and a table)")
-    p.add_argument("--golden", type=Path, required=True, metavar="REF.png", help="the reference image")
+    p.add_argument("--golden", type=Path, default=None, metavar="REF.png", help="the reference image")
+    p.add_argument("--rubric", type=Path, default=None, metavar="FILE.toml",
+                   help="a grading file: several checks, each with its golden, settings and points")
     p.add_argument("--update", action="store_true",
-                   help="write the reference when it is missing or differs (a passing one is kept)")
+                   help="write the references when missing or different (a passing one is kept)")
     p.add_argument("--tolerance", action="append", default=[], metavar="KEY=VALUE",
                    help="threshold=LEVELS (default 2) or max_bad_share=FRACTION (default 0.0005); repeatable")
-    p.add_argument("--csv", type=Path, default=None, metavar="FILE", help="folder mode: the figures as CSV")
-    p.add_argument("--json", type=Path, default=None, metavar="FILE", help="folder mode: the figures as JSON")
+    p.add_argument("--jobs", type=int, default=None, metavar="N",
+                   help="submissions graded at once (default: the number of cores)")
+    p.add_argument("--timeout", type=float, default=None, metavar="SECONDS",
+                   help="time for each picture of a submission (default 30)")
+    p.add_argument("--memory", type=int, default=None, metavar="MB",
+                   help="memory (address space) of each submission (default 2048)")
+    for kind, text in (("csv", "the figures as CSV"), ("json", "the figures as JSON"),
+                       ("html", "a page: a row per student with reference | submission | difference"),
+                       ("junit", "JUnit XML (what CI systems read)"),
+                       ("gradescope", "Gradescope's results.json")):
+        p.add_argument(f"--{kind}", type=Path, default=None, metavar="FILE", help=f"folder mode: {text}")
     add_render_options(p, size_default="the reference's size")
     p.set_defaults(func=cmd_check)
 

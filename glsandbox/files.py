@@ -147,12 +147,45 @@ def read_regular(path: str | os.PathLike[str]) -> bytes:
         return handle.read()
 
 
+#: While grading (in the child rendering one submission): the folders user files must lie in,
+#: the submission's first (empty: any path, the default).
+_sandbox_roots: tuple[str, ...] = ()
+
+
+def set_sandbox_root(root: str | os.PathLike[str] | None, also: tuple[str | os.PathLike[str], ...] = ()) -> None:
+    """Refuse, from now on, user files that resolve outside ``root`` and ``also`` (glsandbox's
+    own shader folders); None: any path, the default.
+
+    Set only in the child process that renders one graded submission
+    (:mod:`glsandbox.measure.sandbox`); everywhere else files are read wherever they are.
+    """
+    global _sandbox_roots
+    _sandbox_roots = () if root is None else tuple(os.path.realpath(r) for r in (root, *also))
+
+
+def inside(path: str, root: str) -> bool:
+    """Whether the real path ``path`` is ``root`` or lies under it."""
+    return path == root or path.startswith(root.rstrip("/") + "/")
+
+
+def check_inside_sandbox(path: str | os.PathLike[str], what: str) -> None:
+    """While grading: a :class:`SandboxError` when ``path`` (symlinks followed) is outside the submission."""
+    if not _sandbox_roots:
+        return
+    real = os.path.realpath(path)
+    if not any(inside(real, root) for root in _sandbox_roots):
+        raise SandboxError(f"{what} {os.fspath(path)} is outside the submission; "
+                           "a graded submission may read only its own files")
+
+
 def open_user_file(path: str | os.PathLike[str], what: str, expected: str) -> BinaryIO:
     """:func:`open_regular` for a file the user named, every failure one line:
     ``<what> <path> not found``, ``... is a folder, expected <expected>``, ``... is a
     named pipe (FIFO), expected <expected>``, ``... is not readable (permission
-    denied)`` or ``... cannot be read (<reason>)``, as :class:`SandboxError`."""
+    denied)``, ``... cannot be read (<reason>)`` or, while grading, ``... is outside
+    the submission`` (:func:`set_sandbox_root`), as :class:`SandboxError`."""
     where = f"{what} {os.fspath(path)}"
+    check_inside_sandbox(path, what)
     try:
         return open_regular(path)
     except FileNotFoundError:

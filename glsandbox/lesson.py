@@ -380,7 +380,9 @@ class SceneFileLesson(Lesson):
 def scene_file_lesson(path: Path) -> type[Lesson]:
     """A lesson class for one scene file; the file is validated now."""
     load_scene(path)  # fail early, with file and line
-    return type(f"SceneFile_{path.stem}", (SceneFileLesson,),
+    # A class name must be text Python can encode: a file name with any bytes is made safe here.
+    stem = "".join(c if c.isalnum() and c.isascii() else "_" for c in path.stem)
+    return type(f"SceneFile_{stem}", (SceneFileLesson,),
                 {"name": path.stem, "title": f"scene file {path}", "path": path})
 
 

@@ -37,7 +37,13 @@ Every problem with the file is one :class:`SandboxError` line naming it: not
 found, a folder, a FIFO or device (checked with ``stat`` before anything opens
 it, so nothing blocks), empty, unreadable, an unknown extension, data trimesh
 cannot read (garbage, truncated), no faces, vertices that are NaN or infinite,
-face indices out of range. Loads are cached by (resolved path, modification
+face indices out of range; before trimesh reads it, an ASCII PLY or OFF cut
+short or with a face line that does not match its count, and a model that
+needs more memory than ``GLSANDBOX_MODEL_MEMORY`` allows
+(:mod:`glsandbox.meshcheck`). Time and memory are linear in the triangles:
+normals and vertices are made by :mod:`glsandbox.meshnormals` (integer ids,
+no per-position square work), a glTF's nodes placed once each, the per-face
+steps done in blocks (about 230 bytes per triangle at the peak). Loads are cached by (resolved path, modification
 time, size, options): loading a file again returns the same :class:`Model`
 (and the same Mesh object, whose GPU buffers the executor keeps), until the
 file changes. trimesh's log messages and warnings are kept off stderr.
@@ -47,6 +53,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import gc
 import io
 import logging
 import math
@@ -64,8 +71,9 @@ from numpy.typing import NDArray
 from glsandbox.errors import SandboxError
 from glsandbox.files import open_user_file
 from glsandbox.geometry import Mesh
+from glsandbox.meshcheck import MEMORY_ENV, check_memory, checked_data, claimed_triangles
 from glsandbox.meshlooks import Look, file_warnings, is_closed, look_of
-from glsandbox.meshnormals import corner_normals, unique_vertices
+from glsandbox.meshnormals import BLOCK_FACES, face_cross, normal_groups, row_ids, split_vertices
 from glsandbox.scene import Material, Node, Texture
 
 __all__ = ["CREASE_ANGLE", "FORMATS", "NORMALS", "Model", "ModelPart", "fit_mesh", "is_model_path", "load_mesh",
@@ -237,8 +245,24 @@ def load_model(path: str | os.PathLike[str], *, fit: bool = False, normals: str 
             data = handle.read()
         except OSError as exc:
             raise SandboxError(f"model file {p} cannot be read ({exc.strerror or exc})") from None
-    parts = _parts(p, _trimesh_scene(p, data, file_type))
-    model = _model(p, file_type, parts, bool(fit), normals, float(crease_angle), data)
+    data = checked_data(p, data, file_type)
+    claimed = claimed_triangles(data, file_type)
+    if claimed is not None:
+        check_memory(p, claimed)  # before the reader makes a single array
+    scene = _trimesh_scene(p, data, file_type)
+    if file_type not in ("gltf", "glb", "obj"):
+        data = b""  # only a glTF's JSON and an OBJ's lines are read again (for what is not drawn)
+    parts = _parts(p, scene)
+    del scene
+    gc.collect()  # trimesh's objects hold reference cycles: its copies of the data go now, not later
+    triangles = sum(part.faces.shape[0] for part in parts)
+    check_memory(p, triangles)  # the count itself, for a glTF whose count no header gives
+    try:
+        model = _model(p, file_type, parts, bool(fit), normals, float(crease_angle), data)
+    except MemoryError:
+        raise SandboxError(f"model file {p}: out of memory making {triangles:,} triangles drawable (set "
+                           f"{MEMORY_ENV} below the memory this machine has, so a model too big is refused "
+                           "before loading)") from None
     _CACHE[key] = model
     while len(_CACHE) > CACHE_SIZE:
         _CACHE.popitem(last=False)
@@ -321,6 +345,10 @@ def _trimesh_scene(p: Path, data: bytes, file_type: str) -> Any:
 
         try:
             resolver = RegularFiles(str(p))
+            # trimesh names the scene's nodes after the file and hashes the names as UTF-8: a name
+            # with bytes that are not UTF-8 (kept by Python as surrogates) is given printable stand-ins.
+            resolver.file_name = _printable(resolver.file_name)
+            resolver.file_path = _printable(resolver.file_path)
             loader = getattr(trimesh, "load_scene", None)
             if loader is not None:
                 return loader(io.BytesIO(data), file_type=file_type, resolver=resolver, process=False)
@@ -330,6 +358,11 @@ def _trimesh_scene(p: Path, data: bytes, file_type: str) -> Any:
             raise
         except (Exception, RecursionError) as exc:  # anything a reader raises on bad data
             raise SandboxError(f"model file {p}: not a readable {file_type.upper()} file: {_reason(exc)}") from None
+
+
+def _printable(name: str) -> str:
+    """``name`` with the undecodable bytes of a file name (surrogates) replaced by U+FFFD."""
+    return name.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
 
 
 @dataclass
@@ -352,11 +385,10 @@ def _parts(p: Path, scene: Any) -> list[_Part]:
     looks: dict[int, Look] = {}  # by material object: many meshes may share one (and its big image)
     with _quiet():
         try:
-            for node in scene.graph.nodes_geometry:
-                transform, name = scene.graph[node]
+            for transform, name in _placements(scene.graph):
                 geometry = scene.geometry.get(name)
                 if isinstance(geometry, trimesh.Trimesh):
-                    parts.append(_part(geometry, np.asarray(transform, dtype=np.float64), len(parts), looks))
+                    parts.append(_part(geometry, transform, len(parts), looks))
         except SandboxError:
             raise
         except Exception as exc:
@@ -364,9 +396,47 @@ def _parts(p: Path, scene: Any) -> list[_Part]:
     return parts
 
 
+def _placements(graph: Any) -> list[tuple[NDArray[np.float64], Any]]:
+    """``(world transform, geometry name)`` of every node with geometry, in trimesh's node order.
+
+    Asking trimesh's graph (``graph[node]``) walks the path from the root for
+    every node and checks a hash of the whole graph on each call: a chain of
+    5,000 nested nodes took minutes. Here each node's world transform is its
+    parent's times its own edge's, each worked out once (linear in the nodes).
+    """
+    from trimesh.transformations import fix_rigid
+
+    forest = graph.transforms
+    base = graph.base_frame
+    world: dict[Any, NDArray[np.float64]] = {base: np.eye(4)}
+
+    def transform_of(node: Any) -> NDArray[np.float64]:
+        chain = []  # the node and its ancestors whose transforms are not known yet, deepest first
+        while node not in world:
+            parent = forest.parents.get(node)
+            if parent is None:  # not under the root: trimesh would not place it either
+                world[node] = np.eye(4)
+                break
+            chain.append((parent, node))
+            node = parent
+        for parent, child in reversed(chain):
+            edge = forest.edge_data.get((parent, child), {}).get("matrix")
+            world[child] = world[parent] if edge is None else world[parent] @ np.asarray(edge, dtype=np.float64)
+        return world[node if not chain else chain[0][1]]
+
+    placed = []
+    for node in graph.nodes_geometry:
+        matrix = transform_of(node)
+        if graph.repair_rigid is not None:  # as trimesh does: an almost rigid product made rigid again
+            matrix = fix_rigid(matrix, max_deviance=graph.repair_rigid)
+        placed.append((np.asarray(matrix, dtype=np.float64), forest.node_data[node].get("geometry")))
+    return placed
+
+
 def _part(mesh: Any, transform: NDArray[np.float64], index: int, looks: dict[int, Look]) -> _Part:
-    positions = np.array(mesh.vertices, dtype=np.float64).reshape(-1, 3)
-    faces = np.array(mesh.faces, dtype=np.int64).reshape(-1, 3)
+    # Views of trimesh's arrays where their types already fit (no copy: every step below makes new arrays).
+    positions = np.asarray(mesh.vertices, dtype=np.float64).reshape(-1, 3)
+    faces = np.asarray(mesh.faces, dtype=np.int64).reshape(-1, 3)
     normals = _file_normals(mesh, positions.shape[0])
     linear = transform[:3, :3]
     if not np.array_equal(transform, np.eye(4)):
@@ -424,8 +494,7 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
         raise SandboxError(f"model file {p} has no faces{what}")
     # One vertex and face list for all parts, to check them as the file numbers them.
     offsets = np.cumsum([0] + [part.positions.shape[0] for part in parts])
-    positions = np.concatenate([part.positions for part in parts])
-    faces = np.concatenate([part.faces + offset for part, offset in zip(parts, offsets)])
+    positions, faces = _all_parts(parts, offsets)
     bad = np.flatnonzero(~np.isfinite(positions).all(axis=1))
     if bad.size:
         raise SandboxError(f"model file {p}: {_count(bad.size, 'vertex', 'vertices')} with NaN or infinite "
@@ -489,8 +558,7 @@ def _group_mesh(p: Path, file_type: str, parts: list[_Part], normals_mode: str, 
     """One mesh for parts that share a material: ``(mesh, triangles, degenerate faces
     dropped, how its normals were made)``; no mesh when every face was degenerate."""
     offsets = np.cumsum([0] + [part.positions.shape[0] for part in parts])
-    positions = np.concatenate([part.positions for part in parts])
-    faces = np.concatenate([part.faces + offset for part, offset in zip(parts, offsets)])
+    positions, faces = _all_parts(parts, offsets)
     # Optional attributes: a part without them gets neutral values when another has them.
     has_uvs = any(part.uvs is not None for part in parts)
     uvs = np.concatenate([part.uvs if part.uvs is not None else np.zeros((part.positions.shape[0], 2))
@@ -504,18 +572,15 @@ def _group_mesh(p: Path, file_type: str, parts: list[_Part], normals_mode: str, 
     dropped = int(faces.shape[0] - keep.sum())
     if not keep.any():
         return None, 0, dropped, ""
-    faces = faces[keep]
+    if dropped:
+        faces = faces[keep]
     if corner_colors is not None:
         corner_colors = corner_colors[keep]
-    normals, how = _corner_normals(p, positions, faces, file_normals, normals_mode, crease)
-    # Per-corner attributes, then vertices made unique again by everything they carry.
+    position_ids = row_ids(positions, ordered=False)[0]
+    group, group_normals, how = _normal_groups(p, positions, faces, file_normals, normals_mode, crease,
+                                               position_ids)
     corners = faces.reshape(-1)
-    rows = [positions[corners], normals.reshape(-1, 3)]
-    if uvs is not None:
-        rows.append(uvs[corners])
-    if corner_colors is not None:
-        rows.append(corner_colors.reshape(-1, 3))
-    index, first = unique_vertices(np.concatenate(rows, axis=1))
+    index, first = _split_vertices(position_ids, uvs, corners, corner_colors, group, group_normals)
     chosen = corners[first]
     where = p.name if part_name is None else f"{p.name}, part {part_name!r}"
     notes = [f"{where}: {_count(faces.shape[0], 'triangle')} ({file_type.upper()})"]
@@ -523,10 +588,18 @@ def _group_mesh(p: Path, file_type: str, parts: list[_Part], normals_mode: str, 
         notes.append(f"{_count(dropped, 'degenerate face')} dropped (zero area or a repeated vertex)")
     notes.append(f"normals {'from the file' if how == 'file' else how}")
     name = p.name if part_name is None else f"{p.name}#{part_name}"
-    mesh = Mesh(name, positions[chosen], index.astype(np.uint32), normals.reshape(-1, 3)[first],
+    mesh = Mesh(name, positions[chosen], index.astype(np.uint32), group_normals[group[first]],
                 None if uvs is None else uvs[chosen],
                 None if corner_colors is None else corner_colors.reshape(-1, 3)[first], notes=tuple(notes))
     return mesh, int(faces.shape[0]), dropped, how
+
+
+def _all_parts(parts: list[_Part], offsets: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """All parts' positions and faces as one list (a single part's arrays as they are: no copy)."""
+    if len(parts) == 1:
+        return parts[0].positions, parts[0].faces
+    return (np.concatenate([part.positions for part in parts]),
+            np.concatenate([part.faces + offset for part, offset in zip(parts, offsets)]))
 
 
 def _count(n: int, one: str, many: str | None = None) -> str:
@@ -548,33 +621,57 @@ def _corner_colors(parts: list[_Part]) -> NDArray[np.float64]:
 
 
 def _degenerate(positions: NDArray[np.float64], faces: NDArray[np.int64]) -> NDArray[np.bool_]:
-    """Faces with a repeated index or (numerically) zero area."""
+    """Faces with a repeated index or (numerically) zero area, worked out in blocks of faces
+    (bounded temporaries)."""
+    flat = np.empty(faces.shape[0], dtype=bool)
+    for lo in range(0, faces.shape[0], BLOCK_FACES):
+        block = faces[lo:lo + BLOCK_FACES]
+        a, b, c = positions[block[:, 0]], positions[block[:, 1]], positions[block[:, 2]]
+        with np.errstate(all="ignore"):
+            cross = face_cross(a, b, c)
+            doubled_area_sq = np.einsum("ij,ij->i", cross, cross)
+            longest = np.zeros(block.shape[0])
+            for e in (b - a, c - b, a - c):
+                np.maximum(longest, np.einsum("ij,ij->i", e, e), out=longest)
+            # |cross| > share * longest², compared squared (both sides are non-negative).
+            flat[lo:lo + BLOCK_FACES] = ~(doubled_area_sq > (DEGENERATE_SHARE * longest) ** 2)
     repeated = (faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 0] == faces[:, 2])
-    a, b, c = positions[faces[:, 0]], positions[faces[:, 1]], positions[faces[:, 2]]
-    with np.errstate(all="ignore"):
-        doubled_area = np.linalg.norm(np.cross(b - a, c - a), axis=1)
-        longest = np.max(np.stack([np.einsum("ij,ij->i", e, e) for e in (b - a, c - b, a - c)]), axis=0)
-        flat = ~(doubled_area > DEGENERATE_SHARE * longest)
     return repeated | flat
 
 
-def _corner_normals(p: Path, positions: NDArray[np.float64], faces: NDArray[np.int64],
-                    file_normals: NDArray[np.float64] | None, mode: str,
-                    crease: float) -> tuple[NDArray[np.float64], str]:
-    """A unit normal per face corner, (F, 3, 3), and how it was made."""
+def _normal_groups(p: Path, positions: NDArray[np.float64], faces: NDArray[np.int64],
+                   file_normals: NDArray[np.float64] | None, mode: str, crease: float,
+                   position_ids: NDArray[np.intp]) -> tuple[NDArray[np.intp], NDArray[np.float64], str]:
+    """Corner normals as ``(group (C,), unit normals (G, 3))`` (corner ``c`` has ``normals[group[c]]``,
+    :func:`glsandbox.meshnormals.normal_groups`), and how they were made."""
     if mode in ("auto", "file"):
         usable = None
         if file_normals is not None:
-            used = file_normals[faces]
             with np.errstate(all="ignore"):
-                size = np.linalg.norm(used, axis=2, keepdims=True)
-                if np.isfinite(used).all() and (size > 1e-12).all():
-                    usable = used / size
+                size = np.sqrt(np.einsum("ij,ij->i", file_normals, file_normals))
+                fine = np.isfinite(file_normals).all(axis=1) & (size > 1e-12)
+                if fine[faces].all():  # only the vertices the faces use need a normal
+                    usable = file_normals / np.where(fine, size, 1.0)[:, None]
         if usable is not None:
-            return usable, "file"
+            return faces.reshape(-1).astype(np.intp), usable, "file"
         if mode == "file":
             why = "has no vertex normals" if file_normals is None else "has zero-length or non-finite normals"
             raise SandboxError(f"model file {p} {why} (normals = \"file\"); use \"auto\" to compute them")
         mode = "crease"
-    normals = corner_normals(positions, faces.astype(np.intp), mode, crease)
-    return normals, f"crease {crease:g}°" if mode == "crease" else mode
+    group, normals = normal_groups(positions, np.asarray(faces, dtype=np.intp), mode, crease, position_ids)
+    return group, normals, f"crease {crease:g}°" if mode == "crease" else mode
+
+
+def _split_vertices(position_ids: NDArray[np.intp], uvs: NDArray[np.float64] | None, corners: NDArray[np.int64],
+                    corner_colors: NDArray[np.float64] | None, group: NDArray[np.intp],
+                    group_normals: NDArray[np.float64]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """The drawn vertices: ``(index (C,), a corner of each)``. Corners share a vertex exactly when
+    their position, uv, colour and normal are bit-identical; each is numbered once (positions and
+    uvs per file vertex, normals per group), so only integers are compared per corner."""
+    attribute = position_ids
+    if uvs is not None:
+        attribute = split_vertices(position_ids, row_ids(uvs, ordered=False)[0])[0]
+    attribute = attribute[corners]
+    if corner_colors is not None:
+        attribute = split_vertices(attribute, row_ids(corner_colors.reshape(-1, 3), ordered=False)[0])[0]
+    return split_vertices(attribute, row_ids(group_normals, ordered=False)[0][group])

@@ -19,51 +19,129 @@ Wüthrich 1998): it does not change when a face is cut into more triangles.
 Faces meeting at a position are found by the position's exact coordinates,
 so vertices split by the file for texture seams still share one normal.
 
-Afterwards vertices are made unique again by everything they carry
-(position, normal, uv, colour): corners that ended up with bit-identical
-attributes share one vertex (:func:`unique_vertices`).
+**Linear time.** Testing every pair of corners at a position costs k² for
+k corners there: a fan of a million triangles around one point would be a
+million million tests. So the crease rule is worked out in three tiers, each
+linear in the number of corners:
+
+1. a position whose face normals all lie within *half* the crease angle of
+   their mean direction has every pair within the crease angle (the angle
+   between two normals is at most the sum of their angles to the mean): every
+   corner there takes the sum over all, one ``bincount``. Scanned surfaces,
+   flat fans and a triangle repeated a million times are all this case;
+2. the other positions with at most :data:`PAIR_LIMIT` corners (a cube's
+   corner, a crease on a scan) test their pairs exactly as the rule says:
+   at most ``PAIR_LIMIT`` tests per corner;
+3. a larger position that fails the test of 1 (the apex of a cone of many
+   faces) sorts its corners by their angle around the position's mean
+   normal, walks that ring and cuts it where two neighbours' normals differ
+   by more than the crease angle; each run between cuts is averaged (the
+   "smoothing group" rule of modelling tools). It agrees with the pairwise
+   rule when the sharp edges are where the normals jump.
+
+The result is a *group* per corner and a unit normal per group
+(:func:`normal_groups`); corners in one group share a normal. Afterwards
+vertices are made unique again by everything they carry (position, normal,
+uv, colour): :func:`split_vertices` numbers (attribute id, normal id) pairs,
+integers, so no corner-sized float matrix is ever hashed.
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["MODES", "corner_normals", "face_normals", "row_ids", "unique_vertices"]
+__all__ = ["BLOCK_FACES", "MODES", "PAIR_LIMIT", "corner_normals", "face_normals", "normal_groups", "row_ids", "split_vertices",
+           "unique_vertices"]
 
 #: The ways to make normals.
 MODES = ("flat", "smooth", "crease")
 
-#: A position shared by more corners than this gets its crease test done as a
-#: matrix product in blocks instead of one (corner, corner) pair per entry.
-_PAIR_GROUP_LIMIT = 64
+#: A position with more corners than this that is not smooth all round is split by
+#: walking its ring of corners (tier 3 of the module docstring), not pair by pair.
+PAIR_LIMIT = 64
+
+#: Faces worked on at once where a step needs several temporary arrays per face (bounds the
+#: memory a big model needs: a few megabytes per array, not one per triangle of the model).
+BLOCK_FACES = 1 << 16
+
+#: Pairs tested at once by the pairwise tier (bounds its temporary arrays).
+_PAIR_BLOCK = 1 << 21
+
+#: Tier 1 asks for normals within half the crease angle less this much (radians), so
+#: rounding in the dot products cannot admit a pair the exact test would refuse.
+_HALF_ANGLE_MARGIN = 1e-6
 
 
 def face_normals(positions: NDArray[np.float64], tris: NDArray[np.intp]) -> NDArray[np.float64]:
     """Unit face normals ``(F, 3)`` of ``N = (V1 − V0) × (V2 − V0)``; zero for a zero-area face."""
-    a, b, c = positions[tris[:, 0]], positions[tris[:, 1]], positions[tris[:, 2]]
-    n = np.cross(b - a, c - a)
-    size = np.linalg.norm(n, axis=1, keepdims=True)
-    return np.divide(n, size, out=np.zeros_like(n), where=size > 0.0)
+    return _unit_rows(face_cross(positions[tris[:, 0]], positions[tris[:, 1]], positions[tris[:, 2]]))[0]
 
 
-def _corner_angles(positions: NDArray[np.float64], tris: NDArray[np.intp]) -> NDArray[np.float64]:
-    """The angle ``(F, 3)`` of each face at each of its corners."""
-    p = positions[tris]  # (F, 3, 3)
-    to_next = np.roll(p, -1, axis=1) - p
-    to_prev = np.roll(p, 1, axis=1) - p
-    sin = np.linalg.norm(np.cross(to_next, to_prev), axis=2)
-    cos = np.einsum("fkj,fkj->fk", to_next, to_prev)
-    return np.arctan2(sin, cos)
+def face_cross(p0: NDArray[np.float64], p1: NDArray[np.float64], p2: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``(V1 − V0) × (V2 − V0)`` per face from its corners' positions ``(F, 3)`` each, written out
+    per component (``np.cross`` is several times slower); its length is the doubled area."""
+    e1 = p1 - p0
+    e2 = p2 - p0
+    n = np.empty_like(e1)
+    n[:, 0] = e1[:, 1] * e2[:, 2] - e1[:, 2] * e2[:, 1]
+    n[:, 1] = e1[:, 2] * e2[:, 0] - e1[:, 0] * e2[:, 2]
+    n[:, 2] = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+    return n
 
 
-def row_ids(rows: NDArray[np.float64]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+def _unit_rows(rows: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``(rows / |row|, |row|)``; a zero row stays zero."""
+    size = np.sqrt(np.einsum("ij,ij->i", rows, rows))
+    return np.divide(rows, size[:, None], out=np.zeros_like(rows), where=size[:, None] > 0.0), size
+
+
+def _faces_and_angles(positions: NDArray[np.float64], tris: NDArray[np.intp],
+                      with_angles: bool) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Unit face normals ``(F, 3)`` and the corner angles ``(3F,)`` (empty unless ``with_angles``),
+    in blocks of :data:`BLOCK_FACES` faces."""
+    f = tris.shape[0]
+    faces = np.empty((f, 3))
+    angles = np.empty((f, 3) if with_angles else (0, 3))
+    for lo in range(0, f, BLOCK_FACES):
+        block = tris[lo:lo + BLOCK_FACES]
+        p0, p1, p2 = (positions[block[:, k]] for k in range(3))
+        faces[lo:lo + BLOCK_FACES], doubled_area = _unit_rows(face_cross(p0, p1, p2))
+        if with_angles:
+            angles[lo:lo + BLOCK_FACES] = _corner_angles(p0, p1, p2, doubled_area)
+    return faces, angles.reshape(-1)
+
+
+def _corner_angles(p0: NDArray[np.float64], p1: NDArray[np.float64], p2: NDArray[np.float64],
+                   doubled_area: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The angle ``(F, 3)`` of each face at each of its corners: ``atan2(|e × e'|, e · e')`` for
+    the two edges leaving the corner, where ``|e × e'|`` is the doubled area at all three corners."""
+    angles = np.empty((p0.shape[0], 3))
+    for k, (here, nxt, prv) in enumerate(((p0, p1, p2), (p1, p2, p0), (p2, p0, p1))):
+        angles[:, k] = np.arctan2(doubled_area, np.einsum("ij,ij->i", nxt - here, prv - here))
+    return angles
+
+
+def _by_first_appearance(first: NDArray[np.intp], inverse: NDArray[np.intp]) -> tuple[NDArray[np.intp],
+                                                                                      NDArray[np.intp]]:
+    """Renumber ``np.unique``'s groups in the order their first member appears."""
+    rank = np.empty(first.size, dtype=np.intp)
+    by_first = np.argsort(first, kind="stable")
+    rank[by_first] = np.arange(first.size)
+    return rank[inverse.reshape(-1)], first[by_first]
+
+
+def row_ids(rows: NDArray[np.float64], ordered: bool = True) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
     """``(ids, firsts)``: ``ids[i] == ids[j]`` exactly when rows ``i`` and ``j`` are bit-identical
-    (``-0.0`` counted as ``0.0``), numbered by first appearance; ``firsts[g]`` is the first row of id ``g``.
+    (``-0.0`` counted as ``0.0``); ``firsts[g]`` is a row of id ``g``. ``ordered``: ids numbered by
+    first appearance and ``firsts[g]`` the first row of id ``g`` (a second sort); otherwise in no
+    particular order, for ids only compared with each other.
 
     A 64-bit hash of each row is sorted (much faster than ``np.unique(axis=0)``),
-    then every row is compared with its group's first row: on a hash collision
-    the exact (slower) row sort answers instead.
+    then every row is compared with its group's representative: on a hash
+    collision the exact (slower) row sort answers instead.
     """
     rows = np.ascontiguousarray(rows + 0.0)  # -0.0 + 0.0 == +0.0: one bit pattern for zero
     n = rows.shape[0]
@@ -76,14 +154,62 @@ def row_ids(rows: NDArray[np.float64]) -> tuple[NDArray[np.intp], NDArray[np.int
             h ^= bits[:, col]
             h *= np.uint64(0x100000001B3)
             h ^= h >> np.uint64(29)
-    _, first, inverse = np.unique(h, return_index=True, return_inverse=True)
+    if ordered:
+        _, first, inverse = np.unique(h, return_index=True, return_inverse=True)
+    else:
+        _, inverse = np.unique(h, return_inverse=True)
+        first = np.empty(int(inverse.max()) + 1, dtype=np.intp)
+        first[inverse] = np.arange(n)  # any row of each id: they are all the same, or a collision shows
+    inverse = inverse.reshape(-1)
+    del h
     if not np.array_equal(bits[first[inverse]], bits):  # a collision: sort the rows themselves
         _, first, inverse = np.unique(bits, axis=0, return_index=True, return_inverse=True)
-    # Number the groups by first appearance, so the output keeps the input's order.
-    rank = np.empty(first.size, dtype=np.intp)
-    by_first = np.argsort(first, kind="stable")
-    rank[by_first] = np.arange(first.size)
-    return rank[inverse.reshape(-1)], first[by_first]
+        inverse = inverse.reshape(-1)
+    return _by_first_appearance(first, inverse) if ordered else (inverse, first)
+
+
+def split_vertices(attribute_ids: NDArray[np.intp], normal_ids: NDArray[np.intp]) -> tuple[NDArray[np.intp],
+                                                                                          NDArray[np.intp]]:
+    """Vertices from corners: ``(index (C,), a corner of each vertex)``. Two corners share a vertex
+    exactly when both their attribute id and their normal id are equal (both ids ``>= 0``).
+
+    Linear, no sort of the corners: each attribute id first takes the normal of
+    one of its corners; only corners whose normal differs from that one (a crease,
+    a flat face's corner) are numbered by sorting, after them. Vertices are
+    numbered in the order of their attribute ids, the extra ones last.
+    """
+    c = attribute_ids.size
+    if c == 0:
+        return np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp)
+    n_attr = int(attribute_ids.max()) + 1
+    owner = np.empty(n_attr, dtype=np.intp)
+    owner[attribute_ids] = normal_ids  # any one corner's normal per attribute id
+    vertex = attribute_ids.astype(np.intp)
+    extra = np.flatnonzero(normal_ids != owner[attribute_ids])
+    del owner
+    count = n_attr
+    if extra.size:
+        span = int(normal_ids.max()) + 1
+        _, again = np.unique(attribute_ids[extra].astype(np.int64) * span + normal_ids[extra], return_inverse=True)
+        vertex[extra] = n_attr + again.reshape(-1)
+        count += int(again.max()) + 1
+    # Attribute ids no corner uses (a vertex only a dropped face had) leave no vertex.
+    used = np.zeros(count, dtype=bool)
+    used[vertex] = True
+    renumber = np.cumsum(used, dtype=np.intp) - 1
+    vertex = renumber[vertex]
+    first = np.empty(int(renumber[-1]) + 1, dtype=np.intp)
+    first[vertex] = np.arange(c, dtype=np.intp)  # any corner of each vertex: they carry the same
+    return vertex, first
+
+
+def unique_vertices(corner_attributes: NDArray[np.float64]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """Vertices from per-corner attribute rows ``(C, k)``: ``(indices (C,), first corner of each vertex)``.
+
+    Corners with bit-identical attributes share a vertex; vertices are
+    numbered in the order their first corner appears.
+    """
+    return row_ids(corner_attributes)
 
 
 def corner_normals(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: str = "crease",
@@ -93,36 +219,107 @@ def corner_normals(positions: NDArray[np.float64], tris: NDArray[np.intp], mode:
     ``tris`` must hold no zero-area face (drop them first). Where the
     weighted sum cancels to zero (a knife edge), the face's own normal is used.
     """
+    group, normals = normal_groups(positions, tris, mode, crease_angle)
+    return normals[group].reshape(-1, 3, 3)
+
+
+def normal_groups(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: str = "crease",
+                  crease_angle: float = 30.0, position_ids: NDArray[np.intp] | None = None,
+                  ) -> tuple[NDArray[np.intp], NDArray[np.float64]]:
+    """``(group (C,), normals (G, 3))``: corner ``c`` (face ``c // 3``, its corner ``c % 3``) has the
+    unit normal ``normals[group[c]]``, made the way ``mode`` says (module docstring).
+
+    ``tris`` must hold no zero-area face. Where a weighted sum cancels to zero
+    (a knife edge), the corner takes its face's own normal. ``position_ids``:
+    :func:`row_ids` of ``positions`` when the caller has it already.
+    """
     if mode not in MODES:
         raise ValueError(f"unknown normals mode {mode!r}; use one of {', '.join(MODES)}")
-    faces = face_normals(positions, tris)
+    tris = np.asarray(tris, dtype=np.intp)
     f = tris.shape[0]
+    faces, angles = _faces_and_angles(positions, tris, with_angles=mode != "flat")
     if mode == "flat" or f == 0:
-        return np.repeat(faces[:, None, :], 3, axis=1)
-    weighted = faces[:, None, :] * _corner_angles(positions, tris)[:, :, None]  # (F, 3, 3)
-    pid, _ = row_ids(positions)
-    corner_pid = pid[tris].reshape(-1)  # the welded position of each corner
-    w = weighted.reshape(-1, 3)
-    total: NDArray[np.float64]
+        return np.repeat(np.arange(f, dtype=np.intp), 3), faces
+    pid = row_ids(positions, ordered=False)[0] if position_ids is None else position_ids
+    corner_pid = pid[tris.reshape(-1)]  # the welded position of each corner
+    del pid
+    npos = int(corner_pid.max()) + 1
     if mode == "smooth":
-        sums = np.stack([np.bincount(corner_pid, w[:, j], minlength=int(pid.max()) + 1) for j in range(3)], axis=1)
-        total = np.asarray(sums[corner_pid], dtype=np.float64)
-    else:
-        total = _crease_sums(corner_pid, np.repeat(faces, 3, axis=0), w, float(np.cos(np.radians(crease_angle))))
-    size = np.linalg.norm(total, axis=1, keepdims=True)
-    own = np.repeat(faces, 3, axis=0)
-    unit = np.where(size > 1e-300, total / np.where(size > 1e-300, size, 1.0), own)
-    return unit.reshape(f, 3, 3)
+        sums = _sums(corner_pid, faces, angles, npos)
+        return _finish(corner_pid, sums, faces)
+    cos_limit = math.cos(math.radians(crease_angle))
+    # Tier 1: positions whose normals all lie within half the crease angle of their mean direction.
+    mean = _unit_rows(np.stack([np.bincount(corner_pid, np.repeat(faces[:, j], 3), minlength=npos)
+                                for j in range(3)], axis=1))[0]
+    half = max(0.0, math.radians(crease_angle) / 2.0 - _HALF_ANGLE_MARGIN)
+    spread = np.zeros(corner_pid.size)
+    for j in range(3):
+        spread += np.repeat(faces[:, j], 3) * mean[corner_pid, j]
+    rough_pos = np.zeros(npos, dtype=bool)
+    rough_pos[corner_pid[spread < math.cos(half)]] = True
+    del spread
+    rough = rough_pos[corner_pid]
+    del rough_pos
+    which = np.flatnonzero(rough)
+    if which.size == 0:
+        return _finish(corner_pid, _sums(corner_pid, faces, angles, npos), faces)
+    # Tiers 2 and 3: every rough corner gets a group of its own numbered after the positions;
+    # corners of one smoothing group get the same sum, so they merge again by their normal.
+    rough_angles = angles[which]
+    angles[which] = 0.0  # rough corners weigh nothing in their position's tier-1 sum
+    smooth_sums = _sums(corner_pid, faces, angles, npos)
+    del angles, rough
+    rough_pid = corner_pid[which]
+    big = np.bincount(rough_pid, minlength=npos)[rough_pid] > PAIR_LIMIT
+    rough_sums = np.zeros((which.size, 3))
+    small_corners = which[~big]
+    if small_corners.size:
+        own = faces[small_corners // 3]
+        rough_sums[~big] = _pair_sums(rough_pid[~big], own, own * rough_angles[~big, None], cos_limit)
+    big_corners = which[big]
+    if big_corners.size:
+        rough_sums[big] = _ring_sums(positions, tris, big_corners, rough_pid[big], faces[big_corners // 3],
+                                     rough_angles[big], mean[rough_pid[big]], cos_limit)
+    group = corner_pid
+    group[which] = npos + np.arange(which.size)
+    return _finish(group, np.concatenate([smooth_sums, rough_sums]), faces)
 
 
-def _crease_sums(corner_pid: NDArray[np.intp], own: NDArray[np.float64], weighted: NDArray[np.float64],
-                 cos_limit: float) -> NDArray[np.float64]:
-    """For every corner: the sum of ``weighted`` over the corners at its position whose
+def _sums(corner_group: NDArray[np.intp], faces: NDArray[np.float64], angles: NDArray[np.float64],
+          groups: int) -> NDArray[np.float64]:
+    """The angle-weighted sum of face normals over the corners of each group, ``(groups, 3)``
+    (every corner given: corner ``c`` is of face ``c // 3``)."""
+    sums = np.empty((groups, 3))
+    for j in range(3):
+        weight = np.repeat(faces[:, j], 3)
+        weight *= angles
+        sums[:, j] = np.bincount(corner_group, weight, minlength=groups)
+    return sums
+
+
+def _finish(group: NDArray[np.intp], sums: NDArray[np.float64],
+            faces: NDArray[np.float64]) -> tuple[NDArray[np.intp], NDArray[np.float64]]:
+    """Unit normals from the groups' sums; a corner whose group's sum cancels takes its face's normal."""
+    size = np.sqrt(np.einsum("ij,ij->i", sums, sums))
+    ok = size > 1e-300
+    unit = np.divide(sums, size[:, None], out=np.zeros_like(sums), where=ok[:, None])
+    cancelled = np.flatnonzero(~ok[group])
+    if cancelled.size:  # a knife edge: those corners get groups of their own, with their face's normal
+        group = group.copy()
+        group[cancelled] = unit.shape[0] + np.arange(cancelled.size)
+        unit = np.concatenate([unit, faces[cancelled // 3]])
+    return group, unit
+
+
+def _pair_sums(corner_pid: NDArray[np.intp], own: NDArray[np.float64], weighted: NDArray[np.float64],
+               cos_limit: float) -> NDArray[np.float64]:
+    """For every corner given: the sum of ``weighted`` over the given corners at its position whose
     face normal is within the crease angle of its own (``own·other >= cos_limit``).
 
     Corners are grouped by position; each (corner, corner) pair of a group is
     tested, summed in the group's order for every corner, so corners with the
     same neighbours get bit-identical sums (and share a vertex afterwards).
+    Every group here has at most :data:`PAIR_LIMIT` corners.
     """
     c = corner_pid.shape[0]
     order = np.argsort(corner_pid, kind="stable")
@@ -130,33 +327,20 @@ def _crease_sums(corner_pid: NDArray[np.intp], own: NDArray[np.float64], weighte
     starts = np.flatnonzero(np.r_[True, sorted_pid[1:] != sorted_pid[:-1]])
     sizes = np.diff(np.r_[starts, c])
     total = np.zeros((c, 3))
-    small = sizes <= _PAIR_GROUP_LIMIT
-    # Small groups: every pair at once, in blocks of about 4M pairs.
-    group_ids = np.flatnonzero(small)
-    work = np.cumsum(sizes[group_ids].astype(np.int64) ** 2)
-    cuts: NDArray[np.intp] = np.zeros(0, dtype=np.intp)
-    if work.size:
-        cuts = np.searchsorted(work, np.arange(1 << 22, int(work[-1]) + (1 << 22), 1 << 22), side="right")
+    work = np.cumsum(sizes.astype(np.int64) ** 2)
+    cuts = np.searchsorted(work, np.arange(_PAIR_BLOCK, int(work[-1]) + _PAIR_BLOCK, _PAIR_BLOCK), side="right")
     lo = 0
-    for hi in np.unique(np.r_[cuts, group_ids.size]):
+    for hi in np.unique(np.r_[cuts, sizes.size]):
         if hi > lo:
-            _pair_block(group_ids[lo:hi], starts, sizes, order, own, weighted, cos_limit, total)
+            _pair_block(np.arange(lo, hi), starts, sizes, order, own, weighted, cos_limit, total)
         lo = hi
-    # Large groups (a fan of many faces at one point): a thresholded matrix product.
-    for g in np.flatnonzero(~small):
-        members = order[starts[g]:starts[g] + sizes[g]]
-        n_own, w_own = own[members], weighted[members]
-        for lo in range(0, members.size, 1024):
-            rows = members[lo:lo + 1024]
-            mask = (own[rows] @ n_own.T) >= cos_limit
-            total[rows] = mask.astype(np.float64) @ w_own
     return total
 
 
 def _pair_block(groups: NDArray[np.intp], starts: NDArray[np.intp], sizes: NDArray[np.intp], order: NDArray[np.intp],
                 own: NDArray[np.float64], weighted: NDArray[np.float64], cos_limit: float,
                 total: NDArray[np.float64]) -> None:
-    """:func:`_crease_sums` for a block of small groups: all their (target, source) pairs as arrays."""
+    """:func:`_pair_sums` for a block of groups: all their (target, source) pairs as arrays."""
     size = sizes[groups]
     start = starts[groups]
     # Targets: each member of each group, repeated once per member of its group.
@@ -175,10 +359,41 @@ def _pair_block(groups: NDArray[np.intp], starts: NDArray[np.intp], sizes: NDArr
         total[:, j] += np.bincount(target, weighted[source, j], minlength=total.shape[0])
 
 
-def unique_vertices(corner_attributes: NDArray[np.float64]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
-    """Vertices from per-corner attribute rows ``(C, k)``: ``(indices (C,), first corner of each vertex)``.
-
-    Corners with bit-identical attributes share a vertex; vertices are
-    numbered in the order their first corner appears.
-    """
-    return row_ids(corner_attributes)
+def _ring_sums(positions: NDArray[np.float64], tris: NDArray[np.intp], corners: NDArray[np.intp],
+               corner_pid: NDArray[np.intp], own: NDArray[np.float64], angles: NDArray[np.float64],
+               mean: NDArray[np.float64], cos_limit: float) -> NDArray[np.float64]:
+    """Tier 3 (module docstring): the corners given, sorted by their angle around their position's
+    mean normal ``mean``, cut into runs where neighbours' normals differ by more than the crease
+    angle (the ring closes: the last run joins the first unless they differ too); each corner
+    gets the angle-weighted sum of its run."""
+    face, k = corners // 3, corners % 3
+    here = positions[tris[face, k]]
+    centre = (positions[tris[face, 0]] + positions[tris[face, 1]] + positions[tris[face, 2]]) / 3.0
+    toward = centre - here  # where the face lies around the position
+    # An axis across the mean normal: the mean with a unit axis it is not close to, crossed.
+    axis = np.where(np.abs(mean[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
+    u = np.cross(mean, axis)
+    u /= np.maximum(np.linalg.norm(u, axis=1, keepdims=True), 1e-300)
+    v = np.cross(mean, u)
+    azimuth = np.arctan2(np.einsum("ij,ij->i", toward, v), np.einsum("ij,ij->i", toward, u))
+    order = np.lexsort((azimuth, corner_pid))
+    pid, normal = corner_pid[order], own[order]
+    n = order.size
+    first = np.r_[True, pid[1:] != pid[:-1]]
+    starts = np.flatnonzero(first)
+    ends = np.r_[starts[1:], n] - 1
+    bend = np.einsum("ij,ij->i", normal[1:], normal[:-1]) < cos_limit  # between ring neighbours i-1 and i
+    cut = np.r_[False, bend] & ~first
+    run = np.cumsum(first | cut) - 1
+    # Close each ring: a ring with cuts whose last and first corners agree joins its last run to its first.
+    has_cut = np.add.reduceat(cut.astype(np.intp), starts) > 0
+    closes = np.einsum("ij,ij->i", normal[ends], normal[starts]) >= cos_limit
+    join = has_cut & closes
+    remap = np.arange(int(run[-1]) + 1)
+    remap[run[ends[join]]] = run[starts[join]]
+    run = remap[run]
+    weighted = own[order] * angles[order, None]
+    sums = np.stack([np.bincount(run, weighted[:, j], minlength=remap.size) for j in range(3)], axis=1)
+    total = np.empty((n, 3))
+    total[order] = sums[run]
+    return total

@@ -34,7 +34,7 @@ import numpy as np
 
 from glsandbox import transforms
 from glsandbox.errors import NUMBER_LIMIT, SandboxError, plain
-from glsandbox.files import read_user_file
+from glsandbox.files import check_inside_sandbox, read_user_file
 from glsandbox.geometry import Mesh, builtin_mesh
 from glsandbox.meshfile import CREASE_ANGLE, NORMALS as MESH_NORMALS, Model, ModelPart, is_model_path, load_model
 from glsandbox.planar import Mirror, PlanarShadow
@@ -293,6 +293,10 @@ class _SceneReader:
             raise self.fail("nodes", i, "shader", "expected a GLSL file path, got an empty text")
         if not path.is_absolute():
             path = self.path.parent / path  # relative to the scene file, not the shell
+        try:
+            check_inside_sandbox(path, "shader file")  # while grading: the submission's own files only
+        except SandboxError as exc:
+            raise self.fail("nodes", i, "shader", str(exc)) from None
         if not path.exists():
             raise self.fail("nodes", i, "shader", f"shader file {path} not found")
         if not isinstance(uniforms, dict):

@@ -22,7 +22,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
               "glsandbox.meshgen", "glsandbox.files", "glsandbox.file_watch", "glsandbox.progress",
               "glsandbox.version")),
     ("scene data", ("glsandbox.scene", "glsandbox.planar", "glsandbox.images",
-                    "glsandbox.overlay", "glsandbox.meshfile")),
+                    "glsandbox.overlay", "glsandbox.meshfile", "glsandbox.meshcheck")),
     ("scene logic", ("glsandbox.scene_file", "glsandbox.shadowmap", "glsandbox.plan", "glsandbox.camera",
                      "glsandbox.lesson")),
     ("renderers", ("glsandbox.gl", "glsandbox.raytrace")),

@@ -19,6 +19,7 @@ import moderngl
 import numpy as np
 
 from glsandbox.errors import SandboxError
+from glsandbox.files import check_inside_sandbox
 from glsandbox.gl.context import GLHost
 from glsandbox.images import texture_levels
 from glsandbox.scene import Texture
@@ -61,6 +62,7 @@ class TextureCache:
         if not spec.is_file:
             return ("builtin", spec.source)
         path = Path(spec.source)
+        check_inside_sandbox(path, "texture file")  # while grading: the submission's own files only
         try:
             stat = path.stat()
         except FileNotFoundError:

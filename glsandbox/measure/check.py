@@ -1,4 +1,4 @@
-"""``glsandbox check``: a lesson or scene file rendered and compared with a reference PNG.
+"""``glsandbox check``: lessons and scene files rendered and compared with reference PNGs.
 
 The comparison is the project's golden rule (:func:`glsandbox.measure.golden.compare_images`:
 a pixel is bad when a channel differs by more than ``threshold`` levels and no
@@ -6,23 +6,26 @@ pixel within one step matches, in both directions; the check fails when the
 bad share exceeds ``max_bad_share``). On a failure the actual and expected
 images and a diff picture are written (:func:`~glsandbox.measure.golden.write_artifacts`).
 
-A folder of submissions (:func:`glsandbox.lesson.lesson_files`) is checked one
-by one, each rendered in this process on a fresh headless context of its
-own, so a submission that breaks GL state, or raises anywhere in its code,
-is reported as BROKEN and the next one starts clean. A fresh context adds
-about 20 ms on llvmpipe; a Python subprocess per submission 1.2 to 1.5 s (the
-imports), so the context is the isolation used. What a context cannot
-contain (a submission that calls ``os._exit``, crashes the interpreter or
-never returns) stops the run.
+A folder of submissions (:func:`glsandbox.lesson.lesson_files`) is graded
+with each submission in a process of its own (:mod:`glsandbox.measure.isolate`),
+under a time and memory limit, reading only its own files
+(:mod:`glsandbox.measure.sandbox`), sending back only pixels. This process
+reads the references, compares and writes every verdict and report: nothing
+a submission does reaches another's verdict, the references, the reports or
+the exit code. Each submission gets one picture per :class:`Check` (one, or
+a rubric's several, :mod:`glsandbox.measure.rubric`) and an outcome per
+picture: PASS, FAIL, BROKEN (its error line), TIMEOUT, CRASHED or OUT OF MEMORY.
 """
 
 from __future__ import annotations
 
-import csv
+import hashlib
 import io
-import json
 import math
+import os
+import re
 import time
+import unicodedata
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,31 +35,43 @@ import numpy as np
 from glsandbox import files
 from glsandbox.errors import SandboxError
 from glsandbox.frame import DEFAULT_SIZE, Frame, HeadlessRenderer
-from glsandbox.lesson import Lesson, find_lesson, lesson_files, submission_lesson, user_code_error
-from glsandbox.measure.golden import DEFAULT_MAX_BAD_SHARE, DEFAULT_THRESHOLD, ImageMatch, compare_images, write_artifacts
+from glsandbox.lesson import Lesson, lesson_files, user_code_error
+from glsandbox.measure.golden import DEFAULT_THRESHOLD, ImageMatch, compare_images, write_artifacts
+from glsandbox.measure.isolate import BROKEN, CRASHED, OOM, TIMEOUT, Job, JobResult, Picture, Render, run_jobs
+from glsandbox.measure.rubric import Check
 
-#: The tolerances ``--tolerance KEY=VALUE`` (and the pytest fixture's keywords) accept.
-TOLERANCES = {"threshold": DEFAULT_THRESHOLD, "max_bad_share": DEFAULT_MAX_BAD_SHARE}
+PASS, FAIL = "PASS", "FAIL"
+#: Every outcome, in the order the summary counts them.
+OUTCOMES = (PASS, FAIL, BROKEN, TIMEOUT, CRASHED, OOM)
+#: The defaults of ``--timeout`` (seconds per picture) and ``--memory`` (MB per submission).
+DEFAULT_TIMEOUT, DEFAULT_MEMORY = 30.0, 2048
+#: Thumbnails kept for the HTML report: at most this wide.
+THUMB_WIDTH = 160
 
 
-def parse_tolerances(items: Sequence[str]) -> dict[str, float]:
-    """``threshold=4``, ``max_bad_share=0.01`` -> keywords of :func:`compare_images`, checked."""
-    tolerances: dict[str, float] = {}
-    for item in items:
-        key, sep, text = item.partition("=")
-        key = key.strip()
-        if not sep or key not in TOLERANCES:
-            raise SandboxError(f"--tolerance {item!r}: expected threshold=LEVELS or max_bad_share=FRACTION")
-        try:
-            value = float(text)
-        except ValueError:
-            value = math.nan
-        if key == "threshold" and not (math.isfinite(value) and value == int(value) and 0 <= value <= 255):
-            raise SandboxError(f"--tolerance {item!r}: threshold is a whole number of levels, 0..255")
-        if key == "max_bad_share" and not 0.0 <= value <= 1.0:  # NaN fails this too
-            raise SandboxError(f"--tolerance {item!r}: max_bad_share is a fraction, 0..1")
-        tolerances[key] = int(value) if key == "threshold" else value
-    return tolerances
+def shown(text: str) -> str:
+    """A name as it may be printed or written anywhere: bytes that are not UTF-8 as ``\\xNN``,
+    control and format characters (newlines, escape sequences) as ``\\n``, ``\\x1b``, ``\\u202e``."""
+    try:
+        raw = os.fsencode(text) if isinstance(text, str) else bytes(text)
+    except UnicodeEncodeError:  # a surrogate no file name gives
+        raw = text.encode("utf-8", "backslashreplace")
+    decoded = raw.decode("utf-8", "backslashreplace")
+    out = []
+    for char in decoded:
+        if unicodedata.category(char)[0] in "CZ" and char != " ":
+            out.append(char.encode("unicode_escape").decode("ascii"))
+        else:
+            out.append(char)
+    return "".join(out)
+
+
+def file_stem(name: str) -> str:
+    """A file name for a submission's artefacts: letters, digits, ``._-`` (and a hash when changed)."""
+    safe = re.sub(r"[^A-Za-z0-9._-]", "_", shown(name))[:80].lstrip(".") or "_"
+    if safe != name:
+        safe += "-" + hashlib.sha1(os.fsencode(name)).hexdigest()[:8]
+    return safe
 
 
 def read_reference(path: Path) -> np.ndarray:
@@ -68,19 +83,9 @@ def read_reference(path: Path) -> np.ndarray:
         raise SandboxError(f"reference {path}: not a PNG image ({exc})") from None
 
 
-def reference_size(path: Path, size: tuple[int, int] | None) -> tuple[int, int]:
-    """The size to render at: the one asked for, else the reference's, else the default."""
-    if size is not None:
-        return size
-    if path.exists():
-        image = read_reference(path)
-        return image.shape[1], image.shape[0]
-    return DEFAULT_SIZE
-
-
 def render_lesson(lesson: Lesson, size: tuple[int, int], samples: int = 0, backend: str | None = None,
                   renderer: HeadlessRenderer | None = None) -> Frame:
-    """Render one lesson; the lesson's own exceptions become one-line errors.
+    """Render one lesson in this process; the lesson's own exceptions become one-line errors.
 
     Without ``renderer`` a fresh context is opened and closed around it, so
     whatever one lesson leaves in GL state dies with its context.
@@ -97,32 +102,82 @@ def render_lesson(lesson: Lesson, size: tuple[int, int], samples: int = 0, backe
 
 
 @dataclass
-class CheckResult:
-    """One submission's outcome: PASS, FAIL or BROKEN (it did not render)."""
+class Outcome:
+    """One check of one submission."""
 
-    name: str
-    path: Path
+    check: Check
     status: str
     match: ImageMatch | None = None
     error: str = ""
     seconds: float = 0.0
     artifacts: dict[str, Path] = field(default_factory=dict)
+    thumb: np.ndarray | None = None
+
+    @property
+    def points(self) -> float:
+        return self.check.points if self.status == PASS else 0.0
+
+    def detail(self) -> str:
+        """The figures of a comparison, or the error line."""
+        if self.match is None:
+            return shown(self.error)
+        return self.match.summary().partition(": ")[2]
+
+
+@dataclass
+class CheckResult:
+    """One submission: its outcome for each check, and the last lines it printed."""
+
+    name: str
+    path: Path
+    outcomes: list[Outcome]
+    output: list[str] = field(default_factory=list)
+
+    @property
+    def shown(self) -> str:
+        return shown(self.name)
+
+    @property
+    def status(self) -> str:
+        """PASS when every check passed, else the first check's outcome that did not."""
+        return next((o.status for o in self.outcomes if o.status != PASS), PASS)
+
+    @property
+    def score(self) -> float:
+        return sum(o.points for o in self.outcomes)
+
+    @property
+    def total(self) -> float:
+        return sum(o.check.points for o in self.outcomes)
+
+    @property
+    def seconds(self) -> float:
+        return sum(o.seconds for o in self.outcomes)
+
+    @property
+    def match(self) -> ImageMatch | None:
+        return self.outcomes[0].match if len(self.outcomes) == 1 else None
 
     def line(self) -> str:
-        if self.match is None:
-            return f"{self.status:<6} {self.name}: {self.error}"
-        return f"{self.status:<6} {self.name}: {self.match.summary().partition(': ')[2]}"
+        """One line: the outcome, the name and (one check) the figures or error, (several) the score."""
+        if len(self.outcomes) == 1:
+            return f"{self.status:<6} {self.shown}: {self.outcomes[0].detail()}"
+        first = self.outcomes[0]
+        if first.status != PASS and all((o.status, o.error) == (first.status, first.error) for o in self.outcomes):
+            parts = f"every check {first.status} ({first.detail()})"  # it did not load: said once
+        else:
+            parts = "; ".join(f"{o.check.name} {o.status}" + ("" if o.status == PASS else f" ({o.detail()})")
+                              for o in self.outcomes)
+        return f"{self.status:<6} {self.shown}: {points(self.score)}/{points(self.total)} points: {parts}"
 
-    def row(self) -> dict[str, object]:
-        m = self.match
-        return {"name": self.name, "path": str(self.path), "status": self.status,
-                "bad_pixels": m.bad_pixels if m else None,
-                "bad_share": round(m.bad_share, 6) if m else None,
-                "max_diff": m.max_diff if m else None,
-                "rmse": None if m is None or math.isnan(m.rmse) else round(m.rmse, 6),
-                "threshold": m.threshold if m else None,
-                "max_bad_share": m.max_bad_share if m else None,
-                "seconds": round(self.seconds, 3), "error": self.error}
+
+def points(value: float) -> str:
+    return f"{value:g}"
+
+
+def _thumbnail(image: np.ndarray) -> np.ndarray:
+    step = max(1, math.ceil(image.shape[1] / THUMB_WIDTH))
+    return np.ascontiguousarray(image[::step, ::step])
 
 
 def judge(actual: np.ndarray, expected: np.ndarray, tolerances: dict[str, float], artifacts_dir: Path,
@@ -139,112 +194,180 @@ def judge(actual: np.ndarray, expected: np.ndarray, tolerances: dict[str, float]
     return match, paths
 
 
-def check_folder(folder: Path, reference: Path, settings: Sequence[str], size: tuple[int, int] | None,
-                 tolerances: dict[str, float], samples: int = 0, backend: str | None = None,
-                 progress: Callable[[str], None] = lambda text: None) -> list[CheckResult]:
-    """Check every submission in ``folder`` against ``reference``; never stops at a broken one.
+def results_dir(check: Check) -> Path:
+    """Where a check's failing pictures go: ``<golden stem>-results/`` beside the golden."""
+    return check.golden.with_name(f"{check.golden.stem}-results")
 
-    Failures leave their images in ``<reference stem>-results/`` beside the reference.
+
+@dataclass(frozen=True)
+class Limits:
+    """What each submission may use: seconds for each picture, MB of memory, submissions at once."""
+
+    timeout: float = DEFAULT_TIMEOUT
+    memory: int = DEFAULT_MEMORY
+    jobs: int = 1
+
+
+def default_jobs() -> int:
+    return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
+
+
+def _renders(checks: Sequence[Check], references: dict[Path, np.ndarray]) -> tuple[Render, ...]:
+    out = []
+    for check in checks:
+        expected = references.get(check.golden)
+        size = check.size or ((expected.shape[1], expected.shape[0]) if expected is not None else DEFAULT_SIZE)
+        out.append(Render(check.settings, size, check.samples))
+    return tuple(out)
+
+
+def submission_jobs(folder: Path, renders: tuple[Render, ...], backend: str | None,
+                    limits: Limits) -> list[tuple[str, Path, Job]]:
+    """(name, path, job) for each submission in ``folder``: a file alone, or the whole of its folder."""
+    out = []
+    for index, (name, path) in enumerate(lesson_files(folder)):
+        if path.parent != folder:  # a student's folder: the folder is the submission, its lesson inside
+            job = Job(index, str(path.parent), path.name, renders, backend, limits.timeout, limits.memory)
+        elif path.is_dir():  # a folder without one lesson file: loading it says why
+            job = Job(index, str(path), "", renders, backend, limits.timeout, limits.memory)
+        else:
+            job = Job(index, str(path), path.name, renders, backend, limits.timeout, limits.memory)
+        out.append((name, path, job))
+    return out
+
+
+def _outcomes(result: JobResult, checks: Sequence[Check], references: dict[Path, np.ndarray],
+              name: str) -> list[Outcome]:
+    outcomes = []
+    for check, picture in zip(checks, result.pictures):
+        outcomes.append(_outcome(check, picture, references[check.golden], name))
+    return outcomes
+
+
+def _outcome(check: Check, picture: Picture, expected: np.ndarray, name: str) -> Outcome:
+    if picture.image is None:
+        return Outcome(check, picture.status or CRASHED, error=shown(picture.error), seconds=picture.seconds)
+    stem = file_stem(name)
+    match, paths = judge(picture.image, expected, check.tolerances, results_dir(check), stem)
+    return Outcome(check, PASS if match.passed else FAIL, match, seconds=picture.seconds, artifacts=paths,
+                   thumb=_thumbnail(picture.image))
+
+
+def read_references(checks: Sequence[Check]) -> dict[Path, np.ndarray]:
+    """Every check's golden, read by the grader (never by a submission); a missing one is one line."""
+    references = {}
+    for check in checks:
+        if not check.golden.exists() and not check.golden.is_symlink():
+            raise SandboxError(f"reference {check.golden} not found; make it from the model answer first: "
+                               f"glsandbox check ANSWER.py --golden {check.golden} --update "
+                               "(or --rubric FILE --update)")
+        references[check.golden] = read_reference(check.golden)
+    return references
+
+
+def check_folder(folder: Path, checks: Sequence[Check], backend: str | None = None, limits: Limits = Limits(),
+                 progress: Callable[[int, int, CheckResult], None] = lambda done, total, result: None,
+                 ) -> list[CheckResult]:
+    """Grade every submission in ``folder`` against ``checks``; never stops at a broken one.
+
+    ``progress`` hears each submission as it finishes (in the order they
+    finish); the results come back in folder order. Failures leave their
+    images in ``<golden stem>-results/`` beside each golden.
     """
-    submissions = lesson_files(folder)
-    if not submissions:
+    if not lesson_files(folder):
         raise SandboxError(f"{folder}: no .py or .toml lesson files (nor subfolders holding one)")
-    if not reference.exists():
-        raise SandboxError(f"reference {reference} not found; make it from the model answer first: "
-                           f"glsandbox check ANSWER.py --golden {reference} --update")
-    expected = read_reference(reference)
-    size = size or (expected.shape[1], expected.shape[0])
-    with HeadlessRenderer(backend):  # no GL at all is the machine's problem, not every submission's
-        pass
-    artifacts_dir = reference.with_name(f"{reference.stem}-results")
-    results = []
-    for number, (name, path) in enumerate(submissions, start=1):
-        progress(f"[{number}/{len(submissions)}] {name} ...")
-        started = time.perf_counter()
-        try:
-            lesson = submission_lesson(path).from_settings(settings)
-            actual = render_lesson(lesson, size, samples, backend).image
-            match, paths = judge(actual, expected, tolerances, artifacts_dir, name)
-            result = CheckResult(name, path, "PASS" if match.passed else "FAIL", match, artifacts=paths)
-        except SandboxError as exc:
-            result = CheckResult(name, path, "BROKEN", error=str(exc))
-        except (Exception, SystemExit) as exc:  # raised while loading, outside render_lesson's net
-            result = CheckResult(name, path, "BROKEN", error=str(user_code_error(exc)))
-        result.seconds = time.perf_counter() - started
-        results.append(result)
-    return results
+    references = read_references(checks)
+    renders = _renders(checks, references)
+    entries = submission_jobs(folder, renders, backend, limits)
+    by_index = {job.index: (name, path) for name, path, job in entries}
+    finished: dict[int, CheckResult] = {}
+
+    def done(result: JobResult) -> None:
+        name, path = by_index[result.job.index]
+        finished[result.job.index] = CheckResult(name, path, _outcomes(result, checks, references, name),
+                                                 [shown(line) for line in result.output])
+        progress(len(finished), len(entries), finished[result.job.index])
+
+    results = run_jobs([job for _, _, job in entries], limits.jobs, done)
+    no_gl = next((r.no_gl for r in results if r.no_gl), "")
+    if no_gl:  # the machine's problem, not every submission's
+        raise SandboxError(no_gl)
+    return [finished[job.index] for _, _, job in entries]
 
 
-def summary_table(results: Sequence[CheckResult]) -> str:
-    """A fixed-width table of every submission's figures, and the counts."""
-    header = f"{'submission':<24} {'status':<6} {'bad %':>8} {'max diff':>8} {'RMSE':>8} {'seconds':>7}"
-    lines = [header, "-" * len(header)]
-    for r in results:
-        m = r.match
-        figures = (f"{m.bad_share * 100:>8.3f} {m.max_diff:>8d} "
-                   f"{'-' if math.isnan(m.rmse) else f'{m.rmse:.5f}':>8}") if m else f"{'-':>8} {'-':>8} {'-':>8}"
-        lines.append(f"{r.name[:24]:<24} {r.status:<6} {figures} {r.seconds:>7.2f}")
-    counts = {s: sum(r.status == s for r in results) for s in ("PASS", "FAIL", "BROKEN")}
-    lines.append(f"{counts['PASS']} passed, {counts['FAIL']} failed, {counts['BROKEN']} broken "
-                 f"of {len(results)}")
-    return "\n".join(lines)
+def render_isolated(spec: str, checks: Sequence[Check], sizes: Sequence[tuple[int, int]],
+                    backend: str | None, limits: Limits, model_answer: bool = False) -> JobResult:
+    """One lesson (a name or a file) rendered once per check in an isolated child, its folder as its root
+    (``model_answer``: its compiled shaders are kept in Mesa's cache, for the submissions)."""
+    renders = tuple(Render(c.settings, size, c.samples) for c, size in zip(checks, sizes))
+    path = Path(spec)
+    if spec.endswith((".py", ".toml")):
+        job = Job(0, str(path.resolve()), path.name, renders, backend, limits.timeout, limits.memory, copy=False,
+                  writes_cache=model_answer)
+    else:
+        job = Job(0, None, spec, renders, backend, limits.timeout, limits.memory, copy=False,
+                  writes_cache=model_answer)
+    (result,) = run_jobs([job], 1, lambda r: None)
+    if result.no_gl:
+        raise SandboxError(result.no_gl)
+    if path.resolve() != path and job.source:  # errors name the file as the user wrote it
+        for picture in result.pictures:
+            picture.error = picture.error.replace(str(path.resolve()), spec)
+    return result
 
 
-def write_reports(results: Sequence[CheckResult], csv_path: Path | None, json_path: Path | None,
-                  reference: Path) -> list[Path]:
-    """The figures as CSV and/or JSON, each written atomically."""
-    rows = [r.row() for r in results]
-    written = []
-    for path, make in ((csv_path, _csv_text), (json_path, _json_text)):
-        if path is None:
-            continue
-        try:
-            files.write_text(path, make(rows, reference))
-        except OSError as exc:
-            raise SandboxError(f"{path}: cannot write ({exc.strerror or exc})") from None
-        written.append(path)
-    return written
+@dataclass
+class OneCheck:
+    """One lesson against one check: the match (None when the reference was just written),
+    the artefacts, what happened to the reference, or the outcome when it did not render."""
+
+    check: Check
+    match: ImageMatch | None = None
+    artifacts: dict[str, Path] = field(default_factory=dict)
+    updated: str = ""
+    status: str = ""
+    error: str = ""
 
 
-def _csv_text(rows: list[dict[str, object]], reference: Path) -> str:
-    out = io.StringIO()
-    writer = csv.DictWriter(out, fieldnames=list(rows[0]), lineterminator="\n")
-    writer.writeheader()
-    writer.writerows({k: "" if v is None else v for k, v in row.items()} for row in rows)
-    return out.getvalue()
+def check_one(spec: str, checks: Sequence[Check], update: bool, backend: str | None = None,
+              limits: Limits = Limits()) -> list[OneCheck]:
+    """One lesson against each check's reference, isolated as a submission is.
 
-
-def _json_text(rows: list[dict[str, object]], reference: Path) -> str:
-    counts = {s.lower(): sum(r["status"] == s for r in rows) for s in ("PASS", "FAIL", "BROKEN")}
-    return json.dumps({"reference": str(reference), **counts, "submissions": rows}, indent=2) + "\n"
-
-
-def check_one(spec: str, reference: Path, settings: Sequence[str], size: tuple[int, int] | None,
-              tolerances: dict[str, float], update: bool, samples: int = 0,
-              backend: str | None = None) -> tuple[ImageMatch | None, dict[str, Path], str]:
-    """One lesson against one reference: (match, artifact paths, what happened to the reference).
-
-    With ``update`` a missing or failing reference is (re)written, atomically,
-    and a passing one is left as it is (the project's golden flow); the match
-    is then against the old reference (None when there was none).
+    The lesson's own mistakes are said first (a :class:`SandboxError`,
+    before a missing reference); a time-out, crash or memory limit is an
+    outcome (exit 1), never a pass. With ``update`` a missing or failing
+    reference is (re)written, atomically, and a passing one is left as it is
+    (the project's golden flow); the match is then against the old reference.
     """
-    lesson = find_lesson(spec).from_settings(settings)  # the lesson's own mistakes first
-    if not update and not reference.exists():
-        raise SandboxError(f"reference {reference} not found; write it with --update")
-    expected = read_reference(reference) if reference.exists() else None
-    size = size or ((expected.shape[1], expected.shape[0]) if expected is not None else DEFAULT_SIZE)
-    actual = render_lesson(lesson, size, samples, backend).image
-    if expected is None:
-        _write_reference(actual, reference)
-        return None, {}, "written"
-    if update:
-        match = compare_images(actual, expected, **tolerances)
-        if match.passed:
-            return match, {}, "unchanged"
-        _write_reference(actual, reference)
-        return match, {}, "rewritten"
-    match, paths = judge(actual, expected, tolerances, reference.parent, reference.stem)
-    return match, paths, ""
+    existing = {c.golden: read_reference(c.golden) for c in checks if c.golden.exists()}
+    sizes = [c.size or ((existing[c.golden].shape[1], existing[c.golden].shape[0]) if c.golden in existing
+                        else DEFAULT_SIZE) for c in checks]
+    result = render_isolated(spec, checks, sizes, backend, limits, model_answer=update)
+    broken = next((p for p in result.pictures if p.status == BROKEN), None)
+    if broken is not None:
+        raise SandboxError(shown(broken.error))
+    if not update:
+        missing = next((c for c in checks if c.golden not in existing), None)
+        if missing is not None:
+            raise SandboxError(f"reference {missing.golden} not found; write it with --update")
+    out = []
+    for check, picture in zip(checks, result.pictures):
+        if picture.image is None:
+            out.append(OneCheck(check, status=picture.status, error=shown(picture.error)))
+            continue
+        expected = existing.get(check.golden)
+        if expected is None:
+            _write_reference(picture.image, check.golden)
+            out.append(OneCheck(check, updated="written"))
+        elif update:
+            match = compare_images(picture.image, expected, **check.tolerances)
+            if not match.passed:
+                _write_reference(picture.image, check.golden)
+            out.append(OneCheck(check, match, updated="unchanged" if match.passed else "rewritten"))
+        else:
+            match, paths = judge(picture.image, expected, check.tolerances, check.golden.parent, check.golden.stem)
+            out.append(OneCheck(check, match, paths))
+    return out
 
 
 def _write_reference(image: np.ndarray, path: Path) -> None:
@@ -252,3 +375,54 @@ def _write_reference(image: np.ndarray, path: Path) -> None:
         files.save_png(image, path)
     except OSError as exc:
         raise SandboxError(f"reference {path}: cannot write ({exc.strerror or exc})") from None
+
+
+def counts(results: Sequence[CheckResult]) -> dict[str, int]:
+    """How many submissions ended with each outcome."""
+    return {status: sum(r.status == status for r in results) for status in OUTCOMES}
+
+
+def counts_line(results: Sequence[CheckResult]) -> str:
+    """``2 passed, 1 failed, 1 broken, 0 timed out, 0 crashed, 0 out of memory of 4``."""
+    c = counts(results)
+    return (f"{c[PASS]} passed, {c[FAIL]} failed, {c[BROKEN]} broken, {c[TIMEOUT]} timed out, "
+            f"{c[CRASHED]} crashed, {c[OOM]} out of memory of {len(results)}")
+
+
+def summary_table(results: Sequence[CheckResult]) -> str:
+    """A fixed-width table of every submission's figures (or score), and the counts."""
+    several = any(len(r.outcomes) > 1 for r in results)
+    last = f"{'score':>9}" if several else f"{'bad %':>8} {'max diff':>8} {'RMSE':>8}"
+    header = f"{'submission':<24} {'status':<13} {last} {'seconds':>7}"
+    lines = [header, "-" * len(header)]
+    for r in results:
+        m = r.match
+        if several:
+            figures = f"{points(r.score) + '/' + points(r.total):>9}"
+        elif m is not None:
+            figures = (f"{m.bad_share * 100:>8.3f} {m.max_diff:>8d} "
+                       f"{'-' if math.isnan(m.rmse) else f'{m.rmse:.5f}':>8}")
+        else:
+            figures = f"{'-':>8} {'-':>8} {'-':>8}"
+        lines.append(f"{r.shown[:24]:<24} {r.status:<13} {figures} {r.seconds:>7.2f}")
+    lines.append(counts_line(results))
+    return "\n".join(lines)
+
+
+def time_in_process(folder: Path, checks: Sequence[Check], backend: str | None = None) -> float:
+    """Seconds to grade ``folder`` in this process, with no isolation (the benchmark's baseline:
+    how ``check`` graded before each submission had a process of its own)."""
+    from glsandbox.lesson import submission_lesson
+
+    references = read_references(checks)
+    renders = _renders(checks, references)
+    started = time.perf_counter()
+    for _name, path in lesson_files(folder):
+        try:
+            cls = submission_lesson(path)
+            for check, render in zip(checks, renders):
+                image = render_lesson(cls.from_settings(render.settings), render.size, render.samples, backend).image
+                compare_images(image, references[check.golden], **check.tolerances)
+        except SandboxError:
+            pass
+    return time.perf_counter() - started

@@ -85,6 +85,7 @@ __all__ = [
     "clear_cache",
     "mesh_digest",
     "mesh_world_triangles",
+    "sah_cost",
 ]
 
 #: Most triangles in a leaf.
@@ -93,6 +94,11 @@ LEAF_SIZE: int = 4
 BINS: int = 16
 #: Triangles of a node whose boxes the SAH bins (a big node's are sampled, see ``_split_levels``).
 SAMPLE: int = 1024
+#: An axis whose triangle centroids span less than this share of the node's binning range is
+#: binned over the centroids' own range instead (``_split_levels``).
+CENTROID_RANGE: float = 0.5
+#: A node whose best SAH cut costs at least this share of ``N·A(node)`` is cut evenly by count instead.
+NO_GAIN: float = 0.99
 #: BVHs kept by :func:`bvh_for_triangles` / :func:`bvh_for_mesh`.
 CACHE_SIZE: int = 16
 
@@ -267,6 +273,17 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
         bins = int(min(max_bins, max(4, 1 << int(np.log2(max(1, width // n))))))
         # Binning range per node and axis: the node's box (from its parent's
         # sweep), cut into `bins` equal slabs; a flat axis puts all in bin 0.
+        # Where the triangles' centroids span less than CENTROID_RANGE of it on
+        # an axis, the centroids' own range instead (Wald 2007): slivers meeting
+        # at one point (a fan) have their centroids bunched in one slab of their
+        # box, and only the stragglers could be cut off, one level each (a fan
+        # of 1M triangles was 5,470 levels deep).
+        starts = np.cumsum(counts) - counts
+        centre_lo = np.minimum.reduceat(rows[0:3], starts, axis=1).T.astype(np.float64)
+        centre_hi = np.maximum.reduceat(rows[0:3], starts, axis=1).T.astype(np.float64)
+        bunched = (centre_hi - centre_lo) < CENTROID_RANGE * (box_hi - box_lo)
+        box_lo = np.where(bunched, centre_lo, box_lo)
+        box_hi = np.where(bunched, centre_hi, box_hi)
         extent = box_hi - box_lo
         scale = np.where(extent > 0.0, bins * (1.0 - 1e-6) / np.where(extent > 0.0, extent, 1.0), 0.0)
         rel = (rows[0:3] - np.repeat(box_lo.T.astype(np.float32), counts, axis=1)) * np.repeat(
@@ -279,6 +296,12 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
         child_lo = np.empty((n, 2, 3))
         child_hi = np.empty((n, 2, 3))
         nodes = np.arange(n)
+        # The most even cut by count over all axes: used where no SAH cut gains (below).
+        even_gap = np.full(n, np.iinfo(np.int64).max)
+        even_axis = np.zeros(n, dtype=np.int64)
+        even_cut = np.ones(n, dtype=np.int64)
+        even_lo = np.empty((n, 2, 3))
+        even_hi = np.empty((n, 2, 3))
         # A big node's bin boxes come from every stride-th of its triangles
         # (about SAMPLE of them): the boxes are only the heuristic's estimate
         # of the children's areas (bin counts are exact). Nodes of up to
@@ -313,6 +336,18 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
             sah = np.where((n_left > 0) & (n_right > 0), sah, np.inf)  # a cut must leave both sides something
             cut = np.argmin(sah, axis=0)  # the best cut on this axis, minus one
             cost = sah[cut, nodes]
+            gap = np.where((n_left > 0) & (n_right > 0), np.abs(2 * n_left - counts), np.iinfo(np.int64).max)
+            even = np.argmin(gap, axis=0)
+            evener = np.flatnonzero(gap[even, nodes] < even_gap)
+            if evener.size:
+                ce = even[evener]
+                even_gap[evener] = gap[ce, evener]
+                even_axis[evener] = axis
+                even_cut[evener] = ce + 1
+                even_lo[evener, 0] = llo[:, ce, evener].T
+                even_hi[evener, 0] = lhi[:, ce, evener].T
+                even_lo[evener, 1] = rlo[:, ce + 1, evener].T
+                even_hi[evener, 1] = rhi[:, ce + 1, evener].T
             better = np.flatnonzero(cost < best_cost)
             if better.size:
                 cb = cut[better]
@@ -323,6 +358,19 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
                 child_hi[better, 0] = lhi[:, cb, better].T
                 child_lo[better, 1] = rlo[:, cb + 1, better].T
                 child_hi[better, 1] = rhi[:, cb + 1, better].T
+        # No gain: when the best cut costs about what the node itself does (N·A: every child box
+        # as big as the parent's), the SAH would peel a few triangles off per level and the tree
+        # grow as deep as the node is large. The most even cut by count keeps the depth logarithmic.
+        node_lo = np.minimum.reduceat(rows[3:6], starts, axis=1)
+        node_hi = np.maximum.reduceat(rows[6:9], starts, axis=1)
+        parent_cost = counts * _half_area(node_lo, node_hi).astype(np.float64)
+        no_gain = np.flatnonzero(np.isfinite(best_cost) & (best_cost >= NO_GAIN * parent_cost)
+                                 & (even_gap < np.iinfo(np.int64).max))
+        if no_gain.size:
+            best_axis[no_gain] = even_axis[no_gain]
+            best_cut[no_gain] = even_cut[no_gain]
+            child_lo[no_gain] = even_lo[no_gain]
+            child_hi[no_gain] = even_hi[no_gain]
         # A child whose sampled triangles were none of its own has no box:
         # bin it over its parent's.
         empty = np.logical_not(np.logical_and(np.isfinite(child_lo).all(axis=2), np.isfinite(child_hi).all(axis=2)))
@@ -337,7 +385,6 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
         if stuck.size:
             # No cut separates them (every centroid in one bin on every axis):
             # split in half by count, in column order.
-            starts = np.cumsum(counts) - counts
             where = np.repeat(~np.isfinite(best_cost), counts)
             rank = np.arange(width) - np.repeat(starts, counts)
             right[where] = (rank >= np.repeat(counts // 2, counts))[where]
@@ -387,6 +434,17 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
         box_lo = child_lo.reshape(2 * n, 3)[kept_children]
         box_hi = child_hi.reshape(2 * n, 3)[kept_children]
     return leaf_of, leaf_rank, np.concatenate(firsts), np.concatenate(counts_of), levels
+
+
+def sah_cost(bvh: BVH) -> float:
+    """The tree's expected cost by the surface area heuristic, relative to its root box:
+    ``Σ_inner A(n)/A(root) + Σ_leaf A(l)/A(root)·N(l)`` (one unit per box test and per
+    triangle test). Lower is better; a single leaf of ``M`` triangles costs ``M``."""
+    e = np.maximum(bvh.node_max - bvh.node_min, 0.0)
+    area = e[:, 0] * e[:, 1] + e[:, 1] * e[:, 2] + e[:, 2] * e[:, 0]
+    if bvh.empty or area[0] <= 0.0:
+        return float(bvh.triangle_count)
+    return float((area * np.where(bvh.node_count == 0, 1, bvh.node_count)).sum() / area[0])
 
 
 def _exact_boxes(lo: NDArray[np.float64], hi: NDArray[np.float64], first: NDArray[np.int64],

@@ -118,3 +118,21 @@ def test_tradeoffs_counts_every_render_of_a_knob(tmp_path) -> None:
     tradeoffs.measure_knob(knob, context=None, out=tmp_path, quick=False, runs=5, advance=steps.append)
     assert len(renders) == tradeoffs.knob_renders(knob, quick=False, runs=5) == 3 * 6
     assert steps == [1] * len(renders)
+
+
+@pytest.mark.slow
+def test_check_a_folder_counts_each_submission(recorded, tmp_path, gl, capsys) -> None:
+    scene = 'name = "cube"\n[[nodes]]\nmesh = "cube"\n'
+    ref = tmp_path / "ref.png"
+    (tmp_path / "model.toml").write_text(scene)
+    assert cli.main(["check", str(tmp_path / "model.toml"), "--golden", str(ref), "--update",
+                     "--size", "32x24"]) == 0
+    subs = tmp_path / "subs"
+    subs.mkdir()
+    for name in ("alice", "bob", "carol"):
+        (subs / f"{name}.toml").write_text(scene)
+    capsys.readouterr()
+    assert cli.main(["check", str(subs), "--golden", str(ref), "--size", "32x24", "--jobs", "1"]) == 0
+    assert recorded.bars == [{"total": 3, "what": "check", "done": 3, "closed": True}]
+    out = capsys.readouterr().out
+    assert [f"[{n}/3]" in out for n in (1, 2, 3)] == [True] * 3  # the lines stay, on stdout

@@ -1,0 +1,239 @@
+"""Benchmark: loading real models (issue 20): file to drawn first frame, the BVH build, peak memory.
+
+Three models, made once per run in a temporary folder (nothing downloaded,
+nothing shipped):
+
+- ``bunny``: the Stanford bunny pymeshlab ships in its wheel (56,172
+  triangles, an OBJ with normals: they are used as given);
+- ``bunny 1.27M``: the same scan subdivided by pymeshlab (the recipe,
+  :func:`big_bunny`: midpoint subdivision, 3 passes, edges over 0.175% of the
+  box's diagonal split), written as a binary PLY *without* normals, so the
+  crease normals are made at load;
+- ``fan 1M``: a million slivers around one vertex (binary PLY), made with
+  numpy: the case that was quadratic.
+
+Rows per model (``--quick``: the bunny only):
+
+- **load + first frame**: trimesh's own ``load`` of the file plus raw ModernGL
+  uploading its vertices and faces and drawing them once (``finish``: the
+  limit) against ``glsandbox.load_model`` (normals, vertex merging, checks)
+  and glsandbox's first frame of the mesh on the same context (goal: 3x);
+- **BVH build**: Embree (``embreex``) building its tree for the same triangles
+  against :func:`glsandbox.raytrace.bvh.build_bvh` (goal: 2x), the SAH cost of
+  glsandbox's tree in the note.
+
+Under the table: peak memory per triangle of a load and first frame, measured
+in a fresh process that has loaded and drawn the model once already (the
+context, shaders and reader's imports are not the model's), as its peak
+resident size (Linux: reset just before the second load) less what it held
+then; goal: at most 250 bytes. pymeshlab and embreex come with
+``uv run --group bench``; without them those rows are skipped and said so.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import subprocess
+import sys
+import tempfile
+from collections.abc import Sequence
+from functools import cache
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from _bunny import bunny_path
+
+GROUP = "model files: load"
+#: Issue 20's goals: load + first frame against trimesh + raw upload; BVH build against Embree.
+LOAD_GOAL = 3.0
+BUILD_GOAL = 2.0
+BYTES_GOAL = 250
+FAN_TRIANGLES = 1_000_000
+_TMP = tempfile.TemporaryDirectory(prefix="glsandbox-models-")
+_ANGLES = itertools.count()
+
+
+@cache
+def big_bunny() -> Path:
+    """The recipe for the 1.27M-triangle model: the bunny subdivided by pymeshlab, binary PLY, no normals."""
+    import pymeshlab
+
+    path = Path(_TMP.name) / "bunny_subdivided.ply"
+    meshes = pymeshlab.MeshSet()
+    meshes.load_new_mesh(str(bunny_path()))
+    meshes.meshing_surface_subdivision_midpoint(iterations=3, threshold=pymeshlab.PercentageValue(0.175))
+    meshes.save_current_mesh(str(path), binary=True, save_vertex_normal=False, save_vertex_color=False,
+                             save_face_color=False, save_wedge_texcoord=False, save_vertex_quality=False,
+                             save_face_quality=False)
+    return path
+
+
+@cache
+def fan() -> Path:
+    """:data:`FAN_TRIANGLES` slivers around one vertex, three quarters of a disc, binary PLY."""
+    import trimesh
+
+    path = Path(_TMP.name) / "fan.ply"
+    angle = np.linspace(0.0, 1.5 * np.pi, FAN_TRIANGLES + 1)
+    rim = np.c_[np.cos(angle), np.sin(angle), np.zeros(FAN_TRIANGLES + 1)]
+    faces = np.c_[np.zeros(FAN_TRIANGLES, dtype=np.int64), np.arange(1, FAN_TRIANGLES + 1),
+                  np.arange(2, FAN_TRIANGLES + 2)]
+    trimesh.Trimesh(np.r_[[[0.0, 0.0, 0.0]], rim], faces, process=False).export(path)
+    return path
+
+
+MODELS = {"bunny": bunny_path, "bunny 1.27M": big_bunny, "fan 1M": fan}
+
+RAW_VS = """#version 330 core
+in vec3 in_position; void main() { gl_Position = vec4(in_position * 0.5, 1.0); }"""
+RAW_FS = """#version 330 core
+out vec4 frag_color; void main() { frag_color = vec4(1.0); }"""
+
+
+def raw_load_and_draw(ctx: Any, path: Path) -> None:
+    """trimesh's load, then raw ModernGL: the vertices and faces uploaded as they are, drawn once."""
+    import trimesh
+
+    mesh = trimesh.load(path, process=False, force="mesh")
+    program = ctx.program(vertex_shader=RAW_VS, fragment_shader=RAW_FS)
+    vbo = ctx.buffer(np.asarray(mesh.vertices, dtype="f4").tobytes())
+    ibo = ctx.buffer(np.asarray(mesh.faces, dtype="u4").tobytes())
+    vao = ctx.vertex_array(program, [(vbo, "3f", "in_position")], ibo)
+    fbo = ctx.simple_framebuffer((256, 256))
+    fbo.use()
+    vao.render()
+    ctx.finish()
+    for thing in (vao, vbo, ibo, fbo, program):
+        thing.release()
+
+
+def glsandbox_load_and_draw(env: Any, path: Path) -> None:
+    """glsandbox: the model file loaded (a new crease angle each time: the cache is bypassed) and its
+    first frame drawn by the headless renderer on the same context."""
+    from glsandbox import Camera, Light, Material, Node, Scene, load_model
+    from glsandbox.lesson import Lesson
+
+    mesh = load_model(path, fit=True, crease_angle=30.0 + 1e-6 * next(_ANGLES)).mesh
+    scene = Scene("model", nodes=(Node("model", mesh, material=Material(shading="phong")),),
+                  camera=Camera(eye=(0.0, 0.5, 3.0)), lights=(Light((1.0, 3.0, 1.5)),))
+
+    class Model(Lesson):
+        name = "bench_model"
+
+        def build(self) -> Any:
+            return scene
+
+    env.renderer.render(Model(), (256, 256))
+
+
+def cases(env: Any) -> list:
+    from glsandbox.measure.bench import Case, Side
+
+    labels = [label for label in MODELS if bunny_path() is not None or label == "fan 1M"]
+    if bunny_path() is None:
+        env.note(f"{GROUP}: the bunny rows skipped: pymeshlab not installed (uv run --group bench glsandbox bench)")
+    if env.quick:
+        labels = labels[:1]
+    found = []
+    for label in labels:
+        path = MODELS[label]
+        found.append(Case(GROUP, f"load + first frame, {label}",
+                          Side("trimesh load + raw ModernGL upload and draw",
+                               lambda _, p=path: raw_load_and_draw(env.renderer.host.ctx, p())),
+                          Side("glsandbox load_model + first frame", lambda _, p=path: glsandbox_load_and_draw(env, p())),
+                          repeat=1, unit="s", goal=LOAD_GOAL,
+                          note="load: file to a drawable mesh with normals; first frame: upload and draw"))
+    try:
+        from raytrace import embree_available
+    except ImportError:  # run from elsewhere than benchmarks/
+        return found
+    if not embree_available():
+        env.note(f"{GROUP}: the BVH rows skipped: embreex not installed (uv run --group bench glsandbox bench)")
+        return found
+    for label in labels:
+        found.append(build_case(label, Case, Side))
+    return found
+
+
+@cache
+def _triangles(label: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    from glsandbox import load_model
+    from glsandbox.raytrace.bvh import mesh_world_triangles
+
+    return mesh_world_triangles(load_model(MODELS[label](), fit=True).mesh)
+
+
+def build_case(label: str, case: Any, side: Any) -> Any:
+    """The BVH build of a model's triangles: Embree's against glsandbox's (SAH cost in the note)."""
+    from glsandbox.raytrace.bvh import build_bvh
+
+    def embree(_: int) -> None:
+        from embreex import rtcore_scene
+        from embreex.mesh_construction import TriangleMesh
+
+        scene = rtcore_scene.EmbreeScene()
+        TriangleMesh(scene, np.stack(_triangles(label), axis=1).astype(np.float32))
+        one = np.zeros((1, 3), dtype=np.float32)
+        scene.run(one, one + np.float32(1.0), output=1)  # Embree builds at its first query
+
+    def ours(_: int) -> float:
+        return build_bvh(*_triangles(label)).build_seconds
+
+    return case(GROUP, f"BVH build, {label}", side("Embree (embreex)", embree), side("build_bvh (binned SAH)", ours),
+                repeat=1, unit="s", goal=BUILD_GOAL,
+                note="both from the same float64 triangles, made once; sah_cost() of glsandbox's tree is printed "
+                     "under the table")
+
+
+def peak_bytes_per_triangle(path: Path) -> tuple[int, float]:
+    """``(triangles, peak bytes per triangle)`` of a load and first frame in a fresh process."""
+    code = f"""
+import json, sys
+sys.path.insert(0, {str(Path(__file__).resolve().parent)!r})
+import trimesh, glsandbox, glsandbox.meshfile
+from glsandbox.measure.bench import BenchEnv
+import model_load
+def status(key):
+    with open('/proc/self/status') as f:
+        return next(int(line.split()[1]) * 1024 for line in f if line.startswith(key))
+env = BenchEnv()
+path = __import__('pathlib').Path({str(path)!r})
+model_load.glsandbox_load_and_draw(env, path)  # warm: the context, the shaders, the reader's imports
+with open('/proc/self/clear_refs', 'w') as f:
+    f.write('5')  # Linux: the peak resident size (VmHWM) starts again from the current one
+before = status('VmRSS:')
+model_load.glsandbox_load_and_draw(env, path)  # a new crease angle: loaded and drawn again
+after = status('VmHWM:')
+model = glsandbox.meshfile.load_model(path, fit=True, crease_angle=30.0 + 1e-6)
+print(json.dumps([model.triangles, (after - before) / model.triangles]))
+"""
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
+    if done.returncode != 0:
+        raise RuntimeError(done.stderr.strip().splitlines()[-1] if done.stderr.strip() else "failed")
+    triangles, per = json.loads(done.stdout.strip().splitlines()[-1])
+    return int(triangles), float(per)
+
+
+def summarize(results: Sequence[Any]) -> list[str]:
+    """Peak memory per triangle of the models the table loaded, and the SAH costs of their trees."""
+    lines = []
+    loaded = [r.case.name.split(", ", 1)[1] for r in results
+              if r.case.group == GROUP and r.case.name.startswith("load") and r.subject_s]
+    for label in loaded:
+        try:
+            triangles, per = peak_bytes_per_triangle(MODELS[label]())
+        except (RuntimeError, subprocess.TimeoutExpired) as exc:
+            lines.append(f"{GROUP}: peak memory, {label}: not measured ({exc})")
+            continue
+        verdict = "met" if per <= BYTES_GOAL else "NOT met"
+        lines.append(f"{GROUP}: peak memory of load + first frame, {label} ({triangles:,} triangles): "
+                     f"{per:.0f} bytes per triangle (goal: at most {BYTES_GOAL}: {verdict})")
+    from glsandbox.raytrace.bvh import build_bvh, sah_cost
+
+    for result in results:
+        if result.case.group == GROUP and result.case.name.startswith("BVH build") and result.subject_s:
+            label = result.case.name.split(", ", 1)[1]
+            lines.append(f"{GROUP}: SAH cost of the tree, {label}: {sah_cost(build_bvh(*_triangles(label))):.2f}")
+    return lines

@@ -1,0 +1,303 @@
+"""Rendering each graded submission in a process of its own, under limits, and getting back only pixels.
+
+The process tree of one grading run::
+
+    grader (never opens a GL context; reads the reference, compares, writes every report)
+     └─ zygote (imported glsandbox, numpy and moderngl once; forks on the grader's word)
+         └─ supervisor, one per submission (own session; a "child subreaper": every process
+            │  the submission leaves behind is re-parented to it, and it kills them all)
+            └─ renderer (own session; stdin /dev/null, stdout and stderr into a file;
+               address-space, CPU-time and file-size limits; working folder a private
+               copy of the submission; confined by :mod:`glsandbox.measure.sandbox`)
+
+The renderer opens its GL context (a fork of a process that had opened one
+would deadlock on llvmpipe's threads, so nothing above it ever does), then
+loads the submission and renders each requested picture, writing each as a
+framed message on a pipe: raw RGBA pixels, or an error line. It knows no
+reference. The supervisor reads the pipe against the clock, kills the
+renderer's whole tree when it is done, times out or dies, and sends the
+grader one plain result per picture (JSON and raw pixels on a pipe of its
+own: the grader never unpickles what a child sends). The zygote is
+Python's "forkserver" idea without its named socket: the grader talks to it
+over a socket pair no other process can find. Nothing the submission does in its
+own process (``os._exit``, a signal, ``atexit``, threads, ``fork``,
+replacing ``sys.stdout`` or glsandbox's functions) reaches the grader: the
+worst it can do is lose its own pictures.
+
+This module is the grader's side and what both sides share (the jobs, the
+framed messages); :mod:`glsandbox.measure.worker` is the zygote, supervisor
+and renderer; :mod:`glsandbox.measure.processes` finds and kills a tree.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import select
+import struct
+import sys
+import time
+from collections import deque
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from glsandbox.measure.processes import descendants, kill_tree, killpg, set_subreaper
+
+__all__ = ["Render", "Job", "Picture", "JobResult", "run_jobs"]
+
+#: Outcomes of one picture, besides the grader's PASS and FAIL.
+BROKEN, TIMEOUT, CRASHED, OOM = "BROKEN", "TIMEOUT", "CRASHED", "OUT OF MEMORY"
+#: The renderer's output kept for the report: its last lines, each cut.
+TAIL_LINES, TAIL_WIDTH = 8, 200
+
+_MAGIC = b"GLSB"
+_HEADER = struct.Struct("!4sIQ")  # magic, JSON header length, payload length
+
+
+@dataclass(frozen=True)
+class Render:
+    """One picture to render: the lesson's ``--set`` values, the size and MSAA samples."""
+
+    settings: tuple[str, ...]
+    size: tuple[int, int]
+    samples: int = 0
+
+
+@dataclass(frozen=True)
+class Job:
+    """One submission: where it is, what to render, and the limits.
+
+    ``source`` is the submission's file or folder, copied into the private
+    folder (``copy=True``, grading) or read where it is (``copy=False``: one
+    lesson checked by its author, whose folder is its root); ``target`` is
+    the lesson file to load inside it (relative), or a built-in lesson's
+    name when ``source`` is None.
+    """
+
+    index: int
+    source: str | None
+    target: str
+    renders: tuple[Render, ...]
+    backend: str | None = None
+    timeout: float = 30.0
+    memory_mb: int = 2048
+    copy: bool = True
+    #: The model answer (``--update``): its compiled shaders may go into Mesa's cache for the submissions.
+    writes_cache: bool = False
+
+
+@dataclass
+class Picture:
+    """What came back for one :class:`Render`: the pixels, or an outcome and its line."""
+
+    image: np.ndarray | None = None
+    status: str = ""
+    error: str = ""
+    seconds: float = 0.0
+
+
+@dataclass
+class JobResult:
+    """Every picture of one job, the renderer's last output lines, and whether GL was there at all."""
+
+    job: Job
+    pictures: list[Picture]
+    output: list[str] = field(default_factory=list)
+    no_gl: str = ""
+
+
+# --- the framed messages of a pipe: a JSON header and raw bytes ---------------------------------
+
+
+def send(fd: int, header: dict, payload: bytes = b"") -> None:
+    data = json.dumps(header).encode()
+    message = _HEADER.pack(_MAGIC, len(data), len(payload)) + data + payload
+    view = memoryview(message)
+    while view:
+        view = view[os.write(fd, view):]
+
+
+class Reader:
+    """The framed messages of the renderer's pipe, read as they arrive."""
+
+    def __init__(self, fd: int) -> None:
+        self.fd, self.buffer, self.closed = fd, bytearray(), False
+
+    def pump(self, timeout: float) -> None:
+        ready, _, _ = select.select([self.fd], [], [], max(timeout, 0.0))
+        if ready:
+            chunk = os.read(self.fd, 1 << 20)
+            self.closed = not chunk
+            self.buffer += chunk
+
+    def messages(self, limit: int) -> Iterator[tuple[dict, bytes]]:
+        while len(self.buffer) >= _HEADER.size:
+            magic, head, size = _HEADER.unpack_from(self.buffer)
+            if magic != _MAGIC or head > 1 << 16 or size > limit:
+                raise ValueError("a malformed message on the result pipe")
+            end = _HEADER.size + head + size
+            if len(self.buffer) < end:
+                return
+            header = json.loads(bytes(self.buffer[_HEADER.size:_HEADER.size + head]))
+            payload = bytes(self.buffer[_HEADER.size + head:end])
+            del self.buffer[:end]
+            yield header, payload
+
+
+def _job_data(job: Job) -> dict:
+    return {"index": job.index, "source": job.source, "target": job.target, "backend": job.backend,
+            "timeout": job.timeout, "memory_mb": job.memory_mb, "copy": job.copy, "writes_cache": job.writes_cache,
+            "renders": [{"settings": list(r.settings), "size": list(r.size), "samples": r.samples}
+                        for r in job.renders]}
+
+
+def job_from(data: dict) -> Job:
+    renders = tuple(Render(tuple(r["settings"]), tuple(r["size"]), r["samples"]) for r in data.pop("renders"))
+    return Job(renders=renders, **data)
+
+
+# --- the grader's side -----------------------------------------------------------------------
+
+
+class _Zygote:
+    """The zygote process and the grader's end of its socket pair."""
+
+    def __init__(self) -> None:
+        import socket
+        import subprocess
+
+        self.channel, theirs = socket.socketpair()
+        code = "import sys; from glsandbox.measure.worker import zygote_main; zygote_main(int(sys.argv[1]))"
+        self.process = subprocess.Popen([sys.executable, "-c", code, str(theirs.fileno())], pass_fds=[theirs.fileno()],
+                                        stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL)  # never the grader's stdout
+        theirs.close()
+
+    def start(self, job: Job) -> int:
+        """Ask for a supervisor for ``job``; the read end of its result pipe."""
+        import socket
+
+        read_end, write_end = os.pipe()
+        data = json.dumps(_job_data(job)).encode()
+        try:
+            self.channel.sendall(struct.pack("!I", len(data)))
+            socket.send_fds(self.channel, [data], [write_end])
+        finally:
+            os.close(write_end)
+        return read_end
+
+    def close(self) -> None:
+        self.channel.close()
+        try:
+            self.process.wait(timeout=10)
+        except Exception:  # noqa: BLE001 - it is killed with the rest of the run
+            pass
+
+
+@dataclass
+class _Running:
+    job: Job
+    reader: Reader
+    deadline: float
+    pid: int = 0
+
+
+def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None]) -> list[JobResult]:
+    """Run every job, ``workers`` at once; ``done`` is called as each finishes; results in job order.
+
+    The grader becomes a subreaper for the run, so a process a submission
+    leaves behind whose supervisor was killed still comes back here, and is
+    killed at the end with everything else the run started.
+    """
+    if not hasattr(os, "fork"):
+        from glsandbox.errors import SandboxError
+
+        raise SandboxError("glsandbox check runs each submission in a process of its own, which needs a POSIX "
+                           "system (Linux, macOS); on Windows run it in WSL or a container")
+    before = set(descendants(os.getpid()))
+    set_subreaper()
+    pending = deque(jobs)
+    running: dict[int, _Running] = {}
+    results: dict[int, JobResult] = {}
+    retried: set[int] = set()
+    zygote_process = _Zygote()
+    try:
+        while pending or running:
+            while pending and len(running) < max(1, workers):
+                job = pending.popleft()
+                try:
+                    fd = zygote_process.start(job)
+                except OSError:  # the zygote is gone (it should not be): a fresh one, once
+                    zygote_process.close()
+                    zygote_process = _Zygote()
+                    fd = zygote_process.start(job)
+                # a supervisor that hangs (it should not) is given up after every picture's time and a margin
+                running[fd] = _Running(job, Reader(fd), time.monotonic() + job.timeout * len(job.renders) + 60)
+            ready, _, _ = select.select(list(running), [], [], 1.0)
+            for fd in list(running):
+                entry = running[fd]
+                if fd in ready:
+                    entry.reader.pump(0.0)
+                message = None
+                try:
+                    for header, payload in entry.reader.messages(1 << 34):
+                        if header.get("kind") == "pid":
+                            entry.pid = int(header["pid"])
+                        elif header.get("kind") == "result":
+                            message = (header, payload)
+                except (ValueError, KeyError, TypeError):
+                    entry.reader.closed = True
+                late = time.monotonic() > entry.deadline
+                if message is None and not entry.reader.closed and not late:
+                    continue
+                if entry.pid and message is None:
+                    kill_tree(entry.pid)
+                    killpg(entry.pid)
+                del running[fd]
+                os.close(fd)
+                result = _result(entry.job, message)
+                if result.no_gl and entry.job.index not in retried:  # once more: a driver can fail now and then
+                    retried.add(entry.job.index)
+                    pending.appendleft(entry.job)
+                    continue
+                results[entry.job.index] = result
+                if result.no_gl:
+                    return [results[j.index] for j in jobs if j.index in results]
+                done(result)
+    finally:
+        for fd, entry in running.items():
+            if entry.pid:
+                killpg(entry.pid)
+            os.close(fd)
+        zygote_process.close()
+        kill_tree(os.getpid(), keep=sorted(before))
+        set_subreaper(False)
+    return [results[j.index] for j in jobs]
+
+
+def _result(job: Job, message: tuple[dict, bytes] | None) -> JobResult:
+    if message is None or (message[0].get("pictures") is None and not message[0].get("no_gl")):
+        pictures = [Picture(status=CRASHED, error="its grading process ended without a result") for _ in job.renders]
+        return JobResult(job, pictures)
+    header, payload = message
+    if header.get("no_gl"):
+        return JobResult(job, [], no_gl=str(header["no_gl"]))
+    pictures, offset = [], 0
+    for entry in header["pictures"]:
+        image = None
+        if entry.get("shape"):
+            h, w, c = entry["shape"]
+            image = np.frombuffer(payload, dtype=np.uint8, count=h * w * c, offset=offset).reshape(h, w, c)
+            offset += h * w * c
+        pictures.append(Picture(image, str(entry.get("status", "")), str(entry.get("error", "")),
+                                float(entry.get("seconds", 0.0))))
+    output = [str(line) for line in header.get("output", [])]
+    root = str(header.get("root") or "")
+    if root and job.source:  # the private copy's path, said as the submission's own
+        original = job.source if Path(job.source).is_dir() else str(Path(job.source).parent)
+        for picture in pictures:
+            picture.error = picture.error.replace(root, original)
+        output = [line.replace(root, original) for line in output]
+    return JobResult(job, pictures, output)

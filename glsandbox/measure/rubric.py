@@ -1,0 +1,217 @@
+"""A grading file: the checks each submission gets, with their settings, tolerances and points.
+
+``glsandbox check DIR --rubric grading.toml`` renders every submission once
+per check and gives each student a score out of the total. The file::
+
+    # every key below [[check]] is optional except golden
+    timeout = 30            # seconds for each picture (the command line's --timeout wins)
+    memory = 2048           # MB of address space for each submission
+
+    [[check]]
+    name = "still"          # default: the golden's stem
+    golden = "goldens/still.png"   # relative to this file; may be a hidden one only the teacher has
+    points = 2              # default 1
+    set = ["time=0"]        # any --set values: time, a Param, renderer, camera, u.NAME
+    size = "320x240"        # default: the golden's size
+    samples = 0
+    renderer = "raster"     # a short way of writing set = ["renderer=..."]
+    tolerance = { threshold = 2, max_bad_share = 0.0005 }
+    hidden = false          # true: Gradescope shows it to the student only after publishing
+
+Every mistake in the file is one line naming the file, the check and the key.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from glsandbox.errors import SandboxError
+from glsandbox.files import read_user_file
+from glsandbox.measure.golden import DEFAULT_MAX_BAD_SHARE, DEFAULT_THRESHOLD
+
+__all__ = ["Check", "Rubric", "load_rubric", "parse_tolerances", "TOLERANCES", "parse_size_text", "STARTER"]
+
+#: The tolerances ``--tolerance KEY=VALUE`` (and the pytest fixture's keywords) accept.
+TOLERANCES = {"threshold": DEFAULT_THRESHOLD, "max_bad_share": DEFAULT_MAX_BAD_SHARE}
+
+
+@dataclass(frozen=True)
+class Check:
+    """One picture every submission must match, and what it is worth."""
+
+    name: str
+    golden: Path
+    settings: tuple[str, ...] = ()
+    size: tuple[int, int] | None = None
+    samples: int = 0
+    tolerances: dict[str, float] = field(default_factory=dict)
+    points: float = 1.0
+    hidden: bool = False
+
+
+@dataclass(frozen=True)
+class Rubric:
+    """The checks, and the limits the file asks for (None: the command line's or the default)."""
+
+    checks: tuple[Check, ...]
+    timeout: float | None = None
+    memory: int | None = None
+
+    @property
+    def total(self) -> float:
+        return sum(check.points for check in self.checks)
+
+
+def tolerance_value(key: str, value: Any, where: str) -> float:
+    """One tolerance checked: ``threshold`` a whole number of levels 0..255, ``max_bad_share`` 0..1."""
+    if key not in TOLERANCES:
+        raise SandboxError(f"{where}: expected threshold=LEVELS or max_bad_share=FRACTION")
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        number = math.nan
+    if key == "threshold" and not (math.isfinite(number) and number == int(number) and 0 <= number <= 255):
+        raise SandboxError(f"{where}: threshold is a whole number of levels, 0..255")
+    if key == "max_bad_share" and not 0.0 <= number <= 1.0:  # NaN fails this too
+        raise SandboxError(f"{where}: max_bad_share is a fraction, 0..1")
+    return int(number) if key == "threshold" else number
+
+
+def parse_tolerances(items: list[str] | tuple[str, ...]) -> dict[str, float]:
+    """``threshold=4``, ``max_bad_share=0.01`` -> keywords of :func:`compare_images`, checked."""
+    tolerances: dict[str, float] = {}
+    for item in items:
+        key, sep, text = item.partition("=")
+        key = key.strip()
+        if not sep:
+            key = ""
+        tolerances[key] = tolerance_value(key, text, f"--tolerance {item!r}")
+    return tolerances
+
+
+def parse_size_text(text: str, where: str) -> tuple[int, int]:
+    """``WxH`` -> (W, H), refusing anything else with ``where`` named."""
+    w, sep, h = str(text).lower().partition("x")
+    try:
+        size = (int(w), int(h))
+    except ValueError:
+        size = (0, 0)
+    if not sep or size[0] <= 0 or size[1] <= 0 or max(size) > 16384:
+        raise SandboxError(f"{where} {text!r}: expected WIDTHxHEIGHT with positive integers, e.g. 640x480")
+    return size
+
+
+_TOP_KEYS = {"timeout", "memory", "check"}
+_CHECK_KEYS = {"name", "golden", "points", "set", "size", "samples", "renderer", "tolerance", "hidden"}
+
+
+def load_rubric(path: Path) -> Rubric:
+    """Read and check a grading file; every mistake is one :class:`SandboxError` naming the file and key."""
+    raw = read_user_file(path, "rubric", "a .toml grading file")
+    try:
+        data = tomllib.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError:
+        raise SandboxError(f"{path}: not UTF-8 text") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise SandboxError(f"{path}: not valid TOML ({exc})") from None
+    unknown = sorted(set(data) - _TOP_KEYS)
+    if unknown:
+        raise SandboxError(f"{path}: unknown key {unknown[0]!r} (expected {', '.join(sorted(_TOP_KEYS))})")
+    entries = data.get("check")
+    if not isinstance(entries, list) or not entries or not all(isinstance(e, dict) for e in entries):
+        raise SandboxError(f"{path}: expected one or more [[check]] tables")
+    checks = [_check(entry, number, path) for number, entry in enumerate(entries, start=1)]
+    names = [c.name for c in checks]
+    twice = next((n for n in names if names.count(n) > 1), None)
+    if twice is not None:
+        raise SandboxError(f"{path}: two checks are named {twice!r}; give each its own name")
+    timeout = data.get("timeout")
+    if timeout is not None and (isinstance(timeout, bool) or not isinstance(timeout, (int, float))
+                                or not 0 < timeout <= 3600):
+        raise SandboxError(f"{path}: timeout = {timeout!r}: expected seconds, more than 0 and at most 3600")
+    memory = data.get("memory")
+    if memory is not None and (isinstance(memory, bool) or not isinstance(memory, int) or not 64 <= memory <= 1 << 20):
+        raise SandboxError(f"{path}: memory = {memory!r}: expected a whole number of MB, at least 64")
+    return Rubric(tuple(checks), None if timeout is None else float(timeout), memory)
+
+
+def _check(entry: dict[str, Any], number: int, path: Path) -> Check:
+    where = f"{path}: check {number}"
+    unknown = sorted(set(entry) - _CHECK_KEYS)
+    if unknown:
+        raise SandboxError(f"{where}: unknown key {unknown[0]!r} (expected {', '.join(sorted(_CHECK_KEYS))})")
+    golden = entry.get("golden")
+    if not isinstance(golden, str) or not golden.lower().endswith(".png"):
+        raise SandboxError(f"{where}: golden = {golden!r}: expected the path of a .png file")
+    golden_path = path.parent / golden
+    name = entry.get("name", golden_path.stem)
+    if not isinstance(name, str) or not name.strip() or not name.isprintable():
+        raise SandboxError(f"{where}: name = {name!r}: expected a short printable text")
+    where = f"{path}: check {name!r}"
+    points = entry.get("points", 1)
+    if isinstance(points, bool) or not isinstance(points, (int, float)) or not (0 <= points <= 1e6):
+        raise SandboxError(f"{where}: points = {points!r}: expected a number, 0 or more")
+    settings = entry.get("set", [])
+    if not isinstance(settings, list) or not all(isinstance(s, str) and "=" in s for s in settings):
+        raise SandboxError(f"{where}: set = {settings!r}: expected a list of \"key=value\" texts")
+    renderer = entry.get("renderer")
+    if renderer is not None:
+        if not isinstance(renderer, str):
+            raise SandboxError(f"{where}: renderer = {renderer!r}: expected a text")
+        settings = [*settings, f"renderer={renderer}"]
+    size = entry.get("size")
+    size_value = None if size is None else parse_size_text(size, f"{where}: size")
+    samples = entry.get("samples", 0)
+    if isinstance(samples, bool) or samples not in (0, 1, 2, 4, 8, 16):
+        raise SandboxError(f"{where}: samples = {samples!r}: expected 0, 1, 2, 4, 8 or 16")
+    tolerance = entry.get("tolerance", {})
+    if not isinstance(tolerance, dict):
+        raise SandboxError(f"{where}: tolerance: expected a table, e.g. {{ threshold = 2, max_bad_share = 0.0005 }}")
+    tolerances = {key: tolerance_value(key, value, f"{where}: tolerance {key} = {value!r}")
+                  for key, value in tolerance.items()}
+    hidden = entry.get("hidden", False)
+    if not isinstance(hidden, bool):
+        raise SandboxError(f"{where}: hidden = {hidden!r}: expected true or false")
+    return Check(name.strip(), golden_path, tuple(settings), size_value, samples, tolerances, float(points), hidden)
+
+
+#: The starting rubric ``glsandbox new --assignment NAME`` writes beside the model answer.
+STARTER = """\
+# Grading file for the assignment "$name" (see the README, "Grading a class").
+#   1. write the goldens from the model answer:
+#        glsandbox check $name.py --rubric $name.grading.toml --update
+#   2. grade a folder of submissions (one .py/.toml file or one folder per student):
+#        glsandbox check submissions/ --rubric $name.grading.toml --html report.html
+# Each [[check]] renders every submission once; its golden may be kept from students.
+
+timeout = 30     # seconds for each picture
+memory = 2048    # MB of memory for each submission
+
+[[check]]
+name = "still"
+golden = "$name-goldens/still.png"
+set = ["time=0"]
+size = "320x240"
+points = 1
+
+[[check]]
+name = "moving"
+golden = "$name-goldens/moving.png"
+set = ["time=1.5"]
+size = "320x240"
+points = 2
+tolerance = { threshold = 2, max_bad_share = 0.0005 }
+
+[[check]]
+name = "traced"
+golden = "$name-goldens/traced.png"
+set = ["time=0"]
+renderer = "ray_numpy"
+size = "160x120"
+points = 1
+hidden = true
+"""

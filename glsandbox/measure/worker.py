@@ -1,0 +1,364 @@
+"""The processes below the grader: the zygote, a supervisor per submission and its renderer.
+
+See :mod:`glsandbox.measure.isolate` for the tree and what each may do. This
+module runs only in those processes; the grader starts the zygote with
+:func:`zygote_main` and never imports the rest.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import json
+import os
+import select
+import shutil
+import signal
+import struct
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from glsandbox.measure.isolate import (BROKEN, CRASHED, OOM, TAIL_LINES, TAIL_WIDTH, TIMEOUT, Job, Picture, Reader,
+                                       job_from, send)
+from glsandbox.measure.processes import kill_tree, killpg, set_subreaper, wait_briefly
+
+__all__ = ["PRELOAD", "zygote_main"]
+
+#: What the zygote imports once, so each submission starts warm (and no module
+#: opens a GL context at import).
+PRELOAD = ["glsandbox.measure.worker", "glsandbox.frame", "glsandbox.lesson", "glsandbox.scene_file",
+           "glsandbox.measure.sandbox", "glsandbox.gl.context", "glsandbox.gl.shaders", "numpy", "moderngl",
+           "glcontext", "glcontext.egl", "PIL.Image", "lessons"]
+
+#: The environment a renderer keeps (by prefix): the drivers', the locale's and glsandbox's own.
+_ENV_KEPT = ("PATH", "HOME", "LANG", "LC_", "TZ", "DISPLAY", "WAYLAND_", "XDG_", "MESA_", "LIBGL_", "GALLIUM_",
+             "LP_", "EGL_", "__EGL_", "__GLX_", "GLCONTEXT_", "PYOPENGL_", "GLSANDBOX_", "PYTHONHASHSEED", "CI")
+
+
+# --- the renderer (grandchild) ---------------------------------------------------------------
+
+
+def _limit(job: Job) -> None:
+    """Address space (--memory), CPU seconds (--timeout for each picture, plus start-up), no core
+    files, and files no larger than 256 MB."""
+    import resource  # POSIX only, as the whole of this module's running side
+
+    memory = job.memory_mb * 1024 * 1024
+    cpu = int(job.timeout * len(job.renders)) + 10
+    for limit, value in ((resource.RLIMIT_AS, memory), (resource.RLIMIT_CPU, cpu), (resource.RLIMIT_CORE, 0),
+                         (resource.RLIMIT_FSIZE, 256 * 1024 * 1024)):
+        try:
+            resource.setrlimit(limit, (value, value + 1 if limit == resource.RLIMIT_CPU else value))
+        except (ValueError, OSError):
+            pass
+
+
+def _renderer(job: Job, root: str, target: str, work: str, out: int) -> None:
+    """The renderer's whole life; it never returns (``os._exit``)."""
+    from glsandbox.errors import SandboxError
+    from glsandbox.frame import HeadlessRenderer
+    from glsandbox.lesson import find_lesson, submission_lesson, user_code_error
+    from glsandbox.measure.sandbox import confine
+
+    os.setsid()
+    null = os.open(os.devnull, os.O_RDONLY)
+    os.dup2(null, 0)
+    log = os.open(os.path.join(work, "output.txt"), os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o600)
+    os.dup2(log, 1)
+    os.dup2(log, 2)
+    os.close(null)
+    os.close(log)
+    os.dup2(out, 3)  # the result pipe; every other descriptor (the supervisor's, the zygote's) is closed
+    out = 3
+    os.closerange(4, os.sysconf("SC_OPEN_MAX"))
+    sys.stdin = open(os.devnull)  # noqa: SIM115 - the submission's, for its life
+    sys.argv = ["submission"]
+    for key in list(os.environ):  # only what rendering reads: no path of the teacher's (PWD, OLDPWD, ...)
+        if not key.startswith(_ENV_KEPT):
+            del os.environ[key]
+    cwd = os.path.join(work, "cwd")
+    os.chdir(root if job.copy else cwd)
+    _limit(job)
+    code = 0
+    try:
+        try:
+            renderer = HeadlessRenderer(job.backend)
+        except SandboxError as exc:
+            send(out, {"kind": "nogl", "error": str(exc)})
+            return
+        confine(root, [root if job.copy else cwd, cwd], cache_writable=job.writes_cache)
+        try:
+            cls = find_lesson(target) if job.source is None else submission_lesson(Path(root) / target)
+        except MemoryError as exc:
+            send(out, {"kind": "oom", "index": 0, "error": str(user_code_error(exc)), "all": True})
+            return
+        except SandboxError as exc:
+            send(out, {"kind": "broken", "index": 0, "error": str(exc), "all": True})
+            return
+        except BaseException as exc:  # noqa: BLE001 - anything the submission raised while loading
+            send(out, {"kind": "broken", "index": 0, "error": str(user_code_error(exc)), "all": True})
+            return
+        for index, render in enumerate(job.renders):
+            started = time.perf_counter()
+            try:
+                image = renderer.render(cls.from_settings(render.settings), render.size, render.samples).image
+                image = np.ascontiguousarray(image, dtype=np.uint8)
+                header = {"kind": "image", "index": index, "shape": list(image.shape),
+                          "seconds": time.perf_counter() - started}
+                send(out, header, image.tobytes())
+            except MemoryError as exc:
+                send(out, {"kind": "oom", "index": index, "error": str(user_code_error(exc))})
+            except SandboxError as exc:
+                send(out, {"kind": "broken", "index": index, "error": str(exc)})
+            except BaseException as exc:  # noqa: BLE001 - KeyboardInterrupt, SystemExit, its own kinds
+                send(out, {"kind": "broken", "index": index, "error": str(user_code_error(exc))})
+    except BaseException:  # noqa: BLE001 - the pipe closed, or worse: the supervisor reports it
+        code = 3
+    finally:
+        for stream in (sys.__stdout__, sys.__stderr__):
+            try:
+                stream.flush()
+            except BaseException:  # noqa: BLE001 - replaced or closed by the submission
+                pass
+        os._exit(code)  # no atexit handler, no thread, no finaliser of the submission runs
+
+
+# --- the supervisor (child) ------------------------------------------------------------------
+
+
+def _copy_submission(source: Path, into: Path) -> Path:
+    """A private copy of a submission's file or folder; symbolic links are copied as links
+    (one that points outside is refused when read, never followed while copying)."""
+    if source.is_dir():
+        shutil.copytree(source, into, symlinks=True)
+    else:
+        into.mkdir()
+        shutil.copy2(source, into / source.name, follow_symlinks=False)
+    return into
+
+
+def _exit_reason(status: int, job: Job) -> tuple[str, str]:
+    if os.WIFSIGNALED(status):
+        number = os.WTERMSIG(status)
+        if number == signal.SIGXCPU:
+            return TIMEOUT, f"CPU time limit ({int(job.timeout * len(job.renders)) + 10} s) reached"
+        name = signal.Signals(number).name if number in signal.Signals._value2member_map_ else str(number)
+        return CRASHED, f"killed by signal {name}"
+    return CRASHED, f"exited with code {os.WEXITSTATUS(status)} before its picture was sent"
+
+
+def _collect(job: Job, pid: int, fd: int) -> list[Picture]:
+    """Each picture as it arrives, against the clock: ``job.timeout`` seconds for each."""
+    pictures: list[Picture] = [Picture() for _ in job.renders]
+    limit = max(w * h * 4 for w, h in (r.size for r in job.renders))
+    reader = Reader(fd)
+    status: int | None = None
+    current, started = 0, time.monotonic()
+
+    def finish(kind: str, error: str) -> list[Picture]:
+        for picture in pictures[current:]:
+            if not picture.status:
+                picture.status, picture.error = kind, error
+        return pictures
+
+    while current < len(pictures):
+        remaining = started + job.timeout - time.monotonic()
+        if remaining <= 0:
+            return finish(TIMEOUT, f"after {job.timeout:g} s")
+        if status is None:
+            done, status_now = os.waitpid(pid, os.WNOHANG)
+            status = status_now if done else None
+        if not reader.closed:
+            reader.pump(0.0 if status is not None else min(remaining, 0.05))
+        elif status is None:  # it closed the pipe but lives on: wait for its end or the clock
+            time.sleep(0.01)
+        try:
+            for header, payload in reader.messages(limit):
+                kind = header.get("kind")
+                if kind == "nogl":
+                    raise _NoGL(str(header.get("error", "")))
+                index = int(header.get("index", -1))
+                if index != current:
+                    raise ValueError("a message out of order on the result pipe")
+                picture = pictures[index]
+                if kind == "image":
+                    shape = tuple(header.get("shape", ()))
+                    w, h = job.renders[index].size
+                    if shape != (h, w, 4) or len(payload) != w * h * 4:
+                        raise ValueError(f"a picture of shape {shape} for a {w}x{h} render")
+                    picture.image = np.frombuffer(payload, dtype=np.uint8).reshape(h, w, 4)
+                    picture.seconds = float(header.get("seconds", 0.0))
+                else:
+                    picture.status = OOM if kind == "oom" else BROKEN
+                    picture.error = str(header.get("error", ""))[:500]
+                    if header.get("all"):  # the lesson did not load: no picture of it can be made
+                        return finish(picture.status, picture.error)
+                current, started = current + 1, time.monotonic()
+        except (ValueError, KeyError, TypeError) as exc:
+            return finish(CRASHED, f"sent {exc}")
+        if status is not None and (reader.closed or not select.select([fd], [], [], 0)[0]) and current < len(pictures):
+            return finish(*_exit_reason(status, job))
+    return pictures
+
+
+class _NoGL(Exception):
+    """The renderer could not open a GL context: the machine's problem, not the submission's."""
+
+
+def _tail(path: str) -> list[str]:
+    try:
+        with open(path, "rb") as handle:
+            handle.seek(max(0, os.fstat(handle.fileno()).st_size - 64 * 1024))
+            lines = handle.read().decode("utf-8", "backslashreplace").splitlines()
+    except OSError:
+        return []
+    return [line[:TAIL_WIDTH] for line in lines[-TAIL_LINES:]]
+
+
+def _supervise(job: Job, out: int) -> None:
+    """One submission, start to end, its result framed on ``out`` (runs in a process the zygote forked)."""
+    os.setsid()
+    set_subreaper()
+    send(out, {"kind": "pid", "pid": os.getpid()})
+    work = tempfile.mkdtemp(prefix="glsandbox-grade-")
+    result: dict = {"kind": "result", "pictures": None, "output": [], "no_gl": "", "root": ""}
+    pictures: list[Picture] | None = None
+    cleaned = False
+    try:
+        os.mkdir(os.path.join(work, "cwd"))
+        if job.source is None:
+            root, target = os.path.join(work, "cwd"), job.target
+        elif job.copy:
+            try:
+                root = str(_copy_submission(Path(job.source), Path(work) / "submission"))
+            except (OSError, shutil.Error) as exc:
+                reason = getattr(exc, "strerror", None) or str(exc).splitlines()[0][:200]
+                pictures = [Picture(status=BROKEN, error=f"{job.source}: cannot be copied for grading ({reason})")
+                            for _ in job.renders]
+                return
+            target = job.target
+            result["root"] = root
+        else:
+            root, target = str(Path(job.source).parent), job.target
+        read_end, write_end = os.pipe()
+        pid = os.fork()
+        if pid == 0:  # the renderer: no GL context exists in this process yet, so forking is safe
+            os.close(read_end)
+            _renderer(job, root, target, work, write_end)
+        os.close(write_end)
+        try:
+            pictures = _collect(job, pid, read_end)
+        except _NoGL as exc:
+            result["no_gl"] = str(exc)
+        wait_briefly(pid)  # after its last picture it ends by itself: then one look finds nothing left
+        killpg(pid)  # the renderer's session (all there is to kill where /proc is missing)
+        kill_tree(os.getpid())
+        cleaned = True
+        os.close(read_end)
+        result["output"] = _tail(os.path.join(work, "output.txt"))
+    finally:
+        if not cleaned:
+            kill_tree(os.getpid())
+        shutil.rmtree(work, ignore_errors=True)
+        payload = b""
+        if pictures is not None:
+            result["pictures"] = []
+            for picture in pictures:
+                image = picture.image
+                result["pictures"].append({"status": picture.status, "error": picture.error,
+                                           "seconds": picture.seconds,
+                                           "shape": None if image is None else list(image.shape)})
+                payload += b"" if image is None else image.tobytes()
+        send(out, result, payload)
+
+
+# --- the zygote: a warm process that forks a supervisor per job -------------------------------
+
+
+def preload_gl_libraries() -> None:
+    """Load (never initialise) the EGL and Mesa driver libraries, so every fork has them mapped and
+    relocated: about 0.05 to 0.1 s off each renderer's first context. Loading starts no thread;
+    a context would (llvmpipe's), which is why none is opened here."""
+    import ctypes.util
+    import functools
+    import glob
+
+    # glcontext looks its libraries up on every context (ctypes.util.find_library runs ldconfig,
+    # 20 to 40 ms): remembered once here, for every renderer forked from this process.
+    ctypes.util.find_library = functools.lru_cache(maxsize=None)(ctypes.util.find_library)
+    for name in ("GL", "EGL", "OSMesa"):
+        ctypes.util.find_library(name)
+    folders = [p for p in os.environ.get("LIBGL_DRIVERS_PATH", "").split(":") if p]
+    folders += ["/usr/lib/x86_64-linux-gnu/dri", "/usr/lib/aarch64-linux-gnu/dri", "/usr/lib64/dri", "/usr/lib/dri"]
+    libraries = ["libEGL.so.1", "libEGL_mesa.so.0", "libglapi.so.0", "libgbm.so.1"]
+    libraries += [path for folder in folders for path in glob.glob(os.path.join(folder, "swrast_dri.so"))][:1]
+    libraries += sorted(glob.glob("/usr/lib*/*/libgallium*.so") + glob.glob("/usr/lib64/libgallium*.so"))[:1]
+    for library in libraries:
+        try:
+            ctypes.CDLL(library, mode=os.RTLD_NOW | os.RTLD_GLOBAL)
+        except OSError:
+            pass
+
+
+def zygote_main(channel_fd: int) -> None:
+    """The zygote process: import :data:`PRELOAD` and the GL libraries once, then :func:`zygote`."""
+    import importlib
+
+    for module in PRELOAD:
+        try:
+            importlib.import_module(module)
+        except ImportError:  # e.g. no lessons package beside an installed glsandbox
+            pass
+    preload_gl_libraries()
+    from glsandbox.measure.sandbox import read_roots
+
+    read_roots()  # worked out once, for every renderer
+    zygote(channel_fd)
+
+
+def zygote(channel_fd: int) -> None:
+    """Serve the grader on ``channel_fd`` (one end of a socket pair): each message is a job and
+    the pipe its result goes to; fork a supervisor for it. Ends when the grader closes its end.
+
+    A socket pair has no name in the file system, so no submission can find it
+    and ask for a process (multiprocessing's forkserver listens on a named socket).
+    """
+    import socket
+
+    channel = socket.socket(fileno=channel_fd)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the grader decides when a run stops
+    signal.signal(signal.SIGCHLD, signal.SIG_IGN)  # supervisors are reaped by the kernel
+    while True:
+        size_bytes = _recv_exact(channel, 4)
+        if size_bytes is None:
+            break
+        (size,) = struct.unpack("!I", size_bytes)
+        first, fds, _, _ = socket.recv_fds(channel, min(size, 1 << 16), 1)
+        data = first + (_recv_exact(channel, size - len(first)) or b"")
+        if not fds:
+            continue
+        pid = os.fork()
+        if pid == 0:
+            signal.signal(signal.SIGCHLD, signal.SIG_DFL)  # the supervisor waits for its renderer
+            channel.close()
+            code = 0
+            try:
+                _supervise(job_from(json.loads(data)), fds[0])
+            except BaseException:  # noqa: BLE001 - the grader sees the pipe close without a result
+                code = 1
+            os._exit(code)
+        os.close(fds[0])
+    os._exit(0)
+
+
+def _recv_exact(channel, size: int) -> bytes | None:
+    data = b""
+    while len(data) < size:
+        chunk = channel.recv(size - len(data))
+        if not chunk:
+            return None
+        data += chunk
+    return data
