@@ -90,20 +90,29 @@ def quiet(timeout: float = 1.0) -> bool:
         time.sleep(0.002)
 
 
-def _warm_up(renderer, sizes: Iterable[tuple[int, int]]) -> None:
-    """Draw every shading once at each size: programs compiled, targets allocated."""
+def _warm_up(renderer, sizes: Iterable[tuple[int, int]]) -> int:
+    """Draw every shading once at each size (programs compiled, targets allocated); how many drew.
+    A shading draws on the first built-in mesh it accepts (``vertex_color`` needs a coloured one)."""
+    from glsandbox.errors import SandboxError
     from glsandbox.lesson import find_lesson
     from glsandbox.scene import SHADINGS
 
-    nodes = "".join(f'[[nodes]]\nmesh = "cube24"\nshading = "{s}"\ncolor = [0.8, 0.4, 0.2]\n'
-                    f'translate = [{i * 0.1}, 0, 0]\n' for i, s in enumerate(SHADINGS))
+    drawn = 0
     with tempfile.TemporaryDirectory(prefix="glsandbox-warm-") as folder:
-        path = os.path.join(folder, "warm.toml")
-        with open(path, "w") as handle:
-            handle.write(_WARM_SCENE + nodes)
-        lesson = find_lesson(path)
-        for size in sizes:
-            renderer.render(lesson.from_settings({}), size)
+        for shading in SHADINGS:
+            for mesh in ("cube24", "cube"):
+                path = os.path.join(folder, f"{shading}-{mesh}.toml")
+                with open(path, "w") as handle:
+                    handle.write(_WARM_SCENE + f'[[nodes]]\nmesh = "{mesh}"\nshading = "{shading}"\n')
+                try:
+                    lesson = find_lesson(path)
+                except SandboxError:
+                    continue
+                for size in sizes:
+                    renderer.render(lesson.from_settings({}), size)
+                drawn += 1
+                break
+    return drawn
 
 
 def open_template(backend: str | None, sizes: Iterable[tuple[int, int]]):
@@ -119,7 +128,8 @@ def open_template(backend: str | None, sizes: Iterable[tuple[int, int]]):
         name = str(renderer.host.ctx.info.get("GL_RENDERER", ""))
         if not name.startswith(SOFTWARE) or _descriptors() != descriptors:
             return None
-        _warm_up(renderer, sizes)
+        if not _warm_up(renderer, sizes):
+            return None
     except Exception:  # noqa: BLE001 - no GL here: the cold renderers report it, one line each
         return None
     # llvmpipe's own threads are named llvmpipe-N; Mesa's cache thread (disk$N) is checked before each fork.

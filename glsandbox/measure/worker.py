@@ -246,7 +246,7 @@ def _supervise(job: Job, out: int) -> None:
             root, target = str(Path(job.source).parent), job.target
         read_end, write_end = os.pipe()
         pid = os.fork()
-        if pid == 0:  # the renderer: no GL context exists in this process yet, so forking is safe
+        if pid == 0:  # the renderer: no GL context here, or the warm template's, checked safe to fork
             os.close(read_end)
             _renderer(job, root, target, work, write_end)
         os.close(write_end)
