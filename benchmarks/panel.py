@@ -21,10 +21,15 @@ LESSON = "phong"
 
 
 def cases(env: Any) -> list:
-    from glsandbox.gl.context import has_display
+    from glsandbox.gl.context import window_unavailable
     from glsandbox.measure.bench import Case, Side
+    from glsandbox.panel import panel_available
 
-    if not has_display():
+    if not panel_available():
+        env.note("skipped: panel (window frame with the live controls): imgui-bundle is not installed "
+                 "(pip install \"glsandbox[panel]\")")
+        return []
+    if window_unavailable():  # glfw's own answer, not a guess from DISPLAY
         env.note("skipped: panel (window frame with the live controls): no display; run under Xvfb, "
                  "e.g. xvfb-run glsandbox bench --only panel")
         return []

@@ -41,7 +41,7 @@ from glsandbox.cli import parse_size
 from glsandbox.frame import HeadlessRenderer
 from glsandbox.lesson import find_lesson
 from glsandbox.raytrace import RenderStats, render
-from glsandbox.raytrace.constants import SHADOW_OFFSET
+from glsandbox.raytrace.constants import SIMPLE_OFFSET
 from glsandbox.raytrace.gpu import gpu_tracer
 from glsandbox.raytrace.world import build_world, camera_rays
 
@@ -141,7 +141,7 @@ class EmbreeCaster:
             point = o[hit] + hits["tfar"][hit, None] * dh
             normal = hits["Ng"][hit]
             normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-30)
-            scale = (SHADOW_OFFSET * np.maximum(1.0, np.abs(point).max(axis=1)))[:, None]
+            scale = (SIMPLE_OFFSET * np.maximum(1.0, np.abs(point).max(axis=1)))[:, None]
             lit = self.lit[nodes]
             for light, occluders in zip(self.lights, self.shadow_scenes):
                 p, n = point[lit], normal[lit]

@@ -28,6 +28,7 @@ The layers below (the README's "How it works" table) import downwards only;
 from glsandbox import camera, geometry, meshgen, transforms
 from glsandbox.planar import Mirror, PlanarShadow
 from glsandbox.errors import SandboxError
+from glsandbox.version import __version__
 from glsandbox.geometry import Mesh
 from glsandbox.images import check_texture_source
 from glsandbox.lesson import Lesson, Param, register
@@ -50,7 +51,6 @@ from glsandbox.scene import (
     Viewport,
 )
 
-__version__ = "0.1.0"
 __all__ = [
     "COURSE_BLUE", "DEPTH_MODES", "LIT_SHADINGS", "NORMAL_MODES", "TEXTURE_FILTERS", "TEXTURE_WRAPS",
     "Camera", "Lesson", "Light", "Material", "Mesh", "Mirror", "Model", "Node", "Overlay", "Param", "PlanarShadow",

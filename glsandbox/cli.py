@@ -30,6 +30,7 @@ from glsandbox.frame import DEFAULT_SIZE, Frame, HeadlessRenderer, with_samples
 from glsandbox.gl.context import BACKENDS
 from glsandbox.lesson import Lesson, all_lessons, find_lesson, lesson_description, lesson_files, submission_lesson
 from glsandbox.plan import plan
+from glsandbox.progress import progress, say
 from glsandbox.scene import Scene
 from glsandbox.window import run_window
 
@@ -109,14 +110,16 @@ def parse_size(text: str) -> tuple[int, int]:
     return parse_size_text(text, "--size")
 
 
-def add_render_options(parser: argparse.ArgumentParser) -> None:
-    """The options shared by every command that renders."""
-    parser.add_argument("--size", default=None, help="frame size WxH (default 640x480)")
+def add_render_options(parser: argparse.ArgumentParser, settings: bool = True,
+                       size_default: str = f"{DEFAULT_SIZE[0]}x{DEFAULT_SIZE[1]}") -> None:
+    """The options shared by every command that renders (``settings``: ``--set``, for one lesson)."""
+    parser.add_argument("--size", default=None, help=f"frame size WxH (default {size_default})")
     parser.add_argument("--samples", type=int, default=0, help="MSAA samples (0: none)")
     parser.add_argument("--backend", default=None, help=f"one of {', '.join(BACKENDS)} "
                         "(default: GLSANDBOX_BACKEND or auto)")
-    parser.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
-                        help="a lesson parameter (repeatable); every lesson has time=SECONDS")
+    if settings:
+        parser.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
+                            help="a lesson parameter (repeatable); every lesson has time=SECONDS")
 
 
 def _lesson(args: argparse.Namespace) -> Lesson:
@@ -167,8 +170,9 @@ def cmd_compare(args: argparse.Namespace) -> int:
     # Everything is parsed and every scene built before a context opens.
     variants, columns = build_variants(lesson_cls, args.vary, args.settings)
     variants = [replace(v, scene=with_samples(v.scene, args.samples)) for v in variants]
-    with HeadlessRenderer(args.backend) as renderer:
-        result = compare_variants(variants, columns, size, renderer)
+    # Each variant is drawn twice: in the composed frame, and alone for the figures.
+    with HeadlessRenderer(args.backend) as renderer, progress(2 * len(variants), "compare", "tile") as bar:
+        result = compare_variants(variants, columns, size, renderer, advance=bar.update)
     write_png(result.image, out)
     print(result.report())
     if result.difference is not None:  # the first two distinct pictures, amplified
@@ -183,8 +187,6 @@ def cmd_tour(args: argparse.Namespace) -> int:
     from glsandbox.measure.check import render_lesson
 
     out: Path = args.out
-    if args.settings:  # refused before the output folder exists
-        raise SandboxError("--set is per lesson; use glsandbox render LESSON --set ... instead of tour")
     if args.lessons is not None and not args.lessons.is_dir():
         raise SandboxError(f"--lessons {args.lessons}: not a folder")
     size = _size(args)
@@ -207,9 +209,9 @@ def cmd_tour(args: argparse.Namespace) -> int:
         commands = {cls.name: f"glsandbox run {cls.name}" for cls in all_lessons()}
     results = []
     started = time.perf_counter()
-    with HeadlessRenderer(args.backend) as renderer:
-        print(f"tour: {len(lessons)} lessons at {size[0]}x{size[1]} on {renderer.host.backend} "
-              f"({renderer.host.ctx.info['GL_RENDERER']}) -> {out}/", file=sys.stderr)
+    with HeadlessRenderer(args.backend) as renderer, progress(len(lessons), "tour", "lesson") as bar:
+        say(f"tour: {len(lessons)} lessons at {size[0]}x{size[1]} on {renderer.host.backend} "
+            f"({renderer.host.ctx.info['GL_RENDERER']}) -> {out}/")
         for number, (name, load) in enumerate(lessons, start=1):
             entry = {"lesson": name, "title": "", "course_section": "", "command": commands[name], "contrasts": []}
             prefix = f"[{number}/{len(lessons)}] {name}"
@@ -224,13 +226,14 @@ def cmd_tour(args: argparse.Namespace) -> int:
                 write_png(frame.image, image_path)
                 entry.update(ok=True, image=image_path.name, render_ms=round(frame.seconds * 1000, 2),
                              plan=frame.plan.to_dict(), plan_text=frame.plan.describe())
-                print(f"{prefix}: ok, {frame.seconds * 1000:.1f} ms", file=sys.stderr, flush=True)
+                say(f"{prefix}: ok, {frame.seconds * 1000:.1f} ms")
                 if args.lessons is None:  # a user's lesson file runs only where its errors are caught
                     entry["contrasts"] = _tour_contrasts(cls, out, size, args.samples, renderer, prefix)
             except SandboxError as exc:  # one broken lesson must not stop the tour
                 entry.update(ok=False, error=str(exc))
-                print(f"{prefix}: FAILED: {exc}", file=sys.stderr, flush=True)
+                say(f"{prefix}: FAILED: {exc}")
             results.append(entry)
+            bar.update(1)
         renderer_name = renderer.host.renderer
         backend = renderer.host.backend
     summary = {"size": list(size), "samples": args.samples, "backend": backend, "renderer": renderer_name,
@@ -280,7 +283,7 @@ def _tour_contrasts(cls: type[Lesson], out: Path, size: tuple[int, int], samples
             entry.update(image=image_path.name, size=list(grid_size), labels=[v.label for v in variants])
         except SandboxError as exc:
             entry["error"] = str(exc)
-            print(f"{prefix}: contrast {vary} FAILED: {exc}", file=sys.stderr, flush=True)
+            say(f"{prefix}: contrast {vary} FAILED: {exc}")
         found.append(entry)
     return found
 
@@ -379,13 +382,23 @@ def cmd_check(args: argparse.Namespace) -> int:
         if args.update:
             raise SandboxError(f"--update writes references from the model answer: give one lesson, not the folder {target}")
 
-        def progress(done: int, total: int, result) -> None:
-            print(f"[{done}/{total}] {result.line()}", flush=True)
+        bars = []  # the progress bar, made when the first submission reports (the total known then)
+
+        def report(done: int, total: int, result) -> None:
+            if not bars:
+                bars.append(progress(total, "check", "submission"))
+            # Lines on stdout above the bar on stderr (only a terminal gets the bar).
+            say(f"[{done}/{total}] {result.line()}", file=sys.stdout)
             for outcome in result.outcomes:
                 for kind, path in outcome.artifacts.items():
-                    print(f"       {kind:<8}: {path}", flush=True)
+                    say(f"       {kind:<8}: {path}", file=sys.stdout)
+            bars[0].update(1)
 
-        results = check_folder(target, checks, args.backend, limits, progress)
+        try:
+            results = check_folder(target, checks, args.backend, limits, report)
+        finally:
+            for bar in bars:
+                bar.close()
         print()
         print(summary_table(results))
         title = str(args.rubric or args.golden)
@@ -433,32 +446,78 @@ def cmd_bench(args: argparse.Namespace) -> int:
     return run_all(json_path=args.json, quick=args.quick, only=args.only)
 
 
+#: Each command: (what it does, in one line; examples). ``glsandbox COMMAND --help`` shows both.
+COMMANDS: dict[str, tuple[str, tuple[str, ...]]] = {
+    "list": ("list the course's lessons in course order, with -v each one's parameters",
+             ("glsandbox list", "glsandbox list -v")),
+    "run": ("open a lesson in a window (ESC quits, F1 the panel, F12 a screenshot, R reloads)",
+            ("glsandbox run phong", "glsandbox run phong --set shading=gouraud --samples 4",
+             "glsandbox run my_lesson.py")),
+    "render": ("render a lesson headless to a PNG file",
+               ("glsandbox render indexed_cube --out cube.png",
+                "glsandbox render phong --set time=1.5 --size 800x600 --out phong.png")),
+    "plan": ("print the passes, buffers and shader variants a lesson's frame needs",
+             ("glsandbox plan mirror", "glsandbox plan scene.toml")),
+    "tour": ("render every lesson headless into a folder, with a gallery page (index.html) and tour.json",
+             ("glsandbox tour", "glsandbox tour --out gallery --size 320x240",
+              "glsandbox tour --lessons submissions/ --out checked")),
+    "compare": ("render one lesson with several parameter values side by side, and say which pictures differ",
+                ("glsandbox compare phong --vary shading=phong,gouraud,blinn_phong",
+                 "glsandbox compare phong --vary shading=phong,gouraud --vary normals=correct,naive")),
+    "new": ("write a small commented starting lesson NAME.py, scene file NAME.toml and shader NAME.glsl "
+            "(or, with --assignment, a model answer and a grading file)",
+            ("glsandbox new my_lesson", "glsandbox new my_lesson --dir lessons_of_mine",
+             "glsandbox new --assignment shading")),
+    "check": ("render a lesson (or each one in a folder) and compare it with a reference PNG or a grading "
+              "file's checks: exit 0 match, 1 differs",
+              ("glsandbox check my_lesson.py --golden expected.png",
+               "glsandbox check submissions/ --golden expected.png --csv marks.csv",
+               "glsandbox check submissions/ --rubric shading.grading.toml --html marks.html",
+               "glsandbox check phong --golden phong.png --update")),
+    "tradeoffs": ("time each accuracy knob and compare it with a reference (FLIP, RMSE): report.md, CSV and plot",
+                  ("glsandbox tradeoffs --quick", "glsandbox tradeoffs --knob antialiasing --out out/aa")),
+    "bench": ("run every benchmark in benchmarks/ and print one table of side-by-side ratios",
+              ("glsandbox bench --quick", "glsandbox bench --only clear_and_swap --json bench.json")),
+}
+
+
+def add_command(sub: argparse._SubParsersAction, name: str) -> argparse.ArgumentParser:
+    """A subcommand whose ``--help`` starts with what it does and ends with examples."""
+    summary, examples = COMMANDS[name]
+    epilog = "examples:\n" + "\n".join(f"  {example}" for example in examples)
+    return sub.add_parser(name, help=summary, description=summary[:1].upper() + summary[1:] + ".", epilog=epilog,
+                          formatter_class=argparse.RawDescriptionHelpFormatter)
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = ArgumentParser(prog="glsandbox", description="A graphics course as runnable ModernGL lessons.")
+    from glsandbox.version import __version__
+
+    parser = ArgumentParser(prog="glsandbox", description="A graphics course as runnable ModernGL lessons.",
+                            epilog="glsandbox COMMAND --help says what a command does, with examples.")
+    parser.add_argument("--version", action="version", version=f"glsandbox {__version__}",
+                        help="print glsandbox's version and exit")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    p = sub.add_parser("list", help="list the lessons")
+    p = add_command(sub, "list")
     p.add_argument("-v", "--verbose", action="store_true", help="also list each lesson's parameters")
     p.set_defaults(func=cmd_list)
 
-    for name, func, help_text in (("run", cmd_run, "open a lesson in a window"),
-                                  ("render", cmd_render, "render a lesson headless to a PNG"),
-                                  ("plan", cmd_plan, "print the passes a lesson's scene needs")):
-        p = sub.add_parser(name, help=help_text)
+    for name, func in (("run", cmd_run), ("render", cmd_render), ("plan", cmd_plan)):
+        p = add_command(sub, name)
         p.add_argument("lesson", metavar="LESSON", help="a lesson name, a lesson .py file or a scene .toml file")
         add_render_options(p)
         if name == "render":
             p.add_argument("--out", type=Path, required=True, help="the PNG file to write")
         p.set_defaults(func=func)
 
-    p = sub.add_parser("tour", help="render every lesson headless, with a gallery page")
-    add_render_options(p)
+    p = add_command(sub, "tour")
+    add_render_options(p, settings=False)  # --set is per lesson: tour refuses it
     p.add_argument("--lessons", type=Path, default=None, metavar="DIR",
                    help="the lesson files (.py, .toml) in DIR instead of the course's lessons")
     p.add_argument("--out", type=Path, default=Path("out"), help="output folder (default out/)")
-    p.set_defaults(func=cmd_tour)
+    p.set_defaults(func=cmd_tour, settings=[])
 
-    p = sub.add_parser("compare", help="render one lesson with several parameter values side by side")
+    p = add_command(sub, "compare")
     p.add_argument("lesson", metavar="LESSON", help="a lesson name, a lesson .py file or a scene .toml file")
     p.add_argument("--vary", action="append", default=[], metavar="KEY=V1,V2,...",
                    help="a parameter and its values, one tile each (twice: a grid)")
@@ -466,7 +525,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", type=Path, default=None, help="the PNG to write (default compare_LESSON.png)")
     p.set_defaults(func=cmd_compare)
 
-    p = sub.add_parser("new", help="write a small commented starting lesson NAME.py, scene file NAME.toml and shader NAME.glsl")
+    p = add_command(sub, "new")
     p.add_argument("name", metavar="NAME", nargs="?", default=None,
                    help="the lesson's name, a Python identifier (e.g. my_lesson)")
     p.add_argument("--assignment", metavar="NAME", default=None,
@@ -474,7 +533,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--dir", type=Path, default=Path("."), help="the folder to write into (default: here)")
     p.set_defaults(func=cmd_new)
 
-    p = sub.add_parser("check", help="render a lesson and compare it with a reference PNG (0 match, 1 differs)")
+    p = add_command(sub, "check")
     p.add_argument("lesson", metavar="LESSON_OR_DIR",
                    help="a lesson name, .py or .toml file, or a folder of them (one line each, and a table)")
     p.add_argument("--golden", type=Path, default=None, metavar="REF.png", help="the reference image")
@@ -495,10 +554,10 @@ def build_parser() -> argparse.ArgumentParser:
                        ("junit", "JUnit XML (what CI systems read)"),
                        ("gradescope", "Gradescope's results.json")):
         p.add_argument(f"--{kind}", type=Path, default=None, metavar="FILE", help=f"folder mode: {text}")
-    add_render_options(p)
+    add_render_options(p, size_default="the reference's size")
     p.set_defaults(func=cmd_check)
 
-    p = sub.add_parser("tradeoffs", help="what accuracy costs in time: each knob timed and compared with a reference")
+    p = add_command(sub, "tradeoffs")
     p.add_argument("--out", type=Path, default=Path("out/tradeoffs"), help="output folder (default out/tradeoffs)")
     p.add_argument("--quick", action="store_true", help="a reduced set at a small size (for CI)")
     p.add_argument("--runs", type=int, default=5, help="timed runs per setting (at least 5, default 5)")
@@ -506,7 +565,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--backend", default=None, help="GL backend (default: GLSANDBOX_BACKEND or auto)")
     p.set_defaults(func=cmd_tradeoffs)
 
-    p = sub.add_parser("bench", help="run every benchmark in benchmarks/ and print one table of ratios")
+    p = add_command(sub, "bench")
     p.add_argument("--json", type=Path, default=None, metavar="FILE", help="also write the figures as JSON")
     p.add_argument("--quick", action="store_true", help="fewer frames and rounds (a smoke run)")
     p.add_argument("--only", action="append", default=[], metavar="NAME",
@@ -522,8 +581,11 @@ def main(argv: list[str] | None = None) -> int:
 
 def lesson_main(lesson_cls: type[Lesson], argv: list[str] | None = None) -> int:
     """Entry point of a lesson module: a window, or ``--headless --out FILE.png``."""
-    parser = ArgumentParser(prog=f"python -m lessons.{lesson_cls.name}",
-                                     description=f"{lesson_cls.title} ({lesson_cls.course_section})")
+    prog = f"python -m lessons.{lesson_cls.name}"
+    parser = ArgumentParser(prog=prog, description=f"{lesson_cls.title} ({lesson_cls.course_section}): "
+                            "opens it in a window, or renders it headless to a PNG.",
+                            epilog=f"examples:\n  {prog}\n  {prog} --headless --out {lesson_cls.name}.png",
+                            formatter_class=argparse.RawDescriptionHelpFormatter)
     add_render_options(parser)
     parser.add_argument("--headless", action="store_true", help="render offscreen instead of opening a window")
     parser.add_argument("--out", type=Path, default=None, help="with --headless: the PNG to write")

@@ -36,6 +36,10 @@ class Mesh:
     ``warnings`` says what of its file is not drawn (a normal map, an
     animation, a missing texture): ``plan`` lists them and ``render``, ``run``
     and ``tour`` print each once as a ``warning:`` line.
+    ``analytic`` names the exact shape the triangles tessellate, for the ray
+    tracer (``"sphere"``: :func:`sphere`, the unit sphere; None: the
+    triangles are the shape); :mod:`glsandbox.raytrace.world` traces that
+    shape instead of the triangles.
     """
 
     name: str
@@ -47,6 +51,7 @@ class Mesh:
     mode: str = "triangles"
     notes: tuple[str, ...] = ()
     warnings: tuple[str, ...] = ()
+    analytic: str | None = None
 
     def __post_init__(self) -> None:
         if self.mode not in MODES:
@@ -323,7 +328,7 @@ def sphere(stacks: int = 24, slices: int = 48) -> Mesh:
                 indices += [a, b, a + 1]
             if i < stacks - 1:
                 indices += [a + 1, b, b + 1]
-    return Mesh("sphere", positions, np.array(indices, dtype=np.uint32), positions.copy(), uvs)
+    return Mesh("sphere", positions, np.array(indices, dtype=np.uint32), positions.copy(), uvs, analytic="sphere")
 
 
 #: Built-in meshes by name, for scene files.

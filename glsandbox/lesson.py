@@ -11,6 +11,7 @@ from __future__ import annotations
 import copy
 import difflib
 import importlib
+import importlib.util
 import inspect
 import itertools
 import math
@@ -398,11 +399,45 @@ def register(cls: type[Lesson]) -> type[Lesson]:
     return cls
 
 
-def all_lessons() -> list[type[Lesson]]:
-    """Every lesson in the ``lessons`` package, in course order."""
-    import lessons
+#: The course's own lessons: the ``lessons`` package installed beside ``glsandbox``
+#: (site-packages from the wheel, the repository's folder in a checkout).
+BUILTIN_LESSONS = Path(__file__).resolve().parent.parent / "lessons"
 
-    for module in pkgutil.iter_modules(lessons.__path__):
+
+def builtin_lessons() -> types.ModuleType:
+    """The built-in ``lessons`` package, imported from :data:`BUILTIN_LESSONS`.
+
+    Not by a search of ``sys.path``: a student's own ``lessons/`` folder in
+    the working directory (first on the path under ``python -m`` and in
+    Jupyter) would shadow the course's. Once imported, ``lessons.<name>``
+    resolves through this package's own folder, so the lessons' imports of
+    each other (``from lessons._scenes import ...``) find the course's too.
+    """
+    loaded = sys.modules.get("lessons")
+    if loaded is None:
+        spec = importlib.util.spec_from_file_location("lessons", BUILTIN_LESSONS / "__init__.py",
+                                                      submodule_search_locations=[str(BUILTIN_LESSONS)])
+        if spec is None or spec.loader is None or not (BUILTIN_LESSONS / "__init__.py").is_file():
+            raise SandboxError(f"the course's lessons are missing from {BUILTIN_LESSONS}; reinstall glsandbox")
+        loaded = importlib.util.module_from_spec(spec)
+        sys.modules["lessons"] = loaded
+        try:
+            spec.loader.exec_module(loaded)
+        except BaseException:
+            del sys.modules["lessons"]
+            raise
+        return loaded
+    folders = [Path(folder).resolve() for folder in getattr(loaded, "__path__", [])]
+    if folders != [BUILTIN_LESSONS]:
+        where = ", ".join(str(f) for f in folders) or "?"
+        raise SandboxError(f"another package named 'lessons' ({where}) was imported before the course's "
+                           f"({BUILTIN_LESSONS}); rename your folder (e.g. my_lessons)")
+    return loaded
+
+
+def all_lessons() -> list[type[Lesson]]:
+    """Every lesson in the built-in ``lessons`` package, in course order."""
+    for module in pkgutil.iter_modules(builtin_lessons().__path__):
         if not module.name.startswith("_"):
             importlib.import_module(f"lessons.{module.name}")
     return sorted(_REGISTRY.values(), key=lambda c: (c.order, c.name))
@@ -426,6 +461,7 @@ def find_lesson(name_or_path: str) -> type[Lesson]:
     if path.is_file() or path.is_dir():
         raise SandboxError(f"{path}: expected a lesson name, a lesson .py file or a scene .toml file")
     if name_or_path.isidentifier() and not name_or_path.startswith("_"):
+        builtin_lessons()
         try:
             importlib.import_module(f"lessons.{name_or_path}")
         except ModuleNotFoundError as exc:

@@ -86,6 +86,10 @@ class Panel:
         px, py, pw, ph = self.rect
         return self.visible and (px <= x < px + pw and py <= y < py + ph or self.io.want_capture_mouse)
 
+    def toggle(self) -> None:
+        """F1: hide or show the panel."""
+        self.visible = not self.visible
+
     def _install(self) -> None:
         glfw, io, window = self.glfw, self.io, self.window
         # pyGLFW's setters return the callback they replace: each handler below
@@ -368,6 +372,44 @@ class Panel:
     def close(self) -> None:
         self.imgui.backends.opengl3_shutdown()
         self.imgui.destroy_context(self.context)
+
+
+#: What F1 says in a window without the panel: imgui-bundle is the optional ``panel`` extra.
+INSTALL_HINT = ("the live controls panel needs imgui-bundle: pip install \"glsandbox[panel]\" "
+                "(from the repository: uv sync --extra panel)")
+
+
+def panel_available() -> bool:
+    """Whether imgui-bundle (the ``panel`` extra) imports; only a window asks, and it needs it then."""
+    try:
+        import imgui_bundle  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+class NoPanel:
+    """Stands in for :class:`Panel` when imgui-bundle is not installed.
+
+    The window works as before (keys, camera, reloads, screenshots); F1, which
+    would show the panel, prints one line saying how to install it.
+    """
+
+    visible = False
+
+    def toggle(self) -> None:
+        print(f"note: {INSTALL_HINT}", file=sys.stderr, flush=True)
+
+    def draw(self, session: Session) -> None:
+        return None
+
+    def close(self) -> None:
+        return None
+
+
+def open_panel(window: Any) -> Panel | NoPanel:
+    """The window's panel, or a :class:`NoPanel` when the ``panel`` extra is not installed."""
+    return Panel(window) if panel_available() else NoPanel()
 
 
 def suggested_values(session: Session, name: str) -> list[str]:

@@ -42,10 +42,18 @@ from __future__ import annotations
 import functools
 import itertools
 import math
+import warnings
 from collections.abc import Sequence
 
 import numpy as np
-import pyrr
+
+# pyrr 0.10.3's docstrings hold invalid escape sequences ("\\s"): compiling them, the
+# first import after install, prints a SyntaxWarning on Python 3.12+ (a
+# DeprecationWarning before) on the student's terminal. Not our code and harmless.
+with warnings.catch_warnings():
+    warnings.filterwarnings("ignore", message="invalid escape sequence", category=SyntaxWarning)
+    warnings.filterwarnings("ignore", message="invalid escape sequence", category=DeprecationWarning)
+    import pyrr
 
 from glsandbox.errors import SandboxError, plain
 

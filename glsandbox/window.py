@@ -6,7 +6,7 @@ F12 for a screenshot, R to reload shaders, the shared camera keys
 frame is drawn exactly as headless draws it (:class:`glsandbox.frame.FrameRenderer`,
 into an offscreen target with the plan's buffers) and its colour copied onto
 the window, so the window shows the headless pixels. The live controls
-(:mod:`glsandbox.panel`, F1 hides them) are drawn over the copy, never into
+(:mod:`glsandbox.panel`, F1 hides them; the optional ``panel`` extra) are drawn over the copy, never into
 the frame, and change the lesson's values, the clock, MSAA and live compare
 (:class:`glsandbox.controls.Session`).
 """
@@ -57,7 +57,7 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
     """
     import glfw
 
-    from glsandbox.panel import Panel  # imgui only where a window opens (not for headless commands)
+    from glsandbox.panel import open_panel  # imgui only where a window opens (not for headless commands)
 
     instead = instead or f"or render it headless: glsandbox render {lesson.name} --out FILE.png"
     host = open_context(backend if backend not in (None, "auto") else "auto", window=True, size=size,
@@ -136,7 +136,7 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
     camera_input, repeat_keys = attach_camera_input(host.window, lesson_scene)
     session.camera = camera_input
     try:
-        panel = Panel(host.window)  # chained in front of the callbacks above
+        panel = open_panel(host.window)  # chained in front of the callbacks above (none without imgui-bundle)
     except Exception:
         renderer.close()
         host.release()
@@ -158,7 +158,7 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
         if key == glfw.KEY_ESCAPE:
             glfw.set_window_should_close(host.window, True)
         elif key == glfw.KEY_F1:
-            panel.visible = not panel.visible
+            panel.toggle()  # without imgui-bundle: one line saying how to install the panel
         elif key == glfw.KEY_F12:
             state["shoot"] = True  # taken from the next frame's target, before the panel is drawn
         elif key == glfw.KEY_R:

@@ -65,7 +65,7 @@ ROCK_SIZE = (48, 36)
 
 
 def scene(name: str) -> Scene:
-    mesh = replace(geometry.sphere(8, 16), name="sphere_mesh")  # a mesh, not the exact sphere
+    mesh = replace(geometry.sphere(8, 16), name="sphere_mesh", analytic=None)  # a mesh, not the exact sphere
     material = Material(color=(0.8, 0.5, 0.3, 1.0), shading="phong", ambient=0.2, diffuse=0.6, specular=0.2)
     nodes = [Node("floor", geometry.plane(20.0), transforms.translate(0.0, -1.0, 0.0),
                   Material(color=(0.5, 0.5, 0.55, 1.0), shading="phong", ambient=0.2, diffuse=0.6, specular=0.2))]

@@ -14,6 +14,14 @@ scene=...``:
   crossed at t = 75 < 100: the point is in shadow. The red sphere is a
   mirror here so the reflection shows; the notes' typo of #9 (subtracting
   the blue centre) is corrected;
+- ``far_eye``: shadow acne from a far eye. Rays from an eye 1e7 away hit a
+  unit sphere at the origin on 400 points that face the light: none can be in
+  shadow (the sphere alone is convex). The simple relative offset
+  (``epsilon=SHADOW_EPSILON``, 2⁻³²·max(1, |P|)) is 2e-10 there, smaller than
+  the hit point's own rounding error (about 1e-9: ``P = R0 + t·Rd`` with
+  ``|t·Rd|`` = 1e7), and about a fifth of the points shadow themselves;
+  the offset from the hit's error bound (:attr:`Hit.error`, the default)
+  shadows none;
 - ``exam2012``: worked example #10. From P = (0,-8,-5) towards L = (0,10,-29)
   (distance 30, direction (0,0.6,-0.8)) the plane N = (0,-0.6,0.8), D = 39.2
   is crossed at t = 40, *beyond* the light: P is lit. The notes conclude
@@ -42,10 +50,10 @@ from glsandbox import (
     text_image,
     transforms,
 )
-from glsandbox.raytrace import Plane, Ray, Sphere, first_hit, in_shadow, reflect, shadow_ray
+from glsandbox.raytrace import SHADOW_EPSILON, Plane, Ray, Sphere, first_hit, in_shadow, reflect, shadow_ray
 from lessons._scenes import KA, KD, KS, demo_scene, dx, lamp, material, sphere
 
-SCENES = ("demo", "exam2013", "exam2012")
+SCENES = ("demo", "exam2013", "exam2012", "far_eye")
 
 
 def fmt(v) -> str:
@@ -66,7 +74,7 @@ def exam2013(name: str) -> tuple[Scene, list[str]]:
             f"red hit t = {hit.t:.6g} at {fmt(hit.point)}, N = {fmt(hit.normal)}",
             f"reflected {fmt(bounce.direction)} hits blue at t = {t_blue:.6g}",
             f"to light: distance {distance:.6g}, blue at t = {t_block:.6g} < {distance:.6g}: "
-            + ("in shadow" if in_shadow(hit.point, light, [red, blue], hit.normal) else "lit")]
+            + ("in shadow" if in_shadow(hit, light, [red, blue]) else "lit")]
     nodes = (sphere("red", tuple(red.center), 10.0, material((0.9, 0.1, 0.1), reflectivity=0.5)),
              sphere("blue", tuple(blue.center), 35.0, material((0.15, 0.25, 0.9))),
              lamp(0, light, 2.0))
@@ -96,6 +104,42 @@ def exam2012(name: str) -> tuple[Scene, list[str]]:
     return Scene(name, nodes=nodes, camera=camera, lights=(Light(light),), clear_color=(0.08, 0.08, 0.12, 1.0)), rows
 
 
+def self_shadowed(eye_distance: float, epsilon: float | None, count: int = 400) -> int:
+    """How many of ``count`` lit points of a unit sphere at the origin, seen from
+    ``eye_distance`` away, :func:`in_shadow` wrongly calls shadowed (the sphere is the
+    only shape): with ``epsilon`` the teaching variant's offset, else the error bound."""
+    import numpy as np
+
+    rng = np.random.default_rng(1)
+    ball, light = Sphere((0.0, 0.0, 0.0), 1.0), np.array([5.0, 5.0, 5.0])
+    eye = -eye_distance * np.array([1.0, 0.3, 0.1])
+    wrong = found = 0
+    while found < count:
+        q = rng.standard_normal(3)
+        q /= np.linalg.norm(q)
+        if q @ eye <= 0.0 or q @ light <= 0.0:
+            continue  # a point the eye cannot see, or one facing away from the light
+        hit = first_hit(Ray(tuple(eye), tuple(q - eye)), [ball])
+        if hit is None or float(np.dot(hit.normal, light - hit.point)) <= 0.0:
+            continue
+        found += 1
+        # The Hit carries its error bound; a bare point and epsilon: the teaching variant.
+        wrong += in_shadow(hit, light, [ball]) if epsilon is None else \
+            in_shadow(hit.point, light, [ball], hit.normal, epsilon=epsilon)
+    return wrong
+
+
+def far_eye(name: str) -> tuple[Scene, list[str]]:
+    rows = ["Shadow acne from a far eye: a unit sphere, the eye 1e7 away",
+            f"simple offset 2^-32*max(1,|P|): {self_shadowed(1e7, SHADOW_EPSILON)} of 400 lit points self-shadowed",
+            f"offset from the hit's error bound: {self_shadowed(1e7, None)} of 400",
+            "(P = R0 + t*Rd is off by ~1e-16*(|R0| + |t*Rd|) = 1e-9; the simple offset is 2e-10)"]
+    light = (5.0, 5.0, 5.0)
+    nodes = (sphere("ball", (0.0, 0.0, 0.0), 1.0, material((0.9, 0.5, 0.2))), lamp(0, light, 0.3))
+    camera = Camera(eye=(-3.0, 1.0, 3.5), target=(0.0, 0.0, 0.0), fov_y=45.0)
+    return Scene(name, nodes=nodes, camera=camera, lights=(Light(light),), clear_color=(0.08, 0.08, 0.12, 1.0)), rows
+
+
 @register
 class RayPhong(Lesson):
     name = "ray_phong"
@@ -112,7 +156,7 @@ class RayPhong(Lesson):
             scene = demo_scene(self.name)
             rows = [f"Phong ka={KA} kd={KD} ks={KS} (sum 1), shadows, reflections to depth 2"]
         else:
-            scene, rows = (exam2013 if which == "exam2013" else exam2012)(self.name)
+            scene, rows = {"exam2013": exam2013, "exam2012": exam2012, "far_eye": far_eye}[which](self.name)
         from dataclasses import replace
 
         return replace(scene, overlays=(Overlay("figures", text_image(rows), None, (4, 4)),))

@@ -1,4 +1,4 @@
-#version 330 core
+#version 400 core
 // The ray tracer as one fragment shader (glsandbox.raytrace.gpu): one
 // fragment = one pixel = one primary ray, with its shadow rays and
 // reflection bounces. The same algorithm as the float64 numpy engine
@@ -7,7 +7,7 @@
 // measured about 5x faster for this.
 //
 // Data (uploaded by glsandbox/raytrace/gpu.py), flat arrays of vec4 records:
-//   triangles  TRI_RECORDS per triangle: v0 | e1 | e2 | n0,uv0.x | n1,uv0.y |
+//   triangles  TRI_RECORDS per triangle: v0 | v1 | v2 | n0,uv0.x | n1,uv0.y |
 //              n2,uv1.x | c0,uv1.y | c1,uv2.x | c2,uv2.y   (world space)
 //   nodes      NODE_RECORDS per node: box min,kind | box max,cull |
 //              start,count,scene order,0 | colour,mode | ka,kd,ks,n |
@@ -59,7 +59,8 @@ uniform vec3 u_background;  // the viewport's clear colour
 uniform int u_max_depth;    // reflection bounces (REFLECT: > 0)
 uniform int u_cull;         // -1: per node (as the rasterizer), 0: never, 1: always
 uniform bool u_aabb;
-uniform float u_offset;     // relative offset of secondary-ray origins (SHADOW_OFFSET)
+uniform bool u_simple_offset;  // the teaching variant: offset u_offset * max(1, max|P|), not the error bound
+uniform float u_offset;
 #if NUM_LIGHTS > 0
 uniform vec3 u_light_pos[NUM_LIGHTS];
 uniform vec3 u_light_color[NUM_LIGHTS];
@@ -94,6 +95,9 @@ vec4 node_rec(int k, int r) { return record(u_nodes, k * NODE_RECORDS + r); }
 vec4 tri_rec(int k, int r) { return record(u_tris, k * TRI_RECORDS + r); }
 #endif
 
+#define WT_DOUBLE_EDGES 0  // see common/watertight.glsl: watertight without, and cheaper
+#include "common/watertight.glsl"
+
 #ifndef BVH
 #define BVH 0
 #endif
@@ -121,27 +125,14 @@ bool slab(vec3 o, vec3 inv_d, vec3 lo, vec3 hi, float best) {
     return near <= far && far > 0.0 && near < best;
 }
 
-// Möller–Trumbore: O + t d = V0 + u e1 + v e2 by Cramer's rule; `uv` gets
-// the hit's barycentric (u, v), which the shading needs (so it is not
-// solved again there). det = e1·(d×e2) = −N·d is positive for a front
-// face: backface culling keeps only det > 0 (course "Hızlandırma: backface
-// culling"). Branchless: under llvmpipe's masks an early return saves
-// nothing.
-float triangle_t(int k, vec3 o, vec3 d, bool cull, out vec2 uv) {
-    vec3 v0 = tri_rec(k, 0).xyz;
-    vec3 e1 = tri_rec(k, 1).xyz;
-    vec3 e2 = tri_rec(k, 2).xyz;
-    vec3 p = cross(d, e2);
-    float det = dot(e1, p);
-    float inv_det = 1.0 / det;
-    vec3 s = o - v0;
-    float u = dot(s, p) * inv_det;
-    vec3 q = cross(s, e1);
-    float v = dot(d, q) * inv_det;
-    float t = dot(e2, q) * inv_det;
-    uv = vec2(u, v);
-    bool ok = (cull ? det > 0.0 : det != 0.0) && u >= 0.0 && u <= 1.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0;
-    return ok ? t : INF;
+// The watertight triangle test (common/watertight.glsl, the one the BVH
+// traversal uses too): a ray through a shared edge or vertex hits one of its
+// triangles, never none. `uv` gets the hit's barycentric (u, v), which the
+// shading needs (so it is not solved again there). Backface culling
+// (course "Hızlandırma: backface culling") keeps the front faces only.
+float triangle_t(int k, WtRay r, bool cull, out vec2 uv) {
+    float t = wt_triangle(r, tri_rec(k, 0).xyz, tri_rec(k, 1).xyz, tri_rec(k, 2).xyz, cull, uv);
+    return t > 0.0 ? t : INF;
 }
 
 // Işın-Küre kesim testi in the unit sphere's own space, the numerically
@@ -192,7 +183,8 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
     hit_node = -1;
     hit_tri = -1;
     hit_uv = vec2(0.0);
-    vec3 inv_d = 1.0 / d;
+    WtRay wr = wt_ray(o, d);
+    vec3 inv_d = wr.inv_d;
     vec2 uv;
 #if defined(SCENE_NODES)
     // The node list unrolled, in scene order: SCENE_NODES is a sequence of
@@ -205,12 +197,12 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
 #define MESH(k, start, cull, lamps) { \
         int stop = start + box_count(k, o, inv_d, best); \
         for (int j = start; j < stop; ++j) { \
-            float t = triangle_t(j, o, d, cull != 0, uv); \
+            float t = triangle_t(j, wr, cull != 0, uv); \
             if (t < best) { best = t; hit_node = k; hit_tri = j; hit_uv = uv; } \
         } \
     }
 #define TRI(k, j, cull, lamps) { \
-        float t = triangle_t(j, o, d, cull != 0, uv); \
+        float t = triangle_t(j, wr, cull != 0, uv); \
         if (t < best) { best = t; hit_node = k; hit_tri = j; hit_uv = uv; } \
     }
 #define SPHERE(k, cull, lamps) { \
@@ -244,7 +236,7 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
         int start = int(r2.x);
         int stop = start + int(r2.y);
         for (int j = start; j < stop; ++j) {
-            float t = triangle_t(j, o, d, cull, uv);
+            float t = triangle_t(j, wr, cull, uv);
             if (t < best || (t == best && t < INF && r2.z < best_order)) {
                 best = t; best_order = r2.z; hit_node = k; hit_tri = j; hit_uv = uv;
             }
@@ -272,7 +264,8 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
 // hit answers it, so a lane stops testing at its first; the light's lamp
 // is skipped.
 bool occluded(vec3 o, vec3 d, int light) {
-    vec3 inv_d = 1.0 / d;
+    WtRay wr = wt_ray(o, d);
+    vec3 inv_d = wr.inv_d;
     vec2 uv;
 #if defined(SCENE_NODES)
     bool hit = false;
@@ -280,10 +273,10 @@ bool occluded(vec3 o, vec3 d, int light) {
     // none where the compiler unrolls the light loop.
 #define MESH(k, start, cull, lamps) if (((lamps >> light) & 1) == 0) { \
         int stop = start + box_count(k, o, inv_d, 1.0); \
-        for (int j = start; j < stop && !hit; ++j) hit = triangle_t(j, o, d, cull != 0, uv) < 1.0; \
+        for (int j = start; j < stop && !hit; ++j) hit = triangle_t(j, wr, cull != 0, uv) < 1.0; \
     }
 #define TRI(k, j, cull, lamps) if (((lamps >> light) & 1) == 0) { \
-        hit = hit || triangle_t(j, o, d, cull != 0, uv) < 1.0; \
+        hit = hit || triangle_t(j, wr, cull != 0, uv) < 1.0; \
     }
 #define SPHERE(k, cull, lamps) if (((lamps >> light) & 1) == 0) { \
         hit = hit || sphere_t(to_object(k, o, 1.0), to_object(k, d, 0.0), cull != 0) < 1.0; \
@@ -313,7 +306,7 @@ bool occluded(vec3 o, vec3 d, int light) {
         int start = int(r2.x);
         int stop = start + int(r2.y);
         for (int j = start; j < stop; ++j) {
-            if (triangle_t(j, o, d, cull, uv) < 1.0) return true;
+            if (triangle_t(j, wr, cull, uv) < 1.0) return true;
         }
     }
 #endif
@@ -410,9 +403,10 @@ void surface(int k, int j, float t, vec2 bary, vec3 o, vec3 d, out vec3 p, out v
         vec3 w = vec3(1.0 - bary.x - bary.y, bary.x, bary.y);
         vec4 a = tri_rec(j, 3), b = tri_rec(j, 4), c = tri_rec(j, 5);
         n = w.x * a.xyz + w.y * b.xyz + w.z * c.xyz;
-        // Two-sided: a back face seen (the ray along the face normal e1 x e2, the
+        // Two-sided: a back face seen (the ray along the face normal (V1-V0) x (V2-V0), the
         // rasterizer's !gl_FrontFacing) is lit as its other side.
-        if ((flags & 2) != 0 && dot(cross(tri_rec(j, 1).xyz, tri_rec(j, 2).xyz), d) > 0.0) n = -n;
+        vec3 v0 = tri_rec(j, 0).xyz;
+        if ((flags & 2) != 0 && dot(cross(tri_rec(j, 1).xyz - v0, tri_rec(j, 2).xyz - v0), d) > 0.0) n = -n;
 #if VERTEX_COLORS || NUM_TEXTURES > 0
         vec4 ca = tri_rec(j, 6), cb = tri_rec(j, 7), cc = tri_rec(j, 8);
         uv = w.x * vec2(a.w, b.w) + w.y * vec2(c.w, ca.w) + w.z * vec2(cb.w, cc.w);
@@ -447,16 +441,65 @@ float coverage(int k, float alpha) {
     return mode == 1 ? (alpha >= look.z ? 1.0 : 0.0) : mode == 2 ? alpha : 1.0;
 }
 
-// Secondary rays start off the surface, on the side of `towards`.
-vec3 offset_point(vec3 p, vec3 n, vec3 towards) {
-    float scale = u_offset * max(1.0, max(max(abs(p.x), abs(p.y)), abs(p.z)));
-    return p + (dot(n, towards) < 0.0 ? -scale : scale) * n;
+// Where secondary rays start (pbrt-v4, "Robust spawned ray origins"): the
+// hit point with a bound `err` on its rounding error per component, and the
+// geometric normal `ng`. A triangle's point is recomputed from its
+// barycentrics, P = b0 V0 + b1 V1 + b2 V2, off the plane by at most
+// TRIANGLE_POINT_ERROR * (|b0 V0| + |b1 V1| + |b2 V2|); a sphere's, O + t D,
+// by SPHERE_POINT_ERROR * (|O| + |t D|) (constants.py gives both).
+struct Spawn {
+    vec3 p;
+    vec3 err;
+    vec3 ng;
+};
+
+Spawn spawn_at(int j, float t, vec2 bary, vec3 o, vec3 d, vec3 n) {
+    Spawn s;
+#if HAS_MESHES
+    if (j >= 0) {
+        vec3 v0 = tri_rec(j, 0).xyz, v1 = tri_rec(j, 1).xyz, v2 = tri_rec(j, 2).xyz;
+        vec3 a = (1.0 - bary.x - bary.y) * v0, b = bary.x * v1, c = bary.y * v2;
+        s.p = a + b + c;
+        s.err = TRIANGLE_POINT_ERROR * (abs(a) + abs(b) + abs(c));
+        vec3 g = cross(v1 - v0, v2 - v0);
+        s.ng = dot(g, g) > 0.0 ? normalize(g) : n;
+        return s;
+    }
+#endif
+    s.p = o + t * d;
+    s.err = SPHERE_POINT_ERROR * (abs(o) + abs(t * d));
+    s.ng = n;
+    return s;
+}
+
+// x moved one float away from zero's side given by `dir` (pbrt's NextFloatUp/Down).
+float next_float(float x, float dir) {
+    if (dir == 0.0) return x;
+    if (x == 0.0) return dir > 0.0 ? 1.1754944e-38 : -1.1754944e-38;
+    int bits = floatBitsToInt(x);
+    return intBitsToFloat((x > 0.0) == (dir > 0.0) ? bits + 1 : bits - 1);
+}
+
+// A secondary ray's origin: the point moved along the geometric normal by the
+// error bound's reach along it, then rounded away (so the move itself cannot
+// round back onto the surface), to the side the shading normal `n` puts
+// `towards` on (as the numpy engine's _offset, which says why).
+vec3 offset_point(Spawn s, vec3 n, vec3 towards) {
+    vec3 offset;
+    if (u_simple_offset) {
+        offset = u_offset * max(1.0, max(max(abs(s.p.x), abs(s.p.y)), abs(s.p.z))) * s.ng;
+    } else {
+        offset = dot(abs(s.ng), s.err) * s.ng;
+    }
+    if ((dot(n, towards) < 0.0) != (dot(s.ng, n) < 0.0)) offset = -offset;
+    vec3 q = s.p + offset;
+    return vec3(next_float(q.x, offset.x), next_float(q.y, offset.y), next_float(q.z, offset.z));
 }
 
 #include "common/course_light.glsl"
 
 // The rasterizer's per-light Phong (common/lighting.glsl), with shadow rays.
-vec3 shade(int k, vec3 p, vec3 n, vec3 mesh, vec3 d) {
+vec3 shade(int k, vec3 p, vec3 n, vec3 mesh, vec3 d, Spawn at) {
     int mode = int(node_rec(k, 3).w);
     if (mode < 2) return mesh;  // solid, vertex colours: unlit
     vec3 color = vec3(0.0);
@@ -469,7 +512,7 @@ vec3 shade(int k, vec3 p, vec3 n, vec3 mesh, vec3 d) {
                      diffuse, specular);
         float visible = 1.0;
 #if SHADOWS
-        vec3 start = offset_point(p, n, u_light_pos[i] - p);
+        vec3 start = offset_point(at, n, u_light_pos[i] - at.p);
         if (occluded(start, u_light_pos[i] - start, i)) visible = 0.0;
 #endif
         color += min(coef.x * mesh + visible * (coef.y * diffuse + coef.z * specular), vec3(1.0));
@@ -496,7 +539,8 @@ void main() {
         vec3 p, n, base;
         float alpha;
         surface(k, j, t, bary, o, d, p, n, base, alpha);
-        vec3 local = shade(k, p, n, base, d);
+        Spawn at = spawn_at(j, t, bary, o, d, n);
+        vec3 local = shade(k, p, n, base, d, at);
         bool last = depth >= u_max_depth;
         // A see-through surface passes the ray on straight, weighted 1 - a; it does not
         // also reflect (numpy_engine._trace). At the last bounce its own colour stands in.
@@ -504,13 +548,13 @@ void main() {
         float r = (last || a < 1.0) ? 0.0 : node_rec(k, 5).x;
         color += weight * a * (1.0 - r) * local;
         if (a < 1.0) {
-            o = offset_point(p, n, d);
+            o = offset_point(at, n, d);  // just behind the surface
             weight *= 1.0 - a;
             continue;
         }
         if (r <= 0.0) break;
         vec3 reflected = d - 2.0 * dot(d, n) * n;  // Yansıma vektörü
-        o = offset_point(p, n, -d);
+        o = offset_point(at, n, -d);
         d = reflected;
         weight *= r;
     }
@@ -524,7 +568,7 @@ void main() {
         vec3 p, n, base;
         float alpha;
         surface(k, j, t, bary, o, d, p, n, base, alpha);
-        color = shade(k, p, n, base, d);
+        color = shade(k, p, n, base, d, spawn_at(j, t, bary, o, d, n));
     }
 #endif
 #if BVH

@@ -19,7 +19,8 @@ ROOT = Path(__file__).resolve().parents[1]
 LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("core", ("glsandbox.errors", "glsandbox.transforms", "glsandbox.meshnormals", "glsandbox.meshlooks",
               "glsandbox.geometry",
-              "glsandbox.meshgen", "glsandbox.files", "glsandbox.file_watch")),
+              "glsandbox.meshgen", "glsandbox.files", "glsandbox.file_watch", "glsandbox.progress",
+              "glsandbox.version")),
     ("scene data", ("glsandbox.scene", "glsandbox.planar", "glsandbox.images",
                     "glsandbox.overlay", "glsandbox.meshfile", "glsandbox.meshcheck")),
     ("scene logic", ("glsandbox.scene_file", "glsandbox.shadowmap", "glsandbox.plan", "glsandbox.camera",
@@ -28,7 +29,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("one frame", ("glsandbox.frame",)),
     ("window and measuring", ("glsandbox.window", "glsandbox.panel", "glsandbox.controls", "glsandbox.notebook",
                               "glsandbox.notebook_view", "glsandbox.course_page", "glsandbox.measure")),
-    ("command line", ("glsandbox.cli", "glsandbox.pytest_plugin")),
+    ("command line", ("glsandbox.cli", "glsandbox.pytest_plugin", "glsandbox.__main__")),
 ]
 
 #: The two doors up, each opened only when called: lesson discovery

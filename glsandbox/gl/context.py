@@ -1,14 +1,20 @@
-"""OpenGL contexts: headless EGL (default), headless OSMesa, or a glfw window.
+"""OpenGL contexts: headless (EGL, OSMesa, or moderngl's standalone WGL/CGL) or a glfw window.
 
-This is the course's "device, context, swap chain" step. ``auto`` picks a
-window when one is asked for and a display exists, else EGL, else OSMesa.
-The backend comes from ``--backend`` or the ``GLSANDBOX_BACKEND`` variable.
+This is the course's "device, context, swap chain" step. ``auto`` opens a
+window when one is asked for (glfw says, in one line, when it cannot);
+otherwise it tries the headless backends that exist on this system, in
+order (:func:`headless_order`): EGL then OSMesa on Linux, moderngl's own
+standalone context on Windows (WGL) and macOS (CGL), where there is no EGL
+or OSMesa. The backend comes from ``--backend`` or the ``GLSANDBOX_BACKEND``
+variable. Every backend asks for OpenGL 3.3 core, which macOS's 4.1 core
+profile gives.
 """
 
 from __future__ import annotations
 
 import os
 import re
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -18,9 +24,23 @@ import moderngl
 from glsandbox.errors import SandboxError
 from glsandbox.gl.rawgl import RawGL
 
-BACKENDS = ("auto", "egl", "osmesa", "window")
-#: OpenGL 3.3 core is all the lessons need; llvmpipe gives 4.5.
+BACKENDS = ("auto", "egl", "osmesa", "standalone", "window")
+#: OpenGL 3.3 core is all the lessons need; llvmpipe gives 4.5, macOS 4.1.
 REQUIRED_GL = 330
+
+
+def headless_order(platform: str | None = None) -> tuple[str, ...]:
+    """The headless backends ``auto`` tries on ``platform`` (default ``sys.platform``), in order.
+
+    Windows and macOS have neither EGL nor OSMesa as system libraries, but
+    moderngl's standalone context (WGL, CGL) needs no display there. On
+    Linux that standalone context is GLX, which needs an X server, so EGL
+    (no display at all) comes first and Mesa's OSMesa is the fallback.
+    """
+    platform = sys.platform if platform is None else platform
+    if platform.startswith(("win32", "cygwin", "darwin")):
+        return ("standalone",)
+    return ("egl", "osmesa")
 
 
 @dataclass
@@ -73,42 +93,60 @@ def requested_backend(backend: str | None) -> str:
     return name
 
 
-def has_display() -> bool:
-    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
-
-
-#: What to do instead of a window, said by errors when none can open, for a
-#: frame rendered offscreen (``glsandbox render`` with ``--backend window``).
-HEADLESS_INSTEAD = "or use a headless backend: --backend egl (or osmesa)"
+def headless_instead(platform: str | None = None) -> str:
+    """What errors offer when no window can open, for a frame rendered offscreen
+    (``glsandbox render`` with ``--backend window``): this system's headless backends."""
+    first, *rest = headless_order(platform)
+    return f"or use a headless backend: --backend {first}" + "".join(f" (or {name})" for name in rest)
 
 
 def open_context(backend: str | None = None, *, window: bool = False, size: tuple[int, int] = (640, 480),
                  title: str = "glsandbox", samples: int = 0, instead: str | None = None) -> GLHost:
     """Open a context. ``window=True`` asks for an on-screen window.
 
-    With ``auto``, a window is used when asked for and a display exists;
-    otherwise EGL, falling back to OSMesa. Errors say what is missing and
-    how to install it; ``instead`` is the alternative they offer when no
-    window can open (the command's own: ``glsandbox render``, ``--headless``),
-    by default :data:`HEADLESS_INSTEAD`.
+    With ``auto``, a window is opened by glfw when one is asked for (no
+    environment variable is checked first: glfw knows the system's
+    displays; its own reason is the error when it cannot). Otherwise the
+    headless backends of :func:`headless_order` are tried in turn. Errors say
+    what is missing and how to install it; ``instead`` is the alternative
+    they offer when no window can open (the command's own: ``glsandbox
+    render``, ``--headless``), by default :func:`headless_instead`.
     """
-    instead = instead or HEADLESS_INSTEAD
+    instead = instead or headless_instead()
     name = requested_backend(backend)
-    if name == "auto":
-        if window and has_display():
-            return _open_window(size, title, samples, instead)
-        try:
-            return _open_egl()
-        except SandboxError as egl_error:
-            try:
-                return _open_osmesa()
-            except SandboxError as osmesa_error:
-                raise SandboxError(f"no OpenGL available: {egl_error}; {osmesa_error}") from None
-    if name == "window":
+    if name == "window" or (name == "auto" and window):
         return _open_window(size, title, samples, instead)
     if window:
         raise SandboxError(f"backend {name!r} is headless and cannot open a window; use --backend window, {instead}")
-    return _open_egl() if name == "egl" else _open_osmesa()
+    if name != "auto":
+        return HEADLESS_OPENERS[name]()
+    errors = []
+    for candidate in headless_order():
+        try:
+            return HEADLESS_OPENERS[candidate]()
+        except SandboxError as exc:
+            errors.append(str(exc))
+    raise SandboxError(f"no OpenGL available: {'; '.join(errors)}")
+
+
+def _standalone_hint(platform: str | None = None) -> str:
+    platform = sys.platform if platform is None else platform
+    if platform.startswith(("win32", "cygwin")):
+        return "update the graphics driver (OpenGL 3.3 is needed; a remote desktop session may offer only 1.1)"
+    if platform.startswith("darwin"):
+        return "macOS 10.9 or later gives OpenGL 4.1 core"
+    return "on Linux it is GLX and needs an X display: use --backend egl or osmesa"
+
+
+def _open_standalone() -> GLHost:
+    """moderngl's own standalone context: WGL on Windows, CGL on macOS (GLX on Linux)."""
+    try:
+        ctx = moderngl.create_standalone_context(require=REQUIRED_GL)
+    except Exception as exc:  # glcontext raises plain Exceptions with the reason
+        reason = " ".join(str(exc).split()) or type(exc).__name__
+        raise SandboxError(f"standalone backend unavailable ({reason}); {_standalone_hint()}") from None
+    loader = ctx.mglo._context  # glcontext's context: it resolves any GL entry point, as for EGL
+    return GLHost(ctx, "standalone", loader.load, _make_current=loader.__enter__)
 
 
 def _open_egl() -> GLHost:
@@ -150,9 +188,6 @@ def _glfw_reason(exc: Exception) -> str:
 
 
 def _open_window(size: tuple[int, int], title: str, samples: int, instead: str) -> GLHost:
-    if not has_display():
-        raise SandboxError("no display for a window: set DISPLAY, or run under Xvfb "
-                           f"(apt-get install xvfb; xvfb-run -a ...), {instead}")
     try:
         import glfw
     except Exception as exc:  # the wheel bundles libglfw, but it needs X11 libraries
@@ -168,17 +203,47 @@ def _open_window(size: tuple[int, int], title: str, samples: int, instead: str) 
     except glfw.GLFWError as exc:
         glfw.ERROR_REPORTING = "ignore"
         glfw.terminate()  # whatever the failed set-up opened (a no-op before glfw.init)
-        raise SandboxError(f"glfw could not open a window on display {os.environ.get('DISPLAY')!r} "
-                           f"({_glfw_reason(exc)}): start an X server there or run under Xvfb, {instead}") from None
+        raise SandboxError(_no_window_message(_glfw_reason(exc), instead)) from None
     finally:
+        glfw.ERROR_REPORTING = reporting
+
+
+def _no_window_message(reason: str, instead: str) -> str:
+    """One line for a window glfw could not open: its reason, and what to do on this system."""
+    display = os.environ.get("DISPLAY")
+    where = f" on display {display!r}" if display else ""
+    if sys.platform.startswith(("win32", "cygwin", "darwin")):
+        return f"no display for a window: glfw could not open one ({reason}), {instead}"
+    return (f"no display for a window: glfw could not open one{where} ({reason}): start an X server"
+            f"{' there' if display else ''} or run under Xvfb (apt-get install xvfb; xvfb-run -a ...), {instead}")
+
+
+def window_unavailable() -> str | None:
+    """Why glfw cannot open a window here (its reason, one line), or None when it can.
+
+    Asks glfw itself (it initialises and terminates), for callers that want
+    to skip window work up front rather than fail in the middle of it.
+    """
+    import glfw
+
+    reporting = glfw.ERROR_REPORTING
+    glfw.ERROR_REPORTING = "raise"
+    try:
+        if not glfw.init():
+            return "glfw could not initialise"
+        return None
+    except glfw.GLFWError as exc:
+        return _glfw_reason(exc)
+    finally:
+        glfw.ERROR_REPORTING = "ignore"
+        glfw.terminate()
         glfw.ERROR_REPORTING = reporting
 
 
 def _glfw_window(glfw: Any, size: tuple[int, int], title: str, samples: int) -> GLHost:
     """The window and its context, once glfw is imported (its errors raise ``GLFWError``)."""
     if not glfw.init():
-        raise SandboxError(f"glfw could not initialise on display {os.environ.get('DISPLAY')!r}; "
-                           "is the X server running?")
+        raise SandboxError(_no_window_message("glfw could not initialise", headless_instead()))
     glfw.window_hint(glfw.CONTEXT_VERSION_MAJOR, 3)
     glfw.window_hint(glfw.CONTEXT_VERSION_MINOR, 3)
     glfw.window_hint(glfw.OPENGL_PROFILE, glfw.OPENGL_CORE_PROFILE)
@@ -209,3 +274,9 @@ def _glfw_window(glfw: Any, size: tuple[int, int], title: str, samples: int) -> 
 
     return GLHost(ctx, "window", get_proc, window=handle, _on_release=close,
                   _make_current=lambda: glfw.make_context_current(handle))
+
+
+#: The headless backends by name (tests replace them with fakes).
+HEADLESS_OPENERS: dict[str, Callable[[], GLHost]] = {
+    "egl": _open_egl, "osmesa": _open_osmesa, "standalone": _open_standalone,
+}

@@ -36,8 +36,10 @@ from typing import Any
 import numpy as np
 
 from glsandbox.errors import SandboxError
+from glsandbox.progress import progress, say
 from glsandbox.files import write_text
 from glsandbox.frame import HeadlessRenderer, LazyRenderer
+from glsandbox.gl.context import headless_order
 
 #: The frame size of the frame benchmarks (the course's 800x600 window).
 FRAME_SIZE = (800, 600)
@@ -92,8 +94,9 @@ class BenchEnv:
     root: Path = field(default_factory=lambda: Path.cwd())
     #: Lines printed under the table (and written to the JSON): what a module skipped and why.
     notes: list[str] = field(default_factory=list)
-    #: The one EGL context every case draws on, opened by the first case that asks for it.
-    gl: LazyRenderer = field(default_factory=lambda: LazyRenderer("egl"))
+    #: The one headless context every case draws on (EGL on Linux, the standalone WGL/CGL one on
+    #: Windows and macOS), opened by the first case that asks for it.
+    gl: LazyRenderer = field(default_factory=lambda: LazyRenderer(headless_order()[0]))
 
     def note(self, text: str) -> None:
         """Print ``text`` under the table, e.g. ``skipped: embreex not installed``."""
@@ -102,7 +105,7 @@ class BenchEnv:
 
     @property
     def renderer(self) -> HeadlessRenderer:
-        """One :class:`~glsandbox.frame.HeadlessRenderer` on EGL for every case (one context)."""
+        """One :class:`~glsandbox.frame.HeadlessRenderer` for every case (one context)."""
         return self.gl.renderer
 
     def renderer_name(self) -> str:
@@ -171,14 +174,20 @@ def _sample(side: Side, repeat: int, start: int) -> tuple[float, float]:
     return (time.perf_counter() - t0) / repeat, (time.thread_time() - cpu0) / repeat
 
 
-def measure(cases: Sequence[Case], rounds: int, log: Callable[[str], None] = lambda s: None) -> list[Result]:
-    """Alternating rounds over every case; the first call of each side is a warm-up and the picture check."""
+def measure(cases: Sequence[Case], rounds: int, log: Callable[[str], None] = lambda s: None,
+            advance: Callable[[int], object] = lambda n: None) -> list[Result]:
+    """Alternating rounds over every case; the first call of each side is a warm-up and the picture check.
+
+    ``advance(1)`` follows each case's warm-up and each case in each round:
+    ``len(cases) * (rounds + 1)`` steps (a progress bar's ``update``).
+    """
     results = []
     for case in cases:
         first_base = case.baseline.run(0) if case.baseline else None
         first_subject = case.subject.run(0)
         same = case.compare(first_base, first_subject) if case.compare and case.baseline else ""
         results.append(Result(case, [], [], same))
+        advance(1)
     for r in range(rounds):
         log(f"bench: round {r + 1}/{rounds}")
         for result in results:
@@ -192,6 +201,7 @@ def measure(cases: Sequence[Case], rounds: int, log: Callable[[str], None] = lam
                     wall, cpu = _sample(side, case.repeat, r * case.repeat)
                     samples.append(wall)
                     cpu_samples.append(cpu)
+            advance(1)
     return results
 
 
@@ -289,7 +299,7 @@ def run_all(json_path: Path | None = None, quick: bool = False, only: Sequence[s
         raise SandboxError(f"--json {json_path}: not a file in an existing folder")
     folder = benchmarks_dir()
     env = BenchEnv(quick=quick, root=folder.parent)
-    log = lambda text: print(text, file=sys.stderr, flush=True)  # noqa: E731
+    log = say  # lines above the progress bar (only a terminal gets the bar)
     try:
         cases: list[Case] = []
         found_lines = []
@@ -318,7 +328,8 @@ def run_all(json_path: Path | None = None, quick: bool = False, only: Sequence[s
         if quick:
             cases = [_quick(c) for c in cases]
         started = time.perf_counter()
-        results = measure(cases, rounds, log)
+        with progress(len(cases) * (rounds + 1), "bench", "case") as bar:
+            results = measure(cases, rounds, log, bar.update)
         for summarize in summaries:
             for line in summarize(results):
                 env.note(line)

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -296,12 +297,21 @@ def render_grid(variants: list[Variant], columns: int, size: tuple[int, int], re
     return stitch(variants, columns, size, renderer)
 
 
-def compare_variants(variants: list[Variant], columns: int, size: tuple[int, int], renderer) -> CompareResult:
-    """Render already built variants: the composed frame, then each alone for the figures."""
+def compare_variants(variants: list[Variant], columns: int, size: tuple[int, int], renderer,
+                     advance: Callable[[int], object] = lambda n: None) -> CompareResult:
+    """Render already built variants: the composed frame, then each alone for the figures.
+
+    ``advance(n)`` is told as the work goes: ``len(variants)`` for the composed
+    frame, then 1 per variant drawn alone (a progress bar's ``update``).
+    """
     rows = math.ceil(len(variants) / columns)
     tile = (max(1, size[0] // columns), max(1, size[1] // rows))
     image = render_grid(variants, columns, size, renderer)
-    alone = [renderer.render_scene(replace(v.scene, overlays=()), tile).image.copy() for v in variants]
+    advance(len(variants))
+    alone = []
+    for v in variants:
+        alone.append(renderer.render_scene(replace(v.scene, overlays=()), tile).image.copy())
+        advance(1)
     groups = group_identical(alone)
     labels = [v.label for v in variants]
     difference = difference_image(alone[groups[0][0]], alone[groups[1][0]]) if len(groups) > 1 else None

@@ -16,6 +16,7 @@ starting with ``_`` is imported and registers its knob with
 from __future__ import annotations
 
 import importlib
+import math
 import pkgutil
 import statistics
 from collections.abc import Callable
@@ -29,7 +30,8 @@ from glsandbox.scene import Scene
 if TYPE_CHECKING:
     from glsandbox.measure.render_context import RenderContext
 
-__all__ = ["Knob", "KnobResult", "PixelCount", "Row", "Setting", "all_knobs", "lesson_scene", "register_knob"]
+__all__ = ["Knob", "KnobResult", "PixelCount", "Row", "Setting", "all_knobs", "lesson_scene", "median_spread",
+           "register_knob"]
 
 
 @dataclass(frozen=True)
@@ -148,6 +150,21 @@ class Row:
     @property
     def spread_ms(self) -> tuple[float, float]:
         return min(self.times_ms), max(self.times_ms)
+
+    @property
+    def median_spread(self) -> float:
+        """How far the median can be trusted: the medians of the odd and the even
+        runs apart, as a share of the median of all (:func:`median_spread`)."""
+        return median_spread(self.times_ms)
+
+
+def median_spread(times: list[float]) -> float:
+    """``|median(odd runs) − median(even runs)| / median(all)``: two independent
+    halves of the runs agreeing on the median is what "stable" means here."""
+    if len(times) < 2:
+        return math.inf
+    whole = statistics.median(times)
+    return abs(statistics.median(times[0::2]) - statistics.median(times[1::2])) / whole if whole > 0 else 0.0
 
 
 @dataclass

@@ -26,7 +26,7 @@ __all__ = ["CSV_COLUMNS", "write_csv", "write_plot", "write_report"]
 
 CSV_COLUMNS = ("knob", "setting", "reference", "width", "height", "runs", "time_median_ms", "time_min_ms",
                "time_max_ms", "rmse", "psnr_db", "flip", "count_px", "count_of_px", "count_share", "image",
-               "error_map")
+               "error_map", "median_spread")
 
 
 def _fmt_psnr(value: float) -> str:
@@ -46,7 +46,7 @@ def write_csv(results: Sequence[KnobResult], size: tuple[int, int], path: Path) 
                              _fmt_psnr(r.psnr), f"{r.flip:.6f}",
                              *(("", "", "") if r.count is None else
                                (r.count.pixels, r.count.of, f"{r.count.share:.6f}")),
-                             r.image, r.error_map])
+                             r.image, r.error_map, f"{r.median_spread:.4f}"])
     write_text(path, buffer.getvalue())
 
 
@@ -72,7 +72,8 @@ def write_report(results: Sequence[KnobResult], info: Mapping[str, str], path: P
             name = f"{r.setting} (reference)" if r.reference else r.setting
             count = "" if not knob.count_label else (
                 " - | - |" if r.count is None else f" {r.count.pixels} | {r.count.share:.1%} |")
-            lines.append(f"| {name} | {r.median_ms:.2f} | {low:.2f}-{high:.2f} |{count} {r.rmse:.4f} | "
+            lines.append(f"| {name} | {r.median_ms:.2f} | {low:.2f}-{high:.2f} (median ±{r.median_spread:.1%}, "
+                         f"{len(r.times_ms)} runs) |{count} {r.rmse:.4f} | "
                          f"{_fmt_psnr(r.psnr)} | {r.flip:.4f} | [map]({r.error_map}) |")
         verdict = result.monotone_ok()
         if verdict is not None:

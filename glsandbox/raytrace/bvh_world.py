@@ -16,7 +16,8 @@ their best hit so far: strictly nearer hits replace it, so on an equal
 same tie rule as :func:`glsandbox.raytrace.numpy_engine._nearest`, by world
 triangle index.
 
-Analytic spheres (``kind == "sphere"``) are not the BVH's business: this
+Analytic shapes (a :class:`~glsandbox.raytrace.world.NodeKind` whose shape is
+not triangles) are not the BVH's business: this
 level answers for mesh nodes only (the engine tests its spheres as before).
 """
 
@@ -31,6 +32,7 @@ from glsandbox.raytrace.aabb import AABB, reciprocals
 from glsandbox.raytrace.base import broadcast_rays
 from glsandbox.raytrace.bvh import BVH, bvh_for_triangles
 from glsandbox.raytrace.bvh_traverse import any_hit, closest_hit
+from glsandbox.raytrace.constants import BVH_BOX_PAD_F64
 from glsandbox.raytrace.world import World
 
 __all__ = ["NodeBVH", "WorldBVH", "WorldHits"]
@@ -74,7 +76,7 @@ class WorldBVH:
         """Build (or fetch from the cache) a BVH for every mesh node of ``world``."""
         nodes: list[NodeBVH] = []
         for k, info in enumerate(world.nodes):
-            if info.kind != "mesh" or info.count == 0:
+            if not info.kind.triangles or info.count == 0:
                 continue
             part = slice(info.start, info.start + info.count)
             bvh = bvh_for_triangles(world.v0[part], world.v1[part], world.v2[part])
@@ -90,7 +92,7 @@ class WorldBVH:
         """Rays whose slab test against node ``i``'s box passes before ``limit`` (Hızlandırma: AABB).
         The box test is only a shortcut: the node's own BVH tests robustly."""
         lo, hi = self.box_min[i], self.box_max[i]
-        pad = 2.0**-30 * (1.0 + max(np.abs(lo).max(), np.abs(hi).max()))
+        pad = BVH_BOX_PAD_F64 * (1.0 + max(np.abs(lo).max(), np.abs(hi).max()))
         near, far = AABB(lo - pad, hi + pad).slabs_reciprocal(o, inverse)
         return np.flatnonzero((near <= far) & (far >= 0.0) & (near <= limit))
 

@@ -89,7 +89,22 @@ leaves after the other loops, shared by every ray of a pixel and every mesh
 node). A ray that reaches the bound writes alpha 0, and the render raises
 :class:`RayTraceError` instead of returning the picture. Scenes whose mesh
 nodes all have at most :data:`BVH_TRIANGLES` triangles (the cubes, quads and
-floors of most lessons) keep the scan.
+floors of most lessons) keep the scan, which tests its triangles with the
+same watertight test (``shaders/common/watertight.glsl``; the triangle
+records hold the three corners, so a corner shared by two triangles is the
+same three floats in both).
+
+Precision far from the origin
+-----------------------------
+Every position is uploaded relative to :func:`world_anchor`, the scene's
+centre, the difference taken in float64 before the float32 rounding: the
+picture, and the BVH's steps per ray, do not depend on where the scene
+sits (``tests/raytrace/test_engine_far_from_origin.py``). Shadow and
+reflected rays leave a surface by a bound on the hit point's rounding
+error (``shaders/raytrace.glsl``'s ``offset_point``, the bounds in
+:mod:`glsandbox.raytrace.constants`), and the triangle test accepts ``t``
+only above its own error bound, so no surface shadows itself and contact
+shadows stay.
 
 Float32 differs from float64 in the last bits of ``t`` and of the shading;
 the image agrees with the numpy engine's to within a couple of 8-bit levels
@@ -108,9 +123,10 @@ from numpy.typing import NDArray
 
 from glsandbox.gl.shaders import compile_program
 from glsandbox.plan import ProgramVariant
-from glsandbox.raytrace.constants import SHADOW_OFFSET
+from glsandbox.raytrace.constants import NODE_BOX_PAD, OFFSETS, SIMPLE_OFFSET, glsl_defines
 from glsandbox.raytrace.errors import RayTraceError
-from glsandbox.raytrace.world import MODES, World, build_world, camera_basis
+from glsandbox.raytrace.watertight import nondegenerate
+from glsandbox.raytrace.world import MODES, World, build_world, camera_basis, kind_defines
 from glsandbox.scene import Scene
 
 __all__ = ["LOOP_LIMIT", "GpuTracer", "MAX_TEXTURES", "check_loop_budget", "gpu_tracer"]
@@ -132,7 +148,7 @@ def check_loop_budget(world: World, lights: int, shadows: bool, reflect: bool, m
     where llvmpipe would silently stop testing (a wrong picture): a conservative bound,
     never a guess."""
     rays = (1 + (lights if shadows else 0)) * (1 + (max_depth if reflect else 0))
-    meshes = [node for node in world.nodes if node.kind != "sphere"]
+    meshes = [node for node in world.nodes if node.kind.triangles]
     worst = rays * (sum(node.count for node in meshes) + len(world.nodes))
     if worst > LOOP_LIMIT:
         largest = max(meshes, key=lambda node: node.count)
@@ -165,7 +181,7 @@ def bvh_step_cap(world: World, lights: int, shadows: bool, reflect: bool, max_de
     raises. Raises :class:`RayTraceError` when the budget leaves too few steps."""
     bounces = 1 + (max_depth if reflect else 0)
     rays = (1 + (lights if shadows else 0)) * bounces
-    meshes = sum(1 for node in world.nodes if node.kind != "sphere")
+    meshes = sum(1 for node in world.nodes if node.kind.triangles)
     other = rays * (len(world.nodes) + 1) + bounces * (lights + 1) + 64
     cap = (LOOP_LIMIT - other) // max(1, rays * meshes)
     if BVH_STEP_CAP is not None:
@@ -248,17 +264,38 @@ def _keep_first_textures(scene: Scene, world: World) -> None:
         print(line, file=sys.stderr, flush=True)
 
 
-def pack_triangles(world: World) -> NDArray[np.float32]:
-    """``TRI_RECORDS`` vec4 per triangle (layout in ``shaders/raytrace.glsl``)."""
+def world_anchor(world: World) -> NDArray[np.float64]:
+    """The point the gpu engine's coordinates are relative to: the centre of the
+    nodes' boxes (the origin for an empty world).
+
+    float32 has 24 bits: at 1e5 its spacing is 0.0078, at 1e6 0.0625, so a scene
+    traced in world coordinates there loses its shape (ids off on 2.9% and 15%
+    of the pixels, and BVH boxes padded in proportion to the coordinates). Every
+    position is therefore taken relative to this anchor in float64 on the CPU
+    (vertices, boxes, lights, the eye, spheres' inverse matrices) and only the
+    difference is rounded to float32: the picture at 1e6 is the one at the
+    origin. The anchor is the scene's own centre, not the eye, so a camera
+    moving around the scene keeps the upload (the eye is one uniform)."""
+    if not world.nodes:
+        return np.zeros(3)
+    lo = np.min([node.box_min for node in world.nodes], axis=0)
+    hi = np.max([node.box_max for node in world.nodes], axis=0)
+    return 0.5 * (lo + hi)
+
+
+def pack_triangles(world: World, anchor: NDArray[np.float64] | None = None) -> NDArray[np.float32]:
+    """``TRI_RECORDS`` vec4 per triangle (layout in ``shaders/raytrace.glsl``), positions
+    relative to ``anchor`` (see :func:`world_anchor`)."""
+    anchor = np.zeros(3) if anchor is None else anchor
     m = world.triangle_count
     rec = np.zeros((m, TRI_RECORDS, 4), dtype=np.float64)
-    e1 = world.v1 - world.v0
-    e2 = world.v2 - world.v0
-    area2 = np.linalg.norm(np.cross(e1, e2), axis=1)
-    ok = area2 > 1e-12 * np.linalg.norm(e1, axis=1) * np.linalg.norm(e2, axis=1)
-    rec[:, 0, :3] = world.v0
-    rec[:, 1, :3] = np.where(ok[:, None], e1, 0.0)  # degenerate: det = 0, never hit
-    rec[:, 2, :3] = np.where(ok[:, None], e2, 0.0)
+    # The corners themselves, not v0 and two edges: the watertight test needs a
+    # corner shared by two triangles to be the same three floats in both.
+    ok = nondegenerate(world.v0, world.v1, world.v2)  # the BVH's rule: a triangle without area is never hit
+    v0 = world.v0 - anchor
+    rec[:, 0, :3] = v0
+    rec[:, 1, :3] = np.where(ok[:, None], world.v1 - anchor, v0)  # degenerate: one point, det = 0
+    rec[:, 2, :3] = np.where(ok[:, None], world.v2 - anchor, v0)
     for k in range(3):
         rec[:, 3 + k, :3] = world.normals[:, k]
         rec[:, 6 + k, :3] = world.colors[:, k]
@@ -269,25 +306,30 @@ def pack_triangles(world: World) -> NDArray[np.float32]:
 
 def node_order(world: World) -> list[int]:
     """The nodes as the shader stores them: mesh nodes first, then sphere nodes (scene order within)."""
-    meshes = [k for k, node in enumerate(world.nodes) if node.kind != "sphere"]
-    return meshes + [k for k, node in enumerate(world.nodes) if node.kind == "sphere"]
+    meshes = [k for k, node in enumerate(world.nodes) if node.kind.triangles]
+    return meshes + [k for k, node in enumerate(world.nodes) if not node.kind.triangles]
 
 
-def pack_nodes(world: World) -> NDArray[np.float32]:
-    """``NODE_RECORDS`` vec4 per node in :func:`node_order` (layout in ``shaders/raytrace.glsl``)."""
+def pack_nodes(world: World, anchor: NDArray[np.float64] | None = None) -> NDArray[np.float32]:
+    """``NODE_RECORDS`` vec4 per node in :func:`node_order` (layout in ``shaders/raytrace.glsl``),
+    positions relative to ``anchor`` (see :func:`world_anchor`)."""
+    anchor = np.zeros(3) if anchor is None else anchor
     rec = np.zeros((len(world.nodes), NODE_RECORDS, 4), dtype=np.float64)
     for slot, k in enumerate(node_order(world)):
         node = world.nodes[k]
+        lo, hi = node.box_min - anchor, node.box_max - anchor
         # Pad the box by a relative hair: float32 slab arithmetic must not
-        # reject a ray that Möller–Trumbore would accept at the box's face.
-        pad = 1e-5 * (1.0 + float(np.abs(np.concatenate([node.box_min, node.box_max])).max()))
-        rec[slot, 0] = (*(node.box_min - pad), 1.0 if node.kind == "sphere" else 0.0)
-        rec[slot, 1] = (*(node.box_max + pad), 1.0 if node.cull else 0.0)
+        # reject a ray that the triangle test would accept at the box's face.
+        pad = NODE_BOX_PAD * (1.0 + float(np.abs(np.concatenate([lo, hi])).max()))
+        rec[slot, 0] = (*(lo - pad), float(node.kind.code))
+        rec[slot, 1] = (*(hi + pad), 1.0 if node.cull else 0.0)
         rec[slot, 2] = (node.start, node.count, k, 0.0)  # k: the scene order, for ties
         rec[slot, 3] = (*node.color, node.mode)
         rec[slot, 4] = (node.ka, node.kd, node.ks, node.shininess)
         rec[slot, 5] = (node.reflectivity, node.texture, node.lamp_of, 0.0)
-        rec[slot, 6:9] = node.inverse[:3, :4]
+        # world -> unit sphere for anchor-relative points: M⁻¹(p + anchor), in float64.
+        rec[slot, 6:9, :3] = node.inverse[:3, :3]
+        rec[slot, 6:9, 3] = node.inverse[:3, :3] @ anchor + node.inverse[:3, 3]
         rec[slot, 9:12, :3] = node.normal_matrix
         rec[slot, 12] = (node.alpha, node.alpha_mode, node.alpha_cutoff,
                          int(node.vertex_colors) | 2 * int(node.two_sided))
@@ -324,16 +366,20 @@ class _Uploaded:
     RGBA32F textures and the shader's general loops.
     """
 
-    def __init__(self, ctx: moderngl.Context, world: World, key: tuple[object, ...], block_records: int) -> None:
+    def __init__(self, ctx: moderngl.Context, world: World, key: tuple[object, ...], block_records: int,
+                 relative: bool = True) -> None:
         self.key = key
         self.world = world
-        self.tris = pack_triangles(world)
-        self.nodes = pack_nodes(world)
-        self.mesh_count = sum(1 for node in world.nodes if node.kind != "sphere")
+        #: Every uploaded position is relative to this point (:func:`world_anchor`; the
+        #: origin for ``relative=False``, world-space float32, what the tradeoffs knob shows).
+        self.anchor = world_anchor(world) if relative else np.zeros(3)
+        self.tris = pack_triangles(world, self.anchor)
+        self.nodes = pack_nodes(world, self.anchor)
+        self.mesh_count = sum(1 for node in world.nodes if node.kind.triangles)
         self.sphere_count = len(world.nodes) - self.mesh_count
-        loops = sum(1 for node in world.nodes if node.kind != "sphere" and node.count > UNROLL_TRIS)
+        loops = sum(1 for node in world.nodes if node.kind.triangles and node.count > UNROLL_TRIS)
         #: Some mesh node is large enough that its BVH beats the scan (:data:`BVH_TRIANGLES`).
-        self.large_mesh = max((node.count for node in world.nodes if node.kind != "sphere"),
+        self.large_mesh = max((node.count for node in world.nodes if node.kind.triangles),
                               default=0) > BVH_TRIANGLES
         self.unrolled = (not self.large_mesh and len(world.nodes) <= UNROLL_NODES and loops <= UNROLL_LOOPS
                          and max(1, self.tris.shape[0]) + max(1, self.nodes.shape[0]) <= block_records)
@@ -376,7 +422,9 @@ class _Uploaded:
         for k in node_order(world)[: self.mesh_count]:
             node = world.nodes[k]
             stop = node.start + node.count
-            bvh = bvh_for_triangles(world.v0[node.start:stop], world.v1[node.start:stop], world.v2[node.start:stop])
+            rows = slice(node.start, stop)
+            bvh = bvh_for_triangles(world.v0[rows] - self.anchor, world.v1[rows] - self.anchor,
+                                    world.v2[rows] - self.anchor)
             nodes, tris = pack_bvh(bvh)
             nodes = nodes.reshape(-1, 2, 4).copy()
             tris = tris.reshape(-1, 3, 4).copy()
@@ -416,7 +464,7 @@ class _Uploaded:
         parts = []
         for k, node in enumerate(self.world.nodes):
             one_sided = int(node.cull if cull is None else cull)
-            if node.kind == "sphere":
+            if not node.kind.triangles:
                 parts.append(f"SPHERE({slots[k]},{one_sided},{node.lamp_of})")
             elif node.count <= UNROLL_TRIS:
                 parts += [f"TRI({slots[k]},{j},{one_sided},{node.lamp_of})" for j in range(node.start, node.start + node.count)]
@@ -433,7 +481,12 @@ class _Uploaded:
         return (len(world.textures) == len(self.world.textures)
                 and all(a is b or np.array_equal(a, b) for (a, _), (b, _) in zip(world.textures, self.world.textures))
                 and [w for _, w in world.textures] == [w for _, w in self.world.textures]
-                and np.array_equal(pack_triangles(world), self.tris) and np.array_equal(pack_nodes(world), self.nodes))
+                and np.array_equal(pack_triangles(world, self.anchor_of(world)), self.tris)
+                and np.array_equal(pack_nodes(world, self.anchor_of(world)), self.nodes))
+
+    def anchor_of(self, world: World) -> NDArray[np.float64]:
+        """Where ``world`` would be anchored in an upload like this one."""
+        return world_anchor(world) if self.key[-1] else np.zeros(3)
 
     def release(self) -> None:
         for texture in self.textures.values():
@@ -469,7 +522,7 @@ class GpuTracer:
                  scene: tuple[tuple[str, str], ...] = ()) -> tuple[moderngl.Program, moderngl.VertexArray]:
         flags = (lights, textures, int(shadows and lights > 0), int(reflect), int(meshes), int(spheres))
         names = ("NUM_LIGHTS", "NUM_TEXTURES", "SHADOWS", "REFLECT", "HAS_MESHES", "HAS_SPHERES")
-        defines = tuple((name, str(value)) for name, value in zip(names, flags)) + scene
+        defines = tuple((name, str(value)) for name, value in zip(names, flags)) + glsl_defines() + kind_defines() + scene
         if defines in self._programs:
             self._programs[defines] = self._programs.pop(defines)  # most recently used last
             self._vaos[defines] = self._vaos.pop(defines)
@@ -491,9 +544,9 @@ class GpuTracer:
             self._targets[size] = (color, self.ctx.framebuffer(color_attachments=[color]))
         return self._targets[size][1]
 
-    def _upload(self, scene: Scene, viewport: int, analytic_spheres: bool) -> _Uploaded:
+    def _upload(self, scene: Scene, viewport: int, analytic_spheres: bool, relative: bool = True) -> _Uploaded:
         """The scene's upload: kept from an earlier render when its World cannot have changed."""
-        key = _scene_key(scene, viewport, analytic_spheres)
+        key = (*_scene_key(scene, viewport, analytic_spheres), relative)
         for i, entry in enumerate(self._scenes):
             if _same_key(entry.key, key):
                 self._scenes.insert(0, self._scenes.pop(i))
@@ -503,12 +556,12 @@ class GpuTracer:
         if len(world.textures) > MAX_TEXTURES:
             _keep_first_textures(scene, world)
         for i, entry in enumerate(self._scenes):  # new objects, same data (glsandbox.frame.trace_viewports rebuilds nodes)
-            if entry.same_data(world):
+            if entry.key[-1] == relative and entry.same_data(world):
                 entry.key = key
                 self._scenes.insert(0, self._scenes.pop(i))
                 self.reuses += 1
                 return entry
-        entry = _Uploaded(self.ctx, world, key, self.block_records)
+        entry = _Uploaded(self.ctx, world, key, self.block_records, relative)
         self.uploads += 1
         self._scenes.insert(0, entry)
         while len(self._scenes) > self.KEEP_SCENES:
@@ -523,9 +576,12 @@ class GpuTracer:
 
     def render_viewport(self, scene: Scene, size: tuple[int, int], viewport: int = 0, *, max_depth: int = 2,
                         shadows: bool = True, cull_backfaces: bool | None = None, aabb: bool = True,
-                        analytic_spheres: bool = True) -> NDArray[np.uint8]:
-        """Trace one viewport at ``size``: ``(H, W, 4)`` uint8, top row first (a read-only view)."""
-        uploaded = self._upload(scene, viewport, analytic_spheres)
+                        analytic_spheres: bool = True, offset: str = "bound",
+                        relative: bool = True) -> NDArray[np.uint8]:
+        """Trace one viewport at ``size``: ``(H, W, 4)`` uint8, top row first (a read-only view).
+        ``relative=False`` traces world coordinates in float32 (the tradeoffs knob's
+        bad example; see :func:`world_anchor`)."""
+        uploaded = self._upload(scene, viewport, analytic_spheres, relative)
         world = uploaded.world
         width, height = size
         vp = scene.viewports[viewport]
@@ -563,10 +619,10 @@ class GpuTracer:
         values = {
             "u_mesh_count": uploaded.mesh_count, "u_sphere_count": uploaded.sphere_count,
             "u_size": (float(width), float(height)),
-            "u_eye": tuple(eye), "u_half": (half_w, half_h), "u_background": tuple(world.background),
+            "u_eye": tuple(eye - uploaded.anchor), "u_half": (half_w, half_h), "u_background": tuple(world.background),
             "u_max_depth": int(max_depth),
             "u_cull": -1 if cull_backfaces is None else int(bool(cull_backfaces)), "u_aabb": bool(aabb),
-            "u_offset": SHADOW_OFFSET,
+            "u_offset": SIMPLE_OFFSET, "u_simple_offset": OFFSETS[offset],
         }
         for name, value in values.items():
             if name in program:
@@ -575,7 +631,7 @@ class GpuTracer:
             program["u_basis"].write(np.asarray(basis, dtype="f4").T.tobytes())  # column-major
         if lights:
             if "u_light_pos" in program:
-                program["u_light_pos"].write(world.light_positions.astype("f4").tobytes())
+                program["u_light_pos"].write((world.light_positions - uploaded.anchor).astype("f4").tobytes())
             if "u_light_color" in program:
                 program["u_light_color"].write(world.light_colors.astype("f4").tobytes())
         target = self._target((width, height))

@@ -34,8 +34,8 @@ earlier node, then the lower triangle). Spheres stay analytic
 (:func:`_hit_node`). Shadow rays are an any-hit query
 (:func:`~glsandbox.raytrace.bvh_traverse.any_hit`): a ray leaves at its first
 occluder. With ``bvh=False``, :func:`_scan_nodes` tests every triangle of a
-node whose box a ray enters (Möller–Trumbore,
-``world.batches[k].nearest_many``), and :func:`_occluded` is that scan cut at
+node whose box a ray enters (the watertight test too,
+:func:`~glsandbox.raytrace.watertight.nearest_watertight`), and :func:`_occluded` is that scan cut at
 ``t = 1``: what ``ray_acceleration`` compares the BVH with.
 :class:`RenderStats` counts the ray-shape tests and the ray-box tests either
 way.
@@ -52,10 +52,12 @@ from numpy.typing import NDArray
 from glsandbox.raytrace.aabb import AABB, reciprocals
 from glsandbox.raytrace.bvh_traverse import TraversalCounts, any_hit, closest_hit
 from glsandbox.raytrace.bvh_world import NodeBVH, WorldBVH
-from glsandbox.raytrace.constants import SHADOW_OFFSET
+from glsandbox.raytrace.constants import (BVH_BOX_PAD_F64, OFFSETS, SIMPLE_OFFSET, RAY_POINT_GAMMA,
+                                          TRIANGLE_POINT_GAMMA, UNIT_F64, gamma)
 from glsandbox.raytrace.sphere import Sphere
-from glsandbox.raytrace.vec import length
-from glsandbox.raytrace.world import World, build_world, camera_rays, coverage
+from glsandbox.raytrace.vec import length, moved_off
+from glsandbox.raytrace.watertight import nearest_watertight
+from glsandbox.raytrace.world import NodeInfo, NodeKind, World, build_world, camera_rays, coverage
 from glsandbox.scene import Scene
 
 __all__ = ["RAY_BLOCK", "RenderStats", "render_viewport", "to_rgba8"]
@@ -139,7 +141,7 @@ def _occluded(world: World, o: NDArray[np.float64], d: NDArray[np.float64], ligh
     for k, node in enumerate(world.nodes):
         if light >= 0 and node.lamp_of >> light & 1:
             continue
-        if node.kind == "sphere":
+        if not node.kind.triangles:  # an analytic shape: its box, then its own test
             idx = np.flatnonzero(~found)
             if aabb:
                 if stats is not None:
@@ -175,7 +177,7 @@ def _box_candidates(entry: NodeBVH, o: NDArray[np.float64], inverse: NDArray[np.
     if stats is not None:
         stats.box_tests += inverse.shape[1]
     lo, hi = entry.bvh.node_min[0], entry.bvh.node_max[0]
-    pad = 2.0**-30 * (1.0 + max(np.abs(lo).max(), np.abs(hi).max(), float(np.abs(o).max(initial=0.0))))
+    pad = BVH_BOX_PAD_F64 * (1.0 + max(np.abs(lo).max(), np.abs(hi).max(), float(np.abs(o).max(initial=0.0))))
     near, far = AABB(lo - pad, hi + pad).slabs_reciprocal(o, inverse)
     return np.flatnonzero((near <= far) & (far >= 0.0) & (near <= limit))
 
@@ -206,7 +208,7 @@ def _scan_nodes(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_
         if light >= 0 and node.lamp_of >> light & 1:
             continue
         one_sided = node.cull if cull is None else cull
-        if bvh is not None and node.kind != "sphere":
+        if bvh is not None and node.kind.triangles:
             entry = bvh.by_node.get(k)
             if entry is None:  # no triangle of non-zero area
                 continue
@@ -252,23 +254,30 @@ def _hit_node(world: World, k: int, o: NDArray[np.float64], d: NDArray[np.float6
 
     A sphere node is the unit sphere under its model matrix: the ray is taken
     into the sphere's own space (Işın-Küre kesim testi there; ``t`` is kept by
-    the affine map). A mesh node's triangles are tested with Möller–Trumbore
-    (:meth:`~glsandbox.raytrace.triangle.TriangleBatch.nearest_many`), the lowest
-    index winning a tie. ``one_sided``: backface culling (course "Hızlandırma:
+    the affine map). A mesh node's triangles are tested with the watertight test
+    (:func:`~glsandbox.raytrace.watertight.nearest_watertight`, as the BVH does), the
+    lowest index winning a tie. ``one_sided``: backface culling (course "Hızlandırma:
     backface culling").
     """
     node = world.nodes[k]
-    if node.kind == "sphere":
-        inv = node.inverse
-        oo = o @ inv[:3, :3].T + inv[:3, 3]  # the ray in the unit sphere's own space
-        dd = d @ inv[:3, :3].T
-        t = _UNIT_SPHERE.intersect_many(oo, dd)
-        if one_sided:  # from inside, the sphere's front faces all face away
-            t = np.where(np.einsum("...j,...j->...", oo, oo) < 1.0, np.inf, t)
-        return t, np.full(d.shape[0], -1, dtype=np.intp)
-    batch = world.batches[k]
-    assert batch is not None
-    t, j = batch.nearest_many(o, d, cull_backfaces=one_sided)
+    return _HIT[node.kind](world, node, o, d, one_sided)
+
+
+def _hit_sphere(world: World, node: NodeInfo, o: NDArray[np.float64], d: NDArray[np.float64], one_sided: bool
+                ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
+    inv = node.inverse
+    oo = o @ inv[:3, :3].T + inv[:3, 3]  # the ray in the unit sphere's own space
+    dd = d @ inv[:3, :3].T
+    t = _UNIT_SPHERE.intersect_many(oo, dd)
+    if one_sided:  # from inside, the sphere's front faces all face away
+        t = np.where(np.einsum("...j,...j->...", oo, oo) < 1.0, np.inf, t)
+    return t, np.full(d.shape[0], -1, dtype=np.intp)
+
+
+def _hit_triangles(world: World, node: NodeInfo, o: NDArray[np.float64], d: NDArray[np.float64], one_sided: bool
+                   ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
+    rows = slice(node.start, node.start + node.count)
+    t, j = nearest_watertight(world.v0[rows], world.v1[rows], world.v2[rows], o, d, cull_backfaces=one_sided)
     return t, np.where(j >= 0, j + node.start, -1)
 
 
@@ -315,12 +324,33 @@ def _sample(image: NDArray[np.float64], wrap: int, uv: NDArray[np.float64]) -> N
     return top * (1 - fy) + bottom * fy
 
 
-def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.float64]
-             ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """``(point, unit normal, base colour, alpha)`` for hit rays (all of ``hits`` must be hits).
-    ``alpha`` is the material colour's times the texture's (what a cut-out or a blend reads)."""
+@dataclass
+class _Spawn:
+    """Where secondary rays start (pbrt-v4's robust spawned origins): the hit point
+    recomputed where its rounding error is bounded, that bound per component, and
+    the geometric normal. A triangle's point is ``b0·V0 + b1·V1 + b2·V2``, off its
+    plane by at most ``γ(7)·Σ|b_i·V_i|``; a sphere's is ``O + t·D`` with
+    ``γ(16)·(|O| + |t·D|)`` (:mod:`glsandbox.raytrace.constants`)."""
+
+    point: NDArray[np.float64]
+    error: NDArray[np.float64]
+    normal: NDArray[np.float64]
+
+    def subset(self, rows: NDArray[np.intp] | NDArray[np.bool_]) -> _Spawn:
+        return _Spawn(self.point[rows], self.error[rows], self.normal[rows])
+
+
+def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.float64], need_spawn: bool = True
+             ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64],
+                        _Spawn | None]:
+    """``(point, unit normal, base colour, alpha, spawn)`` for hit rays (all of ``hits`` must be
+    hits). ``alpha`` is the material colour's times the texture's (what a cut-out or a blend
+    reads); ``spawn`` None unless ``need_spawn`` (no shadow ray or bounce leaves these hits)."""
     n = d.shape[0]
     point = o + hits.t[:, None] * d
+    # Spheres' spawn points are the ray's point; triangles' are replaced below.
+    spawn = _Spawn(point.copy(), gamma(RAY_POINT_GAMMA, UNIT_F64) * (np.abs(o) + np.abs(hits.t[:, None] * d)),
+                   np.zeros((n, 3))) if need_spawn else None
     normal = np.zeros((n, 3))
     base = np.zeros((n, 3))
     alpha = np.ones(n)
@@ -329,28 +359,7 @@ def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.fl
         sel = np.nonzero(hits.node == k)[0]
         if sel.size == 0:
             continue
-        if node.kind == "sphere":
-            inv = node.inverse
-            q = point[sel] @ inv[:3, :3].T + inv[:3, 3]  # the hit on the unit sphere
-            q /= length(q)[:, None]
-            normal[sel] = q @ node.normal_matrix.T
-            # geometry.sphere()'s uv: u = azimuth/2π from +z towards +x, v = polar angle/π from +y.
-            uv[sel, 0] = np.mod(np.arctan2(q[:, 0], q[:, 2]), 2 * np.pi) / (2 * np.pi)
-            uv[sel, 1] = np.arccos(np.clip(q[:, 1], -1.0, 1.0)) / np.pi
-            colors = np.ones((sel.size, 3)) if node.mode == 1 else None
-        else:
-            tri = hits.tri[sel]
-            u, v = _barycentric(world, tri, _rows(o, sel), d[sel])
-            w = (1.0 - u - v)[:, None], u[:, None], v[:, None]  # weights of V0, V1, V2
-            normal[sel] = _interpolate(world.normals[tri], w)
-            if node.two_sided:
-                # A back face seen (the ray runs along the face normal: clockwise from the eye,
-                # the rasterizer's !gl_FrontFacing) is lit as its other side: the normal reversed.
-                face = np.cross(world.v1[tri] - world.v0[tri], world.v2[tri] - world.v0[tri])
-                back = np.einsum("ij,ij->i", face, d[sel]) > 0.0
-                normal[sel[back]] *= -1.0
-            uv[sel] = _interpolate(world.uvs[tri], w)
-            colors = _interpolate(world.colors[tri], w) if node.mode == 1 or node.vertex_colors else None
+        normal[sel], uv[sel], colors = _SURFACE[node.kind](world, node, hits, sel, o, d, point, spawn)
         color = np.broadcast_to(node.color, (sel.size, 3)).copy()
         if colors is not None:  # vertex colours, times the material colour (basic.glsl, phong.glsl)
             color *= colors
@@ -362,7 +371,58 @@ def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.fl
             alpha[sel] *= texel[:, 3]
         base[sel] = color
     normal /= np.maximum(length(normal), 1e-300)[:, None]
-    return point, normal, base, alpha
+    if spawn is not None:
+        spawn.normal /= np.maximum(length(spawn.normal), 1e-300)[:, None]
+    return point, normal, base, alpha, spawn
+
+
+def _surface_sphere(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[np.intp], o: NDArray[np.float64],
+                    d: NDArray[np.float64], point: NDArray[np.float64], spawn: _Spawn | None
+                    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64] | None]:
+    """A sphere node's (normal, uv, vertex colour) at its hits; its spawn points stay ``O + t·D``."""
+    inv = node.inverse
+    q = point[sel] @ inv[:3, :3].T + inv[:3, 3]  # the hit on the unit sphere
+    q /= length(q)[:, None]
+    normal = q @ node.normal_matrix.T
+    if spawn is not None:
+        spawn.normal[sel] = normal
+    # geometry.sphere()'s uv: u = azimuth/2π from +z towards +x, v = polar angle/π from +y.
+    uv = np.stack([np.mod(np.arctan2(q[:, 0], q[:, 2]), 2 * np.pi) / (2 * np.pi),
+                   np.arccos(np.clip(q[:, 1], -1.0, 1.0)) / np.pi], axis=1)
+    return normal, uv, np.ones((sel.size, 3)) if node.mode == 1 else None
+
+
+def _surface_triangles(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[np.intp], o: NDArray[np.float64],
+                       d: NDArray[np.float64], point: NDArray[np.float64], spawn: _Spawn | None
+                       ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64] | None]:
+    """A mesh node's (normal, uv, vertex colour) at its hits, barycentric; its spawn
+    points are the barycentric points with their error bound and the face normal."""
+    tri = hits.tri[sel]
+    u, v = _barycentric(world, tri, _rows(o, sel), d[sel])
+    w = (1.0 - u - v)[:, None], u[:, None], v[:, None]  # weights of V0, V1, V2
+    normal = _interpolate(world.normals[tri], w)
+    if node.two_sided:
+        # A back face seen (the ray runs along the face normal: clockwise from the eye,
+        # the rasterizer's !gl_FrontFacing) is lit as its other side: the normal reversed.
+        face = np.cross(world.v1[tri] - world.v0[tri], world.v2[tri] - world.v0[tri])
+        back = np.einsum("ij,ij->i", face, d[sel]) > 0.0
+        normal[back] *= -1.0
+    if spawn is not None:
+        corners = world.v0[tri] * w[0], world.v1[tri] * w[1], world.v2[tri] * w[2]
+        spawn.point[sel] = corners[0] + corners[1] + corners[2]
+        spawn.error[sel] = gamma(TRIANGLE_POINT_GAMMA, UNIT_F64) * (
+            np.abs(corners[0]) + np.abs(corners[1]) + np.abs(corners[2]))
+        spawn.normal[sel] = np.cross(world.v1[tri] - world.v0[tri], world.v2[tri] - world.v0[tri])
+    colors = _interpolate(world.colors[tri], w) if node.mode == 1 or node.vertex_colors else None  # when shown
+    return normal, _interpolate(world.uvs[tri], w), colors
+
+
+#: The node table's per-kind code (:class:`~glsandbox.raytrace.world.NodeKind`): a hit
+#: test ``(world, node, o, d, one_sided) -> (t, world triangle or −1)`` in the node's
+#: own space, and a surface ``-> (normal, uv, vertex colour or None unless the node
+#: shows vertex colours)`` that also fills the spawn points (when given). A new kind is one entry in each.
+_HIT = {NodeKind.MESH: _hit_triangles, NodeKind.SPHERE: _hit_sphere}
+_SURFACE = {NodeKind.MESH: _surface_triangles, NodeKind.SPHERE: _surface_sphere}
 
 
 def _interpolate(values: NDArray[np.float64], w: tuple[NDArray[np.float64], ...]) -> NDArray[np.float64]:
@@ -371,22 +431,35 @@ def _interpolate(values: NDArray[np.float64], w: tuple[NDArray[np.float64], ...]
     return values[:, 0] * w[0] + values[:, 1] * w[1] + values[:, 2] * w[2]
 
 
-def _offset(point: NDArray[np.float64], normal: NDArray[np.float64], side: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``point`` moved off its surface towards ``side`` by the relative :data:`SHADOW_OFFSET`."""
-    scale = SHADOW_OFFSET * np.maximum(1.0, np.abs(point).max(axis=1))
+def _offset(spawn: _Spawn, normal: NDArray[np.float64], side: NDArray[np.float64],
+            simple: bool = False) -> NDArray[np.float64]:
+    """Secondary-ray origins off their surface: each spawn point moved along its
+    geometric normal by its error bound's reach along it, ``Σ|n_i|·err_i``, then
+    every moved component rounded one float further (so the move cannot round back
+    onto the surface). The side is the one the shading ``normal`` puts ``side``
+    on, as the shading decides whether a point faces its light (on a tessellated
+    sphere's terminator the facet may face away while the normal does not: the ray
+    then starts outside and the facet shadows it). ``simple``: the teaching variant,
+    :data:`~glsandbox.raytrace.constants.SIMPLE_OFFSET`·max(1, max|P|)."""
+    p, n = spawn.point, spawn.normal
+    if simple:
+        reach = SIMPLE_OFFSET * np.maximum(1.0, np.abs(p).max(axis=1))
+    else:
+        reach = np.einsum("ij,ij->i", np.abs(n), spawn.error)
     sign = np.where(np.einsum("ij,ij->i", normal, side) < 0.0, -1.0, 1.0)
-    return point + (scale * sign)[:, None] * normal
+    sign *= np.where(np.einsum("ij,ij->i", n, normal) < 0.0, -1.0, 1.0)  # a geometric normal against the shading one
+    return moved_off(p, (reach * sign)[:, None] * n)
 
 
 # --- shading and bounces -------------------------------------------------------
 
 
 def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.float64], shadows: bool,
-           cull: bool | None, aabb: bool, stats: RenderStats, bvh: WorldBVH | None = None
-           ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """Local colour of hit rays (the raster's per-light formula), plus point, normal and alpha
-    for bounces."""
-    point, normal, base, alpha = _surface(world, hits, o, d)
+           cull: bool | None, aabb: bool, stats: RenderStats, bvh: WorldBVH | None = None, simple: bool = False,
+           bounce: bool = True) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], _Spawn | None]:
+    """Local colour of hit rays (the raster's per-light formula), plus normal, alpha and
+    spawn point for bounces (``bounce``: some may follow; else the spawn is None)."""
+    point, normal, base, alpha, spawn = _surface(world, hits, o, d, need_spawn=shadows or bounce)
     color = base.copy()  # unlit surfaces keep their colour
     table = world.materials
     lit = table.lit[hits.node]
@@ -399,6 +472,7 @@ def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.floa
         shin = table.shininess[nodes]
         blinn = table.blinn[nodes]
         p, nrm, mesh = point[idx], normal[idx], base[idx]
+        lit_spawn = spawn.subset(idx) if spawn is not None else None
         to_eye = -d[idx] / length(d[idx])[:, None]
         total = np.zeros_like(mesh)
         for index, (light, light_color) in enumerate(zip(world.light_positions, world.light_colors)):
@@ -418,17 +492,19 @@ def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.floa
             specular = highlight[:, None] * light_color
             lighting = kd * diffuse + ks * specular
             if shadows:
-                start = _offset(p, nrm, light - p)
+                assert lit_spawn is not None
+                start = _offset(lit_spawn, nrm, light - p, simple)
                 stats.shadow += idx.size
                 blocked = _occluded(world, start, light - start, index, cull, aabb, stats, bvh)
                 lighting *= np.where(blocked, 0.0, 1.0)[:, None]  # in shadow only the ambient term stays
             total += np.minimum(ka * mesh + lighting, 1.0)
         color[idx] = total
-    return color, point, normal, alpha
+    return color, normal, alpha, spawn
 
 
 def _trace(world: World, o: NDArray[np.float64], d: NDArray[np.float64], max_depth: int, shadows: bool,
-           cull: bool | None, aabb: bool, stats: RenderStats, bvh: WorldBVH | None = None) -> NDArray[np.float64]:
+           cull: bool | None, aabb: bool, stats: RenderStats, bvh: WorldBVH | None = None,
+           simple: bool = False) -> NDArray[np.float64]:
     """Colour of each ray, reflections followed iteratively: ``(1−r)·local + r·reflected``.
 
     A see-through surface (a cut-out, a blended one) covers a share ``a`` of what lies
@@ -448,9 +524,10 @@ def _trace(world: World, o: NDArray[np.float64], d: NDArray[np.float64], max_dep
         if not hit.any():
             break
         sub = _Hits(hits.t[hit], hits.node[hit], hits.tri[hit])
-        local, point, normal, alpha = _shade(world, sub, _rows(o, hit), d[hit], shadows, cull, aabb, stats, bvh)
-        table = world.materials
         last = depth >= max_depth
+        local, normal, alpha, spawn = _shade(world, sub, _rows(o, hit), d[hit], shadows, cull, aabb, stats, bvh,
+                                             simple, bounce=not last)
+        table = world.materials
         r = table.reflectivity[sub.node] if not last else np.zeros(sub.node.size)
         a = np.ones(sub.node.size) if last else coverage(table.alpha_mode[sub.node], alpha,
                                                           table.alpha_cutoff[sub.node])
@@ -465,7 +542,8 @@ def _trace(world: World, o: NDArray[np.float64], d: NDArray[np.float64], max_dep
         nh = normal[bounce]
         on = through[bounce][:, None]
         reflected = dh - 2.0 * np.einsum("ij,ij->i", dh, nh)[:, None] * nh  # Yansıma vektörü
-        o = _offset(point[bounce], nh, np.where(on, dh, -dh))  # behind the surface, or back in front
+        assert spawn is not None  # not the last depth: _shade made it
+        o = _offset(spawn.subset(bounce), nh, np.where(on, dh, -dh), simple)  # behind the surface, or back in front
         d = np.where(on, dh, reflected)
         weight = np.where(through, w * (1.0 - a), w * r)[bounce]
         alive = alive[hit][bounce]
@@ -499,7 +577,7 @@ def _world_of(scene: Scene, viewport: int, analytic_spheres: bool, bvh: bool) ->
 def render_viewport(scene: Scene, size: tuple[int, int], viewport: int = 0, *, max_depth: int = 2,
                     shadows: bool = True, cull_backfaces: bool | None = None, aabb: bool = True,
                     bvh: bool = True, analytic_spheres: bool = True,
-                    stats: RenderStats | None = None) -> NDArray[np.uint8]:
+                    stats: RenderStats | None = None, offset: str = "bound") -> NDArray[np.uint8]:
     """Trace one viewport at ``size``: ``(H, W, 4)`` uint8, top row first (see :func:`to_rgba8`).
 
     The options are :func:`glsandbox.raytrace.render`'s; ``stats`` counts the rays cast.
@@ -513,5 +591,6 @@ def render_viewport(scene: Scene, size: tuple[int, int], viewport: int = 0, *, m
     rgb = np.empty((dirs.shape[0], 3))
     for lo in range(0, dirs.shape[0], RAY_BLOCK):
         rays = slice(lo, lo + RAY_BLOCK)
-        rgb[rays] = _trace(world, eye, dirs[rays], max_depth, shadows, cull_backfaces, aabb, stats, accel)
+        rgb[rays] = _trace(world, eye, dirs[rays], max_depth, shadows, cull_backfaces, aabb, stats, accel,
+                           OFFSETS[offset])
     return to_rgba8(rgb.reshape(height, width, 3))

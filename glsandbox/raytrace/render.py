@@ -19,7 +19,10 @@ The algorithm, in the course's order (first half of the notes):
 1. **Primary rays** through the image plane (:func:`~glsandbox.raytrace.world.camera_rays`).
 2. **Nearest hit** (``tDistances``/``min_indis``): for each node, the AABB
    slab test first (course "Hızlandırma: AABB"; ``aabb=False`` skips it),
-   then Möller–Trumbore against its triangles, or the exact sphere test.
+   then the watertight triangle test (Woop, Benthin & Wald; the course's
+   Işın-Üçgen kesim testi ends with it) against its triangles, or the exact
+   sphere test: a ray through a shared edge or vertex never slips through,
+   in either engine, on any path.
    The numpy engine's ``bvh=True`` (the default) traces each mesh node's rays
    through a BVH over its triangles instead (:mod:`glsandbox.raytrace.bvh`,
    built once per mesh and cached), with the watertight triangle test
@@ -27,10 +30,12 @@ The algorithm, in the course's order (first half of the notes):
    vertex hits one of its triangles, never none); spheres stay exact, and
    shadow rays stop at their first occluder. ``bvh=False`` is the per-node
    scan above (what ``ray_acceleration`` compares it with). The gpu engine
-   does not traverse a BVH yet and ignores the option.
+   decides by itself (:mod:`glsandbox.raytrace.gpu`: a scan for small
+   meshes, BVHs for large ones, both with the watertight test) and ignores
+   the option.
    **Backface culling** (course "Hızlandırma: backface culling"): a node the
    rasterizer culls (``cull_back_faces``) is one-sided for *every* ray, as
-   ``det > 0`` in Möller–Trumbore; ``cull_backfaces=True``/``False``
+   the front faces only (``N·d < 0``); ``cull_backfaces=True``/``False``
    overrides all nodes.
 3. **Shading**, the rasterizer's formula (``shaders/common/lighting.glsl``,
    course "Lighting"), so the two renderers differ only where the raster
@@ -47,10 +52,10 @@ The algorithm, in the course's order (first half of the notes):
 4. **Shadow rays** (course "Gölge testi"): a light counts for a lit point only
    if nothing lies between: the ray ``P' + s·(L − P')``, ``0 < s < 1``, hits
    nothing (``s = 1`` is the light itself, so an occluder beyond it never
-   counts). ``P'`` is ``P`` moved off its surface by a relative offset
-   towards the light's side
-   (:data:`~glsandbox.raytrace.constants.SHADOW_OFFSET`, float32-safe, see
-   :mod:`glsandbox.raytrace.trace`). In shadow, only the ambient term stays.
+   counts). ``P'`` is ``P`` moved off its surface, towards the light's side,
+   along the geometric normal by a bound on ``P``'s rounding error (pbrt-v4;
+   the bounds are in :mod:`glsandbox.raytrace.constants`): a contact shadow
+   survives at the origin and at 1e6 alike. In shadow, only the ambient term stays.
    A light's lamp (an unlit node whose box holds it) casts no shadow for it.
 5. **Reflection** (course "Yansıma vektörü"): a surface with
    ``material.reflectivity = r > 0`` shows ``(1 − r)·local + r·reflected``,
@@ -71,6 +76,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from glsandbox.raytrace import numpy_engine
+from glsandbox.raytrace.constants import OFFSETS
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.numpy_engine import RenderStats
 from glsandbox.scene import Scene
@@ -81,7 +87,9 @@ __all__ = ["ENGINES", "RenderStats", "render"]
 ENGINES = ("numpy", "gpu")
 
 
-def _check(size: tuple[int, int], engine: str, max_depth: int) -> None:
+def _check(size: tuple[int, int], engine: str, max_depth: int, offset: str = "bound") -> None:
+    if offset not in OFFSETS:
+        raise RayTraceError(f"unknown shadow-ray offset {offset!r}; use one of {', '.join(OFFSETS)}")
     if engine not in ENGINES:
         raise RayTraceError(f"unknown ray tracing engine {engine!r}; use one of {', '.join(ENGINES)}")
     if len(size) != 2 or any(int(s) != s or s <= 0 or s > 16384 for s in size):
@@ -92,7 +100,8 @@ def _check(size: tuple[int, int], engine: str, max_depth: int) -> None:
 
 def render(scene: Scene, size: tuple[int, int], engine: str = "numpy", *, ctx: object | None = None,
            max_depth: int = 2, shadows: bool = True, cull_backfaces: bool | None = None, aabb: bool = True,
-           bvh: bool = True, analytic_spheres: bool = True, stats: RenderStats | None = None) -> NDArray[np.uint8]:
+           bvh: bool = True, analytic_spheres: bool = True, offset: str = "bound",
+           stats: RenderStats | None = None) -> NDArray[np.uint8]:
     """Ray-trace ``scene`` at ``size = (width, height)``: an ``(H, W, 4)`` uint8 image, top row first.
 
     Every viewport is traced in its rectangle with its camera and clear
@@ -102,15 +111,18 @@ def render(scene: Scene, size: tuple[int, int], engine: str = "numpy", *, ctx: o
     reflection bounces, ``shadows``, ``cull_backfaces`` (None: per node, as
     the rasterizer), ``aabb`` culling, ``bvh`` (numpy engine: mesh nodes
     through their BVH; ``False``: every triangle of each node the box test
-    lets through), ``analytic_spheres`` (see :mod:`glsandbox.raytrace.world`).
+    lets through), ``analytic_spheres`` (see :mod:`glsandbox.raytrace.world`),
+    ``offset`` (how secondary rays leave a surface: ``"bound"``, by the hit
+    point's rounding-error bound; ``"simple"``, the teaching variant
+    :data:`~glsandbox.raytrace.constants.SIMPLE_OFFSET`).
     ``stats`` (numpy engine) counts the rays and the box and shape tests.
     """
-    _check(size, engine, max_depth)
+    _check(size, engine, max_depth, offset)
     width, height = int(size[0]), int(size[1])
     start = time.perf_counter()
     frame = np.zeros((height, width, 4), dtype=np.uint8)
     options = dict(max_depth=int(max_depth), shadows=shadows, cull_backfaces=cull_backfaces, aabb=aabb,
-                   analytic_spheres=analytic_spheres)
+                   analytic_spheres=analytic_spheres, offset=offset)
     # tracer(size, viewport): one viewport's image, from either engine.
     tracer: Callable[[tuple[int, int], int], NDArray[np.uint8]]
     if engine == "gpu":

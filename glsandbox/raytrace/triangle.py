@@ -71,6 +71,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from glsandbox.raytrace.base import broadcast_rays, finite_positive_or_none, shared_origin
+from glsandbox.raytrace.constants import UNIT_F64, gamma
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.ray import Ray
 from glsandbox.raytrace.vec import Vec3, as_vec3, as_vec3_batch, cross, dot, length
@@ -457,7 +458,36 @@ def _watertight(tri: Triangle, ray: Ray, cull: bool) -> float | None:
         return None  # the triangle is seen edge-on
     # 6. Interpolate the (scaled) z of the vertices: that is t along d.
     t = (u * (sz * az) + v * (sz * bz) + w * (sz * cz)) / det
-    return t if t > 0.0 else None
+    # 7. Only a t above its own rounding-error bound counts (pbrt-v4): a shadow ray
+    #    leaving its surface by the hit point's error bound never meets it again.
+    bound = watertight_t_bound((ax, bx, cx), (ay, by, cy), (sz * az, sz * bz, sz * cz), (u, v, w), det)
+    return t if t > bound else None
+
+
+def watertight_t_bound(x, y, z, e, det):  # type: ignore[no-untyped-def]
+    """pbrt-v4's bound on the rounding error of the watertight test's ``t``
+    (float64): ``x, y`` the three sheared corners' coordinates, ``z`` their scaled
+    ``sz·z``, ``e`` the edge functions ``U, V, W``, ``det`` their sum. Floats or
+    numpy arrays alike (the scalar and the vectorized test share it, operation for
+    operation). The error of each step, in ``γ(n)`` (:func:`~glsandbox.raytrace.constants.gamma`):
+    the corners' ``z`` ``γ(3)·max|z|``, their sheared ``x, y`` ``γ(5)·(max|x| + max|z|)``,
+    the edge functions ``2·(γ(2)·max|x|·max|y| + δy·max|x| + δx·max|y|)``, and ``t``
+    three times the error of ``Σ e_i·z_i`` over ``|det|``."""
+    g2, g3, g5 = (gamma(n, UNIT_F64) for n in (2, 3, 5))
+    with np.errstate(over="ignore", invalid="ignore"):  # coordinates near 1e154 and up: an inf bound, a miss
+        return _t_bound(x, y, z, e, det, g2, g3, g5)
+
+
+def _t_bound(x, y, z, e, det, g2, g3, g5):  # type: ignore[no-untyped-def]
+    max_x = np.maximum(np.maximum(np.abs(x[0]), np.abs(x[1])), np.abs(x[2]))
+    max_y = np.maximum(np.maximum(np.abs(y[0]), np.abs(y[1])), np.abs(y[2]))
+    max_z = np.maximum(np.maximum(np.abs(z[0]), np.abs(z[1])), np.abs(z[2]))
+    max_e = np.maximum(np.maximum(np.abs(e[0]), np.abs(e[1])), np.abs(e[2]))
+    delta_z = g3 * max_z
+    delta_x = g5 * (max_x + max_z)
+    delta_y = g5 * (max_y + max_z)
+    delta_e = 2.0 * (g2 * max_x * max_y + delta_y * max_x + delta_x * max_y)
+    return 3.0 * (g3 * max_e * max_z + delta_e * max_z + delta_z * max_e) / np.abs(det)
 
 
 #: The four point-in-triangle tests of the course (step 2 of Işın-Üçgen kesim testi).

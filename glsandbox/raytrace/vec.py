@@ -28,6 +28,7 @@ Vec3 = NDArray[np.float64]
 """A float64 array whose last axis has length 3 (one vector or a batch)."""
 
 __all__ = [
+    "moved_off",
     "Vec3",
     "as_vec3",
     "as_vec3_batch",
@@ -110,3 +111,14 @@ def normalize(v: ArrayLike) -> Vec3:
         raise RayTraceError(f"cannot normalize a zero or non-finite vector: {v.tolist()}")
     unit: Vec3 = v / np.asarray(n)[..., None]
     return unit
+
+
+def moved_off(point: ArrayLike, step: ArrayLike) -> NDArray[np.float64]:
+    """``point + step``, each coordinate the step moves then rounded one float further
+    the same way (pbrt-v4's robust spawned origins): the sum's own rounding can then
+    never put the point back within the bound the step was sized for."""
+    moved = np.asarray(point, dtype=np.float64) + step
+    step = np.broadcast_to(step, moved.shape)
+    result: NDArray[np.float64] = np.where(step > 0.0, np.nextafter(moved, np.inf),
+                                           np.where(step < 0.0, np.nextafter(moved, -np.inf), moved))
+    return result

@@ -22,7 +22,10 @@ and per pair:
 4. inside when ``U, V, W`` share a sign (zeros count on both sides;
    backface culling keeps only ``U, V, W >= 0``, the front faces, ``N·d <
    0``); ``det = U + V + W = 0`` is a triangle seen edge-on;
-5. ``t = (U·z_A + V·z_B + W·z_C)/det`` with the sheared ``z = sz·z``.
+5. ``t = (U·z_A + V·z_B + W·z_C)/det`` with the sheared ``z = sz·z``;
+6. a hit counts only for ``t`` above pbrt-v4's bound on its rounding error
+   (:func:`~glsandbox.raytrace.triangle.watertight_t_bound`), so a secondary
+   ray that leaves its surface by the hit point's error bound never meets it.
 
 When an edge function rounds to exactly 0, its sign is not trustworthy. The
 scalar test recomputes it in exact rational arithmetic; here the same
@@ -47,10 +50,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from glsandbox.raytrace.base import broadcast_rays
-from glsandbox.raytrace.triangle import DEGENERATE_SIN
+from glsandbox.raytrace.triangle import DEGENERATE_SIN, watertight_t_bound
 from glsandbox.raytrace.vec import cross, length
 
-__all__ = ["RaySetup", "nondegenerate", "ray_setup", "watertight_pairs"]
+__all__ = ["RaySetup", "nearest_watertight", "nondegenerate", "ray_setup", "watertight_pairs"]
 
 #: Veltkamp's splitting constant for float64: 2^27 + 1 cuts a double into two
 #: halves of 26 bits whose pairwise products are exact.
@@ -163,5 +166,42 @@ def watertight_pairs(setup: RaySetup, rays: NDArray[np.intp], v0: NDArray[np.flo
         inside &= det != 0.0
         # Step 5: the sheared z interpolated with the scaled barycentrics is t along d.
         t = (u * (sz * az) + v * (sz * bz) + w * (sz * cz)) / det
+        # Step 6: only a t above its rounding-error bound counts (pbrt-v4), as in the scalar test;
+        # formed for the pairs that could hit only (most pairs a traversal tests miss).
         hit = inside & (t > 0.0)
+        near = np.flatnonzero(hit)
+        if near.size:
+            z = (sz * az)[near], (sz * bz)[near], (sz * cz)[near]
+            bound = watertight_t_bound((ax[near], bx[near], cx[near]), (ay[near], by[near], cy[near]), z,
+                                       (u[near], v[near], w[near]), det[near])
+            hit[near] = t[near] > bound
         return np.where(hit, t, np.inf), v / det, w / det
+
+
+def nearest_watertight(v0: NDArray[np.float64], v1: NDArray[np.float64], v2: NDArray[np.float64],
+                       origins: ArrayLike, directions: ArrayLike, cull_backfaces: bool = False,
+                       chunk_pairs: int = 1 << 14) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
+    """Nearest hit of each ray over *every* triangle (no BVH): ``(t, index)``, ``(inf, −1)``
+    for a miss, the lower index winning a tie (the course's ``min_indis``). The
+    numpy engine's per-node scan (``bvh=False``): the watertight test, so a ray
+    through a shared edge or vertex never slips through. Triangles without area
+    (:func:`nondegenerate`) are never hit, as in the BVH. Pairs are tested a
+    block of rays at a time, about ``chunk_pairs`` pairs a block."""
+    o, d = broadcast_rays(origins, directions)
+    n, m = d.shape[0], v0.shape[0]
+    best_t = np.full(n, np.inf)
+    best_i = np.full(n, -1, dtype=np.intp)
+    keep = np.flatnonzero(nondegenerate(v0, v1, v2))
+    if n == 0 or keep.size == 0:
+        return best_t, best_i
+    setup = ray_setup(o, d)
+    step = max(1, chunk_pairs // keep.size)
+    for lo in range(0, n, step):
+        rays = np.arange(lo, min(n, lo + step))
+        t, _, _ = watertight_pairs(setup, np.repeat(rays, keep.size), v0, v1, v2, np.tile(keep, rays.size),
+                                   cull_backfaces)
+        t = t.reshape(rays.size, keep.size)
+        j = np.argmin(t, axis=1)  # the first minimum: the lowest index on a tie
+        best_t[rays] = t[np.arange(rays.size), j]
+        best_i[rays] = np.where(np.isfinite(best_t[rays]), keep[j], -1)
+    return best_t, best_i

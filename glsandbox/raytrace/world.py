@@ -11,9 +11,9 @@ once per viewport by :func:`build_world` from the *same*
   triangle strips become triangles with the strip's winding
   (:meth:`glsandbox.geometry.Mesh.triangles`); line meshes have no surface
   and are not traced;
-- a node whose mesh is :func:`glsandbox.geometry.sphere` (the unit UV sphere,
-  recognised by its name and by every vertex lying on the unit sphere) is
-  traced as the *exact* unit sphere under its model matrix (an ellipsoid in
+- a node whose mesh says it tessellates the unit sphere
+  (``Mesh.analytic == "sphere"``, as :func:`glsandbox.geometry.sphere` does,
+  and every vertex lies on it) is a :attr:`NodeKind.SPHERE` node, traced as the *exact* unit sphere under its model matrix (an ellipsoid in
   general): the ray is taken into the sphere's own space with ``M⁻¹`` and
   tested against ``|p| = 1`` (course section "Işın-Küre kesim testi"). An
   affine map keeps ``t``: ``M⁻¹(O + t·d) = M⁻¹O + t·(M⁻¹d)``, so no
@@ -51,6 +51,7 @@ lesson's scene lies well inside them).
 
 from __future__ import annotations
 
+import enum
 import math
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -63,11 +64,11 @@ from glsandbox.geometry import Mesh
 from glsandbox.images import texture_levels
 from glsandbox.plan import traced_reflectivity
 from glsandbox.raytrace.errors import RayTraceError
-from glsandbox.raytrace.triangle import TriangleBatch
 from glsandbox.scene import MIN_SCALE, Camera, Node, Scene, Texture
 
 __all__ = [
     "MODES",
+    "NodeKind",
     "NodeInfo",
     "NodeMaterials",
     "World",
@@ -84,12 +85,55 @@ ALPHA_CODES = {"opaque": 0, "mask": 1, "blend": 2}
 WRAPS = {"repeat": 0, "mirrored": 1, "clamp": 2}
 
 
+class NodeKind(str, enum.Enum):
+    """What a traced node is: the one table both engines loop over.
+
+    Each kind is a box (:func:`build_world` gives every node its world box), a
+    hit test in the node's own space and a surface (point, normal, uv):
+
+    - ``MESH``: world-space triangles (``NodeInfo.start``/``count``), hit by
+      the watertight test (a BVH or a scan), surface from barycentrics;
+    - ``SPHERE``: the unit sphere under the node's model matrix; rays are taken
+      into its space by ``NodeInfo.inverse``, hit by the stable quadratic,
+      normal through ``NodeInfo.normal_matrix``.
+
+    The value is the kind's name (so ``kind == "sphere"`` still reads true);
+    :attr:`code` is the number the gpu engine stores in a node record
+    (``shaders/raytrace.glsl`` gets ``KIND_<NAME>`` defines from
+    :func:`kind_defines`). The engines' per-kind code is in
+    :mod:`glsandbox.raytrace.numpy_engine` (``_HIT``/``_SURFACE`` tables) and
+    the shader's ``sphere_t``/``triangle_t``; the README's ray tracer section
+    says how to add a kind."""
+
+    MESH = "mesh"
+    SPHERE = "sphere"
+
+    @property
+    def code(self) -> int:
+        """The kind's number in the gpu engine's node records: its place in the table."""
+        return list(NodeKind).index(self)
+
+    @property
+    def triangles(self) -> bool:
+        """Whether the kind's shape is its node's triangles (BVH and scan apply)."""
+        return self is NodeKind.MESH
+
+
+def kind_defines() -> tuple[tuple[str, str], ...]:
+    """``KIND_MESH 0``, ``KIND_SPHERE 1``...: the node kinds as shader defines."""
+    return tuple((f"KIND_{kind.name}", str(kind.code)) for kind in NodeKind)
+
+
+#: The analytic shapes a mesh can name in ``Mesh.analytic``, by name.
+ANALYTIC_KINDS = {"sphere": NodeKind.SPHERE}
+
+
 @dataclass
 class NodeInfo:
     """One traced node: its shape, its box, its material (already numbered for the engines)."""
 
     name: str
-    kind: str  # "mesh" or "sphere" (the unit sphere under the node's model matrix)
+    kind: NodeKind
     start: int  # first triangle in the world arrays
     count: int  # number of triangles
     box_min: NDArray[np.float64]
@@ -152,7 +196,6 @@ class World:
     light_colors: NDArray[np.float64]  # (L, 3)
     background: NDArray[np.float64]  # rgb of the viewport's clear colour
     textures: list[tuple[NDArray[np.float64], int]]  # (image (H, W, 4) in 0..1, wrap code)
-    batches: list[TriangleBatch | None] = field(default_factory=list)
 
     @property
     def triangle_count(self) -> int:
@@ -206,8 +249,8 @@ def coverage(alpha_mode: NDArray[np.intp], alpha: NDArray[np.float64],
 
 
 def is_unit_sphere(mesh: Mesh) -> bool:
-    """Whether ``mesh`` is :func:`glsandbox.geometry.sphere`: named so, every vertex on ``|p| = 1``."""
-    if mesh.name != "sphere" or mesh.mode != "triangles":
+    """Whether ``mesh`` says it is the unit sphere (``analytic="sphere"``) and every vertex is on ``|p| = 1``."""
+    if ANALYTIC_KINDS.get(mesh.analytic or "") is not NodeKind.SPHERE or mesh.mode != "triangles":
         return False
     radii = np.linalg.norm(np.asarray(mesh.positions, dtype=np.float64), axis=1)
     return bool(np.all(np.abs(radii - 1.0) < 1e-9))
@@ -247,7 +290,6 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
     v0s, v1s, v2s, ns, uvs, cols, owners = [], [], [], [], [], [], []
     textures: list[tuple[NDArray[np.float64], int]] = []
     texture_index: dict[tuple[str, str, str], int] = {}
-    batches: list[TriangleBatch | None] = []
     start = 0
     for node in scene.nodes:
         if not node.shown_in(viewport):
@@ -278,10 +320,9 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
         if analytic_spheres and is_unit_sphere(mesh) and invertible:
             corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=np.float64)
             world_corners = transforms.transform_points(model, corners)
-            nodes.append(NodeInfo(kind="sphere", start=start, count=0, box_min=world_corners.min(axis=0),
+            nodes.append(NodeInfo(kind=NodeKind.SPHERE, start=start, count=0, box_min=world_corners.min(axis=0),
                                   box_max=world_corners.max(axis=0), inverse=np.linalg.inv(model),
                                   normal_matrix=transforms.normal_matrix(model), **common))
-            batches.append(None)
             continue
         order = mesh.indices if mesh.indices is not None else np.arange(mesh.vertex_count)
         if mesh.mode == "triangles":
@@ -304,9 +345,8 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
         col = np.asarray(mesh.colors, dtype=np.float64)[tri] if mesh.colors is not None else np.ones((len(tri), 3, 3))
         v0s.append(a), v1s.append(b), v2s.append(c), ns.append(n), uvs.append(uv), cols.append(col)
         owners.append(np.full(len(tri), len(nodes), dtype=np.intp))
-        nodes.append(NodeInfo(kind="mesh", start=start, count=len(tri), box_min=world.min(axis=0),
+        nodes.append(NodeInfo(kind=NodeKind.MESH, start=start, count=len(tri), box_min=world.min(axis=0),
                               box_max=world.max(axis=0), **common))
-        batches.append(TriangleBatch(a, b, c))
         start += len(tri)
     lights = scene.lights
     for info in nodes:
@@ -327,7 +367,7 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
         tri_node=np.concatenate(owners) if owners else np.zeros(0, dtype=np.intp),
         light_positions=np.array([l.position for l in lights], dtype=np.float64).reshape(-1, 3),
         light_colors=np.array([l.color for l in lights], dtype=np.float64).reshape(-1, 3),
-        background=np.asarray(clear[:3], dtype=np.float64), textures=textures, batches=batches,
+        background=np.asarray(clear[:3], dtype=np.float64), textures=textures,
     )
 
 

@@ -32,13 +32,8 @@
 // 0 < t < t_max wins; on an equal t the lower caller's triangle index wins.
 // So a box entered at exactly the best t is still opened (near <= best).
 //
-// The triangle test is the watertight one (Woop, Benthin & Wald 2013) in
-// float32, as glsandbox/raytrace/watertight.py does in float64: permute the
-// axes so d's largest component is z, shear so the ray is the +z axis, and
-// test the 2D edge functions. `precise` (GLSL 4.00) keeps the compiler from
-// fusing a*b - c*d into an fma, which would break the exact antisymmetry that
-// makes neighbouring triangles watertight; an edge function that rounds to 0
-// is recomputed in double (exact for float inputs) where doubles exist.
+// The triangle test is the watertight one (common/watertight.glsl), the
+// same function the ray tracer's scan uses.
 
 #ifndef BVH_TEX_WIDTH
 #define BVH_TEX_WIDTH 4096
@@ -52,13 +47,7 @@
 #ifndef BVH_PAD
 #define BVH_PAD 3.814697265625e-06
 #endif
-#if __VERSION__ >= 400
-#define BVH_PRECISE precise
-#define BVH_DOUBLE_EDGES 1
-#else
-#define BVH_PRECISE
-#define BVH_DOUBLE_EDGES 0
-#endif
+#include "common/watertight.glsl"
 
 uniform sampler2D u_bvh_nodes;
 uniform sampler2D u_bvh_tris;
@@ -75,34 +64,16 @@ vec4 bvh_texel(sampler2D s, int i) {
     return texelFetch(s, ivec2(i % BVH_TEX_WIDTH, i / BVH_TEX_WIDTH), 0);
 }
 
-// What the watertight test needs per ray (steps 1 and 2 of the paper).
+// A ray as the traversal needs it: the watertight test's per-ray setup and
+// the ray's part of the box padding, BVH_PAD * max|o|.
 struct BvhRay {
-    vec3 o;
-    vec3 inv_d;     // for the slab test (zero components made tiny: no NaN)
-    mat3 m;         // permute then shear: m (V - O) = (x - sx z, y - sy z, sz z) on the axes kx, ky, kz
-    float pad;      // the ray's part of the box padding, BVH_PAD * max|o|
+    WtRay w;
+    float pad;
 };
 
 BvhRay bvh_ray(vec3 o, vec3 d) {
     BvhRay r;
-    r.o = o;
-    vec3 ad = abs(d);
-    int kz = ad.x >= ad.y ? (ad.x >= ad.z ? 0 : 2) : (ad.y >= ad.z ? 1 : 2);
-    int kx = kz == 2 ? 0 : kz + 1;
-    int ky = kx == 2 ? 0 : kx + 1;
-    if (d[kz] < 0.0) { int k = kx; kx = ky; ky = k; }  // keep the winding
-    float sx = d[kx] / d[kz], sy = d[ky] / d[kz], sz = 1.0 / d[kz];
-    // The permutation and the shear as one matrix, made once per ray, so a
-    // triangle's corners need no per-lane vector indexing (slow on llvmpipe).
-    // Its rows pick x - sx z, y - sy z and sz z; a corner shared by two
-    // triangles still gets the same numbers in both, which is all the
-    // watertight argument needs of them.
-    vec3 ex = vec3(equal(ivec3(kx), ivec3(0, 1, 2)));
-    vec3 ey = vec3(equal(ivec3(ky), ivec3(0, 1, 2)));
-    vec3 ez = vec3(equal(ivec3(kz), ivec3(0, 1, 2)));
-    r.m = transpose(mat3(ex - sx * ez, ey - sy * ez, sz * ez));
-    vec3 safe = mix(d, mix(vec3(-1e-30), vec3(1e-30), greaterThanEqual(d, vec3(0.0))), lessThan(ad, vec3(1e-30)));
-    r.inv_d = 1.0 / safe;
+    r.w = wt_ray(o, d);
     r.pad = BVH_PAD * max(max(abs(o.x), abs(o.y)), abs(o.z));
     return r;
 }
@@ -112,8 +83,8 @@ BvhRay bvh_ray(vec3 o, vec3 d) {
 bool bvh_box(BvhRay r, int node, float limit, out float near) {
     vec3 lo = bvh_texel(u_bvh_nodes, 2 * node).xyz - r.pad;
     vec3 hi = bvh_texel(u_bvh_nodes, 2 * node + 1).xyz + r.pad;
-    vec3 ta = (lo - r.o) * r.inv_d;
-    vec3 tb = (hi - r.o) * r.inv_d;
+    vec3 ta = (lo - r.w.o) * r.w.inv_d;
+    vec3 tb = (hi - r.w.o) * r.w.inv_d;
     vec3 tn = min(ta, tb);
     vec3 tf = max(ta, tb);
     near = max(max(tn.x, tn.y), tn.z);
@@ -121,33 +92,13 @@ bool bvh_box(BvhRay r, int node, float limit, out float near) {
     return near <= far && far >= 0.0 && near <= limit;
 }
 
-// E(p, q) = px qy - py qx, recomputed exactly when it rounds to 0.
-float bvh_edge(float px, float py, float qx, float qy) {
-    BVH_PRECISE float e = px * qy - py * qx;
-#if BVH_DOUBLE_EDGES
-    if (e == 0.0) e = float(double(px) * double(qy) - double(py) * double(qx));
-#endif
-    return e;
-}
-
 // The watertight test against stored triangle k: t (or -1.0 for a miss),
 // the caller's index and the barycentrics.
 float bvh_triangle(BvhRay r, int k, bool cull, out int index, out vec2 uv) {
     vec4 t0 = bvh_texel(u_bvh_tris, 3 * k);
     index = int(t0.w);
-    vec3 a = r.m * (t0.xyz - r.o);  // (sheared x, sheared y, sz z) of each corner
-    vec3 b = r.m * (bvh_texel(u_bvh_tris, 3 * k + 1).xyz - r.o);
-    vec3 c = r.m * (bvh_texel(u_bvh_tris, 3 * k + 2).xyz - r.o);
-    float u = bvh_edge(c.x, c.y, b.x, b.y);  // the weight of V0
-    float v = bvh_edge(a.x, a.y, c.x, c.y);  // of V1
-    float w = bvh_edge(b.x, b.y, a.x, a.y);  // of V2
-    bool negative = u < 0.0 || v < 0.0 || w < 0.0;
-    bool positive = u > 0.0 || v > 0.0 || w > 0.0;
-    float det = u + v + w;
-    uv = vec2(v, w) / det;
-    if ((cull ? negative : (negative && positive)) || det == 0.0) return -1.0;
-    float t = (u * a.z + v * b.z + w * c.z) / det;
-    return t > 0.0 ? t : -1.0;
+    return wt_triangle(r.w, t0.xyz, bvh_texel(u_bvh_tris, 3 * k + 1).xyz, bvh_texel(u_bvh_tris, 3 * k + 2).xyz,
+                       cull, uv);
 }
 
 // The nearest hit with 0 < t < t_max: an ordered, stackful traversal (the

@@ -123,7 +123,9 @@ def bad_files(folder: Path) -> dict[str, str]:
         "truncated.ply": "not a readable PLY file", "garbage.stl": "not a readable STL file",
         "garbage.obj": "garbage.obj", "points.obj": "has no faces", "degenerate.obj": "all 2 are degenerate",
         "nan.obj": "NaN or infinite", "inf.ply": "NaN or infinite", "range.obj": "out of range",
-        "range.off": "not a readable OFF file", "folder.obj": "is a folder", "model.xyz": "unknown format",
+        # trimesh >= 4.6 refuses an out-of-range OFF face itself; older ones load it and glsandbox refuses it
+        "range.off": ("face index outside the range", "refers to vertex 5"), "folder.obj": "is a folder",
+        "model.xyz": "unknown format",
     }
 
 
@@ -135,7 +137,8 @@ def test_every_bad_model_file_is_one_error_line_exit_2_and_no_output(tmp_path: P
         assert cli.main(["render", str(scene), "--out", str(out), "--size", "32x32"]) == 2, name
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and err[0].startswith(f"error: {scene}:9: nodes[0].mesh: model file "), err
-        assert str(folder / name) in err[0] and what in err[0], err[0]
+        assert str(folder / name) in err[0], err[0]
+        assert any(text in err[0] for text in ((what,) if isinstance(what, str) else what)), err[0]
         assert not out.exists() and "Traceback" not in err[0]
 
 

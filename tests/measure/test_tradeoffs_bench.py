@@ -134,7 +134,7 @@ def test_tradeoffs_report_has_a_table_per_knob(quick_report: Path) -> None:
     rows = _rows(quick_report)
     knobs = {row["knob"] for row in rows}
     assert knobs == {"antialiasing", "lighting", "ray_engine", "texture_filter", "depth", "shadows_mirror",
-                     "shadow_map"}
+                     "shadow_map", "shadow_offset"}
     for knob in knobs:  # one reference per knob, at zero error
         refs = [r for r in rows if r["knob"] == knob and r["reference"] == "1"]
         assert len(refs) == 1 and float(refs[0]["rmse"]) == 0.0 and refs[0]["psnr_db"] == "inf"
@@ -180,8 +180,8 @@ def test_depth_knob_counts_z_fighting_pixels(quick_report: Path) -> None:
     for label in ("standard 24-bit, lift 0.005, near 0.1", "standard 24-bit, lift 0.005, polygon offset",
                   "reverse-Z float, lift 0.005, no offset"):
         assert rows[label]["count_px"] == "0", label
-    others = [r for r in _rows(quick_report) if r["knob"] not in ("depth", "shadow_map")]
-    assert all(r["count_px"] == "" for r in others)  # only the depth and shadow-map knobs count pixels
+    others = [r for r in _rows(quick_report) if r["knob"] not in ("depth", "shadow_map", "shadow_offset")]
+    assert all(r["count_px"] == "" for r in others)  # only the depth, shadow-map and shadow-offset knobs count
     report = (quick_report / "report.md").read_text(encoding="utf-8")
     assert "## Depth precision (`depth`)" in report
     fights = int(rows["standard 24-bit, lift 0, no offset"]["count_px"])
@@ -379,7 +379,7 @@ def test_model_cases_cover_every_size_mode_and_engine(monkeypatch) -> None:
 
     module = _models_module()
     monkeypatch.setattr(module, "embree_available", lambda: True)
-    monkeypatch.setattr(module, "_bunny_path", lambda: None)
+    monkeypatch.setattr(module, "bunny_path", lambda: None)
     found = module.cases(BenchEnv())  # nothing is built until a case runs
     assert found[0].name == "BVH build, 1,000,000 tris"
     assert [c.name for c in found[1:5]] == ["1,000 tris, primary, numpy", "1,000 tris, primary, gpu",

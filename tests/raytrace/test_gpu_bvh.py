@@ -194,9 +194,11 @@ def test_an_empty_bvh_is_missed_and_float32_boxes_contain_the_float64_ones(ctx) 
 
 
 def test_bvh_glsl_also_compiles_into_a_glsl_330_shader(ctx, tmp_path: Path) -> None:
-    # The ray tracer's fragment shader is #version 330: no doubles, no `precise`.
+    # A #version 330 shader has no doubles and no `precise`: bvh.glsl (and the
+    # watertight test it includes) must still compile there.
     (tmp_path / "common").mkdir()
     shutil.copy(shader_root() / "common" / "bvh.glsl", tmp_path / "common" / "bvh.glsl")
+    shutil.copy(shader_root() / "common" / "watertight.glsl", tmp_path / "common" / "watertight.glsl")
     shutil.copy(shader_root() / "common" / "fullscreen_vertex.glsl", tmp_path / "common" / "fullscreen_vertex.glsl")
     (tmp_path / "probe330.glsl").write_text(
         "#version 330 core\n#if defined(VERTEX_SHADER)\n#include \"common/fullscreen_vertex.glsl\"\n"

@@ -1,0 +1,36 @@
+"""Progress with a time left for long commands, on stderr, drawn only for a person.
+
+``tour``, ``tradeoffs``, ``bench``, ``compare`` and ``check DIR`` run for
+seconds to minutes. :func:`progress` is a tqdm bar (steps done, rate and the
+estimated time left) that draws only when stderr is a terminal: piped into a
+file or read by a test, stderr holds just the command's own lines, as before.
+:func:`say` prints such a line above a bar without breaking it.
+
+Use::
+
+    with progress(len(items), "check", unit="submission") as bar:
+        for item in items:
+            say(f"{item}: ok")
+            bar.update(1)
+"""
+
+from __future__ import annotations
+
+import sys
+from typing import TextIO
+
+from tqdm import tqdm
+
+__all__ = ["progress", "say"]
+
+
+def progress(total: int, what: str, unit: str = "step", file: TextIO | None = None) -> tqdm:
+    """A bar for ``total`` steps of ``what`` on ``file`` (stderr); nothing at all unless it is a terminal."""
+    return tqdm(total=total, desc=what, unit=f" {unit}", file=file or sys.stderr, disable=None, leave=False,
+                dynamic_ncols=True, mininterval=0.25, smoothing=0.1)
+
+
+def say(text: str, file: TextIO | None = None) -> None:
+    """One line on ``file`` (stderr), above any bar there (which is drawn again below it)."""
+    tqdm.write(text, file=file or sys.stderr)
+    (file or sys.stderr).flush()
