@@ -10,9 +10,12 @@ when the context has nothing a fork cannot copy:
   child, which then waits for them forever. ``LP_NUM_THREADS=0`` makes
   llvmpipe draw on the calling thread (a 320x240 picture is cheap that way)
   and gives the same pixels;
-- no device: a hardware driver maps GPU memory that a fork would share
-  between submissions, and holds the device's descriptor. Only a software
-  rasterizer (llvmpipe, softpipe) that opened no descriptor qualifies;
+- no device and no shared memory: a hardware driver maps GPU memory that a
+  fork would share between submissions, and holds the device's descriptor.
+  Only a software rasterizer (llvmpipe, softpipe) that opened no descriptor
+  and mapped nothing writable and shared qualifies (Mesa's shader-cache
+  index aside: every process that opens a context maps that file alike,
+  cold renderers too, and an entry it points to is checked when read);
 - Mesa's shader-cache thread (``disk$``) holding no lock at the moment of
   the fork: :func:`quiet` waits until it sleeps on its queue.
 
@@ -62,6 +65,23 @@ def _descriptors() -> set[str]:
             found.add(os.readlink(f"/proc/self/fd/{fd}"))
         except OSError:  # the descriptor listdir itself used
             pass
+    return found
+
+
+def _shared_writable() -> set[str]:
+    """The file mappings this process could write and another process sees (``rw-s``), but
+    Mesa's shader cache's (its index, which every process that opens a context maps alike)."""
+    from glsandbox.measure.sandbox import shader_cache_dirs
+
+    caches = shader_cache_dirs()
+    found = set()
+    with open("/proc/self/maps") as handle:
+        for line in handle:
+            fields = line.split(maxsplit=5)
+            if fields[1][1] == "w" and fields[1][3] == "s":
+                path = fields[5].strip() if len(fields) > 5 else "[anonymous]"
+                if not any(path.startswith(cache + os.sep) for cache in caches):
+                    found.add(path)
     return found
 
 
@@ -120,13 +140,13 @@ def open_template(backend: str | None, sizes: Iterable[tuple[int, int]]):
     driver, a descriptor or a thread a fork cannot copy). Call only in a process that exists to be
     the template: a context that fails the checks stays open in it."""
     os.environ["LP_NUM_THREADS"] = "0"  # llvmpipe: no rasterizer threads (read when the context opens)
-    threads, descriptors = set(_threads()), _descriptors()
+    threads, descriptors, shared = set(_threads()), _descriptors(), _shared_writable()
     try:
         from glsandbox.frame import HeadlessRenderer
 
         renderer = HeadlessRenderer(backend)
         name = str(renderer.host.ctx.info.get("GL_RENDERER", ""))
-        if not name.startswith(SOFTWARE) or _descriptors() != descriptors:
+        if not name.startswith(SOFTWARE) or _descriptors() != descriptors or _shared_writable() != shared:
             return None
         if not _warm_up(renderer, sizes):
             return None
