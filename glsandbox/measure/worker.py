@@ -410,8 +410,12 @@ def _template_for(job: Job, templates: dict, channel, fds: list[int]) -> object 
     except OSError:
         ready = False
     ours.settimeout(None)
-    if not ready:
+    if not ready:  # unsafe, or no answer in time: it goes, and this backend's renderers start cold
         ours.close()
+        try:
+            os.kill(pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
     templates[job.backend] = ours if ready else None
     return templates[job.backend]
 
