@@ -4,14 +4,17 @@ The process tree of one grading run::
 
     grader (never opens a GL context; reads the reference, compares, writes every report)
      └─ zygote (imported glsandbox, numpy and moderngl once; forks on the grader's word)
+         ├─ warm template, one per backend where safe (:mod:`glsandbox.measure.warm`):
+         │   a single-threaded software context drawn with once; forks the supervisors
          └─ supervisor, one per submission (own session; a "child subreaper": every process
             │  the submission leaves behind is re-parented to it, and it kills them all)
             └─ renderer (own session; stdin /dev/null, stdout and stderr into a file;
                address-space, CPU-time and file-size limits; working folder a private
                copy of the submission; confined by :mod:`glsandbox.measure.sandbox`)
 
-The renderer opens its GL context (a fork of a process that had opened one
-would deadlock on llvmpipe's threads, so nothing above it ever does), then
+The renderer opens its GL context, or uses its copy of the warm template's
+(a fork of a process with llvmpipe's rasterizer threads would deadlock on
+them, so only a template without them, checked, is forked from), then
 loads the submission and renders each requested picture, writing each as a
 framed message on a pipe: raw RGBA pixels, or an error line. It knows no
 reference. The supervisor reads the pipe against the clock, kills the

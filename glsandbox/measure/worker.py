@@ -24,6 +24,7 @@ import numpy as np
 from glsandbox.measure.isolate import (BROKEN, CRASHED, OOM, TAIL_LINES, TAIL_WIDTH, TIMEOUT, Job, Picture, Reader,
                                        job_from, send)
 from glsandbox.measure.processes import kill_tree, killpg, set_subreaper, wait_briefly
+from glsandbox.measure.warm import quiet
 
 __all__ = ["PRELOAD", "zygote_main"]
 
@@ -84,8 +85,8 @@ def _renderer(job: Job, root: str, target: str, work: str, out: int) -> None:
     _limit(job)
     code = 0
     try:
-        try:
-            renderer = HeadlessRenderer(job.backend)
+        try:  # forked from a warm template: its context, copied (see glsandbox.measure.warm)
+            renderer = _template if _template is not None else HeadlessRenderer(job.backend)
         except SandboxError as exc:
             send(out, {"kind": "nogl", "error": str(exc)})
             return
@@ -245,7 +246,7 @@ def _supervise(job: Job, out: int) -> None:
             root, target = str(Path(job.source).parent), job.target
         read_end, write_end = os.pipe()
         pid = os.fork()
-        if pid == 0:  # the renderer: no GL context exists in this process yet, so forking is safe
+        if pid == 0:  # the renderer: no GL context here, or the warm template's, checked safe to fork
             os.close(read_end)
             _renderer(job, root, target, work, write_end)
         os.close(write_end)
@@ -321,7 +322,9 @@ def zygote_main(channel_fd: int) -> None:
 
 def zygote(channel_fd: int) -> None:
     """Serve the grader on ``channel_fd`` (one end of a socket pair): each message is a job and
-    the pipe its result goes to; fork a supervisor for it. Ends when the grader closes its end.
+    the pipe its result goes to; fork a supervisor for it, or hand the job to the warm template
+    of its backend (:func:`_template_for`), which forks it from a context already drawn with.
+    Ends when the grader closes its end.
 
     A socket pair has no name in the file system, so no submission can find it
     and ask for a process (multiprocessing's forkserver listens on a named socket).
@@ -331,6 +334,7 @@ def zygote(channel_fd: int) -> None:
     channel = socket.socket(fileno=channel_fd)
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the grader decides when a run stops
     signal.signal(signal.SIGCHLD, signal.SIG_IGN)  # supervisors are reaped by the kernel
+    templates: dict[str | None, socket.socket | None] = {}
     while True:
         size_bytes = _recv_exact(channel, 4)
         if size_bytes is None:
@@ -340,18 +344,84 @@ def zygote(channel_fd: int) -> None:
         data = first + (_recv_exact(channel, size - len(first)) or b"")
         if not fds:
             continue
+        job = job_from(json.loads(data))
+        if _template is None and not job.writes_cache:  # the model answer's renderer fills Mesa's cache: cold
+            warm = _template_for(job, templates, channel, fds)
+            if warm is not None:
+                try:
+                    warm.sendall(size_bytes)
+                    socket.send_fds(warm, [data], fds)
+                    os.close(fds[0])
+                    continue
+                except OSError:  # the template is gone: cold forks for this backend from now on
+                    templates[job.backend] = None
+        if _template is not None:
+            quiet()  # Mesa's cache thread holds no lock the copy could need
         pid = os.fork()
         if pid == 0:
             signal.signal(signal.SIGCHLD, signal.SIG_DFL)  # the supervisor waits for its renderer
             channel.close()
+            for other in templates.values():
+                if other is not None:
+                    other.close()
             code = 0
             try:
-                _supervise(job_from(json.loads(data)), fds[0])
+                _supervise(job, fds[0])
             except BaseException:  # noqa: BLE001 - the grader sees the pipe close without a result
                 code = 1
             os._exit(code)
         os.close(fds[0])
     os._exit(0)
+
+
+def _template_for(job: Job, templates: dict, channel, fds: list[int]) -> object | None:
+    """The zygote's end of the warm template for ``job.backend``, started on first use (a forked
+    child that opens and warms a context, says whether it is safe to fork, then serves as a
+    zygote); None where it is not (:func:`glsandbox.measure.warm.open_template`)."""
+    import socket
+
+    if job.backend in templates:
+        return templates[job.backend]
+    ours, theirs = socket.socketpair()
+    pid = os.fork()
+    if pid == 0:
+        global _template
+        ours.close()
+        channel.close()
+        for fd in fds:  # this job's result pipe: the template passes it on, it never keeps it
+            os.close(fd)
+        for other in templates.values():
+            if other is not None:
+                other.close()
+        from glsandbox.measure.warm import open_template
+
+        _template = open_template(job.backend, {r.size for r in job.renders})
+        try:
+            theirs.sendall(b"1" if _template is not None else b"0")
+            if _template is not None:
+                zygote(theirs.detach())
+        except BaseException:  # noqa: BLE001 - the zygote sees the socket close
+            pass
+        os._exit(0)
+    theirs.close()
+    ours.settimeout(30)
+    try:
+        ready = ours.recv(1) == b"1"
+    except OSError:
+        ready = False
+    ours.settimeout(None)
+    if not ready:  # unsafe, or no answer in time: it goes, and this backend's renderers start cold
+        ours.close()
+        try:
+            os.kill(pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+    templates[job.backend] = ours if ready else None
+    return templates[job.backend]
+
+
+#: In the warm template and the renderers forked from it: the renderer on its warmed context.
+_template = None
 
 
 def _recv_exact(channel, size: int) -> bytes | None:
