@@ -14,10 +14,11 @@ from __future__ import annotations
 
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
-_TMP = tempfile.TemporaryDirectory(prefix="glsandbox-bench-grading-")
+from _scratch import scratch_folder
+
+_TMP = scratch_folder("glsandbox-bench-grading-")
 SIZE = "320x240"
 SCENE = """name = "cube"
 [camera]
@@ -50,7 +51,7 @@ def cases(env) -> list:
     from glsandbox.measure.bench import Case, Side, run_process
 
     count = 20 if env.quick else 100
-    folder = Path(_TMP.name) / "class"
+    folder = _TMP / "class"
     ref = make_class(folder, count)
     baseline = Side("in one process", run_process([sys.executable, "-c", IN_PROCESS, str(folder), str(ref)]))
 

@@ -36,10 +36,11 @@ import itertools
 import json
 import subprocess
 import sys
-import tempfile
 from collections.abc import Sequence
 from functools import cache
 from pathlib import Path
+
+from _scratch import scratch_folder
 from typing import Any
 
 import numpy as np
@@ -51,7 +52,7 @@ LOAD_GOAL = 3.0
 BUILD_GOAL = 2.0
 BYTES_GOAL = 250
 FAN_TRIANGLES = 1_000_000
-_TMP = tempfile.TemporaryDirectory(prefix="glsandbox-models-")
+_TMP = scratch_folder("glsandbox-models-")
 _ANGLES = itertools.count()
 
 
@@ -60,7 +61,7 @@ def big_bunny() -> Path:
     """The recipe for the 1.27M-triangle model: the bunny subdivided by pymeshlab, binary PLY, no normals."""
     import pymeshlab
 
-    path = Path(_TMP.name) / "bunny_subdivided.ply"
+    path = _TMP / "bunny_subdivided.ply"
     meshes = pymeshlab.MeshSet()
     meshes.load_new_mesh(str(bunny_path()))
     meshes.meshing_surface_subdivision_midpoint(iterations=3, threshold=pymeshlab.PercentageValue(0.175))
@@ -75,7 +76,7 @@ def fan() -> Path:
     """:data:`FAN_TRIANGLES` slivers around one vertex, three quarters of a disc, binary PLY."""
     import trimesh
 
-    path = Path(_TMP.name) / "fan.ply"
+    path = _TMP / "fan.ply"
     angle = np.linspace(0.0, 1.5 * np.pi, FAN_TRIANGLES + 1)
     rim = np.c_[np.cos(angle), np.sin(angle), np.zeros(FAN_TRIANGLES + 1)]
     faces = np.c_[np.zeros(FAN_TRIANGLES, dtype=np.int64), np.arange(1, FAN_TRIANGLES + 1),

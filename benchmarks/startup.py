@@ -9,16 +9,17 @@ its time is printed on its own.
 from __future__ import annotations
 
 import sys
-import tempfile
 from pathlib import Path
 
-_TMP = tempfile.TemporaryDirectory(prefix="glsandbox-bench-")
+from _scratch import scratch_folder
+
+_TMP = scratch_folder("glsandbox-bench-")
 
 
 def cases(env) -> list:
     from glsandbox.measure.bench import Case, Side, run_process
 
-    tmp = Path(_TMP.name)
+    tmp = _TMP
     here = Path(__file__).resolve().parent
     ours = [sys.executable, "-m", "glsandbox.cli", "render", "indexed_cube", "--size", "800x600",
             "--backend", "egl", "--out", str(tmp / "ours.png")]
