@@ -11,7 +11,7 @@ import pytest
 
 from glsandbox.errors import SandboxError
 from glsandbox.meshfile import load_model
-from support import assert_user_error, run_cli
+from support import assert_user_error, need, run_cli
 
 PLY_HEAD = ("ply\nformat ascii 1.0\ncomment made by hand\nelement vertex 3\nproperty float x\nproperty float y\n"
             "property float z\nelement face {faces}\nproperty list uchar int vertex_indices\nend_header\n")
@@ -83,6 +83,6 @@ def test_a_file_whose_name_is_not_utf8_loads(tmp_path: Path) -> None:
     try:
         path.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
     except (OSError, UnicodeError):
-        pytest.skip("this file system does not take file names that are not UTF-8")
+        need("a file system that takes file names that are not UTF-8", str(tmp_path))
     model = load_model(path)
     assert model.triangles == 1 and model.mesh.vertex_count == 3
