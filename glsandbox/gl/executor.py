@@ -381,16 +381,22 @@ class Executor:
         self._clear_depth = gl_depth.clear_depth_value(scene)
         framebuffer.use()
         gl_depth.begin_depth_mode(self.ctx, self.raw, scene)
-        for step in frame_plan.passes:
-            runner = PASS_RUNNERS.get(step.kind)
-            if runner is None:
-                raise SandboxError(f"pass kind {step.kind!r} has no runner (gl.executor.PASS_RUNNERS)")
-            try:
-                runner(self, frame, step, self._frame_camera(frame, step))
-            finally:  # every pass starts from the same state, whatever the last one set
-                gl_passes.restore_state(self.ctx, self.raw)
-        gl_depth.end_depth_mode(self.ctx, self.raw, scene)
-        self._unbind_texture()
+        try:
+            for step in frame_plan.passes:
+                runner = PASS_RUNNERS.get(step.kind)
+                if runner is None:
+                    raise SandboxError(f"pass kind {step.kind!r} has no runner (gl.executor.PASS_RUNNERS)")
+                try:
+                    runner(self, frame, step, self._frame_camera(frame, step))
+                finally:  # every pass starts from the same state, whatever the last one set
+                    gl_passes.restore_state(self.ctx, self.raw)
+        finally:
+            # Also when a pass raised (a texture file that cannot be read, say): a sampler
+            # object left on unit 0 overrides the state of every texture later bound there,
+            # and a mipmapped filter makes the gpu ray engine's data textures incomplete
+            # (texelFetch then reads zeros) on a context the next user shares.
+            gl_depth.end_depth_mode(self.ctx, self.raw, scene)
+            self._unbind_texture()
         framebuffer.viewport = (0, 0, *size)
         self._set_depth(False)
         self.ctx.disable(moderngl.CULL_FACE)
