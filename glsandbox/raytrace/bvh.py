@@ -225,7 +225,7 @@ def _build_bvh(v0: ArrayLike, v1: ArrayLike, v2: ArrayLike, *, leaf_size: int = 
     rows[3:6] = hi.T
     tree = _Tree(keep.size)
     small = _split_levels(rows, tree, int(leaf_size), int(bins))
-    _split_small(rows, tree, small, int(leaf_size))
+    _split_small(tree, small, int(leaf_size))
     first, count = tree.arrays()
     # The triangles leaf after leaf: a leaf's first slot plus the place within it.
     leaves = np.flatnonzero(count)
@@ -282,14 +282,16 @@ class _Tree:
 
 
 def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bins: int
-                  ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
+                  ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.int64],
+                             NDArray[np.float32]]:
     """The breadth-first binned-SAH splitting of the nodes of more than :data:`SMALL` triangles
     (see the module docstring).
 
     ``rows`` is ``(6, K)``: box min and box max of each triangle (left as it is).
     Records the nodes in ``tree``; returns the nodes of at most :data:`SMALL`
     triangles still to split (:func:`_split_small`): their triangles (grouped
-    by node), their ids, triangle counts and depths.
+    by node), their ids, triangle counts and depths, and the triangles' boxes
+    (``(6, …)``, in the same order).
 
     The triangles still to split are kept grouped by node (``cols`` columns
     in node order, ``counts`` per node), so per-node values reach their
@@ -301,11 +303,12 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
     small = max(SMALL, leaf_size)
     none = np.zeros(0, dtype=np.int64)
     if k <= leaf_size:
-        return none, none, none, none
+        return none, none, none, none, rows[:, :0]
     if k <= small:
         tree.counts[0][0] = 0
-        return np.arange(k), np.zeros(1, dtype=np.int64), np.array([k], dtype=np.int64), np.ones(1, dtype=np.int64)
-    small_tris, small_ids, small_counts, small_depth = [], [], [], []
+        return (np.arange(k), np.zeros(1, dtype=np.int64), np.array([k], dtype=np.int64), np.ones(1, dtype=np.int64),
+                rows)
+    small_tris, small_ids, small_counts, small_depth, small_boxes = [], [], [], [], []
     tris = np.arange(k)  # the caller's triangle of each column
     cols = rows.copy()  # the open triangles' boxes, grouped by node
     # Two flat buffers the columns are moved between, level after level: a fresh 24 bytes per
@@ -368,8 +371,10 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         # 2·SAMPLE triangles use them all.
         stride = np.maximum(1, counts // SAMPLE)
         if stride.max() > 1:
-            rank = np.arange(width) - np.repeat(starts, counts)
-            sample = np.flatnonzero(rank % np.repeat(stride, counts) == 0)
+            # Node i's sampled columns: starts[i] + stride[i]·q for q = 0 .. ceil(counts[i] / stride[i]) − 1.
+            taken = -(-counts // stride)
+            q = np.arange(taken.sum()) - np.repeat(np.cumsum(taken) - taken, taken)
+            sample = np.repeat(starts, taken) + q * np.repeat(stride, taken)
             box_rows = np.take(cols, sample, axis=1)
             box_key, box_bins = node_key[sample], np.take(bin_of, sample, axis=1)
         else:
@@ -487,11 +492,12 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
             small_counts.append(child_count[smalls])
             small_depth.append(np.full(smalls.size, level, dtype=np.int64))
             tri_small = np.flatnonzero(is_small[child])
-            grouped = np.empty(tri_small.size, dtype=np.int64)
+            grouped = np.empty(tri_small.size, dtype=np.int64)  # their columns, node after node
             small_start = np.zeros(2 * n, dtype=np.int64)
             small_start[smalls] = np.cumsum(child_count[smalls]) - child_count[smalls]
-            grouped[small_start[child[tri_small]] + rank[tri_small]] = tris[tri_small]
-            small_tris.append(grouped)
+            grouped[small_start[child[tri_small]] + rank[tri_small]] = tri_small
+            small_tris.append(tris[grouped])
+            small_boxes.append(np.take(cols, grouped, axis=1))
         # Partition the open columns into the children that stay open (a
         # stable counting sort, no argsort).
         kept_children = np.flatnonzero(~done)
@@ -514,9 +520,9 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         box_lo = child_lo.reshape(2 * n, 3)[kept_children]
         box_hi = child_hi.reshape(2 * n, 3)[kept_children]
     if not small_ids:
-        return none, none, none, none
+        return none, none, none, none, rows[:, :0]
     return (np.concatenate(small_tris), np.concatenate(small_ids), np.concatenate(small_counts),
-            np.concatenate(small_depth))
+            np.concatenate(small_depth), np.concatenate(small_boxes, axis=1))
 
 
 def _box_half_area(box: NDArray[np.float32]) -> NDArray[np.float32]:
@@ -530,9 +536,8 @@ def _box_half_area(box: NDArray[np.float32]) -> NDArray[np.float32]:
     return result
 
 
-def _split_small(rows: NDArray[np.float32], tree: _Tree,
-                 small: tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]],
-                 leaf_size: int) -> None:
+def _split_small(tree: _Tree, small: tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64],
+                                           NDArray[np.int64], NDArray[np.float32]], leaf_size: int) -> None:
     """Split the nodes of at most :data:`SMALL` triangles down to leaves by the *full* SAH sweep.
 
     Binning pays off on big nodes; on a node of a few dozen triangles the
@@ -544,14 +549,16 @@ def _split_small(rows: NDArray[np.float32], tree: _Tree,
     padded to a power of two ``w`` (nodes of similar size together), so each
     step of the running boxes is one numpy call over all the nodes.
     """
-    tris, ids, counts, depths = small
+    caller, ids, counts, depths, boxes = small
     if ids.size == 0:
         return
-    # (6, K) float32: min x, y, z and minus max x, y, z of each triangle: running boxes are then
-    # running minima only.
-    table = np.empty_like(rows)
-    table[0:3] = rows[0:3]
-    np.negative(rows[3:6], out=table[3:6])
+    # (6, K + 1) float32: min x, y, z and minus max x, y, z of each triangle (running boxes are then
+    # running minima only), and last an empty box (all inf) that pads the nodes' columns.
+    tris = np.arange(caller.size)  # indices into table, node after node
+    table = np.empty((6, caller.size + 1), dtype=np.float32)
+    table[0:3, :-1] = boxes[0:3]
+    np.negative(boxes[3:6], out=table[3:6, :-1])
+    table[:, -1] = np.inf
     while ids.size:
         starts = np.cumsum(counts) - counts
         width_class = np.left_shift(1, np.ceil(np.log2(counts)).astype(np.int64))
@@ -577,8 +584,8 @@ def _split_small(rows: NDArray[np.float32], tree: _Tree,
         child = np.repeat(np.arange(child_count.size), child_count)
         rank = np.arange(tris.size) - np.repeat(np.cumsum(child_count) - child_count, child_count)
         tri_leaf = is_leaf[child]
-        tree.leaf_of[tris[tri_leaf]] = child_ids[child[tri_leaf]]
-        tree.leaf_rank[tris[tri_leaf]] = rank[tri_leaf]
+        tree.leaf_of[caller[tris[tri_leaf]]] = child_ids[child[tri_leaf]]
+        tree.leaf_rank[caller[tris[tri_leaf]]] = rank[tri_leaf]
         tris = tris[~tri_leaf]
         ids = child_ids[~is_leaf]
         counts = child_count[~is_leaf]
@@ -593,11 +600,10 @@ def _small_cuts(table: NDArray[np.float32], tris: NDArray[np.int64], starts: NDA
     r = counts.size
     slot = np.arange(w)[:, None]
     valid = slot < counts  # (w, r): slot i of node j holds a triangle
-    tri = tris[np.where(valid, starts + slot, starts)]  # (w, r); padding repeats the node's first
-    boxes = np.take(table, tri, axis=1)  # (6, w, r)
-    centre = boxes[0:3] - boxes[3:6]  # twice the centroid, (3, w, r)
-    centre[:, ~valid] = np.inf  # padding sorts last
-    boxes[:, ~valid] = np.inf  # an empty box: no effect on running minima
+    tri = np.where(valid, tris[np.minimum(starts + slot, tris.size - 1)], table.shape[1] - 1)  # (w, r)
+    boxes = np.take(table, tri, axis=1)  # (6, w, r); padding: the empty box, no effect on running minima
+    with np.errstate(invalid="ignore"):
+        centre = boxes[0:3] - boxes[3:6]  # twice the centroid, (3, w, r); padding: NaN, which sorts last
     flat = boxes.reshape(6, w * r)
     cuts = np.arange(1, w, dtype=np.float32)[:, None]  # cut i: sorted triangles [0, i) go left
     no_cut = cuts >= counts  # (w − 1, r)
