@@ -602,8 +602,15 @@ def _small_cuts(table: NDArray[np.float32], tris: NDArray[np.int64], starts: NDA
     valid = slot < counts  # (w, r): slot i of node j holds a triangle
     tri = np.where(valid, tris[np.minimum(starts + slot, tris.size - 1)], table.shape[1] - 1)  # (w, r)
     boxes = np.take(table, tri, axis=1)  # (6, w, r); padding: the empty box, no effect on running minima
+    # Sort keys: twice the centroid, its float32 bits made an int32 of the same order (a negative
+    # float's magnitude bits flipped), then the slot in the low bits: np.sort of int64 keys is
+    # several times faster than np.argsort of floats, and the slot is read back from the key.
     with np.errstate(invalid="ignore"):
-        centre = boxes[0:3] - boxes[3:6]  # twice the centroid, (3, w, r); padding: NaN, which sorts last
+        centre = boxes[0:3] - boxes[3:6]  # (3, w, r); padding: NaN
+    bits = centre.view(np.int32)
+    bits ^= (bits >> 31) & np.int32(0x7FFFFFFF)
+    bits[:, ~valid] = np.iinfo(np.int32).max  # padding sorts last
+    shift = int(w - 1).bit_length()
     flat = boxes.reshape(6, w * r)
     cuts = np.arange(1, w, dtype=np.float32)[:, None]  # cut i: sorted triangles [0, i) go left
     no_cut = cuts >= counts  # (w − 1, r)
@@ -616,7 +623,11 @@ def _small_cuts(table: NDArray[np.float32], tris: NDArray[np.int64], starts: NDA
     size = counts.astype(np.float32)
     parent = None
     for axis in range(3):
-        order = np.argsort(centre[axis].T, axis=1)  # (r, w): node j's slots by centroid
+        keys = bits[axis].T.astype(np.int64)  # (r, w)
+        keys <<= shift
+        keys |= slot.T
+        keys.sort(axis=1)
+        order = keys & (w - 1)  # (r, w): node j's slots by centroid
         orders.append(order)
         sweep = np.take(flat, order.T * r + columns, axis=1)  # (6, w, r): the boxes in that order
         back = sweep.copy()
