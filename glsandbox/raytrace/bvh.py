@@ -567,7 +567,7 @@ def _split_small(tree: _Tree, small: tuple[NDArray[np.int64], NDArray[np.int64],
             members = np.flatnonzero(width_class == w)
             for part in range(0, members.size, max(1, SMALL_CHUNK // int(w))):
                 sel = members[part:part + max(1, SMALL_CHUNK // int(w))]
-                sorted_tris, cut = _small_cuts(table, tris, starts[sel], counts[sel], int(w))
+                sorted_tris, cut = _small_cuts(table, tris, starts[sel], counts[sel], int(w), leaf_size)
                 out_tris.append(sorted_tris)
                 out_cuts.append(cut)
                 order_nodes.append(sel)
@@ -593,7 +593,7 @@ def _split_small(tree: _Tree, small: tuple[NDArray[np.int64], NDArray[np.int64],
 
 
 def _small_cuts(table: NDArray[np.float32], tris: NDArray[np.int64], starts: NDArray[np.int64],
-                counts: NDArray[np.int64], w: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+                counts: NDArray[np.int64], w: int, leaf_size: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """The best cut of each of ``r`` nodes (triangles ``tris[starts[j] : starts[j] + counts[j]]``,
     at most ``w`` each): their triangles in the chosen order (left child first, node after node)
     and the left child's triangle count."""
@@ -619,7 +619,9 @@ def _small_cuts(table: NDArray[np.float32], tris: NDArray[np.int64], starts: NDA
     costs = np.empty((3, r), dtype=np.float32)
     best = np.empty((3, r), dtype=np.int64)
     middle = np.empty((3, r), dtype=np.float32)
-    half = counts // 2
+    # The even cut of a node with no SAH gain: a multiple of leaf_size near the middle, so that its
+    # subtree ends in full leaves (ceil(N / leaf_size) of them, the fewest boxes).
+    half = np.clip(leaf_size * np.rint(counts / (2 * leaf_size)).astype(np.int64), 1, counts - 1)
     size = counts.astype(np.float32)
     parent = None
     for axis in range(3):
