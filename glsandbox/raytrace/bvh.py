@@ -344,15 +344,18 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         box_hi = np.where(bunched, centre_hi, box_hi)
         extent = box_hi - box_lo
         scale = np.where(extent > 0.0, bins * (1.0 - 1e-6) / np.where(extent > 0.0, extent, 1.0), 0.0)
-        bin_of = np.empty((3, width), dtype=np.int32)
+        # Each column's bin on each axis, as a key node-major over the level: node i's bins are
+        # i·B .. i·B + B − 1.
+        node_key = np.repeat(np.arange(n, dtype=np.int64) * bins, counts)
+        bin_key = np.empty((3, width), dtype=np.int64)
         rel = np.empty(width, dtype=np.float32)
         for axis in range(3):  # one row at a time: np.repeat of a 1-D array is a plain copy loop
             np.subtract(cen[axis], np.repeat(box_lo[:, axis].astype(np.float32), counts), out=rel)
             rel *= np.repeat(scale[:, axis].astype(np.float32), counts)
             np.clip(rel, 0, bins - 1, out=rel)
-            bin_of[axis] = rel
+            bin_key[axis] = rel
+            bin_key[axis] += node_key
         del rel
-        node_key = np.repeat(np.arange(n, dtype=np.int64) * bins, counts)
         best_cost = np.full(n, np.inf)
         best_axis = np.zeros(n, dtype=np.int64)
         best_cut = np.ones(n, dtype=np.int64)
@@ -376,16 +379,15 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
             q = np.arange(taken.sum()) - np.repeat(np.cumsum(taken) - taken, taken)
             sample = np.repeat(starts, taken) + q * np.repeat(stride, taken)
             box_rows = np.take(cols, sample, axis=1)
-            box_key, box_bins = node_key[sample], np.take(bin_of, sample, axis=1)
+            box_keys = np.take(bin_key, sample, axis=1)
         else:
-            box_rows, box_key, box_bins = cols, node_key, bin_of
+            box_rows, box_keys = cols, bin_key
         node_lo = node_hi = None
         for axis in range(3):
-            key = node_key + bin_of[axis]  # node-major: node i's bins are i·B .. i·B + B − 1
-            cnt = np.bincount(key, minlength=n * bins).reshape(n, bins)
+            cnt = np.bincount(bin_key[axis], minlength=n * bins).reshape(n, bins)
             blo = np.full((3, n * bins), np.inf, dtype=np.float32)
             bhi = np.full((3, n * bins), -np.inf, dtype=np.float32)
-            key = box_key + box_bins[axis]
+            key = box_keys[axis]
             for j in range(3):
                 np.minimum.at(blo[j], key, box_rows[j])
                 np.maximum.at(bhi[j], key, box_rows[3 + j])
@@ -445,8 +447,8 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
             child_hi = np.where(empty[:, :, None], box_hi[:, None, :], child_hi)
         # Each column's side (True: the right child) on its node's chosen axis.
         columns = np.arange(width)
-        chosen = np.take(bin_of.reshape(-1), np.repeat(best_axis * width, counts) + columns)
-        right = chosen >= np.repeat(best_cut, counts)
+        chosen = np.take(bin_key.reshape(-1), np.repeat(best_axis * width, counts) + columns)
+        right = chosen >= np.repeat(nodes * bins + best_cut, counts)
         del chosen
         stuck = np.flatnonzero(~np.isfinite(best_cost))
         if stuck.size:
