@@ -315,6 +315,7 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
     # triangle each level would be fresh pages for the kernel to zero and map each time.
     spare = np.empty(cols.size, dtype=np.float32)
     centre = np.empty((3, k), dtype=np.float32)
+    bin_keys = np.empty((3, k), dtype=np.int64)  # made once: fresh pages each level cost more than the casts
     counts = np.array([k], dtype=np.int64)  # columns per open node, in column order
     box_lo = rows[0:3].min(axis=1)[None, :].astype(np.float64)  # the open nodes' binning boxes
     box_hi = rows[3:6].max(axis=1)[None, :].astype(np.float64)
@@ -347,7 +348,7 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         # Each column's bin on each axis, as a key node-major over the level: node i's bins are
         # i·B .. i·B + B − 1.
         node_key = np.repeat(np.arange(n, dtype=np.int64) * bins, counts)
-        bin_key = np.empty((3, width), dtype=np.int64)
+        bin_key = bin_keys[:, :width]
         rel = np.empty(width, dtype=np.float32)
         for axis in range(3):  # one row at a time: np.repeat of a 1-D array is a plain copy loop
             np.subtract(cen[axis], np.repeat(box_lo[:, axis].astype(np.float32), counts), out=rel)
@@ -447,7 +448,7 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
             child_hi = np.where(empty[:, :, None], box_hi[:, None, :], child_hi)
         # Each column's side (True: the right child) on its node's chosen axis.
         columns = np.arange(width)
-        chosen = np.take(bin_key.reshape(-1), np.repeat(best_axis * width, counts) + columns)
+        chosen = np.take(bin_keys.reshape(-1), np.repeat(best_axis * k, counts) + columns)  # row stride: k
         right = chosen >= np.repeat(nodes * bins + best_cut, counts)
         del chosen
         stuck = np.flatnonzero(~np.isfinite(best_cost))
