@@ -33,6 +33,20 @@ triangles all fall into one bin (all centroids in one point) is cut in half
 by count. The boxes used for binning are the heuristic's; the stored node
 boxes are recomputed exactly from the triangles at the end, leaves first.
 
+Small nodes: the full sweep
+---------------------------
+Bins pay off on big nodes. On a node of a few dozen triangles sixteen bins
+per axis cost as much as the triangles and still see only sixteen cuts, so
+nodes of at most :data:`SMALL` triangles are finished differently
+(``_split_small``): along each axis the node's triangles are sorted by
+centroid and *every* cut between them is scored, the boxes of the first
+``i`` triangles and of the rest being running minima and maxima of the
+sorted boxes (the "full sweep" SAH, MacDonald & Booth's original). The small
+nodes lie one per column of a padded ``(width, nodes)`` array, so each step
+of the running boxes is one numpy call over all of them. Where no cut gains
+(slivers sharing one box), the cut is a multiple of ``leaf_size`` near the
+middle: the subtree then ends in full leaves, the fewest boxes.
+
 Layout (flat arrays, what :mod:`glsandbox.raytrace.gpu_bvh` uploads)
 ------------------------------------------------------------------
 Node ``i`` has the box ``node_min[i] .. node_max[i]`` (float64, exact: the
