@@ -18,6 +18,7 @@ import math
 import pkgutil
 import sys
 import types
+import weakref
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -26,7 +27,8 @@ from typing import Any, ClassVar, NoReturn
 from glsandbox.errors import NUMBER_LIMIT, SandboxError, plain
 from glsandbox.files import read_user_file
 from glsandbox.scene import RENDERERS
-from glsandbox.scene import PLAN_MODES, Camera, Scene, check_uniform_name, check_uniform_value
+from glsandbox.scene import (PLAN_MODES, Camera, Motion, Scene, check_uniform_name, check_uniform_value,
+                             moved_scene)
 from glsandbox.scene_file import load_scene
 
 #: The module name prefix of lesson files loaded from outside the package.
@@ -265,7 +267,50 @@ class Lesson:
         return moment
 
     def scene(self) -> Scene:
-        """The Scene for the current values (``renderer`` marks its viewports)."""
+        """The Scene for the current values (``renderer`` marks its viewports).
+
+        A lesson whose :meth:`motion` says what ``time`` moves builds its scene once per
+        set of its other values (kept in :data:`SCENES_KEPT` per lesson class) and per
+        frame only moves that (:func:`glsandbox.scene.moved_scene`): no dataclass is
+        made or checked again but the moved ones, and the renderers keep their plan."""
+        motion = self.motion()
+        if motion is None:
+            return self._scene_as_built()
+        key = self._still_key()
+        if key is None:  # a value that cannot be a key (an array given from Python): built every frame
+            return moved_scene(self._scene_as_built(), motion)
+        kept = _SCENES.setdefault(type(self), {})
+        scene = kept.pop(key, None)
+        if scene is None:
+            scene = self._scene_as_built()
+            if len(kept) >= SCENES_KEPT:
+                del kept[next(iter(kept))]  # the least recently used
+        kept[key] = scene  # the most recent last
+        return moved_scene(scene, motion)
+
+    def _still_key(self) -> tuple | None:
+        """Every value but ``time``, with its type (1, 1.0 and True stay apart), or None when one cannot be hashed."""
+        key = tuple((name, type(value), value) for name, value in sorted(self.values.items()) if name != "time")
+        try:
+            hash(key)
+        except TypeError:
+            return None
+        return key
+
+    def motion(self) -> Motion | None:
+        """What ``time`` moves in :meth:`build`'s scene, at :attr:`time`: the model matrices of
+        the nodes that move (by name) and the positions of the lights that move (by index).
+
+        None (the default): the scene is built again every frame. A lesson that returns a
+        :class:`~glsandbox.scene.Motion` promises that :meth:`build` depends on its
+        :attr:`values` alone, and that its scene at any time is the one built at another
+        time with this motion applied (a static lesson returns an empty ``Motion()``);
+        its frames then pay only for what moves (issue 24). ``tests/core/test_frame_cache.py``
+        checks every built-in lesson's promise, pixel for pixel, at several times."""
+        return None
+
+    def _scene_as_built(self) -> Scene:
+        """:meth:`build`'s scene with the shared parameters applied (renderer, camera, effects, ``u.*``)."""
         scene = built_scene(self)
         renderer = self.values.get("renderer", "raster")
         if renderer != "raster":  # traced by glsandbox.frame.trace_viewports
@@ -288,6 +333,11 @@ class Lesson:
         """Window key hook (glfw key name, e.g. ``"1"``); return True when handled."""
         return False
 
+
+#: Scenes kept per lesson class for :meth:`Lesson.scene` (one per set of values but ``time``):
+#: a window's live compare shows several variants of one lesson at once.
+SCENES_KEPT = 16
+_SCENES: weakref.WeakKeyDictionary[type[Lesson], dict[tuple, Scene]] = weakref.WeakKeyDictionary()  # a reloaded class goes
 
 #: The parameters every lesson has; a lesson's own may not reuse their names.
 SHARED_PARAMS = (TIME, RENDERER, EFFECTS_PARAM, CAMERA)
