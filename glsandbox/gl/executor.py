@@ -106,8 +106,15 @@ _UNIT_0 = struct.pack("i", 0)
 def _material_bytes(material: Material) -> tuple[tuple[str, bytes], ...]:
     """The coefficients of the course's ``0.1*mesh + 0.4*diffuse + 0.3*specular`` and the
     exponent (32) as uniform bytes; a zero coefficient switches its term off."""
-    return (("u_ambient", _float_bytes(material.ambient)), ("u_diffuse", _float_bytes(material.diffuse)),
-            ("u_specular", _float_bytes(material.specular)), ("u_shininess", _float_bytes(material.shininess)))
+    return _coefficient_bytes(material.ambient, material.diffuse, material.specular, material.shininess)
+
+
+@functools.lru_cache(maxsize=256)
+def _coefficient_bytes(ambient: float, diffuse: float, specular: float,
+                       shininess: float) -> tuple[tuple[str, bytes], ...]:
+    """:func:`_material_bytes` made once per set of coefficients (a scene has a few)."""
+    return (("u_ambient", _float_bytes(ambient)), ("u_diffuse", _float_bytes(diffuse)),
+            ("u_specular", _float_bytes(specular)), ("u_shininess", _float_bytes(shininess)))
 
 
 @functools.lru_cache(maxsize=64)
@@ -184,6 +191,21 @@ class _GpuMesh:
     count: int
 
 
+@dataclass
+class _DrawSetup:
+    """What :meth:`Executor.draw_node` needs for one mesh drawn with one program (see ``_draw_setup``)."""
+
+    source: Mesh  # the node's mesh (the key's object)
+    program: moderngl.Program
+    members: frozenset[str]
+    user: UserProgram | None
+    write: Callable[[str, bytes], None]
+    mesh_key: tuple[str, str]  # of the mesh as drawn
+    vao: moderngl.VertexArray
+    gpu: _GpuMesh
+    normal: bool  # the program reads m_normal
+
+
 class Executor:
     """Runs plans on one context, keeping programs and meshes between frames."""
 
@@ -192,6 +214,9 @@ class Executor:
     #: in a long-running window: past this many, the least recently drawn
     #: are released (never one the current frame draws).
     MESH_LIMIT = 256
+    #: Model matrices whose uniform bytes are kept (:meth:`_model_bytes`); the arrays are kept
+    #: with them (so an id is not reused while kept), all dropped at once past this many.
+    MODELS_KEPT = 1024
 
     def __init__(self, host: GLHost) -> None:
         self.host = host
@@ -208,6 +233,14 @@ class Executor:
         self._mesh_last_frame: dict[tuple[str, str], int] = {}
         self._frame = 0
         self._vaos: dict[tuple[tuple[str, str], str], moderngl.VertexArray] = {}
+        # What a draw of one mesh with one program needs, found once (see _draw_setup), by
+        # (program key, id of the mesh); emptied whenever a VAO or a program is released.
+        self._setups: dict[tuple[str, int], _DrawSetup] = {}
+        # Uniform bytes of model matrices, by id of the array (a node that does not move keeps its
+        # array between frames, so its matrix and normal matrix are converted once); see _model_bytes.
+        self._model_bytes_kept: dict[int, tuple[object, bytes, bytes | None]] = {}
+        # Pass cameras by the camera, the viewport's pixels and the depth mode (see _frame_camera).
+        self._cameras: dict[tuple[int, tuple[int, int, int, int], str], tuple[object, PassCamera]] = {}
         self._overlays: OverlayDrawer | None = None  # made on the first overlay pass
         self._textures = TextureCache(host)
         self._lights: tuple[Light, ...] = ()  # the lights of the frame being drawn (draw_node's default)
@@ -259,6 +292,7 @@ class Executor:
         for vao in self._vaos.values():
             vao.release()
         self._vaos.clear()
+        self._setups.clear()
         self._programs = fresh
         self._user = users
         self._member_names.clear()
@@ -338,6 +372,7 @@ class Executor:
             del self._mesh_last_frame[key]
             for vao_key in [k for k in self._vaos if k[0] == key]:
                 self._vaos.pop(vao_key).release()
+            self._setups.clear()
             for buffer in gpu.buffers.values():
                 buffer.release()
             if gpu.index is not None:
@@ -421,7 +456,15 @@ class Executor:
         aspect = rect[2] / rect[3] if rect[3] else 1.0
         frame.framebuffer.viewport = rect
         self._set_depth(step.depth_test)
-        return PassCamera(camera.view(), gl_depth.projection_for(scene, camera.projection(aspect)))
+        # A camera that does not change (a Camera is immutable) keeps its matrices and their bytes.
+        key = (id(camera), rect, scene.depth_mode)
+        kept = self._cameras.get(key)
+        if kept is None or kept[0] is not camera:
+            if len(self._cameras) >= 64:
+                self._cameras.clear()
+            kept = self._cameras[key] = (camera, PassCamera(camera.view(), gl_depth.projection_for(
+                scene, camera.projection(aspect))))
+        return kept[1]
 
     def _clear(self, frame: FrameState, step: Pass, camera: PassCamera | None) -> None:
         framebuffer = frame.framebuffer
@@ -460,20 +503,14 @@ class Executor:
         ``"cw"``, the reflected lights; a planar shadow: the flattening
         matrix and one flat colour).
         """
-        program = self._programs[draw.program][1]
-        members = self._members(draw.program)
-        user = self._user.get(draw.program)
+        setup = self._draw_setup(draw.program, node.mesh)
+        program, members, user, write = setup.program, setup.members, setup.user, setup.write
         own: dict[str, object] = {}
         if user is not None:  # a node's own shader: checked before anything is drawn with it
             own = self._check_user_draw(user, program, members, node)
             self._user_nodes.setdefault(draw.program, {})[node.name] = node
-        mesh = node.mesh
-        if mesh.normals is None and "in_normal" in members:
-            # A lit draw of a mesh without normals (the course's 8-vertex cube, a
-            # file without them) is shaded flat, one face normal per triangle: what
-            # the ray tracer does with such a mesh (geometry.with_face_normals).
-            mesh = with_face_normals(mesh)
-        vao, gpu = self._vao(mesh, draw.program)
+        self._mesh_last_frame[setup.mesh_key] = self._frame
+        vao, gpu = setup.vao, setup.gpu
         model = node.model if model is None else model
         material = node.material if material is None else material
         if draw.cull_back_faces:
@@ -482,13 +519,13 @@ class Executor:
             self.ctx.front_face = front_face
         else:
             self.ctx.disable(moderngl.CULL_FACE)
-        write = self._uniform_writer(draw.program, program, members)
-        write("m_model", transforms.gl_bytes(model))
+        model_bytes, normal_bytes = self._model_bytes(model, setup.normal)
+        write("m_model", model_bytes)
         write("m_view", camera.view_bytes)
         write("m_proj", camera.proj_bytes)
         write("u_color", _color_bytes(material.color))
-        if "m_normal" in members:
-            write("m_normal", _normal_matrix_bytes(np.asarray(model, dtype=np.float64).tobytes()))
+        if normal_bytes is not None:
+            write("m_normal", normal_bytes)
         if material.lit or user is not None:  # a node's own shader may light itself whatever the shading
             write("u_eye", camera.eye_bytes)
             frame_lights = self._lights if lights is None else lights
@@ -519,6 +556,39 @@ class Executor:
             self.ctx.disable(moderngl.BLEND)
             self.ctx.blend_func = moderngl.DEFAULT_BLENDING
 
+    def _draw_setup(self, program_key: str, mesh: Mesh) -> _DrawSetup:
+        """What every draw of ``mesh`` with the program ``program_key`` needs, found once: the
+        program, its member names, its uniform writer, the mesh as drawn (face normals for a
+        lit program and a mesh without normals: what the ray tracer does with such a mesh,
+        :func:`~glsandbox.geometry.with_face_normals`), its buffers and VAO."""
+        setup = self._setups.get((program_key, id(mesh)))
+        if setup is not None and setup.source is mesh:
+            return setup
+        program = self._programs[program_key][1]
+        members = self._members(program_key)
+        drawn = with_face_normals(mesh) if mesh.normals is None and "in_normal" in members else mesh
+        vao, gpu = self._vao(drawn, program_key)
+        if len(self._setups) >= self.MODELS_KEPT:  # new meshes every frame (a trail): start again
+            self._setups.clear()
+        setup = _DrawSetup(mesh, program, members, self._user.get(program_key),
+                           self._uniform_writer(program_key, program, members), _mesh_key(drawn), vao, gpu,
+                           "m_normal" in members)
+        self._setups[(program_key, id(mesh))] = setup
+        return setup
+
+    def _model_bytes(self, model: np.ndarray, normal: bool) -> tuple[bytes, bytes | None]:
+        """``m_model``'s uniform bytes and, with ``normal``, ``m_normal``'s (the inverse transpose,
+        :func:`~glsandbox.transforms.normal_matrix`): made once per model array, so a node that
+        does not move converts its matrix once, not every frame; a moving node's new array
+        once per frame (however many passes draw it)."""
+        kept = self._model_bytes_kept.get(id(model))
+        if kept is None or kept[0] is not model or (normal and kept[2] is None):
+            if len(self._model_bytes_kept) >= self.MODELS_KEPT:
+                self._model_bytes_kept.clear()
+            normal_bytes = _normal_matrix_bytes(np.asarray(model, dtype=np.float64).tobytes()) if normal else None
+            kept = self._model_bytes_kept[id(model)] = (model, transforms.gl_bytes(model), normal_bytes)
+        return kept[1], kept[2]
+
     def _uniform_writer(self, program_key: str, program: moderngl.Program,
                         members: Collection[str]) -> Callable[[str, bytes], None]:
         """``write(name, data)`` for one program: the bytes go to GL only where the program has the
@@ -526,10 +596,14 @@ class Executor:
         A program keeps its uniform values between draws and frames, so what does not change (the
         view while the camera stands, lights, materials, a wall's model) is written once."""
         written = self._written.setdefault(program_key, {})
+        uniforms: dict[str, moderngl.Uniform] = {}
 
         def write(name: str, data: bytes) -> None:
             if written.get(name) != data and name in members:
-                program[name].write(data)
+                uniform = uniforms.get(name)
+                if uniform is None:
+                    uniform = uniforms[name] = program[name]
+                uniform.write(data)
                 written[name] = data
 
         return write
@@ -585,6 +659,9 @@ class Executor:
         self._textures.release()
         self.shadow_maps.release()
         self._vaos.clear()
+        self._setups.clear()
+        self._model_bytes_kept.clear()
+        self._cameras.clear()
         self._meshes.clear()
         self._mesh_last_frame.clear()
         self._programs.clear()
