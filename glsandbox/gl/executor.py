@@ -198,7 +198,6 @@ class _DrawSetup:
     source: Mesh  # the node's mesh (the key's object)
     program: moderngl.Program
     members: frozenset[str]
-    user: UserProgram | None
     write: Callable[[str, bytes], None]
     mesh_key: tuple[str, str]  # of the mesh as drawn
     vao: moderngl.VertexArray
@@ -247,6 +246,7 @@ class Executor:
         self._lights_cache: tuple[tuple[Light, ...], bytes, bytes] | None = None
         # The uniform bytes last written into each program (by program key): see _uniform_writer.
         self._written: dict[str, dict[str, bytes]] = {}
+        self._culling: tuple[bool, str] | None = None  # what _set_culling set last (None: not known)
         self._bound_texture: object | None = None  # the material texture on unit 0 in this frame
         self._clear_depth = 1.0  # 0 with reverse-Z (glsandbox.gl.depth)
         self.shadow_maps = gl_shadowmap.ShadowMaps(self.ctx)  # the lights' depth textures
@@ -415,16 +415,26 @@ class Executor:
         self._lights = scene.lights
         self._clear_depth = gl_depth.clear_depth_value(scene)
         framebuffer.use()
+        self._culling = None  # not known: the first draw sets it
         gl_depth.begin_depth_mode(self.ctx, self.raw, scene)
         try:
             for step in frame_plan.passes:
                 runner = PASS_RUNNERS.get(step.kind)
                 if runner is None:
                     raise SandboxError(f"pass kind {step.kind!r} has no runner (gl.executor.PASS_RUNNERS)")
+                # Every pass starts from the same state (gl.passes.restore_state), whatever the last
+                # one set or raised. A clear pass sets nothing, and a draw pass only culling (blended
+                # draws put blending and depth writes back themselves): those put back only that.
+                restored = False
                 try:
                     runner(self, frame, step, self._frame_camera(frame, step))
-                finally:  # every pass starts from the same state, whatever the last one set
-                    gl_passes.restore_state(self.ctx, self.raw)
+                    restored = step.kind in _STATE_KEEPING
+                finally:
+                    if restored:
+                        self._set_culling(False, "ccw")
+                    else:
+                        gl_passes.restore_state(self.ctx, self.raw)
+                        self._culling = (False, "ccw")  # what restore_state leaves
         finally:
             # Also when a pass raised (a texture file that cannot be read, say): a sampler
             # object left on unit 0 overrides the state of every texture later bound there,
@@ -475,6 +485,21 @@ class Executor:
         if step.clear_stencil:  # moderngl's clear leaves the stencil alone
             self.raw.clear_stencil(rect)
 
+    def _set_culling(self, cull: bool, front_face: str) -> None:
+        """Back-face culling on or off, with the winding rule of front faces, set only where it
+        differs from what the executor set last in this pass (GL keeps it; draws of one
+        pass mostly share it). Only the executor changes culling within a pass."""
+        state = (cull, front_face)
+        if state == self._culling:
+            return
+        if cull:
+            self.ctx.enable(moderngl.CULL_FACE)
+            self.ctx.cull_face = "back"
+        else:
+            self.ctx.disable(moderngl.CULL_FACE)
+        self.ctx.front_face = front_face
+        self._culling = state
+
     def _set_depth(self, on: bool) -> None:
         if on:
             self.ctx.enable(moderngl.DEPTH_TEST)
@@ -503,22 +528,18 @@ class Executor:
         ``"cw"``, the reflected lights; a planar shadow: the flattening
         matrix and one flat colour).
         """
-        setup = self._draw_setup(draw.program, node.mesh)
-        program, members, user, write = setup.program, setup.members, setup.user, setup.write
+        user = self._user.get(draw.program)
         own: dict[str, object] = {}
-        if user is not None:  # a node's own shader: checked before anything is drawn with it
-            own = self._check_user_draw(user, program, members, node)
+        if user is not None:  # a node's own shader: checked before anything is made or drawn with it
+            own = self._check_user_draw(user, self._programs[draw.program][1], self._members(draw.program), node)
             self._user_nodes.setdefault(draw.program, {})[node.name] = node
+        setup = self._draw_setup(draw.program, node.mesh)
+        program, members, write = setup.program, setup.members, setup.write
         self._mesh_last_frame[setup.mesh_key] = self._frame
         vao, gpu = setup.vao, setup.gpu
         model = node.model if model is None else model
         material = node.material if material is None else material
-        if draw.cull_back_faces:
-            self.ctx.enable(moderngl.CULL_FACE)
-            self.ctx.cull_face = "back"
-            self.ctx.front_face = front_face
-        else:
-            self.ctx.disable(moderngl.CULL_FACE)
+        self._set_culling(draw.cull_back_faces, front_face)
         model_bytes, normal_bytes = self._model_bytes(model, setup.normal)
         write("m_model", model_bytes)
         write("m_view", camera.view_bytes)
@@ -570,8 +591,7 @@ class Executor:
         vao, gpu = self._vao(drawn, program_key)
         if len(self._setups) >= self.MODELS_KEPT:  # new meshes every frame (a trail): start again
             self._setups.clear()
-        setup = _DrawSetup(mesh, program, members, self._user.get(program_key),
-                           self._uniform_writer(program_key, program, members), _mesh_key(drawn), vao, gpu,
+        setup = _DrawSetup(mesh, program, members, self._uniform_writer(program_key, program, members), _mesh_key(drawn), vao, gpu,
                            "m_normal" in members)
         self._setups[(program_key, id(mesh))] = setup
         return setup
@@ -680,6 +700,11 @@ def eye_position(view: np.ndarray) -> np.ndarray:
     course's ``vEyePos``)."""
     return np.linalg.inv(np.asarray(view, dtype=np.float64))[:3, 3]
 
+
+#: Pass kinds whose runners leave GL state as :func:`glsandbox.gl.passes.restore_state` sets it,
+#: but for culling (:meth:`Executor._set_culling`): a clear, and a draw pass (its blended draws
+#: put blending and depth writes back).
+_STATE_KEEPING = frozenset({"clear", "draw"})
 
 #: One runner per pass kind (:data:`glsandbox.plan.PASS_KINDS`); a new kind adds
 #: its entry here and its describer in :data:`glsandbox.plan.PASS_DESCRIBERS`.
