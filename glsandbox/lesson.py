@@ -18,7 +18,6 @@ import math
 import pkgutil
 import sys
 import types
-import weakref
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -270,7 +269,7 @@ class Lesson:
         """The Scene for the current values (``renderer`` marks its viewports).
 
         A lesson whose :meth:`motion` says what ``time`` moves builds its scene once per
-        set of its other values (kept in :data:`SCENES_KEPT` per lesson class) and per
+        set of its other values (at most :data:`SCENES_KEPT` kept per lesson class) and per
         frame only moves that (:func:`glsandbox.scene.moved_scene`): no dataclass is
         made or checked again but the moved ones, and the renderers keep their plan."""
         motion = self.motion()
@@ -279,7 +278,11 @@ class Lesson:
         key = self._still_key()
         if key is None:  # a value that cannot be a key (an array given from Python): built every frame
             return moved_scene(self._scene_as_built(), motion)
-        kept = _SCENES.setdefault(type(self), {})
+        cls = type(self)
+        kept = cls.__dict__.get("_scenes_kept")  # the class's own (not a parent's): it goes with the class
+        if kept is None:
+            kept = {}
+            cls._scenes_kept = kept
         scene = kept.pop(key, None)
         if scene is None:
             scene = self._scene_as_built()
@@ -337,7 +340,6 @@ class Lesson:
 #: Scenes kept per lesson class for :meth:`Lesson.scene` (one per set of values but ``time``):
 #: a window's live compare shows several variants of one lesson at once.
 SCENES_KEPT = 16
-_SCENES: weakref.WeakKeyDictionary[type[Lesson], dict[tuple, Scene]] = weakref.WeakKeyDictionary()  # a reloaded class goes
 
 #: The parameters every lesson has; a lesson's own may not reuse their names.
 SHARED_PARAMS = (TIME, RENDERER, EFFECTS_PARAM, CAMERA)

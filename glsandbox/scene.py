@@ -388,7 +388,7 @@ def check_node_model(name: str, model: object) -> np.ndarray:
     matrix = np.asarray(model)
     if matrix.shape != (4, 4) or matrix.dtype.kind not in "biuf":
         raise SandboxError(f"node {name!r}: model matrix must be 4x4 numbers, got {plain(model)}")
-    in_bounds = bool((np.abs(matrix) <= NUMBER_LIMIT).all())  # False for NaN and inf too
+    in_bounds = bool(np.abs(matrix).max() <= NUMBER_LIMIT)  # False for NaN (max propagates it) and inf too
     if not in_bounds and not np.all(np.isfinite(matrix)):
         raise SandboxError(f"node {name!r}: model matrix has a non-finite entry: {plain(matrix)}")
     if not in_bounds:
