@@ -566,7 +566,8 @@ class Executor:
                 self._bound_texture = texture
             write("u_texture", _UNIT_0)
         if draw.shadow_map is not None:  # unit 1: the light's shadow map (a depth texture, compared)
-            self.shadow_maps.bind(draw.shadow_map, SHADOW_MAP_UNIT, program, members)
+            for name, data in self.shadow_maps.use(draw.shadow_map, SHADOW_MAP_UNIT):
+                write(name, data)
         if draw.blend:  # over what is drawn already; hidden by it where nearer, but not hiding
             self.ctx.enable(moderngl.BLEND)
             self.ctx.blend_func = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA)
