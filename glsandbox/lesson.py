@@ -28,7 +28,6 @@ from glsandbox.files import read_user_file
 from glsandbox.scene import RENDERERS
 from glsandbox.scene import (PLAN_MODES, Camera, Motion, Scene, check_uniform_name, check_uniform_value,
                              moved_scene)
-from glsandbox.scene_file import load_scene
 
 #: The module name prefix of lesson files loaded from outside the package.
 _FILE_MODULE = "_glsandbox_lesson_"
@@ -426,11 +425,15 @@ class SceneFileLesson(Lesson):
     path: ClassVar[Path]
 
     def build(self) -> Scene:
+        from glsandbox.scene_file import load_scene  # TOML and its checks: only where a scene file is used
+
         return load_scene(self.path)
 
 
 def scene_file_lesson(path: Path) -> type[Lesson]:
     """A lesson class for one scene file; the file is validated now."""
+    from glsandbox.scene_file import load_scene
+
     load_scene(path)  # fail early, with file and line
     # A class name must be text Python can encode: a file name with any bytes is made safe here.
     stem = "".join(c if c.isalnum() and c.isascii() else "_" for c in path.stem)
