@@ -69,7 +69,7 @@ def write_report(results: Sequence[KnobResult], info: Mapping[str, str], path: P
                   "|---|---:|---:|" + ("---:|---:|" if knob.count_label else "") + "---:|---:|---:|---|"]
         for r in result.rows:
             low, high = r.spread_ms
-            name = f"{r.setting} (reference)" if r.reference else r.setting
+            name = (f"{r.setting} (reference)" if r.reference else r.setting).replace("|", "\\|")  # a cell
             count = "" if not knob.count_label else (
                 " - | - |" if r.count is None else f" {r.count.pixels} | {r.count.share:.1%} |")
             lines.append(f"| {name} | {r.median_ms:.2f} | {low:.2f}-{high:.2f} (median ±{r.median_spread:.1%}, "

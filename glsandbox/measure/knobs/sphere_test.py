@@ -176,9 +176,10 @@ KNOB = register_knob(Knob(
     count_label="wrong px",
     count_of="px",
     notes=(
-        f"wrong px (of the whole frame; the sphere covers about 1/3 of it): a hit where the exact test misses or the reverse, or a hit whose t is off the exact t by "
-        f"more than {T_TOLERANCE:g} of the radius (1e-6 of the radius: well above float64's rounding of t "
-        "even at 1e8, where one unit in the last place of t is 1.5e-8).",
+        f"wrong px (of the whole frame; the sphere covers about a third of it): a hit where the exact test "
+        f"misses or the reverse, or a hit whose t is off the exact t by more than {T_TOLERANCE:g} of the "
+        "radius (well above float64's rounding of t even at 1e8, where one unit in the last place of t is "
+        "1.5e-8; the stable test stays within 1e-7 there).",
         "The geometric test's m² = l·l − s² cancels D² against D²: its error in t grows as D² (about "
         "eps·D²/r), a millionth of the radius near D = 1e4-1e5 and the whole radius at 1e8, where the "
         "silhouette frays and the shading breaks up. The stable form's error grows as eps·D (t's own "

@@ -71,20 +71,23 @@ def moller_trumbore_float32(tris: Triangles, origins: NDArray[np.float64], direc
     ``det = e1·p``, ``s = O − V0``, ``u = s·p/det``, ``q = s × e1``, ``v = d·q/det``,
     ``t = e2·q/det``, a hit when ``u, v >= 0``, ``u + v <= 1`` and ``t > 0``."""
     a, b, c = (np.asarray(v, dtype=np.float32) for v in tris)
-    e1, e2 = b - a, c - a
+    ax, ay, az = a.T
+    e1x, e1y, e1z = (b - a).T
+    e2x, e2y, e2z = (c - a).T
     o32, d32 = origins.astype(np.float32), directions.astype(np.float32)
     nearest = np.full(len(origins), np.inf)
-    for lo in range(0, len(origins), block):
-        o, d = o32[lo:lo + block, None, :], d32[lo:lo + block, None, :]
-        p = np.cross(d, e2)
-        det = np.sum(e1 * p, axis=-1)
+    for lo in range(0, len(origins), block):  # (rays, 1) against (triangles,): float32 throughout
+        ox, oy, oz = (o32[lo:lo + block, k, None] for k in range(3))
+        dx, dy, dz = (d32[lo:lo + block, k, None] for k in range(3))
+        px, py, pz = dy * e2z - dz * e2y, dz * e2x - dx * e2z, dx * e2y - dy * e2x  # p = d × e2
+        det = e1x * px + e1y * py + e1z * pz
         ok = det != 0.0
         inv = np.divide(np.float32(1.0), det, out=np.zeros_like(det), where=ok)
-        s = o - a
-        u = np.sum(s * p, axis=-1) * inv
-        q = np.cross(s, e1)
-        v = np.sum(d * q, axis=-1) * inv
-        t = np.sum(e2 * q, axis=-1) * inv
+        sx, sy, sz = ox - ax, oy - ay, oz - az  # s = O − V0
+        u = (sx * px + sy * py + sz * pz) * inv
+        qx, qy, qz = sy * e1z - sz * e1y, sz * e1x - sx * e1z, sx * e1y - sy * e1x  # q = s × e1
+        v = (dx * qx + dy * qy + dz * qz) * inv
+        t = (e2x * qx + e2y * qy + e2z * qz) * inv
         hit = ok & (u >= 0.0) & (v >= 0.0) & (u + v <= 1.0) & (t > 0.0)
         nearest[lo:lo + block] = np.where(hit, t, np.inf).min(axis=1)
     return nearest
