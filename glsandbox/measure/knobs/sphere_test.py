@@ -27,6 +27,7 @@ from glsandbox.measure.knob import Knob, PixelCount, Setting, register_knob
 from glsandbox.measure.knobs._far import DIRECTION
 from glsandbox.measure.render_context import RenderContext
 from glsandbox.raytrace.sphere import Sphere
+from glsandbox.raytrace.vec import dot, length
 
 #: The sphere's radius, and how much of the frame's height it spans.
 RADIUS = 1.0
@@ -60,16 +61,16 @@ def geometric_many(sphere: Sphere, directions: NDArray[np.float64]) -> NDArray[n
     """The course's geometric test for rays from the origin, vectorized: the steps of
     :meth:`Sphere._intersect_geometric` (``l``, ``s``, ``m² = l·l − s²``, ``q``,
     ``t = s − q`` from outside), ``inf`` for a miss. ``t`` in units of ``directions``."""
-    length = np.sqrt(np.sum(directions * directions, axis=1))
-    d = directions / length[:, None]  # the course's Rd is a unit vector
-    l = sphere.center  # noqa: E741 (the course's l = C − O, with O the origin)
-    s = d @ l
-    l2 = float(l @ l)
+    d_len = length(directions)
+    d = directions / d_len[:, None]  # the course's Rd is a unit vector
+    l = sphere.center - np.zeros(3)  # noqa: E741 (the course's l = C − O, with O the origin)
+    s = dot(l, d)
+    l2 = float(dot(l, l))
     r2 = sphere.radius * sphere.radius
     m2 = l2 - s * s
     hit = (m2 <= r2) & (s >= 0.0)  # the eye is outside the sphere: the entry point
     t = s - np.sqrt(np.where(hit, r2 - m2, 0.0))
-    return np.where(hit & (t > 0.0), t / length, np.inf)
+    return np.where(hit & (t > 0.0), t / d_len, np.inf)
 
 
 def stable_many(sphere: Sphere, directions: NDArray[np.float64]) -> NDArray[np.float64]:
