@@ -39,8 +39,9 @@ from glsandbox.raytrace.world import camera_rays
 #: along the normal), or ``None`` for the error bound.
 OFFSETS: dict[str, float | None] = {"no offset": 0.0, "2^-32*|P|": 2.0**-32, "2^-16*|P|": 2.0**-16,
                                     "error bound": None}
-#: Ambient share of a shadowed point (the engines' default ambient is about this).
-AMBIENT = 0.15
+#: Ambient share of a point, all that is left in shadow (:func:`cube_on_floor`'s
+#: materials: ambient 0.1, diffuse 0.9, no specular).
+AMBIENT = 0.1
 
 
 @functools.lru_cache(maxsize=16)
@@ -56,8 +57,8 @@ def _prepared(at: float, size: tuple[int, int]):  # type: ignore[no-untyped-def]
     return scene, TriangleBatch(a, b, c), owner, colours, origin, directions
 
 
-def trace(at: float, offset: str, size: tuple[int, int]) -> tuple[np.ndarray, NDArray[np.bool_],
-                                                                              NDArray[np.bool_]]:
+def trace(at: float, offset: str, size: tuple[int, int]
+          ) -> tuple[np.ndarray, NDArray[np.bool_], NDArray[np.bool_]]:
     """The frame (RGBA), the floor's pixels, and the floor pixels a shadow ray darkens."""
     scene, batch, owner, colours, origin, directions = _prepared(at, size)
     light = np.asarray(scene.lights[0].position, dtype=np.float64)

@@ -17,7 +17,6 @@ decimal arithmetic from the same float64 inputs.
 from __future__ import annotations
 
 import functools
-import math
 from decimal import Decimal, localcontext
 
 import numpy as np
