@@ -14,7 +14,7 @@ from glsandbox.measure import metrics
 from glsandbox.measure.knob import all_knobs, median_spread
 from glsandbox.measure.knobs import (depth_format, ray_engine, shadow_epsilon, shadow_offset, sphere_test,
                                      triangle_test)
-from glsandbox.measure.knobs._far import DIRECTION
+from glsandbox.measure.knobs._far import DIRECTION, grown
 from glsandbox.measure.render_context import RenderContext
 
 
@@ -200,3 +200,39 @@ def test_shadow_epsilon_reference_is_the_engines_shadow() -> None:
     engine_floor, engine_shadow = contact_shadow(lambda s, sz, **o: render(s, sz, "numpy", **o), 0.0, size)
     assert np.count_nonzero(shadow) > 100
     assert np.count_nonzero(shadow != engine_shadow) <= 2 and np.count_nonzero(floor != engine_floor) <= 20
+
+
+def test_depth_format_model_agrees_with_the_rasterizer(gl) -> None:
+    # The two depth modes the rasterizer has, on the model's own scene (the floor drawn, then
+    # the decal LIFT above it): it fights exactly where the model says a buffer step outgrows
+    # the decal's depth gap (llvmpipe's own float32 interpolation moves the share, not the onset).
+    from glsandbox import geometry, transforms
+    from glsandbox.measure.zfighting import shade_mask
+    from glsandbox.scene import Camera, Material, Node, Scene
+
+    def scene(mode: str, near: float) -> Scene:
+        grey = (0.8, 0.8, 0.8, 1.0)
+        floor = Node("floor", geometry.plane(2 * depth_format.FLOOR_HALF), np.eye(4), Material(color=grey))
+        decal = Node("decal", geometry.plane(2 * depth_format.DECAL_HALF),
+                     transforms.translate(0.0, depth_format.LIFT, 0.0), Material(color=(0.4, 0.4, 0.4, 1)))
+        up = np.radians(depth_format.ELEVATION)
+        eye = depth_format.DISTANCE * np.array([0.0, np.sin(up), np.cos(up)])
+        camera = Camera(eye=tuple(eye), target=(0.0, 0.0, 0.0), fov_y=depth_format.FOV, near=near,
+                        far=depth_format.FAR)
+        return Scene("decal", nodes=(floor, decal), camera=camera, depth_mode=mode, clear_color=(0, 0, 0, 1))
+
+    size = (96, 72)
+    shares = {}
+    for mode, fmt, near in (("standard", "24-bit", 0.01), ("standard", "24-bit", 0.02), ("standard", "24-bit", 0.05),
+                            ("standard", "24-bit", 1.0), ("reverse_z", "reverse-Z float", 0.01)):
+        image = gl.render_scene(scene(mode, near), size).image
+        decal, lost = (mask.reshape(size[1], size[0]) for mask in depth_format.fighting(size, fmt, near))
+        inside = decal & ~grown(~decal)  # the decal's pixels away from its edge
+        drawn = shade_mask(image, depth_format.DECAL_GREY)
+        assert np.count_nonzero(drawn & ~decal) <= 0.05 * np.count_nonzero(decal), (mode, near)  # same footprint
+        gl_lost = inside & shade_mask(image, depth_format.FLOOR_GREY)
+        model_share = np.count_nonzero(lost & inside) / np.count_nonzero(inside)
+        gl_share = np.count_nonzero(gl_lost) / np.count_nonzero(inside)
+        shares[(mode, near)] = gl_share, model_share
+        assert (gl_share > 0.0) == (model_share > 0.0), (mode, near, gl_share, model_share)
+    assert min(shares[("standard", 0.01)]) > 0.5 and min(shares[("standard", 0.02)]) > 0.1

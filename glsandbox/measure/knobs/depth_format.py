@@ -17,8 +17,11 @@ whose stored depth does not beat the floor's (a tie included: the floor was
 drawn first) is a z-fighting pixel.
 
 What the model leaves out: a GPU interpolates ``z/w`` in float32 before it
-stores it, which adds a little noise of its own (the ``depth`` knob measures
-that on the real rasterizer).
+stores it, which moves the share of fighting pixels but not where fighting
+starts. The rasterizer's two modes drawn on this scene at 96x72 fight where
+the model does (tests/measure/test_precision_knobs.py): 24-bit at near
+0.01 loses all of the decal's inner pixels (the model: 79%), at 0.02 36%
+(57%), at 0.05 and 1 none (none); reverse-Z float none (none).
 """
 
 from __future__ import annotations
@@ -165,6 +168,10 @@ KNOB = register_knob(Knob(
         "buffer (d sits near 0, with the same absolute step).",
         "Reverse-Z into a float buffer keeps float32's relative step, 2^-24 of z, at every depth: no "
         "fighting even at far/near 1e5.",
+        "Checked against the rasterizer's two modes on this scene (llvmpipe, 96x72): 24-bit fights where the "
+        "model says it does, near 0.01 on all of the decal's inner pixels (model 79%), 0.02 on 36% (57%), "
+        "0.05 and 1 on none; reverse-Z float on none. Its float32 interpolation moves the share, not the "
+        "onset.",
         "The times are this numpy model's (two planes, one ray per pixel), not a GPU's, where every format "
         "costs about the same (the depth test is fixed-function; 16-bit halves the buffer's memory).",
     ),
