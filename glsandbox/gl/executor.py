@@ -124,6 +124,12 @@ def _eye_bytes(view: bytes) -> bytes:
 
 
 @functools.lru_cache(maxsize=1024)
+def _model_matrix_bytes(model: bytes) -> bytes:
+    """``m_model``'s uniform bytes (float32, column-major) for a float64 model matrix given as bytes."""
+    return transforms.gl_bytes(np.frombuffer(model).reshape(4, 4))
+
+
+@functools.lru_cache(maxsize=1024)
 def _normal_matrix_bytes(model: bytes) -> bytes:
     """The normal matrix's uniform bytes for a float64 model matrix given as
     bytes: models that do not move (walls, floors) skip the inverse each frame."""
@@ -213,9 +219,9 @@ class Executor:
     #: in a long-running window: past this many, the least recently drawn
     #: are released (never one the current frame draws).
     MESH_LIMIT = 256
-    #: Model matrices whose uniform bytes are kept (:meth:`_model_bytes`); the arrays are kept
-    #: with them (so an id is not reused while kept), all dropped at once past this many.
-    MODELS_KEPT = 1024
+    #: Draw set-ups kept (:meth:`_draw_setup`), all dropped at once past this many (a lesson
+    #: making a new mesh every frame).
+    SETUPS_KEPT = 1024
 
     def __init__(self, host: GLHost) -> None:
         self.host = host
@@ -235,9 +241,6 @@ class Executor:
         # What a draw of one mesh with one program needs, found once (see _draw_setup), by
         # (program key, id of the mesh); emptied whenever a VAO or a program is released.
         self._setups: dict[tuple[str, int], _DrawSetup] = {}
-        # Uniform bytes of model matrices, by id of the array (a node that does not move keeps its
-        # array between frames, so its matrix and normal matrix are converted once); see _model_bytes.
-        self._model_bytes_kept: dict[int, tuple[object, bytes, bytes | None]] = {}
         # Pass cameras by the camera, the viewport's pixels and the depth mode (see _frame_camera).
         self._cameras: dict[tuple[int, tuple[int, int, int, int], str], tuple[object, PassCamera]] = {}
         self._overlays: OverlayDrawer | None = None  # made on the first overlay pass
@@ -590,25 +593,21 @@ class Executor:
         members = self._members(program_key)
         drawn = with_face_normals(mesh) if mesh.normals is None and "in_normal" in members else mesh
         vao, gpu = self._vao(drawn, program_key)
-        if len(self._setups) >= self.MODELS_KEPT:  # new meshes every frame (a trail): start again
+        if len(self._setups) >= self.SETUPS_KEPT:  # new meshes every frame (a trail): start again
             self._setups.clear()
         setup = _DrawSetup(mesh, program, members, self._uniform_writer(program_key, program, members), _mesh_key(drawn), vao, gpu,
                            "m_normal" in members)
         self._setups[(program_key, id(mesh))] = setup
         return setup
 
-    def _model_bytes(self, model: np.ndarray, normal: bool) -> tuple[bytes, bytes | None]:
+    @staticmethod
+    def _model_bytes(model: np.ndarray, normal: bool) -> tuple[bytes, bytes | None]:
         """``m_model``'s uniform bytes and, with ``normal``, ``m_normal``'s (the inverse transpose,
-        :func:`~glsandbox.transforms.normal_matrix`): made once per model array, so a node that
-        does not move converts its matrix once, not every frame; a moving node's new array
-        once per frame (however many passes draw it)."""
-        kept = self._model_bytes_kept.get(id(model))
-        if kept is None or kept[0] is not model or (normal and kept[2] is None):
-            if len(self._model_bytes_kept) >= self.MODELS_KEPT:
-                self._model_bytes_kept.clear()
-            normal_bytes = _normal_matrix_bytes(np.asarray(model, dtype=np.float64).tobytes()) if normal else None
-            kept = self._model_bytes_kept[id(model)] = (model, transforms.gl_bytes(model), normal_bytes)
-        return kept[1], kept[2]
+        :func:`~glsandbox.transforms.normal_matrix`), looked up by the matrix's content: a node
+        that does not move converts its matrix once, not every frame, and an array changed in
+        place between frames is converted again (no stale matrix)."""
+        content = np.asarray(model, dtype=np.float64).tobytes()
+        return _model_matrix_bytes(content), _normal_matrix_bytes(content) if normal else None
 
     def _uniform_writer(self, program_key: str, program: moderngl.Program,
                         members: Collection[str]) -> Callable[[str, bytes], None]:
@@ -681,7 +680,6 @@ class Executor:
         self.shadow_maps.release()
         self._vaos.clear()
         self._setups.clear()
-        self._model_bytes_kept.clear()
         self._cameras.clear()
         self._meshes.clear()
         self._mesh_last_frame.clear()

@@ -167,3 +167,21 @@ def test_the_plan_is_kept_only_while_it_would_be_the_same(gl):
     flipped = moved_scene(scene, Motion(models={"a": ahead}))
     assert gl.plan(flipped) is not first and gl.plan(flipped) == plan(flipped)
     assert [d.node for d in gl.plan(flipped).passes[-1].draws] == ["b", "a"]
+
+
+def test_a_model_array_changed_in_place_is_drawn_where_it_is_now(gl):
+    """The executor keeps uniform bytes by a matrix's content, not by the array object."""
+    model = np.eye(4)
+
+    def frame() -> np.ndarray:
+        node = Node("cube", geometry.cube(), model, Material(shading="vertex_color"))
+        return gl.render_scene(Scene("s", nodes=(node,), camera=Camera(eye=(0.0, 0.0, 8.0))), SIZE).image.copy()
+
+    first = frame()
+    model[0, 3] = 1.5  # the same array, moved
+    moved = frame()
+    assert not np.array_equal(first, moved)
+    fresh = gl.render_scene(Scene("s", nodes=(Node("cube", geometry.cube(), model.copy(),
+                                                   Material(shading="vertex_color")),),
+                                  camera=Camera(eye=(0.0, 0.0, 8.0))), SIZE).image
+    assert np.array_equal(moved, fresh)
