@@ -23,18 +23,20 @@ step before the next.
 The BVH
 -------
 :func:`_nearest` and :func:`_occluded` are the only places that look for hits.
-Both loop over the nodes in scene order (:func:`_scan_nodes`; the top level
-is the nodes' boxes, course "Hızlandırma: AABB"). With ``bvh=True`` (the
+Both go through :func:`_top_level`, the one loop over the nodes in scene
+order (the top level is the nodes' boxes, course "Hızlandırma: AABB"; the
+tests call it too). Each node is tested by its kind's hit function, in the
+node's own space (the node table :data:`_HIT`, by
+:class:`~glsandbox.raytrace.world.NodeKind`). With ``bvh=True`` (the
 default) a mesh node's rays that enter its box are traced through the node's
-BVH (:class:`~glsandbox.raytrace.bvh_world.WorldBVH`, built once per mesh and
+BVH instead (:class:`~glsandbox.raytrace.bvh_world.WorldBVH`, built once per mesh and
 cached by content; :func:`~glsandbox.raytrace.bvh_traverse.closest_hit`, the
 watertight triangle test) with ``t_max`` their best hit so far: only strictly
 nearer hits replace it, so the tie rule holds (an equal ``t`` goes to the
-earlier node, then the lower triangle). Spheres stay analytic
-(:func:`_hit_node`). Shadow rays are an any-hit query
+earlier node, then the lower triangle). Shadow rays are then an any-hit query
 (:func:`~glsandbox.raytrace.bvh_traverse.any_hit`): a ray leaves at its first
-occluder. With ``bvh=False``, :func:`_scan_nodes` tests every triangle of a
-node whose box a ray enters (the watertight test too,
+occluder. With ``bvh=False`` a mesh node's kind function tests every triangle of
+a node whose box a ray enters (the watertight test too,
 :func:`~glsandbox.raytrace.watertight.nearest_watertight`), and :func:`_occluded` is that scan cut at
 ``t = 1``: what ``ray_acceleration`` compares the BVH with.
 :class:`RenderStats` counts the ray-shape tests and the ray-box tests either
@@ -121,7 +123,7 @@ def _nearest(world: World, o: NDArray[np.float64], d: NDArray[np.float64], cull:
     tested first; ``bvh`` (the render's ``bvh=True``) traces mesh nodes through
     their BVHs instead of testing all their triangles.
     """
-    return _scan_nodes(world, o, d, np.inf, cull, aabb, -1, stats, bvh)
+    return _top_level(world, o, d, np.inf, cull, aabb, -1, stats, bvh)
 
 
 def _occluded(world: World, o: NDArray[np.float64], d: NDArray[np.float64], light: int, cull: bool | None,
@@ -130,43 +132,9 @@ def _occluded(world: World, o: NDArray[np.float64], d: NDArray[np.float64], ligh
     hits something at ``0 < s < 1`` (``d`` reaches the light at ``s = 1``, so an
     occluder beyond the light never counts). The light's lamp is skipped.
 
-    Without a BVH, the nearest-hit scan cut at ``s = 1``; with one, an any-hit
-    query: a ray leaves at its first occluder, nodes and triangles in any order."""
-    if bvh is None:
-        return _scan_nodes(world, o, d, 1.0, cull, aabb, light, stats, None).node >= 0
-    n = d.shape[0]
-    found = np.zeros(n, dtype=bool)
-    inverse = reciprocals(d)
-    entries = bvh.by_node
-    for k, node in enumerate(world.nodes):
-        if light >= 0 and node.lamp_of >> light & 1:
-            continue
-        if not node.kind.triangles:  # an analytic shape: its box, then its own test
-            idx = np.flatnonzero(~found)
-            if aabb:
-                if stats is not None:
-                    stats.box_tests += idx.size
-                near, far = AABB(node.box_min, node.box_max).slabs_reciprocal(_rows(o, idx), inverse[:, idx])
-                idx = idx[(near <= far) & (far > 0.0) & (near < 1.0)]
-            if idx.size == 0:
-                continue
-            if stats is not None:
-                stats.tests += idx.size
-            t, _ = _hit_node(world, k, _rows(o, idx), d[idx], node.cull if cull is None else cull)
-            found[idx[t < 1.0]] = True
-            continue
-        entry = entries.get(k)
-        if entry is None:  # no triangle of non-zero area
-            continue
-        idx = np.flatnonzero(~found)
-        idx = idx[_box_candidates(entry, _rows(o, idx), inverse[:, idx], 1.0, stats)]
-        if idx.size == 0:
-            continue
-        counts = TraversalCounts()
-        one_sided = entry.cull if cull is None else bool(cull)
-        found[idx] |= any_hit(entry.bvh, _rows(o, idx), d[idx], 1.0, cull_backfaces=one_sided, counts=counts)
-        _add_counts(stats, counts)
-    return found
+    With a BVH an any-hit query (a ray leaves at its first occluder); without one
+    the nearest-hit scan cut at ``s = 1`` (what ``ray_acceleration`` counts)."""
+    return _top_level(world, o, d, 1.0, cull, aabb, light, stats, bvh, first=bvh is not None).node >= 0
 
 
 def _box_candidates(entry: NodeBVH, o: NDArray[np.float64], inverse: NDArray[np.float64],
@@ -188,16 +156,25 @@ def _add_counts(stats: RenderStats | None, counts: TraversalCounts) -> None:
         stats.tests += counts.triangles
 
 
-def _scan_nodes(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_max: float, cull: bool | None,
-                aabb: bool, light: int, stats: RenderStats | None, bvh: WorldBVH | None = None) -> _Hits:
-    """Nearest hit with ``0 < t < t_max``, every node in scene order; ``light >= 0`` skips that light's lamp.
+def _top_level(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_max: float, cull: bool | None,
+               aabb: bool, light: int, stats: RenderStats | None, bvh: WorldBVH | None = None,
+               first: bool = False) -> _Hits:
+    """The top level, the one loop over a World's nodes that renders and tests use: the
+    nearest hit with ``0 < t < t_max``, every node in scene order; ``light >= 0`` skips
+    that light's lamp.
 
-    Each node's box (its slab test, ``1/d`` formed once for all nodes) picks the
-    rays that enter it before the best hit so far; only those are tested
-    against the node. A strict ``<`` keeps ties with the earlier node. With
-    ``bvh``, a mesh node's rays are traced through its BVH with ``t_max`` their
-    best hit so far (strictly nearer hits only, so the tie rule holds: the
-    earlier node, then the lower triangle index); spheres stay analytic.
+    Each node's box (its slab test, ``1/d`` formed once for all nodes) picks the rays
+    that enter it before their best hit so far; only those are tested against the node,
+    by its kind's hit function (:data:`_HIT`, in the node's own space). A strict ``<``
+    keeps ties with the earlier node. With ``bvh``, a mesh node's rays are traced
+    through its BVH instead (its root box widened as the BVH's own boxes are,
+    :func:`_box_candidates`) with ``t_max`` their best hit so far (strictly nearer hits
+    only, so the tie rule holds: the earlier node, then the lower triangle index).
+
+    ``first`` (shadow rays with a BVH): an any-hit query. A ray that has found an
+    occluder is tested against no further node, and a BVH answers with
+    :func:`~glsandbox.raytrace.bvh_traverse.any_hit`; the hits' ``t`` and triangle are
+    then not the nearest, only ``node >= 0`` means something.
     """
     n = d.shape[0]
     best_t = np.broadcast_to(np.asarray(t_max, dtype=np.float64), (n,)).copy()
@@ -207,17 +184,28 @@ def _scan_nodes(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_
     for k, node in enumerate(world.nodes):
         if light >= 0 and node.lamp_of >> light & 1:
             continue
-        one_sided = node.cull if cull is None else cull
+        one_sided = bool(node.cull if cull is None else cull)
+        # The rays still looking: all of them, or (any hit) those without an occluder yet.
+        rays = np.flatnonzero(best_node < 0) if first else None
+        ro = o if rays is None else _rows(o, rays)
+        rinv = inverse if rays is None or inverse is None else inverse[:, rays]
         if bvh is not None and node.kind.triangles:
             entry = bvh.by_node.get(k)
             if entry is None:  # no triangle of non-zero area
                 continue
-            assert inverse is not None
-            idx = _box_candidates(entry, o, inverse, best_t, stats)
+            assert rinv is not None
+            idx = _box_candidates(entry, ro, rinv, t_max if first else best_t, stats)
+            if rays is not None:
+                idx = rays[idx]
             if idx.size == 0:
                 continue
             counts = TraversalCounts()
-            hits = closest_hit(entry.bvh, _rows(o, idx), d[idx], best_t[idx], cull_backfaces=bool(one_sided),
+            if first:
+                found = any_hit(entry.bvh, _rows(o, idx), d[idx], t_max, cull_backfaces=one_sided, counts=counts)
+                best_node[idx[found]] = k
+                _add_counts(stats, counts)
+                continue
+            hits = closest_hit(entry.bvh, _rows(o, idx), d[idx], best_t[idx], cull_backfaces=one_sided,
                                counts=counts)
             _add_counts(stats, counts)
             won = hits.triangle >= 0  # strictly nearer than every earlier node's hit
@@ -226,13 +214,17 @@ def _scan_nodes(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_
             best_node[sel] = k
             best_tri[sel] = entry.start + hits.triangle[won]
             continue
-        if inverse is not None and aabb:
+        count = n if rays is None else rays.size
+        if rinv is not None and aabb:
             if stats is not None:
-                stats.box_tests += n
-            near, far = AABB(node.box_min, node.box_max).slabs_reciprocal(o, inverse)
-            idx = np.nonzero((near <= far) & (far > 0.0) & (near < best_t))[0]
+                stats.box_tests += count
+            near, far = AABB(node.box_min, node.box_max).slabs_reciprocal(ro, rinv)
+            limit = best_t if rays is None else best_t[rays]
+            idx = np.flatnonzero((near <= far) & (far > 0.0) & (near < limit))
         else:
-            idx = np.arange(n)
+            idx = np.arange(count)
+        if rays is not None:
+            idx = rays[idx]
         if idx.size == 0:
             continue
         if stats is not None:

@@ -324,12 +324,7 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
                                   box_max=world_corners.max(axis=0), inverse=np.linalg.inv(model),
                                   normal_matrix=transforms.normal_matrix(model), **common))
             continue
-        order = mesh.indices if mesh.indices is not None else np.arange(mesh.vertex_count)
-        if mesh.mode == "triangles":
-            tri = np.asarray(order, dtype=np.intp).reshape(-1, 3)
-        else:  # a strip: triangle k is (k, k+1, k+2), odd ones swapped to keep the winding
-            tri = np.array([(order[k + 1], order[k], order[k + 2]) if k % 2 else (order[k], order[k + 1], order[k + 2])
-                            for k in range(len(order) - 2)], dtype=np.intp).reshape(-1, 3)
+        tri = mesh.triangle_indices()  # a strip's keep its winding
         if len(tri) == 0:
             continue
         world = transforms.transform_points(model, np.asarray(mesh.positions, dtype=np.float64))
