@@ -125,6 +125,7 @@ from glsandbox.gl.shaders import compile_program
 from glsandbox.plan import ProgramVariant
 from glsandbox.raytrace.constants import NODE_BOX_PAD, OFFSETS, SIMPLE_OFFSET, glsl_defines
 from glsandbox.raytrace.errors import RayTraceError
+from glsandbox.raytrace.gpu_records import NODE, TRI, layout_defines
 from glsandbox.raytrace.watertight import nondegenerate
 from glsandbox.raytrace.world import MODES, World, build_world, camera_basis, kind_defines
 from glsandbox.scene import Scene
@@ -133,8 +134,9 @@ __all__ = ["LOOP_LIMIT", "GpuTracer", "MAX_TEXTURES", "check_loop_budget", "gpu_
 
 #: Width of the record textures (must match TEX_WIDTH in the shader).
 TEX_WIDTH = 1024
-TRI_RECORDS = 9
-NODE_RECORDS = 13
+#: ``vec4`` records per triangle and per node (the layouts: :mod:`glsandbox.raytrace.gpu_records`).
+TRI_RECORDS = TRI.records
+NODE_RECORDS = NODE.records
 #: Samplers the shader declares at most.
 MAX_TEXTURES = 4
 #: llvmpipe's loop iterations per shader invocation, all loops together (see the module docstring).
@@ -293,14 +295,14 @@ def pack_triangles(world: World, anchor: NDArray[np.float64] | None = None) -> N
     # corner shared by two triangles to be the same three floats in both.
     ok = nondegenerate(world.v0, world.v1, world.v2)  # the BVH's rule: a triangle without area is never hit
     v0 = world.v0 - anchor
-    rec[:, 0, :3] = v0
-    rec[:, 1, :3] = np.where(ok[:, None], world.v1 - anchor, v0)  # degenerate: one point, det = 0
-    rec[:, 2, :3] = np.where(ok[:, None], world.v2 - anchor, v0)
+    rec[:, TRI["v0"], :3] = v0
+    rec[:, TRI["v1"], :3] = np.where(ok[:, None], world.v1 - anchor, v0)  # degenerate: one point, det = 0
+    rec[:, TRI["v2"], :3] = np.where(ok[:, None], world.v2 - anchor, v0)
     for k in range(3):
-        rec[:, 3 + k, :3] = world.normals[:, k]
-        rec[:, 6 + k, :3] = world.colors[:, k]
+        rec[:, TRI["normal"] + k, :3] = world.normals[:, k]
+        rec[:, TRI["color"] + k, :3] = world.colors[:, k]
     flat_uv = world.uvs.reshape(m, 6)  # uv0.x, uv0.y, uv1.x, uv1.y, uv2.x, uv2.y
-    rec[:, 3:9, 3] = flat_uv
+    rec[:, TRI["normal"]:TRI["color"] + 3, 3] = flat_uv
     return rec.reshape(-1, 4).astype(np.float32)
 
 
@@ -321,18 +323,19 @@ def pack_nodes(world: World, anchor: NDArray[np.float64] | None = None) -> NDArr
         # Pad the box by a relative hair: float32 slab arithmetic must not
         # reject a ray that the triangle test would accept at the box's face.
         pad = NODE_BOX_PAD * (1.0 + float(np.abs(np.concatenate([lo, hi])).max()))
-        rec[slot, 0] = (*(lo - pad), float(node.kind.code))
-        rec[slot, 1] = (*(hi + pad), 1.0 if node.cull else 0.0)
-        rec[slot, 2] = (node.start, node.count, k, 0.0)  # k: the scene order, for ties
-        rec[slot, 3] = (*node.color, node.mode)
-        rec[slot, 4] = (node.ka, node.kd, node.ks, node.shininess)
-        rec[slot, 5] = (node.reflectivity, node.texture, node.lamp_of, 0.0)
-        # world -> unit sphere for anchor-relative points: M⁻¹(p + anchor), in float64.
-        rec[slot, 6:9, :3] = node.inverse[:3, :3]
-        rec[slot, 6:9, 3] = node.inverse[:3, :3] @ anchor + node.inverse[:3, 3]
-        rec[slot, 9:12, :3] = node.normal_matrix
-        rec[slot, 12] = (node.alpha, node.alpha_mode, node.alpha_cutoff,
-                         int(node.vertex_colors) | 2 * int(node.two_sided))
+        rec[slot, NODE["box_min"]] = (*(lo - pad), float(node.kind.code))
+        rec[slot, NODE["box_max"]] = (*(hi + pad), 1.0 if node.cull else 0.0)
+        rec[slot, NODE["range"]] = (node.start, node.count, k, 0.0)  # k: the scene order, for ties
+        rec[slot, NODE["color"]] = (*node.color, node.mode)
+        rec[slot, NODE["phong"]] = (node.ka, node.kd, node.ks, node.shininess)
+        rec[slot, NODE["extra"]] = (node.reflectivity, node.texture, node.lamp_of, 0.0)
+        # world -> the node's own space for anchor-relative points: M⁻¹(p + anchor), in float64.
+        inverse = slice(NODE["inverse"], NODE["inverse"] + 3)
+        rec[slot, inverse, :3] = node.inverse[:3, :3]
+        rec[slot, inverse, 3] = node.inverse[:3, :3] @ anchor + node.inverse[:3, 3]
+        rec[slot, NODE["normal"]:NODE["normal"] + 3, :3] = node.normal_matrix
+        rec[slot, NODE["look"]] = (node.alpha, node.alpha_mode, node.alpha_cutoff,
+                                   int(node.vertex_colors) | 2 * int(node.two_sided))
     return rec.reshape(-1, 4).astype(np.float32)
 
 
@@ -522,7 +525,8 @@ class GpuTracer:
                  scene: tuple[tuple[str, str], ...] = ()) -> tuple[moderngl.Program, moderngl.VertexArray]:
         flags = (lights, textures, int(shadows and lights > 0), int(reflect), int(meshes), int(spheres))
         names = ("NUM_LIGHTS", "NUM_TEXTURES", "SHADOWS", "REFLECT", "HAS_MESHES", "HAS_SPHERES")
-        defines = tuple((name, str(value)) for name, value in zip(names, flags)) + glsl_defines() + kind_defines() + scene
+        defines = (tuple((name, str(value)) for name, value in zip(names, flags)) + glsl_defines() + kind_defines()
+                   + layout_defines() + scene)
         if defines in self._programs:
             self._programs[defines] = self._programs.pop(defines)  # most recently used last
             self._vaos[defines] = self._vaos.pop(defines)

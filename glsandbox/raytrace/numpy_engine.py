@@ -54,7 +54,7 @@ from numpy.typing import NDArray
 from glsandbox.raytrace.aabb import AABB, reciprocals
 from glsandbox.raytrace.bvh_traverse import TraversalCounts, any_hit, closest_hit
 from glsandbox.raytrace.bvh_world import NodeBVH, WorldBVH
-from glsandbox.raytrace.constants import (BVH_BOX_PAD_F64, OFFSETS, SIMPLE_OFFSET, RAY_POINT_GAMMA,
+from glsandbox.raytrace.constants import (BVH_BOX_PAD_F64, LENGTH_TINY, OFFSETS, SIMPLE_OFFSET, RAY_POINT_GAMMA,
                                           TRIANGLE_POINT_GAMMA, UNIT_F64, gamma)
 from glsandbox.raytrace.sphere import Sphere
 from glsandbox.raytrace.vec import length, moved_off
@@ -362,9 +362,9 @@ def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.fl
             color *= texel[:, :3]
             alpha[sel] *= texel[:, 3]
         base[sel] = color
-    normal /= np.maximum(length(normal), 1e-300)[:, None]
+    normal /= np.maximum(length(normal), LENGTH_TINY)[:, None]
     if spawn is not None:
-        spawn.normal /= np.maximum(length(spawn.normal), 1e-300)[:, None]
+        spawn.normal /= np.maximum(length(spawn.normal), LENGTH_TINY)[:, None]
     return point, normal, base, alpha, spawn
 
 
@@ -469,7 +469,7 @@ def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.floa
         total = np.zeros_like(mesh)
         for index, (light, light_color) in enumerate(zip(world.light_positions, world.light_colors)):
             to_light = light - p
-            to_light /= np.maximum(length(to_light), 1e-300)[:, None]
+            to_light /= np.maximum(length(to_light), LENGTH_TINY)[:, None]
             n_dot_l = np.einsum("ij,ij->i", nrm, to_light)
             diffuse = np.maximum(n_dot_l, 0.0)[:, None] * mesh * light_color
             reflected = -to_light + 2.0 * n_dot_l[:, None] * nrm  # fromLight − 2(fromLight·N)N
@@ -477,7 +477,7 @@ def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.floa
             cosine = r_dot_e
             if blinn.any():  # Blinn-Phong: N·H, H the unit halfway vector
                 halfway = to_light + to_eye
-                halfway /= np.maximum(length(halfway), 1e-300)[:, None]
+                halfway /= np.maximum(length(halfway), LENGTH_TINY)[:, None]
                 cosine = np.where(blinn, np.einsum("ij,ij->i", nrm, halfway), r_dot_e)
             cosine = np.maximum(cosine, 0.0)
             highlight = np.where(n_dot_l > 0.0, cosine ** shin, 0.0)

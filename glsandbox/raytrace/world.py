@@ -63,6 +63,7 @@ from glsandbox import transforms
 from glsandbox.geometry import Mesh
 from glsandbox.images import texture_levels
 from glsandbox.plan import traced_reflectivity
+from glsandbox.raytrace.constants import LENGTH_TINY, SQUARES_UNDERFLOW, UNIT_SHAPE_TOLERANCE
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.scene import MIN_SCALE, Camera, Node, Scene, Texture
 
@@ -253,7 +254,7 @@ def is_unit_sphere(mesh: Mesh) -> bool:
     if ANALYTIC_KINDS.get(mesh.analytic or "") is not NodeKind.SPHERE or mesh.mode != "triangles":
         return False
     radii = np.linalg.norm(np.asarray(mesh.positions, dtype=np.float64), axis=1)
-    return bool(np.all(np.abs(radii - 1.0) < 1e-9))
+    return bool(np.all(np.abs(radii - 1.0) < UNIT_SHAPE_TOLERANCE))
 
 
 def _unit_rows(v: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -262,13 +263,13 @@ def _unit_rows(v: NDArray[np.float64]) -> NDArray[np.float64]:
     underflows) is rescaled by its largest component first, so its direction
     survives instead of blowing up by ``1/1e-300``."""
     length = np.linalg.norm(v, axis=1, keepdims=True)
-    tiny = length[:, 0] < 1e-150
+    tiny = length[:, 0] < SQUARES_UNDERFLOW
     if np.any(tiny):
         big = np.abs(v[tiny]).max(axis=1, keepdims=True)
         v = v.copy()
         v[tiny] = np.divide(v[tiny], big, out=np.zeros_like(v[tiny]), where=big > 0.0)
         length[tiny] = np.linalg.norm(v[tiny], axis=1, keepdims=True)
-    return v / np.maximum(length, 1e-300)
+    return v / np.maximum(length, LENGTH_TINY)
 
 
 def _texture_image(texture: Texture) -> NDArray[np.float64]:
@@ -331,7 +332,7 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
         a, b, c = world[tri[:, 0]], world[tri[:, 1]], world[tri[:, 2]]
         if mesh.normals is not None and invertible:
             n_world = np.asarray(mesh.normals, dtype=np.float64) @ transforms.normal_matrix(model).T
-            n_world /= np.maximum(np.linalg.norm(n_world, axis=1, keepdims=True), 1e-300)
+            n_world /= np.maximum(np.linalg.norm(n_world, axis=1, keepdims=True), LENGTH_TINY)
             n = n_world[tri]
         else:  # flat (or flattened by the model): the face normal, counter-clockwise front (OpenGL's rule)
             face = _unit_rows(np.cross(b - a, c - a))
