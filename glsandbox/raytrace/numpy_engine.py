@@ -266,6 +266,52 @@ def _hit_sphere(world: World, node: NodeInfo, o: NDArray[np.float64], d: NDArray
     return t, np.full(d.shape[0], -1, dtype=np.intp)
 
 
+def _hit_cylinder(world: World, node: NodeInfo, o: NDArray[np.float64], d: NDArray[np.float64], one_sided: bool
+                  ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
+    inv = node.inverse
+    oo = o @ inv[:3, :3].T + inv[:3, 3]  # the ray in the unit cylinder's own space
+    dd = d @ inv[:3, :3].T
+    t = unit_cylinder_t(np.broadcast_to(oo, dd.shape), dd)
+    if one_sided:  # from inside, every front face faces away
+        inside = (oo[..., 0] ** 2 + oo[..., 2] ** 2 < 1.0) & (np.abs(oo[..., 1]) < 1.0)
+        t = np.where(inside, np.inf, t)
+    return t, np.full(d.shape[0], -1, dtype=np.intp)
+
+
+def unit_cylinder_t(o: NDArray[np.float64], d: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The nearest ``t > 0`` where rays ``o + t·d`` (``(N, 3)`` each) meet the capped unit
+    cylinder ``x² + z² ≤ 1, |y| ≤ 1``; inf for a miss.
+
+    The side is the circle ``x² + z² = 1`` in the xz-plane: the sphere's stable
+    quadratic (Ray Tracing Gems ch. 7) in two dimensions, its roots kept where
+    ``|y| ≤ 1``; each cap is the plane ``y = ±1`` (course "Işın-Düzlem kesim
+    testi"), kept where ``x² + z² ≤ 1``. A ray along the axis (``d_x = d_z =
+    0``) meets only the caps, one parallel to them only the side."""
+    ox, oy, oz = o[:, 0], o[:, 1], o[:, 2]
+    dx, dy, dz = d[:, 0], d[:, 1], d[:, 2]
+    best = np.full(d.shape[0], np.inf)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a = dx * dx + dz * dz
+        b = -(ox * dx + oz * dz)  # l·d with l = −o, in the xz-plane
+        hx = -ox - (b / a) * dx
+        hz = -oz - (b / a) * dz
+        disc = a * (1.0 - (hx * hx + hz * hz))
+        root = np.sqrt(np.maximum(disc, 0.0))
+        q = b + np.where(b >= 0.0, root, -root)
+        ell = np.hypot(ox, oz)
+        c = (ell - 1.0) * (ell + 1.0)
+        side = (a > 0.0) & (disc >= 0.0) & (q != 0.0)
+        for t in (c / q, q / a):
+            ok = side & (t > 0.0) & (t < best) & (np.abs(oy + t * dy) <= 1.0)
+            best = np.where(ok, t, best)
+        for y in (-1.0, 1.0):
+            t = (y - oy) / dy
+            px, pz = ox + t * dx, oz + t * dz
+            ok = (dy != 0.0) & (t > 0.0) & (t < best) & (px * px + pz * pz <= 1.0)
+            best = np.where(ok, t, best)
+    return best
+
+
 def _hit_triangles(world: World, node: NodeInfo, o: NDArray[np.float64], d: NDArray[np.float64], one_sided: bool
                    ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
     rows = slice(node.start, node.start + node.count)
@@ -384,6 +430,27 @@ def _surface_sphere(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[np.i
     return normal, uv, np.ones((sel.size, 3)) if node.mode == 1 else None
 
 
+def _surface_cylinder(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[np.intp], o: NDArray[np.float64],
+                      d: NDArray[np.float64], point: NDArray[np.float64], spawn: _Spawn | None
+                      ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64] | None]:
+    """A cylinder node's (normal, uv, vertex colour) at its hits, as :func:`glsandbox.geometry.cylinder`
+    lays them out: on a cap (the hit nearer ``|y| = 1`` than ``x² + z² = 1``) the cap's
+    normal and ``(½ + x/2, ½ + z/2)``, on the side the radial normal and ``(azimuth/2π, (1 − y)/2)``."""
+    inv = node.inverse
+    q = point[sel] @ inv[:3, :3].T + inv[:3, 3]  # the hit on the unit cylinder
+    r = np.hypot(q[:, 0], q[:, 2])
+    cap = np.abs(np.abs(q[:, 1]) - 1.0) < np.abs(r - 1.0)
+    own = np.where(cap[:, None], np.stack([np.zeros_like(r), np.sign(q[:, 1]), np.zeros_like(r)], axis=1),
+                   q * np.array([1.0, 0.0, 1.0]) / np.maximum(r, LENGTH_TINY)[:, None])
+    normal = own @ node.normal_matrix.T
+    if spawn is not None:
+        spawn.normal[sel] = normal
+    uv = np.where(cap[:, None], np.stack([0.5 + 0.5 * q[:, 0], 0.5 + 0.5 * q[:, 2]], axis=1),
+                  np.stack([np.mod(np.arctan2(q[:, 0], q[:, 2]), 2 * np.pi) / (2 * np.pi), 0.5 * (1.0 - q[:, 1])],
+                           axis=1))
+    return normal, uv, np.ones((sel.size, 3)) if node.mode == 1 else None
+
+
 def _surface_triangles(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[np.intp], o: NDArray[np.float64],
                        d: NDArray[np.float64], point: NDArray[np.float64], spawn: _Spawn | None
                        ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64] | None]:
@@ -413,8 +480,9 @@ def _surface_triangles(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[n
 #: test ``(world, node, o, d, one_sided) -> (t, world triangle or −1)`` in the node's
 #: own space, and a surface ``-> (normal, uv, vertex colour or None unless the node
 #: shows vertex colours)`` that also fills the spawn points (when given). A new kind is one entry in each.
-_HIT = {NodeKind.MESH: _hit_triangles, NodeKind.SPHERE: _hit_sphere}
-_SURFACE = {NodeKind.MESH: _surface_triangles, NodeKind.SPHERE: _surface_sphere}
+_HIT = {NodeKind.MESH: _hit_triangles, NodeKind.SPHERE: _hit_sphere, NodeKind.CYLINDER: _hit_cylinder}
+_SURFACE = {NodeKind.MESH: _surface_triangles, NodeKind.SPHERE: _surface_sphere,
+            NodeKind.CYLINDER: _surface_cylinder}
 
 
 def _interpolate(values: NDArray[np.float64], w: tuple[NDArray[np.float64], ...]) -> NDArray[np.float64]:
