@@ -11,14 +11,15 @@
 // offset glsandbox/raytrace/gpu_records.py defines (TRI_V0, NODE_INVERSE...,
 // with what each float holds); the node's kind code (NODE_BOX_MIN's w) is a
 // KIND_<NAME> define from glsandbox.raytrace.world.NodeKind. Mesh nodes
-// first (u_mesh_count of them), then the analytic nodes (u_sphere_count).
+// first (u_mesh_count of them), then the analytic nodes (u_shape_count).
 // A small scene has them in a uniform block (SceneData: u_node, u_tri), a
 // larger one in RGBA32F textures read with texelFetch (u_nodes, u_tris).
 //
 // Variants: NUM_LIGHTS (the light loop), NUM_TEXTURES (0..4 samplers),
 // SHADOWS (shadow rays), REFLECT (reflection bounces and passes through
 // see-through surfaces: some node reflects, is a cut-out or is blended, and
-// max_depth > 0), HAS_MESHES, HAS_SPHERES, VERTEX_COLORS (a node uses
+// max_depth > 0), HAS_MESHES, HAS_SHAPES (some analytic node) and
+// HAS_<KIND> per analytic kind (HAS_SPHERE, HAS_CYLINDER), VERTEX_COLORS (a node uses
 // them); SCENE_NODES (the scene's node list, see nearest()) with
 // NODE_COUNT and TRI_COUNT for a small scene, whose records are in the
 // uniform block.
@@ -45,7 +46,7 @@
 
 #elif defined(FRAGMENT_SHADER)
 uniform int u_mesh_count;    // mesh nodes: records 0 .. u_mesh_count-1
-uniform int u_sphere_count;  // sphere nodes: the next u_sphere_count records
+uniform int u_shape_count;  // analytic nodes (spheres, cylinders): the next u_shape_count records
 uniform vec2 u_size;        // the image in pixels
 uniform vec3 u_eye;         // camera position (world)
 uniform mat3 u_basis;       // view space -> world (right, up, back)
@@ -152,6 +153,71 @@ float sphere_t(vec3 o, vec3 d, bool cull) {
     return near > 0.0 ? near : (far > 0.0 ? far : INF);
 }
 
+// The capped unit cylinder x² + z² <= 1, |y| <= 1 in its own space
+// (numpy_engine.unit_cylinder_t): the side is the sphere's stable quadratic
+// in the xz-plane, its roots kept where |y| <= 1; each cap the plane y = ±1,
+// kept where x² + z² <= 1.
+float cylinder_t(vec3 o, vec3 d, bool cull) {
+    if (cull && dot(o.xz, o.xz) < 1.0 && abs(o.y) < 1.0) return INF;  // from inside
+    float best = INF;
+    float a = dot(d.xz, d.xz);
+    vec2 l = -o.xz;
+    float b = dot(l, d.xz);
+    vec2 h = l - (b / a) * d.xz;
+    float disc = a * (1.0 - dot(h, h));
+    if (a > 0.0 && disc >= 0.0) {
+        float q = b + (b >= 0.0 ? sqrt(disc) : -sqrt(disc));
+        if (q != 0.0) {
+            float l_len = length(l);
+            float c = (l_len - 1.0) * (l_len + 1.0);
+            float t0 = c / q, t1 = q / a;
+            if (t0 > 0.0 && t0 < best && abs(o.y + t0 * d.y) <= 1.0) best = t0;
+            if (t1 > 0.0 && t1 < best && abs(o.y + t1 * d.y) <= 1.0) best = t1;
+        }
+    }
+    if (d.y != 0.0) {
+        float tb = (-1.0 - o.y) / d.y, tt = (1.0 - o.y) / d.y;
+        vec2 pb = o.xz + tb * d.xz, pt = o.xz + tt * d.xz;
+        if (tb > 0.0 && tb < best && dot(pb, pb) <= 1.0) best = tb;
+        if (tt > 0.0 && tt < best && dot(pt, pt) <= 1.0) best = tt;
+    }
+    return best;
+}
+
+// --- the analytic kinds (glsandbox.raytrace.world.NodeKind, KIND_* defines):
+// a hit test and a surface (own-space normal, uv) per kind. A kind the scene
+// has not is compiled out (HAS_<KIND>); a new kind is one line in each.
+float shape_t(int kind, vec3 o, vec3 d, bool cull) {
+#if HAS_CYLINDER
+    if (kind == KIND_CYLINDER) return cylinder_t(o, d, cull);
+#endif
+    return sphere_t(o, d, cull);
+}
+
+const float PI = 3.14159265358979;
+
+// q: the hit in the kind's own space; n: its own-space normal.
+void shape_surface(int kind, vec3 q, out vec3 n, out vec2 uv) {
+#if HAS_CYLINDER
+    if (kind == KIND_CYLINDER) {  // as geometry.cylinder() lays them out
+        float r = length(q.xz);
+        float phi = atan(q.x, q.z);
+        if (abs(abs(q.y) - 1.0) < abs(r - 1.0)) {  // a cap
+            n = vec3(0.0, sign(q.y), 0.0);
+            uv = 0.5 + 0.5 * q.xz;
+        } else {
+            n = vec3(q.x, 0.0, q.z) / r;
+            uv = vec2((phi < 0.0 ? phi + 2.0 * PI : phi) / (2.0 * PI), 0.5 * (1.0 - q.y));
+        }
+        return;
+    }
+#endif
+    n = normalize(q);  // the hit on the unit sphere
+    float phi = atan(n.x, n.z);
+    uv = vec2((phi < 0.0 ? phi + 2.0 * PI : phi) / (2.0 * PI), acos(clamp(n.y, -1.0, 1.0)) / PI);
+}
+// --- end of the analytic kinds
+
 vec3 to_object(int k, vec3 p, float w) {
     vec4 h = vec4(p, w);
     return vec3(dot(node_rec(k, NODE_INVERSE), h), dot(node_rec(k, NODE_INVERSE + 1), h), dot(node_rec(k, NODE_INVERSE + 2), h));
@@ -185,7 +251,8 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
     // The node list unrolled, in scene order: SCENE_NODES is a sequence of
     // MESH(k, start, cull, lamps) (a loop over the node's triangles from
     // `start`), TRI(k, j, cull, lamps) (one triangle of a node too small to
-    // be worth a loop, gpu.UNROLL_TRIS) and SPHERE(k, cull, lamps), with the
+    // be worth a loop, gpu.UNROLL_TRIS) and SHAPE(k, kind, cull, lamps) (an
+    // analytic node, its KIND_* a literal), with the
     // record slot, triangles, one-sidedness and lamp bits as literals, so
     // node records are read at constant indices, and a strict `<` gives
     // ties to the earlier node and triangle (min_indis).
@@ -200,14 +267,14 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
         float t = triangle_t(j, wr, cull != 0, uv); \
         if (t < best) { best = t; hit_node = k; hit_tri = j; hit_uv = uv; } \
     }
-#define SPHERE(k, cull, lamps) { \
-        float t = sphere_t(to_object(k, o, 1.0), to_object(k, d, 0.0), cull != 0); \
+#define SHAPE(k, kind, cull, lamps) { \
+        float t = shape_t(kind, to_object(k, o, 1.0), to_object(k, d, 0.0), cull != 0); \
         if (t < best) { best = t; hit_node = k; hit_tri = -1; } \
     }
     SCENE_NODES
 #undef TRI
 #undef MESH
-#undef SPHERE
+#undef SHAPE
 #else
     // Any number of nodes: mesh nodes, then sphere nodes, in two loops over
     // the records; an equal t goes to the node first in scene order (r2.z),
@@ -238,12 +305,12 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
         }
     }
 #endif
-#if HAS_SPHERES
-    for (int k = u_mesh_count; k < u_mesh_count + u_sphere_count; ++k) {
+#if HAS_SHAPES
+    for (int k = u_mesh_count; k < u_mesh_count + u_shape_count; ++k) {
         vec4 r0 = node_rec(k, NODE_BOX_MIN);
         vec4 r1 = node_rec(k, NODE_BOX_MAX);
         if (u_aabb && !slab(o, inv_d, r0.xyz, r1.xyz, best)) continue;
-        float t = sphere_t(to_object(k, o, 1.0), to_object(k, d, 0.0), node_cull(r1));
+        float t = shape_t(int(r0.w), to_object(k, o, 1.0), to_object(k, d, 0.0), node_cull(r1));
         float order = node_rec(k, NODE_RANGE).z;
         if (t < best || (t == best && t < INF && order < best_order)) {
             best = t; best_order = order; hit_node = k; hit_tri = -1;
@@ -273,13 +340,13 @@ bool occluded(vec3 o, vec3 d, int light) {
 #define TRI(k, j, cull, lamps) if (((lamps >> light) & 1) == 0) { \
         hit = hit || triangle_t(j, wr, cull != 0, uv) < 1.0; \
     }
-#define SPHERE(k, cull, lamps) if (((lamps >> light) & 1) == 0) { \
-        hit = hit || sphere_t(to_object(k, o, 1.0), to_object(k, d, 0.0), cull != 0) < 1.0; \
+#define SHAPE(k, kind, cull, lamps) if (((lamps >> light) & 1) == 0) { \
+        hit = hit || shape_t(kind, to_object(k, o, 1.0), to_object(k, d, 0.0), cull != 0) < 1.0; \
     }
     SCENE_NODES
 #undef TRI
 #undef MESH
-#undef SPHERE
+#undef SHAPE
     return hit;
 #else
 #if HAS_MESHES && BVH
@@ -305,13 +372,13 @@ bool occluded(vec3 o, vec3 d, int light) {
         }
     }
 #endif
-#if HAS_SPHERES
-    for (int k = u_mesh_count; k < u_mesh_count + u_sphere_count; ++k) {
+#if HAS_SHAPES
+    for (int k = u_mesh_count; k < u_mesh_count + u_shape_count; ++k) {
         vec4 r0 = node_rec(k, NODE_BOX_MIN);
         vec4 r1 = node_rec(k, NODE_BOX_MAX);
         if (((int(node_rec(k, NODE_EXTRA).z) >> light) & 1) != 0) continue;
         if (u_aabb && !slab(o, inv_d, r0.xyz, r1.xyz, 1.0)) continue;
-        if (sphere_t(to_object(k, o, 1.0), to_object(k, d, 0.0), node_cull(r1)) < 1.0) return true;
+        if (shape_t(int(r0.w), to_object(k, o, 1.0), to_object(k, d, 0.0), node_cull(r1)) < 1.0) return true;
     }
 #endif
     return false;
@@ -380,17 +447,16 @@ void surface(int k, int j, float t, vec2 bary, vec3 o, vec3 d, out vec3 p, out v
     p = o + t * d;
     vec2 uv = vec2(0.0);
     vec3 colors = vec3(1.0);
-#if HAS_SPHERES && HAS_MESHES
+#if HAS_SHAPES && HAS_MESHES
     if (j < 0) {
 #endif
-#if HAS_SPHERES
-        vec3 q = normalize(to_object(k, p, 1.0));  // the hit on the unit sphere
-        n = vec3(dot(node_rec(k, NODE_NORMAL).xyz, q), dot(node_rec(k, NODE_NORMAL + 1).xyz, q), dot(node_rec(k, NODE_NORMAL + 2).xyz, q));
-        const float PI = 3.14159265358979;
-        float phi = atan(q.x, q.z);
-        uv = vec2((phi < 0.0 ? phi + 2.0 * PI : phi) / (2.0 * PI), acos(clamp(q.y, -1.0, 1.0)) / PI);
+#if HAS_SHAPES
+        vec3 q;  // the hit's own-space normal, through the normal matrix
+        shape_surface(int(node_rec(k, NODE_BOX_MIN).w), to_object(k, p, 1.0), q, uv);
+        n = vec3(dot(node_rec(k, NODE_NORMAL).xyz, q), dot(node_rec(k, NODE_NORMAL + 1).xyz, q),
+                 dot(node_rec(k, NODE_NORMAL + 2).xyz, q));
 #endif
-#if HAS_SPHERES && HAS_MESHES
+#if HAS_SHAPES && HAS_MESHES
     } else {
 #endif
 #if HAS_MESHES
@@ -408,7 +474,7 @@ void surface(int k, int j, float t, vec2 bary, vec3 o, vec3 d, out vec3 p, out v
         colors = w.x * ca.xyz + w.y * cb.xyz + w.z * cc.xyz;
 #endif
 #endif
-#if HAS_SPHERES && HAS_MESHES
+#if HAS_SHAPES && HAS_MESHES
     }
 #endif
     n = normalize(n);

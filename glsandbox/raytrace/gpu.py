@@ -36,7 +36,8 @@ early, and a record read at an index that varies per pixel costs 8 loads.
 So what a scene cannot reach is compiled out rather than branched around:
 ``NUM_LIGHTS`` and ``NUM_TEXTURES`` size the light loop and the samplers;
 ``SHADOWS`` (shadow rays), ``REFLECT`` (the bounce loop: some node reflects
-and ``max_depth > 0``), ``HAS_MESHES``, ``HAS_SPHERES`` and
+and ``max_depth > 0``), ``HAS_MESHES``, ``HAS_SHAPES`` (analytic nodes), one
+``HAS_<KIND>`` per analytic :class:`~glsandbox.raytrace.world.NodeKind` and
 ``VERTEX_COLORS`` switch code on.
 
 A small scene, at most :data:`UNROLL_NODES` nodes of which at most
@@ -127,7 +128,7 @@ from glsandbox.raytrace.constants import NODE_BOX_PAD, OFFSETS, SIMPLE_OFFSET, g
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.gpu_records import NODE, TRI, layout_defines
 from glsandbox.raytrace.watertight import nondegenerate
-from glsandbox.raytrace.world import MODES, World, build_world, camera_basis, kind_defines
+from glsandbox.raytrace.world import MODES, NodeKind, World, build_world, camera_basis, kind_defines
 from glsandbox.scene import Scene
 
 __all__ = ["LOOP_LIMIT", "GpuTracer", "MAX_TEXTURES", "check_loop_budget", "gpu_tracer"]
@@ -379,7 +380,10 @@ class _Uploaded:
         self.tris = pack_triangles(world, self.anchor)
         self.nodes = pack_nodes(world, self.anchor)
         self.mesh_count = sum(1 for node in world.nodes if node.kind.triangles)
-        self.sphere_count = len(world.nodes) - self.mesh_count
+        #: Analytic nodes (spheres, cylinders): the records after the mesh nodes'.
+        self.shape_count = len(world.nodes) - self.mesh_count
+        #: The node kinds present (the program's HAS_<KIND> defines).
+        self.kinds = frozenset(node.kind for node in world.nodes)
         loops = sum(1 for node in world.nodes if node.kind.triangles and node.count > UNROLL_TRIS)
         #: Some mesh node is large enough that its BVH beats the scan (:data:`BVH_TRIANGLES`).
         self.large_mesh = max((node.count for node in world.nodes if node.kind.triangles),
@@ -461,14 +465,14 @@ class _Uploaded:
 
     def scene_nodes(self, cull: bool | None) -> str:
         """The shader's unrolled node list: each node in scene order as
-        ``MESH(slot, start, count, cull, lamps)`` or ``SPHERE(slot, cull, lamps)``,
+        ``MESH(slot, start, count, cull, lamps)`` or ``SHAPE(slot, KIND_<NAME>, cull, lamps)``,
         ``cull`` resolved from the render's ``cull_backfaces`` (None: the node's own)."""
         slots = {k: slot for slot, k in enumerate(node_order(self.world))}
         parts = []
         for k, node in enumerate(self.world.nodes):
             one_sided = int(node.cull if cull is None else cull)
             if not node.kind.triangles:
-                parts.append(f"SPHERE({slots[k]},{one_sided},{node.lamp_of})")
+                parts.append(f"SHAPE({slots[k]},KIND_{node.kind.name},{one_sided},{node.lamp_of})")
             elif node.count <= UNROLL_TRIS:
                 parts += [f"TRI({slots[k]},{j},{one_sided},{node.lamp_of})" for j in range(node.start, node.start + node.count)]
             else:
@@ -521,10 +525,13 @@ class GpuTracer:
         self.reuses = 0
 
     def _program(self, lights: int, textures: int, shadows: bool = True, reflect: bool = True,
-                 meshes: bool = True, spheres: bool = True,
+                 kinds: frozenset[NodeKind] = frozenset(NodeKind),
                  scene: tuple[tuple[str, str], ...] = ()) -> tuple[moderngl.Program, moderngl.VertexArray]:
-        flags = (lights, textures, int(shadows and lights > 0), int(reflect), int(meshes), int(spheres))
-        names = ("NUM_LIGHTS", "NUM_TEXTURES", "SHADOWS", "REFLECT", "HAS_MESHES", "HAS_SPHERES")
+        shapes = [kind for kind in NodeKind if not kind.triangles]
+        flags = (lights, textures, int(shadows and lights > 0), int(reflect), int(NodeKind.MESH in kinds),
+                 int(any(kind in kinds for kind in shapes)), *(int(kind in kinds) for kind in shapes))
+        names = ("NUM_LIGHTS", "NUM_TEXTURES", "SHADOWS", "REFLECT", "HAS_MESHES", "HAS_SHAPES",
+                 *(f"HAS_{kind.name}" for kind in shapes))
         defines = (tuple((name, str(value)) for name, value in zip(names, flags)) + glsl_defines() + kind_defines()
                    + layout_defines() + scene)
         if defines in self._programs:
@@ -609,7 +616,7 @@ class GpuTracer:
             stack = uploaded.bvh_textures(self.ctx)
             scene_defines += (("BVH", "1"), ("BVH_STACK", str(stack)), ("BVH_MAX_STEPS", str(cap)))
         program, vao = self._program(lights, len(world.textures), shadows=bool(shadows), reflect=reflect,
-                                     meshes=uploaded.mesh_count > 0, spheres=uploaded.sphere_count > 0,
+                                     kinds=uploaded.kinds,
                                      scene=scene_defines)
         if uploaded.block is not None:
             program["SceneData"].binding = 0
@@ -621,7 +628,7 @@ class GpuTracer:
         if world.textures:  # as bytes: moderngl wants a bare int for a one-element array (one texture)
             program["u_wrap"].write(np.array([wrap for _, wrap in world.textures], dtype="i4").tobytes())
         values = {
-            "u_mesh_count": uploaded.mesh_count, "u_sphere_count": uploaded.sphere_count,
+            "u_mesh_count": uploaded.mesh_count, "u_shape_count": uploaded.shape_count,
             "u_size": (float(width), float(height)),
             "u_eye": tuple(eye - uploaded.anchor), "u_half": (half_w, half_h), "u_background": tuple(world.background),
             "u_max_depth": int(max_depth),
