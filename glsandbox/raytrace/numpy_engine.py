@@ -255,11 +255,17 @@ def _hit_node(world: World, k: int, o: NDArray[np.float64], d: NDArray[np.float6
     return _HIT[node.kind](world, node, o, d, one_sided)
 
 
+def _own_space(node: NodeInfo, o: NDArray[np.float64], d: NDArray[np.float64]
+               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Rays taken into an analytic node's own space by its inverse model matrix (an
+    affine map keeps ``t``: ``M⁻¹(O + t·d) = M⁻¹O + t·(M⁻¹d)``)."""
+    inv = node.inverse
+    return o @ inv[:3, :3].T + inv[:3, 3], d @ inv[:3, :3].T
+
+
 def _hit_sphere(world: World, node: NodeInfo, o: NDArray[np.float64], d: NDArray[np.float64], one_sided: bool
                 ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
-    inv = node.inverse
-    oo = o @ inv[:3, :3].T + inv[:3, 3]  # the ray in the unit sphere's own space
-    dd = d @ inv[:3, :3].T
+    oo, dd = _own_space(node, o, d)
     t = _UNIT_SPHERE.intersect_many(oo, dd)
     if one_sided:  # from inside, the sphere's front faces all face away
         t = np.where(np.einsum("...j,...j->...", oo, oo) < 1.0, np.inf, t)
@@ -268,9 +274,7 @@ def _hit_sphere(world: World, node: NodeInfo, o: NDArray[np.float64], d: NDArray
 
 def _hit_cylinder(world: World, node: NodeInfo, o: NDArray[np.float64], d: NDArray[np.float64], one_sided: bool
                   ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
-    inv = node.inverse
-    oo = o @ inv[:3, :3].T + inv[:3, 3]  # the ray in the unit cylinder's own space
-    dd = d @ inv[:3, :3].T
+    oo, dd = _own_space(node, o, d)
     t = unit_cylinder_t(np.broadcast_to(oo, dd.shape), dd)
     if one_sided:  # from inside, every front face faces away
         inside = (oo[..., 0] ** 2 + oo[..., 2] ** 2 < 1.0) & (np.abs(oo[..., 1]) < 1.0)
