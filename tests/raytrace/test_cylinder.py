@@ -149,3 +149,17 @@ def test_the_gpu_engine_traces_the_cylinder_as_the_numpy_engine(gl, monkeypatch)
     for image in images:
         diff = np.abs(image.astype(int) - ref.astype(int)).max(axis=-1)
         assert np.count_nonzero(diff > 2) <= 3 and diff.mean() < 0.5
+
+
+def test_a_scene_file_cylinder_is_traced_as_the_cylinder(tmp_path) -> None:
+    from glsandbox.scene_file import load_scene
+
+    path = tmp_path / "scene.toml"
+    path.write_text('[camera]\neye = [0, 2, 6]\n\n[[nodes]]\nname = "post"\nmesh = "cylinder"\n'
+                    'scale = [0.5, 1.5, 0.5]\nshading = "phong"\n\n[[lights]]\nposition = [2, 3, 2]\n')
+    scene = load_scene(path)
+    world = build_world(scene)
+    assert [node.kind for node in world.nodes] == [NodeKind.CYLINDER]
+    np.testing.assert_allclose(world.nodes[0].box_max, [0.5, 1.5, 0.5])
+    image = render(scene, (48, 36))
+    assert np.any(image != image[0, 0], axis=-1).mean() > 0.05
