@@ -49,8 +49,8 @@ with ``NODE_COUNT`` and ``TRI_COUNT``) lists every node in scene order as
 ``MESH`` (a loop over its triangles that runs as many times as the node's
 AABB test allows: none when the ray misses the box), ``TRI`` (each triangle
 of a node of at most :data:`UNROLL_TRIS`, tested without a loop) or
-``SPHERE``, with its record slot, triangle range, one-sidedness and lamp
-bits as literals, so its records are read at constant indices. Any larger
+``SHAPE`` (an analytic node, its ``KIND_<NAME>`` a literal), with its
+record slot, triangle range, one-sidedness and lamp bits as literals, so its records are read at constant indices. Any larger
 scene gets the general program: a loop over the node records and, inside
 it, over each node's triangles. Unrolling is paid in compile time (Mesa's
 shader cache is off): it grows exponentially with the number of triangle
@@ -179,7 +179,7 @@ BVH_MIN_STEPS = 256
 def bvh_step_cap(world: World, lights: int, shadows: bool, reflect: bool, max_depth: int) -> int:
     """The per-ray, per-mesh-node traversal bound (``BVH_MAX_STEPS``) of the BVH program:
     every ray of a pixel may traverse every mesh node's BVH to the bound, and the
-    sum with the other loops (node records, spheres, lights, bounces) stays within
+    sum with the other loops (node records, analytic nodes, lights, bounces) stays within
     :data:`LOOP_LIMIT`. A ray that reaches it is flagged (alpha 0) and the render
     raises. Raises :class:`RayTraceError` when the budget leaves too few steps."""
     bounces = 1 + (max_depth if reflect else 0)
@@ -275,7 +275,7 @@ def world_anchor(world: World) -> NDArray[np.float64]:
     traced in world coordinates there loses its shape (ids off on 2.9% and 15%
     of the pixels, and BVH boxes padded in proportion to the coordinates). Every
     position is therefore taken relative to this anchor in float64 on the CPU
-    (vertices, boxes, lights, the eye, spheres' inverse matrices) and only the
+    (vertices, boxes, lights, the eye, analytic nodes' inverse matrices) and only the
     difference is rounded to float32: the picture at 1e6 is the one at the
     origin. The anchor is the scene's own centre, not the eye, so a camera
     moving around the scene keeps the upload (the eye is one uniform)."""
@@ -308,7 +308,7 @@ def pack_triangles(world: World, anchor: NDArray[np.float64] | None = None) -> N
 
 
 def node_order(world: World) -> list[int]:
-    """The nodes as the shader stores them: mesh nodes first, then sphere nodes (scene order within)."""
+    """The nodes as the shader stores them: mesh nodes first, then analytic nodes (scene order within)."""
     meshes = [k for k, node in enumerate(world.nodes) if node.kind.triangles]
     return meshes + [k for k, node in enumerate(world.nodes) if not node.kind.triangles]
 
