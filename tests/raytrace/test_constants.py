@@ -9,11 +9,11 @@ import re
 import numpy as np
 
 from glsandbox.gl.shaders import shader_root
+from glsandbox.lesson import find_lesson
 from glsandbox.raytrace.constants import glsl_defines
 from glsandbox.raytrace.gpu import pack_nodes, pack_triangles
 from glsandbox.raytrace.gpu_records import NODE, TRI, layout_defines
 from glsandbox.raytrace.world import NodeKind, build_world, kind_defines
-from glsandbox.lesson import find_lesson
 
 
 def test_the_shared_glsl_fallbacks_are_the_constants() -> None:
