@@ -220,7 +220,8 @@ void shape_surface(int kind, vec3 q, out vec3 n, out vec2 uv) {
 
 vec3 to_object(int k, vec3 p, float w) {
     vec4 h = vec4(p, w);
-    return vec3(dot(node_rec(k, NODE_INVERSE), h), dot(node_rec(k, NODE_INVERSE + 1), h), dot(node_rec(k, NODE_INVERSE + 2), h));
+    return vec3(dot(node_rec(k, NODE_INVERSE), h), dot(node_rec(k, NODE_INVERSE + 1), h),
+                dot(node_rec(k, NODE_INVERSE + 2), h));
 }
 
 bool node_cull(vec4 r1) { return u_cull < 0 ? r1.w > 0.5 : u_cull == 1; }
@@ -234,7 +235,8 @@ bool node_cull(vec4 r1) { return u_cull < 0 ? r1.w > 0.5 : u_cull == 1; }
 // triangle, each behind its own exit (measured on 8 and 16 mesh nodes:
 // slower, and 1.5 to 1.7 times the compile time).
 int box_count(int k, vec3 o, vec3 inv_d, float best) {
-    return !u_aabb || slab(o, inv_d, node_rec(k, NODE_BOX_MIN).xyz, node_rec(k, NODE_BOX_MAX).xyz, best) ? int(node_rec(k, NODE_RANGE).y) : 0;
+    return !u_aabb || slab(o, inv_d, node_rec(k, NODE_BOX_MIN).xyz, node_rec(k, NODE_BOX_MAX).xyz, best)
+        ? int(node_rec(k, NODE_RANGE).y) : 0;
 }
 
 // The nearest hit with t > 0 (tDistances / min_indis): its t, node `k`,

@@ -51,9 +51,10 @@ AABB test allows: none when the ray misses the box), ``TRI`` (each triangle
 of a node of at most :data:`UNROLL_TRIS`, tested without a loop) or
 ``SHAPE`` (an analytic node, its ``KIND_<NAME>`` a literal), with its
 record slot, triangle range, one-sidedness and lamp bits as literals, so
-its records are read at constant indices. Any larger scene gets the general program: a loop over the node records and, inside
-it, over each node's triangles. Unrolling is paid in compile time (Mesa's
-shader cache is off): it grows exponentially with the number of triangle
+its records are read at constant indices. Any larger scene gets the
+general program: a loop over the node records and, inside it, over each
+node's triangles. Unrolling is paid in compile time (Mesa's shader cache
+is off): it grows exponentially with the number of triangle
 loops, which the bounds keep near a second; a lesson's first render, which
 compiles its variant, takes 0.4 to 0.9 s. In both programs shadow rays stop
 at their first hit, and the shading reuses the triangle test's barycentrics.
