@@ -117,6 +117,9 @@ NO_GAIN: float = 0.99
 SMALL: int = 64
 #: Padded slots (nodes × width) that ``_split_small`` scores in one batch: about a few MB of boxes each.
 SMALL_CHUNK: int = 1 << 16
+#: The widths ``_split_small`` pads nodes to (powers of two and halfway between: at most a third wasted),
+#: up to 64: SMALL and leaf_size (1..64) at most.
+WIDTHS = np.array([2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64])
 #: BVHs kept by :func:`bvh_for_triangles` / :func:`bvh_for_mesh`.
 CACHE_SIZE: int = 16
 
@@ -578,7 +581,7 @@ def _split_small(tree: _Tree, small: tuple[NDArray[np.int64], NDArray[np.int64],
     table[:, -1] = np.inf
     while ids.size:
         starts = np.cumsum(counts) - counts
-        width_class = np.left_shift(1, np.ceil(np.log2(counts)).astype(np.int64))
+        width_class = WIDTHS[np.searchsorted(WIDTHS, counts)]  # the narrowest padding that holds the node
         out_tris, out_cuts, order_nodes = [], [], []
         for w in np.unique(width_class):
             members = np.flatnonzero(width_class == w)
@@ -646,7 +649,7 @@ def _small_cuts(table: NDArray[np.float32], tris: NDArray[np.int64], starts: NDA
         keys <<= shift
         keys |= slot.T
         keys.sort(axis=1)
-        order = keys & (w - 1)  # (r, w): node j's slots by centroid
+        order = keys & ((1 << shift) - 1)  # (r, w): node j's slots by centroid
         orders.append(order)
         sweep = np.take(flat, order.T * r + columns, axis=1)  # (6, w, r): the boxes in that order
         back = sweep.copy()
