@@ -171,30 +171,26 @@ def watertight_pairs(setup: RaySetup, rays: NDArray[np.intp], v0: NDArray[np.flo
     sx, sy, sz = s[0], s[1], s[2]
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         coords = []
-        scratch = np.empty(rays.shape[0])
         for vertex in (v0, v1, v2):
             # Step 3: relative to the origin (the scalar's V − O), then sheared: x − sx·z, y − sy·z.
             p = vertex.reshape(-1).take(index)
             p -= s[3:]
-            x, y, z = p
-            x -= np.multiply(sx, z, out=scratch)
-            y -= np.multiply(sy, z, out=scratch)
-            coords.append((x, y, z))
+            p[:2] -= s[:2] * p[2]
+            coords.append(p)
         (ax, ay, az), (bx, by, bz), (cx, cy, cz) = coords
         u = _edge(cx, cy, bx, by)  # edge V1-V2: the weight of V0
         v = _edge(ax, ay, cx, cy)  # edge V2-V0: the weight of V1
         w = _edge(bx, by, ax, ay)  # edge V0-V1: the weight of V2
-        # Step 4: all signs alike (zeros on both sides); culling keeps the front faces only.
-        negative = u < 0.0
-        negative |= v < 0.0
-        negative |= w < 0.0
-        if cull_backfaces:
-            inside = ~negative
-        else:
-            positive = u > 0.0
-            positive |= v > 0.0
-            positive |= w > 0.0
-            inside = ~(negative & positive)
+        # Step 4: all signs alike (zeros on both sides): the smallest >= 0 or the largest <= 0;
+        # culling keeps the front faces only (the smallest >= 0). A NaN edge (coordinates
+        # that overflow) is neither: a miss, as its NaN t would be.
+        low = np.minimum(u, v)
+        np.minimum(low, w, out=low)
+        inside = low >= 0.0
+        if not cull_backfaces:
+            high = np.maximum(u, v, out=low)
+            np.maximum(high, w, out=high)
+            inside |= high <= 0.0
         det = u + v
         det += w
         inside &= det != 0.0
