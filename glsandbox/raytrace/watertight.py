@@ -154,7 +154,7 @@ def _edge(px: NDArray[np.float64], py: NDArray[np.float64], qx: NDArray[np.float
 
 def watertight_pairs(setup: RaySetup, rays: NDArray[np.intp], v0: NDArray[np.float64], v1: NDArray[np.float64],
                      v2: NDArray[np.float64], tris: NDArray[np.intp], cull_backfaces: bool = False,
-                     barycentrics: bool = True
+                     barycentrics: bool = True, relative: bool = False
                      ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None]:
     """Ray ``rays[i]`` against triangle ``tris[i]`` for every ``i``: ``(t, u, v)``, ``(P,)`` each.
 
@@ -162,19 +162,21 @@ def watertight_pairs(setup: RaySetup, rays: NDArray[np.intp], v0: NDArray[np.flo
     ``(u, v)`` are the hit's barycentrics in the course's form
     ``P = V0 + u·(V1 − V0) + v·(V2 − V0)`` (meaningless for a miss; None
     when ``barycentrics`` is False: a traversal needs ``t`` alone).
-    ``v0, v1, v2`` are ``(M, 3)`` float64 arrays.
+    ``v0, v1, v2`` are ``(M, 3)`` float64 arrays; ``relative``: they are already
+    ``V − O`` for the one origin every ray shares (the same numbers step 3 forms).
     """
     # Each pair's flat vertex rows: component k of triangle j is [3j + k] (kx, ky, kz rows).
     index = setup.k.take(rays, axis=1)
     index += tris * 3
-    s = setup.s.take(rays, axis=1)  # sx, sy, sz, ox, oy, oz
+    s = (setup.s[:3] if relative else setup.s).take(rays, axis=1)  # sx, sy, sz(, ox, oy, oz)
     sx, sy, sz = s[0], s[1], s[2]
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         coords = []
         for vertex in (v0, v1, v2):
             # Step 3: relative to the origin (the scalar's V − O), then sheared: x − sx·z, y − sy·z.
             p = vertex.reshape(-1).take(index)
-            p -= s[3:]
+            if not relative:
+                p -= s[3:]
             p[:2] -= s[:2] * p[2]
             coords.append(p)
         (ax, ay, az), (bx, by, bz), (cx, cy, cz) = coords
