@@ -92,27 +92,27 @@ def ray_setup(origins: ArrayLike, directions: ArrayLike) -> RaySetup:
     """Steps 1 and 2 for ``N`` rays (``origins`` may be one shared ``(3,)`` point)."""
     o, d = broadcast_rays(origins, directions)
     n = d.shape[0]
-    a = np.abs(d.T)
-    if np.isnan(a).any():  # argmax's rule for NaN (the first NaN is the largest); such a ray misses anyway
-        kz = np.argmax(a, axis=0)
-    else:  # the first largest component, as np.argmax in the scalar test, without a per-row reduction
-        kz = np.where((a[0] >= a[1]) & (a[0] >= a[2]), 0, np.where(a[1] >= a[2], 1, 2))
-    k = np.empty((3, n), dtype=np.intp)
-    k[2] = kz
-    np.add(kz, 1, out=k[0])
-    k[0][k[0] == 3] = 0
-    np.add(k[0], 1, out=k[1])
-    k[1][k[1] == 3] = 0
     rows = np.arange(n)
+    a = np.abs(d)
+    if np.isnan(a).any():  # argmax's rule for NaN (the first NaN is the largest); such a ray misses anyway
+        kz = np.argmax(a, axis=1)
+    else:  # the first largest component, as np.argmax in the scalar test, without a per-row reduction
+        ax, ay, az = a.T
+        kz = np.where((ax >= ay) & (ax >= az), 0, np.where(ay >= az, 1, 2))
+    k = np.empty((3, n), dtype=np.intp)
+    kx = (kz + 1) % 3
+    ky = (kx + 1) % 3
     flip = d[rows, kz] < 0.0  # keep the winding: swap kx and ky
-    k[0], k[1] = np.where(flip, k[1], k[0]), np.where(flip, k[0], k[1])
+    k[0] = np.where(flip, ky, kx)
+    k[1] = np.where(flip, kx, ky)
+    k[2] = kz
     s = np.empty((6, n))
-    dx, dy, dz = d[rows, k[0]], d[rows, k[1]], d[rows, kz]
+    dz = d[rows, kz]
     with np.errstate(divide="ignore", invalid="ignore"):  # a zero direction: NaN, and it misses
-        np.divide(dx, dz, out=s[0])
-        np.divide(dy, dz, out=s[1])
+        np.divide(d[rows, k[0]], dz, out=s[0])
+        np.divide(d[rows, k[1]], dz, out=s[1])
         np.divide(1.0, dz, out=s[2])
-    if o.strides[0] == 0:  # one shared origin: gather from its (3,) row
+    if n and o.strides[0] == 0:  # one shared origin: its (3,) row permuted
         s[3:] = o[0][k]
     else:
         s[3], s[4], s[5] = o[rows, k[0]], o[rows, k[1]], o[rows, kz]
