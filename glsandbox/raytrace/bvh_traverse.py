@@ -5,18 +5,24 @@ it (the slab test, :mod:`glsandbox.raytrace.aabb`)? A BVH asks it again for
 the two boxes inside, and so on down to the leaves, where the triangles are
 tested with the watertight test (:mod:`glsandbox.raytrace.watertight`).
 
-No Python loop runs per ray. The traversal keeps a *frontier* of (ray, node)
-pairs and advances all of them one tree level per step:
+No Python loop runs per ray. The traversal tests the root's box for every
+ray, then keeps a *frontier* of (ray, inner node) pairs whose box the ray
+entered and advances all of them one tree level per step:
 
-1. the slab test for every pair at once (three component arrays), dropping
-   pairs whose ray misses the box, or enters it only beyond the ray's best
-   hit so far;
-2. leaf pairs become (ray, triangle) pairs, tested all at once; each ray
-   keeps its nearest hit;
-3. inner pairs become two pairs, one per child, for the next step.
+1. the slab test of both children of every pair at once: the children's
+   twelve planes are one column of a table kept per node (:class:`_Boxes`),
+   gathered in one call, and the arithmetic runs on ``(2, 2, 3, pairs)``
+   arrays (side, child, axis), dropping children the ray misses or enters
+   only beyond its best hit so far;
+2. kept leaf children become (ray, triangle) pairs, tested all at once; each
+   ray keeps its nearest hit (before the next level's boxes are tested);
+3. kept inner children are the next frontier.
 
-Rays are traced in blocks (:data:`RAY_BLOCK`) so a block's frontier stays
-small. Shadow rays (:func:`any_hit`) leave the frontier at their first hit.
+Every ray does exactly the tests of a level-by-level walk of its own (a
+level's boxes, then its leaves): how the pairs are batched changes the time,
+never what is tested or counted. Rays are traced in blocks
+(:data:`RAY_BLOCK`) so a step's temporaries stay in cache. Shadow rays
+(:func:`any_hit`) leave the frontier at their first hit.
 
 The nearest hit keeps the course's ``min_indis`` rule exactly as
 :func:`glsandbox.raytrace.numpy_engine._nearest` does: the smallest ``t`` with
