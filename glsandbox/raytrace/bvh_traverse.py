@@ -64,6 +64,9 @@ BOX_PAD: float = 2.0**-40
 #: in a core's cache: 4,096 rays measured 15% faster than 16,384 on a 10k-triangle
 #: model, and 1,024 slower again (numpy's per-call cost).
 RAY_BLOCK: int = 1 << 12
+#: Rays that share an origin test triangles moved to it (``V − O`` kept per BVH for the
+#: last origin) up to this many triangles: a few percent faster, 72 bytes a triangle.
+MOVED_CORNERS: int = 1 << 18
 _NO_TRIANGLE = np.iinfo(np.int64).max
 
 
@@ -134,18 +137,22 @@ class _Boxes:
         self.kids, self.root, self.kid_leaf, self.left, self.root_leaf = layout
         origin = shared_origin(o)
         self.shared = origin.ndim == 1
+        corners = None
         if self.shared:
             key = origin.tobytes()
             moved = bvh.__dict__.get("_kernel_moved")
             if moved is None or moved[0] != key:
                 o_pad = BOX_PAD * float(np.abs(origin).max(initial=0.0))
-                # The triangles too: V − O, the watertight test's first step, once per origin.
-                corners = tuple(np.subtract(v, origin) for v in (bvh.v0, bvh.v1, bvh.v2))
+                # The triangles too: V − O, the watertight test's first step, once per origin
+                # (up to MOVED_CORNERS triangles: 72 bytes each).
+                corners = tuple(np.subtract(v, origin) for v in (bvh.v0, bvh.v1, bvh.v2)) \
+                    if bvh.triangle_count <= MOVED_CORNERS else None
                 moved = (key, _moved(self.kids, o_pad, origin), _moved(self.root, o_pad, origin), corners)
                 object.__setattr__(bvh, "_kernel_moved", moved)
-            self.kids, self.root, self.corners = moved[1], moved[2], moved[3]
-        else:
-            self.corners = (bvh.v0, bvh.v1, bvh.v2)
+            self.kids, self.root, corners = moved[1], moved[2], moved[3]
+        #: The corners the watertight test reads, and whether they are already ``V − O``.
+        self.relative = self.shared and corners is not None
+        self.corners = corners if self.relative else (bvh.v0, bvh.v1, bvh.v2)
 
 
 def _layout(bvh: BVH) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_], NDArray[np.intp], bool]:
@@ -302,7 +309,7 @@ def _closest_block(bvh: BVH, block: _Block, cull: bool, counts: TraversalCounts 
     def leaves(rays: NDArray[np.intp], nodes: NDArray[np.intp]) -> None:
         rr, slots = _leaf_pairs(bvh, rays, nodes)
         t, _, _ = watertight_pairs(block.setup, rr, *block.boxes.corners, slots, cull, barycentrics=False,
-                                   relative=block.boxes.shared)
+                                   relative=block.boxes.relative)
         if counts is not None:
             counts.triangles += rr.size
         # Only pairs at or before their ray's best so far (and before its t_max) can change
@@ -353,7 +360,7 @@ def closest_hit(bvh: BVH, origins: ArrayLike, directions: ArrayLike, t_max: Arra
                 counts.triangles += hit.size
             # The winners' barycentrics, from the same test (so the same t).
             t, u, v = watertight_pairs(block.setup, hit, *block.boxes.corners, block.best_slot[hit],
-                                       bool(cull_backfaces), relative=boxes.shared)
+                                       bool(cull_backfaces), relative=boxes.relative)
             rows = hit + lo
             out.t[rows] = t
             out.triangle[rows] = block.best_tri[hit]
@@ -384,7 +391,7 @@ def any_hit(bvh: BVH, origins: ArrayLike, directions: ArrayLike, t_max: ArrayLik
                    done: NDArray[np.bool_] = done) -> None:
             rr, slots = _leaf_pairs(bvh, rays, nodes)
             t, _, _ = watertight_pairs(block.setup, rr, *block.boxes.corners, slots, cull, barycentrics=False,
-                                   relative=block.boxes.shared)
+                                   relative=block.boxes.relative)
             if counts is not None:
                 counts.triangles += rr.size
             done[rr[t < block.limit[rr]]] = True

@@ -243,6 +243,21 @@ def test_shared_origin_rays_of_a_camera_on_a_real_model() -> None:
     assert 0.2 < got.hit.mean() < 0.9
 
 
+@pytest.mark.parametrize("moved", [True, False])
+def test_shared_origin_rays_with_and_without_the_corners_moved_to_the_eye(moved: bool, monkeypatch) -> None:
+    """Below ``MOVED_CORNERS`` triangles a BVH keeps its corners moved to the eye (``V − O``,
+    the watertight test's first step, done once); above it each pair forms ``V − O``: the same numbers."""
+    from glsandbox.raytrace import bvh_traverse
+
+    monkeypatch.setattr(bvh_traverse, "MOVED_CORNERS", 1 << 18 if moved else 0)
+    a, b, c = soup(21, 300)
+    bvh = build_bvh(a, b, c)
+    _, dirs = rays(22, 400)
+    eye = np.array([0.5, 7.0, -1.0])
+    assert_same_hits(closest_hit(bvh, eye, dirs), closest_hit_brute_force(a, b, c, eye, dirs))
+    assert (bvh.__dict__["_kernel_moved"][3] is not None) == moved  # the path taken is the one meant
+
+
 def test_brute_force_keeps_the_first_minimum_and_the_scalar_t() -> None:
     a, b, c = soup(11, 30)
     o, d = rays(11, 40)
