@@ -73,7 +73,7 @@ from glsandbox.files import open_user_file
 from glsandbox.geometry import Mesh
 from glsandbox.meshcheck import MEMORY_ENV, check_memory, checked_data, claimed_triangles
 from glsandbox.meshlooks import Look, file_warnings, is_closed, look_of
-from glsandbox.meshnormals import BLOCK_FACES, face_cross, normal_groups, row_ids, split_vertices
+from glsandbox.meshnormals import face_geometry, normal_groups, row_ids, split_vertices
 from glsandbox.scene import Material, Node, Texture
 
 __all__ = ["CREASE_ANGLE", "FORMATS", "NORMALS", "Model", "ModelPart", "fit_mesh", "is_model_path", "load_mesh",
@@ -471,12 +471,11 @@ def _part(mesh: Any, transform: NDArray[np.float64], index: int, looks: dict[int
 def _file_normals(mesh: Any, count: int) -> NDArray[np.float64] | None:
     """The vertex normals the file gave, or None. trimesh keeps given normals in the
     mesh's cache (its exporters test the same way); asking ``mesh.vertex_normals``
-    would compute some instead."""
-    cache = getattr(mesh, "_cache", None)
-    try:
-        given = cache["vertex_normals"] if cache is not None and "vertex_normals" in cache else None
-    except Exception:
-        return None
+    would compute some instead. The cache's own dict is read: asking the cache
+    (``in``, ``[]``) first hashes the mesh's arrays to see whether they changed since,
+    which they have not (``process=False``: nothing after reading touches them)."""
+    store = getattr(getattr(mesh, "_cache", None), "cache", None)
+    given = store.get("vertex_normals") if isinstance(store, dict) else None
     if given is None:
         return None
     normals = np.array(given, dtype=np.float64)
@@ -567,18 +566,26 @@ def _group_mesh(p: Path, file_type: str, parts: list[_Part], normals_mode: str, 
     file_normals = None
     if all(part.normals is not None for part in parts):
         file_normals = np.concatenate([part.normals for part in parts])  # type: ignore[misc]
-    # Degenerate faces: dropped and counted.
-    keep = ~_degenerate(positions, faces)
+    # What normals need of each face (its unit normal, its corner angles: none when the file's normals
+    # will do), and its area: degenerate faces are dropped and counted.
+    angles_needed = normals_mode not in ("auto", "file", "flat") or (normals_mode == "auto" and file_normals is None)
+    unit, angles, flat = face_geometry(positions, faces, angles_needed, DEGENERATE_SHARE)
+    keep = ~((faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 0] == faces[:, 2]) | flat)
+    del flat
     dropped = int(faces.shape[0] - keep.sum())
     if not keep.any():
         return None, 0, dropped, ""
     if dropped:
-        faces = faces[keep]
+        faces, unit = faces[keep], unit[keep]
+        if angles.size:
+            angles = angles.reshape(-1, 3)[keep].reshape(-1)
     if corner_colors is not None:
         corner_colors = corner_colors[keep]
+    del keep
     position_ids = row_ids(positions, ordered=False)[0]
     group, group_normals, how = _normal_groups(p, positions, faces, file_normals, normals_mode, crease,
-                                               position_ids)
+                                               position_ids, (unit, angles))
+    del unit, angles
     corners = faces.reshape(-1)
     index, first = _split_vertices(position_ids, uvs, corners, corner_colors, group, group_normals)
     chosen = corners[first]
@@ -620,30 +627,14 @@ def _corner_colors(parts: list[_Part]) -> NDArray[np.float64]:
     return np.concatenate(blocks)
 
 
-def _degenerate(positions: NDArray[np.float64], faces: NDArray[np.int64]) -> NDArray[np.bool_]:
-    """Faces with a repeated index or (numerically) zero area, worked out in blocks of faces
-    (bounded temporaries)."""
-    flat = np.empty(faces.shape[0], dtype=bool)
-    for lo in range(0, faces.shape[0], BLOCK_FACES):
-        block = faces[lo:lo + BLOCK_FACES]
-        a, b, c = (positions.take(block[:, k], axis=0) for k in range(3))  # take: faster than positions[...]
-        with np.errstate(all="ignore"):
-            cross = face_cross(a, b, c)
-            doubled_area_sq = np.einsum("ij,ij->i", cross, cross)
-            longest = np.zeros(block.shape[0])
-            for e in (b - a, c - b, a - c):
-                np.maximum(longest, np.einsum("ij,ij->i", e, e), out=longest)
-            # |cross| > share * longest², compared squared (both sides are non-negative).
-            flat[lo:lo + BLOCK_FACES] = ~(doubled_area_sq > (DEGENERATE_SHARE * longest) ** 2)
-    repeated = (faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 0] == faces[:, 2])
-    return repeated | flat
-
-
 def _normal_groups(p: Path, positions: NDArray[np.float64], faces: NDArray[np.int64],
                    file_normals: NDArray[np.float64] | None, mode: str, crease: float,
-                   position_ids: NDArray[np.intp]) -> tuple[NDArray[np.intp], NDArray[np.float64], str]:
+                   position_ids: NDArray[np.intp], geometry: tuple[NDArray[np.float64], NDArray[np.float64]],
+                   ) -> tuple[NDArray[np.intp], NDArray[np.float64], str]:
     """Corner normals as ``(group (C,), unit normals (G, 3))`` (corner ``c`` has ``normals[group[c]]``,
-    :func:`glsandbox.meshnormals.normal_groups`), and how they were made."""
+    :func:`glsandbox.meshnormals.normal_groups`), and how they were made. ``geometry``: the faces'
+    unit normals and corner angles (:func:`glsandbox.meshnormals.face_geometry`; no angles when
+    the file's normals were expected)."""
     if mode in ("auto", "file"):
         usable = None
         if file_normals is not None:
@@ -658,7 +649,8 @@ def _normal_groups(p: Path, positions: NDArray[np.float64], faces: NDArray[np.in
             why = "has no vertex normals" if file_normals is None else "has zero-length or non-finite normals"
             raise SandboxError(f"model file {p} {why} (normals = \"file\"); use \"auto\" to compute them")
         mode = "crease"
-    group, normals = normal_groups(positions, np.asarray(faces, dtype=np.intp), mode, crease, position_ids)
+    known = geometry if mode == "flat" or geometry[1].size else None
+    group, normals = normal_groups(positions, np.asarray(faces, dtype=np.intp), mode, crease, position_ids, known)
     return group, normals, f"crease {crease:g}°" if mode == "crease" else mode
 
 

@@ -53,7 +53,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["BLOCK_FACES", "MODES", "PAIR_LIMIT", "corner_normals", "face_normals", "normal_groups", "row_ids", "split_vertices",
+__all__ = ["BLOCK_FACES", "MODES", "PAIR_LIMIT", "corner_normals", "face_geometry", "face_normals", "normal_groups", "row_ids", "split_vertices",
            "unique_vertices"]
 
 #: The ways to make normals.
@@ -81,10 +81,13 @@ def face_normals(positions: NDArray[np.float64], tris: NDArray[np.intp]) -> NDAr
 
 
 def face_cross(p0: NDArray[np.float64], p1: NDArray[np.float64], p2: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``(V1 − V0) × (V2 − V0)`` per face from its corners' positions ``(F, 3)`` each, written out
-    per component (``np.cross`` is several times slower); its length is the doubled area."""
-    e1 = p1 - p0
-    e2 = p2 - p0
+    """``(V1 − V0) × (V2 − V0)`` per face from its corners' positions ``(F, 3)`` each; its length
+    is the doubled area."""
+    return _cross(p1 - p0, p2 - p0)
+
+
+def _cross(e1: NDArray[np.float64], e2: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``e1 × e2`` row by row, written out per component (``np.cross`` is several times slower)."""
     n = np.empty_like(e1)
     n[:, 0] = e1[:, 1] * e2[:, 2] - e1[:, 2] * e2[:, 1]
     n[:, 1] = e1[:, 2] * e2[:, 0] - e1[:, 0] * e2[:, 2]
@@ -98,30 +101,46 @@ def _unit_rows(rows: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[
     return np.divide(rows, size[:, None], out=np.zeros_like(rows), where=size[:, None] > 0.0), size
 
 
-def _faces_and_angles(positions: NDArray[np.float64], tris: NDArray[np.intp],
-                      with_angles: bool) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Unit face normals ``(F, 3)`` and the corner angles ``(3F,)`` (empty unless ``with_angles``),
-    in blocks of :data:`BLOCK_FACES` faces."""
+def face_geometry(positions: NDArray[np.float64], tris: NDArray[np.intp], with_angles: bool = True,
+                  degenerate_share: float | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64],
+                                                                   NDArray[np.bool_] | None]:
+    """What normals need of each face, in one pass over its corners' positions (blocks of
+    :data:`BLOCK_FACES` faces): ``(unit normals (F, 3), corner angles (3F,), flat)``.
+
+    The angles are empty unless ``with_angles``. ``flat`` (None unless
+    ``degenerate_share`` is given) marks the faces whose doubled area is at most
+    ``degenerate_share`` times their longest edge squared (the sine of the
+    largest angle is that small): zero area up to rounding.
+    """
     f = tris.shape[0]
     faces = np.empty((f, 3))
     angles = np.empty((f, 3) if with_angles else (0, 3))
+    flat = None if degenerate_share is None else np.empty(f, dtype=bool)
     for lo in range(0, f, BLOCK_FACES):
         block = tris[lo:lo + BLOCK_FACES]
         p0, p1, p2 = (positions.take(block[:, k], axis=0) for k in range(3))  # take: faster than positions[...]
-        faces[lo:lo + BLOCK_FACES], doubled_area = _unit_rows(face_cross(p0, p1, p2))
+        e01, e02, e12 = p1 - p0, p2 - p0, p2 - p1
+        del p0, p1, p2
+        cross = _cross(e01, e02)
+        area_sq = np.einsum("ij,ij->i", cross, cross)
+        size = np.sqrt(area_sq)
+        unit = faces[lo:lo + BLOCK_FACES]
+        unit[:] = 0.0  # a zero row stays zero
+        np.divide(cross, size[:, None], out=unit, where=size[:, None] > 0.0)
+        if flat is not None:
+            longest = np.einsum("ij,ij->i", e01, e01)
+            for e in (e12, e02):
+                np.maximum(longest, np.einsum("ij,ij->i", e, e), out=longest)
+            # |cross| > share * longest², compared squared (both sides are non-negative).
+            flat[lo:lo + BLOCK_FACES] = ~(area_sq > (degenerate_share * longest) ** 2)
         if with_angles:
-            angles[lo:lo + BLOCK_FACES] = _corner_angles(p0, p1, p2, doubled_area)
-    return faces, angles.reshape(-1)
-
-
-def _corner_angles(p0: NDArray[np.float64], p1: NDArray[np.float64], p2: NDArray[np.float64],
-                   doubled_area: NDArray[np.float64]) -> NDArray[np.float64]:
-    """The angle ``(F, 3)`` of each face at each of its corners: ``atan2(|e × e'|, e · e')`` for
-    the two edges leaving the corner, where ``|e × e'|`` is the doubled area at all three corners."""
-    angles = np.empty((p0.shape[0], 3))
-    for k, (here, nxt, prv) in enumerate(((p0, p1, p2), (p1, p2, p0), (p2, p0, p1))):
-        angles[:, k] = np.arctan2(doubled_area, np.einsum("ij,ij->i", nxt - here, prv - here))
-    return angles
+            # atan2(|e × e'|, e · e') for the two edges leaving each corner; |e × e'| is the doubled
+            # area at all three corners. At V1 the edges are -e01 and e12, at V2 -e02 and -e12.
+            block_angles = angles[lo:lo + BLOCK_FACES]
+            block_angles[:, 0] = np.arctan2(size, np.einsum("ij,ij->i", e01, e02))
+            block_angles[:, 1] = np.arctan2(size, -np.einsum("ij,ij->i", e12, e01))
+            block_angles[:, 2] = np.arctan2(size, np.einsum("ij,ij->i", e02, e12))
+    return faces, angles.reshape(-1), flat
 
 
 def _by_first_appearance(first: NDArray[np.intp], inverse: NDArray[np.intp]) -> tuple[NDArray[np.intp],
@@ -227,19 +246,24 @@ def corner_normals(positions: NDArray[np.float64], tris: NDArray[np.intp], mode:
 
 def normal_groups(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: str = "crease",
                   crease_angle: float = 30.0, position_ids: NDArray[np.intp] | None = None,
+                  geometry: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
                   ) -> tuple[NDArray[np.intp], NDArray[np.float64]]:
     """``(group (C,), normals (G, 3))``: corner ``c`` (face ``c // 3``, its corner ``c % 3``) has the
     unit normal ``normals[group[c]]``, made the way ``mode`` says (module docstring).
 
     ``tris`` must hold no zero-area face. Where a weighted sum cancels to zero
     (a knife edge), the corner takes its face's own normal. ``position_ids``:
-    :func:`row_ids` of ``positions`` when the caller has it already.
+    :func:`row_ids` of ``positions`` when the caller has it already; ``geometry``: the unit
+    face normals and corner angles of :func:`face_geometry`, likewise.
     """
     if mode not in MODES:
         raise ValueError(f"unknown normals mode {mode!r}; use one of {', '.join(MODES)}")
     tris = np.asarray(tris, dtype=np.intp)
     f = tris.shape[0]
-    faces, angles = _faces_and_angles(positions, tris, with_angles=mode != "flat")
+    if geometry is None:
+        faces, angles, _ = face_geometry(positions, tris, with_angles=mode != "flat")
+    else:
+        faces, angles = geometry
     if mode == "flat" or f == 0:
         return np.repeat(np.arange(f, dtype=np.intp), 3), faces
     pid = row_ids(positions, ordered=False)[0] if position_ids is None else position_ids
@@ -250,22 +274,21 @@ def normal_groups(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: 
         sums = _sums(corner_pid, faces, angles, npos)
         return _finish(corner_pid, sums, faces)
     cos_limit = math.cos(math.radians(crease_angle))
-    # Tier 1: positions whose normals all lie within half the crease angle of their mean direction.
-    mean = _unit_rows(_sums(corner_pid, faces, None, npos))[0]
+    # Tier 1: positions whose normals all lie within half the crease angle of the direction of their
+    # angle-weighted sum (any reference direction serves the triangle inequality; this one is the
+    # answer of tier 1 already, so it is summed once).
+    sums = _sums(corner_pid, faces, angles, npos)
     half = max(0.0, math.radians(crease_angle) / 2.0 - _HALF_ANGLE_MARGIN)
-    rough_pos = _rough_positions(corner_pid, faces, mean, math.cos(half))
-    rough = rough_pos[corner_pid]
+    rough_pos = _rough_positions(corner_pid, faces, _unit_rows(sums)[0], math.cos(half))
+    which = np.flatnonzero(rough_pos[corner_pid])
     del rough_pos
-    which = np.flatnonzero(rough)
     if which.size == 0:
-        del mean, rough, which  # (memory: they go before the sums are made)
-        return _finish(corner_pid, _sums(corner_pid, faces, angles, npos), faces)
+        return _finish(corner_pid, sums, faces)
     # Tiers 2 and 3: every rough corner gets a group of its own numbered after the positions;
     # corners of one smoothing group get the same sum, so they merge again by their normal.
+    # (Every corner of a rough position is rough: that position's row of ``sums`` is not used.)
     rough_angles = angles[which]
-    angles[which] = 0.0  # rough corners weigh nothing in their position's tier-1 sum
-    smooth_sums = _sums(corner_pid, faces, angles, npos)
-    del angles, rough
+    del angles
     rough_pid = corner_pid[which]
     big = np.bincount(rough_pid, minlength=npos)[rough_pid] > PAIR_LIMIT
     rough_sums = np.zeros((which.size, 3))
@@ -275,11 +298,15 @@ def normal_groups(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: 
         rough_sums[~big] = _pair_sums(rough_pid[~big], own, own * rough_angles[~big, None], cos_limit)
     big_corners = which[big]
     if big_corners.size:
-        rough_sums[big] = _ring_sums(positions, tris, big_corners, rough_pid[big], faces[big_corners // 3],
-                                     rough_angles[big], mean[rough_pid[big]], cos_limit)
+        big_pid = rough_pid[big]
+        own = faces[big_corners // 3]
+        # The ring is walked around the position's unweighted mean normal: summed over its corners in order.
+        mean = _unit_rows(np.stack([np.bincount(big_pid, own[:, j], minlength=npos) for j in range(3)], axis=1))[0]
+        rough_sums[big] = _ring_sums(positions, tris, big_corners, big_pid, own, rough_angles[big], mean[big_pid],
+                                     cos_limit)
     group = corner_pid
     group[which] = npos + np.arange(which.size)
-    return _finish(group, np.concatenate([smooth_sums, rough_sums]), faces)
+    return _finish(group, np.concatenate([sums, rough_sums]), faces)
 
 
 def _rough_positions(corner_pid: NDArray[np.intp], faces: NDArray[np.float64], mean: NDArray[np.float64],
@@ -305,11 +332,14 @@ def _sums(corner_group: NDArray[np.intp], faces: NDArray[np.float64], angles: ND
     """The angle-weighted sum of face normals over the corners of each group, ``(groups, 3)``
     (every corner given: corner ``c`` is of face ``c // 3``); ``angles`` None: unweighted."""
     sums = np.empty((groups, 3))
+    per_face = None if angles is None else angles.reshape(-1, 3)
+    weight = np.empty((faces.shape[0], 3))
     for j in range(3):
-        weight = np.repeat(faces[:, j], 3)
-        if angles is not None:
-            weight *= angles
-        sums[:, j] = np.bincount(corner_group, weight, minlength=groups)
+        if per_face is None:
+            weight[:] = faces[:, j, None]
+        else:
+            np.multiply(per_face, faces[:, j, None], out=weight)  # the face's component, at its three corners
+        sums[:, j] = np.bincount(corner_group, weight.reshape(-1), minlength=groups)
     return sums
 
 
