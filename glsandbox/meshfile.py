@@ -525,7 +525,10 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
     if not built:
         raise SandboxError(f"model file {p} has no faces: all {faces.shape[0]:,} are degenerate "
                            "(zero area or a repeated vertex)")
-    transform = _fit_transform(np.concatenate([mesh.positions for _, mesh, _, _ in built])) if fit else None
+    transform = None
+    if fit:  # the box of all parts' boxes
+        corners = np.concatenate([[mesh.positions.min(axis=0), mesh.positions.max(axis=0)] for _, mesh, _, _ in built])
+        transform = _fit_transform(corners)
     model_parts = []
     for i, (look, mesh, kept, how) in enumerate(built):
         said = [f"model file {p}: {', '.join(undrawn[''])} not drawn"] if i == 0 and undrawn.get("") else []
@@ -541,10 +544,13 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
             else:
                 where = "" if len(built) == 1 else f"{look.name}/"
                 texture = Texture(f"{p}#{where}base_color", image=look.image)
+        positions = mesh.positions
         if transform is not None:
             notes.append("fitted into -1..1")
-            mesh = replace(mesh, positions=(np.asarray(mesh.positions) - transform[0]) * transform[1])
-        mesh = replace(mesh, notes=tuple(notes), warnings=tuple(said))
+            positions -= transform[0]
+            positions *= transform[1]
+        mesh = Mesh(mesh.name, positions, mesh.indices, mesh.normals, mesh.uvs, mesh.colors, notes=tuple(notes),
+                    warnings=tuple(said))
         sided = look.double_sided if look.double_sided is not None else not closed
         model_parts.append(ModelPart(look.name, mesh, texture, look.color, look.alpha_mode, look.alpha_cutoff,
                                      sided, kept))
@@ -552,10 +558,24 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
     return Model(p, tuple(model_parts), total, dropped, built[0][3], closed)
 
 
+@dataclass
+class _Arrays:
+    """A part's mesh before it is fitted and made a :class:`~glsandbox.geometry.Mesh` (once: making one
+    checks every array)."""
+
+    name: str
+    positions: NDArray[np.float64]
+    indices: NDArray[np.uint32]
+    normals: NDArray[np.float64]
+    uvs: NDArray[np.float64] | None
+    colors: NDArray[np.float64] | None
+    notes: tuple[str, ...]
+
+
 def _group_mesh(p: Path, file_type: str, parts: list[_Part], normals_mode: str, crease: float,
-                part_name: str | None) -> tuple[Mesh | None, int, int, str]:
-    """One mesh for parts that share a material: ``(mesh, triangles, degenerate faces
-    dropped, how its normals were made)``; no mesh when every face was degenerate."""
+                part_name: str | None) -> tuple[_Arrays | None, int, int, str]:
+    """One mesh for parts that share a material: ``(its arrays, triangles, degenerate faces
+    dropped, how its normals were made)``; none when every face was degenerate."""
     offsets = np.cumsum([0] + [part.positions.shape[0] for part in parts])
     positions, faces = _all_parts(parts, offsets)
     # Optional attributes: a part without them gets neutral values when another has them.
@@ -587,7 +607,7 @@ def _group_mesh(p: Path, file_type: str, parts: list[_Part], normals_mode: str, 
                                                position_ids, (unit, angles))
     del unit, angles
     corners = faces.reshape(-1)
-    index, first = _split_vertices(position_ids, uvs, corners, corner_colors, group, group_normals)
+    index, first = _split_vertices(position_ids, uvs, corners, corner_colors, group)
     chosen = corners[first]
     where = p.name if part_name is None else f"{p.name}, part {part_name!r}"
     notes = [f"{where}: {_count(faces.shape[0], 'triangle')} ({file_type.upper()})"]
@@ -595,9 +615,9 @@ def _group_mesh(p: Path, file_type: str, parts: list[_Part], normals_mode: str, 
         notes.append(f"{_count(dropped, 'degenerate face')} dropped (zero area or a repeated vertex)")
     notes.append(f"normals {'from the file' if how == 'file' else how}")
     name = p.name if part_name is None else f"{p.name}#{part_name}"
-    mesh = Mesh(name, positions.take(chosen, axis=0), index.astype(np.uint32),
-                group_normals.take(group[first], axis=0), None if uvs is None else uvs.take(chosen, axis=0),
-                None if corner_colors is None else corner_colors.reshape(-1, 3)[first], notes=tuple(notes))
+    mesh = _Arrays(name, positions.take(chosen, axis=0), index.astype(np.uint32),
+                   group_normals.take(group[first], axis=0), None if uvs is None else uvs.take(chosen, axis=0),
+                   None if corner_colors is None else corner_colors.reshape(-1, 3)[first], tuple(notes))
     return mesh, int(faces.shape[0]), dropped, how
 
 
@@ -643,8 +663,9 @@ def _normal_groups(p: Path, positions: NDArray[np.float64], faces: NDArray[np.in
                 fine = np.isfinite(file_normals).all(axis=1) & (size > 1e-12)
                 if fine[faces].all():  # only the vertices the faces use need a normal
                     usable = file_normals / np.where(fine, size, 1.0)[:, None]
-        if usable is not None:
-            return faces.reshape(-1).astype(np.intp), usable, "file"
+        if usable is not None:  # one group per distinct normal: with the position, it tells vertices apart
+            ids, firsts = row_ids(usable, ordered=False)
+            return ids[faces.reshape(-1)], usable[firsts], "file"
         if mode == "file":
             why = "has no vertex normals" if file_normals is None else "has zero-length or non-finite normals"
             raise SandboxError(f"model file {p} {why} (normals = \"file\"); use \"auto\" to compute them")
@@ -655,15 +676,16 @@ def _normal_groups(p: Path, positions: NDArray[np.float64], faces: NDArray[np.in
 
 
 def _split_vertices(position_ids: NDArray[np.intp], uvs: NDArray[np.float64] | None, corners: NDArray[np.int64],
-                    corner_colors: NDArray[np.float64] | None, group: NDArray[np.intp],
-                    group_normals: NDArray[np.float64]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+                    corner_colors: NDArray[np.float64] | None,
+                    group: NDArray[np.intp]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
     """The drawn vertices: ``(index (C,), a corner of each)``. Corners share a vertex exactly when
     their position, uv, colour and normal are bit-identical; each is numbered once (positions and
-    uvs per file vertex, normals per group), so only integers are compared per corner."""
+    uvs per file vertex; normals by ``group``, which at one position is equal exactly when the
+    normals are), so only integers are compared per corner."""
     attribute = position_ids
     if uvs is not None:
         attribute = split_vertices(position_ids, row_ids(uvs, ordered=False)[0])[0]
     attribute = attribute[corners]
     if corner_colors is not None:
         attribute = split_vertices(attribute, row_ids(corner_colors.reshape(-1, 3), ordered=False)[0])[0]
-    return split_vertices(attribute, row_ids(group_normals, ordered=False)[0][group])
+    return split_vertices(attribute, group)

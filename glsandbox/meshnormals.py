@@ -249,7 +249,9 @@ def normal_groups(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: 
                   geometry: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
                   ) -> tuple[NDArray[np.intp], NDArray[np.float64]]:
     """``(group (C,), normals (G, 3))``: corner ``c`` (face ``c // 3``, its corner ``c % 3``) has the
-    unit normal ``normals[group[c]]``, made the way ``mode`` says (module docstring).
+    unit normal ``normals[group[c]]``, made the way ``mode`` says (module docstring). Two corners
+    at one position (equal ``position_ids``) share a group exactly when their normals are
+    bit-identical: with the position, the group tells the vertices apart.
 
     ``tris`` must hold no zero-area face. Where a weighted sum cancels to zero
     (a knife edge), the corner takes its face's own normal. ``position_ids``:
@@ -265,14 +267,15 @@ def normal_groups(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: 
     else:
         faces, angles = geometry
     if mode == "flat" or f == 0:
-        return np.repeat(np.arange(f, dtype=np.intp), 3), faces
+        ids, firsts = row_ids(faces, ordered=False)  # coplanar faces' corners at one position: one vertex
+        return np.repeat(ids, 3), faces[firsts]
     pid = row_ids(positions, ordered=False)[0] if position_ids is None else position_ids
     corner_pid = pid[tris.reshape(-1)]  # the welded position of each corner
     del pid
     npos = int(corner_pid.max()) + 1
     if mode == "smooth":
         sums = _sums(corner_pid, faces, angles, npos)
-        return _finish(corner_pid, sums, faces)
+        return _finish(corner_pid, sums, faces, npos)
     cos_limit = math.cos(math.radians(crease_angle))
     # Tier 1: positions whose normals all lie within half the crease angle of the direction of their
     # angle-weighted sum (any reference direction serves the triangle inequality; this one is the
@@ -280,10 +283,10 @@ def normal_groups(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: 
     sums = _sums(corner_pid, faces, angles, npos)
     half = max(0.0, math.radians(crease_angle) / 2.0 - _HALF_ANGLE_MARGIN)
     rough_pos = _rough_positions(corner_pid, faces, _unit_rows(sums)[0], math.cos(half))
+    if not rough_pos.any():
+        return _finish(corner_pid, sums, faces, npos)
     which = np.flatnonzero(rough_pos[corner_pid])
     del rough_pos
-    if which.size == 0:
-        return _finish(corner_pid, sums, faces)
     # Tiers 2 and 3: every rough corner gets a group of its own numbered after the positions;
     # corners of one smoothing group get the same sum, so they merge again by their normal.
     # (Every corner of a rough position is rough: that position's row of ``sums`` is not used.)
@@ -306,23 +309,19 @@ def normal_groups(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: 
                                      cos_limit)
     group = corner_pid
     group[which] = npos + np.arange(which.size)
-    return _finish(group, np.concatenate([sums, rough_sums]), faces)
+    return _finish(group, np.concatenate([sums, rough_sums]), faces, npos, which)
 
 
 def _rough_positions(corner_pid: NDArray[np.intp], faces: NDArray[np.float64], mean: NDArray[np.float64],
                      cos_half: float) -> NDArray[np.bool_]:
     """Per position: whether a face normal there is further than the half angle from the
     position's ``mean`` (``normal · mean < cos_half``: tier 1 does not apply). Worked out in
-    blocks of :data:`BLOCK_FACES` faces, in ``(faces, 3)`` corner layout, one component at a
-    time: no corner-sized float array at once."""
+    blocks of :data:`BLOCK_FACES` faces, in ``(faces, 3)`` corner layout."""
     rough_pos = np.zeros(mean.shape[0], dtype=bool)
     for lo in range(0, faces.shape[0], BLOCK_FACES):
         block_pid = corner_pid[3 * lo:3 * (lo + BLOCK_FACES)].reshape(-1, 3)
-        spread = np.zeros(block_pid.shape)
-        for j in range(3):
-            term = mean[block_pid, j]
-            term *= faces[lo:lo + BLOCK_FACES, j, None]  # the face's component, for its three corners
-            spread += term
+        # Each corner's position's mean, dotted with the corner's face normal.
+        spread = np.einsum("fkj,fj->fk", mean.take(block_pid, axis=0), faces[lo:lo + BLOCK_FACES])
         rough_pos[block_pid[spread < cos_half]] = True
     return rough_pos
 
@@ -343,17 +342,25 @@ def _sums(corner_group: NDArray[np.intp], faces: NDArray[np.float64], angles: ND
     return sums
 
 
-def _finish(group: NDArray[np.intp], sums: NDArray[np.float64],
-            faces: NDArray[np.float64]) -> tuple[NDArray[np.intp], NDArray[np.float64]]:
-    """Unit normals from the groups' sums; a corner whose group's sum cancels takes its face's normal."""
+def _finish(group: NDArray[np.intp], sums: NDArray[np.float64], faces: NDArray[np.float64], merge_from: int,
+            extra: NDArray[np.intp] | None = None) -> tuple[NDArray[np.intp], NDArray[np.float64]]:
+    """Unit normals from the groups' sums; a corner whose group's sum cancels takes its face's normal.
+    Groups numbered ``merge_from`` and up (the corners ``extra``: a rough corner's, and a cancelled
+    corner's) that got bit-identical normals become one; those below are one per position already."""
     size = np.sqrt(np.einsum("ij,ij->i", sums, sums))
     ok = size > 1e-300
     unit = np.divide(sums, size[:, None], out=np.zeros_like(sums), where=ok[:, None])
-    cancelled = np.flatnonzero(~ok[group])
-    if cancelled.size:  # a knife edge: those corners get groups of their own, with their face's normal
-        group = group.copy()
-        group[cancelled] = unit.shape[0] + np.arange(cancelled.size)
-        unit = np.concatenate([unit, faces[cancelled // 3]])
+    extra = np.zeros(0, dtype=np.intp) if extra is None else extra
+    if not ok.all():
+        cancelled = np.flatnonzero(~ok[group])
+        if cancelled.size:  # a knife edge: those corners get groups of their own, with their face's normal
+            group[cancelled] = unit.shape[0] + np.arange(cancelled.size)
+            unit = np.concatenate([unit, faces[cancelled // 3]])
+            extra = np.union1d(extra, cancelled)
+    if extra.size:
+        ids, firsts = row_ids(unit[merge_from:], ordered=False)
+        group[extra] = merge_from + ids[group[extra] - merge_from]
+        unit = np.concatenate([unit[:merge_from], unit[merge_from:][firsts]])
     return group, unit
 
 
