@@ -608,16 +608,24 @@ def _group_mesh(p: Path, file_type: str, parts: list[_Part], normals_mode: str, 
     del unit, angles
     corners = faces.reshape(-1)
     index, first = _split_vertices(position_ids, uvs, corners, corner_colors, group)
-    chosen = corners[first]
+    del position_ids
+    # The drawn arrays, each corner-sized temporary dropped as soon as it is used (the peak).
+    normals = group_normals.take(group.take(first), axis=0)
+    del group, group_normals
+    indices = index.astype(np.uint32)
+    del index
+    colors = None if corner_colors is None else corner_colors.reshape(-1, 3).take(first, axis=0)
+    del corner_colors
+    chosen = corners.take(first)
+    del first
     where = p.name if part_name is None else f"{p.name}, part {part_name!r}"
     notes = [f"{where}: {_count(faces.shape[0], 'triangle')} ({file_type.upper()})"]
     if dropped:
         notes.append(f"{_count(dropped, 'degenerate face')} dropped (zero area or a repeated vertex)")
     notes.append(f"normals {'from the file' if how == 'file' else how}")
     name = p.name if part_name is None else f"{p.name}#{part_name}"
-    mesh = _Arrays(name, positions.take(chosen, axis=0), index.astype(np.uint32),
-                   group_normals.take(group[first], axis=0), None if uvs is None else uvs.take(chosen, axis=0),
-                   None if corner_colors is None else corner_colors.reshape(-1, 3)[first], tuple(notes))
+    mesh = _Arrays(name, positions.take(chosen, axis=0), indices, normals,
+                   None if uvs is None else uvs.take(chosen, axis=0), colors, tuple(notes))
     return mesh, int(faces.shape[0]), dropped, how
 
 
@@ -685,7 +693,8 @@ def _split_vertices(position_ids: NDArray[np.intp], uvs: NDArray[np.float64] | N
     attribute = position_ids
     if uvs is not None:
         attribute = split_vertices(position_ids, row_ids(uvs, ordered=False)[0])[0]
-    attribute = attribute[corners]
+    attribute = attribute.take(corners)
     if corner_colors is not None:
-        attribute = split_vertices(attribute, row_ids(corner_colors.reshape(-1, 3), ordered=False)[0])[0]
-    return split_vertices(attribute, group)
+        attribute = split_vertices(attribute, row_ids(corner_colors.reshape(-1, 3), ordered=False)[0],
+                                   reuse=True)[0]
+    return split_vertices(attribute, group, reuse=True)

@@ -95,9 +95,13 @@ def _cross(e1: NDArray[np.float64], e2: NDArray[np.float64]) -> NDArray[np.float
     return n
 
 
-def _unit_rows(rows: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """``(rows / |row|, |row|)``; a zero row stays zero."""
+def _unit_rows(rows: NDArray[np.float64], in_place: bool = False) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``(rows / |row|, |row|)``; a zero row stays zero. ``in_place``: written over ``rows``."""
     size = np.sqrt(np.einsum("ij,ij->i", rows, rows))
+    if in_place:
+        np.divide(rows, size[:, None], out=rows, where=size[:, None] > 0.0)
+        rows[size == 0.0] = 0.0  # (-0.0 too)
+        return rows, size
     return np.divide(rows, size[:, None], out=np.zeros_like(rows), where=size[:, None] > 0.0), size
 
 
@@ -187,10 +191,12 @@ def row_ids(rows: NDArray[np.float64], ordered: bool = True) -> tuple[NDArray[np
     return _by_first_appearance(first, inverse) if ordered else (inverse, first)
 
 
-def split_vertices(attribute_ids: NDArray[np.intp], normal_ids: NDArray[np.intp]) -> tuple[NDArray[np.intp],
-                                                                                          NDArray[np.intp]]:
+def split_vertices(attribute_ids: NDArray[np.intp], normal_ids: NDArray[np.intp],
+                   reuse: bool = False) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
     """Vertices from corners: ``(index (C,), a corner of each vertex)``. Two corners share a vertex
     exactly when both their attribute id and their normal id are equal (both ids ``>= 0``).
+    ``reuse``: the index is written over ``attribute_ids`` (an ``intp`` array the caller no longer
+    needs; one corner-sized array less at the peak).
 
     Linear, no sort of the corners: each attribute id first takes the normal of
     one of its corners; only corners whose normal differs from that one (a crease,
@@ -203,9 +209,9 @@ def split_vertices(attribute_ids: NDArray[np.intp], normal_ids: NDArray[np.intp]
     n_attr = int(attribute_ids.max()) + 1
     owner = np.empty(n_attr, dtype=np.intp)
     owner[attribute_ids] = normal_ids  # any one corner's normal per attribute id
-    vertex = attribute_ids.astype(np.intp)
-    extra = np.flatnonzero(normal_ids != owner[attribute_ids])
+    extra = np.flatnonzero(normal_ids != owner.take(attribute_ids))
     del owner
+    vertex = attribute_ids if reuse and attribute_ids.dtype == np.intp else attribute_ids.astype(np.intp)
     count = n_attr
     if extra.size:
         span = int(normal_ids.max()) + 1
@@ -274,22 +280,21 @@ def normal_groups(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: 
     del pid
     npos = int(corner_pid.max()) + 1
     if mode == "smooth":
-        sums = _sums(corner_pid, faces, angles, npos)
-        return _finish(corner_pid, sums, faces, npos)
+        return _finish(corner_pid, _unit_rows(_sums(corner_pid, faces, angles, npos), in_place=True), faces, npos)
     cos_limit = math.cos(math.radians(crease_angle))
     # Tier 1: positions whose normals all lie within half the crease angle of the direction of their
     # angle-weighted sum (any reference direction serves the triangle inequality; this one is the
     # answer of tier 1 already, so it is summed once).
-    sums = _sums(corner_pid, faces, angles, npos)
+    unit = _unit_rows(_sums(corner_pid, faces, angles, npos), in_place=True)  # (normals, lengths), written over the sums
     half = max(0.0, math.radians(crease_angle) / 2.0 - _HALF_ANGLE_MARGIN)
-    rough_pos = _rough_positions(corner_pid, faces, _unit_rows(sums)[0], math.cos(half))
+    rough_pos = _rough_positions(corner_pid, faces, unit[0], math.cos(half))
     if not rough_pos.any():
-        return _finish(corner_pid, sums, faces, npos)
+        return _finish(corner_pid, unit, faces, npos)
     which = np.flatnonzero(rough_pos[corner_pid])
     del rough_pos
     # Tiers 2 and 3: every rough corner gets a group of its own numbered after the positions;
     # corners of one smoothing group get the same sum, so they merge again by their normal.
-    # (Every corner of a rough position is rough: that position's row of ``sums`` is not used.)
+    # (Every corner of a rough position is rough: that position's row of ``unit`` is not used.)
     rough_angles = angles[which]
     del angles
     rough_pid = corner_pid[which]
@@ -309,7 +314,9 @@ def normal_groups(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: 
                                      cos_limit)
     group = corner_pid
     group[which] = npos + np.arange(which.size)
-    return _finish(group, np.concatenate([sums, rough_sums]), faces, npos, which)
+    rough_unit = _unit_rows(rough_sums, in_place=True)
+    unit = (np.concatenate([unit[0], rough_unit[0]]), np.concatenate([unit[1], rough_unit[1]]))
+    return _finish(group, unit, faces, npos, which)
 
 
 def _rough_positions(corner_pid: NDArray[np.intp], faces: NDArray[np.float64], mean: NDArray[np.float64],
@@ -342,14 +349,15 @@ def _sums(corner_group: NDArray[np.intp], faces: NDArray[np.float64], angles: ND
     return sums
 
 
-def _finish(group: NDArray[np.intp], sums: NDArray[np.float64], faces: NDArray[np.float64], merge_from: int,
+def _finish(group: NDArray[np.intp], unit_sums: tuple[NDArray[np.float64], NDArray[np.float64]],
+            faces: NDArray[np.float64], merge_from: int,
             extra: NDArray[np.intp] | None = None) -> tuple[NDArray[np.intp], NDArray[np.float64]]:
-    """Unit normals from the groups' sums; a corner whose group's sum cancels takes its face's normal.
+    """Unit normals from the groups' sums, given as ``(sums / |sums|, |sums|)`` (:func:`_unit_rows`);
+    a corner whose group's sum cancels (``|sum| <= 1e-300``) takes its face's normal.
     Groups numbered ``merge_from`` and up (the corners ``extra``: a rough corner's, and a cancelled
     corner's) that got bit-identical normals become one; those below are one per position already."""
-    size = np.sqrt(np.einsum("ij,ij->i", sums, sums))
-    ok = size > 1e-300
-    unit = np.divide(sums, size[:, None], out=np.zeros_like(sums), where=ok[:, None])
+    unit, size = unit_sums
+    ok = size > 1e-300  # (a row that is not ok is used by no corner below)
     extra = np.zeros(0, dtype=np.intp) if extra is None else extra
     if not ok.all():
         cancelled = np.flatnonzero(~ok[group])
