@@ -367,18 +367,19 @@ def _coplanar(positions: np.ndarray) -> bool:
 _CENTRES: weakref.WeakKeyDictionary[Mesh, np.ndarray] = weakref.WeakKeyDictionary()
 
 
-def _distance(node: Node, camera: Camera) -> float:
+def _distance(node: Node, camera: Camera | np.ndarray) -> float:
     """How far the centre of a node's bounding box lies from the eye, in world space:
     blended nodes are drawn farthest first, so each blends over what lies behind it
     (sorted by part, not by triangle: a part that wraps round another can still be
-    wrong, as in any rasterizer that sorts objects)."""
+    wrong, as in any rasterizer that sorts objects). ``camera``: a camera, or the eye's position."""
     centre = _CENTRES.get(node.mesh)
     if centre is None:  # meshes are immutable: once per mesh, not per frame
         points = np.asarray(node.mesh.positions, dtype=np.float64)
         centre = (points.min(axis=0) + points.max(axis=0)) / 2.0 if points.size else np.zeros(3)
         _CENTRES[node.mesh] = centre
     world = np.asarray(node.model, dtype=np.float64) @ np.append(centre, 1.0)
-    return float(np.linalg.norm(world[:3] - np.asarray(camera.eye, dtype=np.float64)))
+    return float(np.linalg.norm(world[:3] - np.asarray(camera.eye if isinstance(camera, Camera) else camera,
+                                                        dtype=np.float64)))
 
 
 def _needs_depth(scene: Scene) -> bool:
@@ -703,15 +704,23 @@ def planar_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
         if mirror.stencil:
             passes.append(Pass("mark_mirror", index, draws=(glass_draw,), depth_test=True,
                                stencil=MARK_MIRROR_STENCIL))
-        reflected = []
+        reflected, blended = [], []
         for name in mirror.reflected:
             if name not in nodes:
                 raise SandboxError(f"mirror reflects {name!r}, which is not a node of the scene")
             node = nodes[name]
             if node.shown_in(index):
-                variant = program_for(node, len(scene.lights))
+                variant = program_for(node, len(scene.lights))  # a cut-out's ALPHA_MASK too, as in the main pass
                 programs.add(variant)
-                reflected.append(Draw(name, variant.key, node.cull_back_faces))
+                blend = node.material.alpha_mode == "blend"
+                (blended if blend else reflected).append((node, Draw(name, variant.key, node.cull_back_faces,
+                                                                     blend=blend)))
+        # Blended parts after the opaque ones, farthest first as seen in the mirror: from the eye's
+        # mirror image (the reflection is an isometry, so its distances are the reflected ones).
+        camera = scene.viewports[index].camera or scene.camera
+        mirrored_eye = (mirror.matrix() @ np.append(np.asarray(camera.eye, dtype=np.float64), 1.0))[:3]
+        reflected = [d for _, d in reflected] + [d for _, d in sorted(blended,
+                                                                      key=lambda nd: -_distance(nd[0], mirrored_eye))]
         passes.append(Pass("reflection", index, draws=tuple(reflected), depth_test=True,
                            stencil=REFLECTION_STENCIL if mirror.stencil else None,
                            detail="front faces clockwise, lights reflected"))

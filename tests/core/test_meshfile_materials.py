@@ -252,3 +252,22 @@ def test_a_scene_file_node_s_own_alpha_mode_wins_over_its_model_file_s(tmp_path:
     scene_path.write_text('[[nodes]]\nname = "m"\nmesh = "two.glb"\nalpha_mode = "opaque"\n')
     assert {n.name: n.material.alpha_mode for n in load_scene(scene_path).nodes} == {"m/paint": "opaque",
                                                                                      "m/glass": "opaque"}
+
+
+def test_blended_parts_are_blended_in_the_mirror_too_after_the_opaque_ones_farthest_first() -> None:
+    from glsandbox.planar import Mirror
+
+    square = glsandbox.geometry.quad_list()
+    glass = Material(color=(0, 0, 1, 0.5), alpha_mode="blend")
+    cutout = Material(color=(1, 1, 1, 1), alpha_mode="mask", alpha_cutoff=0.5)
+    # A mirror in the plane z = -5 facing +z; the eye at z = +3 (the default camera looks from +z).
+    wall = Node("wall", square, glsandbox.transforms.translate(0, 0, -5), Material())
+    near = Node("near", square, glsandbox.transforms.translate(0, 0, 2), glass)  # far from the mirror: farther in it
+    far = Node("far", square, glsandbox.transforms.translate(0, 0, -3), glass)
+    solid = Node("solid", square, np.eye(4), cutout)
+    mirror = Mirror("wall", (0.0, 0.0, 1.0, 5.0), ("near", "solid", "far"))  # z + 5 = 0
+    scene = Scene("s", nodes=(wall, near, solid, far), mirror=mirror)
+    (reflection,) = [p for p in plan(scene).passes if p.kind == "reflection"]
+    # Seen in the mirror, "near" (7 from the glass) lies farther than "far" (2 from it): it blends first.
+    assert [(d.node, d.blend) for d in reflection.draws] == [("solid", False), ("near", True), ("far", True)]
+    assert "ALPHA_MASK" in reflection.draws[0].program
