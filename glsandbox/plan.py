@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 import functools
+import math
 import weakref
 from typing import Any, Callable
 
@@ -662,6 +663,24 @@ REFLECTION_STENCIL = StencilState("equal", MIRROR_STENCIL_BIT, mask=MIRROR_STENC
 PLANAR_SHADOW_STENCIL = StencilState("equal", 0, mask=PLANAR_SHADOW_STENCIL_BIT, write_mask=PLANAR_SHADOW_STENCIL_BIT, on_pass="invert")
 #: Shadows are drawn in one flat colour.
 PLANAR_SHADOW_PROGRAM = ProgramVariant("basic", (("SOLID_COLOR", ""),))
+#: A textured cut-out's planar shadow: the flat colour only where its texture's alpha reaches the cutoff.
+CUTOUT_SHADOW_PROGRAM = ProgramVariant("basic", (("SOLID_COLOR", ""), ("TEXTURED", ""), ("ALPHA_MASK", ""),
+                                                 ("CUTOUT_SHADOW", "")))
+
+
+def cutout_shadow(material: Any) -> float | None:
+    """How a caster's planar shadow is cut out as the part is (drawn with :data:`CUTOUT_SHADOW_PROGRAM`):
+    the cutoff its texture's alpha is compared with (the part's alpha is its colour's alpha times the
+    texture's), None for a caster that is not a textured cut-out (its whole shadow is drawn), and
+    ``inf`` for one cut out everywhere (it casts none)."""
+    if material.alpha_mode != "mask":
+        return None
+    alpha = float(material.color[3]) if len(material.color) > 3 else 1.0
+    if material.texture is None:
+        return None if alpha >= material.alpha_cutoff else math.inf
+    if alpha <= 0.0 or material.alpha_cutoff / alpha > 1.0:
+        return math.inf if material.alpha_cutoff > 0.0 else None
+    return material.alpha_cutoff / alpha
 
 
 def _has_planar_effects(scene: Scene) -> bool:
@@ -736,10 +755,18 @@ def planar_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
         culled = [f"{name} culled ({why})" for name, why in casting.culled]
         if casting.reason:
             culled.append(f"culled: {casting.reason}")
-        draws = tuple(Draw(name, PLANAR_SHADOW_PROGRAM.key, False) for name in casting.kept if nodes[name].shown_in(index))
-        if draws:
-            programs.add(PLANAR_SHADOW_PROGRAM)
-        passes.append(Pass("planar_shadow", index, draws=draws, depth_test=True,
+        draws = []
+        for name in casting.kept:
+            if not nodes[name].shown_in(index):
+                continue
+            cut = cutout_shadow(nodes[name].material) if nodes[name].mesh.uvs is not None or \
+                nodes[name].material.texture is None else None
+            if cut == math.inf:
+                continue  # cut out everywhere: drawn nowhere, it casts nothing either
+            variant = PLANAR_SHADOW_PROGRAM if cut is None else CUTOUT_SHADOW_PROGRAM
+            programs.add(variant)
+            draws.append(Draw(name, variant.key, False))
+        passes.append(Pass("planar_shadow", index, draws=tuple(draws), depth_test=True,
                            stencil=PLANAR_SHADOW_STENCIL if shadow.stencil else None,
                            detail="; ".join([", ".join(how), *culled])))
     return passes

@@ -15,7 +15,8 @@ import trimesh
 
 import glsandbox
 from glsandbox.meshlooks import is_closed
-from support import CUBE_OBJ, coloured_ply, gltf_part, quad, reversed_obj, two_material_glb, two_usemtl_obj
+from support import (CUBE_OBJ, coloured_ply, gltf_part, masked_glb, quad, reversed_obj, two_material_glb,
+                     two_usemtl_obj)
 from glsandbox.plan import plan
 from glsandbox.scene import Material, Node, Scene
 from glsandbox.scene_file import load_scene
@@ -271,3 +272,31 @@ def test_blended_parts_are_blended_in_the_mirror_too_after_the_opaque_ones_farth
     # Seen in the mirror, "near" (7 from the glass) lies farther than "far" (2 from it): it blends first.
     assert [(d.node, d.blend) for d in reflection.draws] == [("solid", False), ("near", True), ("far", True)]
     assert "ALPHA_MASK" in reflection.draws[0].program
+
+
+
+@pytest.mark.slow
+def test_a_cut_out_casts_a_planar_shadow_only_where_it_is_drawn(tmp_path: Path, gl) -> None:
+    from glsandbox.planar import PlanarShadow
+    from glsandbox.scene import Camera
+
+    stencil = next(p for p in glsandbox.load_model(masked_glb(tmp_path / "m.glb")).parts if p.alpha_mode == "mask")
+    floor = Node("floor", glsandbox.geometry.plane(8.0), np.eye(4), Material(color=(1, 1, 1, 1)))
+    # The 2x2 square (half of it cut out) laid flat 1 above the floor, lit from up and to the right:
+    # its shadow falls beside it, at x in -3..-1, seen from straight above.
+    lay = glsandbox.transforms.translate(0, 1, 0) @ glsandbox.transforms.rotate_x(-np.pi / 2)
+    shadow = PlanarShadow("floor", (0, 1, 0, 0), (2.0, 1.0, 0.0, 0.0), ("caster",), color=(0, 0, 0, 1))
+
+    def black_pixels(material: Material) -> int:
+        scene = Scene("s", nodes=(floor, Node("caster", stencil.mesh, lay, material)), planar_shadow=shadow,
+                      camera=Camera(eye=(0.0, 10.0, 0.01)))
+        image = np.asarray(gl.render_scene(scene, (64, 64)).image)
+        return int((image[..., :3] == 0).all(axis=-1).sum())
+
+    whole = black_pixels(Material(color=(1, 0, 0, 1)))
+    cut = black_pixels(stencil.material())
+    assert whole > 100
+    assert 0.35 * whole < cut < 0.65 * whole  # the cut-away half casts nothing
+    (step,) = [p for p in plan(Scene("s", nodes=(floor, Node("caster", stencil.mesh, lay, stencil.material())),
+                                     planar_shadow=shadow)).passes if p.kind == "planar_shadow"]
+    assert "CUTOUT_SHADOW" in step.describe()
