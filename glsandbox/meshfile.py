@@ -511,13 +511,18 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
     for part in parts:
         groups.setdefault(part.look.key, []).append(part)
     # Sidedness: glTF says per material; otherwise one-sided only when the model is closed.
-    closed = file_type in ("gltf", "glb") or is_closed(positions, faces)
+    # Equal positions, numbered once for the whole file: for closedness and for every part's vertices.
+    position_ids = row_ids(positions, ordered=False)[0]
+    closed = file_type in ("gltf", "glb") or is_closed(positions, faces, position_ids)
     undrawn = file_warnings(p, data, file_type, [part.look for part in parts])
     built = []
     dropped = 0
+    index = {id(part): i for i, part in enumerate(parts)}
     for members in groups.values():
         look = members[0].look
-        mesh, kept, lost, how = _group_mesh(p, file_type, members, normals_mode, crease,
+        ids = [position_ids[offsets[index[id(part)]]:offsets[index[id(part)] + 1]] for part in members]
+        mesh, kept, lost, how = _group_mesh(p, file_type, members, ids[0] if len(ids) == 1 else np.concatenate(ids),
+                                            normals_mode, crease,
                                             look.name if len(groups) > 1 else None)
         dropped += lost
         if mesh is not None:
@@ -572,10 +577,12 @@ class _Arrays:
     notes: tuple[str, ...]
 
 
-def _group_mesh(p: Path, file_type: str, parts: list[_Part], normals_mode: str, crease: float,
+def _group_mesh(p: Path, file_type: str, parts: list[_Part], position_ids: NDArray[np.intp], normals_mode: str,
+                crease: float,
                 part_name: str | None) -> tuple[_Arrays | None, int, int, str]:
     """One mesh for parts that share a material: ``(its arrays, triangles, degenerate faces
-    dropped, how its normals were made)``; none when every face was degenerate."""
+    dropped, how its normals were made)``; none when every face was degenerate. ``position_ids``:
+    the parts' vertices numbered by position (:func:`glsandbox.meshnormals.row_ids`)."""
     offsets = np.cumsum([0] + [part.positions.shape[0] for part in parts])
     positions, faces = _all_parts(parts, offsets)
     # Optional attributes: a part without them gets neutral values when another has them.
@@ -602,7 +609,6 @@ def _group_mesh(p: Path, file_type: str, parts: list[_Part], normals_mode: str, 
     if corner_colors is not None:
         corner_colors = corner_colors[keep]
     del keep
-    position_ids = row_ids(positions, ordered=False)[0]
     group, group_normals, how = _normal_groups(p, positions, faces, file_normals, normals_mode, crease,
                                                position_ids, (unit, angles))
     del unit, angles

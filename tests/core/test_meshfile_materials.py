@@ -15,6 +15,7 @@ import trimesh
 
 import glsandbox
 from glsandbox.meshlooks import is_closed
+from glsandbox.meshnormals import row_ids
 from support import (CUBE_OBJ, coloured_ply, gltf_part, masked_glb, quad, reversed_obj, two_material_glb,
                      two_usemtl_obj)
 from glsandbox.plan import plan
@@ -90,6 +91,12 @@ def test_closedness_welds_equal_positions_and_needs_opposite_windings() -> None:
     flipped[0] = flipped[0][::-1]  # one face wound the other way: not consistently closed
     assert not is_closed(np.asarray(box.vertices), flipped)
     assert not is_closed(np.asarray(box.vertices), np.asarray(box.faces)[:-1])  # a hole
+    # The same answers from position ids (the loader's way: positions numbered once, then hashed).
+    ids = row_ids(corners, ordered=False)[0]
+    assert is_closed(corners, np.arange(corners.shape[0]).reshape(-1, 3), ids)
+    assert not is_closed(corners, np.arange(corners.shape[0] - 3).reshape(-1, 3), ids)
+    box_ids = row_ids(np.asarray(box.vertices), ordered=False)[0]
+    assert not is_closed(np.asarray(box.vertices), flipped, box_ids)
 
 
 # --- what is not drawn -----------------------------------------------------------
