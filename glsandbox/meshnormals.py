@@ -25,9 +25,11 @@ million million tests. So the crease rule is worked out in three tiers, each
 linear in the number of corners:
 
 1. a position whose face normals all lie within *half* the crease angle of
-   their mean direction has every pair within the crease angle (the angle
-   between two normals is at most the sum of their angles to the mean): every
-   corner there takes the sum over all, one ``bincount``. Scanned surfaces,
+   one direction has every pair within the crease angle (the angle between
+   two normals is at most the sum of their angles to that direction): every
+   corner there takes the sum over all. The direction tested is that sum's
+   own (the angle-weighted sum, one ``bincount`` per component), so a smooth
+   position costs one sum and one dot product per corner. Scanned surfaces,
    flat fans and a triangle repeated a million times are all this case;
 2. the other positions with at most :data:`PAIR_LIMIT` corners (a cube's
    corner, a crease on a scan) test their pairs exactly as the rule says:
