@@ -383,6 +383,48 @@ def _distance(node: Node, camera: Camera | np.ndarray) -> float:
                                                         dtype=np.float64)))
 
 
+def _farthest_first(blended: list[tuple[Node, Any]], camera: Camera | np.ndarray) -> list[tuple[Node, Any]]:
+    """``(node, anything)`` pairs of blended nodes in drawing order: farthest from the eye first
+    (``camera``: a camera, or the eye's position)."""
+    return sorted(blended, key=lambda pair: -_distance(pair[0], camera))
+
+
+def _mirrored_eye(mirror: Any, camera: Camera) -> np.ndarray:
+    """The eye's mirror image: seen in the mirror, a node lies as far as it lies from this point
+    (the reflection is an isometry), so blended reflected nodes are sorted from it."""
+    return (mirror.matrix() @ np.append(np.asarray(camera.eye, dtype=np.float64), 1.0))[:3]
+
+
+def motion_decisions(scene: Scene) -> tuple:
+    """What of :func:`plan`'s answer depends on where nodes, lights and cameras are: the order
+    of each viewport's blended draws (:func:`_distance`) and which casters the planar shadow
+    keeps or culls, and why (:func:`glsandbox.planar.shadow_casters`). Everything else of a
+    plan depends on the scene's other parts. So two scenes that differ only in model
+    matrices, light positions and cameras (:func:`glsandbox.scene.moved_scene`) and have
+    equal decisions have equal plans: the frame renderer keeps the plan between such frames."""
+    decisions: list[object] = []
+    glass = scene.mirror.node if scene.mirror is not None else None
+    blended = [node for node in scene.nodes if node.material.alpha_mode == "blend" and node.name != glass]
+    if blended:
+        for index, viewport in enumerate(scene.viewports):
+            shown = [(node, None) for node in blended if node.shown_in(index)]
+            decisions.append(tuple(node.name for node, _ in _farthest_first(shown, viewport.camera or scene.camera)))
+    mirror = scene.mirror
+    if mirror is not None:  # the blended nodes it reflects, in their order seen in it
+        reflected = [node for node in scene.nodes if node.name in mirror.reflected and node.material.alpha_mode == "blend"]
+        for index, viewport in enumerate(scene.viewports):
+            shown = [(node, None) for node in reflected if node.shown_in(index)]
+            if shown:
+                eye = _mirrored_eye(mirror, viewport.camera or scene.camera)
+                decisions.append(("mirror", tuple(node.name for node, _ in _farthest_first(shown, eye))))
+    shadow = scene.planar_shadow
+    if shadow is not None:
+        nodes = {node.name: node for node in scene.nodes}
+        models = {name: (nodes[name].model, nodes[name].mesh.positions) for name in shadow.casters if name in nodes}
+        decisions.append(shadow_casters(shadow, models))
+    return tuple(decisions)
+
+
 def _needs_depth(scene: Scene) -> bool:
     """A depth buffer is needed only where something can hide something else:
     two nodes in one viewport, or one mesh that is not flat."""
@@ -590,7 +632,7 @@ def plan(scene: Scene) -> Plan:
                             texture=texture.describe() if texture is not None else None, blend=blend,
                             shadow_map=receives if "SHADOW_LIGHT" in dict(variant.defines) else None)))
         camera = viewport.camera or scene.camera
-        draws = [d for _, d in draws] + [d for _, d in sorted(blended, key=lambda nd: -_distance(nd[0], camera))]
+        draws = [d for _, d in draws] + [d for _, d in _farthest_first(blended, camera)]
         if draws:
             passes.append(Pass("draw", index, draws=tuple(draws), depth_test=uses_depth))
         passes.extend(planar_passes(scene, index, programs))
@@ -736,10 +778,8 @@ def planar_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
                                                                      blend=blend)))
         # Blended parts after the opaque ones, farthest first as seen in the mirror: from the eye's
         # mirror image (the reflection is an isometry, so its distances are the reflected ones).
-        camera = scene.viewports[index].camera or scene.camera
-        mirrored_eye = (mirror.matrix() @ np.append(np.asarray(camera.eye, dtype=np.float64), 1.0))[:3]
-        reflected = [d for _, d in reflected] + [d for _, d in sorted(blended,
-                                                                      key=lambda nd: -_distance(nd[0], mirrored_eye))]
+        mirrored = _mirrored_eye(mirror, scene.viewports[index].camera or scene.camera)
+        reflected = [d for _, d in reflected] + [d for _, d in _farthest_first(blended, mirrored)]
         passes.append(Pass("reflection", index, draws=tuple(reflected), depth_test=True,
                            stencil=REFLECTION_STENCIL if mirror.stencil else None,
                            detail="front faces clockwise, lights reflected"))

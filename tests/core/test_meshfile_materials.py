@@ -279,6 +279,12 @@ def test_blended_parts_are_blended_in_the_mirror_too_after_the_opaque_ones_farth
     # Seen in the mirror, "near" (7 from the glass) lies farther than "far" (2 from it): it blends first.
     assert [(d.node, d.blend) for d in reflection.draws] == [("solid", False), ("near", True), ("far", True)]
     assert "ALPHA_MASK" in reflection.draws[0].program
+    # The order depends on where things are: a plan kept between frames must see it change.
+    from glsandbox.plan import motion_decisions
+
+    swapped = Scene("s", nodes=(wall, Node("near", square, far.model, glass), solid, Node("far", square, near.model, glass)),
+                    mirror=mirror)
+    assert motion_decisions(scene) != motion_decisions(swapped)
 
 
 
