@@ -51,14 +51,14 @@ def _gpu_arrays(mesh: Mesh) -> dict[str, np.ndarray]:
     return arrays
 
 
-def _mesh_key(mesh: Mesh, arrays: dict[str, np.ndarray]) -> tuple[str, str]:
+def _mesh_key(mesh: Mesh, arrays: dict[str, np.ndarray] | None = None) -> tuple[str, str]:
     """Name and a digest of what the GPU gets (``arrays``, :func:`_gpu_arrays`): meshes that upload
     the same bytes share GPU buffers. Meshes are immutable, so the digest is made once per mesh
     object."""
     key = _MESH_KEYS.get(mesh)
     if key is None:
         digest = hashlib.blake2b(digest_size=12)
-        for name, array in arrays.items():
+        for name, array in (arrays if arrays is not None else _gpu_arrays(mesh)).items():
             digest.update(name.encode())
             digest.update(array)  # the array's memory as it is: no copy
         digest.update(mesh.mode.encode())
@@ -348,7 +348,7 @@ class Executor:
 
     def _gpu_mesh(self, mesh: Mesh) -> tuple[tuple[str, str], _GpuMesh]:
         arrays = None if mesh in _MESH_KEYS else _gpu_arrays(mesh)  # made once for the digest and the upload
-        key = _mesh_key(mesh, arrays or {})
+        key = _mesh_key(mesh, arrays)
         gpu = self._meshes.get(key)
         if gpu is None:
             arrays = arrays or _gpu_arrays(mesh)
