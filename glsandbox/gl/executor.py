@@ -447,8 +447,8 @@ class Executor:
             # (texelFetch then reads zeros) on a context the next user shares.
             gl_depth.end_depth_mode(self.ctx, self.raw, scene)
             self._unbind_texture()
+            self._set_depth(False)  # the depth test a pass switched on, also when it raised
         framebuffer.viewport = (0, 0, *size)
-        self._set_depth(False)
         self.ctx.disable(moderngl.CULL_FACE)
         self._release_stale_meshes()
         return frame_plan
