@@ -333,6 +333,7 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
     spare = np.empty(cols.size, dtype=np.float32)
     centre = np.empty((3, k), dtype=np.float32)
     bin_keys = np.empty((3, k), dtype=np.int64)  # made once: fresh pages each level cost more than the casts
+    bin_rows = np.empty((3, k), dtype=np.uint8)  # each column's bin on each axis (the key less its node's i·B)
     counts = np.array([k], dtype=np.int64)  # columns per open node, in column order
     box_lo = rows[0:3].min(axis=1)[None, :].astype(np.float64)  # the open nodes' binning boxes
     box_hi = rows[3:6].max(axis=1)[None, :].astype(np.float64)
@@ -364,15 +365,17 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         scale = np.where(extent > 0.0, bins * (1.0 - 1e-6) / np.where(extent > 0.0, extent, 1.0), 0.0)
         # Each column's bin on each axis, as a key node-major over the level: node i's bins are
         # i·B .. i·B + B − 1.
-        node_key = np.repeat(np.arange(n, dtype=np.int64) * bins, counts)
+        node_of = np.repeat(np.arange(n, dtype=np.int64), counts)  # each column's node
+        node_key = node_of * bins
         bin_key = bin_keys[:, :width]
+        bin_row = bin_rows[:, :width]
         rel = np.empty(width, dtype=np.float32)
         for axis in range(3):  # one row at a time: np.repeat of a 1-D array is a plain copy loop
             np.subtract(cen[axis], np.repeat(box_lo[:, axis].astype(np.float32), counts), out=rel)
             rel *= np.repeat(scale[:, axis].astype(np.float32), counts)
             np.clip(rel, 0, bins - 1, out=rel)
-            bin_key[axis] = rel
-            bin_key[axis] += node_key
+            bin_row[axis] = rel
+            np.add(node_key, bin_row[axis], out=bin_key[axis])
         del rel
         best_cost = np.full(n, np.inf)
         best_axis = np.zeros(n, dtype=np.int64)
@@ -464,10 +467,13 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
             child_lo = np.where(empty[:, :, None], box_lo[:, None, :], child_lo)
             child_hi = np.where(empty[:, :, None], box_hi[:, None, :], child_hi)
         # Each column's side (True: the right child) on its node's chosen axis.
-        columns = np.arange(width)
-        chosen = np.take(bin_keys.reshape(-1), np.repeat(best_axis * k, counts) + columns)  # row stride: k
-        right = chosen >= np.repeat(nodes * bins + best_cut, counts)
-        del chosen
+        # (Byte rows: the column's bin on each axis, its node's axis and cut repeated per column.)
+        axis_of = np.repeat(best_axis.astype(np.uint8), counts)
+        cut_of = np.repeat(best_cut.astype(np.uint8), counts)
+        right = np.greater_equal(bin_row[2], cut_of)
+        np.copyto(right, np.greater_equal(bin_row[1], cut_of), where=axis_of == 1)
+        np.copyto(right, np.greater_equal(bin_row[0], cut_of), where=axis_of == 0)
+        del axis_of, cut_of
         stuck = np.flatnonzero(~np.isfinite(best_cost))
         if stuck.size:
             # No cut separates them (every centroid in one bin on every axis):
@@ -478,7 +484,9 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
             child_lo[stuck] = box_lo[stuck][:, None, :]
             child_hi[stuck] = box_hi[stuck][:, None, :]
         # Children in pairs: open node i gets the ids of children 2i (left) and 2i + 1.
-        child = 2 * np.repeat(nodes, counts) + right
+        child = node_of
+        child *= 2
+        child += right
         child_count = np.bincount(child, minlength=2 * n)
         child_ids, is_leaf = tree.children(open_ids, child_count, leaf_size)
         level += 1
@@ -488,54 +496,53 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         # A right column's rank is the rights before it less the rights before its node's first
         # column; a left's, the lefts before it less the lefts before its node: one gather per
         # column of a per-child offset, no per-column repeat of per-node values.
-        rights_before = np.cumsum(right)
+        rights_before = right.astype(np.int64)
+        np.cumsum(rights_before, out=rights_before)
         rights_before -= right  # rights in columns [0, i)
         at_start = rights_before[starts]
         offset = np.empty(2 * n, dtype=np.int64)
         offset[0::2] = starts - at_start  # lefts before each node's first column
         offset[1::2] = at_start
-        rank = np.subtract(columns, rights_before, out=columns)  # lefts in columns [0, i)
+        rank = np.arange(width)
+        rank -= rights_before  # lefts in columns [0, i)
         np.copyto(rank, rights_before, where=right)
         rank -= offset[child]
-        # Leaves and small children (SMALL triangles at most) leave the level loop here: a leaf's
-        # triangles get their places, a small child's go on to _split_small in child order.
+        # One stable counting sort of all the columns by child, the children in three runs: those
+        # that stay open, then the small ones (SMALL triangles at most: on to _split_small, node
+        # after node), then the leaves (whose triangles get their places here).
         is_small = ~is_leaf & (child_count <= small)
-        done = is_leaf | is_small
-        tri_done = done[child]
-        tri_leaf = is_leaf[child]
-        leaf_of = tree.leaf_of
-        leaf_of[tris[tri_leaf]] = child_ids[child[tri_leaf]]
-        tree.leaf_rank[tris[tri_leaf]] = rank[tri_leaf]
-        if is_small.any():
+        group = is_leaf.astype(np.int8) * 2 + is_small  # 0 open, 1 small, 2 leaf
+        runs = np.argsort(group, kind="stable")
+        child_start = np.empty(2 * n, dtype=np.int64)
+        run_counts = child_count[runs]
+        child_start[runs] = np.cumsum(run_counts) - run_counts
+        rank += child_start[child]  # each column's place in the sorted order
+        source = np.empty(width, dtype=np.int64)
+        source[rank] = np.arange(width)
+        n_open = int(child_count[group == 0].sum())
+        n_small = int(child_count[is_small].sum())
+        leaf_cols = source[n_open + n_small:]
+        leaf_tris = tris[leaf_cols]
+        tree.leaf_of[leaf_tris] = child_ids[child[leaf_cols]]
+        tree.leaf_rank[leaf_tris] = rank[leaf_cols] - child_start[child[leaf_cols]]
+        if n_small:
             smalls = np.flatnonzero(is_small)
             small_ids.append(child_ids[smalls])
             small_counts.append(child_count[smalls])
             small_depth.append(np.full(smalls.size, level, dtype=np.int64))
-            tri_small = np.flatnonzero(is_small[child])
-            grouped = np.empty(tri_small.size, dtype=np.int64)  # their columns, node after node
-            small_start = np.zeros(2 * n, dtype=np.int64)
-            small_start[smalls] = np.cumsum(child_count[smalls]) - child_count[smalls]
-            grouped[small_start[child[tri_small]] + rank[tri_small]] = tri_small
+            grouped = source[n_open:n_open + n_small]  # their columns, node after node
             small_tris.append(tris[grouped])
             small_boxes.append(np.take(cols, grouped, axis=1))
-        # Partition the open columns into the children that stay open (a
-        # stable counting sort, no argsort).
-        kept_children = np.flatnonzero(~done)
-        if kept_children.size == 0:
+        if n_open == 0:
             break
-        new_counts = child_count[kept_children]
-        child_start = np.zeros(2 * n, dtype=np.int64)
-        child_start[kept_children] = np.cumsum(new_counts) - new_counts
-        keep = np.flatnonzero(~tri_done)
-        dest = child_start[child[keep]] + rank[keep]
-        source = np.empty(keep.size, dtype=np.int64)
-        source[dest] = keep
-        moved = spare[:6 * source.size].reshape(6, source.size)
+        kept_children = np.flatnonzero(group == 0)
+        source = source[:n_open]
+        moved = spare[:6 * n_open].reshape(6, n_open)
         np.take(cols, source, axis=1, out=moved, mode="clip")  # "clip": unbuffered (all in range)
         spare = cols.base if cols.base is not None and cols.base.ndim == 1 else cols.reshape(-1)
         cols = moved
-        tris = tris[source]
-        counts = new_counts
+        tris = np.take(tris, source)
+        counts = child_count[kept_children]
         open_ids = child_ids[kept_children]
         box_lo = child_lo.reshape(2 * n, 3)[kept_children]
         box_hi = child_hi.reshape(2 * n, 3)[kept_children]
