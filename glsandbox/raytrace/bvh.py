@@ -411,7 +411,6 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         even_hi = np.empty((n, 2, 3))
         to_counts = (counts / taken)[:, None] if sampled else None  # a sampled bin's count: stride × its own
         node_lo = node_hi = None
-        sweeps, areas = [], []  # per axis: the running boxes and the cuts' half areas (left, right)
         for axis in range(3):
             cnt = np.bincount(bin_key[axis], minlength=n * bins).reshape(n, bins)
             if to_counts is not None:
@@ -433,11 +432,7 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
                 node_lo, node_hi = llo[:, -1], lhi[:, -1]
             n_left = np.cumsum(cnt.T[:-1], axis=0)
             n_right = counts - n_left
-            area_left, area_right = _half_area(llo[:, :-1], lhi[:, :-1]), _half_area(rlo[:, 1:], rhi[:, 1:])
-            if sampled:
-                sweeps.append((llo, lhi, rlo, rhi))
-                areas.append((area_left, area_right))
-            sah = n_left * area_left + n_right * area_right
+            sah = n_left * _half_area(llo[:, :-1], lhi[:, :-1]) + n_right * _half_area(rlo[:, 1:], rhi[:, 1:])
             sah = np.where((n_left > 0) & (n_right > 0), sah, np.inf)  # a cut must leave both sides something
             cut = np.argmin(sah, axis=0)  # the best cut on this axis, minus one
             cost = sah[cut, nodes]
@@ -485,31 +480,14 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         axis_of = np.repeat(best_axis.astype(np.uint8), counts)
         cut_of = np.repeat(best_cut.astype(np.uint8), counts)
         if sampled:
-            # Only the chosen axis's bin of every column, by the same float32 steps as above; its
-            # exact counts then pick the cut on that axis (the sample chose the axis).
+            # Only the chosen axis's bin of every column, by the same float32 steps as above.
             rel = np.where(axis_of == 0, cen[0], np.where(axis_of == 1, cen[1], cen[2]))
             rel -= np.repeat(box_lo[nodes, best_axis].astype(np.float32), counts)
             rel *= np.repeat(scale[nodes, best_axis].astype(np.float32), counts)
             np.clip(rel, 0, bins - 1, out=rel)
-            chosen_bin = rel.astype(np.uint8)
+            right = np.greater_equal(rel.astype(np.uint8), cut_of)
             del rel
             node_of = np.repeat(nodes, counts)
-            exact = np.bincount(node_of * bins + chosen_bin, minlength=n * bins).reshape(n, bins)
-            best_cut = _exact_cut(exact, counts, best_axis, best_cut, no_gain, areas)
-            cut_of = np.repeat(best_cut.astype(np.uint8), counts)
-            right = np.greater_equal(chosen_bin, cut_of)
-            del chosen_bin
-            moved_cut = np.flatnonzero(np.isfinite(best_cost))
-            if moved_cut.size:
-                ax, cb = best_axis[moved_cut], best_cut[moved_cut] - 1
-                for j, run in enumerate(sweeps):  # the children's boxes at the new cut: from its axis's sweep
-                    on = moved_cut[ax == j]
-                    llo, lhi, rlo, rhi = run
-                    cj = cb[ax == j]
-                    child_lo[on, 0] = llo[:, cj, on].T
-                    child_hi[on, 0] = lhi[:, cj, on].T
-                    child_lo[on, 1] = rlo[:, cj + 1, on].T
-                    child_hi[on, 1] = rhi[:, cj + 1, on].T
         else:
             right = np.greater_equal(bin_row[2], cut_of)
             np.copyto(right, np.greater_equal(bin_row[1], cut_of), where=axis_of == 1)
@@ -591,29 +569,6 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         return none, none, none, none, rows[:, :0]
     return (np.concatenate(small_tris), np.concatenate(small_ids), np.concatenate(small_counts),
             np.concatenate(small_depth), np.concatenate(small_boxes, axis=1))
-
-
-def _exact_cut(exact: NDArray[np.int64], counts: NDArray[np.int64], axis: NDArray[np.int64], cut: NDArray[np.int64],
-               no_gain: NDArray[np.int64], areas: list[tuple[NDArray[np.float32], NDArray[np.float32]]]
-               ) -> NDArray[np.int64]:
-    """The cut (first bin on the right) of each node on its chosen ``axis`` from its exact bin
-    counts there (``exact``, ``(n, B)``): the cheapest by the SAH with the sampled bins' areas,
-    or the most even by count for the ``no_gain`` nodes; ``cut`` where no cut leaves both
-    sides something."""
-    n = counts.size
-    nodes = np.arange(n)
-    area_left = np.stack([a[0] for a in areas])[axis, :, nodes].T  # (B − 1, n)
-    area_right = np.stack([a[1] for a in areas])[axis, :, nodes].T
-    n_left = np.cumsum(exact.T[:-1], axis=0)
-    n_right = counts - n_left
-    both = (n_left > 0) & (n_right > 0)
-    sah = np.where(both, n_left * area_left + n_right * area_right, np.inf)
-    best = np.argmin(sah, axis=0) + 1
-    if no_gain.size:
-        gap = np.where(both, np.abs(2 * n_left - counts), np.iinfo(np.int64).max)
-        best[no_gain] = np.argmin(gap[:, no_gain], axis=0) + 1
-    result: NDArray[np.int64] = np.where(both.any(axis=0), best, cut)
-    return result
 
 
 def _box_half_area(box: NDArray[np.float32]) -> NDArray[np.float32]:
