@@ -363,40 +363,20 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         box_hi = np.where(bunched, centre_hi, box_hi)
         extent = box_hi - box_lo
         scale = np.where(extent > 0.0, bins * (1.0 - 1e-6) / np.where(extent > 0.0, extent, 1.0), 0.0)
-        # A big node is binned from every stride-th of its triangles (about
-        # SAMPLE of them): its bins' counts (scaled by stride) and boxes are
-        # the heuristic's estimate of the children's sizes and areas; only the
-        # chosen cut then sorts all of its triangles (below). Nodes of up to
-        # 2·SAMPLE triangles use them all: their counts are exact.
-        stride = np.maximum(1, counts // SAMPLE)
-        sampled = bool(stride.max() > 1)
-        if sampled:
-            # Node i's sampled columns: starts[i] + stride[i]·q for q = 0 .. ceil(counts[i] / stride[i]) − 1.
-            taken = -(-counts // stride)
-            q = np.arange(taken.sum()) - np.repeat(np.cumsum(taken) - taken, taken)
-            sample = np.repeat(starts, taken) + q * np.repeat(stride, taken)
-            box_rows = np.take(cols, sample, axis=1)
-            bin_cen = np.take(cen, sample, axis=1)
-            del q, sample
-        else:
-            taken = counts
-            box_rows, bin_cen = cols, cen
-        binned = bin_cen.shape[1]
-        # Each binned column's bin on each axis, as a key node-major over the level: node i's bins
-        # are i·B .. i·B + B − 1.
-        node_of = np.repeat(np.arange(n, dtype=np.int64), taken)  # each binned column's node
+        # Each column's bin on each axis, as a key node-major over the level: node i's bins are
+        # i·B .. i·B + B − 1.
+        node_of = np.repeat(np.arange(n, dtype=np.int64), counts)  # each column's node
         node_key = node_of * bins
-        bin_key = bin_keys[:, :binned]
-        bin_row = bin_rows[:, :binned]
-        rel = np.empty(binned, dtype=np.float32)
+        bin_key = bin_keys[:, :width]
+        bin_row = bin_rows[:, :width]
+        rel = np.empty(width, dtype=np.float32)
         for axis in range(3):  # one row at a time: np.repeat of a 1-D array is a plain copy loop
-            np.subtract(bin_cen[axis], np.repeat(box_lo[:, axis].astype(np.float32), taken), out=rel)
-            rel *= np.repeat(scale[:, axis].astype(np.float32), taken)
+            np.subtract(cen[axis], np.repeat(box_lo[:, axis].astype(np.float32), counts), out=rel)
+            rel *= np.repeat(scale[:, axis].astype(np.float32), counts)
             np.clip(rel, 0, bins - 1, out=rel)
             bin_row[axis] = rel
-            bin_key[axis] = bin_row[axis]
-            bin_key[axis] += node_key
-        del rel, node_key
+            np.add(node_key, bin_row[axis], out=bin_key[axis])
+        del rel
         best_cost = np.full(n, np.inf)
         best_axis = np.zeros(n, dtype=np.int64)
         best_cut = np.ones(n, dtype=np.int64)
@@ -404,20 +384,31 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         child_hi = np.empty((n, 2, 3))
         nodes = np.arange(n)
         # The most even cut by count over all axes: used where no SAH cut gains (below).
-        even_gap = np.full(n, np.inf)
+        even_gap = np.full(n, np.iinfo(np.int64).max)
         even_axis = np.zeros(n, dtype=np.int64)
         even_cut = np.ones(n, dtype=np.int64)
         even_lo = np.empty((n, 2, 3))
         even_hi = np.empty((n, 2, 3))
-        to_counts = (counts / taken)[:, None] if sampled else None  # a sampled bin's count: stride × its own
+        # A big node's bin boxes come from every stride-th of its triangles
+        # (about SAMPLE of them): the boxes are only the heuristic's estimate
+        # of the children's areas (bin counts are exact). Nodes of up to
+        # 2·SAMPLE triangles use them all.
+        stride = np.maximum(1, counts // SAMPLE)
+        if stride.max() > 1:
+            # Node i's sampled columns: starts[i] + stride[i]·q for q = 0 .. ceil(counts[i] / stride[i]) − 1.
+            taken = -(-counts // stride)
+            q = np.arange(taken.sum()) - np.repeat(np.cumsum(taken) - taken, taken)
+            sample = np.repeat(starts, taken) + q * np.repeat(stride, taken)
+            box_rows = np.take(cols, sample, axis=1)
+            box_keys = np.take(bin_key, sample, axis=1)
+        else:
+            box_rows, box_keys = cols, bin_key
         node_lo = node_hi = None
         for axis in range(3):
             cnt = np.bincount(bin_key[axis], minlength=n * bins).reshape(n, bins)
-            if to_counts is not None:
-                cnt = cnt * to_counts
             blo = np.full((3, n * bins), np.inf, dtype=np.float32)
             bhi = np.full((3, n * bins), -np.inf, dtype=np.float32)
-            key = bin_key[axis]
+            key = box_keys[axis]
             for j in range(3):
                 np.minimum.at(blo[j], key, box_rows[j])
                 np.maximum.at(bhi[j], key, box_rows[3 + j])
@@ -436,7 +427,7 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
             sah = np.where((n_left > 0) & (n_right > 0), sah, np.inf)  # a cut must leave both sides something
             cut = np.argmin(sah, axis=0)  # the best cut on this axis, minus one
             cost = sah[cut, nodes]
-            gap = np.where((n_left > 0) & (n_right > 0), np.abs(2 * n_left - counts), np.inf)
+            gap = np.where((n_left > 0) & (n_right > 0), np.abs(2 * n_left - counts), np.iinfo(np.int64).max)
             even = np.argmin(gap, axis=0)
             evener = np.flatnonzero(gap[even, nodes] < even_gap)
             if evener.size:
@@ -463,7 +454,7 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         # grow as deep as the node is large. The most even cut by count keeps the depth logarithmic.
         parent_cost = counts * _half_area(node_lo, node_hi).astype(np.float64)
         no_gain = np.flatnonzero(np.isfinite(best_cost) & (best_cost >= NO_GAIN * parent_cost)
-                                 & np.isfinite(even_gap))
+                                 & (even_gap < np.iinfo(np.int64).max))
         if no_gain.size:
             best_axis[no_gain] = even_axis[no_gain]
             best_cut[no_gain] = even_cut[no_gain]
@@ -479,19 +470,9 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         # (Byte rows: the column's bin on each axis, its node's axis and cut repeated per column.)
         axis_of = np.repeat(best_axis.astype(np.uint8), counts)
         cut_of = np.repeat(best_cut.astype(np.uint8), counts)
-        if sampled:
-            # Only the chosen axis's bin of every column, by the same float32 steps as above.
-            rel = np.where(axis_of == 0, cen[0], np.where(axis_of == 1, cen[1], cen[2]))
-            rel -= np.repeat(box_lo[nodes, best_axis].astype(np.float32), counts)
-            rel *= np.repeat(scale[nodes, best_axis].astype(np.float32), counts)
-            np.clip(rel, 0, bins - 1, out=rel)
-            right = np.greater_equal(rel.astype(np.uint8), cut_of)
-            del rel
-            node_of = np.repeat(nodes, counts)
-        else:
-            right = np.greater_equal(bin_row[2], cut_of)
-            np.copyto(right, np.greater_equal(bin_row[1], cut_of), where=axis_of == 1)
-            np.copyto(right, np.greater_equal(bin_row[0], cut_of), where=axis_of == 0)
+        right = np.greater_equal(bin_row[2], cut_of)
+        np.copyto(right, np.greater_equal(bin_row[1], cut_of), where=axis_of == 1)
+        np.copyto(right, np.greater_equal(bin_row[0], cut_of), where=axis_of == 0)
         del axis_of, cut_of
         stuck = np.flatnonzero(~np.isfinite(best_cost))
         if stuck.size:
@@ -678,12 +659,11 @@ def _small_cuts(table: NDArray[np.float32], tris: NDArray[np.int64], starts: NDA
         order = keys & ((1 << shift) - 1)  # (r, w): node j's slots by centroid
         orders.append(order)
         sweep = np.take(flat, order.T * r + columns, axis=1)  # (6, w, r): the boxes in that order
-        back = np.empty_like(sweep)
-        back[:, w - 1] = sweep[:, w - 1]
-        for i in range(w - 2, -1, -1):  # boxes of slots i ..
-            np.minimum(back[:, i + 1], sweep[:, i], out=back[:, i])
+        back = sweep.copy()
         for i in range(1, w):  # boxes of the first i + 1
             np.minimum(sweep[:, i - 1], sweep[:, i], out=sweep[:, i])
+        for i in range(w - 2, -1, -1):  # boxes of slots i ..
+            np.minimum(back[:, i + 1], back[:, i], out=back[:, i])
         if parent is None:
             parent = size * _box_half_area(sweep[:, w - 1])
         sah = _box_half_area(sweep[:, :-1])
@@ -692,7 +672,7 @@ def _small_cuts(table: NDArray[np.float32], tris: NDArray[np.int64], starts: NDA
         right *= size - cuts
         sah += right
         sah[no_cut] = np.inf
-        pick = np.argmin(sah, axis=0)
+        pick = np.argmin(sah.T, axis=1)
         best[axis] = pick + 1
         costs[axis] = sah[pick, columns]
         middle[axis] = sah[half - 1, columns]
