@@ -343,8 +343,7 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         n = counts.size
         width = tris.size
         cen = centre[:, :width]
-        np.add(cols[0:3], cols[3:6], out=cen)
-        cen *= np.float32(0.5)
+        np.add(cols[0:3], cols[3:6], out=cen)  # twice the centroids (halving them would be one more pass)
         # Bins per node: max_bins, fewer once nodes are small (about one per
         # triangle), so the per-bin work never exceeds the per-triangle work.
         bins = int(min(max_bins, max(4, 1 << int(np.log2(max(1, width // n))))))
@@ -356,8 +355,8 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         # box, and only the stragglers could be cut off, one level each (a fan
         # of 1M triangles was 5,470 levels deep).
         starts = np.cumsum(counts) - counts
-        centre_lo = np.minimum.reduceat(cen, starts, axis=1).T.astype(np.float64)
-        centre_hi = np.maximum.reduceat(cen, starts, axis=1).T.astype(np.float64)
+        centre_lo = 0.5 * np.minimum.reduceat(cen, starts, axis=1).T.astype(np.float64)
+        centre_hi = 0.5 * np.maximum.reduceat(cen, starts, axis=1).T.astype(np.float64)
         bunched = (centre_hi - centre_lo) < CENTROID_RANGE * (box_hi - box_lo)
         box_lo = np.where(bunched, centre_lo, box_lo)
         box_hi = np.where(bunched, centre_hi, box_hi)
@@ -371,11 +370,14 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         bin_row = bin_rows[:, :width]
         rel = np.empty(width, dtype=np.float32)
         for axis in range(3):  # one row at a time: np.repeat of a 1-D array is a plain copy loop
-            np.subtract(cen[axis], np.repeat(box_lo[:, axis].astype(np.float32), counts), out=rel)
-            rel *= np.repeat(scale[:, axis].astype(np.float32), counts)
+            # (2c − 2·lo)·(scale / 2): the same float32 value as (c − lo)·scale (halving and
+            # doubling are exact), from the doubled centroids.
+            np.subtract(cen[axis], np.repeat((2.0 * box_lo[:, axis]).astype(np.float32), counts), out=rel)
+            rel *= np.repeat((0.5 * scale[:, axis]).astype(np.float32), counts)
             np.clip(rel, 0, bins - 1, out=rel)
             bin_row[axis] = rel
-            np.add(node_key, bin_row[axis], out=bin_key[axis])
+            bin_key[axis] = bin_row[axis]
+            bin_key[axis] += node_key
         del rel
         best_cost = np.full(n, np.inf)
         best_axis = np.zeros(n, dtype=np.int64)
@@ -506,7 +508,6 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         rank = np.arange(width)
         rank -= rights_before  # lefts in columns [0, i)
         np.copyto(rank, rights_before, where=right)
-        rank -= offset[child]
         # One stable counting sort of all the columns by child, the children in three runs: those
         # that stay open, then the small ones (SMALL triangles at most: on to _split_small, node
         # after node), then the leaves (whose triangles get their places here).
@@ -516,15 +517,18 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         child_start = np.empty(2 * n, dtype=np.int64)
         run_counts = child_count[runs]
         child_start[runs] = np.cumsum(run_counts) - run_counts
-        rank += child_start[child]  # each column's place in the sorted order
+        offset -= child_start
+        rank -= offset[child]  # each column's place in the sorted order: its rank in its child after the child's start
         source = np.empty(width, dtype=np.int64)
         source[rank] = np.arange(width)
         n_open = int(child_count[group == 0].sum())
         n_small = int(child_count[is_small].sum())
         leaf_cols = source[n_open + n_small:]
         leaf_tris = tris[leaf_cols]
-        tree.leaf_of[leaf_tris] = child_ids[child[leaf_cols]]
-        tree.leaf_rank[leaf_tris] = rank[leaf_cols] - child_start[child[leaf_cols]]
+        leaf_child = child[leaf_cols]
+        tree.leaf_of[leaf_tris] = child_ids[leaf_child]
+        # A leaf column's place in its leaf: its place in the sorted order less the leaf's start.
+        tree.leaf_rank[leaf_tris] = np.arange(n_open + n_small, width) - child_start[leaf_child]
         if n_small:
             smalls = np.flatnonzero(is_small)
             small_ids.append(child_ids[smalls])
@@ -659,11 +663,12 @@ def _small_cuts(table: NDArray[np.float32], tris: NDArray[np.int64], starts: NDA
         order = keys & ((1 << shift) - 1)  # (r, w): node j's slots by centroid
         orders.append(order)
         sweep = np.take(flat, order.T * r + columns, axis=1)  # (6, w, r): the boxes in that order
-        back = sweep.copy()
+        back = np.empty_like(sweep)
+        back[:, w - 1] = sweep[:, w - 1]
+        for i in range(w - 2, -1, -1):  # boxes of slots i ..
+            np.minimum(back[:, i + 1], sweep[:, i], out=back[:, i])
         for i in range(1, w):  # boxes of the first i + 1
             np.minimum(sweep[:, i - 1], sweep[:, i], out=sweep[:, i])
-        for i in range(w - 2, -1, -1):  # boxes of slots i ..
-            np.minimum(back[:, i + 1], back[:, i], out=back[:, i])
         if parent is None:
             parent = size * _box_half_area(sweep[:, w - 1])
         sah = _box_half_area(sweep[:, :-1])
@@ -672,7 +677,7 @@ def _small_cuts(table: NDArray[np.float32], tris: NDArray[np.int64], starts: NDA
         right *= size - cuts
         sah += right
         sah[no_cut] = np.inf
-        pick = np.argmin(sah.T, axis=1)
+        pick = np.argmin(sah, axis=0)
         best[axis] = pick + 1
         costs[axis] = sah[pick, columns]
         middle[axis] = sah[half - 1, columns]
