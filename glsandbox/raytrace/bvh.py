@@ -518,7 +518,7 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         run_counts = child_count[runs]
         child_start[runs] = np.cumsum(run_counts) - run_counts
         offset -= child_start
-        rank -= offset[child]  # each column's place in the sorted order: its rank in its child after the child's start
+        rank -= offset[child]  # each column's place in the sorted order: the child's start plus its rank in it
         source = np.empty(width, dtype=np.int64)
         source[rank] = np.arange(width)
         n_open = int(child_count[group == 0].sum())
