@@ -411,13 +411,13 @@ class _Uploaded:
         if self.bvh_stack:
             return self.bvh_stack
         from glsandbox.raytrace.bvh import bvh_for_triangles
-        from glsandbox.raytrace.gpu_bvh import TEX_WIDTH as BVH_TEX_WIDTH, _texture, pack_bvh
+        from glsandbox.raytrace.gpu_bvh import RECORD_TEXELS, TEX_WIDTH as BVH_TEX_WIDTH, _texture, pack_bvh
 
         world = self.world
         node_parts: list[NDArray[np.float32]] = []
         tri_parts: list[NDArray[np.float32]] = []
         roots: list[int] = []
-        node_offset = tri_offset = 0
+        record_offset = tri_offset = 0
         depth = 1
         for k in node_order(world)[: self.mesh_count]:
             node = world.nodes[k]
@@ -426,18 +426,18 @@ class _Uploaded:
             bvh = bvh_for_triangles(world.v0[rows] - self.anchor, world.v1[rows] - self.anchor,
                                     world.v2[rows] - self.anchor)
             nodes, tris = pack_bvh(bvh)
-            nodes = nodes.reshape(-1, 2, 4).copy()
-            tris = tris.reshape(-1, 3, 4).copy()
-            leaf = nodes[:, 1, 3] > 0
-            nodes[:, 0, 3] += np.where(leaf, tri_offset, node_offset).astype(np.float32)
+            children = nodes.reshape(-1, 2, 4)  # (box min, ref), (box max, count) per child: a view
+            tris = tris.reshape(-1, 3, 4)
+            leaf = children[:, 1, 3] > 0
+            children[:, 0, 3] += np.where(leaf, tri_offset, record_offset).astype(np.float32)
             tris[:, 0, 3] += node.start
-            roots.append(node_offset)
-            node_offset += nodes.shape[0]
+            roots.append(record_offset)
+            record_offset += nodes.shape[0] // RECORD_TEXELS
             tri_offset += tris.shape[0]
             depth = max(depth, bvh.depth)
-            node_parts.append(nodes.reshape(-1, 4))
+            node_parts.append(nodes)
             tri_parts.append(tris.reshape(-1, 4))
-        if 2 * node_offset > (1 << 24) or 3 * tri_offset > (1 << 24):
+        if RECORD_TEXELS * record_offset > (1 << 24) or 3 * tri_offset > (1 << 24):
             raise RayTraceError(f"the gpu BVH holds at most {(1 << 24) // 3:,} triangles, this scene has {tri_offset:,}")
         self.textures["u_bvh_nodes"] = _texture(ctx, np.concatenate(node_parts), BVH_TEX_WIDTH)
         self.textures["u_bvh_tris"] = _texture(ctx, np.concatenate(tri_parts), BVH_TEX_WIDTH)

@@ -4,8 +4,14 @@ and trace batches of rays with it (float32), to test the GLSL traversal against 
 Packing (the layout ``bvh.glsl`` documents): two RGBA32F textures
 :data:`TEX_WIDTH` texels wide, read with ``texelFetch``:
 
-- nodes, 2 texels each: ``(min.xyz, first)``, ``(max.xyz, count)``; the boxes
-  rounded *outwards* to float32 (a float64 box edge never moves inside);
+- nodes, one record of 4 texels per *inner* node holding its two children:
+  ``(min.xyz, ref)``, ``(max.xyz, count)`` for the left child, then the same for
+  the right one; ``ref`` is the child's record (an inner child, ``count`` 0) or
+  its first stored triangle (a leaf of ``count`` triangles). Record 0 describes
+  the root the same way (its first two texels; the other two unused). A visit
+  of an inner node is then 4 fetches for both children's boxes, and a leaf
+  needs no visit of its own. The boxes are rounded *outwards* to float32 (a
+  float64 box edge never moves inside);
 - triangles in the BVH's storage order, 3 texels each: ``(v0.xyz, caller's
   index)``, ``(v1.xyz, 0)``, ``(v2.xyz, 0)``.
 
@@ -44,7 +50,7 @@ from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.world import camera_basis
 from glsandbox.scene import Camera
 
-__all__ = ["EXACT_INTEGERS", "LOOP_LIMIT", "MAX_STEPS", "TEX_WIDTH", "GpuBVH", "GpuHits", "pack_bvh"]
+__all__ = ["EXACT_INTEGERS", "LOOP_LIMIT", "MAX_STEPS", "RECORD_TEXELS", "TEX_WIDTH", "GpuBVH", "GpuHits", "pack_bvh"]
 
 #: Texels per row of the node and triangle textures (``BVH_TEX_WIDTH`` in the shader).
 TEX_WIDTH: int = 4096
@@ -66,27 +72,45 @@ def _outward(values: NDArray[np.float64], down: bool) -> NDArray[np.float32]:
     return np.where(wrong, np.nextafter(rounded, towards), rounded).astype(np.float32)
 
 
+#: Texels per node record (``BVH_RECORD`` in ``bvh.glsl``): two children, two texels each.
+RECORD_TEXELS: int = 4
+
+
 def pack_bvh(bvh: BVH) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
-    """The node and triangle records of ``bvh`` as ``(texels, 4)`` float32 arrays (module docstring)."""
-    if bvh.node_total * 2 > EXACT_INTEGERS or bvh.triangle_count * 3 > EXACT_INTEGERS or \
+    """The node and triangle records of ``bvh`` as ``(texels, 4)`` float32 arrays (module docstring):
+    ``RECORD_TEXELS`` texels per record, record 0 the root, then one per inner node."""
+    inner = np.flatnonzero(bvh.node_count == 0) if not bvh.empty else np.zeros(0, dtype=np.int64)
+    if (inner.size + 1) * RECORD_TEXELS > EXACT_INTEGERS or bvh.triangle_count * 3 > EXACT_INTEGERS or \
             bvh.input_count > EXACT_INTEGERS:
         raise RayTraceError(f"the gpu BVH holds at most {EXACT_INTEGERS // 3:,} triangles and "
-                            f"{EXACT_INTEGERS // 2:,} nodes; this one has {bvh.triangle_count:,} and {bvh.node_total:,}")
-    nodes = np.zeros((bvh.node_total, 2, 4), dtype=np.float32)
+                            f"{EXACT_INTEGERS // RECORD_TEXELS:,} inner nodes; this one has "
+                            f"{bvh.triangle_count:,} and {inner.size:,}")
+    records = np.zeros((inner.size + 1, 2, 2, 4), dtype=np.float32)  # record, child, (min|max), xyzw
     tris = np.zeros((max(1, bvh.triangle_count), 3, 4), dtype=np.float32)
     if bvh.empty:
         # No triangles: a root leaf holding one zero-area triangle at the origin,
         # which the watertight test never hits (det = 0).
-        nodes[0, 1, 3] = 1
-        return nodes.reshape(-1, 4), tris.reshape(-1, 4)
-    nodes[:, 0, :3] = _outward(bvh.node_min, down=True)
-    nodes[:, 1, :3] = _outward(bvh.node_max, down=False)
-    nodes[:, 0, 3] = bvh.node_first
-    nodes[:, 1, 3] = bvh.node_count
+        records[0, 0, 1, 3] = 1
+        return records.reshape(-1, 4), tris.reshape(-1, 4)
+    record_of = np.zeros(bvh.node_total, dtype=np.int64)
+    record_of[inner] = np.arange(1, inner.size + 1)
+    lo = _outward(bvh.node_min, down=True)
+    hi = _outward(bvh.node_max, down=False)
+    ref = np.where(bvh.node_count == 0, record_of, bvh.node_first).astype(np.float32)
+
+    def child(slot: NDArray[np.int64] | int, nodes: NDArray[np.int64] | int, side: int) -> None:
+        records[slot, side, 0, :3] = lo[nodes]
+        records[slot, side, 0, 3] = ref[nodes]
+        records[slot, side, 1, :3] = hi[nodes]
+        records[slot, side, 1, 3] = bvh.node_count[nodes]
+
+    child(0, 0, 0)
+    child(record_of[inner], bvh.node_first[inner], 0)
+    child(record_of[inner], bvh.node_first[inner] + 1, 1)
     if bvh.triangle_count:
         tris[:, 0, :3], tris[:, 1, :3], tris[:, 2, :3] = bvh.v0, bvh.v1, bvh.v2
         tris[:, 0, 3] = bvh.tri_index
-    return nodes.reshape(-1, 4), tris.reshape(-1, 4)
+    return records.reshape(-1, 4), tris.reshape(-1, 4)
 
 
 @dataclass

@@ -4,11 +4,14 @@
 // glsandbox.raytrace.bvh.BVH into two RGBA32F textures read with texelFetch,
 // texel i at (i % BVH_TEX_WIDTH, i / BVH_TEX_WIDTH):
 //
-//   u_bvh_nodes  2 texels per node i:  2i   = (box min xyz, first)
-//                                      2i+1 = (box max xyz, count)
-//                count == 0: an inner node, children first and first + 1;
-//                count >  0: a leaf of stored triangles first .. first+count-1.
-//                Boxes are rounded outwards to float32. Node 0 is the root.
+//   u_bvh_nodes  4 texels per record r: its two children, each as
+//                (box min xyz, ref), (box max xyz, count):
+//                count == 0: an inner child, whose own children are in record ref;
+//                count >  0: a leaf of stored triangles ref .. ref+count-1.
+//                Record 0 holds the root in its first two texels. A visit of an
+//                inner node reads both children's boxes (4 fetches) and a leaf
+//                is never visited on its own: its range comes with its box.
+//                Boxes are rounded outwards to float32.
 //   u_bvh_tris   3 texels per stored triangle k: 3k = (v0 xyz, caller's index),
 //                3k+1 = (v1 xyz, 0), 3k+2 = (v2 xyz, 0).
 // Integers are stored as floats: exact up to 2^24 (the host checks).
@@ -20,8 +23,9 @@
 // iterations IN TOTAL, silently: sequential loops and nested loops share one
 // counter (measured: two loops of 40,000 ran 40,000 and 25,534). A ray that
 // needed more would just lose triangles. So the traversal is ONE loop whose
-// every iteration is one unit of work (visiting an inner node: its two
-// children's boxes; or testing one triangle of a leaf), bounded by
+// every iteration is one unit of work (taking the next subtree off the stack
+// and visiting it: its two children's boxes; or testing one triangle of a
+// leaf), bounded by
 // BVH_MAX_STEPS, far below the limit. A ray that reaches the bound (or
 // would overflow the stack) is not finished: the result says so
 // (BvhHit.overflow) and the host raises instead of using it. A shader that
@@ -78,18 +82,30 @@ BvhRay bvh_ray(vec3 o, vec3 d) {
     return r;
 }
 
-// The slab test against node `node`'s box (Hızlandırma: AABB): the ray is in
-// the box between the largest entry and the smallest exit. `near` is the entry.
-bool bvh_box(BvhRay r, int node, float limit, out float near) {
-    vec3 lo = bvh_texel(u_bvh_nodes, 2 * node).xyz - r.pad;
-    vec3 hi = bvh_texel(u_bvh_nodes, 2 * node + 1).xyz + r.pad;
-    vec3 ta = (lo - r.w.o) * r.w.inv_d;
-    vec3 tb = (hi - r.w.o) * r.w.inv_d;
+// The slab test against child `side` (0 or 1) of record `rec` (Hızlandırma: AABB):
+// the ray is in the box between the largest entry and the smallest exit. `near`
+// is the entry; `entry` what the traversal holds for the child (bvh_entry).
+bool bvh_child(BvhRay r, int rec, int side, float limit, out float near, out int entry) {
+    vec4 lo = bvh_texel(u_bvh_nodes, 4 * rec + 2 * side);
+    vec4 hi = bvh_texel(u_bvh_nodes, 4 * rec + 2 * side + 1);
+    vec3 ta = (lo.xyz - r.pad - r.w.o) * r.w.inv_d;
+    vec3 tb = (hi.xyz + r.pad - r.w.o) * r.w.inv_d;
     vec3 tn = min(ta, tb);
     vec3 tf = max(ta, tb);
     near = max(max(tn.x, tn.y), tn.z);
     float far = min(min(tf.x, tf.y), tf.z);
+    int count = int(hi.w);
+    // An inner child: its record (>= 0). A leaf: -2 - (first * 64 + count - 1)
+    // (leaves hold 1..64 triangles, first < 2^24: within an int). -1: nothing.
+    entry = count > 0 ? -2 - (int(lo.w) * 64 + count - 1) : int(lo.w);
     return near <= far && far >= 0.0 && near <= limit;
+}
+
+// A leaf entry's triangle range.
+void bvh_leaf(int entry, out int first, out int stop) {
+    int code = -2 - entry;
+    first = code / 64;
+    stop = first + code % 64 + 1;
 }
 
 // The watertight test against stored triangle k: t (or -1.0 for a miss),
@@ -103,9 +119,13 @@ float bvh_triangle(BvhRay r, int k, bool cull, out int index, out vec2 uv) {
 
 // The nearest hit with 0 < t < t_max: an ordered, stackful traversal (the
 // nearer child first, the other pushed with its entry distance so it can be
-// skipped once a nearer hit is known), one unit of work per loop iteration.
-// bvh_closest_at / bvh_any_at start at node `root` (several BVHs concatenated in
-// one texture pair, their indices offset); bvh_closest / bvh_any at node 0.
+// skipped once a nearer hit is known). Each loop iteration tests one triangle
+// of the current leaf, or else takes the next subtree (popped when there is
+// none, skipped if it starts beyond the best hit) and visits it; a leaf that
+// comes up is opened in the same iteration. On 8-wide SIMD every iteration
+// runs all of that under masks, so fewer iterations is what counts.
+// bvh_closest_at / bvh_any_at start at record `root` (several BVHs concatenated
+// in one texture pair, their indices offset); bvh_closest / bvh_any at record 0.
 BvhHit bvh_closest_at(int root, vec3 o, vec3 d, float t_max, bool cull) {
     BvhHit hit = BvhHit(t_max, -1, vec2(0.0), false, 0);
     BvhRay r = bvh_ray(o, d);
@@ -113,10 +133,12 @@ BvhHit bvh_closest_at(int root, vec3 o, vec3 d, float t_max, bool cull) {
     float stack_near[BVH_STACK];
     int sp = 0;
     float near;
-    int node = bvh_box(r, root, t_max, near) ? root : -1;
+    int node;
+    if (!bvh_child(r, root, 0, t_max, near, node)) node = -1;
     int tri = 0;
     int tri_end = 0;
-    bool finished = node < 0;
+    if (node < -1) { bvh_leaf(node, tri, tri_end); node = -1; }
+    bool finished = node == -1 && tri_end == 0;
     for (int step = 0; step < BVH_MAX_STEPS && !finished; ++step) {
         hit.steps = step + 1;
         if (tri < tri_end) {  // one triangle of the current leaf
@@ -129,35 +151,32 @@ BvhHit bvh_closest_at(int root, vec3 o, vec3 d, float t_max, bool cull) {
                 hit.uv = uv;
             }
             ++tri;
-            continue;
-        }
-        if (node < 0) {  // pop the next subtree still worth entering
-            if (sp == 0) { finished = true; continue; }
-            --sp;
-            if (stack_near[sp] <= hit.t) node = stack[sp];
-            continue;
-        }
-        vec4 lo = bvh_texel(u_bvh_nodes, 2 * node);
-        int count = int(bvh_texel(u_bvh_nodes, 2 * node + 1).w);
-        int first = int(lo.w);
-        if (count > 0) {  // a leaf: its triangles in the next iterations
-            tri = first;
-            tri_end = first + count;
-            node = -1;
-            continue;
-        }
-        float near_l, near_r;
-        bool hit_l = bvh_box(r, first, hit.t, near_l);
-        bool hit_r = bvh_box(r, first + 1, hit.t, near_r);
-        if (hit_l && hit_r) {
-            if (sp == BVH_STACK) { hit.overflow = true; break; }  // never drop a subtree silently
-            bool left_first = near_l <= near_r;
-            stack[sp] = left_first ? first + 1 : first;
-            stack_near[sp] = left_first ? near_r : near_l;
-            ++sp;
-            node = left_first ? first : first + 1;
         } else {
-            node = hit_l ? first : (hit_r ? first + 1 : -1);
+            if (node == -1) {  // pop the next subtree, skipped if it starts beyond the best hit
+                if (sp == 0) { finished = true; continue; }
+                --sp;
+                node = stack_near[sp] <= hit.t ? stack[sp] : -1;
+            }
+            if (node >= 0) {  // an inner node: both children's boxes
+                float near_l, near_r;
+                int left, right;
+                bool hit_l = bvh_child(r, node, 0, hit.t, near_l, left);
+                bool hit_r = bvh_child(r, node, 1, hit.t, near_r, right);
+                if (hit_l && hit_r) {
+                    if (sp == BVH_STACK) { hit.overflow = true; break; }  // never drop a subtree silently
+                    bool left_first = near_l <= near_r;
+                    stack[sp] = left_first ? right : left;
+                    stack_near[sp] = left_first ? near_r : near_l;
+                    ++sp;
+                    node = left_first ? left : right;
+                } else {
+                    node = hit_l ? left : (hit_r ? right : -1);
+                }
+            }
+            if (node < -1) {  // a leaf: its triangles from the next iteration
+                bvh_leaf(node, tri, tri_end);
+                node = -1;
+            }
         }
     }
     if (!finished) hit.overflow = true;
@@ -165,16 +184,18 @@ BvhHit bvh_closest_at(int root, vec3 o, vec3 d, float t_max, bool cull) {
 }
 
 // Whether anything is hit with 0 < t < t_max (a shadow ray): the same walk,
-// ending at the first hit. Unfinished rays set `overflow`.
+// unordered, ending at the first hit. Unfinished rays set `overflow`.
 bool bvh_any_at(int root, vec3 o, vec3 d, float t_max, bool cull, out bool overflow) {
     BvhRay r = bvh_ray(o, d);
     int stack[BVH_STACK];
     int sp = 0;
     float near;
-    int node = bvh_box(r, root, t_max, near) ? root : -1;
+    int node;
+    if (!bvh_child(r, root, 0, t_max, near, node)) node = -1;
     int tri = 0;
     int tri_end = 0;
-    bool finished = node < 0;
+    if (node < -1) { bvh_leaf(node, tri, tri_end); node = -1; }
+    bool finished = node == -1 && tri_end == 0;
     bool found = false;
     overflow = false;
     for (int step = 0; step < BVH_MAX_STEPS && !finished; ++step) {
@@ -184,31 +205,28 @@ bool bvh_any_at(int root, vec3 o, vec3 d, float t_max, bool cull, out bool overf
             float t = bvh_triangle(r, tri, cull, index, uv);
             if (t > 0.0 && t < t_max) { found = true; finished = true; }
             ++tri;
-            continue;
-        }
-        if (node < 0) {
-            if (sp == 0) { finished = true; continue; }
-            node = stack[--sp];
-            continue;
-        }
-        vec4 lo = bvh_texel(u_bvh_nodes, 2 * node);
-        int count = int(bvh_texel(u_bvh_nodes, 2 * node + 1).w);
-        int first = int(lo.w);
-        if (count > 0) {
-            tri = first;
-            tri_end = first + count;
-            node = -1;
-            continue;
-        }
-        float near_l, near_r;
-        bool hit_l = bvh_box(r, first, t_max, near_l);
-        bool hit_r = bvh_box(r, first + 1, t_max, near_r);
-        if (hit_l && hit_r) {
-            if (sp == BVH_STACK) { overflow = true; break; }
-            stack[sp++] = first + 1;
-            node = first;
         } else {
-            node = hit_l ? first : (hit_r ? first + 1 : -1);
+            if (node == -1) {
+                if (sp == 0) { finished = true; continue; }
+                node = stack[--sp];
+            }
+            if (node >= 0) {
+                float near_l, near_r;
+                int left, right;
+                bool hit_l = bvh_child(r, node, 0, t_max, near_l, left);
+                bool hit_r = bvh_child(r, node, 1, t_max, near_r, right);
+                if (hit_l && hit_r) {
+                    if (sp == BVH_STACK) { overflow = true; break; }
+                    stack[sp++] = right;
+                    node = left;
+                } else {
+                    node = hit_l ? left : (hit_r ? right : -1);
+                }
+            }
+            if (node < -1) {
+                bvh_leaf(node, tri, tri_end);
+                node = -1;
+            }
         }
     }
     if (!finished) overflow = true;
