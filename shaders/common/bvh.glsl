@@ -119,11 +119,13 @@ float bvh_triangle(BvhRay r, int k, bool cull, out int index, out vec2 uv) {
 
 // The nearest hit with 0 < t < t_max: an ordered, stackful traversal (the
 // nearer child first, the other pushed with its entry distance so it can be
-// skipped once a nearer hit is known). Each loop iteration tests one triangle
-// of the current leaf, or else takes the next subtree (popped when there is
-// none, skipped if it starts beyond the best hit) and visits it; a leaf that
-// comes up is opened in the same iteration. On 8-wide SIMD every iteration
-// runs all of that under masks, so fewer iterations is what counts.
+// skipped once a nearer hit is known). On 8-wide SIMD every loop iteration
+// runs all of its code under masks, so each iteration does two things at
+// once: it tests one triangle of the current leaf, and it takes the walk one
+// node further (pops the next subtree, skipped if it starts beyond the best
+// hit, and visits it: both children's boxes). A leaf the walk comes to waits
+// (one at most: the walk pauses meanwhile) until the current one is done. The
+// walk may so run one leaf ahead of the best hit, which only skips less.
 // bvh_closest_at / bvh_any_at start at record `root` (several BVHs concatenated
 // in one texture pair, their indices offset); bvh_closest / bvh_any at record 0.
 BvhHit bvh_closest_at(int root, vec3 o, vec3 d, float t_max, bool cull) {
@@ -135,10 +137,10 @@ BvhHit bvh_closest_at(int root, vec3 o, vec3 d, float t_max, bool cull) {
     float near;
     int node;
     if (!bvh_child(r, root, 0, t_max, near, node)) node = -1;
+    int waiting = -1;  // a leaf entry waiting for the current leaf to be done
     int tri = 0;
     int tri_end = 0;
-    if (node < -1) { bvh_leaf(node, tri, tri_end); node = -1; }
-    bool finished = node == -1 && tri_end == 0;
+    bool finished = node == -1;
     for (int step = 0; step < BVH_MAX_STEPS && !finished; ++step) {
         hit.steps = step + 1;
         if (tri < tri_end) {  // one triangle of the current leaf
@@ -151,9 +153,9 @@ BvhHit bvh_closest_at(int root, vec3 o, vec3 d, float t_max, bool cull) {
                 hit.uv = uv;
             }
             ++tri;
-        } else {
-            if (node == -1) {  // pop the next subtree, skipped if it starts beyond the best hit
-                if (sp == 0) { finished = true; continue; }
+        }
+        if (waiting == -1) {  // the walk: one node further
+            if (node == -1 && sp > 0) {  // pop the next subtree, skipped if it starts beyond the best hit
                 --sp;
                 node = stack_near[sp] <= hit.t ? stack[sp] : -1;
             }
@@ -173,11 +175,16 @@ BvhHit bvh_closest_at(int root, vec3 o, vec3 d, float t_max, bool cull) {
                     node = hit_l ? left : (hit_r ? right : -1);
                 }
             }
-            if (node < -1) {  // a leaf: its triangles from the next iteration
-                bvh_leaf(node, tri, tri_end);
+            if (node < -1) {
+                waiting = node;
                 node = -1;
             }
         }
+        if (waiting != -1 && tri >= tri_end) {  // the waiting leaf's triangles from the next iteration
+            bvh_leaf(waiting, tri, tri_end);
+            waiting = -1;
+        }
+        finished = tri >= tri_end && waiting == -1 && node == -1 && sp == 0;
     }
     if (!finished) hit.overflow = true;
     return hit;
@@ -192,10 +199,10 @@ bool bvh_any_at(int root, vec3 o, vec3 d, float t_max, bool cull, out bool overf
     float near;
     int node;
     if (!bvh_child(r, root, 0, t_max, near, node)) node = -1;
+    int waiting = -1;
     int tri = 0;
     int tri_end = 0;
-    if (node < -1) { bvh_leaf(node, tri, tri_end); node = -1; }
-    bool finished = node == -1 && tri_end == 0;
+    bool finished = node == -1;
     bool found = false;
     overflow = false;
     for (int step = 0; step < BVH_MAX_STEPS && !finished; ++step) {
@@ -203,13 +210,11 @@ bool bvh_any_at(int root, vec3 o, vec3 d, float t_max, bool cull, out bool overf
             int index;
             vec2 uv;
             float t = bvh_triangle(r, tri, cull, index, uv);
-            if (t > 0.0 && t < t_max) { found = true; finished = true; }
+            found = t > 0.0 && t < t_max;
             ++tri;
-        } else {
-            if (node == -1) {
-                if (sp == 0) { finished = true; continue; }
-                node = stack[--sp];
-            }
+        }
+        if (waiting == -1) {
+            if (node == -1 && sp > 0) node = stack[--sp];
             if (node >= 0) {
                 float near_l, near_r;
                 int left, right;
@@ -224,10 +229,15 @@ bool bvh_any_at(int root, vec3 o, vec3 d, float t_max, bool cull, out bool overf
                 }
             }
             if (node < -1) {
-                bvh_leaf(node, tri, tri_end);
+                waiting = node;
                 node = -1;
             }
         }
+        if (waiting != -1 && tri >= tri_end) {
+            bvh_leaf(waiting, tri, tri_end);
+            waiting = -1;
+        }
+        finished = found || (tri >= tri_end && waiting == -1 && node == -1 && sp == 0);
     }
     if (!finished) overflow = true;
     return found;
