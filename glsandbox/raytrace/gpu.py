@@ -454,6 +454,8 @@ class _Uploaded:
         if self.unrolled:
             found += [("SCENE_NODES", self.scene_nodes(cull)), ("NODE_COUNT", str(max(1, len(self.world.nodes)))),
                       ("TRI_COUNT", str(max(1, self.world.triangle_count)))]
+        else:  # the node loops' bounds as literals (see MESH_NODES in the shader)
+            found += [("MESH_NODES", str(self.mesh_count)), ("SPHERE_NODES", str(self.sphere_count))]
         return tuple(found)
 
     def scene_nodes(self, cull: bool | None) -> str:
