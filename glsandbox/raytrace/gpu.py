@@ -114,7 +114,7 @@ except on a few pixels where a ray grazes an edge or a shadow boundary
 
 from __future__ import annotations
 
-import math
+import hashlib
 import sys
 
 import moderngl
@@ -234,15 +234,6 @@ def _at_least_one(rows: NDArray[np.float32]) -> NDArray[np.float32]:
     return rows if rows.shape[0] else np.zeros((1, 4), dtype=np.float32)
 
 
-def _records(rows: NDArray[np.float32]) -> tuple[tuple[int, int], bytes]:
-    """Pad ``(n, 4)`` float32 records to a ``TEX_WIDTH``-wide texture: (size, data)."""
-    count = max(1, rows.shape[0])
-    height = math.ceil(count / TEX_WIDTH)
-    data = np.zeros((height * TEX_WIDTH, 4), dtype=np.float32)
-    data[: rows.shape[0]] = rows
-    return (TEX_WIDTH, height), data.tobytes()
-
-
 #: The warnings already printed by this process (once per run, not per frame).
 _WARNED: set[str] = set()
 
@@ -288,7 +279,9 @@ def pack_triangles(world: World, anchor: NDArray[np.float64] | None = None) -> N
     relative to ``anchor`` (see :func:`world_anchor`)."""
     anchor = np.zeros(3) if anchor is None else anchor
     m = world.triangle_count
-    rec = np.zeros((m, TRI_RECORDS, 4), dtype=np.float64)
+    # Filled in float32 directly (each value rounded once, as a float64 array cast
+    # afterwards would): a 1M-triangle model's records are 144 MB, not 288 + 144.
+    rec = np.zeros((m, TRI_RECORDS, 4), dtype=np.float32)
     # The corners themselves, not v0 and two edges: the watertight test needs a
     # corner shared by two triangles to be the same three floats in both.
     ok = nondegenerate(world.v0, world.v1, world.v2)  # the BVH's rule: a triangle without area is never hit
@@ -301,7 +294,7 @@ def pack_triangles(world: World, anchor: NDArray[np.float64] | None = None) -> N
         rec[:, 6 + k, :3] = world.colors[:, k]
     flat_uv = world.uvs.reshape(m, 6)  # uv0.x, uv0.y, uv1.x, uv1.y, uv2.x, uv2.y
     rec[:, 3:9, 3] = flat_uv
-    return rec.reshape(-1, 4).astype(np.float32)
+    return rec.reshape(-1, 4)
 
 
 def node_order(world: World) -> list[int]:
@@ -356,6 +349,24 @@ def _same_key(a: tuple[object, ...] | None, b: tuple[object, ...]) -> bool:
         return False
 
 
+def _records_digest(tris: NDArray[np.float32], nodes: NDArray[np.float32]) -> bytes:
+    """A blake2b digest of the packed records (equal records, equal digests)."""
+    h = hashlib.blake2b(digest_size=20)
+    for rows in (tris, nodes):
+        h.update(np.int64(rows.shape[0]).tobytes())
+        h.update(np.ascontiguousarray(rows).data)
+    return h.digest()
+
+
+def _drop_triangle_arrays(world: World, corners: bool) -> None:
+    """Empty ``world``'s per-triangle shading arrays (normals, uvs, colours) and, with
+    ``corners``, its corners too (an upload's own World, once its textures hold them)."""
+    world.normals, world.uvs, world.colors = np.zeros((0, 3, 3)), np.zeros((0, 3, 2)), np.zeros((0, 3, 3))
+    if corners:
+        world.v0 = world.v1 = world.v2 = np.zeros((0, 3))
+        world.tri_node = np.zeros(0, dtype=np.intp)
+
+
 class _Uploaded:
     """One scene's World on the context: its records and images, kept between renders.
 
@@ -373,8 +384,11 @@ class _Uploaded:
         #: Every uploaded position is relative to this point (:func:`world_anchor`; the
         #: origin for ``relative=False``, world-space float32, what the tradeoffs knob shows).
         self.anchor = world_anchor(world) if relative else np.zeros(3)
-        self.tris = pack_triangles(world, self.anchor)
-        self.nodes = pack_nodes(world, self.anchor)
+        tris = pack_triangles(world, self.anchor)
+        nodes = pack_nodes(world, self.anchor)
+        #: What the records pack to (:meth:`same_data`), not the records themselves: a
+        #: 1M-triangle model's are 144 MB, and the texture holds them already.
+        self.digest = _records_digest(tris, nodes)
         self.mesh_count = sum(1 for node in world.nodes if node.kind.triangles)
         self.sphere_count = len(world.nodes) - self.mesh_count
         loops = sum(1 for node in world.nodes if node.kind.triangles and node.count > UNROLL_TRIS)
@@ -382,26 +396,35 @@ class _Uploaded:
         self.large_mesh = max((node.count for node in world.nodes if node.kind.triangles),
                               default=0) > BVH_TRIANGLES
         self.unrolled = (not self.large_mesh and len(world.nodes) <= UNROLL_NODES and loops <= UNROLL_LOOPS
-                         and max(1, self.tris.shape[0]) + max(1, self.nodes.shape[0]) <= block_records)
+                         and max(1, tris.shape[0]) + max(1, nodes.shape[0]) <= block_records)
         self.block: moderngl.Buffer | None = None
         #: The BVH program's stack depth once its textures are uploaded (0: not yet).
         self.bvh_stack = 0
         #: Samplers by uniform name, in texture unit order.
         self.textures: dict[str, moderngl.Texture] = {}
         if self.unrolled:
-            self.block = ctx.buffer(np.concatenate([_at_least_one(self.nodes), _at_least_one(self.tris)]).tobytes())
+            self.block = ctx.buffer(np.concatenate([_at_least_one(nodes), _at_least_one(tris)]).tobytes())
         else:
-            for name, rows in (("u_tris", self.tris), ("u_nodes", self.nodes)):
-                tex_size, data = _records(rows)
-                texture = ctx.texture(tex_size, 4, data, dtype="f4")
-                texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
-                self.textures[name] = texture
+            from glsandbox.raytrace.gpu_bvh import _texture
+
+            for name, rows in (("u_tris", tris), ("u_nodes", nodes)):
+                self.textures[name] = _texture(ctx, _at_least_one(rows), TEX_WIDTH)
         for slot, (image, _wrap) in enumerate(world.textures):
             pixels = np.floor(image * 255.0 + 0.5).astype(np.uint8)
             h, w = pixels.shape[:2]
             texture = ctx.texture((w, h), 4, np.ascontiguousarray(pixels).tobytes())
             texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
             self.textures[f"u_tex{slot}"] = texture
+        del tris, nodes
+        if self.large_mesh:
+            # Every render of this scene traces its meshes through BVHs: build them now,
+            # and keep of the World (this upload's own) only what the renders read (its
+            # nodes, lights, textures): its per-triangle float64 arrays are 336 bytes a
+            # triangle, and the textures hold what the shader needs of them. The shading
+            # arrays go before the BVH is built, the corners after.
+            _drop_triangle_arrays(world, corners=False)
+            self.bvh_textures(ctx)
+            _drop_triangle_arrays(world, corners=True)
 
     def bvh_textures(self, ctx: moderngl.Context) -> int:
         """Upload (once) one BVH per mesh node, concatenated into one node/triangle
@@ -410,7 +433,7 @@ class _Uploaded:
         slot k's root). Returns the stack depth the shader needs."""
         if self.bvh_stack:
             return self.bvh_stack
-        from glsandbox.raytrace.bvh import bvh_for_triangles
+        from glsandbox.raytrace.bvh import build_bvh
         from glsandbox.raytrace.gpu_bvh import RECORD_TEXELS, TEX_WIDTH as BVH_TEX_WIDTH, _texture, pack_bvh
 
         world = self.world
@@ -423,8 +446,10 @@ class _Uploaded:
             node = world.nodes[k]
             stop = node.start + node.count
             rows = slice(node.start, stop)
-            bvh = bvh_for_triangles(world.v0[rows] - self.anchor, world.v1[rows] - self.anchor,
-                                    world.v2[rows] - self.anchor)
+            # Built, not taken from bvh.py's cache: these are anchor-relative triangles
+            # no other engine asks for, and the upload keeps what the shader needs.
+            bvh = build_bvh(world.v0[rows] - self.anchor, world.v1[rows] - self.anchor,
+                            world.v2[rows] - self.anchor)
             nodes, tris = pack_bvh(bvh)
             children = nodes.reshape(-1, 2, 4)  # (box min, ref), (box max, count) per child: a view
             tris = tris.reshape(-1, 3, 4)
@@ -483,8 +508,8 @@ class _Uploaded:
         return (len(world.textures) == len(self.world.textures)
                 and all(a is b or np.array_equal(a, b) for (a, _), (b, _) in zip(world.textures, self.world.textures))
                 and [w for _, w in world.textures] == [w for _, w in self.world.textures]
-                and np.array_equal(pack_triangles(world, self.anchor_of(world)), self.tris)
-                and np.array_equal(pack_nodes(world, self.anchor_of(world)), self.nodes))
+                and _records_digest(pack_triangles(world, self.anchor_of(world)),
+                                    pack_nodes(world, self.anchor_of(world))) == self.digest)
 
     def anchor_of(self, world: World) -> NDArray[np.float64]:
         """Where ``world`` would be anchored in an upload like this one."""
