@@ -180,6 +180,8 @@ class GpuBVH:
         #: The shader's stack: the ordered traversal pushes at most one entry per level.
         self.stack = max(2, bvh.depth + 1)
         self._programs: dict[tuple[bool, bool], tuple[moderngl.Program, moderngl.VertexArray]] = {}
+        #: The two float result targets and their framebuffer, kept for the last grid size.
+        self._target: tuple[tuple[int, int], list[moderngl.Texture], moderngl.Framebuffer] | None = None
         # A far point the padding rays of a grid start from, pointing away: they miss the root at once.
         root_hi = np.where(np.isfinite(bvh.node_max[0]), bvh.node_max[0], 0.0)
         self._away = root_hi + 1.0 + np.abs(root_hi)
@@ -199,26 +201,32 @@ class GpuBVH:
 
     def _draw(self, program: moderngl.Program, vao: moderngl.VertexArray, width: int, height: int,
               rays: dict[str, moderngl.Texture]) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
-        """One fragment per ray over a ``width x height`` grid: the two result targets, row 0 first."""
-        outputs = [self.ctx.texture((width, height), 4, dtype="f4") for _ in range(2)]
-        fbo = self.ctx.framebuffer(color_attachments=outputs)
-        try:
-            textures = {"u_bvh_nodes": self._nodes, "u_bvh_tris": self._tris, **rays}
-            for unit, (name, texture) in enumerate(textures.items()):
-                texture.use(unit)
-                if name in program:
-                    program[name].value = unit
-            fbo.use()
-            fbo.viewport = (0, 0, width, height)
-            self.ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
-            vao.render(moderngl.TRIANGLE_STRIP, vertices=4)
-            hit = np.frombuffer(fbo.read(components=4, attachment=0, dtype="f4"), dtype=np.float32)
-            info = np.frombuffer(fbo.read(components=4, attachment=1, dtype="f4"), dtype=np.float32)
-        finally:
-            fbo.release()
-            for texture in outputs:
-                texture.release()
+        """One fragment per ray over a ``width x height`` grid: the two result targets, row 0 first
+        (the targets are kept for the next call of the same size)."""
+        if self._target is None or self._target[0] != (width, height):
+            self._release_target()
+            outputs = [self.ctx.texture((width, height), 4, dtype="f4") for _ in range(2)]
+            self._target = ((width, height), outputs, self.ctx.framebuffer(color_attachments=outputs))
+        fbo = self._target[2]
+        textures = {"u_bvh_nodes": self._nodes, "u_bvh_tris": self._tris, **rays}
+        for unit, (name, texture) in enumerate(textures.items()):
+            texture.use(unit)
+            if name in program:
+                program[name].value = unit
+        fbo.use()
+        fbo.viewport = (0, 0, width, height)
+        self.ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
+        vao.render(moderngl.TRIANGLE_STRIP, vertices=4)
+        hit = np.frombuffer(fbo.read(components=4, attachment=0, dtype="f4"), dtype=np.float32)
+        info = np.frombuffer(fbo.read(components=4, attachment=1, dtype="f4"), dtype=np.float32)
         return hit.reshape(-1, 4), info.reshape(-1, 4)
+
+    def _release_target(self) -> None:
+        if self._target is not None:
+            self._target[2].release()
+            for texture in self._target[1]:
+                texture.release()
+            self._target = None
 
     def _run(self, origins: ArrayLike, directions: ArrayLike, t_max: ArrayLike, cull: bool, any_hit: bool
              ) -> tuple[NDArray[np.float32], NDArray[np.float32], int]:
@@ -303,5 +311,6 @@ class GpuBVH:
             vao.release()
             program.release()
         self._programs.clear()
+        self._release_target()
         self._nodes.release()
         self._tris.release()
