@@ -44,6 +44,7 @@ from glsandbox.scene import (
     Camera,
     Light,
     Material,
+    Motion,
     Node,
     Scene,
     ShadowMap,
@@ -53,7 +54,7 @@ from glsandbox.scene import (
 
 __all__ = [
     "COURSE_BLUE", "DEPTH_MODES", "LIT_SHADINGS", "NORMAL_MODES", "TEXTURE_FILTERS", "TEXTURE_WRAPS",
-    "Camera", "Lesson", "Light", "Material", "Mesh", "Mirror", "Model", "Node", "Overlay", "Param", "PlanarShadow",
+    "Camera", "Lesson", "Light", "Material", "Mesh", "Mirror", "Model", "Motion", "Node", "Overlay", "Param", "PlanarShadow",
     "SandboxError", "Scene", "ShadowMap", "Texture", "Viewport",
     "__version__", "camera", "check_texture_source", "fit_mesh", "geometry", "load_mesh", "load_model", "meshgen", "register", "run",
     "show", "text_image", "transforms", "view", "widget",

@@ -34,12 +34,12 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
 from glsandbox.errors import SandboxError, plain
-from glsandbox.scene import Camera, Scene
+from glsandbox.scene import Camera, Motion, Scene, moved_scene
 
 #: One A/D press: the course's 15° turn.
 TURN_DEGREES = 15.0
@@ -272,4 +272,5 @@ class CameraInput:
         """The scene seen through the interactive camera, or unchanged if never moved."""
         if self.camera is None:
             return scene
-        return replace(scene, camera=self.camera.camera())
+        # Moved, not replaced: the renderers keep the plan while only the camera changes.
+        return moved_scene(scene, Motion(camera=self.camera.camera()))

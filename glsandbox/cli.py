@@ -32,7 +32,6 @@ from glsandbox.lesson import Lesson, all_lessons, find_lesson, lesson_descriptio
 from glsandbox.plan import plan
 from glsandbox.progress import progress, say
 from glsandbox.scene import Scene
-from glsandbox.window import run_window
 
 EXIT_USAGE = 2
 #: What a Unix tool exits with when its reader went away (128 + SIGPIPE).
@@ -155,6 +154,8 @@ def cmd_render(args: argparse.Namespace) -> int:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    from glsandbox.window import run_window  # glfw and the panel only where a window opens
+
     run_window(_lesson(args), _size(args), args.samples, args.backend)
     return 0
 
@@ -599,6 +600,8 @@ def lesson_main(lesson_cls: type[Lesson], argv: list[str] | None = None) -> int:
             frame = render_to_file(lesson, out, size, args.samples, args.backend)
             print(f"wrote {out} ({size[0]}x{size[1]}, {frame.seconds * 1000:.1f} ms)")
         else:
+            from glsandbox.window import run_window
+
             run_window(lesson, size, args.samples, args.backend,
                        instead=f"or render it headless: python -m lessons.{lesson_cls.name} --headless --out FILE.png")
         return 0

@@ -34,8 +34,8 @@ from glsandbox.gl.executor import Executor
 from glsandbox.gl.target import OffscreenTarget
 from glsandbox.lesson import Lesson
 from glsandbox.overlay import Overlay
-from glsandbox.plan import TRACE_OPTIONS, Buffers, Plan, plan, traced_image_name, traced_scene
-from glsandbox.scene import Scene
+from glsandbox.plan import TRACE_OPTIONS, Buffers, Plan, motion_decisions, plan, traced_image_name, traced_scene
+from glsandbox.scene import Scene, scene_origin
 
 __all__ = ["DEFAULT_SIZE", "Frame", "FrameRenderer", "HeadlessRenderer", "InteractiveResolution",
            "LazyRenderer", "trace_viewports", "with_samples"]
@@ -146,11 +146,14 @@ class FrameRenderer:
 
     #: Targets kept for reuse; a window being resized makes one per size.
     KEEP_TARGETS = 8
+    #: Plans kept for frames moved from one scene (:meth:`plan`): a live compare's variants.
+    KEEP_PLANS = 16
 
     def __init__(self, host: GLHost) -> None:
         self.host = host
         self.executor = Executor(host)
         self._targets: dict[tuple[tuple[int, int], Buffers], OffscreenTarget] = {}
+        self._plans: dict[int, tuple[Scene, tuple, Plan]] = {}  # by id of the scene frames were moved from
         self._noted: set[str] = set()  # user-shader notes already printed: once per run, not per frame
 
     def target(self, size: tuple[int, int], buffers: Buffers) -> OffscreenTarget:
@@ -171,7 +174,7 @@ class FrameRenderer:
         each on stderr, once per run."""
         self.host.make_current()
         traced = trace_viewports(scene, size, self.host.ctx, ray_resolution)
-        raster_plan = plan(traced)
+        raster_plan = self.plan(traced)
         target = self.target(size, raster_plan.buffers)
         self.executor.render(traced, target.framebuffer, size, raster_plan)
         # The whole frame's plan: the same raster passes after the trace passes, with the
@@ -182,6 +185,27 @@ class FrameRenderer:
                 self._noted.add(note)
                 print(f"warning: {note}", file=sys.stderr, flush=True)
         return frame_plan, target
+
+    def plan(self, scene: Scene) -> Plan:
+        """:func:`~glsandbox.plan.plan` of ``scene``, kept while only time moves it.
+
+        A scene moved from another (:func:`glsandbox.scene.moved_scene`: a lesson's
+        :meth:`~glsandbox.lesson.Lesson.motion`) reuses the plan of the last frame moved from
+        the same scene when their :func:`~glsandbox.plan.motion_decisions` agree: the plan
+        is then the same (blended order and planar shadow casters are its only parts that
+        depend on positions). Any other scene is planned afresh."""
+        origin = scene_origin(scene)
+        if origin is None:
+            return plan(scene)
+        decisions = motion_decisions(scene)
+        kept = self._plans.get(id(origin))
+        if kept is not None and kept[0] is origin and kept[1] == decisions:
+            return kept[2]
+        fresh = plan(scene)
+        if len(self._plans) >= self.KEEP_PLANS and id(origin) not in self._plans:
+            self._plans.pop(next(iter(self._plans)))
+        self._plans[id(origin)] = (origin, decisions, fresh)
+        return fresh
 
     def render_scene(self, scene: Scene, size: tuple[int, int]) -> Frame:
         """Draw one frame and read it back (headless, and the window's live compare tiles)."""

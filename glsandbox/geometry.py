@@ -37,7 +37,8 @@ class Mesh:
     animation, a missing texture): ``plan`` lists them and ``render``, ``run``
     and ``tour`` print each once as a ``warning:`` line.
     ``analytic`` names the exact shape the triangles tessellate, for the ray
-    tracer (``"sphere"``: :func:`sphere`, the unit sphere; None: the
+    tracer (``"sphere"``: :func:`sphere`, the unit sphere; ``"cylinder"``:
+    :func:`cylinder`, the capped unit cylinder; None: the
     triangles are the shape); :mod:`glsandbox.raytrace.world` traces that
     shape instead of the triangles.
     """
@@ -331,6 +332,45 @@ def sphere(stacks: int = 24, slices: int = 48) -> Mesh:
     return Mesh("sphere", positions, np.array(indices, dtype=np.uint32), positions.copy(), uvs, analytic="sphere")
 
 
+@functools.cache
+def cylinder(slices: int = 48) -> Mesh:
+    """The capped unit cylinder ``x² + z² ≤ 1, |y| ≤ 1`` (axis +y), with outward normals and uv.
+
+    The side is one band of ``slices`` quads: column ``j`` at azimuth
+    ``2*pi*j/slices`` from +z towards +x (as :func:`sphere`), ``u = j/slices``
+    (the seam column duplicated), ``v = (1 − y)/2``; each cap is a fan around
+    its centre with the cap's normal and ``uv = (½ + x/2, ½ + z/2)``, its own
+    vertices so the rim has both normals. The ray tracer traces the exact
+    cylinder (``analytic="cylinder"``, :class:`glsandbox.raytrace.world.NodeKind`)
+    under the node's model matrix. Counter-clockwise seen from outside.
+    """
+    phi = np.linspace(0.0, 2.0 * np.pi, slices + 1)
+    x, z = np.sin(phi), np.cos(phi)
+    x[-1], z[-1] = x[0], z[0]  # the seam: the same point twice, exactly
+    ring = slices + 1
+    side = np.concatenate([np.stack([x, np.ones(ring), z], axis=1), np.stack([x, -np.ones(ring), z], axis=1)])
+    side_n = side * np.array([1.0, 0.0, 1.0])
+    u = np.linspace(0.0, 1.0, ring)
+    side_uv = np.concatenate([np.stack([u, np.zeros(ring)], axis=1), np.stack([u, np.ones(ring)], axis=1)])
+    indices = []
+    for j in range(slices):
+        a, b = j, ring + j  # a on top, b below it
+        indices += [a, b, a + 1, a + 1, b, b + 1]
+    positions, normals, uvs = [side], [side_n], [side_uv]
+    base = 2 * ring
+    for y in (1.0, -1.0):  # the caps: centre, then the rim
+        cap = np.concatenate([[[0.0, y, 0.0]], np.stack([x[:-1], np.full(slices, y), z[:-1]], axis=1)])
+        positions.append(cap)
+        normals.append(np.tile([0.0, y, 0.0], (slices + 1, 1)))
+        uvs.append(np.stack([0.5 + 0.5 * cap[:, 0], 0.5 + 0.5 * cap[:, 2]], axis=1))
+        for j in range(slices):
+            p, q = base + 1 + j, base + 1 + (j + 1) % slices
+            indices += [base, p, q] if y > 0 else [base, q, p]
+        base += slices + 1
+    return Mesh("cylinder", np.concatenate(positions), np.array(indices, dtype=np.uint32), np.concatenate(normals),
+                np.concatenate(uvs), analytic="cylinder")
+
+
 #: Built-in meshes by name, for scene files.
 BUILTIN_MESHES: dict[str, Callable[[], Mesh]] = {
     "cube": cube,
@@ -341,6 +381,7 @@ BUILTIN_MESHES: dict[str, Callable[[], Mesh]] = {
     "triangle": triangle,
     "plane": plane,
     "sphere": sphere,
+    "cylinder": cylinder,
 }
 
 

@@ -26,8 +26,8 @@ from typing import Any, ClassVar, NoReturn
 from glsandbox.errors import NUMBER_LIMIT, SandboxError, plain
 from glsandbox.files import read_user_file
 from glsandbox.scene import RENDERERS
-from glsandbox.scene import PLAN_MODES, Camera, Scene, check_uniform_name, check_uniform_value
-from glsandbox.scene_file import load_scene
+from glsandbox.scene import (PLAN_MODES, Camera, Motion, Scene, check_uniform_name, check_uniform_value,
+                             moved_scene)
 
 #: The module name prefix of lesson files loaded from outside the package.
 _FILE_MODULE = "_glsandbox_lesson_"
@@ -265,7 +265,54 @@ class Lesson:
         return moment
 
     def scene(self) -> Scene:
-        """The Scene for the current values (``renderer`` marks its viewports)."""
+        """The Scene for the current values (``renderer`` marks its viewports).
+
+        A lesson whose :meth:`motion` says what ``time`` moves builds its scene once per
+        set of its other values (at most :data:`SCENES_KEPT` kept per lesson class) and per
+        frame only moves that (:func:`glsandbox.scene.moved_scene`): no dataclass is
+        made or checked again but the moved ones, and the renderers keep their plan."""
+        motion = self.motion()
+        if motion is None:
+            return self._scene_as_built()
+        key = self._still_key()
+        if key is None:  # a value that cannot be a key (an array given from Python): built every frame
+            return moved_scene(self._scene_as_built(), motion)
+        cls = type(self)
+        kept = cls.__dict__.get("_scenes_kept")  # the class's own (not a parent's): it goes with the class
+        if kept is None:
+            kept = {}
+            cls._scenes_kept = kept
+        scene = kept.pop(key, None)
+        if scene is None:
+            scene = self._scene_as_built()
+            if len(kept) >= SCENES_KEPT:
+                del kept[next(iter(kept))]  # the least recently used
+        kept[key] = scene  # the most recent last
+        return moved_scene(scene, motion)
+
+    def _still_key(self) -> tuple | None:
+        """Every value but ``time``, with its type (1, 1.0 and True stay apart), or None when one cannot be hashed."""
+        key = tuple((name, type(value), value) for name, value in sorted(self.values.items()) if name != "time")
+        try:
+            hash(key)
+        except TypeError:
+            return None
+        return key
+
+    def motion(self) -> Motion | None:
+        """What ``time`` moves in :meth:`build`'s scene, at :attr:`time`: the model matrices of
+        the nodes that move (by name) and the positions of the lights that move (by index).
+
+        None (the default): the scene is built again every frame. A lesson that returns a
+        :class:`~glsandbox.scene.Motion` promises that :meth:`build` depends on its
+        :attr:`values` alone, and that its scene at any time is the one built at another
+        time with this motion applied (a static lesson returns an empty ``Motion()``);
+        its frames then pay only for what moves (issue 24). ``tests/core/test_frame_cache.py``
+        checks every built-in lesson's promise, pixel for pixel, at several times."""
+        return None
+
+    def _scene_as_built(self) -> Scene:
+        """:meth:`build`'s scene with the shared parameters applied (renderer, camera, effects, ``u.*``)."""
         scene = built_scene(self)
         renderer = self.values.get("renderer", "raster")
         if renderer != "raster":  # traced by glsandbox.frame.trace_viewports
@@ -288,6 +335,10 @@ class Lesson:
         """Window key hook (glfw key name, e.g. ``"1"``); return True when handled."""
         return False
 
+
+#: Scenes kept per lesson class for :meth:`Lesson.scene` (one per set of values but ``time``):
+#: a window's live compare shows several variants of one lesson at once.
+SCENES_KEPT = 16
 
 #: The parameters every lesson has; a lesson's own may not reuse their names.
 SHARED_PARAMS = (TIME, RENDERER, EFFECTS_PARAM, CAMERA)
@@ -374,11 +425,15 @@ class SceneFileLesson(Lesson):
     path: ClassVar[Path]
 
     def build(self) -> Scene:
+        from glsandbox.scene_file import load_scene  # TOML and its checks: only where a scene file is used
+
         return load_scene(self.path)
 
 
 def scene_file_lesson(path: Path) -> type[Lesson]:
     """A lesson class for one scene file; the file is validated now."""
+    from glsandbox.scene_file import load_scene
+
     load_scene(path)  # fail early, with file and line
     # A class name must be text Python can encode: a file name with any bytes is made safe here.
     stem = "".join(c if c.isalnum() and c.isascii() else "_" for c in path.stem)

@@ -381,6 +381,33 @@ def _distance(node: Node, camera: Camera) -> float:
     return float(np.linalg.norm(world[:3] - np.asarray(camera.eye, dtype=np.float64)))
 
 
+def _farthest_first(blended: list[tuple[Node, Any]], camera: Camera) -> list[tuple[Node, Any]]:
+    """``(node, anything)`` pairs of blended nodes in drawing order: farthest from the eye first."""
+    return sorted(blended, key=lambda pair: -_distance(pair[0], camera))
+
+
+def motion_decisions(scene: Scene) -> tuple:
+    """What of :func:`plan`'s answer depends on where nodes, lights and cameras are: the order
+    of each viewport's blended draws (:func:`_distance`) and which casters the planar shadow
+    keeps or culls, and why (:func:`glsandbox.planar.shadow_casters`). Everything else of a
+    plan depends on the scene's other parts. So two scenes that differ only in model
+    matrices, light positions and cameras (:func:`glsandbox.scene.moved_scene`) and have
+    equal decisions have equal plans: the frame renderer keeps the plan between such frames."""
+    decisions: list[object] = []
+    glass = scene.mirror.node if scene.mirror is not None else None
+    blended = [node for node in scene.nodes if node.material.alpha_mode == "blend" and node.name != glass]
+    if blended:
+        for index, viewport in enumerate(scene.viewports):
+            shown = [(node, None) for node in blended if node.shown_in(index)]
+            decisions.append(tuple(node.name for node, _ in _farthest_first(shown, viewport.camera or scene.camera)))
+    shadow = scene.planar_shadow
+    if shadow is not None:
+        nodes = {node.name: node for node in scene.nodes}
+        models = {name: (nodes[name].model, nodes[name].mesh.positions) for name in shadow.casters if name in nodes}
+        decisions.append(shadow_casters(shadow, models))
+    return tuple(decisions)
+
+
 def _needs_depth(scene: Scene) -> bool:
     """A depth buffer is needed only where something can hide something else:
     two nodes in one viewport, or one mesh that is not flat."""
@@ -588,7 +615,7 @@ def plan(scene: Scene) -> Plan:
                             texture=texture.describe() if texture is not None else None, blend=blend,
                             shadow_map=receives if "SHADOW_LIGHT" in dict(variant.defines) else None)))
         camera = viewport.camera or scene.camera
-        draws = [d for _, d in draws] + [d for _, d in sorted(blended, key=lambda nd: -_distance(nd[0], camera))]
+        draws = [d for _, d in draws] + [d for _, d in _farthest_first(blended, camera)]
         if draws:
             passes.append(Pass("draw", index, draws=tuple(draws), depth_test=uses_depth))
         passes.extend(planar_passes(scene, index, programs))

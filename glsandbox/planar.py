@@ -11,6 +11,7 @@ No GL here.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -27,6 +28,19 @@ def _bounded_plane(plane: tuple[float, ...], what: str) -> tuple[float, ...]:
     normalized = tuple(float(v) for v in transforms.normalize_plane(plane))
     check_number(normalized[3], f"{what} plane's distance from the origin (d of the normalized plane)")
     return normalized
+
+
+def _kept(owner: object, name: str, make: Callable[[], np.ndarray]) -> np.ndarray:
+    """``make()`` kept in the frozen ``owner`` under ``name`` (not a field: equality, hashing
+    and repr ignore it), read-only so that no caller changes what the next one gets. The
+    owner is immutable, so the matrix made from its fields stays right: the frames of a
+    scene that only moves make it once."""
+    matrix = owner.__dict__.get(name)
+    if matrix is None:
+        matrix = np.array(make(), dtype=np.float64)
+        matrix.setflags(write=False)
+        object.__setattr__(owner, name, matrix)
+    return matrix
 
 
 @dataclass(frozen=True)
@@ -54,8 +68,8 @@ class Mirror:
             raise SandboxError(f"mirror node {self.node!r} cannot reflect itself")
 
     def matrix(self) -> np.ndarray:
-        """The reflection matrix R (det -1, R² = I)."""
-        return transforms.reflection_matrix(self.plane)
+        """The reflection matrix R (det -1, R² = I); made once per mirror (read-only)."""
+        return _kept(self, "_matrix", lambda: transforms.reflection_matrix(self.plane))
 
 
 @dataclass(frozen=True)
@@ -97,8 +111,10 @@ class PlanarShadow:
         return float(np.dot(self.plane, self.light))
 
     def matrix(self) -> np.ndarray:
-        """The lifted shadow matrix ``T(lift·n) @ S`` (see :func:`glsandbox.transforms.shadow_matrix`)."""
-        return transforms.offset_along_normal(self.plane, self.lift) @ transforms.shadow_matrix(self.plane, self.light)
+        """The lifted shadow matrix ``T(lift·n) @ S`` (see :func:`glsandbox.transforms.shadow_matrix`);
+        made once per shadow (read-only). A light the matrix refuses is refused at every call."""
+        return _kept(self, "_matrix", lambda: transforms.offset_along_normal(self.plane, self.lift)
+                     @ transforms.shadow_matrix(self.plane, self.light))
 
 
 @dataclass(frozen=True)
@@ -128,7 +144,7 @@ def shadow_casters(shadow: PlanarShadow, models: dict[str, tuple[np.ndarray, np.
       :func:`glsandbox.transforms.shadow_matrix`) and its triangles would be
       projected through infinity: that caster is culled, with the reason.
     """
-    transforms.shadow_matrix(shadow.plane, shadow.light)  # refuses the degenerate lights
+    shadow.matrix()  # refuses the degenerate lights (transforms.shadow_matrix)
     height = shadow.height
     if height < 0.0:
         return ShadowCasting((), reason=f"light is below the receiver plane (P·L = {height:.3g})")

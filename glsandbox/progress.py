@@ -17,20 +17,28 @@ Use::
 from __future__ import annotations
 
 import sys
-from typing import TextIO
+from typing import TYPE_CHECKING, TextIO
 
-from tqdm import tqdm
+if TYPE_CHECKING:
+    from tqdm import tqdm
+
+# tqdm is imported where a bar or a line is made, not with this module: the CLI imports this
+# module for every command, and tqdm's import (importlib.metadata) is a fifth of a cold start.
 
 __all__ = ["progress", "say"]
 
 
 def progress(total: int, what: str, unit: str = "step", file: TextIO | None = None) -> tqdm:
     """A bar for ``total`` steps of ``what`` on ``file`` (stderr); nothing at all unless it is a terminal."""
+    from tqdm import tqdm
+
     return tqdm(total=total, desc=what, unit=f" {unit}", file=file or sys.stderr, disable=None, leave=False,
                 dynamic_ncols=True, mininterval=0.25, smoothing=0.1)
 
 
 def say(text: str, file: TextIO | None = None) -> None:
     """One line on ``file`` (stderr), above any bar there (which is drawn again below it)."""
+    from tqdm import tqdm
+
     tqdm.write(text, file=file or sys.stderr)
     (file or sys.stderr).flush()

@@ -382,6 +382,34 @@ def check_uniforms(values: object, what: str) -> Mapping[str, UniformValue]:
 _NO_UNIFORMS: Mapping[str, UniformValue] = MappingProxyType({})
 
 
+def check_node_model(name: str, model: object) -> np.ndarray:
+    """A node's model matrix as an array, or a :class:`SandboxError` naming the node: 4x4
+    numbers, each finite and within +-NUMBER_LIMIT."""
+    matrix = np.asarray(model)
+    if matrix.shape != (4, 4) or matrix.dtype.kind not in "biuf":
+        raise SandboxError(f"node {name!r}: model matrix must be 4x4 numbers, got {plain(model)}")
+    in_bounds = bool(np.abs(matrix).max() <= NUMBER_LIMIT)  # False for NaN (max propagates it) and inf too
+    if not in_bounds and not np.all(np.isfinite(matrix)):
+        raise SandboxError(f"node {name!r}: model matrix has a non-finite entry: {plain(matrix)}")
+    if not in_bounds:
+        raise SandboxError(f"node {name!r}: model matrix entry {plain(np.max(np.abs(matrix)))} is beyond "
+                           f"+-{NUMBER_LIMIT:g} (scale and position within +-{NUMBER_LIMIT:g})")
+    return matrix
+
+
+def check_lit_model(name: str, model: object) -> None:
+    """A lit node's model must keep every direction at least :data:`MIN_SCALE` long: its normal
+    matrix (the inverse transpose) then exists and stays within +-NUMBER_LIMIT."""
+    if transforms.scales_at_least(model, MIN_SCALE):
+        return
+    smallest = transforms.smallest_scale(model)
+    if smallest < MIN_SCALE:
+        what = ("is singular (a scale of 0?)" if smallest == 0.0 else
+                f"shrinks one direction to {smallest:.3g}, below {MIN_SCALE:g}")
+        raise SandboxError(f"node {name!r}: model matrix {what}, so a lit node has no usable normals; "
+                           f"scale every axis by at least {MIN_SCALE:g}, or use an unlit shading")
+
+
 @dataclass(frozen=True, eq=False)
 class Node:
     """A mesh placed in the world with a model matrix and a material.
@@ -432,15 +460,7 @@ class Node:
             _set(self, "uniforms", check_uniforms(self.uniforms, f"node {self.name!r}: uniform {{name}}"))
             if self.uniforms and self.shader is None:
                 raise SandboxError(f"node {self.name!r}: uniforms need a shader of the node's own (shader = ...)")
-        model = np.asarray(self.model)
-        if model.shape != (4, 4) or model.dtype.kind not in "biuf":
-            raise SandboxError(f"node {self.name!r}: model matrix must be 4x4 numbers, got {plain(self.model)}")
-        in_bounds = bool((np.abs(model) <= NUMBER_LIMIT).all())  # False for NaN and inf too
-        if not in_bounds and not np.all(np.isfinite(model)):
-            raise SandboxError(f"node {self.name!r}: model matrix has a non-finite entry: {plain(model)}")
-        if not in_bounds:
-            raise SandboxError(f"node {self.name!r}: model matrix entry {plain(np.max(np.abs(model)))} is beyond "
-                               f"+-{NUMBER_LIMIT:g} (scale and position within +-{NUMBER_LIMIT:g})")
+        check_node_model(self.name, self.model)
         # What the material reads from the mesh (the renderers would fail later, naming no node).
         # Normals are not among them: a lit mesh without normals is shaded flat by both
         # renderers (glsandbox.geometry.with_face_normals).
@@ -450,13 +470,8 @@ class Node:
             if data and getattr(self.mesh, attribute, None) is None:
                 raise SandboxError(f"node {self.name!r}: mesh {self.mesh.name!r} has no {attribute[:-1]} data, "
                                    f"which {needed} needs")
-        if self.material.lit and not transforms.scales_at_least(model, MIN_SCALE):
-            smallest = transforms.smallest_scale(model)
-            if smallest < MIN_SCALE:
-                what = ("is singular (a scale of 0?)" if smallest == 0.0 else
-                        f"shrinks one direction to {smallest:.3g}, below {MIN_SCALE:g}")
-                raise SandboxError(f"node {self.name!r}: model matrix {what}, so a lit node has no usable normals; "
-                                   f"scale every axis by at least {MIN_SCALE:g}, or use an unlit shading")
+        if self.material.lit:
+            check_lit_model(self.name, self.model)
 
     def shown_in(self, viewport: int) -> bool:
         """Whether the node is drawn in viewport ``viewport`` (by index)."""
@@ -564,3 +579,77 @@ class Scene:
                 raise SandboxError(f"scene {self.name!r}: {field_name} must be a {kind.__name__}, got {plain(value)}")
         if isinstance(self.samples, bool) or not isinstance(self.samples, (int, np.integer)) or self.samples < 0:
             raise SandboxError(f"scene {self.name!r}: samples must be a whole number >= 0, got {plain(self.samples)}")
+
+
+# --- frames that pay only for what moves (issue 24) ------------------------------
+
+
+@dataclass(frozen=True)
+class Motion:
+    """What ``time`` moves in a lesson's scene (:meth:`glsandbox.Lesson.motion`): new model
+    matrices of nodes, by node name, new positions of lights, by index, and a new camera
+    (the window's camera keys). Everything else
+    of the scene stays as it was built, so a frame whose only change is time keeps its
+    Scene, the Scene's checks and its plan (:func:`moved_scene`)."""
+
+    models: Mapping[str, Any] = field(default_factory=dict)
+    lights: Mapping[int, tuple[float, float, float]] = field(default_factory=dict)
+    #: A camera replacing the scene's (the window's camera keys, :meth:`glsandbox.camera.CameraInput.apply`).
+    camera: Camera | None = None
+
+
+def _copy_with(obj: Any, **changes: Any) -> Any:
+    """A frozen dataclass ``obj`` with ``changes``, without running its ``__post_init__`` again:
+    the caller has checked the changed fields (the others were checked when ``obj`` was made)."""
+    new = object.__new__(type(obj))
+    new.__dict__.update(obj.__dict__)
+    new.__dict__.update(changes)
+    return new
+
+
+def moved_scene(scene: Scene, motion: Motion) -> Scene:
+    """``scene`` with ``motion`` applied: the moved nodes and lights are new objects, each new
+    value checked as the dataclasses check it (a model matrix of 4x4 bounded numbers, at
+    least :data:`MIN_SCALE` in every direction for a lit node; a light position of three
+    bounded numbers); every other part is the same object as in ``scene``. The result
+    remembers ``scene`` (:func:`scene_origin`): the renderers keep what they derived from
+    it (the plan, per-draw uniform bytes) while only positions change."""
+    origin = scene_origin(scene) or scene
+    nodes, lights = scene.nodes, scene.lights
+    if motion.models:
+        models = dict(motion.models)
+        moved = []
+        for node in nodes:
+            model = models.get(node.name)
+            if model is None:
+                moved.append(node)
+                continue
+            matrix = check_node_model(node.name, model)
+            if node.material.lit:
+                check_lit_model(node.name, matrix)
+            moved.append(_copy_with(node, model=model))
+        unknown = set(models) - {node.name for node in nodes}
+        if unknown:
+            raise SandboxError(f"scene {scene.name!r}: the motion moves {', '.join(map(repr, sorted(unknown)))}, "
+                               f"which is not a node of the scene")
+        nodes = tuple(moved)
+    if motion.lights:
+        lights = list(lights)
+        for index, position in motion.lights.items():
+            if not (isinstance(index, int) and 0 <= index < len(lights)):
+                raise SandboxError(f"scene {scene.name!r}: the motion moves light {plain(index)}, and the scene "
+                                   f"has {len(lights)}")
+            lights[index] = _copy_with(lights[index], position=check_numbers(position, "light position"))
+        lights = tuple(lights)
+    camera = scene.camera
+    if motion.camera is not None:
+        if not isinstance(motion.camera, Camera):
+            raise SandboxError(f"scene {scene.name!r}: the motion's camera must be a Camera, got {plain(motion.camera)}")
+        camera = motion.camera
+    return _copy_with(scene, nodes=nodes, lights=lights, camera=camera, _moved_from=origin)
+
+
+def scene_origin(scene: Scene) -> Scene | None:
+    """The scene ``scene`` was moved from by :func:`moved_scene` (None: it was built as it is).
+    A scene made from it any other way (``dataclasses.replace``) has none."""
+    return scene.__dict__.get("_moved_from")

@@ -84,9 +84,8 @@ def identity() -> Matrix:
 
 def translate(x: float, y: float, z: float) -> Matrix:
     """Translation by (x, y, z): the last column carries the offset."""
-    m = np.eye(4)
-    m[:3, 3] = (x, y, z)
-    return m
+    return np.array([[1.0, 0.0, 0.0, x], [0.0, 1.0, 0.0, y], [0.0, 0.0, 1.0, z], [0.0, 0.0, 0.0, 1.0]],
+                    dtype=np.float64)
 
 
 def scale(x: float, y: float, z: float) -> Matrix:
@@ -181,9 +180,12 @@ def scales_at_least(model: Matrix, bound: float) -> bool:
     s3 = |det A| / (s1 s2) and s1 s2 <= (s1² + s2²) / 2 <= |A|²_F / 2, so
     s3 >= 2 |det A| / |A|²_F. When that lower bound clears ``bound`` (every
     ordinary model matrix) no singular value decomposition is needed."""
-    a = np.asarray(model, dtype=np.float64)[:3, :3]
-    frobenius2 = float(np.einsum("ij,ij->", a, a))
-    if frobenius2 > 0.0 and 2.0 * abs(float(np.linalg.det(a))) / frobenius2 >= bound:
+    # Nine Python floats: cheaper than numpy's det and einsum on a 3x3 (lessons move nodes
+    # every frame, and each moved lit node is checked).
+    (a, b, c), (d, e, f), (g, h, i) = np.asarray(model, dtype=np.float64)[:3, :3].tolist()
+    frobenius2 = a * a + b * b + c * c + d * d + e * e + f * f + g * g + h * h + i * i
+    determinant = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
+    if frobenius2 > 0.0 and 2.0 * abs(determinant) / frobenius2 >= bound:
         return True
     return smallest_scale(model) >= bound
 

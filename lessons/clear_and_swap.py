@@ -13,7 +13,7 @@ from __future__ import annotations
 import sys
 
 import glsandbox
-from glsandbox import COURSE_BLUE, Lesson, Param, Scene, Viewport, register
+from glsandbox import COURSE_BLUE, Lesson, Motion, Param, Scene, Viewport, register
 
 
 #: Player two's colour: the course's blue with red and blue swapped.
@@ -34,6 +34,10 @@ class ClearAndSwap(Lesson):
         left = Viewport(rect=(0.0, 0.0, 0.5, 1.0), clear_color=COURSE_BLUE, label="player 1")
         right = Viewport(rect=(0.5, 0.0, 0.5, 1.0), clear_color=PLAYER_TWO, label="player 2")
         return Scene(self.name, clear_color=COURSE_BLUE, viewports=(left, right))
+
+    def motion(self) -> Motion:
+        """Nothing moves: the scene is built once per set of values."""
+        return Motion()
 
 
 if __name__ == "__main__":

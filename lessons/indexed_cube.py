@@ -23,7 +23,7 @@ import sys
 import numpy as np
 
 import glsandbox
-from glsandbox import Camera, Lesson, Material, Node, Param, Scene, geometry, register, transforms
+from glsandbox import Camera, Lesson, Material, Motion, Node, Param, Scene, geometry, register, transforms
 
 
 #: Which two of the 12 triangles make each face, in the course's index order.
@@ -65,16 +65,21 @@ class IndexedCube(Lesson):
         Param("cull", True, "back-face culling"),
     )
 
-    def build(self) -> Scene:
+    def cube_model(self) -> np.ndarray:
+        """The cube's model at :attr:`time`: DirectX's XMMatrixRotationY(speed*t), converted by the z mirror."""
         angle = float(self.values["speed"]) * self.time
         c, s = math.cos(angle), math.sin(angle)
-        # DirectX's XMMatrixRotationY(angle), converted by the z mirror.
         dx_rotation = np.array([[c, 0.0, -s, 0.0], [0.0, 1.0, 0.0, 0.0], [s, 0.0, c, 0.0], [0.0, 0.0, 0.0, 1.0]])
-        model = transforms.from_directx_matrix(dx_rotation)
-        node = Node("cube", CUBES[self.values["flip"]], model, VERTEX_COLORS,
+        return transforms.from_directx_matrix(dx_rotation)
+
+    def build(self) -> Scene:
+        node = Node("cube", CUBES[self.values["flip"]], self.cube_model(), VERTEX_COLORS,
                     cull_back_faces=bool(self.values["cull"]))
         return Scene(self.name, nodes=(node,), camera=COURSE_CAMERA)
 
+    def motion(self) -> Motion:
+        """Only the cube turns with time."""
+        return Motion(models={"cube": self.cube_model()})
 
 if __name__ == "__main__":
     sys.exit(glsandbox.run(IndexedCube))

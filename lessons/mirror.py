@@ -52,6 +52,7 @@ from glsandbox import (
     Light,
     Material,
     Mirror,
+    Motion,
     Node,
     Param,
     PlanarShadow,
@@ -190,10 +191,7 @@ class MirrorLesson(Lesson):
             shading_light = Light(tuple(float(c) for c in FAR_LIGHT * light[:3]))
         nodes = [
             *ROOM,
-            Node("cube", geometry.cube24(),
-                 transforms.translate(*CUBE_CENTRE) @ transforms.rotate_y(0.5 + float(v["speed"]) * self.time)
-                 @ transforms.scale(CUBE_HALF, CUBE_HALF, CUBE_HALF),
-                 _lit((1.0, 0.5, 0.15))),
+            Node("cube", geometry.cube24(), self.cube_model(), _lit((1.0, 0.5, 0.15))),
         ]
         reflected = ["floor", "wall_left", "cube"]
         if light[3] == 1.0:
@@ -215,6 +213,15 @@ class MirrorLesson(Lesson):
                         near=float(v["near"]), far=float(v["far"]))
         return Scene(self.name, nodes=tuple(nodes), camera=camera, lights=(shading_light,),
                      clear_color=(0.08, 0.08, 0.12, 1.0), mirror=mirror, planar_shadow=shadow, depth_mode=v["depth"])
+
+    def cube_model(self) -> np.ndarray:
+        """The cube's model at :attr:`time`: turning about y at its place."""
+        turn = transforms.rotate_y(0.5 + float(self.values["speed"]) * self.time)
+        return transforms.translate(*CUBE_CENTRE) @ turn @ transforms.scale(CUBE_HALF, CUBE_HALF, CUBE_HALF)
+
+    def motion(self) -> Motion:
+        """Only the cube turns with time (its reflection and shadow follow it in the passes)."""
+        return Motion(models={"cube": self.cube_model()})
 
     def on_key(self, key: str) -> bool:
         """1: cycle the mirror mode; 2: the shadow mode; 3: the depth mode; 4: the light type."""

@@ -27,6 +27,8 @@ from __future__ import annotations
 import math
 import sys
 
+import numpy as np
+
 import glsandbox
 from glsandbox import (
     LIT_SHADINGS,
@@ -35,6 +37,7 @@ from glsandbox import (
     Lesson,
     Light,
     Material,
+    Motion,
     Node,
     Param,
     Scene,
@@ -70,8 +73,13 @@ def light_positions(time: float, speed: float, count: int = 2) -> list[tuple[flo
 
 def light_cube(index: int, light: Light) -> Node:
     """A light drawn as a small cube in its own colour, unlit (solid program)."""
-    model = transforms.translate(*light.position) @ transforms.scale(*(LIGHT_CUBE_SCALE,) * 3)
-    return Node(f"light{index}", geometry.cube(), model, Material(color=(*light.color, 1.0), shading="solid"))
+    return Node(f"light{index}", geometry.cube(), light_cube_model(light.position),
+                Material(color=(*light.color, 1.0), shading="solid"))
+
+
+def light_cube_model(position: tuple[float, float, float]) -> np.ndarray:
+    """A light's cube: the course cube scaled by :data:`LIGHT_CUBE_SCALE`, at the light."""
+    return transforms.translate(*position) @ transforms.scale(*(LIGHT_CUBE_SCALE,) * 3)
 
 
 @register
@@ -116,6 +124,13 @@ class PhongLesson(Lesson):
         ]
         camera = Camera(eye=(0.0, 2.5, 8.0), target=(0.0, 0.0, 0.0), fov_y=45.0, near=0.01, far=100.0)
         return Scene(self.name, nodes=tuple(nodes), camera=camera, lights=lights)
+
+    def motion(self) -> Motion:
+        """The lights orbit with time, and their cubes with them."""
+        count = int(self.values["lights"])
+        positions = light_positions(self.time, float(self.values["speed"]), count)
+        return Motion(models={f"light{i}": light_cube_model(p) for i, p in enumerate(positions)},
+                      lights=dict(enumerate(positions)))
 
     def on_key(self, key: str) -> bool:
         """1, 2, 3: toggle ambient, diffuse, specular; 4: next shading; 5: normals."""

@@ -27,8 +27,10 @@ from __future__ import annotations
 
 import sys
 
+import numpy as np
+
 import glsandbox
-from glsandbox import Camera, Lesson, Light, Material, Node, Param, PlanarShadow, Scene, ShadowMap, Viewport
+from glsandbox import Camera, Lesson, Light, Material, Motion, Node, Param, PlanarShadow, Scene, ShadowMap, Viewport
 from glsandbox import geometry, register, transforms
 
 #: The floor y = 0, normal up.
@@ -93,10 +95,9 @@ class ShadowMapLesson(Lesson):
         views = None if viewport is None else (viewport,)
         # Only the map's own tile casts and receives it (a lone ray tile too: --set renderer=ray on show=map).
         mapped = technique == "map" or viewport is None and technique == "ray"
-        turn = transforms.rotate_y(0.4 + float(self.values["speed"]) * self.time)
         models = {
             "floor": transforms.scale(FLOOR_SIZE, 1.0, FLOOR_SIZE),
-            "cube": transforms.translate(*CUBE_AT) @ turn @ transforms.scale(*(CUBE_HALF,) * 3),
+            "cube": self.cube_model(),
             "sphere": transforms.translate(*SPHERE[0]) @ transforms.scale(*(SPHERE[1],) * 3),
             "panel": transforms.translate(*PANEL[0]) @ transforms.scale(*PANEL[1]),
         }
@@ -106,9 +107,24 @@ class ShadowMapLesson(Lesson):
         return [Node(prefix + name, meshes[name], models[name], _lit(COLORS[name]), viewports=views,
                      casts_shadow=mapped, receives_shadow=mapped) for name in models]
 
-    def build(self) -> Scene:
+    def cube_model(self) -> np.ndarray:
+        """The cube's model at :attr:`time`: turning about y on the floor."""
+        turn = transforms.rotate_y(0.4 + float(self.values["speed"]) * self.time)
+        return transforms.translate(*CUBE_AT) @ turn @ transforms.scale(*(CUBE_HALF,) * 3)
+
+    def techniques(self) -> tuple[str, ...]:
         show = self.values["show"]
-        techniques = TECHNIQUES if show == "all" else (show,)
+        return TECHNIQUES if show == "all" else (show,)
+
+    def motion(self) -> Motion:
+        """Only the cube turns with time, in every tile."""
+        techniques = self.techniques()
+        prefixes = [f"{t}_" for t in techniques] if len(techniques) > 1 else [""]
+        model = self.cube_model()
+        return Motion(models={f"{prefix}cube": model for prefix in prefixes})
+
+    def build(self) -> Scene:
+        techniques = self.techniques()
         several = len(techniques) > 1
         width = 1.0 / len(techniques)
         viewports, nodes = [], []

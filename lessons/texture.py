@@ -26,6 +26,8 @@ import math
 import sys
 from dataclasses import replace
 
+import numpy as np
+
 import glsandbox
 from glsandbox import (
     TEXTURE_FILTERS,
@@ -33,6 +35,7 @@ from glsandbox import (
     Camera,
     Lesson,
     Material,
+    Motion,
     Node,
     Param,
     Scene,
@@ -83,14 +86,21 @@ class TextureLesson(Lesson):
         sampler = {"filter": v["filter"], "wrap": v["wrap"]}
         cube_texture = Texture(str(v["image"]), **sampler)
         ground_texture = Texture(str(v["ground"]), **sampler)
-        turn = transforms.rotate_y(START_ANGLE + float(v["speed"]) * self.time)
         nodes = (
             Node("ground", ground(GROUND_SIZE, float(v["tile"])), transforms.translate(0.0, GROUND_Y, 0.0),
                  Material(texture=ground_texture)),
-            Node("cube", geometry.cube24(), turn, Material(texture=cube_texture)),
+            Node("cube", geometry.cube24(), self.cube_turn(), Material(texture=cube_texture)),
         )
         camera = Camera(eye=(0.0, 1.9, 5.5), target=(0.0, -0.3, 0.0), fov_y=45.0, near=0.01, far=100.0)
         return Scene(self.name, nodes=nodes, camera=camera, clear_color=(0.55, 0.7, 0.9, 1.0))
+
+    def cube_turn(self) -> np.ndarray:
+        """The cube's model at :attr:`time`: turned about y from :data:`START_ANGLE`."""
+        return transforms.rotate_y(START_ANGLE + float(self.values["speed"]) * self.time)
+
+    def motion(self) -> Motion:
+        """Only the cube turns with time."""
+        return Motion(models={"cube": self.cube_turn()})
 
 
 def course_uv_table() -> dict[str, list[tuple[tuple[float, float, float], tuple[float, float]]]]:

@@ -14,7 +14,7 @@ from __future__ import annotations
 import sys
 
 import glsandbox
-from glsandbox import Camera, Lesson, Material, Node, Param, Scene, Viewport, geometry, register
+from glsandbox import Camera, Lesson, Material, Motion, Node, Param, Scene, Viewport, geometry, register
 
 
 ORANGE = (1.0, 0.55, 0.1, 1.0)
@@ -52,6 +52,10 @@ class Triangle(Lesson):
             viewports = (Viewport(label=topology),)
             nodes = (Node(topology, mesh, material=Material(ORANGE), cull_back_faces=cull),)
         return Scene(self.name, nodes=nodes, camera=CAMERA, viewports=viewports)
+
+    def motion(self) -> Motion:
+        """Nothing moves: the scene is built once per set of values."""
+        return Motion()
 
 
 if __name__ == "__main__":

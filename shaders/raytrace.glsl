@@ -7,22 +7,19 @@
 // measured about 5x faster for this.
 //
 // Data (uploaded by glsandbox/raytrace/gpu.py), flat arrays of vec4 records:
-//   triangles  TRI_RECORDS per triangle: v0 | v1 | v2 | n0,uv0.x | n1,uv0.y |
-//              n2,uv1.x | c0,uv1.y | c1,uv2.x | c2,uv2.y   (world space)
-//   nodes      NODE_RECORDS per node: box min,kind | box max,cull |
-//              start,count,scene order,0 | colour,mode | ka,kd,ks,n |
-//              reflectivity,texture,lamp bits | inverse model (3 rows) |
-//              normal matrix (3 rows) | alpha,alpha mode,cutoff,flags
-//              (flags: 1 vertex colours tint a lit colour, 2 two-sided);
-//              mesh nodes first (u_mesh_count of
-//              them), then sphere nodes (u_sphere_count).
+// TRI_RECORDS per triangle and NODE_RECORDS per node, each field at the
+// offset glsandbox/raytrace/gpu_records.py defines (TRI_V0, NODE_INVERSE...,
+// with what each float holds); the node's kind code (NODE_BOX_MIN's w) is a
+// KIND_<NAME> define from glsandbox.raytrace.world.NodeKind. Mesh nodes
+// first (u_mesh_count of them), then the analytic nodes (u_shape_count).
 // A small scene has them in a uniform block (SceneData: u_node, u_tri), a
 // larger one in RGBA32F textures read with texelFetch (u_nodes, u_tris).
 //
 // Variants: NUM_LIGHTS (the light loop), NUM_TEXTURES (0..4 samplers),
 // SHADOWS (shadow rays), REFLECT (reflection bounces and passes through
 // see-through surfaces: some node reflects, is a cut-out or is blended, and
-// max_depth > 0), HAS_MESHES, HAS_SPHERES, VERTEX_COLORS (a node uses
+// max_depth > 0), HAS_MESHES, HAS_SHAPES (some analytic node) and
+// HAS_<KIND> per analytic kind (HAS_SPHERE, HAS_CYLINDER), VERTEX_COLORS (a node uses
 // them); SCENE_NODES (the scene's node list, see nearest()) with
 // NODE_COUNT and TRI_COUNT for a small scene, whose records are in the
 // uniform block.
@@ -41,16 +38,15 @@
 // order, then the first triangle, wins.
 
 #define TEX_WIDTH 1024
-#define TRI_RECORDS 9
-#define NODE_RECORDS 13
-#define INF 1e30
+// INF (no hit), FLT_MIN_NORMAL and the error bounds come from
+// glsandbox/raytrace/constants.py's glsl_defines().
 
 #if defined(VERTEX_SHADER)
 #include "common/fullscreen_vertex.glsl"
 
 #elif defined(FRAGMENT_SHADER)
 uniform int u_mesh_count;    // mesh nodes: records 0 .. u_mesh_count-1
-uniform int u_sphere_count;  // sphere nodes: the next u_sphere_count records
+uniform int u_shape_count;  // analytic nodes (spheres, cylinders): the next u_shape_count records
 uniform vec2 u_size;        // the image in pixels
 uniform vec3 u_eye;         // camera position (world)
 uniform mat3 u_basis;       // view space -> world (right, up, back)
@@ -87,8 +83,8 @@ out vec4 frag_color;
 #ifndef MESH_NODES
 #define MESH_NODES u_mesh_count
 #endif
-#ifndef SPHERE_NODES
-#define SPHERE_NODES u_sphere_count
+#ifndef SHAPE_NODES
+#define SHAPE_NODES u_shape_count
 #endif
 
 #if defined(SCENE_NODES)
@@ -142,7 +138,7 @@ bool slab(vec3 o, vec3 inv_d, vec3 lo, vec3 hi, float best) {
 // shading needs (so it is not solved again there). Backface culling
 // (course "Hızlandırma: backface culling") keeps the front faces only.
 float triangle_t(int k, WtRay r, bool cull, out vec2 uv) {
-    float t = wt_triangle(r, tri_rec(k, 0).xyz, tri_rec(k, 1).xyz, tri_rec(k, 2).xyz, cull, uv);
+    float t = wt_triangle(r, tri_rec(k, TRI_V0).xyz, tri_rec(k, TRI_V1).xyz, tri_rec(k, TRI_V2).xyz, cull, uv);
     return t > 0.0 ? t : INF;
 }
 
@@ -168,9 +164,75 @@ float sphere_t(vec3 o, vec3 d, bool cull) {
     return near > 0.0 ? near : (far > 0.0 ? far : INF);
 }
 
+// The capped unit cylinder x² + z² <= 1, |y| <= 1 in its own space
+// (numpy_engine.unit_cylinder_t): the side is the sphere's stable quadratic
+// in the xz-plane, its roots kept where |y| <= 1; each cap the plane y = ±1,
+// kept where x² + z² <= 1.
+float cylinder_t(vec3 o, vec3 d, bool cull) {
+    if (cull && dot(o.xz, o.xz) < 1.0 && abs(o.y) < 1.0) return INF;  // from inside
+    float best = INF;
+    float a = dot(d.xz, d.xz);
+    vec2 l = -o.xz;
+    float b = dot(l, d.xz);
+    vec2 h = l - (b / a) * d.xz;
+    float disc = a * (1.0 - dot(h, h));
+    if (a > 0.0 && disc >= 0.0) {
+        float q = b + (b >= 0.0 ? sqrt(disc) : -sqrt(disc));
+        if (q != 0.0) {
+            float l_len = length(l);
+            float c = (l_len - 1.0) * (l_len + 1.0);
+            float t0 = c / q, t1 = q / a;
+            if (t0 > 0.0 && t0 < best && abs(o.y + t0 * d.y) <= 1.0) best = t0;
+            if (t1 > 0.0 && t1 < best && abs(o.y + t1 * d.y) <= 1.0) best = t1;
+        }
+    }
+    if (d.y != 0.0) {
+        float tb = (-1.0 - o.y) / d.y, tt = (1.0 - o.y) / d.y;
+        vec2 pb = o.xz + tb * d.xz, pt = o.xz + tt * d.xz;
+        if (tb > 0.0 && tb < best && dot(pb, pb) <= 1.0) best = tb;
+        if (tt > 0.0 && tt < best && dot(pt, pt) <= 1.0) best = tt;
+    }
+    return best;
+}
+
+// --- the analytic kinds (glsandbox.raytrace.world.NodeKind, KIND_* defines):
+// a hit test and a surface (own-space normal, uv) per kind. A kind the scene
+// has not is compiled out (HAS_<KIND>); a new kind is one line in each.
+float shape_t(int kind, vec3 o, vec3 d, bool cull) {
+#if HAS_CYLINDER
+    if (kind == KIND_CYLINDER) return cylinder_t(o, d, cull);
+#endif
+    return sphere_t(o, d, cull);
+}
+
+const float PI = 3.14159265358979;
+
+// q: the hit in the kind's own space; n: its own-space normal.
+void shape_surface(int kind, vec3 q, out vec3 n, out vec2 uv) {
+#if HAS_CYLINDER
+    if (kind == KIND_CYLINDER) {  // as geometry.cylinder() lays them out
+        float r = length(q.xz);
+        float phi = atan(q.x, q.z);
+        if (abs(abs(q.y) - 1.0) < abs(r - 1.0)) {  // a cap
+            n = vec3(0.0, sign(q.y), 0.0);
+            uv = 0.5 + 0.5 * q.xz;
+        } else {
+            n = vec3(q.x, 0.0, q.z) / r;
+            uv = vec2((phi < 0.0 ? phi + 2.0 * PI : phi) / (2.0 * PI), 0.5 * (1.0 - q.y));
+        }
+        return;
+    }
+#endif
+    n = normalize(q);  // the hit on the unit sphere
+    float phi = atan(n.x, n.z);
+    uv = vec2((phi < 0.0 ? phi + 2.0 * PI : phi) / (2.0 * PI), acos(clamp(n.y, -1.0, 1.0)) / PI);
+}
+// --- end of the analytic kinds
+
 vec3 to_object(int k, vec3 p, float w) {
     vec4 h = vec4(p, w);
-    return vec3(dot(node_rec(k, 6), h), dot(node_rec(k, 7), h), dot(node_rec(k, 8), h));
+    return vec3(dot(node_rec(k, NODE_INVERSE), h), dot(node_rec(k, NODE_INVERSE + 1), h),
+                dot(node_rec(k, NODE_INVERSE + 2), h));
 }
 
 bool node_cull(vec4 r1) { return u_cull < 0 ? r1.w > 0.5 : u_cull == 1; }
@@ -184,7 +246,8 @@ bool node_cull(vec4 r1) { return u_cull < 0 ? r1.w > 0.5 : u_cull == 1; }
 // triangle, each behind its own exit (measured on 8 and 16 mesh nodes:
 // slower, and 1.5 to 1.7 times the compile time).
 int box_count(int k, vec3 o, vec3 inv_d, float best) {
-    return !u_aabb || slab(o, inv_d, node_rec(k, 0).xyz, node_rec(k, 1).xyz, best) ? int(node_rec(k, 2).y) : 0;
+    return !u_aabb || slab(o, inv_d, node_rec(k, NODE_BOX_MIN).xyz, node_rec(k, NODE_BOX_MAX).xyz, best)
+        ? int(node_rec(k, NODE_RANGE).y) : 0;
 }
 
 // The nearest hit with t > 0 (tDistances / min_indis): its t, node `k`,
@@ -201,7 +264,8 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
     // The node list unrolled, in scene order: SCENE_NODES is a sequence of
     // MESH(k, start, cull, lamps) (a loop over the node's triangles from
     // `start`), TRI(k, j, cull, lamps) (one triangle of a node too small to
-    // be worth a loop, gpu.UNROLL_TRIS) and SPHERE(k, cull, lamps), with the
+    // be worth a loop, gpu.UNROLL_TRIS) and SHAPE(k, kind, cull, lamps) (an
+    // analytic node, its KIND_* a literal), with the
     // record slot, triangles, one-sidedness and lamp bits as literals, so
     // node records are read at constant indices, and a strict `<` gives
     // ties to the earlier node and triangle (min_indis).
@@ -216,14 +280,14 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
         float t = triangle_t(j, wr, cull != 0, uv); \
         if (t < best) { best = t; hit_node = k; hit_tri = j; hit_uv = uv; } \
     }
-#define SPHERE(k, cull, lamps) { \
-        float t = sphere_t(to_object(k, o, 1.0), to_object(k, d, 0.0), cull != 0); \
+#define SHAPE(k, kind, cull, lamps) { \
+        float t = shape_t(kind, to_object(k, o, 1.0), to_object(k, d, 0.0), cull != 0); \
         if (t < best) { best = t; hit_node = k; hit_tri = -1; } \
     }
     SCENE_NODES
 #undef TRI
 #undef MESH
-#undef SPHERE
+#undef SHAPE
 #else
     // Any number of nodes: mesh nodes, then sphere nodes, in two loops over
     // the records; an equal t goes to the node first in scene order (r2.z),
@@ -231,19 +295,19 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
     float best_order = 1e9;
 #if HAS_MESHES && BVH
     for (int k = 0; k < MESH_NODES; ++k) {
-        BvhHit h = bvh_closest_at(bvh_root(k), o, d, best, node_cull(node_rec(k, 1)));
+        BvhHit h = bvh_closest_at(bvh_root(k), o, d, best, node_cull(node_rec(k, NODE_BOX_MAX)));
         if (h.overflow) g_overflow = true;
         if (h.index >= 0 && h.t < best) {
-            best = h.t; best_order = node_rec(k, 2).z; hit_node = k; hit_tri = h.index; hit_uv = h.uv;
+            best = h.t; best_order = node_rec(k, NODE_RANGE).z; hit_node = k; hit_tri = h.index; hit_uv = h.uv;
         }
     }
 #elif HAS_MESHES
     for (int k = 0; k < MESH_NODES; ++k) {
-        vec4 r0 = node_rec(k, 0);
-        vec4 r1 = node_rec(k, 1);
+        vec4 r0 = node_rec(k, NODE_BOX_MIN);
+        vec4 r1 = node_rec(k, NODE_BOX_MAX);
         if (u_aabb && !slab(o, inv_d, r0.xyz, r1.xyz, best)) continue;
         bool cull = node_cull(r1);
-        vec4 r2 = node_rec(k, 2);
+        vec4 r2 = node_rec(k, NODE_RANGE);
         int start = int(r2.x);
         int stop = start + int(r2.y);
         for (int j = start; j < stop; ++j) {
@@ -254,13 +318,13 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
         }
     }
 #endif
-#if HAS_SPHERES
-    for (int k = MESH_NODES; k < MESH_NODES + SPHERE_NODES; ++k) {
-        vec4 r0 = node_rec(k, 0);
-        vec4 r1 = node_rec(k, 1);
+#if HAS_SHAPES
+    for (int k = MESH_NODES; k < MESH_NODES + SHAPE_NODES; ++k) {
+        vec4 r0 = node_rec(k, NODE_BOX_MIN);
+        vec4 r1 = node_rec(k, NODE_BOX_MAX);
         if (u_aabb && !slab(o, inv_d, r0.xyz, r1.xyz, best)) continue;
-        float t = sphere_t(to_object(k, o, 1.0), to_object(k, d, 0.0), node_cull(r1));
-        float order = node_rec(k, 2).z;
+        float t = shape_t(int(r0.w), to_object(k, o, 1.0), to_object(k, d, 0.0), node_cull(r1));
+        float order = node_rec(k, NODE_RANGE).z;
         if (t < best || (t == best && t < INF && order < best_order)) {
             best = t; best_order = order; hit_node = k; hit_tri = -1;
         }
@@ -289,31 +353,31 @@ bool occluded(vec3 o, vec3 d, int light) {
 #define TRI(k, j, cull, lamps) if (((lamps >> light) & 1) == 0) { \
         hit = hit || triangle_t(j, wr, cull != 0, uv) < 1.0; \
     }
-#define SPHERE(k, cull, lamps) if (((lamps >> light) & 1) == 0) { \
-        hit = hit || sphere_t(to_object(k, o, 1.0), to_object(k, d, 0.0), cull != 0) < 1.0; \
+#define SHAPE(k, kind, cull, lamps) if (((lamps >> light) & 1) == 0) { \
+        hit = hit || shape_t(kind, to_object(k, o, 1.0), to_object(k, d, 0.0), cull != 0) < 1.0; \
     }
     SCENE_NODES
 #undef TRI
 #undef MESH
-#undef SPHERE
+#undef SHAPE
     return hit;
 #else
 #if HAS_MESHES && BVH
     for (int k = 0; k < MESH_NODES; ++k) {
-        if (((int(node_rec(k, 5).z) >> light) & 1) != 0) continue;
+        if (((int(node_rec(k, NODE_EXTRA).z) >> light) & 1) != 0) continue;
         bool overflow;
-        bool blocked = bvh_any_at(bvh_root(k), o, d, 1.0, node_cull(node_rec(k, 1)), overflow);
+        bool blocked = bvh_any_at(bvh_root(k), o, d, 1.0, node_cull(node_rec(k, NODE_BOX_MAX)), overflow);
         if (overflow) g_overflow = true;
         if (blocked) return true;
     }
 #elif HAS_MESHES
     for (int k = 0; k < MESH_NODES; ++k) {
-        vec4 r0 = node_rec(k, 0);
-        vec4 r1 = node_rec(k, 1);
-        if (((int(node_rec(k, 5).z) >> light) & 1) != 0) continue;
+        vec4 r0 = node_rec(k, NODE_BOX_MIN);
+        vec4 r1 = node_rec(k, NODE_BOX_MAX);
+        if (((int(node_rec(k, NODE_EXTRA).z) >> light) & 1) != 0) continue;
         if (u_aabb && !slab(o, inv_d, r0.xyz, r1.xyz, 1.0)) continue;
         bool cull = node_cull(r1);
-        vec4 r2 = node_rec(k, 2);
+        vec4 r2 = node_rec(k, NODE_RANGE);
         int start = int(r2.x);
         int stop = start + int(r2.y);
         for (int j = start; j < stop; ++j) {
@@ -321,13 +385,13 @@ bool occluded(vec3 o, vec3 d, int light) {
         }
     }
 #endif
-#if HAS_SPHERES
-    for (int k = MESH_NODES; k < MESH_NODES + SPHERE_NODES; ++k) {
-        vec4 r0 = node_rec(k, 0);
-        vec4 r1 = node_rec(k, 1);
-        if (((int(node_rec(k, 5).z) >> light) & 1) != 0) continue;
+#if HAS_SHAPES
+    for (int k = MESH_NODES; k < MESH_NODES + SHAPE_NODES; ++k) {
+        vec4 r0 = node_rec(k, NODE_BOX_MIN);
+        vec4 r1 = node_rec(k, NODE_BOX_MAX);
+        if (((int(node_rec(k, NODE_EXTRA).z) >> light) & 1) != 0) continue;
         if (u_aabb && !slab(o, inv_d, r0.xyz, r1.xyz, 1.0)) continue;
-        if (sphere_t(to_object(k, o, 1.0), to_object(k, d, 0.0), node_cull(r1)) < 1.0) return true;
+        if (shape_t(int(r0.w), to_object(k, o, 1.0), to_object(k, d, 0.0), node_cull(r1)) < 1.0) return true;
     }
 #endif
     return false;
@@ -391,51 +455,50 @@ vec4 sample_texture(int slot, vec2 uv) {
 // texture's) of a hit; `bary` is the (u, v) the triangle test found.
 void surface(int k, int j, float t, vec2 bary, vec3 o, vec3 d, out vec3 p, out vec3 n, out vec3 base,
              out float alpha) {
-    vec4 look = node_rec(k, 12);  // alpha, alpha mode, cutoff, flags
+    vec4 look = node_rec(k, NODE_LOOK);  // alpha, alpha mode, cutoff, flags
     int flags = int(look.w);
     p = o + t * d;
     vec2 uv = vec2(0.0);
     vec3 colors = vec3(1.0);
-#if HAS_SPHERES && HAS_MESHES
+#if HAS_SHAPES && HAS_MESHES
     if (j < 0) {
 #endif
-#if HAS_SPHERES
-        vec3 q = normalize(to_object(k, p, 1.0));  // the hit on the unit sphere
-        n = vec3(dot(node_rec(k, 9).xyz, q), dot(node_rec(k, 10).xyz, q), dot(node_rec(k, 11).xyz, q));
-        const float PI = 3.14159265358979;
-        float phi = atan(q.x, q.z);
-        uv = vec2((phi < 0.0 ? phi + 2.0 * PI : phi) / (2.0 * PI), acos(clamp(q.y, -1.0, 1.0)) / PI);
+#if HAS_SHAPES
+        vec3 q;  // the hit's own-space normal, through the normal matrix
+        shape_surface(int(node_rec(k, NODE_BOX_MIN).w), to_object(k, p, 1.0), q, uv);
+        n = vec3(dot(node_rec(k, NODE_NORMAL).xyz, q), dot(node_rec(k, NODE_NORMAL + 1).xyz, q),
+                 dot(node_rec(k, NODE_NORMAL + 2).xyz, q));
 #endif
-#if HAS_SPHERES && HAS_MESHES
+#if HAS_SHAPES && HAS_MESHES
     } else {
 #endif
 #if HAS_MESHES
         // Barycentric weights of the hit: t(u,v) = V0 + u(V1−V0) + v(V2−V0).
         vec3 w = vec3(1.0 - bary.x - bary.y, bary.x, bary.y);
-        vec4 a = tri_rec(j, 3), b = tri_rec(j, 4), c = tri_rec(j, 5);
+        vec4 a = tri_rec(j, TRI_NORMAL), b = tri_rec(j, TRI_NORMAL + 1), c = tri_rec(j, TRI_NORMAL + 2);
         n = w.x * a.xyz + w.y * b.xyz + w.z * c.xyz;
         // Two-sided: a back face seen (the ray along the face normal (V1-V0) x (V2-V0), the
         // rasterizer's !gl_FrontFacing) is lit as its other side.
-        vec3 v0 = tri_rec(j, 0).xyz;
-        if ((flags & 2) != 0 && dot(cross(tri_rec(j, 1).xyz - v0, tri_rec(j, 2).xyz - v0), d) > 0.0) n = -n;
+        vec3 v0 = tri_rec(j, TRI_V0).xyz;
+        if ((flags & 2) != 0 && dot(cross(tri_rec(j, TRI_V1).xyz - v0, tri_rec(j, TRI_V2).xyz - v0), d) > 0.0) n = -n;
 #if VERTEX_COLORS || NUM_TEXTURES > 0
-        vec4 ca = tri_rec(j, 6), cb = tri_rec(j, 7), cc = tri_rec(j, 8);
+        vec4 ca = tri_rec(j, TRI_COLOR), cb = tri_rec(j, TRI_COLOR + 1), cc = tri_rec(j, TRI_COLOR + 2);
         uv = w.x * vec2(a.w, b.w) + w.y * vec2(c.w, ca.w) + w.z * vec2(cb.w, cc.w);
         colors = w.x * ca.xyz + w.y * cb.xyz + w.z * cc.xyz;
 #endif
 #endif
-#if HAS_SPHERES && HAS_MESHES
+#if HAS_SHAPES && HAS_MESHES
     }
 #endif
     n = normalize(n);
-    vec4 m = node_rec(k, 3);
+    vec4 m = node_rec(k, NODE_COLOR);
     base = m.rgb;
 #if VERTEX_COLORS
     if (int(m.w) == 1 || (flags & 1) != 0) base *= colors;  // vertex colours (unlit, or tinting a lit colour)
 #endif
     alpha = look.x;
 #if NUM_TEXTURES > 0
-    int slot = int(node_rec(k, 5).y);
+    int slot = int(node_rec(k, NODE_EXTRA).y);
     if (slot >= 0) {
         vec4 texel = sample_texture(slot, uv);
         base *= texel.rgb;
@@ -447,7 +510,7 @@ void surface(int k, int j, float t, vec2 bary, vec3 o, vec3 d, out vec3 p, out v
 // How much of a hit surface covers what lies behind it (numpy_engine's coverage):
 // opaque 1, a cut-out 1 or 0 by its cutoff, a blended surface its alpha.
 float coverage(int k, float alpha) {
-    vec4 look = node_rec(k, 12);
+    vec4 look = node_rec(k, NODE_LOOK);
     int mode = int(look.y);
     return mode == 1 ? (alpha >= look.z ? 1.0 : 0.0) : mode == 2 ? alpha : 1.0;
 }
@@ -468,7 +531,7 @@ Spawn spawn_at(int j, float t, vec2 bary, vec3 o, vec3 d, vec3 n) {
     Spawn s;
 #if HAS_MESHES
     if (j >= 0) {
-        vec3 v0 = tri_rec(j, 0).xyz, v1 = tri_rec(j, 1).xyz, v2 = tri_rec(j, 2).xyz;
+        vec3 v0 = tri_rec(j, TRI_V0).xyz, v1 = tri_rec(j, TRI_V1).xyz, v2 = tri_rec(j, TRI_V2).xyz;
         vec3 a = (1.0 - bary.x - bary.y) * v0, b = bary.x * v1, c = bary.y * v2;
         s.p = a + b + c;
         s.err = TRIANGLE_POINT_ERROR * (abs(a) + abs(b) + abs(c));
@@ -486,7 +549,7 @@ Spawn spawn_at(int j, float t, vec2 bary, vec3 o, vec3 d, vec3 n) {
 // x moved one float away from zero's side given by `dir` (pbrt's NextFloatUp/Down).
 float next_float(float x, float dir) {
     if (dir == 0.0) return x;
-    if (x == 0.0) return dir > 0.0 ? 1.1754944e-38 : -1.1754944e-38;
+    if (x == 0.0) return dir > 0.0 ? FLT_MIN_NORMAL : -FLT_MIN_NORMAL;
     int bits = floatBitsToInt(x);
     return intBitsToFloat((x > 0.0) == (dir > 0.0) ? bits + 1 : bits - 1);
 }
@@ -511,11 +574,11 @@ vec3 offset_point(Spawn s, vec3 n, vec3 towards) {
 
 // The rasterizer's per-light Phong (common/lighting.glsl), with shadow rays.
 vec3 shade(int k, vec3 p, vec3 n, vec3 mesh, vec3 d, Spawn at) {
-    int mode = int(node_rec(k, 3).w);
+    int mode = int(node_rec(k, NODE_COLOR).w);
     if (mode < 2) return mesh;  // solid, vertex colours: unlit
     vec3 color = vec3(0.0);
 #if NUM_LIGHTS > 0
-    vec4 coef = node_rec(k, 4);
+    vec4 coef = node_rec(k, NODE_PHONG);
     vec3 to_eye = -normalize(d);
     for (int i = 0; i < NUM_LIGHTS; ++i) {
         vec3 diffuse, specular;
@@ -556,7 +619,7 @@ void main() {
         // A see-through surface passes the ray on straight, weighted 1 - a; it does not
         // also reflect (numpy_engine._trace). At the last bounce its own colour stands in.
         float a = last ? 1.0 : coverage(k, alpha);
-        float r = (last || a < 1.0) ? 0.0 : node_rec(k, 5).x;
+        float r = (last || a < 1.0) ? 0.0 : node_rec(k, NODE_EXTRA).x;
         color += weight * a * (1.0 - r) * local;
         if (a < 1.0) {
             o = offset_point(at, n, d);  // just behind the surface

@@ -106,14 +106,27 @@ _UNIT_0 = struct.pack("i", 0)
 def _material_bytes(material: Material) -> tuple[tuple[str, bytes], ...]:
     """The coefficients of the course's ``0.1*mesh + 0.4*diffuse + 0.3*specular`` and the
     exponent (32) as uniform bytes; a zero coefficient switches its term off."""
-    return (("u_ambient", _float_bytes(material.ambient)), ("u_diffuse", _float_bytes(material.diffuse)),
-            ("u_specular", _float_bytes(material.specular)), ("u_shininess", _float_bytes(material.shininess)))
+    return _coefficient_bytes(material.ambient, material.diffuse, material.specular, material.shininess)
+
+
+@functools.lru_cache(maxsize=256)
+def _coefficient_bytes(ambient: float, diffuse: float, specular: float,
+                       shininess: float) -> tuple[tuple[str, bytes], ...]:
+    """:func:`_material_bytes` made once per set of coefficients (a scene has a few)."""
+    return (("u_ambient", _float_bytes(ambient)), ("u_diffuse", _float_bytes(diffuse)),
+            ("u_specular", _float_bytes(specular)), ("u_shininess", _float_bytes(shininess)))
 
 
 @functools.lru_cache(maxsize=64)
 def _eye_bytes(view: bytes) -> bytes:
     """The eye position's uniform bytes for a float64 view matrix given as bytes."""
     return eye_position(np.frombuffer(view).reshape(4, 4)).astype("f4").tobytes()
+
+
+@functools.lru_cache(maxsize=1024)
+def _model_matrix_bytes(model: bytes) -> bytes:
+    """``m_model``'s uniform bytes (float32, column-major) for a float64 model matrix given as bytes."""
+    return transforms.gl_bytes(np.frombuffer(model).reshape(4, 4))
 
 
 @functools.lru_cache(maxsize=1024)
@@ -184,6 +197,20 @@ class _GpuMesh:
     count: int
 
 
+@dataclass
+class _DrawSetup:
+    """What :meth:`Executor.draw_node` needs for one mesh drawn with one program (see ``_draw_setup``)."""
+
+    source: Mesh  # the node's mesh (the key's object)
+    program: moderngl.Program
+    members: frozenset[str]
+    write: Callable[[str, bytes], None]
+    mesh_key: tuple[str, str]  # of the mesh as drawn
+    vao: moderngl.VertexArray
+    gpu: _GpuMesh
+    normal: bool  # the program reads m_normal
+
+
 class Executor:
     """Runs plans on one context, keeping programs and meshes between frames."""
 
@@ -192,6 +219,9 @@ class Executor:
     #: in a long-running window: past this many, the least recently drawn
     #: are released (never one the current frame draws).
     MESH_LIMIT = 256
+    #: Draw set-ups kept (:meth:`_draw_setup`), all dropped at once past this many (a lesson
+    #: making a new mesh every frame).
+    SETUPS_KEPT = 1024
 
     def __init__(self, host: GLHost) -> None:
         self.host = host
@@ -208,12 +238,18 @@ class Executor:
         self._mesh_last_frame: dict[tuple[str, str], int] = {}
         self._frame = 0
         self._vaos: dict[tuple[tuple[str, str], str], moderngl.VertexArray] = {}
+        # What a draw of one mesh with one program needs, found once (see _draw_setup), by
+        # (program key, id of the mesh); emptied whenever a VAO or a program is released.
+        self._setups: dict[tuple[str, int], _DrawSetup] = {}
+        # Pass cameras by the camera, the viewport's pixels and the depth mode (see _frame_camera).
+        self._cameras: dict[tuple[int, tuple[int, int, int, int], str], tuple[object, PassCamera]] = {}
         self._overlays: OverlayDrawer | None = None  # made on the first overlay pass
         self._textures = TextureCache(host)
         self._lights: tuple[Light, ...] = ()  # the lights of the frame being drawn (draw_node's default)
         self._lights_cache: tuple[tuple[Light, ...], bytes, bytes] | None = None
         # The uniform bytes last written into each program (by program key): see _uniform_writer.
         self._written: dict[str, dict[str, bytes]] = {}
+        self._culling: tuple[bool, str] | None = None  # what _set_culling set last (None: not known)
         self._bound_texture: object | None = None  # the material texture on unit 0 in this frame
         self._clear_depth = 1.0  # 0 with reverse-Z (glsandbox.gl.depth)
         self.shadow_maps = gl_shadowmap.ShadowMaps(self.ctx)  # the lights' depth textures
@@ -259,6 +295,7 @@ class Executor:
         for vao in self._vaos.values():
             vao.release()
         self._vaos.clear()
+        self._setups.clear()
         self._programs = fresh
         self._user = users
         self._member_names.clear()
@@ -338,6 +375,7 @@ class Executor:
             del self._mesh_last_frame[key]
             for vao_key in [k for k in self._vaos if k[0] == key]:
                 self._vaos.pop(vao_key).release()
+            self._setups.clear()
             for buffer in gpu.buffers.values():
                 buffer.release()
             if gpu.index is not None:
@@ -380,16 +418,26 @@ class Executor:
         self._lights = scene.lights
         self._clear_depth = gl_depth.clear_depth_value(scene)
         framebuffer.use()
+        self._culling = None  # not known: the first draw sets it
         gl_depth.begin_depth_mode(self.ctx, self.raw, scene)
         try:
             for step in frame_plan.passes:
                 runner = PASS_RUNNERS.get(step.kind)
                 if runner is None:
                     raise SandboxError(f"pass kind {step.kind!r} has no runner (gl.executor.PASS_RUNNERS)")
+                # Every pass starts from the same state (gl.passes.restore_state), whatever the last
+                # one set or raised. A clear pass sets nothing, and a draw pass only culling (blended
+                # draws put blending and depth writes back themselves): those put back only that.
+                restored = False
                 try:
                     runner(self, frame, step, self._frame_camera(frame, step))
-                finally:  # every pass starts from the same state, whatever the last one set
-                    gl_passes.restore_state(self.ctx, self.raw)
+                    restored = step.kind in _STATE_KEEPING
+                finally:
+                    if restored:
+                        self._set_culling(False, "ccw")
+                    else:
+                        gl_passes.restore_state(self.ctx, self.raw)
+                        self._culling = (False, "ccw")  # what restore_state leaves
         finally:
             # Also when a pass raised (a texture file that cannot be read, say): a sampler
             # object left on unit 0 overrides the state of every texture later bound there,
@@ -421,7 +469,15 @@ class Executor:
         aspect = rect[2] / rect[3] if rect[3] else 1.0
         frame.framebuffer.viewport = rect
         self._set_depth(step.depth_test)
-        return PassCamera(camera.view(), gl_depth.projection_for(scene, camera.projection(aspect)))
+        # A camera that does not change (a Camera is immutable) keeps its matrices and their bytes.
+        key = (id(camera), rect, scene.depth_mode)
+        kept = self._cameras.get(key)
+        if kept is None or kept[0] is not camera:
+            if len(self._cameras) >= 64:
+                self._cameras.clear()
+            kept = self._cameras[key] = (camera, PassCamera(camera.view(), gl_depth.projection_for(
+                scene, camera.projection(aspect))))
+        return kept[1]
 
     def _clear(self, frame: FrameState, step: Pass, camera: PassCamera | None) -> None:
         framebuffer = frame.framebuffer
@@ -431,6 +487,21 @@ class Executor:
         clear_opaque(framebuffer, (r, g, b), self._clear_depth, rect)
         if step.clear_stencil:  # moderngl's clear leaves the stencil alone
             self.raw.clear_stencil(rect)
+
+    def _set_culling(self, cull: bool, front_face: str) -> None:
+        """Back-face culling on or off, with the winding rule of front faces, set only where it
+        differs from what the executor set last in this pass (GL keeps it; draws of one
+        pass mostly share it). Only the executor changes culling within a pass."""
+        state = (cull, front_face)
+        if state == self._culling:
+            return
+        if cull:
+            self.ctx.enable(moderngl.CULL_FACE)
+            self.ctx.cull_face = "back"
+        else:
+            self.ctx.disable(moderngl.CULL_FACE)
+        self.ctx.front_face = front_face
+        self._culling = state
 
     def _set_depth(self, on: bool) -> None:
         if on:
@@ -460,35 +531,25 @@ class Executor:
         ``"cw"``, the reflected lights; a planar shadow: the flattening
         matrix and one flat colour).
         """
-        program = self._programs[draw.program][1]
-        members = self._members(draw.program)
         user = self._user.get(draw.program)
         own: dict[str, object] = {}
-        if user is not None:  # a node's own shader: checked before anything is drawn with it
-            own = self._check_user_draw(user, program, members, node)
+        if user is not None:  # a node's own shader: checked before anything is made or drawn with it
+            own = self._check_user_draw(user, self._programs[draw.program][1], self._members(draw.program), node)
             self._user_nodes.setdefault(draw.program, {})[node.name] = node
-        mesh = node.mesh
-        if mesh.normals is None and "in_normal" in members:
-            # A lit draw of a mesh without normals (the course's 8-vertex cube, a
-            # file without them) is shaded flat, one face normal per triangle: what
-            # the ray tracer does with such a mesh (geometry.with_face_normals).
-            mesh = with_face_normals(mesh)
-        vao, gpu = self._vao(mesh, draw.program)
+        setup = self._draw_setup(draw.program, node.mesh)
+        program, members, write = setup.program, setup.members, setup.write
+        self._mesh_last_frame[setup.mesh_key] = self._frame
+        vao, gpu = setup.vao, setup.gpu
         model = node.model if model is None else model
         material = node.material if material is None else material
-        if draw.cull_back_faces:
-            self.ctx.enable(moderngl.CULL_FACE)
-            self.ctx.cull_face = "back"
-            self.ctx.front_face = front_face
-        else:
-            self.ctx.disable(moderngl.CULL_FACE)
-        write = self._uniform_writer(draw.program, program, members)
-        write("m_model", transforms.gl_bytes(model))
+        self._set_culling(draw.cull_back_faces, front_face)
+        model_bytes, normal_bytes = self._model_bytes(model, setup.normal)
+        write("m_model", model_bytes)
         write("m_view", camera.view_bytes)
         write("m_proj", camera.proj_bytes)
         write("u_color", _color_bytes(material.color))
-        if "m_normal" in members:
-            write("m_normal", _normal_matrix_bytes(np.asarray(model, dtype=np.float64).tobytes()))
+        if normal_bytes is not None:
+            write("m_normal", normal_bytes)
         if material.lit or user is not None:  # a node's own shader may light itself whatever the shading
             write("u_eye", camera.eye_bytes)
             frame_lights = self._lights if lights is None else lights
@@ -508,7 +569,8 @@ class Executor:
                 self._bound_texture = texture
             write("u_texture", _UNIT_0)
         if draw.shadow_map is not None:  # unit 1: the light's shadow map (a depth texture, compared)
-            self.shadow_maps.bind(draw.shadow_map, SHADOW_MAP_UNIT, program, members)
+            for name, data in self.shadow_maps.use(draw.shadow_map, SHADOW_MAP_UNIT):
+                write(name, data)
         if draw.blend:  # over what is drawn already; hidden by it where nearer, but not hiding
             self.ctx.enable(moderngl.BLEND)
             self.ctx.blend_func = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA)
@@ -519,6 +581,34 @@ class Executor:
             self.ctx.disable(moderngl.BLEND)
             self.ctx.blend_func = moderngl.DEFAULT_BLENDING
 
+    def _draw_setup(self, program_key: str, mesh: Mesh) -> _DrawSetup:
+        """What every draw of ``mesh`` with the program ``program_key`` needs, found once: the
+        program, its member names, its uniform writer, the mesh as drawn (face normals for a
+        lit program and a mesh without normals: what the ray tracer does with such a mesh,
+        :func:`~glsandbox.geometry.with_face_normals`), its buffers and VAO."""
+        setup = self._setups.get((program_key, id(mesh)))
+        if setup is not None and setup.source is mesh:
+            return setup
+        program = self._programs[program_key][1]
+        members = self._members(program_key)
+        drawn = with_face_normals(mesh) if mesh.normals is None and "in_normal" in members else mesh
+        vao, gpu = self._vao(drawn, program_key)
+        if len(self._setups) >= self.SETUPS_KEPT:  # new meshes every frame (a trail): start again
+            self._setups.clear()
+        setup = _DrawSetup(mesh, program, members, self._uniform_writer(program_key, program, members), _mesh_key(drawn), vao, gpu,
+                           "m_normal" in members)
+        self._setups[(program_key, id(mesh))] = setup
+        return setup
+
+    @staticmethod
+    def _model_bytes(model: np.ndarray, normal: bool) -> tuple[bytes, bytes | None]:
+        """``m_model``'s uniform bytes and, with ``normal``, ``m_normal``'s (the inverse transpose,
+        :func:`~glsandbox.transforms.normal_matrix`), looked up by the matrix's content: a node
+        that does not move converts its matrix once, not every frame, and an array changed in
+        place between frames is converted again (no stale matrix)."""
+        content = np.asarray(model, dtype=np.float64).tobytes()
+        return _model_matrix_bytes(content), _normal_matrix_bytes(content) if normal else None
+
     def _uniform_writer(self, program_key: str, program: moderngl.Program,
                         members: Collection[str]) -> Callable[[str, bytes], None]:
         """``write(name, data)`` for one program: the bytes go to GL only where the program has the
@@ -526,10 +616,14 @@ class Executor:
         A program keeps its uniform values between draws and frames, so what does not change (the
         view while the camera stands, lights, materials, a wall's model) is written once."""
         written = self._written.setdefault(program_key, {})
+        uniforms: dict[str, moderngl.Uniform] = {}
 
         def write(name: str, data: bytes) -> None:
             if written.get(name) != data and name in members:
-                program[name].write(data)
+                uniform = uniforms.get(name)
+                if uniform is None:
+                    uniform = uniforms[name] = program[name]
+                uniform.write(data)
                 written[name] = data
 
         return write
@@ -585,6 +679,8 @@ class Executor:
         self._textures.release()
         self.shadow_maps.release()
         self._vaos.clear()
+        self._setups.clear()
+        self._cameras.clear()
         self._meshes.clear()
         self._mesh_last_frame.clear()
         self._programs.clear()
@@ -603,6 +699,11 @@ def eye_position(view: np.ndarray) -> np.ndarray:
     course's ``vEyePos``)."""
     return np.linalg.inv(np.asarray(view, dtype=np.float64))[:3, 3]
 
+
+#: Pass kinds whose runners leave GL state as :func:`glsandbox.gl.passes.restore_state` sets it,
+#: but for culling (:meth:`Executor._set_culling`): a clear, and a draw pass (its blended draws
+#: put blending and depth writes back).
+_STATE_KEEPING = frozenset({"clear", "draw"})
 
 #: One runner per pass kind (:data:`glsandbox.plan.PASS_KINDS`); a new kind adds
 #: its entry here and its describer in :data:`glsandbox.plan.PASS_DESCRIBERS`.

@@ -17,6 +17,7 @@ masks, so one 8-bit buffer serves both without a clear in between.
 
 from __future__ import annotations
 
+import functools
 from typing import Any, Protocol
 
 import moderngl
@@ -26,6 +27,7 @@ from glsandbox import transforms
 from glsandbox.gl import rawgl
 from glsandbox.gl.passes import FrameState
 from glsandbox.plan import Draw, Pass, StencilState
+from glsandbox.planar import Mirror
 from glsandbox.scene import Light, Material, Node
 
 
@@ -89,6 +91,13 @@ def reflected_lights(lights: tuple[Light, ...], reflection: np.ndarray) -> tuple
                  for l in lights)
 
 
+@functools.lru_cache(maxsize=16)
+def _mirrored_lights(lights: tuple[Light, ...], mirror: Mirror) -> tuple[Light, ...]:
+    """:func:`reflected_lights` through ``mirror``, once per set of lights (Lights and Mirrors are
+    immutable and compare by value): lights that do not move are reflected once, not every frame."""
+    return reflected_lights(lights, mirror.matrix())
+
+
 def reflection(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any) -> None:
     """``DrawReflectionDSS``: the reflected nodes, only where the mirror bit is set.
 
@@ -103,7 +112,7 @@ def reflection(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any) -
     if step.stencil is not None:  # read only: write mask 0
         set_stencil(drawer.raw, step.stencil)
     reflection = scene.mirror.matrix()
-    lights = reflected_lights(scene.lights, reflection)
+    lights = _mirrored_lights(scene.lights, scene.mirror)
     for draw in step.draws:
         node = nodes[draw.node]
         drawer.draw_node(node, draw, camera, model=reflection @ node.model, front_face="cw", lights=lights)

@@ -115,6 +115,7 @@ class RawGL:
             restype, *argtypes = _SIGNATURES[name]
             fn = ctypes.CFUNCTYPE(restype, *argtypes)(address)
             self._fns[name] = fn
+        setattr(self, name, fn)  # found as a plain attribute from now on: __getattr__ runs once per name
         return fn
 
     def get_integer(self, pname: int) -> int:

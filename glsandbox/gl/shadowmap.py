@@ -11,6 +11,8 @@ texel and the percentage-closer filter's grid is the phong shader's own.
 
 from __future__ import annotations
 
+import functools
+import struct
 from collections.abc import Collection
 from typing import Any
 
@@ -48,17 +50,18 @@ class ShadowMaps:
     def drawn(self, light: int, texture: moderngl.Texture, matrix: np.ndarray, settings: ShadowMap) -> None:
         self._current[light] = (texture, transforms.gl_bytes(matrix), settings)
 
-    def bind(self, light: int, unit: int, program: moderngl.Program, members: Collection[str]) -> None:
-        """Light ``light``'s map on texture unit ``unit``, and the receiver's uniforms."""
+    def use(self, light: int, unit: int) -> tuple[tuple[str, bytes], ...]:
+        """Light ``light``'s map on texture unit ``unit``; returns the receiver's uniforms as
+        ``(name, bytes)`` (the executor writes those a program has and that changed)."""
         texture, matrix, settings = self._current[light]
         texture.use(unit)
-        values = {"u_shadow_map": unit, "u_shadow_bias": settings.bias, "u_shadow_slope_bias": settings.slope_bias,
-                  "u_shadow_texel": 1.0 / settings.size}
-        for name, value in values.items():
+        return (*_settings_bytes(unit, settings), ("u_shadow_matrix", matrix))
+
+    def bind(self, light: int, unit: int, program: moderngl.Program, members: Collection[str]) -> None:
+        """Light ``light``'s map on texture unit ``unit``, and the receiver's uniforms."""
+        for name, data in self.use(light, unit):
             if name in members:
-                program[name].value = value
-        if "u_shadow_matrix" in members:
-            program["u_shadow_matrix"].write(matrix)
+                program[name].write(data)
 
     def release(self) -> None:
         for texture, framebuffer in self._maps.values():
@@ -66,6 +69,14 @@ class ShadowMaps:
             texture.release()
         self._maps.clear()
         self._current.clear()
+
+
+@functools.lru_cache(maxsize=64)
+def _settings_bytes(unit: int, settings: ShadowMap) -> tuple[tuple[str, bytes], ...]:
+    """The sampler's unit, the biases and the texel size as uniform bytes, once per map settings."""
+    return (("u_shadow_map", struct.pack("i", unit)), ("u_shadow_bias", struct.pack("f", settings.bias)),
+            ("u_shadow_slope_bias", struct.pack("f", settings.slope_bias)),
+            ("u_shadow_texel", struct.pack("f", 1.0 / settings.size)))
 
 
 def run_shadow_map_pass(executor: Any, frame: FrameState, step: Pass, camera: Any) -> None:

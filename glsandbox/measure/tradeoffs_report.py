@@ -69,7 +69,7 @@ def write_report(results: Sequence[KnobResult], info: Mapping[str, str], path: P
                   "|---|---:|---:|" + ("---:|---:|" if knob.count_label else "") + "---:|---:|---:|---|"]
         for r in result.rows:
             low, high = r.spread_ms
-            name = f"{r.setting} (reference)" if r.reference else r.setting
+            name = (f"{r.setting} (reference)" if r.reference else r.setting).replace("|", "\\|")  # a cell
             count = "" if not knob.count_label else (
                 " - | - |" if r.count is None else f" {r.count.pixels} | {r.count.share:.1%} |")
             lines.append(f"| {name} | {r.median_ms:.2f} | {low:.2f}-{high:.2f} (median ±{r.median_spread:.1%}, "
@@ -128,7 +128,8 @@ def write_plot(results: Sequence[KnobResult], path: Path) -> None:
         ax.grid(True, which="both", alpha=0.3)
         ax.margins(x=0.15, y=0.12)
         if counted:  # shares lie in 0..1; the room above keeps the legend off the points
-            ax.set_ylim(-0.05, 1.9)
+            legend = min(0.8, 0.03 + 0.048 * len(result.rows))  # its height, as a share of the panel's
+            ax.set_ylim(-0.05, max(1.9, (1.05 + 0.05 * legend) / (1.0 - legend)))
             ax.set_yticks([0.0, 0.25, 0.5, 0.75, 1.0])
         ax.legend(fontsize=8, loc="upper center" if counted else "best", framealpha=0.85)
     for ax in list(axes.flat)[count:]:

@@ -25,6 +25,11 @@ __all__ = [
     "BVH_BOX_PAD",
     "BVH_BOX_PAD_F64",
     "DIRECTION_TINY",
+    "FLOAT32_MIN_NORMAL",
+    "LENGTH_TINY",
+    "NO_HIT_F32",
+    "SQUARES_UNDERFLOW",
+    "UNIT_SHAPE_TOLERANCE",
     "NODE_BOX_PAD",
     "OFFSETS",
     "SIMPLE_OFFSET",
@@ -75,6 +80,23 @@ BVH_BOX_PAD_F64: float = 2.0**-30
 #: Direction components below this are made ±this before ``1/d`` (a slab
 #: test with ``0·inf`` would give NaN); far below any direction a scene uses.
 DIRECTION_TINY: float = 1e-30
+#: A vector is divided by ``max(|v|, LENGTH_TINY)`` when normalised (float64): a
+#: zero vector (a degenerate triangle's normal) stays zero instead of 0/0 = NaN,
+#: and any length float64 can square without underflow is far above it.
+LENGTH_TINY: float = 1e-300
+#: Rows shorter than this are rescaled by their largest component before their
+#: length is taken: their squares (below 1e-300) would underflow towards 0.
+SQUARES_UNDERFLOW: float = 1e-150
+#: How far (relative) a mesh's vertices may lie off the analytic shape its
+#: ``Mesh.analytic`` names for the node to be traced as that shape: a vertex
+#: computed with ``cos``/``sin`` in float64 is within a few ulps of it.
+UNIT_SHAPE_TOLERANCE: float = 1e-9
+#: The GLSL engine's "no hit" ``t`` (``INF``): float32 has no literal infinity in
+#: GLSL 4.0, and no ray a scene casts reaches 1e30.
+NO_HIT_F32: float = 1e30
+#: The smallest normal float32, 2⁻¹²⁶: the first float away from 0 in the GLSL
+#: engine's ``next_float`` (rounding a spawned origin off the surface).
+FLOAT32_MIN_NORMAL: float = 2.0**-126
 
 
 def gamma(n: int, unit: float) -> float:
@@ -92,4 +114,6 @@ def glsl_defines() -> tuple[tuple[str, str], ...]:
         ("GAMMA5", repr(gamma(5, UNIT_F32))),
         ("BVH_PAD", repr(BVH_BOX_PAD)),
         ("DIRECTION_TINY", repr(DIRECTION_TINY)),
+        ("INF", repr(NO_HIT_F32)),
+        ("FLT_MIN_NORMAL", repr(FLOAT32_MIN_NORMAL)),
     )

@@ -36,7 +36,8 @@ early, and a record read at an index that varies per pixel costs 8 loads.
 So what a scene cannot reach is compiled out rather than branched around:
 ``NUM_LIGHTS`` and ``NUM_TEXTURES`` size the light loop and the samplers;
 ``SHADOWS`` (shadow rays), ``REFLECT`` (the bounce loop: some node reflects
-and ``max_depth > 0``), ``HAS_MESHES``, ``HAS_SPHERES`` and
+and ``max_depth > 0``), ``HAS_MESHES``, ``HAS_SHAPES`` (analytic nodes), one
+``HAS_<KIND>`` per analytic :class:`~glsandbox.raytrace.world.NodeKind` and
 ``VERTEX_COLORS`` switch code on.
 
 A small scene, at most :data:`UNROLL_NODES` nodes of which at most
@@ -48,14 +49,15 @@ with ``NODE_COUNT`` and ``TRI_COUNT``) lists every node in scene order as
 ``MESH`` (a loop over its triangles that runs as many times as the node's
 AABB test allows: none when the ray misses the box), ``TRI`` (each triangle
 of a node of at most :data:`UNROLL_TRIS`, tested without a loop) or
-``SPHERE``, with its record slot, triangle range, one-sidedness and lamp
-bits as literals, so its records are read at constant indices. Any larger
-scene gets the general program: a loop over the node records and, inside
-it, over each node's triangles; its node counts come as literals
-(``MESH_NODES``, ``SPHERE_NODES``), so a model's one mesh node runs as
-straight code (a loop bounded by a uniform measured about 15% of a
-1,000-triangle model's primary frame). Unrolling is paid in compile time (Mesa's
-shader cache is off): it grows exponentially with the number of triangle
+``SHAPE`` (an analytic node, its ``KIND_<NAME>`` a literal), with its
+record slot, triangle range, one-sidedness and lamp bits as literals, so
+its records are read at constant indices. Any larger scene gets the
+general program: a loop over the node records and, inside it, over each
+node's triangles; its node counts come as literals (``MESH_NODES``,
+``SHAPE_NODES``), so a model's one mesh node runs as straight code (a loop
+bounded by a uniform measured about 15% of a 1,000-triangle model's primary
+frame). Unrolling is paid in compile time (Mesa's shader cache
+is off): it grows exponentially with the number of triangle
 loops, which the bounds keep near a second; a lesson's first render, which
 compiles its variant, takes 0.4 to 0.9 s. In both programs shadow rays stop
 at their first hit, and the shading reuses the triangle test's barycentrics.
@@ -131,16 +133,18 @@ from glsandbox.gl.shaders import compile_program
 from glsandbox.plan import ProgramVariant
 from glsandbox.raytrace.constants import NODE_BOX_PAD, OFFSETS, SIMPLE_OFFSET, glsl_defines
 from glsandbox.raytrace.errors import RayTraceError
+from glsandbox.raytrace.gpu_records import NODE, TRI, layout_defines
 from glsandbox.raytrace.watertight import nondegenerate
-from glsandbox.raytrace.world import MODES, World, build_world, camera_basis, kind_defines
+from glsandbox.raytrace.world import MODES, NodeKind, World, build_world, camera_basis, kind_defines
 from glsandbox.scene import Scene
 
 __all__ = ["LOOP_LIMIT", "GpuTracer", "MAX_TEXTURES", "check_loop_budget", "gpu_tracer"]
 
 #: Width of the record textures (must match TEX_WIDTH in the shader).
 TEX_WIDTH = 1024
-TRI_RECORDS = 9
-NODE_RECORDS = 13
+#: ``vec4`` records per triangle and per node (the layouts: :mod:`glsandbox.raytrace.gpu_records`).
+TRI_RECORDS = TRI.records
+NODE_RECORDS = NODE.records
 #: Samplers the shader declares at most.
 MAX_TEXTURES = 4
 #: llvmpipe's loop iterations per shader invocation, all loops together (see the module docstring).
@@ -182,7 +186,7 @@ BVH_MIN_STEPS = 256
 def bvh_step_cap(world: World, lights: int, shadows: bool, reflect: bool, max_depth: int) -> int:
     """The per-ray, per-mesh-node traversal bound (``BVH_MAX_STEPS``) of the BVH program:
     every ray of a pixel may traverse every mesh node's BVH to the bound, and the
-    sum with the other loops (node records, spheres, lights, bounces) stays within
+    sum with the other loops (node records, analytic nodes, lights, bounces) stays within
     :data:`LOOP_LIMIT`. A ray that reaches it is flagged (alpha 0) and the render
     raises. Raises :class:`RayTraceError` when the budget leaves too few steps."""
     bounces = 1 + (max_depth if reflect else 0)
@@ -269,7 +273,7 @@ def world_anchor(world: World) -> NDArray[np.float64]:
     traced in world coordinates there loses its shape (ids off on 2.9% and 15%
     of the pixels, and BVH boxes padded in proportion to the coordinates). Every
     position is therefore taken relative to this anchor in float64 on the CPU
-    (vertices, boxes, lights, the eye, spheres' inverse matrices) and only the
+    (vertices, boxes, lights, the eye, analytic nodes' inverse matrices) and only the
     difference is rounded to float32: the picture at 1e6 is the one at the
     origin. The anchor is the scene's own centre, not the eye, so a camera
     moving around the scene keeps the upload (the eye is one uniform)."""
@@ -292,19 +296,19 @@ def pack_triangles(world: World, anchor: NDArray[np.float64] | None = None) -> N
     # corner shared by two triangles to be the same three floats in both.
     ok = nondegenerate(world.v0, world.v1, world.v2)  # the BVH's rule: a triangle without area is never hit
     v0 = world.v0 - anchor
-    rec[:, 0, :3] = v0
-    rec[:, 1, :3] = np.where(ok[:, None], world.v1 - anchor, v0)  # degenerate: one point, det = 0
-    rec[:, 2, :3] = np.where(ok[:, None], world.v2 - anchor, v0)
+    rec[:, TRI["v0"], :3] = v0
+    rec[:, TRI["v1"], :3] = np.where(ok[:, None], world.v1 - anchor, v0)  # degenerate: one point, det = 0
+    rec[:, TRI["v2"], :3] = np.where(ok[:, None], world.v2 - anchor, v0)
     for k in range(3):
-        rec[:, 3 + k, :3] = world.normals[:, k]
-        rec[:, 6 + k, :3] = world.colors[:, k]
+        rec[:, TRI["normal"] + k, :3] = world.normals[:, k]
+        rec[:, TRI["color"] + k, :3] = world.colors[:, k]
     flat_uv = world.uvs.reshape(m, 6)  # uv0.x, uv0.y, uv1.x, uv1.y, uv2.x, uv2.y
-    rec[:, 3:9, 3] = flat_uv
+    rec[:, TRI["normal"]:TRI["color"] + 3, 3] = flat_uv
     return rec.reshape(-1, 4)
 
 
 def node_order(world: World) -> list[int]:
-    """The nodes as the shader stores them: mesh nodes first, then sphere nodes (scene order within)."""
+    """The nodes as the shader stores them: mesh nodes first, then analytic nodes (scene order within)."""
     meshes = [k for k, node in enumerate(world.nodes) if node.kind.triangles]
     return meshes + [k for k, node in enumerate(world.nodes) if not node.kind.triangles]
 
@@ -320,18 +324,19 @@ def pack_nodes(world: World, anchor: NDArray[np.float64] | None = None) -> NDArr
         # Pad the box by a relative hair: float32 slab arithmetic must not
         # reject a ray that the triangle test would accept at the box's face.
         pad = NODE_BOX_PAD * (1.0 + float(np.abs(np.concatenate([lo, hi])).max()))
-        rec[slot, 0] = (*(lo - pad), float(node.kind.code))
-        rec[slot, 1] = (*(hi + pad), 1.0 if node.cull else 0.0)
-        rec[slot, 2] = (node.start, node.count, k, 0.0)  # k: the scene order, for ties
-        rec[slot, 3] = (*node.color, node.mode)
-        rec[slot, 4] = (node.ka, node.kd, node.ks, node.shininess)
-        rec[slot, 5] = (node.reflectivity, node.texture, node.lamp_of, 0.0)
-        # world -> unit sphere for anchor-relative points: M⁻¹(p + anchor), in float64.
-        rec[slot, 6:9, :3] = node.inverse[:3, :3]
-        rec[slot, 6:9, 3] = node.inverse[:3, :3] @ anchor + node.inverse[:3, 3]
-        rec[slot, 9:12, :3] = node.normal_matrix
-        rec[slot, 12] = (node.alpha, node.alpha_mode, node.alpha_cutoff,
-                         int(node.vertex_colors) | 2 * int(node.two_sided))
+        rec[slot, NODE["box_min"]] = (*(lo - pad), float(node.kind.code))
+        rec[slot, NODE["box_max"]] = (*(hi + pad), 1.0 if node.cull else 0.0)
+        rec[slot, NODE["range"]] = (node.start, node.count, k, 0.0)  # k: the scene order, for ties
+        rec[slot, NODE["color"]] = (*node.color, node.mode)
+        rec[slot, NODE["phong"]] = (node.ka, node.kd, node.ks, node.shininess)
+        rec[slot, NODE["extra"]] = (node.reflectivity, node.texture, node.lamp_of, 0.0)
+        # world -> the node's own space for anchor-relative points: M⁻¹(p + anchor), in float64.
+        inverse = slice(NODE["inverse"], NODE["inverse"] + 3)
+        rec[slot, inverse, :3] = node.inverse[:3, :3]
+        rec[slot, inverse, 3] = node.inverse[:3, :3] @ anchor + node.inverse[:3, 3]
+        rec[slot, NODE["normal"]:NODE["normal"] + 3, :3] = node.normal_matrix
+        rec[slot, NODE["look"]] = (node.alpha, node.alpha_mode, node.alpha_cutoff,
+                                   int(node.vertex_colors) | 2 * int(node.two_sided))
     return rec.reshape(-1, 4).astype(np.float32)
 
 
@@ -396,7 +401,10 @@ class _Uploaded:
         #: 1M-triangle model's are 144 MB, and the texture holds them already.
         self.digest = _records_digest(tris, nodes)
         self.mesh_count = sum(1 for node in world.nodes if node.kind.triangles)
-        self.sphere_count = len(world.nodes) - self.mesh_count
+        #: Analytic nodes (spheres, cylinders): the records after the mesh nodes'.
+        self.shape_count = len(world.nodes) - self.mesh_count
+        #: The node kinds present (the program's HAS_<KIND> defines).
+        self.kinds = frozenset(node.kind for node in world.nodes)
         loops = sum(1 for node in world.nodes if node.kind.triangles and node.count > UNROLL_TRIS)
         #: Some mesh node is large enough that its BVH beats the scan (:data:`BVH_TRIANGLES`).
         self.large_mesh = max((node.count for node in world.nodes if node.kind.triangles),
@@ -486,19 +494,19 @@ class _Uploaded:
             found += [("SCENE_NODES", self.scene_nodes(cull)), ("NODE_COUNT", str(max(1, len(self.world.nodes)))),
                       ("TRI_COUNT", str(max(1, self.world.triangle_count)))]
         else:  # the node loops' bounds as literals (see MESH_NODES in the shader)
-            found += [("MESH_NODES", str(self.mesh_count)), ("SPHERE_NODES", str(self.sphere_count))]
+            found += [("MESH_NODES", str(self.mesh_count)), ("SHAPE_NODES", str(self.shape_count))]
         return tuple(found)
 
     def scene_nodes(self, cull: bool | None) -> str:
         """The shader's unrolled node list: each node in scene order as
-        ``MESH(slot, start, count, cull, lamps)`` or ``SPHERE(slot, cull, lamps)``,
+        ``MESH(slot, start, count, cull, lamps)`` or ``SHAPE(slot, KIND_<NAME>, cull, lamps)``,
         ``cull`` resolved from the render's ``cull_backfaces`` (None: the node's own)."""
         slots = {k: slot for slot, k in enumerate(node_order(self.world))}
         parts = []
         for k, node in enumerate(self.world.nodes):
             one_sided = int(node.cull if cull is None else cull)
             if not node.kind.triangles:
-                parts.append(f"SPHERE({slots[k]},{one_sided},{node.lamp_of})")
+                parts.append(f"SHAPE({slots[k]},KIND_{node.kind.name},{one_sided},{node.lamp_of})")
             elif node.count <= UNROLL_TRIS:
                 parts += [f"TRI({slots[k]},{j},{one_sided},{node.lamp_of})" for j in range(node.start, node.start + node.count)]
             else:
@@ -551,11 +559,15 @@ class GpuTracer:
         self.reuses = 0
 
     def _program(self, lights: int, textures: int, shadows: bool = True, reflect: bool = True,
-                 meshes: bool = True, spheres: bool = True,
+                 kinds: frozenset[NodeKind] = frozenset(NodeKind),
                  scene: tuple[tuple[str, str], ...] = ()) -> tuple[moderngl.Program, moderngl.VertexArray]:
-        flags = (lights, textures, int(shadows and lights > 0), int(reflect), int(meshes), int(spheres))
-        names = ("NUM_LIGHTS", "NUM_TEXTURES", "SHADOWS", "REFLECT", "HAS_MESHES", "HAS_SPHERES")
-        defines = tuple((name, str(value)) for name, value in zip(names, flags)) + glsl_defines() + kind_defines() + scene
+        shapes = [kind for kind in NodeKind if not kind.triangles]
+        flags = (lights, textures, int(shadows and lights > 0), int(reflect), int(NodeKind.MESH in kinds),
+                 int(any(kind in kinds for kind in shapes)), *(int(kind in kinds) for kind in shapes))
+        names = ("NUM_LIGHTS", "NUM_TEXTURES", "SHADOWS", "REFLECT", "HAS_MESHES", "HAS_SHAPES",
+                 *(f"HAS_{kind.name}" for kind in shapes))
+        defines = (tuple((name, str(value)) for name, value in zip(names, flags)) + glsl_defines() + kind_defines()
+                   + layout_defines() + scene)
         if defines in self._programs:
             self._programs[defines] = self._programs.pop(defines)  # most recently used last
             self._vaos[defines] = self._vaos.pop(defines)
@@ -638,7 +650,7 @@ class GpuTracer:
             stack = uploaded.bvh_textures(self.ctx)
             scene_defines += (("BVH", "1"), ("BVH_STACK", str(stack)), ("BVH_MAX_STEPS", str(cap)))
         program, vao = self._program(lights, len(world.textures), shadows=bool(shadows), reflect=reflect,
-                                     meshes=uploaded.mesh_count > 0, spheres=uploaded.sphere_count > 0,
+                                     kinds=uploaded.kinds,
                                      scene=scene_defines)
         if uploaded.block is not None:
             program["SceneData"].binding = 0
@@ -650,7 +662,7 @@ class GpuTracer:
         if world.textures:  # as bytes: moderngl wants a bare int for a one-element array (one texture)
             program["u_wrap"].write(np.array([wrap for _, wrap in world.textures], dtype="i4").tobytes())
         values = {
-            "u_mesh_count": uploaded.mesh_count, "u_sphere_count": uploaded.sphere_count,
+            "u_mesh_count": uploaded.mesh_count, "u_shape_count": uploaded.shape_count,
             "u_size": (float(width), float(height)),
             "u_eye": tuple(eye - uploaded.anchor), "u_half": (half_w, half_h), "u_background": tuple(world.background),
             "u_max_depth": int(max_depth),

@@ -46,6 +46,7 @@ from glsandbox.gl.shaders import compile_program
 from glsandbox.plan import ProgramVariant
 from glsandbox.raytrace.base import broadcast_rays
 from glsandbox.raytrace.bvh import BVH
+from glsandbox.raytrace.constants import glsl_defines
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.world import camera_basis
 from glsandbox.scene import Camera
@@ -190,7 +191,7 @@ class GpuBVH:
         """The ``#define`` lines of the probe program (what an including shader sets too)."""
         return (("BVH_TEX_WIDTH", str(TEX_WIDTH)), ("BVH_STACK", str(self.stack)),
                 ("BVH_MAX_STEPS", str(self.max_steps)), ("BVH_ANY", str(int(any_hit))),
-                ("BVH_CAMERA", str(int(camera))))
+                ("BVH_CAMERA", str(int(camera))), *glsl_defines())
 
     def _program(self, any_hit: bool, camera: bool = False) -> tuple[moderngl.Program, moderngl.VertexArray]:
         key = (any_hit, camera)

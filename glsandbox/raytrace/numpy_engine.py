@@ -23,18 +23,20 @@ step before the next.
 The BVH
 -------
 :func:`_nearest` and :func:`_occluded` are the only places that look for hits.
-Both loop over the nodes in scene order (:func:`_scan_nodes`; the top level
-is the nodes' boxes, course "Hızlandırma: AABB"). With ``bvh=True`` (the
+Both go through :func:`_top_level`, the one loop over the nodes in scene
+order (the top level is the nodes' boxes, course "Hızlandırma: AABB"; the
+tests call it too). Each node is tested by its kind's hit function, in the
+node's own space (the node table :data:`_HIT`, by
+:class:`~glsandbox.raytrace.world.NodeKind`). With ``bvh=True`` (the
 default) a mesh node's rays that enter its box are traced through the node's
-BVH (:class:`~glsandbox.raytrace.bvh_world.WorldBVH`, built once per mesh and
+BVH instead (:class:`~glsandbox.raytrace.bvh_world.WorldBVH`, built once per mesh and
 cached by content; :func:`~glsandbox.raytrace.bvh_traverse.closest_hit`, the
 watertight triangle test) with ``t_max`` their best hit so far: only strictly
 nearer hits replace it, so the tie rule holds (an equal ``t`` goes to the
-earlier node, then the lower triangle). Spheres stay analytic
-(:func:`_hit_node`). Shadow rays are an any-hit query
+earlier node, then the lower triangle). Shadow rays are then an any-hit query
 (:func:`~glsandbox.raytrace.bvh_traverse.any_hit`): a ray leaves at its first
-occluder. With ``bvh=False``, :func:`_scan_nodes` tests every triangle of a
-node whose box a ray enters (the watertight test too,
+occluder. With ``bvh=False`` a mesh node's kind function tests every triangle of
+a node whose box a ray enters (the watertight test too,
 :func:`~glsandbox.raytrace.watertight.nearest_watertight`), and :func:`_occluded` is that scan cut at
 ``t = 1``: what ``ray_acceleration`` compares the BVH with.
 :class:`RenderStats` counts the ray-shape tests and the ray-box tests either
@@ -52,7 +54,7 @@ from numpy.typing import NDArray
 from glsandbox.raytrace.aabb import AABB, reciprocals
 from glsandbox.raytrace.bvh_traverse import TraversalCounts, any_hit, closest_hit
 from glsandbox.raytrace.bvh_world import NodeBVH, WorldBVH
-from glsandbox.raytrace.constants import (BVH_BOX_PAD_F64, OFFSETS, SIMPLE_OFFSET, RAY_POINT_GAMMA,
+from glsandbox.raytrace.constants import (BVH_BOX_PAD_F64, LENGTH_TINY, OFFSETS, SIMPLE_OFFSET, RAY_POINT_GAMMA,
                                           TRIANGLE_POINT_GAMMA, UNIT_F64, gamma)
 from glsandbox.raytrace.sphere import Sphere
 from glsandbox.raytrace.vec import length, moved_off
@@ -121,7 +123,7 @@ def _nearest(world: World, o: NDArray[np.float64], d: NDArray[np.float64], cull:
     tested first; ``bvh`` (the render's ``bvh=True``) traces mesh nodes through
     their BVHs instead of testing all their triangles.
     """
-    return _scan_nodes(world, o, d, np.inf, cull, aabb, -1, stats, bvh)
+    return _top_level(world, o, d, np.inf, cull, aabb, -1, stats, bvh)
 
 
 def _occluded(world: World, o: NDArray[np.float64], d: NDArray[np.float64], light: int, cull: bool | None,
@@ -130,43 +132,9 @@ def _occluded(world: World, o: NDArray[np.float64], d: NDArray[np.float64], ligh
     hits something at ``0 < s < 1`` (``d`` reaches the light at ``s = 1``, so an
     occluder beyond the light never counts). The light's lamp is skipped.
 
-    Without a BVH, the nearest-hit scan cut at ``s = 1``; with one, an any-hit
-    query: a ray leaves at its first occluder, nodes and triangles in any order."""
-    if bvh is None:
-        return _scan_nodes(world, o, d, 1.0, cull, aabb, light, stats, None).node >= 0
-    n = d.shape[0]
-    found = np.zeros(n, dtype=bool)
-    inverse = reciprocals(d)
-    entries = bvh.by_node
-    for k, node in enumerate(world.nodes):
-        if light >= 0 and node.lamp_of >> light & 1:
-            continue
-        if not node.kind.triangles:  # an analytic shape: its box, then its own test
-            idx = np.flatnonzero(~found)
-            if aabb:
-                if stats is not None:
-                    stats.box_tests += idx.size
-                near, far = AABB(node.box_min, node.box_max).slabs_reciprocal(_rows(o, idx), inverse[:, idx])
-                idx = idx[(near <= far) & (far > 0.0) & (near < 1.0)]
-            if idx.size == 0:
-                continue
-            if stats is not None:
-                stats.tests += idx.size
-            t, _ = _hit_node(world, k, _rows(o, idx), d[idx], node.cull if cull is None else cull)
-            found[idx[t < 1.0]] = True
-            continue
-        entry = entries.get(k)
-        if entry is None:  # no triangle of non-zero area
-            continue
-        idx = np.flatnonzero(~found)
-        idx = idx[_box_candidates(entry, _rows(o, idx), inverse[:, idx], 1.0, stats)]
-        if idx.size == 0:
-            continue
-        counts = TraversalCounts()
-        one_sided = entry.cull if cull is None else bool(cull)
-        found[idx] |= any_hit(entry.bvh, _rows(o, idx), d[idx], 1.0, cull_backfaces=one_sided, counts=counts)
-        _add_counts(stats, counts)
-    return found
+    With a BVH an any-hit query (a ray leaves at its first occluder); without one
+    the nearest-hit scan cut at ``s = 1`` (what ``ray_acceleration`` counts)."""
+    return _top_level(world, o, d, 1.0, cull, aabb, light, stats, bvh, first=bvh is not None).node >= 0
 
 
 def _box_candidates(entry: NodeBVH, o: NDArray[np.float64], inverse: NDArray[np.float64],
@@ -188,16 +156,25 @@ def _add_counts(stats: RenderStats | None, counts: TraversalCounts) -> None:
         stats.tests += counts.triangles
 
 
-def _scan_nodes(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_max: float, cull: bool | None,
-                aabb: bool, light: int, stats: RenderStats | None, bvh: WorldBVH | None = None) -> _Hits:
-    """Nearest hit with ``0 < t < t_max``, every node in scene order; ``light >= 0`` skips that light's lamp.
+def _top_level(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_max: float, cull: bool | None,
+               aabb: bool, light: int, stats: RenderStats | None, bvh: WorldBVH | None = None,
+               first: bool = False) -> _Hits:
+    """The top level, the one loop over a World's nodes that renders and tests use: the
+    nearest hit with ``0 < t < t_max``, every node in scene order; ``light >= 0`` skips
+    that light's lamp.
 
-    Each node's box (its slab test, ``1/d`` formed once for all nodes) picks the
-    rays that enter it before the best hit so far; only those are tested
-    against the node. A strict ``<`` keeps ties with the earlier node. With
-    ``bvh``, a mesh node's rays are traced through its BVH with ``t_max`` their
-    best hit so far (strictly nearer hits only, so the tie rule holds: the
-    earlier node, then the lower triangle index); spheres stay analytic.
+    Each node's box (its slab test, ``1/d`` formed once for all nodes) picks the rays
+    that enter it before their best hit so far; only those are tested against the node,
+    by its kind's hit function (:data:`_HIT`, in the node's own space). A strict ``<``
+    keeps ties with the earlier node. With ``bvh``, a mesh node's rays are traced
+    through its BVH instead (its root box widened as the BVH's own boxes are,
+    :func:`_box_candidates`) with ``t_max`` their best hit so far (strictly nearer hits
+    only, so the tie rule holds: the earlier node, then the lower triangle index).
+
+    ``first`` (shadow rays with a BVH): an any-hit query. A ray that has found an
+    occluder is tested against no further node, and a BVH answers with
+    :func:`~glsandbox.raytrace.bvh_traverse.any_hit`; the hits' ``t`` and triangle are
+    then not the nearest, only ``node >= 0`` means something.
     """
     n = d.shape[0]
     best_t = np.broadcast_to(np.asarray(t_max, dtype=np.float64), (n,)).copy()
@@ -207,17 +184,28 @@ def _scan_nodes(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_
     for k, node in enumerate(world.nodes):
         if light >= 0 and node.lamp_of >> light & 1:
             continue
-        one_sided = node.cull if cull is None else cull
+        one_sided = bool(node.cull if cull is None else cull)
+        # The rays still looking: all of them, or (any hit) those without an occluder yet.
+        rays = np.flatnonzero(best_node < 0) if first else None
+        ro = o if rays is None else _rows(o, rays)
+        rinv = inverse if rays is None or inverse is None else inverse[:, rays]
         if bvh is not None and node.kind.triangles:
             entry = bvh.by_node.get(k)
             if entry is None:  # no triangle of non-zero area
                 continue
-            assert inverse is not None
-            idx = _box_candidates(entry, o, inverse, best_t, stats)
+            assert rinv is not None
+            idx = _box_candidates(entry, ro, rinv, t_max if first else best_t, stats)
+            if rays is not None:
+                idx = rays[idx]
             if idx.size == 0:
                 continue
             counts = TraversalCounts()
-            hits = closest_hit(entry.bvh, _rows(o, idx), d[idx], best_t[idx], cull_backfaces=bool(one_sided),
+            if first:
+                found = any_hit(entry.bvh, _rows(o, idx), d[idx], t_max, cull_backfaces=one_sided, counts=counts)
+                best_node[idx[found]] = k
+                _add_counts(stats, counts)
+                continue
+            hits = closest_hit(entry.bvh, _rows(o, idx), d[idx], best_t[idx], cull_backfaces=one_sided,
                                counts=counts)
             _add_counts(stats, counts)
             won = hits.triangle >= 0  # strictly nearer than every earlier node's hit
@@ -226,13 +214,17 @@ def _scan_nodes(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_
             best_node[sel] = k
             best_tri[sel] = entry.start + hits.triangle[won]
             continue
-        if inverse is not None and aabb:
+        count = n if rays is None else rays.size
+        if rinv is not None and aabb:
             if stats is not None:
-                stats.box_tests += n
-            near, far = AABB(node.box_min, node.box_max).slabs_reciprocal(o, inverse)
-            idx = np.nonzero((near <= far) & (far > 0.0) & (near < best_t))[0]
+                stats.box_tests += count
+            near, far = AABB(node.box_min, node.box_max).slabs_reciprocal(ro, rinv)
+            limit = best_t if rays is None else best_t[rays]
+            idx = np.flatnonzero((near <= far) & (far > 0.0) & (near < limit))
         else:
-            idx = np.arange(n)
+            idx = np.arange(count)
+        if rays is not None:
+            idx = rays[idx]
         if idx.size == 0:
             continue
         if stats is not None:
@@ -263,15 +255,65 @@ def _hit_node(world: World, k: int, o: NDArray[np.float64], d: NDArray[np.float6
     return _HIT[node.kind](world, node, o, d, one_sided)
 
 
+def _own_space(node: NodeInfo, o: NDArray[np.float64], d: NDArray[np.float64]
+               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Rays taken into an analytic node's own space by its inverse model matrix (an
+    affine map keeps ``t``: ``M⁻¹(O + t·d) = M⁻¹O + t·(M⁻¹d)``)."""
+    inv = node.inverse
+    return o @ inv[:3, :3].T + inv[:3, 3], d @ inv[:3, :3].T
+
+
 def _hit_sphere(world: World, node: NodeInfo, o: NDArray[np.float64], d: NDArray[np.float64], one_sided: bool
                 ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
-    inv = node.inverse
-    oo = o @ inv[:3, :3].T + inv[:3, 3]  # the ray in the unit sphere's own space
-    dd = d @ inv[:3, :3].T
+    oo, dd = _own_space(node, o, d)
     t = _UNIT_SPHERE.intersect_many(oo, dd)
     if one_sided:  # from inside, the sphere's front faces all face away
         t = np.where(np.einsum("...j,...j->...", oo, oo) < 1.0, np.inf, t)
     return t, np.full(d.shape[0], -1, dtype=np.intp)
+
+
+def _hit_cylinder(world: World, node: NodeInfo, o: NDArray[np.float64], d: NDArray[np.float64], one_sided: bool
+                  ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
+    oo, dd = _own_space(node, o, d)
+    t = unit_cylinder_t(np.broadcast_to(oo, dd.shape), dd)
+    if one_sided:  # from inside, every front face faces away
+        inside = (oo[..., 0] ** 2 + oo[..., 2] ** 2 < 1.0) & (np.abs(oo[..., 1]) < 1.0)
+        t = np.where(inside, np.inf, t)
+    return t, np.full(d.shape[0], -1, dtype=np.intp)
+
+
+def unit_cylinder_t(o: NDArray[np.float64], d: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The nearest ``t > 0`` where rays ``o + t·d`` (``(N, 3)`` each) meet the capped unit
+    cylinder ``x² + z² ≤ 1, |y| ≤ 1``; inf for a miss.
+
+    The side is the circle ``x² + z² = 1`` in the xz-plane: the sphere's stable
+    quadratic (Ray Tracing Gems ch. 7) in two dimensions, its roots kept where
+    ``|y| ≤ 1``; each cap is the plane ``y = ±1`` (course "Işın-Düzlem kesim
+    testi"), kept where ``x² + z² ≤ 1``. A ray along the axis (``d_x = d_z =
+    0``) meets only the caps, one parallel to them only the side."""
+    ox, oy, oz = o[:, 0], o[:, 1], o[:, 2]
+    dx, dy, dz = d[:, 0], d[:, 1], d[:, 2]
+    best = np.full(d.shape[0], np.inf)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a = dx * dx + dz * dz
+        b = -(ox * dx + oz * dz)  # l·d with l = −o, in the xz-plane
+        hx = -ox - (b / a) * dx
+        hz = -oz - (b / a) * dz
+        disc = a * (1.0 - (hx * hx + hz * hz))
+        root = np.sqrt(np.maximum(disc, 0.0))
+        q = b + np.where(b >= 0.0, root, -root)
+        ell = np.hypot(ox, oz)
+        c = (ell - 1.0) * (ell + 1.0)
+        side = (a > 0.0) & (disc >= 0.0) & (q != 0.0)
+        for t in (c / q, q / a):
+            ok = side & (t > 0.0) & (t < best) & (np.abs(oy + t * dy) <= 1.0)
+            best = np.where(ok, t, best)
+        for y in (-1.0, 1.0):
+            t = (y - oy) / dy
+            px, pz = ox + t * dx, oz + t * dz
+            ok = (dy != 0.0) & (t > 0.0) & (t < best) & (px * px + pz * pz <= 1.0)
+            best = np.where(ok, t, best)
+    return best
 
 
 def _hit_triangles(world: World, node: NodeInfo, o: NDArray[np.float64], d: NDArray[np.float64], one_sided: bool
@@ -370,9 +412,9 @@ def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.fl
             color *= texel[:, :3]
             alpha[sel] *= texel[:, 3]
         base[sel] = color
-    normal /= np.maximum(length(normal), 1e-300)[:, None]
+    normal /= np.maximum(length(normal), LENGTH_TINY)[:, None]
     if spawn is not None:
-        spawn.normal /= np.maximum(length(spawn.normal), 1e-300)[:, None]
+        spawn.normal /= np.maximum(length(spawn.normal), LENGTH_TINY)[:, None]
     return point, normal, base, alpha, spawn
 
 
@@ -389,6 +431,27 @@ def _surface_sphere(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[np.i
     # geometry.sphere()'s uv: u = azimuth/2π from +z towards +x, v = polar angle/π from +y.
     uv = np.stack([np.mod(np.arctan2(q[:, 0], q[:, 2]), 2 * np.pi) / (2 * np.pi),
                    np.arccos(np.clip(q[:, 1], -1.0, 1.0)) / np.pi], axis=1)
+    return normal, uv, np.ones((sel.size, 3)) if node.mode == 1 else None
+
+
+def _surface_cylinder(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[np.intp], o: NDArray[np.float64],
+                      d: NDArray[np.float64], point: NDArray[np.float64], spawn: _Spawn | None
+                      ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64] | None]:
+    """A cylinder node's (normal, uv, vertex colour) at its hits, as :func:`glsandbox.geometry.cylinder`
+    lays them out: on a cap (the hit nearer ``|y| = 1`` than ``x² + z² = 1``) the cap's
+    normal and ``(½ + x/2, ½ + z/2)``, on the side the radial normal and ``(azimuth/2π, (1 − y)/2)``."""
+    inv = node.inverse
+    q = point[sel] @ inv[:3, :3].T + inv[:3, 3]  # the hit on the unit cylinder
+    r = np.hypot(q[:, 0], q[:, 2])
+    cap = np.abs(np.abs(q[:, 1]) - 1.0) < np.abs(r - 1.0)
+    own = np.where(cap[:, None], np.stack([np.zeros_like(r), np.sign(q[:, 1]), np.zeros_like(r)], axis=1),
+                   q * np.array([1.0, 0.0, 1.0]) / np.maximum(r, LENGTH_TINY)[:, None])
+    normal = own @ node.normal_matrix.T
+    if spawn is not None:
+        spawn.normal[sel] = normal
+    uv = np.where(cap[:, None], np.stack([0.5 + 0.5 * q[:, 0], 0.5 + 0.5 * q[:, 2]], axis=1),
+                  np.stack([np.mod(np.arctan2(q[:, 0], q[:, 2]), 2 * np.pi) / (2 * np.pi), 0.5 * (1.0 - q[:, 1])],
+                           axis=1))
     return normal, uv, np.ones((sel.size, 3)) if node.mode == 1 else None
 
 
@@ -421,8 +484,9 @@ def _surface_triangles(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[n
 #: test ``(world, node, o, d, one_sided) -> (t, world triangle or −1)`` in the node's
 #: own space, and a surface ``-> (normal, uv, vertex colour or None unless the node
 #: shows vertex colours)`` that also fills the spawn points (when given). A new kind is one entry in each.
-_HIT = {NodeKind.MESH: _hit_triangles, NodeKind.SPHERE: _hit_sphere}
-_SURFACE = {NodeKind.MESH: _surface_triangles, NodeKind.SPHERE: _surface_sphere}
+_HIT = {NodeKind.MESH: _hit_triangles, NodeKind.SPHERE: _hit_sphere, NodeKind.CYLINDER: _hit_cylinder}
+_SURFACE = {NodeKind.MESH: _surface_triangles, NodeKind.SPHERE: _surface_sphere,
+            NodeKind.CYLINDER: _surface_cylinder}
 
 
 def _interpolate(values: NDArray[np.float64], w: tuple[NDArray[np.float64], ...]) -> NDArray[np.float64]:
@@ -477,7 +541,7 @@ def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.floa
         total = np.zeros_like(mesh)
         for index, (light, light_color) in enumerate(zip(world.light_positions, world.light_colors)):
             to_light = light - p
-            to_light /= np.maximum(length(to_light), 1e-300)[:, None]
+            to_light /= np.maximum(length(to_light), LENGTH_TINY)[:, None]
             n_dot_l = np.einsum("ij,ij->i", nrm, to_light)
             diffuse = np.maximum(n_dot_l, 0.0)[:, None] * mesh * light_color
             reflected = -to_light + 2.0 * n_dot_l[:, None] * nrm  # fromLight − 2(fromLight·N)N
@@ -485,7 +549,7 @@ def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.floa
             cosine = r_dot_e
             if blinn.any():  # Blinn-Phong: N·H, H the unit halfway vector
                 halfway = to_light + to_eye
-                halfway /= np.maximum(length(halfway), 1e-300)[:, None]
+                halfway /= np.maximum(length(halfway), LENGTH_TINY)[:, None]
                 cosine = np.where(blinn, np.einsum("ij,ij->i", nrm, halfway), r_dot_e)
             cosine = np.maximum(cosine, 0.0)
             highlight = np.where(n_dot_l > 0.0, cosine ** shin, 0.0)

@@ -20,14 +20,16 @@ The algorithm, in the course's order (first half of the notes):
 2. **Nearest hit** (``tDistances``/``min_indis``): for each node, the AABB
    slab test first (course "Hızlandırma: AABB"; ``aabb=False`` skips it),
    then the watertight triangle test (Woop, Benthin & Wald; the course's
-   Işın-Üçgen kesim testi ends with it) against its triangles, or the exact
-   sphere test: a ray through a shared edge or vertex never slips through,
-   in either engine, on any path.
+   Işın-Üçgen kesim testi ends with it) against its triangles, or an analytic
+   node's own test in its own space (the exact sphere, the capped cylinder:
+   the node table, :class:`~glsandbox.raytrace.world.NodeKind`): a ray
+   through a shared edge or vertex never slips through, in either engine, on
+   any path.
    The numpy engine's ``bvh=True`` (the default) traces each mesh node's rays
    through a BVH over its triangles instead (:mod:`glsandbox.raytrace.bvh`,
    built once per mesh and cached), with the watertight triangle test
    (:mod:`glsandbox.raytrace.watertight`: a ray through a shared edge or
-   vertex hits one of its triangles, never none); spheres stay exact, and
+   vertex hits one of its triangles, never none); analytic nodes stay exact, and
    shadow rays stop at their first occluder. ``bvh=False`` is the per-node
    scan above (what ``ray_acceleration`` compares it with). The gpu engine
    decides by itself (:mod:`glsandbox.raytrace.gpu`: a scan for small
@@ -111,7 +113,8 @@ def render(scene: Scene, size: tuple[int, int], engine: str = "numpy", *, ctx: o
     reflection bounces, ``shadows``, ``cull_backfaces`` (None: per node, as
     the rasterizer), ``aabb`` culling, ``bvh`` (numpy engine: mesh nodes
     through their BVH; ``False``: every triangle of each node the box test
-    lets through), ``analytic_spheres`` (see :mod:`glsandbox.raytrace.world`),
+    lets through), ``analytic_spheres`` (every analytic kind, spheres and cylinders,
+    exact; ``False``: their triangles; see :mod:`glsandbox.raytrace.world`),
     ``offset`` (how secondary rays leave a surface: ``"bound"``, by the hit
     point's rounding-error bound; ``"simple"``, the teaching variant
     :data:`~glsandbox.raytrace.constants.SIMPLE_OFFSET`).

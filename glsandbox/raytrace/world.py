@@ -14,7 +14,8 @@ once per viewport by :func:`build_world` from the *same*
 - a node whose mesh says it tessellates the unit sphere
   (``Mesh.analytic == "sphere"``, as :func:`glsandbox.geometry.sphere` does,
   and every vertex lies on it) is a :attr:`NodeKind.SPHERE` node, traced as the *exact* unit sphere under its model matrix (an ellipsoid in
-  general): the ray is taken into the sphere's own space with ``M⁻¹`` and
+  general; the capped unit cylinder, :func:`glsandbox.geometry.cylinder`, likewise
+  a :attr:`NodeKind.CYLINDER` node): the ray is taken into the sphere's own space with ``M⁻¹`` and
   tested against ``|p| = 1`` (course section "Işın-Küre kesim testi"). An
   affine map keeps ``t``: ``M⁻¹(O + t·d) = M⁻¹O + t·(M⁻¹d)``, so no
   renormalising is needed. The rasterizer draws the tessellation; the
@@ -63,6 +64,7 @@ from glsandbox import transforms
 from glsandbox.geometry import Mesh
 from glsandbox.images import texture_levels
 from glsandbox.plan import traced_reflectivity
+from glsandbox.raytrace.constants import LENGTH_TINY, SQUARES_UNDERFLOW, UNIT_SHAPE_TOLERANCE
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.scene import MIN_SCALE, Camera, Node, Scene, Texture
 
@@ -88,25 +90,34 @@ WRAPS = {"repeat": 0, "mirrored": 1, "clamp": 2}
 class NodeKind(str, enum.Enum):
     """What a traced node is: the one table both engines loop over.
 
-    Each kind is a box (:func:`build_world` gives every node its world box), a
-    hit test in the node's own space and a surface (point, normal, uv):
+    Each kind is a box (:attr:`own_box`: :func:`build_world` gives every node
+    its world box from it), a hit test in the node's own space and a surface
+    (point, normal, uv):
 
     - ``MESH``: world-space triangles (``NodeInfo.start``/``count``), hit by
       the watertight test (a BVH or a scan), surface from barycentrics;
-    - ``SPHERE``: the unit sphere under the node's model matrix; rays are taken
-      into its space by ``NodeInfo.inverse``, hit by the stable quadratic,
-      normal through ``NodeInfo.normal_matrix``.
+    - ``SPHERE``: the unit sphere ``|p| = 1`` under the node's model matrix;
+    - ``CYLINDER``: the capped unit cylinder ``x² + z² ≤ 1, |y| ≤ 1`` (axis
+      +y) under the node's model matrix.
+
+    An analytic kind's rays are taken into its own space by
+    ``NodeInfo.inverse`` (an affine map keeps ``t``), hit there, and its normal
+    goes back through ``NodeInfo.normal_matrix``. A mesh says it tessellates
+    one (``Mesh.analytic``, the kind's value, as :func:`glsandbox.geometry.sphere`
+    and :func:`~glsandbox.geometry.cylinder` do) and :meth:`holds` checks its
+    vertices lie on it.
 
     The value is the kind's name (so ``kind == "sphere"`` still reads true);
     :attr:`code` is the number the gpu engine stores in a node record
     (``shaders/raytrace.glsl`` gets ``KIND_<NAME>`` defines from
     :func:`kind_defines`). The engines' per-kind code is in
     :mod:`glsandbox.raytrace.numpy_engine` (``_HIT``/``_SURFACE`` tables) and
-    the shader's ``sphere_t``/``triangle_t``; the README's ray tracer section
+    the shader's ``shape_t``/``shape_surface``; the README's ray tracer section
     says how to add a kind."""
 
     MESH = "mesh"
     SPHERE = "sphere"
+    CYLINDER = "cylinder"
 
     @property
     def code(self) -> int:
@@ -118,14 +129,40 @@ class NodeKind(str, enum.Enum):
         """Whether the kind's shape is its node's triangles (BVH and scan apply)."""
         return self is NodeKind.MESH
 
+    @property
+    def own_box(self) -> NDArray[np.float64]:
+        """An analytic kind's box in its own space, ``(2, 3)`` min and max: the cube
+        ``[−1, 1]³`` holds the unit sphere and the unit cylinder exactly."""
+        return np.array([[-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]])
+
+    def holds(self, positions: NDArray[np.float64]) -> bool:
+        """Whether every point lies on this analytic kind's unit shape (to
+        :data:`~glsandbox.raytrace.constants.UNIT_SHAPE_TOLERANCE`)."""
+        p = np.asarray(positions, dtype=np.float64)
+        tol = UNIT_SHAPE_TOLERANCE
+        if self is NodeKind.SPHERE:
+            return bool(np.all(np.abs(np.linalg.norm(p, axis=1) - 1.0) < tol))
+        if self is NodeKind.CYLINDER:
+            r = np.hypot(p[:, 0], p[:, 2])
+            side = (np.abs(r - 1.0) < tol) & (np.abs(p[:, 1]) <= 1.0 + tol)
+            cap = (np.abs(np.abs(p[:, 1]) - 1.0) < tol) & (r <= 1.0 + tol)
+            return bool(np.all(side | cap))
+        return False
+
 
 def kind_defines() -> tuple[tuple[str, str], ...]:
     """``KIND_MESH 0``, ``KIND_SPHERE 1``...: the node kinds as shader defines."""
     return tuple((f"KIND_{kind.name}", str(kind.code)) for kind in NodeKind)
 
 
-#: The analytic shapes a mesh can name in ``Mesh.analytic``, by name.
-ANALYTIC_KINDS = {"sphere": NodeKind.SPHERE}
+def analytic_kind(mesh: Mesh) -> NodeKind | None:
+    """The analytic kind ``mesh`` tessellates (``Mesh.analytic`` names it and every
+    vertex lies on it), or None: then its triangles are the shape."""
+    kinds = {kind.value: kind for kind in NodeKind if not kind.triangles}
+    kind = kinds.get(mesh.analytic or "")
+    if kind is None or mesh.mode != "triangles" or not kind.holds(mesh.positions):
+        return None
+    return kind
 
 
 @dataclass
@@ -248,27 +285,19 @@ def coverage(alpha_mode: NDArray[np.intp], alpha: NDArray[np.float64],
                     np.where(alpha_mode == ALPHA_CODES["blend"], alpha, 1.0))
 
 
-def is_unit_sphere(mesh: Mesh) -> bool:
-    """Whether ``mesh`` says it is the unit sphere (``analytic="sphere"``) and every vertex is on ``|p| = 1``."""
-    if ANALYTIC_KINDS.get(mesh.analytic or "") is not NodeKind.SPHERE or mesh.mode != "triangles":
-        return False
-    radii = np.linalg.norm(np.asarray(mesh.positions, dtype=np.float64), axis=1)
-    return bool(np.all(np.abs(radii - 1.0) < 1e-9))
-
-
 def _unit_rows(v: NDArray[np.float64]) -> NDArray[np.float64]:
     """Each row of ``v`` scaled to length 1 (a zero row stays zero). A row too
     small for its squares (a triangle of a tiny node: ``|v|² < 1e-300``
     underflows) is rescaled by its largest component first, so its direction
     survives instead of blowing up by ``1/1e-300``."""
     length = np.linalg.norm(v, axis=1, keepdims=True)
-    tiny = length[:, 0] < 1e-150
+    tiny = length[:, 0] < SQUARES_UNDERFLOW
     if np.any(tiny):
         big = np.abs(v[tiny]).max(axis=1, keepdims=True)
         v = v.copy()
         v[tiny] = np.divide(v[tiny], big, out=np.zeros_like(v[tiny]), where=big > 0.0)
         length[tiny] = np.linalg.norm(v[tiny], axis=1, keepdims=True)
-    return v / np.maximum(length, 1e-300)
+    return v / np.maximum(length, LENGTH_TINY)
 
 
 def _texture_image(texture: Texture) -> NDArray[np.float64]:
@@ -317,26 +346,23 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
         )
         # A model that flattens the node (a scale of 0, or below MIN_SCALE) has no usable inverse.
         invertible = transforms.smallest_scale(model) >= MIN_SCALE
-        if analytic_spheres and is_unit_sphere(mesh) and invertible:
-            corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=np.float64)
+        kind = analytic_kind(mesh) if analytic_spheres and invertible else None
+        if kind is not None:
+            lo, hi = kind.own_box
+            corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
             world_corners = transforms.transform_points(model, corners)
-            nodes.append(NodeInfo(kind=NodeKind.SPHERE, start=start, count=0, box_min=world_corners.min(axis=0),
+            nodes.append(NodeInfo(kind=kind, start=start, count=0, box_min=world_corners.min(axis=0),
                                   box_max=world_corners.max(axis=0), inverse=np.linalg.inv(model),
                                   normal_matrix=transforms.normal_matrix(model), **common))
             continue
-        order = mesh.indices if mesh.indices is not None else np.arange(mesh.vertex_count)
-        if mesh.mode == "triangles":
-            tri = np.asarray(order, dtype=np.intp).reshape(-1, 3)
-        else:  # a strip: triangle k is (k, k+1, k+2), odd ones swapped to keep the winding
-            tri = np.array([(order[k + 1], order[k], order[k + 2]) if k % 2 else (order[k], order[k + 1], order[k + 2])
-                            for k in range(len(order) - 2)], dtype=np.intp).reshape(-1, 3)
+        tri = mesh.triangle_indices()  # a strip's keep its winding
         if len(tri) == 0:
             continue
         world = transforms.transform_points(model, np.asarray(mesh.positions, dtype=np.float64))
         a, b, c = world[tri[:, 0]], world[tri[:, 1]], world[tri[:, 2]]
         if mesh.normals is not None and invertible:
             n_world = np.asarray(mesh.normals, dtype=np.float64) @ transforms.normal_matrix(model).T
-            n_world /= np.maximum(np.linalg.norm(n_world, axis=1, keepdims=True), 1e-300)
+            n_world /= np.maximum(np.linalg.norm(n_world, axis=1, keepdims=True), LENGTH_TINY)
             n = n_world[tri]
         else:  # flat (or flattened by the model): the face normal, counter-clockwise front (OpenGL's rule)
             face = _unit_rows(np.cross(b - a, c - a))

@@ -122,7 +122,7 @@ def test_tradeoffs_writes_every_file(quick_report: Path) -> None:
 def test_tradeoffs_report_has_a_table_per_knob(quick_report: Path) -> None:
     report = (quick_report / "report.md").read_text(encoding="utf-8")
     header = "| setting | time median (ms) | spread min-max (ms) | RMSE | PSNR (dB) | FLIP | error map |"
-    assert report.count(header) == 5
+    assert report.count(header) == 4  # the knobs without a pixel count
     assert report.count("| setting | time median (ms) | spread min-max (ms) | z-fighting px | share of shadow px | "
                         "RMSE | PSNR (dB) | FLIP | error map |") == 1
     for title in ("## Anti-aliasing (`antialiasing`)", "## Lighting model (`lighting`)",
@@ -134,7 +134,7 @@ def test_tradeoffs_report_has_a_table_per_knob(quick_report: Path) -> None:
     rows = _rows(quick_report)
     knobs = {row["knob"] for row in rows}
     assert knobs == {"antialiasing", "lighting", "ray_engine", "texture_filter", "depth", "shadows_mirror",
-                     "shadow_map", "shadow_offset"}
+                     "shadow_map", "shadow_offset", "shadow_epsilon", "triangle_test", "sphere_test", "depth_format"}
     for knob in knobs:  # one reference per knob, at zero error
         refs = [r for r in rows if r["knob"] == knob and r["reference"] == "1"]
         assert len(refs) == 1 and float(refs[0]["rmse"]) == 0.0 and refs[0]["psnr_db"] == "inf"
@@ -158,7 +158,7 @@ def test_tradeoffs_errors_fall_where_they_must(quick_report: Path) -> None:
     psnr = [float(rows[("antialiasing", s)]["psnr_db"]) for s in ("none", "SSAA 2x", "SSAA 4x")]
     assert psnr[0] < psnr[1] < psnr[2]
     report = (quick_report / "report.md").read_text(encoding="utf-8")
-    assert "DOES NOT HOLD" not in report and report.count("(RMSE): holds") == 2
+    assert "DOES NOT HOLD" not in report and report.count("(RMSE): holds") == 3  # + depth_format's
 
 
 @pytest.mark.slow
@@ -180,13 +180,43 @@ def test_depth_knob_counts_z_fighting_pixels(quick_report: Path) -> None:
     for label in ("standard 24-bit, lift 0.005, near 0.1", "standard 24-bit, lift 0.005, polygon offset",
                   "reverse-Z float, lift 0.005, no offset"):
         assert rows[label]["count_px"] == "0", label
-    others = [r for r in _rows(quick_report) if r["knob"] not in ("depth", "shadow_map", "shadow_offset")]
-    assert all(r["count_px"] == "" for r in others)  # only the depth, shadow-map and shadow-offset knobs count
+    uncounted = {"antialiasing", "lighting", "texture_filter", "shadows_mirror"}
+    others = [r for r in _rows(quick_report) if r["knob"] in uncounted]
+    assert others and all(r["count_px"] == "" for r in others)  # the picture-only knobs count nothing
+    assert all(r["count_px"] != "" for r in _rows(quick_report) if r["knob"] not in uncounted and r["reference"] == "0")
     report = (quick_report / "report.md").read_text(encoding="utf-8")
     assert "## Depth precision (`depth`)" in report
     fights = int(rows["standard 24-bit, lift 0, no offset"]["count_px"])
     assert "| standard 24-bit, lift 0, no offset | " in report and f" | {fights} | " in report
     assert "| default: reverse-Z float, lift 0.005, polygon offset (reference) | " in report
+
+
+@pytest.mark.slow
+def test_precision_knobs_in_the_quick_report(quick_report: Path) -> None:
+    # What precision costs (issue 21): each new knob's counts in the report order as the numerics say.
+    rows = {(r["knob"], r["setting"]): r for r in _rows(quick_report)}
+
+    def count(knob: str, setting: str) -> int:
+        return int(rows[(knob, setting)]["count_px"])
+
+    assert count("triangle_test", "Möller–Trumbore float64, at 0") > 0
+    assert count("triangle_test", "Möller–Trumbore float32, at 0") > 0
+    assert count("triangle_test", "watertight float64, at 100000") == 0
+    assert count("triangle_test", "watertight float64, at 0") == 0
+    far = rows[("sphere_test", "geometric, at 1e+08")]
+    assert int(far["count_px"]) > 0.2 * int(far["count_of_px"])
+    assert count("sphere_test", "stable, at 1e+08") == count("sphere_test", "geometric, at 10000") == 0
+    assert float(far["rmse"]) > float(rows[("sphere_test", "stable, at 1e+08")]["rmse"])
+    depth = {s: count("depth_format", s) for k, s in rows if k == "depth_format"}
+    assert depth["16-bit, near 1 (far/near 1e+03)"] > 0 and depth["24-bit, near 0.01 (far/near 1e+05)"] > 0
+    assert depth["reverse-Z float, near 0.01 (far/near 1e+05)"] == 0
+    assert count("shadow_epsilon", "no offset, at 1") > count("shadow_epsilon", "error bound, at 100000") == 0
+    assert count("shadow_epsilon", "2^-16*|P|, at 100000") > 0
+    assert count("ray_engine", "gpu world-space float32, at 1e5") > count("ray_engine", "gpu, at 1e5")
+    report = (quick_report / "report.md").read_text(encoding="utf-8")
+    for title in ("(`triangle_test`)", "(`sphere_test`)", "(`depth_format`)", "(`shadow_epsilon`)"):
+        assert title in report
+    assert "| no offset, at 1 | " in report and "| 2^-16*\\|P\\|, at 100000 | " in report  # a '|' kept in its cell
 
 
 @pytest.mark.slow

@@ -1,9 +1,9 @@
-"""The BVH top level over a World's mesh nodes: the same nearest hit as testing every
-triangle, and, on lesson scenes, the node the numpy engine's own loop finds.
+"""The top level over a World's nodes (the numpy engine's ``_top_level``, the one loop
+renders use) through the mesh nodes' BVHs: the same nearest hit as testing every
+triangle, and, on lesson scenes, the node the per-node scan finds.
 
-``WorldBVH.closest_hit`` is public, but renders trace through the numpy engine's own loop
-(tests/raytrace/test_numpy_engine_bvh.py), so these checks use a small grid of rays: the
-brute force they compare with tests every ray against every triangle."""
+These checks use a small grid of rays: the brute force they compare with tests every ray
+against every triangle."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ import pytest
 from glsandbox.lesson import find_lesson
 from glsandbox.raytrace.bvh_traverse import closest_hit_brute_force
 from glsandbox.raytrace.bvh_world import WorldBVH
-from glsandbox.raytrace.numpy_engine import _nearest
+from glsandbox.raytrace.numpy_engine import _nearest, _occluded
 from glsandbox.raytrace.world import World, build_world, camera_rays
 
 LESSONS = ("phong", "ray_phong", "ray_acceleration")
@@ -56,25 +56,23 @@ def brute_force(world: World, o: np.ndarray, d: np.ndarray, cull: bool | None) -
 @pytest.mark.parametrize("cull", [None, False, True])
 def test_world_bvh_equals_testing_every_triangle(lesson: str, cull: bool | None) -> None:
     world, eye, dirs = world_of(lesson)
-    top = WorldBVH.from_world(world)
-    hits = top.closest_hit(eye, dirs, cull_backfaces=cull)
+    hits = _nearest(world, eye, dirs, cull, True, None, WorldBVH.from_world(world))
     t, k = brute_force(world, eye, dirs, cull)
-    np.testing.assert_array_equal(hits.triangle, k)
+    np.testing.assert_array_equal(hits.tri, k)
     np.testing.assert_array_equal(hits.t, t)
     np.testing.assert_array_equal(hits.node, np.where(k >= 0, world.tri_node[np.maximum(k, 0)], -1))
 
 
 @pytest.mark.parametrize("lesson", LESSONS)
 def test_world_bvh_finds_the_node_the_engine_finds(lesson: str) -> None:
-    # The engine tests triangles with Möller-Trumbore, the BVH with the
-    # watertight test: they may differ only where a ray grazes an edge.
+    # The scan and the BVH both use the watertight test: the same triangles, so the
+    # same nodes and t (the BVH's order of tests may only change which of two
+    # triangles at one t wins, never the node or t).
     world, eye, dirs = world_of(lesson)
-    hits = WorldBVH.from_world(world).closest_hit(eye, dirs)
-    engine = _nearest(world, eye, dirs, None, True)  # the per-node scan (no BVH): Möller-Trumbore
-    same = hits.node == engine.node
-    assert same.mean() > 0.995
-    both = same & (hits.node >= 0)
-    np.testing.assert_allclose(hits.t[both], engine.t[both], rtol=1e-9)
+    hits = _nearest(world, eye, dirs, None, True, None, WorldBVH.from_world(world))
+    engine = _nearest(world, eye, dirs, None, True)  # the per-node scan (no BVH)
+    np.testing.assert_array_equal(hits.node, engine.node)
+    np.testing.assert_array_equal(hits.t, engine.t)
 
 
 def test_shadow_rays_skip_the_lights_lamp() -> None:
@@ -88,5 +86,6 @@ def test_shadow_rays_skip_the_lights_lamp() -> None:
     # A ray from just outside the lamp to the light: only the lamp is between.
     box = world.nodes[lamps[0].node]
     outside = np.array([[box.box_max[0] + 1e-3, target[1], target[2]]])
-    assert top.any_hit(outside, target - outside, 1.0)[0]
-    assert not top.any_hit(outside, target - outside, 1.0, light=light)[0]
+    for accel in (top, None):  # any hit through the BVHs, and the scan cut at t = 1
+        assert _occluded(world, outside, target - outside, -1, None, True, None, accel)[0]  # no lamp skipped
+        assert not _occluded(world, outside, target - outside, light, None, True, None, accel)[0]

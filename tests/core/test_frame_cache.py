@@ -1,0 +1,187 @@
+"""Frames that pay only for what changed (issue 24): a lesson's Motion, the kept Scene and plan.
+
+A lesson that says what ``time`` moves (:meth:`glsandbox.Lesson.motion`) builds its scene
+once per set of its other values and per frame only moves it
+(:func:`glsandbox.scene.moved_scene`); the frame renderer keeps the plan while only positions
+and cameras change. These tests hold every built-in lesson to its promise: a moved scene is
+the scene a fresh build gives, part for part and pixel for pixel, and changing a parameter
+between frames changes the picture.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from glsandbox import geometry
+from glsandbox.errors import SandboxError
+from glsandbox.lesson import all_lessons, find_lesson
+from glsandbox.plan import plan
+from glsandbox.scene import Camera, Light, Material, Motion, Node, Scene, moved_scene, scene_origin
+
+#: Moments the frames are checked at (seconds): the first, and three that turn things well apart.
+TIMES = (0.0, 0.37, 1.9, 7.3)
+#: The settings each lesson is checked with besides its defaults (the bench's shadow-map frame).
+EXTRA_SETTINGS = {"shadow_map": ({"show": "map"},), "phong": ({"lights": 1, "shading": "gouraud"},),
+                  "mirror": ({"light": "directional", "shadow": "double_blend"},)}
+
+
+def moving_lessons() -> list[tuple[str, dict]]:
+    """(lesson name, settings) for every built-in lesson that declares a motion."""
+    found = []
+    for cls in all_lessons():
+        if cls().motion() is not None:
+            found += [(cls.name, {}), *((cls.name, s) for s in EXTRA_SETTINGS.get(cls.name, ()))]
+    return found
+
+
+def assert_same_scene(moved: Scene, built: Scene) -> None:
+    """Everything a renderer reads is equal (models exactly: the same floats)."""
+    assert moved.name == built.name
+    assert [n.name for n in moved.nodes] == [n.name for n in built.nodes]
+    for a, b in zip(moved.nodes, built.nodes):
+        assert np.array_equal(np.asarray(a.model), np.asarray(b.model)), a.name
+        assert a.material == b.material and a.mesh.name == b.mesh.name, a.name
+        assert (a.cull_back_faces, a.viewports, a.casts_shadow, a.receives_shadow) == \
+            (b.cull_back_faces, b.viewports, b.casts_shadow, b.receives_shadow), a.name
+    assert moved.lights == built.lights
+    assert (moved.camera, moved.viewports, moved.mirror, moved.planar_shadow, moved.depth_mode, moved.plan_mode) == \
+        (built.camera, built.viewports, built.mirror, built.planar_shadow, built.depth_mode, built.plan_mode)
+    assert [o.name for o in moved.overlays] == [o.name for o in built.overlays]
+
+
+def test_the_course_lessons_that_move_declare_it():
+    names = {name for name, _ in moving_lessons()}
+    assert {"clear_and_swap", "triangle", "indexed_cube", "phong", "texture", "mirror", "shadow_map"} <= names
+
+
+@pytest.mark.parametrize(("name", "settings"), moving_lessons(), ids=lambda v: str(v) if v else "")
+def test_a_moved_scene_is_a_fresh_build(name, settings):
+    lesson = find_lesson(name)(**settings)
+    first = lesson.scene()
+    for t in TIMES:
+        moment = lesson.at(t)
+        scene = moment.scene()
+        assert scene_origin(scene) is scene_origin(first)  # built once, moved since
+        assert_same_scene(scene, moment._scene_as_built())
+
+
+def test_a_changed_value_builds_the_scene_again():
+    lesson = find_lesson("phong")()
+    before = lesson.scene()
+    lesson.on_key("4")  # the next shading
+    after = lesson.scene()
+    assert scene_origin(after) is not scene_origin(before)
+    assert {n.material.shading for n in after.nodes if n.material.lit} == {"gouraud"}
+    lesson.on_key("4"), lesson.on_key("4")  # back to phong: the kept scene again
+    assert scene_origin(lesson.scene()) is scene_origin(before)
+
+
+def test_a_lesson_without_motion_is_built_every_frame():
+    lesson = find_lesson("transform_order")()
+    assert lesson.motion() is None
+    assert scene_origin(lesson.scene()) is None
+
+
+def _lit_scene() -> Scene:
+    return Scene("s", nodes=(Node("ball", geometry.sphere(), material=Material(shading="phong")),
+                             Node("flat", geometry.cube())), lights=(Light((1.0, 2.0, 3.0)),))
+
+
+def test_moved_scene_changes_only_what_moves():
+    scene = _lit_scene()
+    moved = moved_scene(scene, Motion(models={"ball": np.diag([2.0, 2.0, 2.0, 1.0])}, lights={0: (0.0, 5.0, 0.0)}))
+    assert scene_origin(moved) is scene and moved.nodes[1] is scene.nodes[1]
+    assert moved.nodes[0].mesh is scene.nodes[0].mesh and moved.nodes[0].model[0, 0] == 2.0
+    assert moved.lights[0].position == (0.0, 5.0, 0.0) and scene.lights[0].position == (1.0, 2.0, 3.0)
+    again = moved_scene(moved, Motion(camera=Camera(eye=(0.0, 0.0, 5.0))))
+    assert scene_origin(again) is scene and again.camera.eye == (0.0, 0.0, 5.0)
+    assert scene_origin(replace(moved, name="other")) is None  # made another way: planned afresh
+
+
+@pytest.mark.parametrize(("motion", "message"), [
+    (Motion(models={"ghost": np.eye(4)}), "'ghost', which is not a node"),
+    (Motion(models={"ball": np.diag([1.0, 0.0, 1.0, 1.0])}), "node 'ball': model matrix is singular"),
+    (Motion(models={"flat": np.full((4, 4), np.nan)}), "node 'flat': model matrix has a non-finite entry"),
+    (Motion(models={"flat": np.eye(3)}), "node 'flat': model matrix must be 4x4"),
+    (Motion(lights={1: (0.0, 0.0, 0.0)}), "moves light 1, and the scene has 1"),
+    (Motion(lights={0: (0.0, float("inf"), 0.0)}), "light position"),
+])
+def test_moved_scene_checks_what_moves(motion, message):
+    with pytest.raises(SandboxError, match=message.replace("(", r"\(")):
+        moved_scene(_lit_scene(), motion)
+
+
+def test_the_camera_keys_move_the_scene():
+    from glsandbox.camera import CameraInput
+
+    scene = find_lesson("indexed_cube")().scene()
+    camera = CameraInput()
+    camera.scroll(1.0, scene)
+    seen = camera.apply(scene)
+    assert scene_origin(seen) is scene_origin(scene) and seen.camera != scene.camera
+
+
+# --- on a GL context ------------------------------------------------------------
+
+SIZE = (96, 72)
+
+
+@pytest.mark.parametrize(("name", "settings"), [
+    case for case in moving_lessons() if case[0] not in ("model",)])
+def test_time_only_frames_equal_a_fresh_build_pixel_for_pixel(gl, name, settings):
+    lesson = find_lesson(name)(**settings)
+    gl.render(lesson, SIZE)  # the first frame builds, plans and uploads
+    for t in TIMES:
+        moment = lesson.at(t)
+        kept = gl.render(moment, SIZE)
+        fresh = gl.render_scene(moment._scene_as_built(), SIZE)  # built, planned and drawn afresh
+        assert kept.plan == fresh.plan
+        assert np.array_equal(kept.image, fresh.image), f"{name} {settings} at t={t}"
+
+
+def test_a_parameter_changed_between_frames_changes_the_picture(gl):
+    lesson = find_lesson("phong")()
+    before = gl.render(lesson.at(1.0), SIZE).image.copy()
+    lesson.values["specular"] = False  # as the window's key 3 does
+    after = gl.render(lesson.at(1.0), SIZE)
+    assert not np.array_equal(before, after.image)
+    fresh = gl.render_scene(lesson.at(1.0)._scene_as_built(), SIZE)
+    assert np.array_equal(after.image, fresh.image)
+    cube = find_lesson("indexed_cube")()
+    turning = [gl.render(cube.at(t), SIZE).image.copy() for t in (0.0, 0.5)]
+    assert not np.array_equal(*turning)  # time moves the cube
+
+
+def test_the_plan_is_kept_only_while_it_would_be_the_same(gl):
+    """A blended node passing another flips their drawing order: the kept plan is not reused."""
+    glass = Material(color=(0.2, 0.4, 1.0, 0.5), alpha_mode="blend")
+    scene = Scene("blend", nodes=(Node("a", geometry.cube(), material=glass), Node("b", geometry.cube(), material=glass)),
+                  camera=Camera(eye=(0.0, 0.0, 10.0)))
+    first = gl.plan(moved_scene(scene, Motion(models={"a": np.eye(4)})))
+    assert gl.plan(moved_scene(scene, Motion(models={"b": np.eye(4)}))) is first  # same order: kept
+    ahead = np.eye(4)
+    ahead[2, 3] = 3.0  # a nearer the eye: drawn last now
+    flipped = moved_scene(scene, Motion(models={"a": ahead}))
+    assert gl.plan(flipped) is not first and gl.plan(flipped) == plan(flipped)
+    assert [d.node for d in gl.plan(flipped).passes[-1].draws] == ["b", "a"]
+
+
+def test_a_model_array_changed_in_place_is_drawn_where_it_is_now(gl):
+    """The executor keeps uniform bytes by a matrix's content, not by the array object."""
+    model = np.eye(4)
+
+    def frame() -> np.ndarray:
+        node = Node("cube", geometry.cube(), model, Material(shading="vertex_color"))
+        return gl.render_scene(Scene("s", nodes=(node,), camera=Camera(eye=(0.0, 0.0, 8.0))), SIZE).image.copy()
+
+    first = frame()
+    model[0, 3] = 1.5  # the same array, moved
+    moved = frame()
+    assert not np.array_equal(first, moved)
+    fresh = gl.render_scene(Scene("s", nodes=(Node("cube", geometry.cube(), model.copy(),
+                                                   Material(shading="vertex_color")),),
+                                  camera=Camera(eye=(0.0, 0.0, 8.0))), SIZE).image
+    assert np.array_equal(moved, fresh)
