@@ -179,6 +179,12 @@ BVH_STEP_CAP: int | None = None
 #: shadow+bounce): 32 triangles scan 0.033/0.045 s vs BVH 0.054/0.087 s; 72: 0.060/0.114
 #: vs 0.058/0.093; 128: 0.098/0.148 vs 0.063/0.098; 1,058: 1.43/2.22 vs 0.082/0.179.
 BVH_TRIANGLES = 64
+#: Triangles per leaf of the gpu engine's BVHs (bvh.py's default is 4): each walk
+#: iteration tests one triangle while the walk moves one node, so smaller leaves
+#: keep the two in step. Measured (CPU time, 800x600, primary / shadow+bounce,
+#: against 4): 2 took 0.96/0.94x on the 1k terrain, 0.99/1.00x on the bunny,
+#: 0.97/0.97x on 100k; 1 took 1.04-1.09x of 2's, 3 0.98-1.03x, 8 1.07-1.15x of 4's.
+BVH_LEAF_SIZE = 2
 #: A BVH render is refused when the budget leaves a ray fewer steps than this.
 BVH_MIN_STEPS = 256
 
@@ -463,7 +469,7 @@ class _Uploaded:
             # Built, not taken from bvh.py's cache: these are anchor-relative triangles
             # no other engine asks for, and the upload keeps what the shader needs.
             bvh = build_bvh(world.v0[rows] - self.anchor, world.v1[rows] - self.anchor,
-                            world.v2[rows] - self.anchor)
+                            world.v2[rows] - self.anchor, leaf_size=BVH_LEAF_SIZE)
             nodes, tris = pack_bvh(bvh)
             children = nodes.reshape(-1, 2, 4)  # (box min, ref), (box max, count) per child: a view
             tris = tris.reshape(-1, 3, 4)

@@ -81,7 +81,7 @@ def rock_scene() -> Scene:
 @pytest.mark.parametrize("cap", [64, 96])
 def test_the_gpu_bvh_takes_the_same_steps_at_1e6_as_at_the_origin(gl, monkeypatch, cap) -> None:
     # Steps per ray, seen through the step bound: at 64 the same pixels run out of steps
-    # wherever the rock sits (62 of them), at 96 none does and the pictures are the same. (In world
+    # wherever the rock sits (60 of them), at 96 none does and the pictures are the same. (In world
     # space the boxes' padding grew with the coordinates: 22 steps a ray at the origin,
     # 479 at 1e5, the 8,192 cap at 1e6, where a frame with a bounce raised.)
     from glsandbox.raytrace import RayTraceError
