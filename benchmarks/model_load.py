@@ -26,7 +26,10 @@ Under the table: peak memory per triangle of a load and first frame, measured
 in a fresh process that has loaded and drawn the model once already (the
 context, shaders and reader's imports are not the model's), as its peak
 resident size (Linux: reset just before the second load) less what it held
-then; goal: at most 250 bytes. pymeshlab and embreex come with
+then; goal: at most 250 bytes. Beside it, from ``tracemalloc`` in a third
+load, the peak and the held bytes of Python's and numpy's allocations (the
+reader's and glsandbox's arrays, not the GL driver's), and the loaded model's
+own arrays (what the load cache keeps). pymeshlab and embreex come with
 ``uv run --group bench``; without them those rows are skipped and said so.
 """
 
@@ -188,10 +191,14 @@ def build_case(label: str, case: Any, side: Any) -> Any:
                      "under the table")
 
 
-def peak_bytes_per_triangle(path: Path) -> tuple[int, float]:
-    """``(triangles, peak bytes per triangle)`` of a load and first frame in a fresh process."""
+def peak_bytes_per_triangle(path: Path) -> tuple[int, float, float, float, float]:
+    """``(triangles, peak, traced peak, traced held, arrays)`` of a load and first frame in a fresh
+    process, in bytes per triangle: the growth of the peak resident size (what the system sees; the
+    GPU buffers included, which llvmpipe keeps in host memory); the peak and what is still held at
+    the end of Python's and numpy's allocations (``tracemalloc``: the reader's and glsandbox's
+    arrays, not the driver's); and the loaded model's own arrays (kept in the load cache)."""
     code = f"""
-import json, sys
+import json, sys, tracemalloc
 sys.path.insert(0, {str(Path(__file__).resolve().parent)!r})
 import trimesh, glsandbox, glsandbox.meshfile
 from glsandbox.measure.bench import BenchEnv
@@ -207,14 +214,21 @@ with open('/proc/self/clear_refs', 'w') as f:
 before = status('VmRSS:')
 model_load.glsandbox_load_and_draw(env, path)  # a new crease angle: loaded and drawn again
 after = status('VmHWM:')
+tracemalloc.start()  # a third time, traced (tracing's own records would swell the resident size above)
+model_load.glsandbox_load_and_draw(env, path)
+traced_held, traced_peak = tracemalloc.get_traced_memory()
+tracemalloc.stop()
 model = glsandbox.meshfile.load_model(path, fit=True, crease_angle=30.0 + 1e-6)
-print(json.dumps([model.triangles, (after - before) / model.triangles]))
+arrays = sum(a.nbytes for part in model.parts for a in (part.mesh.positions, part.mesh.indices, part.mesh.normals,
+                                                         part.mesh.uvs, part.mesh.colors) if a is not None)
+t = model.triangles
+print(json.dumps([t, (after - before) / t, traced_peak / t, traced_held / t, arrays / t]))
 """
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
     if done.returncode != 0:
         raise RuntimeError(done.stderr.strip().splitlines()[-1] if done.stderr.strip() else "failed")
-    triangles, per = json.loads(done.stdout.strip().splitlines()[-1])
-    return int(triangles), float(per)
+    triangles, per, traced_peak, traced_held, arrays = json.loads(done.stdout.strip().splitlines()[-1])
+    return int(triangles), float(per), float(traced_peak), float(traced_held), float(arrays)
 
 
 def summarize(results: Sequence[Any]) -> list[str]:
@@ -224,13 +238,15 @@ def summarize(results: Sequence[Any]) -> list[str]:
               if r.case.group == GROUP and r.case.name.startswith("load") and r.subject_s]
     for label in loaded:
         try:
-            triangles, per = peak_bytes_per_triangle(MODELS[label]())
+            triangles, per, traced_peak, traced_held, arrays = peak_bytes_per_triangle(MODELS[label]())
         except (RuntimeError, subprocess.TimeoutExpired) as exc:
             lines.append(f"{GROUP}: peak memory, {label}: not measured ({exc})")
             continue
         verdict = "met" if per <= BYTES_GOAL else "NOT met"
         lines.append(f"{GROUP}: peak memory of load + first frame, {label} ({triangles:,} triangles): "
-                     f"{per:.0f} bytes per triangle (goal: at most {BYTES_GOAL}: {verdict})")
+                     f"{per:.0f} bytes per triangle (goal: at most {BYTES_GOAL}: {verdict}); numpy and Python "
+                     f"allocations: {traced_peak:.0f} at the peak, {traced_held:.0f} held after; the loaded "
+                     f"model's arrays: {arrays:.0f}")
     from glsandbox.raytrace.bvh import build_bvh, sah_cost
 
     for result in results:

@@ -35,7 +35,7 @@ from glsandbox.errors import SandboxError
 __all__ = ["BYTES_PER_TRIANGLE", "MEMORY_ENV", "check_memory", "checked_data", "claimed_triangles", "memory_limit"]
 
 #: The memory a model needs per triangle to be loaded and drawn, at the peak (measured by
-#: ``glsandbox bench``'s model rows at about 230 bytes; rounded up).
+#: ``glsandbox bench``'s model rows at 165-206 bytes for binary files; rounded up).
 BYTES_PER_TRIANGLE = 256
 
 #: The environment variable that sets the memory a model may use (bytes, or ``512M``, ``8G``).

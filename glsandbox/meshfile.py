@@ -43,7 +43,8 @@ needs more memory than ``GLSANDBOX_MODEL_MEMORY`` allows
 (:mod:`glsandbox.meshcheck`). Time and memory are linear in the triangles:
 normals and vertices are made by :mod:`glsandbox.meshnormals` (integer ids,
 no per-position square work), a glTF's nodes placed once each, the per-face
-steps done in blocks (about 230 bytes per triangle at the peak). Loads are cached by (resolved path, modification
+steps done in blocks (about 155-190 bytes per triangle of numpy's arrays at the peak for a binary
+file; an OBJ's text costs trimesh's reader about 600 more). Loads are cached by (resolved path, modification
 time, size, options): loading a file again returns the same :class:`Model`
 (and the same Mesh object, whose GPU buffers the executor keeps), until the
 file changes. trimesh's log messages and warnings are kept off stderr.
@@ -73,7 +74,7 @@ from glsandbox.files import open_user_file
 from glsandbox.geometry import Mesh
 from glsandbox.meshcheck import MEMORY_ENV, check_memory, checked_data, claimed_triangles
 from glsandbox.meshlooks import Look, file_warnings, is_closed, look_of
-from glsandbox.meshnormals import BLOCK_FACES, face_cross, normal_groups, row_ids, split_vertices
+from glsandbox.meshnormals import face_geometry, normal_groups, row_ids, split_vertices
 from glsandbox.scene import Material, Node, Texture
 
 __all__ = ["CREASE_ANGLE", "FORMATS", "NORMALS", "Model", "ModelPart", "fit_mesh", "is_model_path", "load_mesh",
@@ -471,12 +472,11 @@ def _part(mesh: Any, transform: NDArray[np.float64], index: int, looks: dict[int
 def _file_normals(mesh: Any, count: int) -> NDArray[np.float64] | None:
     """The vertex normals the file gave, or None. trimesh keeps given normals in the
     mesh's cache (its exporters test the same way); asking ``mesh.vertex_normals``
-    would compute some instead."""
-    cache = getattr(mesh, "_cache", None)
-    try:
-        given = cache["vertex_normals"] if cache is not None and "vertex_normals" in cache else None
-    except Exception:
-        return None
+    would compute some instead. The cache's own dict is read: asking the cache
+    (``in``, ``[]``) first hashes the mesh's arrays to see whether they changed since,
+    which they have not (``process=False``: nothing after reading touches them)."""
+    store = getattr(getattr(mesh, "_cache", None), "cache", None)
+    given = store.get("vertex_normals") if isinstance(store, dict) else None
     if given is None:
         return None
     normals = np.array(given, dtype=np.float64)
@@ -512,13 +512,18 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
     for part in parts:
         groups.setdefault(part.look.key, []).append(part)
     # Sidedness: glTF says per material; otherwise one-sided only when the model is closed.
-    closed = file_type in ("gltf", "glb") or is_closed(positions, faces)
+    # Equal positions, numbered once for the whole file: for closedness and for every part's vertices.
+    position_ids = row_ids(positions, ordered=False)[0]
+    closed = file_type in ("gltf", "glb") or is_closed(positions, faces, position_ids)
     undrawn = file_warnings(p, data, file_type, [part.look for part in parts])
     built = []
     dropped = 0
+    index = {id(part): i for i, part in enumerate(parts)}
     for members in groups.values():
         look = members[0].look
-        mesh, kept, lost, how = _group_mesh(p, file_type, members, normals_mode, crease,
+        ids = [position_ids[offsets[index[id(part)]]:offsets[index[id(part)] + 1]] for part in members]
+        mesh, kept, lost, how = _group_mesh(p, file_type, members, ids[0] if len(ids) == 1 else np.concatenate(ids),
+                                            normals_mode, crease,
                                             look.name if len(groups) > 1 else None)
         dropped += lost
         if mesh is not None:
@@ -526,7 +531,10 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
     if not built:
         raise SandboxError(f"model file {p} has no faces: all {faces.shape[0]:,} are degenerate "
                            "(zero area or a repeated vertex)")
-    transform = _fit_transform(np.concatenate([mesh.positions for _, mesh, _, _ in built])) if fit else None
+    transform = None
+    if fit:  # the box of all parts' boxes
+        corners = np.concatenate([[mesh.positions.min(axis=0), mesh.positions.max(axis=0)] for _, mesh, _, _ in built])
+        transform = _fit_transform(corners)
     model_parts = []
     for i, (look, mesh, kept, how) in enumerate(built):
         said = [f"model file {p}: {', '.join(undrawn[''])} not drawn"] if i == 0 and undrawn.get("") else []
@@ -542,10 +550,13 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
             else:
                 where = "" if len(built) == 1 else f"{look.name}/"
                 texture = Texture(f"{p}#{where}base_color", image=look.image)
+        positions = mesh.positions
         if transform is not None:
             notes.append("fitted into -1..1")
-            mesh = replace(mesh, positions=(np.asarray(mesh.positions) - transform[0]) * transform[1])
-        mesh = replace(mesh, notes=tuple(notes), warnings=tuple(said))
+            positions -= transform[0]
+            positions *= transform[1]
+        mesh = Mesh(mesh.name, positions, mesh.indices, mesh.normals, mesh.uvs, mesh.colors, notes=tuple(notes),
+                    warnings=tuple(said))
         sided = look.double_sided if look.double_sided is not None else not closed
         model_parts.append(ModelPart(look.name, mesh, texture, look.color, look.alpha_mode, look.alpha_cutoff,
                                      sided, kept))
@@ -553,10 +564,26 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
     return Model(p, tuple(model_parts), total, dropped, built[0][3], closed)
 
 
-def _group_mesh(p: Path, file_type: str, parts: list[_Part], normals_mode: str, crease: float,
-                part_name: str | None) -> tuple[Mesh | None, int, int, str]:
-    """One mesh for parts that share a material: ``(mesh, triangles, degenerate faces
-    dropped, how its normals were made)``; no mesh when every face was degenerate."""
+@dataclass
+class _Arrays:
+    """A part's mesh before it is fitted and made a :class:`~glsandbox.geometry.Mesh` (once: making one
+    checks every array)."""
+
+    name: str
+    positions: NDArray[np.float64]
+    indices: NDArray[np.uint32]
+    normals: NDArray[np.float64]
+    uvs: NDArray[np.float64] | None
+    colors: NDArray[np.float64] | None
+    notes: tuple[str, ...]
+
+
+def _group_mesh(p: Path, file_type: str, parts: list[_Part], position_ids: NDArray[np.intp], normals_mode: str,
+                crease: float,
+                part_name: str | None) -> tuple[_Arrays | None, int, int, str]:
+    """One mesh for parts that share a material: ``(its arrays, triangles, degenerate faces
+    dropped, how its normals were made)``; none when every face was degenerate. ``position_ids``:
+    the parts' vertices numbered by position (:func:`glsandbox.meshnormals.row_ids`)."""
     offsets = np.cumsum([0] + [part.positions.shape[0] for part in parts])
     positions, faces = _all_parts(parts, offsets)
     # Optional attributes: a part without them gets neutral values when another has them.
@@ -567,30 +594,45 @@ def _group_mesh(p: Path, file_type: str, parts: list[_Part], normals_mode: str, 
     file_normals = None
     if all(part.normals is not None for part in parts):
         file_normals = np.concatenate([part.normals for part in parts])  # type: ignore[misc]
-    # Degenerate faces: dropped and counted.
-    keep = ~_degenerate(positions, faces)
+    # What normals need of each face (its unit normal, its corner angles: none when the file's normals
+    # will do), and its area: degenerate faces are dropped and counted.
+    angles_needed = normals_mode not in ("auto", "file", "flat") or (normals_mode == "auto" and file_normals is None)
+    unit, angles, flat = face_geometry(positions, faces, angles_needed, DEGENERATE_SHARE)
+    keep = ~((faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 0] == faces[:, 2]) | flat)
+    del flat
     dropped = int(faces.shape[0] - keep.sum())
     if not keep.any():
         return None, 0, dropped, ""
     if dropped:
-        faces = faces[keep]
+        faces, unit = faces[keep], unit[keep]
+        if angles.size:
+            angles = angles.reshape(-1, 3)[keep].reshape(-1)
     if corner_colors is not None:
         corner_colors = corner_colors[keep]
-    position_ids = row_ids(positions, ordered=False)[0]
+    del keep
     group, group_normals, how = _normal_groups(p, positions, faces, file_normals, normals_mode, crease,
-                                               position_ids)
+                                               position_ids, (unit, angles))
+    del unit, angles
     corners = faces.reshape(-1)
-    index, first = _split_vertices(position_ids, uvs, corners, corner_colors, group, group_normals)
-    chosen = corners[first]
+    index, first = _split_vertices(position_ids, uvs, corners, corner_colors, group)
+    del position_ids
+    # The drawn arrays, each corner-sized temporary dropped as soon as it is used (the peak).
+    normals = group_normals.take(group.take(first), axis=0)
+    del group, group_normals
+    indices = index.astype(np.uint32)
+    del index
+    colors = None if corner_colors is None else corner_colors.reshape(-1, 3).take(first, axis=0)
+    del corner_colors
+    chosen = corners.take(first)
+    del first
     where = p.name if part_name is None else f"{p.name}, part {part_name!r}"
     notes = [f"{where}: {_count(faces.shape[0], 'triangle')} ({file_type.upper()})"]
     if dropped:
         notes.append(f"{_count(dropped, 'degenerate face')} dropped (zero area or a repeated vertex)")
     notes.append(f"normals {'from the file' if how == 'file' else how}")
     name = p.name if part_name is None else f"{p.name}#{part_name}"
-    mesh = Mesh(name, positions.take(chosen, axis=0), index.astype(np.uint32),
-                group_normals.take(group[first], axis=0), None if uvs is None else uvs.take(chosen, axis=0),
-                None if corner_colors is None else corner_colors.reshape(-1, 3)[first], notes=tuple(notes))
+    mesh = _Arrays(name, positions.take(chosen, axis=0), indices, normals,
+                   None if uvs is None else uvs.take(chosen, axis=0), colors, tuple(notes))
     return mesh, int(faces.shape[0]), dropped, how
 
 
@@ -620,30 +662,14 @@ def _corner_colors(parts: list[_Part]) -> NDArray[np.float64]:
     return np.concatenate(blocks)
 
 
-def _degenerate(positions: NDArray[np.float64], faces: NDArray[np.int64]) -> NDArray[np.bool_]:
-    """Faces with a repeated index or (numerically) zero area, worked out in blocks of faces
-    (bounded temporaries)."""
-    flat = np.empty(faces.shape[0], dtype=bool)
-    for lo in range(0, faces.shape[0], BLOCK_FACES):
-        block = faces[lo:lo + BLOCK_FACES]
-        a, b, c = (positions.take(block[:, k], axis=0) for k in range(3))  # take: faster than positions[...]
-        with np.errstate(all="ignore"):
-            cross = face_cross(a, b, c)
-            doubled_area_sq = np.einsum("ij,ij->i", cross, cross)
-            longest = np.zeros(block.shape[0])
-            for e in (b - a, c - b, a - c):
-                np.maximum(longest, np.einsum("ij,ij->i", e, e), out=longest)
-            # |cross| > share * longest², compared squared (both sides are non-negative).
-            flat[lo:lo + BLOCK_FACES] = ~(doubled_area_sq > (DEGENERATE_SHARE * longest) ** 2)
-    repeated = (faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 0] == faces[:, 2])
-    return repeated | flat
-
-
 def _normal_groups(p: Path, positions: NDArray[np.float64], faces: NDArray[np.int64],
                    file_normals: NDArray[np.float64] | None, mode: str, crease: float,
-                   position_ids: NDArray[np.intp]) -> tuple[NDArray[np.intp], NDArray[np.float64], str]:
+                   position_ids: NDArray[np.intp], geometry: tuple[NDArray[np.float64], NDArray[np.float64]],
+                   ) -> tuple[NDArray[np.intp], NDArray[np.float64], str]:
     """Corner normals as ``(group (C,), unit normals (G, 3))`` (corner ``c`` has ``normals[group[c]]``,
-    :func:`glsandbox.meshnormals.normal_groups`), and how they were made."""
+    :func:`glsandbox.meshnormals.normal_groups`), and how they were made. ``geometry``: the faces'
+    unit normals and corner angles (:func:`glsandbox.meshnormals.face_geometry`; no angles when
+    the file's normals were expected)."""
     if mode in ("auto", "file"):
         usable = None
         if file_normals is not None:
@@ -652,26 +678,30 @@ def _normal_groups(p: Path, positions: NDArray[np.float64], faces: NDArray[np.in
                 fine = np.isfinite(file_normals).all(axis=1) & (size > 1e-12)
                 if fine[faces].all():  # only the vertices the faces use need a normal
                     usable = file_normals / np.where(fine, size, 1.0)[:, None]
-        if usable is not None:
-            return faces.reshape(-1).astype(np.intp), usable, "file"
+        if usable is not None:  # one group per distinct normal: with the position, it tells vertices apart
+            ids, firsts = row_ids(usable, ordered=False)
+            return ids[faces.reshape(-1)], usable[firsts], "file"
         if mode == "file":
             why = "has no vertex normals" if file_normals is None else "has zero-length or non-finite normals"
             raise SandboxError(f"model file {p} {why} (normals = \"file\"); use \"auto\" to compute them")
         mode = "crease"
-    group, normals = normal_groups(positions, np.asarray(faces, dtype=np.intp), mode, crease, position_ids)
+    known = geometry if mode == "flat" or geometry[1].size else None
+    group, normals = normal_groups(positions, np.asarray(faces, dtype=np.intp), mode, crease, position_ids, known)
     return group, normals, f"crease {crease:g}°" if mode == "crease" else mode
 
 
 def _split_vertices(position_ids: NDArray[np.intp], uvs: NDArray[np.float64] | None, corners: NDArray[np.int64],
-                    corner_colors: NDArray[np.float64] | None, group: NDArray[np.intp],
-                    group_normals: NDArray[np.float64]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+                    corner_colors: NDArray[np.float64] | None,
+                    group: NDArray[np.intp]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
     """The drawn vertices: ``(index (C,), a corner of each)``. Corners share a vertex exactly when
     their position, uv, colour and normal are bit-identical; each is numbered once (positions and
-    uvs per file vertex, normals per group), so only integers are compared per corner."""
+    uvs per file vertex; normals by ``group``, which at one position is equal exactly when the
+    normals are), so only integers are compared per corner."""
     attribute = position_ids
     if uvs is not None:
         attribute = split_vertices(position_ids, row_ids(uvs, ordered=False)[0])[0]
-    attribute = attribute[corners]
+    attribute = attribute.take(corners)
     if corner_colors is not None:
-        attribute = split_vertices(attribute, row_ids(corner_colors.reshape(-1, 3), ordered=False)[0])[0]
-    return split_vertices(attribute, row_ids(group_normals, ordered=False)[0][group])
+        attribute = split_vertices(attribute, row_ids(corner_colors.reshape(-1, 3), ordered=False)[0],
+                                   reuse=True)[0]
+    return split_vertices(attribute, group, reuse=True)

@@ -145,7 +145,8 @@ def _rgba(factor: Any) -> Rgba | None:
     return float(f[0]), float(f[1]), float(f[2]), float(f[3]) if f.size >= 4 else 1.0
 
 
-def is_closed(positions: NDArray[np.float64], faces: NDArray[np.int64]) -> bool:
+def is_closed(positions: NDArray[np.float64], faces: NDArray[np.int64],
+              position_ids: NDArray[np.intp] | None = None) -> bool:
     """Whether the triangles close a volume with a consistent winding: with vertices at
     equal positions taken as one, the directed edges ``a→b`` of all faces are, as a
     multiset, their own reverses ``b→a`` (the faces on either side of an edge run it in
@@ -156,19 +157,26 @@ def is_closed(positions: NDArray[np.float64], faces: NDArray[np.int64]) -> bool:
     bits, each directed edge a hash of its two ends' (order matters), and the sum of
     the edges' hashes must equal the sum of the reversed edges' (mod 2⁶⁴). Two
     different multisets agree by chance with odds of about 2⁻⁶⁴; then an open mesh
-    would be culled as if closed."""
+    would be culled as if closed. ``position_ids``: equal exactly where the positions are
+    (:func:`glsandbox.meshnormals.row_ids`), when the caller has them: each id is hashed
+    instead of each position's bits."""
     if faces.shape[0] == 0:
         return False
-    bits = np.ascontiguousarray(positions + 0.0, dtype=np.float64).view(np.uint64).reshape(-1, 3)  # -0 is 0
     with np.errstate(over="ignore"):
-        position_key = _mix(_mix(_mix(bits[:, 0]) ^ bits[:, 1]) ^ bits[:, 2])
-        # Sums mod 2⁶⁴ in blocks of faces (bounded temporaries; the order of a modular sum is free).
+        if position_ids is not None:
+            position_key = _mix(position_ids.astype(np.uint64) + np.uint64(1))  # (_mix(0) is 0)
+        else:
+            bits = np.ascontiguousarray(positions + 0.0, dtype=np.float64).view(np.uint64).reshape(-1, 3)  # -0 is 0
+            position_key = _mix(_mix(_mix(bits[:, 0]) ^ bits[:, 1]) ^ bits[:, 2])
+        # Sums mod 2⁶⁴ in blocks of faces (bounded temporaries; the order of a modular sum is free),
+        # one corner column with the next at a time (edge k runs from corner k to corner k + 1).
         forward = backward = np.uint64(0)
         for lo in range(0, faces.shape[0], BLOCK_FACES):
-            key = position_key[faces[lo:lo + BLOCK_FACES]]
-            ends = key[:, [1, 2, 0]]
-            forward += _mix(key * _ODD ^ ends).sum(dtype=np.uint64)
-            backward += _mix(ends * _ODD ^ key).sum(dtype=np.uint64)
+            key = position_key.take(faces[lo:lo + BLOCK_FACES])
+            for k in range(3):
+                start, end = key[:, k], key[:, (k + 1) % 3]
+                forward += _mix(start * _ODD ^ end).sum(dtype=np.uint64)
+                backward += _mix(end * _ODD ^ start).sum(dtype=np.uint64)
         return bool(forward == backward)
 
 

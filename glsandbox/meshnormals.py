@@ -25,9 +25,11 @@ million million tests. So the crease rule is worked out in three tiers, each
 linear in the number of corners:
 
 1. a position whose face normals all lie within *half* the crease angle of
-   their mean direction has every pair within the crease angle (the angle
-   between two normals is at most the sum of their angles to the mean): every
-   corner there takes the sum over all, one ``bincount``. Scanned surfaces,
+   one direction has every pair within the crease angle (the angle between
+   two normals is at most the sum of their angles to that direction): every
+   corner there takes the sum over all. The direction tested is that sum's
+   own (the angle-weighted sum, one ``bincount`` per component), so a smooth
+   position costs one sum and one dot product per corner. Scanned surfaces,
    flat fans and a triangle repeated a million times are all this case;
 2. the other positions with at most :data:`PAIR_LIMIT` corners (a cube's
    corner, a crease on a scan) test their pairs exactly as the rule says:
@@ -53,7 +55,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["BLOCK_FACES", "MODES", "PAIR_LIMIT", "corner_normals", "face_normals", "normal_groups", "row_ids", "split_vertices",
+__all__ = ["BLOCK_FACES", "MODES", "PAIR_LIMIT", "corner_normals", "face_geometry", "face_normals", "normal_groups", "row_ids", "split_vertices",
            "unique_vertices"]
 
 #: The ways to make normals.
@@ -81,10 +83,13 @@ def face_normals(positions: NDArray[np.float64], tris: NDArray[np.intp]) -> NDAr
 
 
 def face_cross(p0: NDArray[np.float64], p1: NDArray[np.float64], p2: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``(V1 − V0) × (V2 − V0)`` per face from its corners' positions ``(F, 3)`` each, written out
-    per component (``np.cross`` is several times slower); its length is the doubled area."""
-    e1 = p1 - p0
-    e2 = p2 - p0
+    """``(V1 − V0) × (V2 − V0)`` per face from its corners' positions ``(F, 3)`` each; its length
+    is the doubled area."""
+    return _cross(p1 - p0, p2 - p0)
+
+
+def _cross(e1: NDArray[np.float64], e2: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``e1 × e2`` row by row, written out per component (``np.cross`` is several times slower)."""
     n = np.empty_like(e1)
     n[:, 0] = e1[:, 1] * e2[:, 2] - e1[:, 2] * e2[:, 1]
     n[:, 1] = e1[:, 2] * e2[:, 0] - e1[:, 0] * e2[:, 2]
@@ -92,36 +97,56 @@ def face_cross(p0: NDArray[np.float64], p1: NDArray[np.float64], p2: NDArray[np.
     return n
 
 
-def _unit_rows(rows: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """``(rows / |row|, |row|)``; a zero row stays zero."""
+def _unit_rows(rows: NDArray[np.float64], in_place: bool = False) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``(rows / |row|, |row|)``; a zero row stays zero. ``in_place``: written over ``rows``."""
     size = np.sqrt(np.einsum("ij,ij->i", rows, rows))
+    if in_place:
+        np.divide(rows, size[:, None], out=rows, where=size[:, None] > 0.0)
+        rows[size == 0.0] = 0.0  # (-0.0 too)
+        return rows, size
     return np.divide(rows, size[:, None], out=np.zeros_like(rows), where=size[:, None] > 0.0), size
 
 
-def _faces_and_angles(positions: NDArray[np.float64], tris: NDArray[np.intp],
-                      with_angles: bool) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Unit face normals ``(F, 3)`` and the corner angles ``(3F,)`` (empty unless ``with_angles``),
-    in blocks of :data:`BLOCK_FACES` faces."""
+def face_geometry(positions: NDArray[np.float64], tris: NDArray[np.intp], with_angles: bool = True,
+                  degenerate_share: float | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64],
+                                                                   NDArray[np.bool_] | None]:
+    """What normals need of each face, in one pass over its corners' positions (blocks of
+    :data:`BLOCK_FACES` faces): ``(unit normals (F, 3), corner angles (3F,), flat)``.
+
+    The angles are empty unless ``with_angles``. ``flat`` (None unless
+    ``degenerate_share`` is given) marks the faces whose doubled area is at most
+    ``degenerate_share`` times their longest edge squared (the sine of the
+    largest angle is that small): zero area up to rounding.
+    """
     f = tris.shape[0]
     faces = np.empty((f, 3))
     angles = np.empty((f, 3) if with_angles else (0, 3))
+    flat = None if degenerate_share is None else np.empty(f, dtype=bool)
     for lo in range(0, f, BLOCK_FACES):
         block = tris[lo:lo + BLOCK_FACES]
         p0, p1, p2 = (positions.take(block[:, k], axis=0) for k in range(3))  # take: faster than positions[...]
-        faces[lo:lo + BLOCK_FACES], doubled_area = _unit_rows(face_cross(p0, p1, p2))
+        e01, e02, e12 = p1 - p0, p2 - p0, p2 - p1
+        del p0, p1, p2
+        cross = _cross(e01, e02)
+        area_sq = np.einsum("ij,ij->i", cross, cross)
+        size = np.sqrt(area_sq)
+        unit = faces[lo:lo + BLOCK_FACES]
+        unit[:] = 0.0  # a zero row stays zero
+        np.divide(cross, size[:, None], out=unit, where=size[:, None] > 0.0)
+        if flat is not None:
+            longest = np.einsum("ij,ij->i", e01, e01)
+            for e in (e12, e02):
+                np.maximum(longest, np.einsum("ij,ij->i", e, e), out=longest)
+            # |cross| > share * longest², compared squared (both sides are non-negative).
+            flat[lo:lo + BLOCK_FACES] = ~(area_sq > (degenerate_share * longest) ** 2)
         if with_angles:
-            angles[lo:lo + BLOCK_FACES] = _corner_angles(p0, p1, p2, doubled_area)
-    return faces, angles.reshape(-1)
-
-
-def _corner_angles(p0: NDArray[np.float64], p1: NDArray[np.float64], p2: NDArray[np.float64],
-                   doubled_area: NDArray[np.float64]) -> NDArray[np.float64]:
-    """The angle ``(F, 3)`` of each face at each of its corners: ``atan2(|e × e'|, e · e')`` for
-    the two edges leaving the corner, where ``|e × e'|`` is the doubled area at all three corners."""
-    angles = np.empty((p0.shape[0], 3))
-    for k, (here, nxt, prv) in enumerate(((p0, p1, p2), (p1, p2, p0), (p2, p0, p1))):
-        angles[:, k] = np.arctan2(doubled_area, np.einsum("ij,ij->i", nxt - here, prv - here))
-    return angles
+            # atan2(|e × e'|, e · e') for the two edges leaving each corner; |e × e'| is the doubled
+            # area at all three corners. At V1 the edges are -e01 and e12, at V2 -e02 and -e12.
+            block_angles = angles[lo:lo + BLOCK_FACES]
+            block_angles[:, 0] = np.arctan2(size, np.einsum("ij,ij->i", e01, e02))
+            block_angles[:, 1] = np.arctan2(size, -np.einsum("ij,ij->i", e12, e01))
+            block_angles[:, 2] = np.arctan2(size, np.einsum("ij,ij->i", e02, e12))
+    return faces, angles.reshape(-1), flat
 
 
 def _by_first_appearance(first: NDArray[np.intp], inverse: NDArray[np.intp]) -> tuple[NDArray[np.intp],
@@ -168,10 +193,12 @@ def row_ids(rows: NDArray[np.float64], ordered: bool = True) -> tuple[NDArray[np
     return _by_first_appearance(first, inverse) if ordered else (inverse, first)
 
 
-def split_vertices(attribute_ids: NDArray[np.intp], normal_ids: NDArray[np.intp]) -> tuple[NDArray[np.intp],
-                                                                                          NDArray[np.intp]]:
+def split_vertices(attribute_ids: NDArray[np.intp], normal_ids: NDArray[np.intp],
+                   reuse: bool = False) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
     """Vertices from corners: ``(index (C,), a corner of each vertex)``. Two corners share a vertex
     exactly when both their attribute id and their normal id are equal (both ids ``>= 0``).
+    ``reuse``: the index is written over ``attribute_ids`` (an ``intp`` array the caller no longer
+    needs; one corner-sized array less at the peak).
 
     Linear, no sort of the corners: each attribute id first takes the normal of
     one of its corners; only corners whose normal differs from that one (a crease,
@@ -184,9 +211,9 @@ def split_vertices(attribute_ids: NDArray[np.intp], normal_ids: NDArray[np.intp]
     n_attr = int(attribute_ids.max()) + 1
     owner = np.empty(n_attr, dtype=np.intp)
     owner[attribute_ids] = normal_ids  # any one corner's normal per attribute id
-    vertex = attribute_ids.astype(np.intp)
-    extra = np.flatnonzero(normal_ids != owner[attribute_ids])
+    extra = np.flatnonzero(normal_ids != owner.take(attribute_ids))
     del owner
+    vertex = attribute_ids if reuse and attribute_ids.dtype == np.intp else attribute_ids.astype(np.intp)
     count = n_attr
     if extra.size:
         span = int(normal_ids.max()) + 1
@@ -227,45 +254,51 @@ def corner_normals(positions: NDArray[np.float64], tris: NDArray[np.intp], mode:
 
 def normal_groups(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: str = "crease",
                   crease_angle: float = 30.0, position_ids: NDArray[np.intp] | None = None,
+                  geometry: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
                   ) -> tuple[NDArray[np.intp], NDArray[np.float64]]:
     """``(group (C,), normals (G, 3))``: corner ``c`` (face ``c // 3``, its corner ``c % 3``) has the
-    unit normal ``normals[group[c]]``, made the way ``mode`` says (module docstring).
+    unit normal ``normals[group[c]]``, made the way ``mode`` says (module docstring). Two corners
+    at one position (equal ``position_ids``) share a group exactly when their normals are
+    bit-identical: with the position, the group tells the vertices apart.
 
     ``tris`` must hold no zero-area face. Where a weighted sum cancels to zero
     (a knife edge), the corner takes its face's own normal. ``position_ids``:
-    :func:`row_ids` of ``positions`` when the caller has it already.
+    :func:`row_ids` of ``positions`` when the caller has it already; ``geometry``: the unit
+    face normals and corner angles of :func:`face_geometry`, likewise.
     """
     if mode not in MODES:
         raise ValueError(f"unknown normals mode {mode!r}; use one of {', '.join(MODES)}")
     tris = np.asarray(tris, dtype=np.intp)
     f = tris.shape[0]
-    faces, angles = _faces_and_angles(positions, tris, with_angles=mode != "flat")
+    if geometry is None:
+        faces, angles, _ = face_geometry(positions, tris, with_angles=mode != "flat")
+    else:
+        faces, angles = geometry
     if mode == "flat" or f == 0:
-        return np.repeat(np.arange(f, dtype=np.intp), 3), faces
+        ids, firsts = row_ids(faces, ordered=False)  # coplanar faces' corners at one position: one vertex
+        return np.repeat(ids, 3), faces[firsts]
     pid = row_ids(positions, ordered=False)[0] if position_ids is None else position_ids
     corner_pid = pid[tris.reshape(-1)]  # the welded position of each corner
     del pid
     npos = int(corner_pid.max()) + 1
     if mode == "smooth":
-        sums = _sums(corner_pid, faces, angles, npos)
-        return _finish(corner_pid, sums, faces)
+        return _finish(corner_pid, _unit_rows(_sums(corner_pid, faces, angles, npos), in_place=True), faces, npos)
     cos_limit = math.cos(math.radians(crease_angle))
-    # Tier 1: positions whose normals all lie within half the crease angle of their mean direction.
-    mean = _unit_rows(_sums(corner_pid, faces, None, npos))[0]
+    # Tier 1: positions whose normals all lie within half the crease angle of the direction of their
+    # angle-weighted sum (any reference direction serves the triangle inequality; this one is the
+    # answer of tier 1 already, so it is summed once).
+    unit = _unit_rows(_sums(corner_pid, faces, angles, npos), in_place=True)  # (normals, lengths), written over the sums
     half = max(0.0, math.radians(crease_angle) / 2.0 - _HALF_ANGLE_MARGIN)
-    rough_pos = _rough_positions(corner_pid, faces, mean, math.cos(half))
-    rough = rough_pos[corner_pid]
+    rough_pos = _rough_positions(corner_pid, faces, unit[0], math.cos(half))
+    if not rough_pos.any():
+        return _finish(corner_pid, unit, faces, npos)
+    which = np.flatnonzero(rough_pos[corner_pid])
     del rough_pos
-    which = np.flatnonzero(rough)
-    if which.size == 0:
-        del mean, rough, which  # (memory: they go before the sums are made)
-        return _finish(corner_pid, _sums(corner_pid, faces, angles, npos), faces)
     # Tiers 2 and 3: every rough corner gets a group of its own numbered after the positions;
     # corners of one smoothing group get the same sum, so they merge again by their normal.
+    # (Every corner of a rough position is rough: that position's row of ``unit`` is not used.)
     rough_angles = angles[which]
-    angles[which] = 0.0  # rough corners weigh nothing in their position's tier-1 sum
-    smooth_sums = _sums(corner_pid, faces, angles, npos)
-    del angles, rough
+    del angles
     rough_pid = corner_pid[which]
     big = np.bincount(rough_pid, minlength=npos)[rough_pid] > PAIR_LIMIT
     rough_sums = np.zeros((which.size, 3))
@@ -275,27 +308,29 @@ def normal_groups(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: 
         rough_sums[~big] = _pair_sums(rough_pid[~big], own, own * rough_angles[~big, None], cos_limit)
     big_corners = which[big]
     if big_corners.size:
-        rough_sums[big] = _ring_sums(positions, tris, big_corners, rough_pid[big], faces[big_corners // 3],
-                                     rough_angles[big], mean[rough_pid[big]], cos_limit)
+        big_pid = rough_pid[big]
+        own = faces[big_corners // 3]
+        # The ring is walked around the position's unweighted mean normal: summed over its corners in order.
+        mean = _unit_rows(np.stack([np.bincount(big_pid, own[:, j], minlength=npos) for j in range(3)], axis=1))[0]
+        rough_sums[big] = _ring_sums(positions, tris, big_corners, big_pid, own, rough_angles[big], mean[big_pid],
+                                     cos_limit)
     group = corner_pid
     group[which] = npos + np.arange(which.size)
-    return _finish(group, np.concatenate([smooth_sums, rough_sums]), faces)
+    rough_unit = _unit_rows(rough_sums, in_place=True)
+    unit = (np.concatenate([unit[0], rough_unit[0]]), np.concatenate([unit[1], rough_unit[1]]))
+    return _finish(group, unit, faces, npos, which)
 
 
 def _rough_positions(corner_pid: NDArray[np.intp], faces: NDArray[np.float64], mean: NDArray[np.float64],
                      cos_half: float) -> NDArray[np.bool_]:
     """Per position: whether a face normal there is further than the half angle from the
     position's ``mean`` (``normal · mean < cos_half``: tier 1 does not apply). Worked out in
-    blocks of :data:`BLOCK_FACES` faces, in ``(faces, 3)`` corner layout, one component at a
-    time: no corner-sized float array at once."""
+    blocks of :data:`BLOCK_FACES` faces, in ``(faces, 3)`` corner layout."""
     rough_pos = np.zeros(mean.shape[0], dtype=bool)
     for lo in range(0, faces.shape[0], BLOCK_FACES):
         block_pid = corner_pid[3 * lo:3 * (lo + BLOCK_FACES)].reshape(-1, 3)
-        spread = np.zeros(block_pid.shape)
-        for j in range(3):
-            term = mean[block_pid, j]
-            term *= faces[lo:lo + BLOCK_FACES, j, None]  # the face's component, for its three corners
-            spread += term
+        # Each corner's position's mean, dotted with the corner's face normal.
+        spread = np.einsum("fkj,fj->fk", mean.take(block_pid, axis=0), faces[lo:lo + BLOCK_FACES])
         rough_pos[block_pid[spread < cos_half]] = True
     return rough_pos
 
@@ -305,25 +340,37 @@ def _sums(corner_group: NDArray[np.intp], faces: NDArray[np.float64], angles: ND
     """The angle-weighted sum of face normals over the corners of each group, ``(groups, 3)``
     (every corner given: corner ``c`` is of face ``c // 3``); ``angles`` None: unweighted."""
     sums = np.empty((groups, 3))
+    per_face = None if angles is None else angles.reshape(-1, 3)
+    weight = np.empty((faces.shape[0], 3))
     for j in range(3):
-        weight = np.repeat(faces[:, j], 3)
-        if angles is not None:
-            weight *= angles
-        sums[:, j] = np.bincount(corner_group, weight, minlength=groups)
+        if per_face is None:
+            weight[:] = faces[:, j, None]
+        else:
+            np.multiply(per_face, faces[:, j, None], out=weight)  # the face's component, at its three corners
+        sums[:, j] = np.bincount(corner_group, weight.reshape(-1), minlength=groups)
     return sums
 
 
-def _finish(group: NDArray[np.intp], sums: NDArray[np.float64],
-            faces: NDArray[np.float64]) -> tuple[NDArray[np.intp], NDArray[np.float64]]:
-    """Unit normals from the groups' sums; a corner whose group's sum cancels takes its face's normal."""
-    size = np.sqrt(np.einsum("ij,ij->i", sums, sums))
-    ok = size > 1e-300
-    unit = np.divide(sums, size[:, None], out=np.zeros_like(sums), where=ok[:, None])
-    cancelled = np.flatnonzero(~ok[group])
-    if cancelled.size:  # a knife edge: those corners get groups of their own, with their face's normal
-        group = group.copy()
-        group[cancelled] = unit.shape[0] + np.arange(cancelled.size)
-        unit = np.concatenate([unit, faces[cancelled // 3]])
+def _finish(group: NDArray[np.intp], unit_sums: tuple[NDArray[np.float64], NDArray[np.float64]],
+            faces: NDArray[np.float64], merge_from: int,
+            extra: NDArray[np.intp] | None = None) -> tuple[NDArray[np.intp], NDArray[np.float64]]:
+    """Unit normals from the groups' sums, given as ``(sums / |sums|, |sums|)`` (:func:`_unit_rows`);
+    a corner whose group's sum cancels (``|sum| <= 1e-300``) takes its face's normal.
+    Groups numbered ``merge_from`` and up (the corners ``extra``: a rough corner's, and a cancelled
+    corner's) that got bit-identical normals become one; those below are one per position already."""
+    unit, size = unit_sums
+    ok = size > 1e-300  # (a row that is not ok is used by no corner below)
+    extra = np.zeros(0, dtype=np.intp) if extra is None else extra
+    if not ok.all():
+        cancelled = np.flatnonzero(~ok[group])
+        if cancelled.size:  # a knife edge: those corners get groups of their own, with their face's normal
+            group[cancelled] = unit.shape[0] + np.arange(cancelled.size)
+            unit = np.concatenate([unit, faces[cancelled // 3]])
+            extra = np.union1d(extra, cancelled)
+    if extra.size:
+        ids, firsts = row_ids(unit[merge_from:], ordered=False)
+        group[extra] = merge_from + ids[group[extra] - merge_from]
+        unit = np.concatenate([unit[:merge_from], unit[merge_from:][firsts]])
     return group, unit
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 import functools
+import math
 import weakref
 from typing import Any, Callable
 
@@ -367,23 +368,31 @@ def _coplanar(positions: np.ndarray) -> bool:
 _CENTRES: weakref.WeakKeyDictionary[Mesh, np.ndarray] = weakref.WeakKeyDictionary()
 
 
-def _distance(node: Node, camera: Camera) -> float:
+def _distance(node: Node, camera: Camera | np.ndarray) -> float:
     """How far the centre of a node's bounding box lies from the eye, in world space:
     blended nodes are drawn farthest first, so each blends over what lies behind it
     (sorted by part, not by triangle: a part that wraps round another can still be
-    wrong, as in any rasterizer that sorts objects)."""
+    wrong, as in any rasterizer that sorts objects). ``camera``: a camera, or the eye's position."""
     centre = _CENTRES.get(node.mesh)
     if centre is None:  # meshes are immutable: once per mesh, not per frame
         points = np.asarray(node.mesh.positions, dtype=np.float64)
         centre = (points.min(axis=0) + points.max(axis=0)) / 2.0 if points.size else np.zeros(3)
         _CENTRES[node.mesh] = centre
     world = np.asarray(node.model, dtype=np.float64) @ np.append(centre, 1.0)
-    return float(np.linalg.norm(world[:3] - np.asarray(camera.eye, dtype=np.float64)))
+    return float(np.linalg.norm(world[:3] - np.asarray(camera.eye if isinstance(camera, Camera) else camera,
+                                                        dtype=np.float64)))
 
 
-def _farthest_first(blended: list[tuple[Node, Any]], camera: Camera) -> list[tuple[Node, Any]]:
-    """``(node, anything)`` pairs of blended nodes in drawing order: farthest from the eye first."""
+def _farthest_first(blended: list[tuple[Node, Any]], camera: Camera | np.ndarray) -> list[tuple[Node, Any]]:
+    """``(node, anything)`` pairs of blended nodes in drawing order: farthest from the eye first
+    (``camera``: a camera, or the eye's position)."""
     return sorted(blended, key=lambda pair: -_distance(pair[0], camera))
+
+
+def _mirrored_eye(mirror: Any, camera: Camera) -> np.ndarray:
+    """The eye's mirror image: seen in the mirror, a node lies as far as it lies from this point
+    (the reflection is an isometry), so blended reflected nodes are sorted from it."""
+    return (mirror.matrix() @ np.append(np.asarray(camera.eye, dtype=np.float64), 1.0))[:3]
 
 
 def motion_decisions(scene: Scene) -> tuple:
@@ -400,6 +409,14 @@ def motion_decisions(scene: Scene) -> tuple:
         for index, viewport in enumerate(scene.viewports):
             shown = [(node, None) for node in blended if node.shown_in(index)]
             decisions.append(tuple(node.name for node, _ in _farthest_first(shown, viewport.camera or scene.camera)))
+    mirror = scene.mirror
+    if mirror is not None:  # the blended nodes it reflects, in their order seen in it
+        reflected = [node for node in scene.nodes if node.name in mirror.reflected and node.material.alpha_mode == "blend"]
+        for index, viewport in enumerate(scene.viewports):
+            shown = [(node, None) for node in reflected if node.shown_in(index)]
+            if shown:
+                eye = _mirrored_eye(mirror, viewport.camera or scene.camera)
+                decisions.append(("mirror", tuple(node.name for node, _ in _farthest_first(shown, eye))))
     shadow = scene.planar_shadow
     if shadow is not None:
         nodes = {node.name: node for node in scene.nodes}
@@ -688,6 +705,24 @@ REFLECTION_STENCIL = StencilState("equal", MIRROR_STENCIL_BIT, mask=MIRROR_STENC
 PLANAR_SHADOW_STENCIL = StencilState("equal", 0, mask=PLANAR_SHADOW_STENCIL_BIT, write_mask=PLANAR_SHADOW_STENCIL_BIT, on_pass="invert")
 #: Shadows are drawn in one flat colour.
 PLANAR_SHADOW_PROGRAM = ProgramVariant("basic", (("SOLID_COLOR", ""),))
+#: A textured cut-out's planar shadow: the flat colour only where its texture's alpha reaches the cutoff.
+CUTOUT_SHADOW_PROGRAM = ProgramVariant("basic", (("SOLID_COLOR", ""), ("TEXTURED", ""), ("ALPHA_MASK", ""),
+                                                 ("CUTOUT_SHADOW", "")))
+
+
+def cutout_shadow(material: Any) -> float | None:
+    """How a caster's planar shadow is cut out as the part is (drawn with :data:`CUTOUT_SHADOW_PROGRAM`):
+    the cutoff its texture's alpha is compared with (the part's alpha is its colour's alpha times the
+    texture's), None for a caster that is not a textured cut-out (its whole shadow is drawn), and
+    ``inf`` for one cut out everywhere (it casts none)."""
+    if material.alpha_mode != "mask":
+        return None
+    alpha = float(material.color[3]) if len(material.color) > 3 else 1.0
+    if material.texture is None:
+        return None if alpha >= material.alpha_cutoff else math.inf
+    if alpha <= 0.0 or material.alpha_cutoff / alpha > 1.0:
+        return math.inf if material.alpha_cutoff > 0.0 else None
+    return material.alpha_cutoff / alpha
 
 
 def _has_planar_effects(scene: Scene) -> bool:
@@ -730,15 +765,21 @@ def planar_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
         if mirror.stencil:
             passes.append(Pass("mark_mirror", index, draws=(glass_draw,), depth_test=True,
                                stencil=MARK_MIRROR_STENCIL))
-        reflected = []
+        reflected, blended = [], []
         for name in mirror.reflected:
             if name not in nodes:
                 raise SandboxError(f"mirror reflects {name!r}, which is not a node of the scene")
             node = nodes[name]
             if node.shown_in(index):
-                variant = program_for(node, len(scene.lights))
+                variant = program_for(node, len(scene.lights))  # a cut-out's ALPHA_MASK too, as in the main pass
                 programs.add(variant)
-                reflected.append(Draw(name, variant.key, node.cull_back_faces))
+                blend = node.material.alpha_mode == "blend"
+                (blended if blend else reflected).append((node, Draw(name, variant.key, node.cull_back_faces,
+                                                                     blend=blend)))
+        # Blended parts after the opaque ones, farthest first as seen in the mirror: from the eye's
+        # mirror image (the reflection is an isometry, so its distances are the reflected ones).
+        mirrored = _mirrored_eye(mirror, scene.viewports[index].camera or scene.camera)
+        reflected = [d for _, d in reflected] + [d for _, d in _farthest_first(blended, mirrored)]
         passes.append(Pass("reflection", index, draws=tuple(reflected), depth_test=True,
                            stencil=REFLECTION_STENCIL if mirror.stencil else None,
                            detail="front faces clockwise, lights reflected"))
@@ -754,10 +795,18 @@ def planar_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
         culled = [f"{name} culled ({why})" for name, why in casting.culled]
         if casting.reason:
             culled.append(f"culled: {casting.reason}")
-        draws = tuple(Draw(name, PLANAR_SHADOW_PROGRAM.key, False) for name in casting.kept if nodes[name].shown_in(index))
-        if draws:
-            programs.add(PLANAR_SHADOW_PROGRAM)
-        passes.append(Pass("planar_shadow", index, draws=draws, depth_test=True,
+        draws = []
+        for name in casting.kept:
+            if not nodes[name].shown_in(index):
+                continue
+            cut = cutout_shadow(nodes[name].material) if nodes[name].mesh.uvs is not None or \
+                nodes[name].material.texture is None else None
+            if cut == math.inf:
+                continue  # cut out everywhere: drawn nowhere, it casts nothing either
+            variant = PLANAR_SHADOW_PROGRAM if cut is None else CUTOUT_SHADOW_PROGRAM
+            programs.add(variant)
+            draws.append(Draw(name, variant.key, False))
+        passes.append(Pass("planar_shadow", index, draws=tuple(draws), depth_test=True,
                            stencil=PLANAR_SHADOW_STENCIL if shadow.stencil else None,
                            detail="; ".join([", ".join(how), *culled])))
     return passes

@@ -121,9 +121,31 @@ def gl_renderer():
 def gl(gl_renderer):
     """The shared :class:`~glsandbox.frame.HeadlessRenderer` (``gl.render(lesson, size)``), its
     context current: a command run in this process (support.run_cli) opens and closes a context
-    of its own and leaves that one current, and ``gl.host.ctx`` used directly must not see it."""
-    gl_renderer.host.make_current()
-    return gl_renderer
+    of its own and leaves that one current, and ``gl.host.ctx`` used directly must not see it.
+
+    Each test leaves the context's pipeline state as it found it (the state every frame and the
+    gpu ray engine start from): what a test, or the code it drives, leaves set would change
+    what later tests draw, and which test follows which depends on the order (``-n`` workers)."""
+    host = gl_renderer.host
+    host.make_current()
+    before = shared_state(host)
+    yield gl_renderer
+    host.make_current()
+    after = shared_state(host)
+    changed = {key: (before[key], after[key]) for key in before if before[key] != after[key]}
+    assert not changed, f"the test left GL state changed on the shared context (before, after): {changed}"
+
+
+def shared_state(host) -> dict[str, object]:
+    """What of a context's state one user can leave to the next: the pipeline switches
+    (:meth:`~glsandbox.gl.rawgl.RawGL.state_snapshot`) and the sampler objects on units 0-3.
+    Not the colour and depth write masks: moderngl sets a framebuffer's own at each ``use()``
+    and ``clear()``, so nobody starts from the ones left (a frame leaves alpha off, its rule;
+    the gpu ray engine's target has no depth, so its ``use()`` turns depth writes off)."""
+    state = host.raw.state_snapshot()
+    del state["color_writemask"], state["depth_writemask"]
+    state["samplers"] = host.raw.sampler_bindings()
+    return state
 
 
 @pytest.fixture(scope="session")

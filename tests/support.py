@@ -191,6 +191,11 @@ class LessonWindow:
                 self.proc.kill()
 
 
+def not_blank(image: np.ndarray) -> bool:
+    """More than a clear colour: many distinct colours."""
+    return len(np.unique(image.reshape(-1, 4), axis=0)) > 20
+
+
 def wait_for(path: Path, timeout: float = 20.0) -> Path:
     """``path`` once it exists (a screenshot the window writes), or an AssertionError."""
     deadline = time.monotonic() + timeout

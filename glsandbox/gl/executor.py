@@ -41,26 +41,29 @@ _ATTRIBUTES = (("positions", "in_position", 3), ("normals", "in_normal", 3),
 _MESH_KEYS: weakref.WeakKeyDictionary[Mesh, tuple[str, str]] = weakref.WeakKeyDictionary()
 
 
-def _mesh_key(mesh: Mesh) -> tuple[str, str]:
-    """Name and content digest: equal meshes share GPU buffers. Meshes are
-    immutable, so the digest is computed once per mesh object."""
+def _gpu_arrays(mesh: Mesh) -> dict[str, np.ndarray]:
+    """What the GPU gets of ``mesh``: each vertex array as contiguous float32 (by attribute name),
+    the indices as uint32 (``"indices"``)."""
+    arrays = {attr: np.ascontiguousarray(getattr(mesh, field), dtype="f4")
+              for field, attr, _ in _ATTRIBUTES if getattr(mesh, field) is not None}
+    if mesh.indices is not None:
+        arrays["indices"] = np.ascontiguousarray(mesh.indices, dtype="u4")
+    return arrays
+
+
+def _mesh_key(mesh: Mesh, arrays: dict[str, np.ndarray] | None = None) -> tuple[str, str]:
+    """Name and a digest of what the GPU gets (``arrays``, :func:`_gpu_arrays`): meshes that upload
+    the same bytes share GPU buffers. Meshes are immutable, so the digest is made once per mesh
+    object."""
     key = _MESH_KEYS.get(mesh)
     if key is None:
-        key = _MESH_KEYS[mesh] = _digest(mesh)
-    return key
-
-
-def _digest(mesh: Mesh) -> tuple[str, str]:
-    digest = hashlib.blake2b(digest_size=12)
-    for name, _, _ in _ATTRIBUTES:
-        array = getattr(mesh, name)
-        if array is not None:
+        digest = hashlib.blake2b(digest_size=12)
+        for name, array in (arrays if arrays is not None else _gpu_arrays(mesh)).items():
             digest.update(name.encode())
-            digest.update(np.ascontiguousarray(array).tobytes())
-    if mesh.indices is not None:
-        digest.update(np.ascontiguousarray(mesh.indices).tobytes())
-    digest.update(mesh.mode.encode())
-    return mesh.name, digest.hexdigest()
+            digest.update(array)  # the array's memory as it is: no copy
+        digest.update(mesh.mode.encode())
+        key = _MESH_KEYS[mesh] = (mesh.name, digest.hexdigest())
+    return key
 
 
 class PassCamera:
@@ -344,16 +347,15 @@ class Executor:
         return values
 
     def _gpu_mesh(self, mesh: Mesh) -> tuple[tuple[str, str], _GpuMesh]:
-        key = _mesh_key(mesh)
+        arrays = None if mesh in _MESH_KEYS else _gpu_arrays(mesh)  # made once for the digest and the upload
+        key = _mesh_key(mesh, arrays)
         gpu = self._meshes.get(key)
         if gpu is None:
-            buffers = {
-                attr: self.ctx.buffer(np.asarray(getattr(mesh, field), dtype="f4").tobytes())
-                for field, attr, _ in _ATTRIBUTES if getattr(mesh, field) is not None
-            }
-            index = None
-            if mesh.indices is not None:
-                index = self.ctx.buffer(np.asarray(mesh.indices, dtype="u4").tobytes())
+            arrays = arrays or _gpu_arrays(mesh)
+            index_array = arrays.pop("indices", None)
+            buffers = {attr: self.ctx.buffer(array) for attr, array in arrays.items()}
+            index = None if index_array is None else self.ctx.buffer(index_array)
+            del arrays, index_array
             gpu = _GpuMesh(buffers, index, _MODES[mesh.mode], mesh.element_count)
             self._meshes[key] = gpu
         self._mesh_last_frame[key] = self._frame
@@ -445,8 +447,8 @@ class Executor:
             # (texelFetch then reads zeros) on a context the next user shares.
             gl_depth.end_depth_mode(self.ctx, self.raw, scene)
             self._unbind_texture()
+            self._set_depth(False)  # the depth test a pass switched on, also when it raised
         framebuffer.viewport = (0, 0, *size)
-        self._set_depth(False)
         self.ctx.disable(moderngl.CULL_FACE)
         self._release_stale_meshes()
         return frame_plan

@@ -26,7 +26,7 @@ import numpy as np
 from glsandbox import transforms
 from glsandbox.gl import rawgl
 from glsandbox.gl.passes import FrameState
-from glsandbox.plan import Draw, Pass, StencilState
+from glsandbox.plan import CUTOUT_SHADOW_PROGRAM, Draw, Pass, StencilState, cutout_shadow
 from glsandbox.planar import Mirror
 from glsandbox.scene import Light, Material, Node
 
@@ -155,4 +155,9 @@ def planar_shadow(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any
     flat = Material(color=shadow.color)  # one colour, unlit, untextured
     for draw in step.draws:  # drawn without culling, as the plan says
         node = nodes[draw.node]
-        drawer.draw_node(node, draw, camera, model=flatten @ node.model, material=flat)
+        material = flat
+        if draw.program == CUTOUT_SHADOW_PROGRAM.key:  # a cut-out: its texture's alpha, the part's cutoff
+            cutoff = cutout_shadow(node.material)
+            material = Material(color=shadow.color, texture=node.material.texture, alpha_mode="mask",
+                                alpha_cutoff=float(cutoff) if cutoff is not None else 0.0)
+        drawer.draw_node(node, draw, camera, model=flatten @ node.model, material=material)

@@ -61,6 +61,9 @@ STATE_FLAGS = {"stencil_test": GL_STENCIL_TEST, "depth_test": 0x0B71, "cull_face
                "polygon_offset_fill": 0x8037, "scissor_test": GL_SCISSOR_TEST}
 STATE_FLOATS = {"polygon_offset_factor": 0x8038, "polygon_offset_units": 0x2A00, "depth_clear_value": 0x0B73}
 GL_COLOR_WRITEMASK = 0x0C23
+GL_TEXTURE0 = 0x84C0
+GL_ACTIVE_TEXTURE = 0x84E0
+GL_SAMPLER_BINDING = 0x8919
 
 _VOID = None
 _UINT = ctypes.c_uint
@@ -86,6 +89,7 @@ _SIGNATURES: dict[str, tuple] = {
     "glClearStencil": (_VOID, _INT),
     "glClear": (_VOID, _UINT),
     "glSamplerParameteri": (_VOID, _UINT, _UINT, _INT),
+    "glActiveTexture": (_VOID, _UINT),
     "glColorMask": (_VOID, ctypes.c_ubyte, ctypes.c_ubyte, ctypes.c_ubyte, ctypes.c_ubyte),
     "glDepthMask": (_VOID, ctypes.c_ubyte),
     "glClipControl": (_VOID, _UINT, _UINT),
@@ -179,6 +183,18 @@ class RawGL:
         ``GL_MIRRORED_REPEAT``)."""
         self.glSamplerParameteri(sampler, GL_TEXTURE_WRAP_S, mode)
         self.glSamplerParameteri(sampler, GL_TEXTURE_WRAP_T, mode)
+
+    def sampler_bindings(self, units: int = 4) -> tuple[int, ...]:
+        """The sampler object bound to each of the first ``units`` texture units (0: none, the
+        texture's own filter and wrap apply). GL reads the active unit's, so each unit is made
+        active in turn and the active unit is put back."""
+        active = self.get_integer(GL_ACTIVE_TEXTURE)
+        bound = []
+        for unit in range(units):
+            self.glActiveTexture(GL_TEXTURE0 + unit)
+            bound.append(self.get_integer(GL_SAMPLER_BINDING))
+        self.glActiveTexture(active)
+        return tuple(bound)
 
     def clear_stencil(self, rect: tuple[int, int, int, int], value: int = 0) -> None:
         """Clear the stencil of the bound framebuffer inside ``rect`` to ``value``

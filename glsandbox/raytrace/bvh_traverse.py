@@ -5,18 +5,24 @@ it (the slab test, :mod:`glsandbox.raytrace.aabb`)? A BVH asks it again for
 the two boxes inside, and so on down to the leaves, where the triangles are
 tested with the watertight test (:mod:`glsandbox.raytrace.watertight`).
 
-No Python loop runs per ray. The traversal keeps a *frontier* of (ray, node)
-pairs and advances all of them one tree level per step:
+No Python loop runs per ray. The traversal tests the root's box for every
+ray, then keeps a *frontier* of (ray, inner node) pairs whose box the ray
+entered and advances all of them one tree level per step:
 
-1. the slab test for every pair at once (three component arrays), dropping
-   pairs whose ray misses the box, or enters it only beyond the ray's best
-   hit so far;
-2. leaf pairs become (ray, triangle) pairs, tested all at once; each ray
-   keeps its nearest hit;
-3. inner pairs become two pairs, one per child, for the next step.
+1. the slab test of both children of every pair at once: the children's
+   twelve planes are one column of a table kept per node (:class:`_Boxes`),
+   gathered in one call, and the arithmetic runs on ``(2, 2, 3, pairs)``
+   arrays (side, child, axis), dropping children the ray misses or enters
+   only beyond its best hit so far;
+2. kept leaf children become (ray, triangle) pairs, tested all at once; each
+   ray keeps its nearest hit (before the next level's boxes are tested);
+3. kept inner children are the next frontier.
 
-Rays are traced in blocks (:data:`RAY_BLOCK`) so a block's frontier stays
-small. Shadow rays (:func:`any_hit`) leave the frontier at their first hit.
+Every ray does exactly the tests of a level-by-level walk of its own (a
+level's boxes, then its leaves): how the pairs are batched changes the time,
+never what is tested or counted. Rays are traced in blocks
+(:data:`RAY_BLOCK`) so a step's temporaries stay in cache. Shadow rays
+(:func:`any_hit`) leave the frontier at their first hit.
 
 The nearest hit keeps the course's ``min_indis`` rule exactly as
 :func:`glsandbox.raytrace.numpy_engine._nearest` does: the smallest ``t`` with
@@ -39,6 +45,7 @@ lower triangle index elsewhere must still be found.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -53,8 +60,13 @@ __all__ = ["BOX_PAD", "RAY_BLOCK", "Hits", "TraversalCounts", "any_hit", "closes
 
 #: Relative widening of every box in the slab test (see the module docstring).
 BOX_PAD: float = 2.0**-40
-#: Rays traced together.
-RAY_BLOCK: int = 1 << 14
+#: Rays traced together. A step's temporaries (a dozen planes per pair) then stay
+#: in a core's cache: 4,096 rays measured 15% faster than 16,384 on a 10k-triangle
+#: model, and 1,024 slower again (numpy's per-call cost).
+RAY_BLOCK: int = 1 << 12
+#: Rays that share an origin test triangles moved to it (``V − O`` kept per BVH for the
+#: last origin) up to this many triangles: a few percent faster, 72 bytes a triangle.
+MOVED_CORNERS: int = 1 << 18
 _NO_TRIANGLE = np.iinfo(np.int64).max
 
 
@@ -100,34 +112,77 @@ def _rays(origins: ArrayLike, directions: ArrayLike, t_max: ArrayLike
 
 
 class _Boxes:
-    """The nodes' padded boxes as contiguous rows, one per axis.
+    """The nodes' padded boxes laid out for the traversal, kept on the BVH.
 
-    Rays that share one origin (primary rays from the eye) get the boxes
+    The traversal tests the two children of an inner node together, so each
+    inner node ``p`` holds its children's padded planes as one column of a
+    ``(12, N)`` table, rows ``[side][child][axis]`` (side 0 the low planes,
+    1 the high ones): a step gathers all twelve planes of its pairs in one
+    call. ``root`` is the root's own padded box ``(2, 1, 3, 1)``.
+
+    Rays that share one origin (primary rays from the eye) get the planes
     already moved to that origin, ``(plane − pad) − O``: the slab test is then
-    a gather and a product per plane. Both are kept on the BVH (the padded
-    boxes, and those moved to the last shared origin): an engine traces a
+    a gather and a product per plane; and the triangles' corners ``V − O``
+    (``corners``, the watertight test's first step). Both are kept on the BVH (the padded
+    planes, and those moved to the last shared origin): an engine traces a
     frame in blocks of rays, and remaking them per block cost O(nodes) each
     time, 2.3 of 5.4 s for a 1M-triangle terrain at 800x600.
     """
 
     def __init__(self, bvh: BVH, o: NDArray[np.float64]) -> None:
-        padded = bvh.__dict__.get("_padded_boxes")
-        if padded is None:
-            pad = _node_pad(bvh)[None, :]
-            padded = (np.ascontiguousarray(bvh.node_min.T - pad), np.ascontiguousarray(bvh.node_max.T + pad))
-            object.__setattr__(bvh, "_padded_boxes", padded)  # frozen: a cache of what it holds
-        self.lo, self.hi = padded
+        layout = bvh.__dict__.get("_kernel_layout")
+        if layout is None:
+            layout = _layout(bvh)
+            object.__setattr__(bvh, "_kernel_layout", layout)  # frozen: a cache of what it holds
+        self.kids, self.root, self.kid_leaf, self.left, self.root_leaf = layout
         origin = shared_origin(o)
         self.shared = origin.ndim == 1
+        corners = None
         if self.shared:
             key = origin.tobytes()
-            moved = bvh.__dict__.get("_moved_boxes")
+            moved = bvh.__dict__.get("_kernel_moved")
             if moved is None or moved[0] != key:
                 o_pad = BOX_PAD * float(np.abs(origin).max(initial=0.0))
-                moved = (key, np.ascontiguousarray(self.lo - o_pad - origin[:, None]),
-                         np.ascontiguousarray(self.hi + o_pad - origin[:, None]))
-                object.__setattr__(bvh, "_moved_boxes", moved)
-            self.lo, self.hi = moved[1], moved[2]
+                # The triangles too: V − O, the watertight test's first step, once per origin
+                # (up to MOVED_CORNERS triangles: 72 bytes each).
+                corners = tuple(np.subtract(v, origin) for v in (bvh.v0, bvh.v1, bvh.v2)) \
+                    if bvh.triangle_count <= MOVED_CORNERS else None
+                moved = (key, _moved(self.kids, o_pad, origin), _moved(self.root, o_pad, origin), corners)
+                object.__setattr__(bvh, "_kernel_moved", moved)
+            self.kids, self.root, corners = moved[1], moved[2], moved[3]
+        #: The corners the watertight test reads, and whether they are already ``V − O``.
+        self.relative = self.shared and corners is not None
+        self.corners = corners if self.relative else (bvh.v0, bvh.v1, bvh.v2)
+
+
+def _layout(bvh: BVH) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_], NDArray[np.intp], bool]:
+    """``(kids, root, kid_leaf, left, root_leaf)`` of :class:`_Boxes`: the children's padded
+    planes per inner node, the root's, whether each child is a leaf, the left child."""
+    pad = _node_pad(bvh)[None, :]
+    lo = bvh.node_min.T - pad  # (3, N) padded planes of every node
+    hi = bvh.node_max.T + pad
+    n = bvh.node_total
+    inner = np.flatnonzero(bvh.node_count == 0)
+    left = np.ascontiguousarray(bvh.node_first, dtype=np.intp)
+    kids = np.zeros((2, 2, 3, n))
+    kid_leaf = np.zeros((2, n), dtype=bool)
+    for child in (0, 1):
+        index = left[inner] + child
+        kids[0, child][:, inner] = lo[:, index]
+        kids[1, child][:, inner] = hi[:, index]
+        kid_leaf[child, inner] = bvh.node_count[index] > 0
+    root = np.stack([lo[:, 0], hi[:, 0]]).reshape(2, 1, 3, 1)
+    return kids.reshape(12, n), root, kid_leaf, left, bool(bvh.node_count[0] > 0)
+
+
+def _moved(planes: NDArray[np.float64], o_pad: float, origin: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Planes ``[side][child][axis]`` moved to ``origin``: ``(lo − o_pad) − O``, ``(hi + o_pad) − O``."""
+    rows = planes.reshape(2, -1, 3, planes.shape[-1])
+    moved = np.empty_like(rows)
+    np.subtract(rows[0], o_pad, out=moved[0])
+    np.add(rows[1], o_pad, out=moved[1])
+    moved -= origin[:, None]
+    return moved.reshape(planes.shape)
 
 
 class _Block:
@@ -138,40 +193,40 @@ class _Block:
         self.n = d.shape[0]
         self.boxes = boxes
         with np.errstate(divide="ignore"):
-            self.inv = np.ascontiguousarray(1.0 / d.T)  # 1/(+0) = +inf, 1/(−0) = −inf: the slab test's special cases
+            self.inv = np.divide(1.0, d.T, out=np.empty((3, self.n)))  # 1/(+0) = +inf, 1/(−0) = −inf: the slab test's special cases
         self.setup: RaySetup = ray_setup(o, d)
-        if not boxes.shared:  # the ray's part of the padding goes with its origin
+        if not boxes.shared:  # the ray's part of the padding goes with its origin: (2 sides, 3, N)
             o_pad = BOX_PAD * np.abs(o).max(axis=1)
-            self.o_lo = np.ascontiguousarray((o + o_pad[:, None]).T)
-            self.o_hi = np.ascontiguousarray((o - o_pad[:, None]).T)
+            self.o_sides = np.stack([(o + o_pad[:, None]).T, (o - o_pad[:, None]).T])
         self.limit = limit
         self.best_t = limit.copy()
         self.best_tri = np.full(self.n, _NO_TRIANGLE, dtype=np.int64)
         self.best_slot = np.full(self.n, -1, dtype=np.int64)
 
-    def slab(self, bvh: BVH, rays: NDArray[np.intp], nodes: NDArray[np.intp]
+    def slab(self, planes: NDArray[np.float64], rays: NDArray[np.intp] | None
              ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """``(near, far)`` of each pair's ray through its node's (padded) box.
+        """``(near, far)``, ``(K, P)``, of each pair's ray through ``K`` (padded) boxes.
 
+        ``planes`` is ``(2, K, 3, P)`` (low and high planes of ``K`` boxes per pair,
+        or ``P = 1`` for one box every ray meets); ``rays`` the pairs' rays (None: all).
         Per axis ``t = (plane − O)·(1/d)``, as :meth:`~glsandbox.raytrace.aabb.AABB.slabs_reciprocal`:
         ``minimum``/``maximum`` keep the NaN of ``0·inf`` (an origin on a plane
         the ray runs along) and ``fmax``/``fmin`` then skip it: inside the slab.
+        The caller holds ``errstate(invalid="ignore")``.
         """
-        near = np.full(rays.size, -np.inf)
-        far = np.full(rays.size, np.inf)
-        boxes = self.boxes
-        with np.errstate(invalid="ignore"):
-            for axis in range(3):
-                inv = self.inv[axis, rays]
-                if boxes.shared:
-                    ta = boxes.lo[axis, nodes] * inv
-                    tb = boxes.hi[axis, nodes] * inv
-                else:
-                    ta = (boxes.lo[axis, nodes] - self.o_lo[axis, rays]) * inv
-                    tb = (boxes.hi[axis, nodes] - self.o_hi[axis, rays]) * inv
-                np.fmax(near, np.minimum(ta, tb), out=near)
-                np.fmin(far, np.maximum(ta, tb, out=tb), out=far)
-        return near, far
+        if rays is None:  # the root: planes shared by every ray
+            inv = self.inv
+            t = planes * inv if self.boxes.shared else (planes - self.o_sides[:, None]) * inv
+        else:  # planes gathered for these pairs: worked on in place
+            inv = self.inv.take(rays, axis=1)
+            t = planes
+            if not self.boxes.shared:
+                t -= self.o_sides.take(rays, axis=2)[:, None]
+            t *= inv
+        low, high = t[0], t[1]
+        first = np.minimum(low, high)
+        np.maximum(low, high, out=high)
+        return np.fmax.reduce(first, axis=1, initial=-np.inf), np.fmin.reduce(high, axis=1, initial=np.inf)
 
 
 def _node_pad(bvh: BVH) -> NDArray[np.float64]:
@@ -182,50 +237,101 @@ def _node_pad(bvh: BVH) -> NDArray[np.float64]:
 
 
 def _leaf_pairs(bvh: BVH, rays: NDArray[np.intp], nodes: NDArray[np.intp]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
-    """(ray, stored triangle) pairs for (ray, leaf) pairs: each leaf's triangles in turn."""
-    count = bvh.node_count[nodes]
-    total = int(count.sum())
+    """(ray, stored triangle) pairs for (ray, leaf) pairs: each leaf's triangles in turn
+    (slot ``first + i`` for the ``i``-th pair of a leaf: ``arange`` minus the leaf's start)."""
+    count = bvh.node_count.take(nodes)
     rr = np.repeat(rays, count)
-    starts = np.cumsum(count) - count
-    slots = np.repeat(bvh.node_first[nodes], count) + (np.arange(total) - np.repeat(starts, count))
+    starts = np.cumsum(count)
+    total = int(starts[-1])
+    starts -= count
+    slots = np.repeat(bvh.node_first.take(nodes) - starts, count)
+    slots += np.arange(total)
     return rr, slots
 
 
-def _closest_block(bvh: BVH, block: _Block, cull: bool, counts: TraversalCounts | None = None) -> None:
-    rays = np.arange(block.n)
-    nodes = np.zeros(block.n, dtype=np.int64)
-    while rays.size:
-        near, far = block.slab(bvh, rays, nodes)
+def _traverse(bvh: BVH, block: _Block, counts: TraversalCounts | None, bound: NDArray[np.float64], strict: bool,
+              leaves: Callable[[NDArray[np.intp], NDArray[np.intp]], None],
+              done: NDArray[np.bool_] | None = None) -> None:
+    """Walk the tree one level a step for every ray of ``block`` at once.
+
+    A pair (ray, node) is kept when its ray meets the node's box at ``far >= 0``
+    and enters it at ``near <= bound`` (``< bound`` when ``strict``); ``bound``
+    is read afresh at every step (the nearest hit so far shrinks it). The two
+    children of every kept inner pair are tested together at the next step;
+    kept leaf pairs go to ``leaves(rays, leaf nodes)`` before that, so the next
+    step sees their hits. Rays set in ``done`` leave (any-hit).
+    """
+    boxes = block.boxes
+    less = np.less if strict else np.less_equal
+    with np.errstate(invalid="ignore"):
+        near, far = block.slab(boxes.root, None)
         if counts is not None:
-            counts.boxes += rays.size
-        keep = (near <= far) & (far >= 0.0) & (near <= block.best_t[rays])
-        rays, nodes = rays[keep], nodes[keep]
-        leaf = bvh.node_count[nodes] > 0
-        if leaf.any():
-            rr, slots = _leaf_pairs(bvh, rays[leaf], nodes[leaf])
-            t, _, _ = watertight_pairs(block.setup, rr, bvh.v0, bvh.v1, bvh.v2, slots, cull)
+            counts.boxes += block.n
+        keep = _kept(near[0], far[0], bound, less)
+        rays = np.flatnonzero(keep)
+        if boxes.root_leaf:
+            if rays.size:
+                leaves(rays, np.zeros(rays.size, dtype=np.intp))
+            return
+        parents = np.zeros(rays.size, dtype=np.intp)
+        while rays.size:
+            m = rays.size
+            near, far = block.slab(boxes.kids.take(parents, axis=1).reshape(2, 2, 3, m), rays)
             if counts is not None:
-                counts.triangles += rr.size
-            ok = t < block.limit[rr]
-            if ok.any():
-                rr, slots, t = rr[ok], slots[ok], t[ok]
-                # The nearest t per ray; where it improved, forget the old triangle.
-                new_t = block.best_t.copy()
-                np.minimum.at(new_t, rr, t)
-                block.best_tri[new_t < block.best_t] = _NO_TRIANGLE
-                block.best_t = new_t
-                # Among the pairs at that t, the lowest triangle index (ties: min_indis).
-                at_best = t == new_t[rr]
-                rr, slots = rr[at_best], slots[at_best]
-                index = bvh.tri_index[slots]
-                np.minimum.at(block.best_tri, rr, index)
-                won = index == block.best_tri[rr]
-                block.best_slot[rr[won]] = slots[won]
-        inner = ~leaf
-        rays, nodes = rays[inner], nodes[inner]
-        left = bvh.node_first[nodes]
-        rays = np.concatenate([rays, rays])
-        nodes = np.concatenate([left, left + 1])
+                counts.boxes += 2 * m
+            keep = _kept(near, far, bound.take(rays), less)
+            leaf = boxes.kid_leaf.take(parents, axis=1)
+            leaf &= keep
+            if leaf.any():
+                child, pair = np.nonzero(leaf)
+                leaves(rays[pair], boxes.left[parents[pair]] + child)
+            keep &= ~leaf
+            if done is not None:
+                keep &= ~done.take(rays)
+            child, pair = np.nonzero(keep)
+            rays = rays[pair]
+            parents = boxes.left[parents[pair]]
+            parents += child
+
+
+def _kept(near: NDArray[np.float64], far: NDArray[np.float64], bound: NDArray[np.float64],
+          less: Callable[..., NDArray[np.bool_]]) -> NDArray[np.bool_]:
+    """``near <= far``, ``far >= 0`` and ``near`` before ``bound`` (``less``: ``<`` or ``<=``)."""
+    keep = near <= far
+    keep &= far >= 0.0
+    keep &= less(near, bound)
+    return keep
+
+
+def _closest_block(bvh: BVH, block: _Block, cull: bool, counts: TraversalCounts | None = None) -> None:
+    best_t = block.best_t  # updated in place: the traversal reads it as its bound at every step
+
+    def leaves(rays: NDArray[np.intp], nodes: NDArray[np.intp]) -> None:
+        rr, slots = _leaf_pairs(bvh, rays, nodes)
+        t, _, _ = watertight_pairs(block.setup, rr, *block.boxes.corners, slots, cull, barycentrics=False,
+                                   relative=block.boxes.relative)
+        if counts is not None:
+            counts.triangles += rr.size
+        # Only pairs at or before their ray's best so far (and before its t_max) can change
+        # it: a tie may still win on its lower triangle index.
+        ok = np.flatnonzero(t <= best_t.take(rr))
+        ok = ok[t[ok] < block.limit[rr[ok]]]
+        if ok.size:
+            rr, slots, t = rr[ok], slots[ok], t[ok]
+            # The nearest t per ray; where it improved, forget the old triangle.
+            before = best_t[rr]
+            np.minimum.at(best_t, rr, t)
+            after = best_t[rr]
+            block.best_tri[rr[after < before]] = _NO_TRIANGLE
+            # Among the pairs at that t, the lowest triangle index (ties: min_indis).
+            at_best = t == after
+            rr, slots = rr[at_best], slots[at_best]
+            index = bvh.tri_index[slots]
+            np.minimum.at(block.best_tri, rr, index)
+            won = index == block.best_tri[rr]
+            block.best_slot[rr[won]] = slots[won]
+
+    _traverse(bvh, block, counts, best_t, False, leaves)
 
 
 def closest_hit(bvh: BVH, origins: ArrayLike, directions: ArrayLike, t_max: ArrayLike = np.inf, *,
@@ -253,8 +359,8 @@ def closest_hit(bvh: BVH, origins: ArrayLike, directions: ArrayLike, t_max: Arra
             if counts is not None:
                 counts.triangles += hit.size
             # The winners' barycentrics, from the same test (so the same t).
-            t, u, v = watertight_pairs(block.setup, hit, bvh.v0, bvh.v1, bvh.v2, block.best_slot[hit],
-                                       bool(cull_backfaces))
+            t, u, v = watertight_pairs(block.setup, hit, *block.boxes.corners, block.best_slot[hit],
+                                       bool(cull_backfaces), relative=boxes.relative)
             rows = hit + lo
             out.t[rows] = t
             out.triangle[rows] = block.best_tri[hit]
@@ -280,26 +386,17 @@ def any_hit(bvh: BVH, origins: ArrayLike, directions: ArrayLike, t_max: ArrayLik
         part = slice(lo, min(n, lo + RAY_BLOCK))
         block = _Block(boxes, o[part], d[part], limit[part])
         done = np.zeros(block.n, dtype=bool)
-        rays = np.arange(block.n)
-        nodes = np.zeros(block.n, dtype=np.int64)
-        while rays.size:
-            near, far = block.slab(bvh, rays, nodes)
+
+        def leaves(rays: NDArray[np.intp], nodes: NDArray[np.intp], block: _Block = block,
+                   done: NDArray[np.bool_] = done) -> None:
+            rr, slots = _leaf_pairs(bvh, rays, nodes)
+            t, _, _ = watertight_pairs(block.setup, rr, *block.boxes.corners, slots, cull, barycentrics=False,
+                                   relative=block.boxes.relative)
             if counts is not None:
-                counts.boxes += rays.size
-            keep = (near <= far) & (far >= 0.0) & (near < block.limit[rays])
-            rays, nodes = rays[keep], nodes[keep]
-            leaf = bvh.node_count[nodes] > 0
-            if leaf.any():
-                rr, slots = _leaf_pairs(bvh, rays[leaf], nodes[leaf])
-                t, _, _ = watertight_pairs(block.setup, rr, bvh.v0, bvh.v1, bvh.v2, slots, cull)
-                if counts is not None:
-                    counts.triangles += rr.size
-                done[rr[t < block.limit[rr]]] = True
-            inner = ~leaf & ~done[rays]
-            rays, nodes = rays[inner], nodes[inner]
-            left = bvh.node_first[nodes]
-            rays = np.concatenate([rays, rays])
-            nodes = np.concatenate([left, left + 1])
+                counts.triangles += rr.size
+            done[rr[t < block.limit[rr]]] = True
+
+        _traverse(bvh, block, counts, block.limit, True, leaves, done)
         found[part] = done
     return found
 

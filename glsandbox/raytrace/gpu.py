@@ -661,6 +661,10 @@ class GpuTracer:
         if uploaded.block is not None:
             program["SceneData"].binding = 0
             uploaded.block.bind_to_uniform_block(0)
+        # The records and images are read by texelFetch with their own NEAREST, mipmap-free
+        # state; a sampler object another user of the context left on a unit (a rasterized
+        # material's mipmapped filter) would override it and make them incomplete: zeros.
+        self.ctx.clear_samplers(0, len(uploaded.textures))
         for unit, (name, texture) in enumerate(uploaded.textures.items()):
             texture.use(unit)
             if name in program:

@@ -210,6 +210,7 @@ class GpuBVH:
             self._target = ((width, height), outputs, self.ctx.framebuffer(color_attachments=outputs))
         fbo = self._target[2]
         textures = {"u_bvh_nodes": self._nodes, "u_bvh_tris": self._tris, **rays}
+        self.ctx.clear_samplers(0, len(textures))  # their own NEAREST state, not a sampler left bound
         for unit, (name, texture) in enumerate(textures.items()):
             texture.use(unit)
             if name in program:

@@ -326,12 +326,9 @@ def _hit_triangles(world: World, node: NodeInfo, o: NDArray[np.float64], d: NDAr
 # --- surface attributes at the hits --------------------------------------------
 
 
-def _barycentric(world: World, tri: NDArray[np.intp], o: NDArray[np.float64],
+def _barycentric(v0: NDArray[np.float64], e1: NDArray[np.float64], e2: NDArray[np.float64], o: NDArray[np.float64],
                  d: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Möller–Trumbore's ``(u, v)`` of each ray on its own triangle: ``P = V0 + u·e1 + v·e2``."""
-    v0 = world.v0[tri]
-    e1 = world.v1[tri] - v0
-    e2 = world.v2[tri] - v0
+    """Möller–Trumbore's ``(u, v)`` of each ray on its own triangle ``(V0, e1, e2)``: ``P = V0 + u·e1 + v·e2``."""
     p = np.cross(d, e2)
     det = np.einsum("ij,ij->i", e1, p)
     det = np.where(det == 0.0, 1.0, det)
@@ -461,21 +458,26 @@ def _surface_triangles(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[n
     """A mesh node's (normal, uv, vertex colour) at its hits, barycentric; its spawn
     points are the barycentric points with their error bound and the face normal."""
     tri = hits.tri[sel]
-    u, v = _barycentric(world, tri, _rows(o, sel), d[sel])
+    v0, v1, v2 = world.v0[tri], world.v1[tri], world.v2[tri]  # each gathered once
+    e1 = v1 - v0
+    e2 = v2 - v0
+    u, v = _barycentric(v0, e1, e2, _rows(o, sel), d[sel])
     w = (1.0 - u - v)[:, None], u[:, None], v[:, None]  # weights of V0, V1, V2
     normal = _interpolate(world.normals[tri], w)
+    face = np.cross(e1, e2) if node.two_sided or spawn is not None else None
     if node.two_sided:
         # A back face seen (the ray runs along the face normal: clockwise from the eye,
         # the rasterizer's !gl_FrontFacing) is lit as its other side: the normal reversed.
-        face = np.cross(world.v1[tri] - world.v0[tri], world.v2[tri] - world.v0[tri])
         back = np.einsum("ij,ij->i", face, d[sel]) > 0.0
         normal[back] *= -1.0
     if spawn is not None:
-        corners = world.v0[tri] * w[0], world.v1[tri] * w[1], world.v2[tri] * w[2]
+        corners = v0 * w[0], v1 * w[1], v2 * w[2]
         spawn.point[sel] = corners[0] + corners[1] + corners[2]
-        spawn.error[sel] = gamma(TRIANGLE_POINT_GAMMA, UNIT_F64) * (
-            np.abs(corners[0]) + np.abs(corners[1]) + np.abs(corners[2]))
-        spawn.normal[sel] = np.cross(world.v1[tri] - world.v0[tri], world.v2[tri] - world.v0[tri])
+        reach = np.abs(corners[0], out=corners[0])
+        reach += np.abs(corners[1])
+        reach += np.abs(corners[2])
+        spawn.error[sel] = gamma(TRIANGLE_POINT_GAMMA, UNIT_F64) * reach
+        spawn.normal[sel] = face
     colors = _interpolate(world.colors[tri], w) if node.mode == 1 or node.vertex_colors else None  # when shown
     return normal, _interpolate(world.uvs[tri], w), colors
 

@@ -65,21 +65,27 @@ class RaySetup:
     """The per-ray constants of the watertight test, ``(N,)`` each.
 
     ``kx, ky, kz`` are the permuted axes, ``sx, sy, sz`` the shear, and
-    ``ox, oy, oz`` the origin's components on the permuted axes.
+    ``ox, oy, oz`` the origin's components on the permuted axes. They are rows
+    of two stacked arrays, ``k = [kx, ky, kz]`` ``(3, N)`` and ``s = [sx, sy,
+    sz, ox, oy, oz]`` ``(6, N)``, so a batch of pairs gathers its rays' constants
+    in two calls.
     """
 
-    kx: NDArray[np.intp]
-    ky: NDArray[np.intp]
-    kz: NDArray[np.intp]
-    sx: NDArray[np.float64]
-    sy: NDArray[np.float64]
-    sz: NDArray[np.float64]
-    ox: NDArray[np.float64]
-    oy: NDArray[np.float64]
-    oz: NDArray[np.float64]
+    k: NDArray[np.intp]
+    s: NDArray[np.float64]
+
+    kx = property(lambda self: self.k[0])
+    ky = property(lambda self: self.k[1])
+    kz = property(lambda self: self.k[2])
+    sx = property(lambda self: self.s[0])
+    sy = property(lambda self: self.s[1])
+    sz = property(lambda self: self.s[2])
+    ox = property(lambda self: self.s[3])
+    oy = property(lambda self: self.s[4])
+    oz = property(lambda self: self.s[5])
 
     def __len__(self) -> int:
-        return int(self.kx.shape[0])
+        return int(self.k.shape[1])
 
 
 def ray_setup(origins: ArrayLike, directions: ArrayLike) -> RaySetup:
@@ -87,17 +93,30 @@ def ray_setup(origins: ArrayLike, directions: ArrayLike) -> RaySetup:
     o, d = broadcast_rays(origins, directions)
     n = d.shape[0]
     rows = np.arange(n)
-    kz = np.argmax(np.abs(d), axis=1)  # the first largest component, as np.argmax in the scalar test
+    a = np.abs(d)
+    if np.isnan(a).any():  # argmax's rule for NaN (the first NaN is the largest); such a ray misses anyway
+        kz = np.argmax(a, axis=1)
+    else:  # the first largest component, as np.argmax in the scalar test, without a per-row reduction
+        ax, ay, az = a.T
+        kz = np.where((ax >= ay) & (ax >= az), 0, np.where(ay >= az, 1, 2))
+    k = np.empty((3, n), dtype=np.intp)
     kx = (kz + 1) % 3
     ky = (kx + 1) % 3
     flip = d[rows, kz] < 0.0  # keep the winding: swap kx and ky
-    kx, ky = np.where(flip, ky, kx), np.where(flip, kx, ky)
-    dx, dy, dz = d[rows, kx], d[rows, ky], d[rows, kz]
+    k[0] = np.where(flip, ky, kx)
+    k[1] = np.where(flip, kx, ky)
+    k[2] = kz
+    s = np.empty((6, n))
+    dz = d[rows, kz]
     with np.errstate(divide="ignore", invalid="ignore"):  # a zero direction: NaN, and it misses
-        sx = dx / dz
-        sy = dy / dz
-        sz = 1.0 / dz
-    return RaySetup(kx, ky, kz, sx, sy, sz, o[rows, kx], o[rows, ky], o[rows, kz])
+        np.divide(d[rows, k[0]], dz, out=s[0])
+        np.divide(d[rows, k[1]], dz, out=s[1])
+        np.divide(1.0, dz, out=s[2])
+    if n and o.strides[0] == 0:  # one shared origin: its (3,) row permuted
+        s[3:] = o[0][k]
+    else:
+        s[3], s[4], s[5] = o[rows, k[0]], o[rows, k[1]], o[rows, kz]
+    return RaySetup(k, s)
 
 
 def nondegenerate(v0: NDArray[np.float64], v1: NDArray[np.float64], v2: NDArray[np.float64]) -> NDArray[np.bool_]:
@@ -134,48 +153,71 @@ def _edge(px: NDArray[np.float64], py: NDArray[np.float64], qx: NDArray[np.float
 
 
 def watertight_pairs(setup: RaySetup, rays: NDArray[np.intp], v0: NDArray[np.float64], v1: NDArray[np.float64],
-                     v2: NDArray[np.float64], tris: NDArray[np.intp], cull_backfaces: bool = False
-                     ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+                     v2: NDArray[np.float64], tris: NDArray[np.intp], cull_backfaces: bool = False,
+                     barycentrics: bool = True, relative: bool = False
+                     ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None]:
     """Ray ``rays[i]`` against triangle ``tris[i]`` for every ``i``: ``(t, u, v)``, ``(P,)`` each.
 
     ``t`` is ``inf`` for a miss (outside, edge-on, culled, or ``t <= 0``);
     ``(u, v)`` are the hit's barycentrics in the course's form
-    ``P = V0 + u·(V1 − V0) + v·(V2 − V0)`` (meaningless for a miss).
-    ``v0, v1, v2`` are ``(M, 3)`` float64 arrays.
+    ``P = V0 + u·(V1 − V0) + v·(V2 − V0)`` (meaningless for a miss; None
+    when ``barycentrics`` is False: a traversal needs ``t`` alone).
+    ``v0, v1, v2`` are ``(M, 3)`` float64 arrays; ``relative``: they are already
+    ``V − O`` for the one origin every ray shares (the same numbers step 3 forms).
     """
-    kx, ky, kz = setup.kx[rays], setup.ky[rays], setup.kz[rays]
-    sx, sy, sz = setup.sx[rays], setup.sy[rays], setup.sz[rays]
-    ox, oy, oz = setup.ox[rays], setup.oy[rays], setup.oz[rays]
-    base = tris * 3  # flat (M·3,) rows: vertex component k of triangle j is [3j + k]
-    ix, iy, iz = base + kx, base + ky, base + kz
+    # Each pair's flat vertex rows: component k of triangle j is [3j + k] (kx, ky, kz rows).
+    index = setup.k.take(rays, axis=1)
+    index += tris * 3
+    s = (setup.s[:3] if relative else setup.s).take(rays, axis=1)  # sx, sy, sz(, ox, oy, oz)
+    sx, sy, sz = s[0], s[1], s[2]
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         coords = []
         for vertex in (v0, v1, v2):
-            flat = vertex.reshape(-1)
-            # Step 3: relative to the origin (the scalar's V − O), then sheared.
-            x, y, z = flat[ix] - ox, flat[iy] - oy, flat[iz] - oz
-            coords.append((x - sx * z, y - sy * z, z))
+            # Step 3: relative to the origin (the scalar's V − O), then sheared: x − sx·z, y − sy·z.
+            p = vertex.reshape(-1).take(index)
+            if not relative:
+                p -= s[3:]
+            p[:2] -= s[:2] * p[2]
+            coords.append(p)
         (ax, ay, az), (bx, by, bz), (cx, cy, cz) = coords
         u = _edge(cx, cy, bx, by)  # edge V1-V2: the weight of V0
         v = _edge(ax, ay, cx, cy)  # edge V2-V0: the weight of V1
         w = _edge(bx, by, ax, ay)  # edge V0-V1: the weight of V2
-        negative = (u < 0.0) | (v < 0.0) | (w < 0.0)
-        # Step 4: all signs alike (zeros on both sides); culling keeps the front faces only.
-        inside = ~negative if cull_backfaces else ~(negative & ((u > 0.0) | (v > 0.0) | (w > 0.0)))
-        det = u + v + w
+        # Step 4: all signs alike (zeros on both sides): the smallest >= 0 or the largest <= 0;
+        # culling keeps the front faces only (the smallest >= 0). A NaN edge (coordinates
+        # that overflow) is neither: a miss, as its NaN t would be.
+        low = np.minimum(u, v)
+        np.minimum(low, w, out=low)
+        inside = low >= 0.0
+        if not cull_backfaces:
+            high = np.maximum(u, v, out=low)
+            np.maximum(high, w, out=high)
+            inside |= high <= 0.0
+        det = u + v
+        det += w
         inside &= det != 0.0
-        # Step 5: the sheared z interpolated with the scaled barycentrics is t along d.
-        t = (u * (sz * az) + v * (sz * bz) + w * (sz * cz)) / det
-        # Step 6: only a t above its rounding-error bound counts (pbrt-v4), as in the scalar test;
-        # formed for the pairs that could hit only (most pairs a traversal tests miss).
-        hit = inside & (t > 0.0)
-        near = np.flatnonzero(hit)
+        t = np.full(rays.shape[0], np.inf)
+        near = np.flatnonzero(inside)  # most pairs a traversal tests are outside: the rest for these only
         if near.size:
-            z = (sz * az)[near], (sz * bz)[near], (sz * cz)[near]
-            bound = watertight_t_bound((ax[near], bx[near], cx[near]), (ay[near], by[near], cy[near]), z,
-                                       (u[near], v[near], w[near]), det[near])
-            hit[near] = t[near] > bound
-        return np.where(hit, t, np.inf), v / det, w / det
+            zn = sz[near]
+            z = zn * az[near], zn * bz[near], zn * cz[near]
+            e = u[near], v[near], w[near]
+            dn = det[near]
+            # Step 5: the sheared z interpolated with the scaled barycentrics is t along d.
+            tn = (e[0] * z[0] + e[1] * z[1] + e[2] * z[2]) / dn
+            # Step 6: only a t above its rounding-error bound counts (pbrt-v4), as in the scalar test;
+            # formed for the pairs that could hit only.
+            front = np.flatnonzero(tn > 0.0)
+            if front.size:
+                bound = watertight_t_bound((ax[near[front]], bx[near[front]], cx[near[front]]),
+                                           (ay[near[front]], by[near[front]], cy[near[front]]),
+                                           (z[0][front], z[1][front], z[2][front]),
+                                           (e[0][front], e[1][front], e[2][front]), dn[front])
+                keep = front[tn[front] > bound]
+                t[near[keep]] = tn[keep]
+        if not barycentrics:
+            return t, None, None
+        return t, v / det, w / det
 
 
 def nearest_watertight(v0: NDArray[np.float64], v1: NDArray[np.float64], v2: NDArray[np.float64],
@@ -199,7 +241,7 @@ def nearest_watertight(v0: NDArray[np.float64], v1: NDArray[np.float64], v2: NDA
     for lo in range(0, n, step):
         rays = np.arange(lo, min(n, lo + step))
         t, _, _ = watertight_pairs(setup, np.repeat(rays, keep.size), v0, v1, v2, np.tile(keep, rays.size),
-                                   cull_backfaces)
+                                   cull_backfaces, barycentrics=False)
         t = t.reshape(rays.size, keep.size)
         j = np.argmin(t, axis=1)  # the first minimum: the lowest index on a tie
         best_t[rays] = t[np.arange(rays.size), j]

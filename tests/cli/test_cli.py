@@ -13,9 +13,10 @@ import numpy as np
 import pytest
 
 from support import REPO_ROOT as REPO
-from support import assert_user_error, glsandbox, run_cli
+from support import EXAMPLES_DIR, SPIN, assert_user_error, glsandbox, not_blank, run_cli
 
 from glsandbox.files import load_png
+from glsandbox.lesson import find_lesson
 
 
 def test_list_shows_the_lessons() -> None:
@@ -154,3 +155,66 @@ def test_tour_goes_on_when_a_lesson_fails_and_exits_non_zero(tmp_path: Path, gl)
     assert not by_name["indexed_cube"]["ok"] and "basic.glsl:2" in by_name["indexed_cube"]["error"]
     assert (out / "clear_and_swap.png").exists() and not (out / "indexed_cube.png").exists()
     assert "FAILED" in proc.stderr and "failed: " in proc.stderr
+
+
+# --- new, and tour --lessons (moved from tests/core/test_lesson.py) ---------------------
+
+
+def test_new_writes_a_lesson_and_a_scene_that_render_as_they_are(tmp_path: Path, gl) -> None:
+    proc = run_cli("new", "my_lesson", "--dir", str(tmp_path))
+    assert proc.returncode == 0, proc.stderr
+    lesson, scene = tmp_path / "my_lesson.py", tmp_path / "my_lesson.toml"
+    assert "class MyLesson(Lesson)" in lesson.read_text() and 'name = "my_lesson"' in scene.read_text()
+    for source in (lesson, scene):
+        out = tmp_path / f"{source.suffix[1:]}.png"
+        proc = run_cli("render", str(source), "--out", str(out), "--size", "96x72", "--set", "time=1")
+        assert proc.returncode == 0, proc.stderr
+        assert not_blank(load_png(out)), source
+    # its parameters are real: a slower turn is another picture, each shading another
+    cls = find_lesson(str(lesson))
+    assert {p.name for p in cls.params} == {"speed", "shading", "size"}
+    a = gl.render(cls.from_settings(["time=1"]), (96, 72)).image
+    b = gl.render(cls.from_settings(["time=1", "speed=0.3"]), (96, 72)).image
+    c = gl.render(cls.from_settings(["time=1", "shading=gouraud"]), (96, 72)).image
+    assert not np.array_equal(a, b) and not np.array_equal(a, c)
+    # the scene's ball is drawn with the new shader file, whose rim is a uniform of its own
+    assert 'shader = "my_lesson.glsl"' in scene.read_text() and (tmp_path / "my_lesson.glsl").is_file()
+    rims = []
+    for power in ("3", "1"):
+        out = tmp_path / f"rim{power}.png"
+        proc = run_cli("render", str(scene), "--out", str(out), "--size", "96x72", "--set", f"u.rim_power={power}")
+        assert proc.returncode == 0, proc.stderr
+        rims.append(load_png(out).astype(int))
+    changed = np.any(rims[0] != rims[1], axis=-1)
+    assert 0 < changed.mean() < 0.2  # only the ball, where the rim widened
+    assert (rims[1][..., 2] - rims[0][..., 2])[changed].mean() > 5  # and bluer (rim_color is blue)
+
+
+def test_new_refuses_to_overwrite_and_bad_names(tmp_path: Path) -> None:
+    (tmp_path / "taken.toml").write_text("# mine\n")
+    assert_user_error(run_cli("new", "taken", "--dir", str(tmp_path)), "taken.toml already exists", "not overwritten")
+    assert (tmp_path / "taken.toml").read_text() == "# mine\n" and not (tmp_path / "taken.py").exists()
+    assert not (tmp_path / "taken.glsl").exists()
+    for name in ("9lives", "my-lesson", "_hidden", "a b", "../up"):
+        assert_user_error(run_cli("new", name, "--dir", str(tmp_path)), "must be a Python identifier")
+    assert_user_error(run_cli("new", "fine", "--dir", str(tmp_path / "nowhere")), "does not exist")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["taken.toml"]
+
+
+def test_tour_lessons_dir_renders_each_file_and_goes_on_past_a_broken_one(tmp_path: Path, gl) -> None:
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "spin.py").write_text(SPIN)
+    (mine / "room.toml").write_text((EXAMPLES_DIR / "mirror_room.toml").read_text())
+    (mine / "broken.py").write_text("def oops(:\n")
+    out = tmp_path / "tour"
+    proc = run_cli("tour", "--lessons", str(mine), "--out", str(out), "--size", "64x48")
+    assert proc.returncode == 1
+    summary = json.loads((out / "tour.json").read_text())
+    by_name = {r["lesson"]: r for r in summary["lessons"]}
+    assert list(by_name) == ["broken", "room", "spin"]  # instead of the course's lessons
+    assert by_name["spin"]["ok"] and by_name["room"]["ok"]
+    assert "broken.py:1: syntax error" in by_name["broken"]["error"]
+    assert not_blank(load_png(out / "room.png")) and load_png(out / "spin.png").shape == (48, 64, 4)
+    assert "[1/3] broken: FAILED" in proc.stderr and "[3/3] spin: ok" in proc.stderr
+    assert_user_error(run_cli("tour", "--lessons", str(tmp_path / "none"), "--out", str(out)), "not a folder")

@@ -15,7 +15,9 @@ import trimesh
 
 import glsandbox
 from glsandbox.meshlooks import is_closed
-from support import CUBE_OBJ, coloured_ply, gltf_part, quad, reversed_obj, two_material_glb, two_usemtl_obj
+from glsandbox.meshnormals import row_ids
+from support import (CUBE_OBJ, coloured_ply, gltf_part, masked_glb, quad, reversed_obj, two_material_glb,
+                     two_usemtl_obj)
 from glsandbox.plan import plan
 from glsandbox.scene import Material, Node, Scene
 from glsandbox.scene_file import load_scene
@@ -89,6 +91,12 @@ def test_closedness_welds_equal_positions_and_needs_opposite_windings() -> None:
     flipped[0] = flipped[0][::-1]  # one face wound the other way: not consistently closed
     assert not is_closed(np.asarray(box.vertices), flipped)
     assert not is_closed(np.asarray(box.vertices), np.asarray(box.faces)[:-1])  # a hole
+    # The same answers from position ids (the loader's way: positions numbered once, then hashed).
+    ids = row_ids(corners, ordered=False)[0]
+    assert is_closed(corners, np.arange(corners.shape[0]).reshape(-1, 3), ids)
+    assert not is_closed(corners, np.arange(corners.shape[0] - 3).reshape(-1, 3), ids)
+    box_ids = row_ids(np.asarray(box.vertices), ordered=False)[0]
+    assert not is_closed(np.asarray(box.vertices), flipped, box_ids)
 
 
 # --- what is not drawn -----------------------------------------------------------
@@ -252,3 +260,56 @@ def test_a_scene_file_node_s_own_alpha_mode_wins_over_its_model_file_s(tmp_path:
     scene_path.write_text('[[nodes]]\nname = "m"\nmesh = "two.glb"\nalpha_mode = "opaque"\n')
     assert {n.name: n.material.alpha_mode for n in load_scene(scene_path).nodes} == {"m/paint": "opaque",
                                                                                      "m/glass": "opaque"}
+
+
+def test_blended_parts_are_blended_in_the_mirror_too_after_the_opaque_ones_farthest_first() -> None:
+    from glsandbox.planar import Mirror
+
+    square = glsandbox.geometry.quad_list()
+    glass = Material(color=(0, 0, 1, 0.5), alpha_mode="blend")
+    cutout = Material(color=(1, 1, 1, 1), alpha_mode="mask", alpha_cutoff=0.5)
+    # A mirror in the plane z = -5 facing +z; the eye at z = +3 (the default camera looks from +z).
+    wall = Node("wall", square, glsandbox.transforms.translate(0, 0, -5), Material())
+    near = Node("near", square, glsandbox.transforms.translate(0, 0, 2), glass)  # far from the mirror: farther in it
+    far = Node("far", square, glsandbox.transforms.translate(0, 0, -3), glass)
+    solid = Node("solid", square, np.eye(4), cutout)
+    mirror = Mirror("wall", (0.0, 0.0, 1.0, 5.0), ("near", "solid", "far"))  # z + 5 = 0
+    scene = Scene("s", nodes=(wall, near, solid, far), mirror=mirror)
+    (reflection,) = [p for p in plan(scene).passes if p.kind == "reflection"]
+    # Seen in the mirror, "near" (7 from the glass) lies farther than "far" (2 from it): it blends first.
+    assert [(d.node, d.blend) for d in reflection.draws] == [("solid", False), ("near", True), ("far", True)]
+    assert "ALPHA_MASK" in reflection.draws[0].program
+    # The order depends on where things are: a plan kept between frames must see it change.
+    from glsandbox.plan import motion_decisions
+
+    swapped = Scene("s", nodes=(wall, Node("near", square, far.model, glass), solid, Node("far", square, near.model, glass)),
+                    mirror=mirror)
+    assert motion_decisions(scene) != motion_decisions(swapped)
+
+
+
+@pytest.mark.slow
+def test_a_cut_out_casts_a_planar_shadow_only_where_it_is_drawn(tmp_path: Path, gl) -> None:
+    from glsandbox.planar import PlanarShadow
+    from glsandbox.scene import Camera
+
+    stencil = next(p for p in glsandbox.load_model(masked_glb(tmp_path / "m.glb")).parts if p.alpha_mode == "mask")
+    floor = Node("floor", glsandbox.geometry.plane(8.0), np.eye(4), Material(color=(1, 1, 1, 1)))
+    # The 2x2 square (half of it cut out) laid flat 1 above the floor, lit from up and to the right:
+    # its shadow falls beside it, at x in -3..-1, seen from straight above.
+    lay = glsandbox.transforms.translate(0, 1, 0) @ glsandbox.transforms.rotate_x(-np.pi / 2)
+    shadow = PlanarShadow("floor", (0, 1, 0, 0), (2.0, 1.0, 0.0, 0.0), ("caster",), color=(0, 0, 0, 1))
+
+    def black_pixels(material: Material) -> int:
+        scene = Scene("s", nodes=(floor, Node("caster", stencil.mesh, lay, material)), planar_shadow=shadow,
+                      camera=Camera(eye=(0.0, 10.0, 0.01)))
+        image = np.asarray(gl.render_scene(scene, (64, 64)).image)
+        return int((image[..., :3] == 0).all(axis=-1).sum())
+
+    whole = black_pixels(Material(color=(1, 0, 0, 1)))
+    cut = black_pixels(stencil.material())
+    assert whole > 100
+    assert 0.35 * whole < cut < 0.65 * whole  # the cut-away half casts nothing
+    (step,) = [p for p in plan(Scene("s", nodes=(floor, Node("caster", stencil.mesh, lay, stencil.material())),
+                                     planar_shadow=shadow)).passes if p.kind == "planar_shadow"]
+    assert "CUTOUT_SHADOW" in step.describe()

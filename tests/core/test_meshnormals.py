@@ -12,9 +12,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import trimesh
 
 from glsandbox import Camera, Light, Material, Node, Scene, Viewport, geometry, transforms
 from glsandbox.lesson import scene_file_lesson
+from glsandbox.meshnormals import normal_groups, row_ids
 
 
 def test_meshes_without_normals_get_face_normals_once() -> None:
@@ -61,3 +63,22 @@ def test_a_scene_file_lit_cube_renders_in_every_lit_shading(gl, tmp_path: Path) 
                         'rotate = [20, 35, 0]\ncolor = [0.2, 0.5, 0.9]\n')
         image = gl.render(scene_file_lesson(path)(), (64, 64)).image
         assert image[32, 32, 2] > image[32, 32, 0]  # the blue cube, lit, in the middle
+
+
+@pytest.mark.parametrize("mode", ["flat", "smooth", "crease"])
+def test_corners_at_one_position_share_a_group_exactly_when_their_normals_are_bit_identical(mode: str) -> None:
+    # A box split per face (24 vertices, 8 positions), a cone apex of 80 faces (the ring walk) and a
+    # fan of coplanar faces: groups are what tells a position's vertices apart, with no hash of normals.
+    box = trimesh.creation.box()
+    cone = trimesh.creation.cone(1.0, 1.0, sections=80)
+    for vertices, faces in ((np.asarray(box.vertices)[np.asarray(box.faces).reshape(-1)], np.arange(36).reshape(-1, 3)),
+                            (np.asarray(cone.vertices), np.asarray(cone.faces))):
+        tris = faces.astype(np.intp)
+        group, normals = normal_groups(vertices, tris, mode, 30.0)
+        position = row_ids(vertices)[0][tris.reshape(-1)]
+        bits = normals[group].view(np.uint64)
+        for p in np.unique(position):
+            here = np.flatnonzero(position == p)
+            same_group = group[here][:, None] == group[here][None, :]
+            same_normal = (bits[here][:, None, :] == bits[here][None, :, :]).all(axis=-1)
+            assert (same_group == same_normal).all()

@@ -29,7 +29,9 @@ class GoldensOnly:
         items[:] = kept
         print(f"golden tests: {len(kept)}", flush=True)
 
-sys.exit(pytest.main(["tests", "-q", "-p", "no:cacheprovider", "-x"], plugins=[GoldensOnly()]))
+# -n 0: in this process, where the plugin is (pyproject's -n auto would start workers without it,
+# each running the whole suite, this test again included).
+sys.exit(pytest.main(["tests", "-n", "0", "-q", "-p", "no:cacheprovider", "-x"], plugins=[GoldensOnly()]))
 """
 
 

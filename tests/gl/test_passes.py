@@ -57,3 +57,20 @@ def test_gl_state_is_the_same_when_every_pass_starts(gl, monkeypatch):
     for name in ("shadow_map", "mirror"):  # a frame's depth mode (reverse-Z in the mirror) holds for all its passes
         states = [(kind, state) for scene, kind, state in seen if scene == name]
         assert [kind for kind, state in states if state != states[0][1]] == [], name
+
+
+def test_a_frame_leaves_no_sampler_object_or_depth_test_even_when_a_pass_raises(gl, tmp_path):
+    """The material's sampler object and the pass's depth test go with the frame: a sampler
+    left on unit 0 overrides the filter of any texture a later user of the shared context
+    binds there (a mipmapped filter on the gpu ray engine's record textures makes them
+    incomplete: texelFetch reads zeros). The texture lesson's ground is drawn (its sampler
+    bound, depth test on) before the cube's missing image stops the frame."""
+    from glsandbox.errors import SandboxError
+    from lessons.texture import TextureLesson
+
+    gl.render(TextureLesson(filter="mip_linear"), (32, 32))
+    assert gl.host.raw.sampler_bindings() == (0, 0, 0, 0)
+    with pytest.raises(SandboxError, match="not found"):
+        gl.render(TextureLesson(filter="mip_linear", image=str(tmp_path / "nope.png")), (32, 32))
+    assert gl.host.raw.sampler_bindings() == (0, 0, 0, 0)
+    assert gl.host.raw.state_snapshot()["depth_test"] is False

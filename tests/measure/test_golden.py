@@ -428,7 +428,7 @@ def test_update_goldens_option_is_a_usage_error_on_ci() -> None:
     root = Path(__file__).resolve().parents[2]
     env = {**os.environ, "CI": "1"}
     proc = subprocess.run(
-        [sys.executable, "-m", "pytest", "--update-goldens", "--collect-only", "-q",
+        [sys.executable, "-m", "pytest", "--update-goldens", "--collect-only", "-q", "-n", "0",
          "-p", "no:cacheprovider", "tests/measure/test_metrics.py"],
         cwd=root, env=env, capture_output=True, text=True, timeout=60,
     )

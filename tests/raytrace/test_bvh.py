@@ -18,7 +18,7 @@ from glsandbox.raytrace.bvh import (
     clear_cache,
     mesh_world_triangles,
 )
-from glsandbox.raytrace.bvh_traverse import any_hit, closest_hit, closest_hit_brute_force
+from glsandbox.raytrace.bvh_traverse import BOX_PAD, TraversalCounts, any_hit, closest_hit, closest_hit_brute_force
 from glsandbox.raytrace.ray import Ray
 from glsandbox.raytrace.triangle import Triangle, _watertight
 from glsandbox.raytrace.watertight import nondegenerate, ray_setup, watertight_pairs
@@ -78,6 +78,11 @@ def check_structure(bvh: BVH, a: np.ndarray, b: np.ndarray, c: np.ndarray, leaf_
         assert np.all(bvh.node_max[child] <= bvh.node_max[inner])
     reached = np.concatenate([[0], left, left + 1])
     assert np.array_equal(np.sort(reached), np.arange(bvh.node_total))
+    # depth: the nodes on the longest path from the root (the GPU traversal's stack is sized by it).
+    level = np.ones(bvh.node_total, dtype=np.int64)
+    for k in inner:  # in id order: a parent before its children
+        level[bvh.node_first[k]] = level[bvh.node_first[k] + 1] = level[k] + 1
+    assert bvh.depth == level.max()
     if ok.any():
         np.testing.assert_array_equal(bvh.node_min[0], np.minimum(np.minimum(a[ok], b[ok]), c[ok]).min(axis=0))
 
@@ -90,6 +95,14 @@ def test_every_triangle_is_in_exactly_one_leaf_and_children_lie_inside_parents(s
     bvh = build_bvh(a, b, c, leaf_size=leaf_size)
     assert bvh.input_count == count
     check_structure(bvh, a, b, c, leaf_size)
+
+
+@pytest.mark.parametrize("leaf_size", [33, 64])
+def test_leaves_as_big_as_the_small_node_limit(leaf_size: int) -> None:
+    # Nodes of up to bvh.SMALL triangles are split by the full sweep; a leaf size at or above it
+    # leaves that phase nothing (or everything) to do.
+    a, b, c = soup(7, 1500)
+    check_structure(build_bvh(a, b, c, leaf_size=leaf_size), a, b, c, leaf_size)
 
 
 def test_triangles_that_no_cut_separates_are_split_by_count() -> None:
@@ -176,6 +189,60 @@ def test_closest_hit_equals_brute_force(seed: int, count: int, cull: bool, limit
     np.testing.assert_array_equal(any_hit(bvh, o, d, t_max, cull_backfaces=cull), want.hit)
 
 
+def level_by_level(bvh: BVH, o: np.ndarray, d: np.ndarray, t_max: np.ndarray, cull: bool,
+                   first_hit: bool) -> tuple[int, int]:
+    """The (box, triangle) tests of the traversal's rule, one ray at a time in plain Python:
+    a level's boxes are all tested, then its leaves' triangles (the ray's best hit, or with
+    ``first_hit`` whether it hit at all, counting from then on), then the kept inner nodes'
+    children make the next level. Boxes padded as the traversal pads them."""
+    pad = BOX_PAD * np.maximum(np.abs(bvh.node_min), np.abs(bvh.node_max)).max(axis=1)
+    lo, hi = bvh.node_min - pad[:, None], bvh.node_max + pad[:, None]
+    boxes = triangles = 0
+    for ray in range(len(d)):
+        o_pad = BOX_PAD * np.abs(o[ray]).max()
+        with np.errstate(divide="ignore"):
+            inv = 1.0 / d[ray]
+        setup = ray_setup(o[ray:ray + 1], d[ray:ray + 1])
+        best, level, done = t_max[ray], [0], False
+        while level and not done:
+            kept = []
+            for node in level:
+                boxes += 1
+                ta, tb = (lo[node] - (o[ray] + o_pad)) * inv, (hi[node] - (o[ray] - o_pad)) * inv
+                near, far = np.minimum(ta, tb).max(), np.maximum(ta, tb).min()
+                if near <= far and far >= 0.0 and (near < t_max[ray] if first_hit else near <= best):
+                    kept.append(node)
+            for node in (k for k in kept if bvh.node_count[k]):
+                slots = np.arange(bvh.node_first[node], bvh.node_first[node] + bvh.node_count[node])
+                triangles += slots.size
+                t, _, _ = watertight_pairs(setup, np.zeros(slots.size, dtype=np.intp), bvh.v0, bvh.v1, bvh.v2,
+                                           slots, cull)
+                hit = t[t < t_max[ray]]
+                done = first_hit and (done or hit.size > 0)
+                best = min(best, hit.min(initial=np.inf))
+            level = [bvh.node_first[k] + child for k in kept if not bvh.node_count[k] for child in (0, 1)]
+    return boxes, triangles
+
+
+@pytest.mark.parametrize("seed", [3, 4])
+@pytest.mark.parametrize("cull", [False, True])
+def test_the_tests_counted_are_those_of_a_level_by_level_traversal(seed: int, cull: bool) -> None:
+    """What ``counts`` says (the ray_acceleration lesson prints it) is what the rule does,
+    however the packet traversal batches its work: a level's boxes, then its leaves."""
+    a, b, c = soup(seed, 250)
+    o, d = rays(seed, 80)
+    t_max = np.where(np.arange(80) % 3 == 0, np.random.default_rng(seed).uniform(0.5, 4.0, 80), np.inf)
+    bvh = build_bvh(a, b, c)
+    counts = TraversalCounts()
+    hits = closest_hit(bvh, o, d, t_max, cull_backfaces=cull, counts=counts)
+    boxes, triangles = level_by_level(bvh, o, d, t_max, cull, first_hit=False)
+    assert (counts.boxes, counts.triangles) == (boxes, triangles + int(hits.hit.sum()))  # + the winners' uv test
+    counts = TraversalCounts()
+    any_hit(bvh, o, d, t_max, cull_backfaces=cull, counts=counts)
+    assert (counts.boxes, counts.triangles) == level_by_level(bvh, o, d, t_max, cull, first_hit=True)
+    assert 0 < hits.hit.sum() < 80 and counts.boxes > 3 * 80
+
+
 def test_shared_origin_rays_of_a_camera_on_a_real_model() -> None:
     from glsandbox.raytrace.world import camera_rays
     from glsandbox.scene import Camera
@@ -187,6 +254,21 @@ def test_shared_origin_rays_of_a_camera_on_a_real_model() -> None:
     got = closest_hit(build_bvh(a, b, c), eye, dirs)
     assert_same_hits(got, want)
     assert 0.2 < got.hit.mean() < 0.9
+
+
+@pytest.mark.parametrize("moved", [True, False])
+def test_shared_origin_rays_with_and_without_the_corners_moved_to_the_eye(moved: bool, monkeypatch) -> None:
+    """Below ``MOVED_CORNERS`` triangles a BVH keeps its corners moved to the eye (``V − O``,
+    the watertight test's first step, done once); above it each pair forms ``V − O``: the same numbers."""
+    from glsandbox.raytrace import bvh_traverse
+
+    monkeypatch.setattr(bvh_traverse, "MOVED_CORNERS", 1 << 18 if moved else 0)
+    a, b, c = soup(21, 300)
+    bvh = build_bvh(a, b, c)
+    _, dirs = rays(22, 400)
+    eye = np.array([0.5, 7.0, -1.0])
+    assert_same_hits(closest_hit(bvh, eye, dirs), closest_hit_brute_force(a, b, c, eye, dirs))
+    assert (bvh.__dict__["_kernel_moved"][3] is not None) == moved  # the path taken is the one meant
 
 
 def test_brute_force_keeps_the_first_minimum_and_the_scalar_t() -> None:

@@ -2,10 +2,12 @@
 triangle past llvmpipe's 65,535 loop iterations appears (tests/raytrace/test_render.py,
 with the numpy engine), a ~20k-triangle rock agrees
 with the numpy engine pixel for pixel but for float32 edge grazes, and a ray that runs
-out of its step bound raises instead of drawing a wrong picture."""
+out of its step bound raises instead of drawing a wrong picture; a sampler object another
+user left bound on the shared context changes nothing."""
 
 from __future__ import annotations
 
+import moderngl
 import numpy as np
 import pytest
 
@@ -45,3 +47,35 @@ def test_a_ray_out_of_steps_raises(gl, monkeypatch) -> None:
         render(rock_scene(), (40, 30), "gpu", ctx=gl.host.ctx)
     message = str(info.value)
     assert "\n" not in message and "4 steps" in message and "renderer=ray_numpy" in message
+
+
+def test_a_sampler_object_left_bound_on_the_context_changes_nothing(gl) -> None:
+    """The rasterizer binds a sampler object per material filter. One left on the units the
+    engine uses (here a mipmapped filter on units 0-3, what a frame that raised half-way
+    left before the executor unbound it) overrides the records' NEAREST state: they are
+    incomplete without mip levels and texelFetch reads zeros (wrong hits, rays cut off)."""
+    from glsandbox.raytrace.bvh import build_bvh, mesh_world_triangles
+    from glsandbox.raytrace.gpu_bvh import GpuBVH
+    from glsandbox.raytrace.world import camera_rays
+
+    ctx, scene, size = gl.host.ctx, rock_scene(3), (64, 48)  # 1,280 triangles: the BVH program
+    bvh = GpuBVH(ctx, build_bvh(*mesh_world_triangles(scene.nodes[0].mesh)))
+    eye, dirs = camera_rays(scene.camera, *size)
+
+    def both() -> tuple[np.ndarray, np.ndarray]:
+        gpu_engine.gpu_tracer(ctx).forget_scenes()  # uploaded again, then drawn
+        return render(scene, size, "gpu", ctx=ctx).copy(), bvh.trace(eye, dirs).triangle
+
+    sampler = ctx.sampler(filter=(moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR))
+    try:
+        clean_image, clean_hits = both()
+        assert 0.2 < np.mean(clean_hits >= 0) < 0.9
+        for unit in range(gpu_engine.MAX_TEXTURES):
+            sampler.use(unit)
+        image, hits = both()
+        np.testing.assert_array_equal(image, clean_image)
+        np.testing.assert_array_equal(hits, clean_hits)
+    finally:
+        ctx.clear_samplers(0, gpu_engine.MAX_TEXTURES)
+        sampler.release()
+        bvh.release()
