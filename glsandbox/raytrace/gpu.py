@@ -38,7 +38,7 @@ So what a scene cannot reach is compiled out rather than branched around:
 ``SHADOWS`` (shadow rays), ``REFLECT`` (the bounce loop: some node reflects
 and ``max_depth > 0``), ``HAS_MESHES``, ``HAS_SHAPES`` (analytic nodes), one
 ``HAS_<KIND>`` per analytic :class:`~glsandbox.raytrace.world.NodeKind` and
-``VERTEX_COLORS`` switch code on.
+``VERTEX_COLORS`` and ``TWO_SIDED`` (a node lit on both sides) switch code on.
 
 A small scene, at most :data:`UNROLL_NODES` nodes of which at most
 :data:`UNROLL_LOOPS` have more than :data:`UNROLL_TRIS` triangles, its
@@ -495,7 +495,8 @@ class _Uploaded:
     def defines(self, cull: bool | None) -> tuple[tuple[str, str], ...]:
         """The program variant's scene-shaped defines (see ``shaders/raytrace.glsl``)."""
         found = [("VERTEX_COLORS", str(int(any(node.mode == MODES["vertex_color"] or node.vertex_colors
-                                               for node in self.world.nodes))))]
+                                               for node in self.world.nodes)))),
+                 ("TWO_SIDED", str(int(any(node.two_sided for node in self.world.nodes))))]
         if self.unrolled:
             found += [("SCENE_NODES", self.scene_nodes(cull)), ("NODE_COUNT", str(max(1, len(self.world.nodes)))),
                       ("TRI_COUNT", str(max(1, self.world.triangle_count)))]
