@@ -56,8 +56,7 @@ uniform vec3 u_background;  // the viewport's clear colour
 uniform int u_max_depth;    // reflection bounces (REFLECT: > 0)
 uniform int u_cull;         // -1: per node (as the rasterizer), 0: never, 1: always
 uniform bool u_aabb;
-uniform bool u_simple_offset;  // the teaching variant: offset u_offset * max(1, max|P|), not the error bound
-uniform float u_offset;
+uniform float u_offset;     // SIMPLE_OFFSET (the teaching variant): offset u_offset * max(1, max|P|), not the error bound
 #if NUM_LIGHTS > 0
 uniform vec3 u_light_pos[NUM_LIGHTS];
 uniform vec3 u_light_color[NUM_LIGHTS];
@@ -564,11 +563,11 @@ float next_float(float x, float dir) {
 // `towards` on (as the numpy engine's _offset, which says why).
 vec3 offset_point(Spawn s, vec3 n, vec3 towards) {
     vec3 offset;
-    if (u_simple_offset) {
-        offset = u_offset * max(1.0, max(max(abs(s.p.x), abs(s.p.y)), abs(s.p.z))) * s.ng;
-    } else {
-        offset = dot(abs(s.ng), s.err) * s.ng;
-    }
+#if SIMPLE_OFFSET
+    offset = u_offset * max(1.0, max(max(abs(s.p.x), abs(s.p.y)), abs(s.p.z))) * s.ng;
+#else
+    offset = dot(abs(s.ng), s.err) * s.ng;
+#endif
     if ((dot(n, towards) < 0.0) != (dot(s.ng, n) < 0.0)) offset = -offset;
     vec3 q = s.p + offset;
     return vec3(next_float(q.x, offset.x), next_float(q.y, offset.y), next_float(q.z, offset.z));
@@ -620,6 +619,7 @@ void main() {
         Spawn at = spawn_at(j, t, bary, o, d, n);
         vec3 local = shade(k, p, n, base, d, at);
         bool last = depth >= u_max_depth;
+#if SEE_THROUGH
         // A see-through surface passes the ray on straight, weighted 1 - a; it does not
         // also reflect (numpy_engine._trace). At the last bounce its own colour stands in.
         float a = last ? 1.0 : coverage(k, alpha);
@@ -630,6 +630,10 @@ void main() {
             weight *= 1.0 - a;
             continue;
         }
+#else  // every surface opaque: coverage 1
+        float r = last ? 0.0 : node_rec(k, NODE_EXTRA).x;
+        color += weight * (1.0 - r) * local;
+#endif
         if (r <= 0.0) break;
         vec3 reflected = d - 2.0 * dot(d, n) * n;  // Yansıma vektörü
         o = offset_point(at, n, -d);

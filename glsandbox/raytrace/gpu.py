@@ -38,7 +38,9 @@ So what a scene cannot reach is compiled out rather than branched around:
 ``SHADOWS`` (shadow rays), ``REFLECT`` (the bounce loop: some node reflects
 and ``max_depth > 0``), ``HAS_MESHES``, ``HAS_SHAPES`` (analytic nodes), one
 ``HAS_<KIND>`` per analytic :class:`~glsandbox.raytrace.world.NodeKind` and
-``VERTEX_COLORS`` and ``TWO_SIDED`` (a node lit on both sides) switch code on.
+``VERTEX_COLORS``, ``TWO_SIDED`` (a node lit on both sides), ``SEE_THROUGH``
+(a cut-out or blended node) and ``SIMPLE_OFFSET`` (the teaching variant of
+the secondary rays' offset) switch code on.
 
 A small scene, at most :data:`UNROLL_NODES` nodes of which at most
 :data:`UNROLL_LOOPS` have more than :data:`UNROLL_TRIS` triangles, its
@@ -496,7 +498,8 @@ class _Uploaded:
         """The program variant's scene-shaped defines (see ``shaders/raytrace.glsl``)."""
         found = [("VERTEX_COLORS", str(int(any(node.mode == MODES["vertex_color"] or node.vertex_colors
                                                for node in self.world.nodes)))),
-                 ("TWO_SIDED", str(int(any(node.two_sided for node in self.world.nodes))))]
+                 ("TWO_SIDED", str(int(any(node.two_sided for node in self.world.nodes)))),
+                 ("SEE_THROUGH", str(int(any(node.see_through for node in self.world.nodes))))]
         if self.unrolled:
             found += [("SCENE_NODES", self.scene_nodes(cull)), ("NODE_COUNT", str(max(1, len(self.world.nodes)))),
                       ("TRI_COUNT", str(max(1, self.world.triangle_count)))]
@@ -641,7 +644,7 @@ class GpuTracer:
         lights = world.light_positions.shape[0]
         # The bounce loop only where some node reflects or lets rays through (a cut-out, a blend).
         reflect = max_depth > 0 and any(node.reflectivity > 0.0 or node.see_through for node in world.nodes)
-        scene_defines = uploaded.defines(cull_backfaces)
+        scene_defines = uploaded.defines(cull_backfaces) + (("SIMPLE_OFFSET", str(int(OFFSETS[offset]))),)
         use_bvh = False
         try:
             check_loop_budget(world, lights, bool(shadows), reflect, int(max_depth))
@@ -678,7 +681,7 @@ class GpuTracer:
             "u_eye": tuple(eye - uploaded.anchor), "u_half": (half_w, half_h), "u_background": tuple(world.background),
             "u_max_depth": int(max_depth),
             "u_cull": -1 if cull_backfaces is None else int(bool(cull_backfaces)), "u_aabb": bool(aabb),
-            "u_offset": SIMPLE_OFFSET, "u_simple_offset": OFFSETS[offset],
+            "u_offset": SIMPLE_OFFSET,
         }
         for name, value in values.items():
             if name in program:
