@@ -20,7 +20,8 @@
 // see-through surfaces: some node reflects, is a cut-out or is blended, and
 // max_depth > 0), HAS_MESHES, HAS_SHAPES (some analytic node) and
 // HAS_<KIND> per analytic kind (HAS_SPHERE, HAS_CYLINDER), TWO_SIDED (a node is lit
-// on both sides), VERTEX_COLORS (a node uses
+// on both sides), SEE_THROUGH (a node is a cut-out or blended), SIMPLE_OFFSET
+// (the teaching variant of the secondary rays' offset), VERTEX_COLORS (a node uses
 // them); SCENE_NODES (the scene's node list, see nearest()) with
 // NODE_COUNT and TRI_COUNT for a small scene, whose records are in the
 // uniform block.
