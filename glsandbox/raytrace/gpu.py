@@ -459,6 +459,8 @@ class _Uploaded:
         """The program variant's scene-shaped defines (see ``shaders/raytrace.glsl``)."""
         found = [("VERTEX_COLORS", str(int(any(node.mode == MODES["vertex_color"] or node.vertex_colors
                                                for node in self.world.nodes))))]
+        if any(node.texel_shadow for node in self.world.nodes):  # shadow rays read a cut-out's texels
+            found.append(("CUTOUT_SHADOWS", "1"))
         if self.unrolled:
             found += [("SCENE_NODES", self.scene_nodes(cull)), ("NODE_COUNT", str(max(1, len(self.world.nodes)))),
                       ("TRI_COUNT", str(max(1, self.world.triangle_count)))]
