@@ -854,7 +854,8 @@ def describe_planar_pass(step: Pass) -> str:
 
 #: The texture unit a receiver's shadow map is bound to (unit 0 is the material's texture).
 SHADOW_MAP_UNIT = 1
-#: Casters are drawn into the map with the flat program; only their depth is kept.
+#: Casters are drawn into the map with the flat program (a textured cut-out with
+#: :data:`CUTOUT_SHADOW_PROGRAM`, a blended one not at all: :func:`caster_program`); only their depth is kept.
 DEPTH_PROGRAM = ProgramVariant("basic", (("SOLID_COLOR", ""),))
 
 

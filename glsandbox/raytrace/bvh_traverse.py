@@ -59,7 +59,8 @@ from glsandbox.raytrace.watertight import RaySetup, nondegenerate, ray_setup, wa
 #: An any-hit filter: ``(rays, triangles, t) -> which hits count`` (bool per hit).
 Accept = Callable[[NDArray[np.intp], NDArray[np.intp], NDArray[np.float64]], NDArray[np.bool_]]
 
-__all__ = ["BOX_PAD", "RAY_BLOCK", "Accept", "Hits", "TraversalCounts", "any_hit", "closest_hit", "closest_hit_brute_force"]
+__all__ = ["BOX_PAD", "RAY_BLOCK", "Accept", "Hits", "TraversalCounts", "any_hit", "closest_hit",
+           "closest_hit_brute_force"]
 
 #: Relative widening of every box in the slab test (see the module docstring).
 BOX_PAD: float = 2.0**-40

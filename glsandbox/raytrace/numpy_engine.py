@@ -130,7 +130,9 @@ def _occluded(world: World, o: NDArray[np.float64], d: NDArray[np.float64], ligh
               aabb: bool, stats: RenderStats | None = None, bvh: WorldBVH | None = None) -> NDArray[np.bool_]:
     """Gölge testi for shadow rays towards light ``light``: whether each ray ``o + s·d``
     hits something at ``0 < s < 1`` (``d`` reaches the light at ``s = 1``, so an
-    occluder beyond the light never counts). The light's lamp is skipped.
+    occluder beyond the light never counts). The light's lamp is skipped, and so
+    are blended nodes; a textured cut-out occludes only at its drawn texels
+    (:func:`_drawn_texels`, an any-hit filter).
 
     With a BVH an any-hit query (a ray leaves at its first occluder); without one
     the nearest-hit scan cut at ``s = 1`` (what ``ray_acceleration`` counts)."""
