@@ -16,7 +16,8 @@
 // larger one in RGBA32F textures read with texelFetch (u_nodes, u_tris).
 //
 // Variants: NUM_LIGHTS (the light loop), NUM_TEXTURES (0..4 samplers),
-// SHADOWS (shadow rays), REFLECT (reflection bounces and passes through
+// SHADOWS (shadow rays; CUTOUT_SHADOWS: some textured cut-out, whose shadow
+// rays read its texels), REFLECT (reflection bounces and passes through
 // see-through surfaces: some node reflects, is a cut-out or is blended, and
 // max_depth > 0), HAS_MESHES, HAS_SHAPES (some analytic node) and
 // HAS_<KIND> per analytic kind (HAS_SPHERE, HAS_CYLINDER), TWO_SIDED (a node is lit
@@ -108,6 +109,18 @@ vec4 tri_rec(int k, int r) { return record(u_tris, k * TRI_RECORDS + r); }
 
 #ifndef BVH
 #define BVH 0
+#endif
+#ifndef CUTOUT_SHADOWS
+#define CUTOUT_SHADOWS 0
+#endif
+#if SHADOWS && CUTOUT_SHADOWS
+// A textured cut-out blocks a shadow ray only on a drawn texel (shadow_texel,
+// below); the BVH's any-hit walk asks it for the node g_shadow_node.
+bool shadow_texel(int k, int j, float t, vec2 bary, vec3 o, vec3 d);
+int g_shadow_node = -1;
+#define BVH_ANY_ACCEPT(index, t, uv) shadow_texel(g_shadow_node, index, t, uv, o, d)
+#else
+#define shadow_texel(k, j, t, bary, o, d) true
 #endif
 #if BVH
 // Mesh nodes traced through their BVHs (gpu.py packs one per mesh node into
@@ -349,10 +362,14 @@ bool occluded(vec3 o, vec3 d, int light) {
     // none where the compiler unrolls the light loop.
 #define MESH(k, start, cull, lamps) if (((lamps >> light) & 1) == 0) { \
         int stop = start + box_count(k, o, inv_d, 1.0); \
-        for (int j = start; j < stop && !hit; ++j) hit = triangle_t(j, wr, cull != 0, uv) < 1.0; \
+        for (int j = start; j < stop && !hit; ++j) { \
+            float t = triangle_t(j, wr, cull != 0, uv); \
+            hit = t < 1.0 && shadow_texel(k, j, t, uv, o, d); \
+        } \
     }
-#define TRI(k, j, cull, lamps) if (((lamps >> light) & 1) == 0) { \
-        hit = hit || triangle_t(j, wr, cull != 0, uv) < 1.0; \
+#define TRI(k, j, cull, lamps) if (((lamps >> light) & 1) == 0 && !hit) { \
+        float t = triangle_t(j, wr, cull != 0, uv); \
+        hit = t < 1.0 && shadow_texel(k, j, t, uv, o, d); \
     }
 #define SHAPE(k, kind, cull, lamps) if (((lamps >> light) & 1) == 0) { \
         hit = hit || shape_t(kind, to_object(k, o, 1.0), to_object(k, d, 0.0), cull != 0) < 1.0; \
@@ -366,6 +383,9 @@ bool occluded(vec3 o, vec3 d, int light) {
 #if HAS_MESHES && BVH
     for (int k = 0; k < MESH_NODES; ++k) {
         if (((int(node_rec(k, NODE_EXTRA).z) >> light) & 1) != 0) continue;
+#if CUTOUT_SHADOWS
+        g_shadow_node = k;
+#endif
         bool overflow;
         bool blocked = bvh_any_at(bvh_root(k), o, d, 1.0, node_cull(node_rec(k, NODE_BOX_MAX)), overflow);
         if (overflow) g_overflow = true;
@@ -382,7 +402,8 @@ bool occluded(vec3 o, vec3 d, int light) {
         int start = int(r2.x);
         int stop = start + int(r2.y);
         for (int j = start; j < stop; ++j) {
-            if (triangle_t(j, wr, cull, uv) < 1.0) return true;
+            float t = triangle_t(j, wr, cull, uv);
+            if (t < 1.0 && shadow_texel(k, j, t, uv, o, d)) return true;
         }
     }
 #endif
@@ -518,6 +539,22 @@ float coverage(int k, float alpha) {
     int mode = int(look.y);
     return mode == 1 ? (alpha >= look.z ? 1.0 : 0.0) : mode == 2 ? alpha : 1.0;
 }
+
+#if SHADOWS && CUTOUT_SHADOWS
+// Whether shadow ray o + t d (0 < t < 1) meeting node k's triangle j at `bary`
+// is blocked there (numpy_engine._drawn_texels): anywhere on an opaque node,
+// on a cut-out only where it is drawn, its alpha (surface's: the colour's
+// times the texel's) at or above the cutoff. The rasterizer's planar shadow
+// and shadow map discard the same texels.
+bool shadow_texel(int k, int j, float t, vec2 bary, vec3 o, vec3 d) {
+    vec4 look = node_rec(k, NODE_LOOK);  // alpha, alpha mode, cutoff, flags
+    if (int(look.y) != 1) return true;
+    vec3 p, n, base;
+    float alpha;
+    surface(k, j, t, bary, o, d, p, n, base, alpha);
+    return alpha >= look.z;
+}
+#endif
 
 // Where secondary rays start (pbrt-v4, "Robust spawned ray origins"): the
 // hit point with a bound `err` on its rounding error per component, and the

@@ -500,6 +500,8 @@ class _Uploaded:
                                                for node in self.world.nodes)))),
                  ("TWO_SIDED", str(int(any(node.two_sided for node in self.world.nodes)))),
                  ("SEE_THROUGH", str(int(any(node.see_through for node in self.world.nodes))))]
+        if any(node.texel_shadow for node in self.world.nodes):  # shadow rays read a cut-out's texels
+            found.append(("CUTOUT_SHADOWS", "1"))
         if self.unrolled:
             found += [("SCENE_NODES", self.scene_nodes(cull)), ("NODE_COUNT", str(max(1, len(self.world.nodes)))),
                       ("TRI_COUNT", str(max(1, self.world.triangle_count)))]

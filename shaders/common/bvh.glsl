@@ -51,6 +51,12 @@
 #ifndef BVH_PAD
 #define BVH_PAD 3.814697265625e-06
 #endif
+// BVH_ANY_ACCEPT(index, t, uv): whether bvh_any counts a hit (an any-hit
+// filter, as Embree's; `o`, `d` are the ray's): every hit unless the
+// includer defines it (the ray tracer's cut-out shadows).
+#ifndef BVH_ANY_ACCEPT
+#define BVH_ANY_ACCEPT(index, t, uv) true
+#endif
 #include "common/watertight.glsl"
 
 uniform sampler2D u_bvh_nodes;
@@ -210,7 +216,7 @@ bool bvh_any_at(int root, vec3 o, vec3 d, float t_max, bool cull, out bool overf
             int index;
             vec2 uv;
             float t = bvh_triangle(r, tri, cull, index, uv);
-            found = t > 0.0 && t < t_max;
+            found = t > 0.0 && t < t_max && BVH_ANY_ACCEPT(index, t, uv);
             ++tri;
         }
         if (waiting == -1) {
