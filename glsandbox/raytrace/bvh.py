@@ -331,9 +331,11 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
     # Two flat buffers the columns are moved between, level after level: a fresh 24 bytes per
     # triangle each level would be fresh pages for the kernel to zero and map each time.
     spare = np.empty(cols.size, dtype=np.float32)
-    centre = np.empty((3, k), dtype=np.float32)
-    bin_keys = np.empty((3, k), dtype=np.int64)  # made once: fresh pages each level cost more than the casts
-    bin_rows = np.empty((3, k), dtype=np.uint8)  # each column's bin on each axis (the key less its node's i·B)
+    # Flat buffers, made once (fresh pages each level cost more than the casts), viewed as
+    # contiguous (3, width) arrays each level: np.take copies a strided array whole first.
+    centre = np.empty(3 * k, dtype=np.float32)
+    bin_keys = np.empty(3 * k, dtype=np.int64)
+    bin_rows = np.empty(3 * k, dtype=np.uint8)  # each column's bin on each axis (the key less its node's i·B)
     counts = np.array([k], dtype=np.int64)  # columns per open node, in column order
     box_lo = rows[0:3].min(axis=1)[None, :].astype(np.float64)  # the open nodes' binning boxes
     box_hi = rows[3:6].max(axis=1)[None, :].astype(np.float64)
@@ -342,7 +344,7 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
     while counts.size:
         n = counts.size
         width = tris.size
-        cen = centre[:, :width]
+        cen = centre[:3 * width].reshape(3, width)
         np.add(cols[0:3], cols[3:6], out=cen)  # twice the centroids (halving them would be one more pass)
         # Bins per node: max_bins, fewer once nodes are small (about one per
         # triangle), so the per-bin work never exceeds the per-triangle work.
@@ -366,8 +368,8 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         # i·B .. i·B + B − 1.
         node_of = np.repeat(np.arange(n, dtype=np.int64), counts)  # each column's node
         node_key = node_of * bins
-        bin_key = bin_keys[:, :width]
-        bin_row = bin_rows[:, :width]
+        bin_key = bin_keys[:3 * width].reshape(3, width)
+        bin_row = bin_rows[:3 * width].reshape(3, width)
         rel = np.empty(width, dtype=np.float32)
         for axis in range(3):  # one row at a time: np.repeat of a 1-D array is a plain copy loop
             # (2c − 2·lo)·(scale / 2): the same float32 value as (c − lo)·scale (halving and
