@@ -29,7 +29,7 @@ from glsandbox.gl.target import clear_opaque
 from glsandbox.gl.textures import TextureCache
 from glsandbox.gl.passes import FrameState, PassRunner
 from glsandbox.plan import SHADOW_MAP_UNIT, Draw, Pass, Plan, ProgramVariant, plan as make_plan
-from glsandbox.scene import Light, Material, Node, Scene
+from glsandbox.scene import Light, Material, Node, Scene, mesh_origin
 
 _MODES = {"triangles": moderngl.TRIANGLES, "triangle_strip": moderngl.TRIANGLE_STRIP,
           "lines": moderngl.LINES, "line_strip": moderngl.LINE_STRIP}
@@ -63,6 +63,18 @@ def _mesh_key(mesh: Mesh, arrays: dict[str, np.ndarray] | None = None) -> tuple[
             digest.update(array)  # the array's memory as it is: no copy
         digest.update(mesh.mode.encode())
         key = _MESH_KEYS[mesh] = (mesh.name, digest.hexdigest())
+    return key
+
+
+#: The GPU key of each mesh moved by a lesson's Motion (``Motion.positions``): its own buffers,
+#: shared with no mesh of equal content, since the positions are written into them every frame.
+_MOVED_KEYS: weakref.WeakKeyDictionary[Mesh, tuple[str, str]] = weakref.WeakKeyDictionary()
+
+
+def _moved_key(origin: Mesh) -> tuple[str, str]:
+    key = _MOVED_KEYS.get(origin)
+    if key is None:
+        key = _MOVED_KEYS[origin] = (origin.name, f"moved-{len(_MOVED_KEYS)}-{id(origin):x}")
     return key
 
 
@@ -198,6 +210,7 @@ class _GpuMesh:
     index: moderngl.Buffer | None
     mode: int
     count: int
+    positions: np.ndarray | None = None  # a moved mesh's: the positions its buffer holds now
 
 
 @dataclass
@@ -347,6 +360,9 @@ class Executor:
         return values
 
     def _gpu_mesh(self, mesh: Mesh) -> tuple[tuple[str, str], _GpuMesh]:
+        origin = mesh_origin(mesh)
+        if origin is not None:
+            return self._moved_gpu_mesh(mesh, origin)
         arrays = None if mesh in _MESH_KEYS else _gpu_arrays(mesh)  # made once for the digest and the upload
         key = _mesh_key(mesh, arrays)
         gpu = self._meshes.get(key)
@@ -358,6 +374,24 @@ class Executor:
             del arrays, index_array
             gpu = _GpuMesh(buffers, index, _MODES[mesh.mode], mesh.element_count)
             self._meshes[key] = gpu
+        self._mesh_last_frame[key] = self._frame
+        return key, gpu
+
+    def _moved_gpu_mesh(self, mesh: Mesh, origin: Mesh) -> tuple[tuple[str, str], _GpuMesh]:
+        """A moved mesh (:func:`glsandbox.scene.moved_mesh`): the buffers of the mesh it was moved
+        from, its own, with ``mesh``'s positions written into the position buffer where they
+        are not the ones it holds (once per frame however many passes draw it)."""
+        key = _moved_key(origin)
+        gpu = self._meshes.get(key)
+        if gpu is None:
+            arrays = _gpu_arrays(mesh)
+            index_array = arrays.pop("indices", None)
+            buffers = {attr: self.ctx.buffer(array, dynamic=attr == "in_position") for attr, array in arrays.items()}
+            index = None if index_array is None else self.ctx.buffer(index_array)
+            gpu = self._meshes[key] = _GpuMesh(buffers, index, _MODES[mesh.mode], mesh.element_count, mesh.positions)
+        elif gpu.positions is not mesh.positions:
+            gpu.buffers["in_position"].write(np.ascontiguousarray(mesh.positions, dtype="f4"))
+            gpu.positions = mesh.positions
         self._mesh_last_frame[key] = self._frame
         return key, gpu
 
@@ -594,6 +628,19 @@ class Executor:
         program = self._programs[program_key][1]
         members = self._members(program_key)
         drawn = with_face_normals(mesh) if mesh.normals is None and "in_normal" in members else mesh
+        origin = mesh_origin(mesh)
+        if origin is not None and drawn is mesh:  # (face normals made for a moved mesh: a mesh of its own)
+            # A moved mesh: the setup of the mesh it was moved from, this frame's positions in its buffer.
+            moved_key = (program_key + "#moved", id(origin))  # apart from a setup of ``origin`` itself
+            setup = self._setups.get(moved_key)
+            if setup is not None and setup.source is origin:
+                self._moved_gpu_mesh(mesh, origin)
+                return setup
+            vao, gpu = self._vao(mesh, program_key)
+            setup = _DrawSetup(origin, program, members, self._uniform_writer(program_key, program, members),
+                               _moved_key(origin), vao, gpu, "m_normal" in members)
+            self._setups[moved_key] = setup
+            return setup
         vao, gpu = self._vao(drawn, program_key)
         if len(self._setups) >= self.SETUPS_KEPT:  # new meshes every frame (a trail): start again
             self._setups.clear()
