@@ -12,7 +12,7 @@ import hashlib
 import struct
 import weakref
 from collections.abc import Callable, Collection, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import moderngl
@@ -225,6 +225,12 @@ class _DrawSetup:
     vao: moderngl.VertexArray
     gpu: _GpuMesh
     normal: bool  # the program reads m_normal
+    # The program's uniforms by name, and the bytes last written into each (the program's
+    # entry of Executor._written): draw_node's loop writes only what changed.
+    uniforms: dict[str, moderngl.Uniform] = field(default_factory=dict)
+    written: dict[str, bytes] = field(default_factory=dict)
+    # Per material drawn with it (by id, the object kept to check): its constant uniform bytes.
+    constants: dict[int, tuple[Material, tuple[tuple[str, bytes], ...]]] = field(default_factory=dict)
 
 
 class Executor:
@@ -554,6 +560,12 @@ class Executor:
             names = self._member_names[program_key] = frozenset(self._programs[program_key][1])
         return names
 
+    def _uniforms(self, program_key: str) -> dict[str, moderngl.Uniform]:
+        """A program's uniforms by name (its other members are attributes)."""
+        program = self._programs[program_key][1]
+        return {name: member for name in self._members(program_key)
+                if isinstance(member := program[name], moderngl.Uniform)}
+
     def draw_node(self, node: Node, draw: Draw, camera: PassCamera, *, model: np.ndarray | None = None,
                   front_face: str = "ccw", lights: tuple[Light, ...] | None = None,
                   material: Material | None = None) -> None:
@@ -573,40 +585,48 @@ class Executor:
             own = self._check_user_draw(user, self._programs[draw.program][1], self._members(draw.program), node)
             self._user_nodes.setdefault(draw.program, {})[node.name] = node
         setup = self._draw_setup(draw.program, node.mesh)
-        program, members, write = setup.program, setup.members, setup.write
         self._mesh_last_frame[setup.mesh_key] = self._frame
-        vao, gpu = setup.vao, setup.gpu
         model = node.model if model is None else model
         material = node.material if material is None else material
-        self._set_culling(draw.cull_back_faces, front_face)
+        if (draw.cull_back_faces, front_face) != self._culling:
+            self._set_culling(draw.cull_back_faces, front_face)
         model_bytes, normal_bytes = self._model_bytes(model, setup.normal)
-        write("m_model", model_bytes)
-        write("m_view", camera.view_bytes)
-        write("m_proj", camera.proj_bytes)
-        write("u_color", _color_bytes(material.color))
+        # What this draw writes: the matrices, then (lit) the eye and the lights, then the
+        # material's constants (made once per material and program, _material_constants).
+        values = [("m_model", model_bytes), ("m_view", camera.view_bytes), ("m_proj", camera.proj_bytes)]
         if normal_bytes is not None:
-            write("m_normal", normal_bytes)
-        if material.lit or user is not None:  # a node's own shader may light itself whatever the shading
-            write("u_eye", camera.eye_bytes)
+            values.append(("m_normal", normal_bytes))
+        lit = material.lit or user is not None  # a node's own shader may light itself whatever the shading
+        if lit:
+            values.append(("u_eye", camera.eye_bytes))
             frame_lights = self._lights if lights is None else lights
             if frame_lights:  # with none, the shader's arrays do not exist (NUM_LIGHTS 0)
                 light_pos, light_color = self._light_bytes(frame_lights)
-                write("u_light_pos", light_pos)
-                write("u_light_color", light_color)
-            for name, data in _material_bytes(material):
-                write(name, data)
-        for name, value in own.items():
-            program[name].value = value
-        write("u_alpha_cutoff", _float_bytes(material.alpha_cutoff))
+                values += (("u_light_pos", light_pos), ("u_light_color", light_color))
+        constants = setup.constants.get(id(material))
+        if constants is None or constants[0] is not material:
+            constants = setup.constants[id(material)] = (material, self._material_constants(material, lit))
+        written, uniforms = setup.written, setup.uniforms
+        for name, data in (*values, *constants[1]):
+            # A program keeps its uniform values between draws and frames: bytes equal to the
+            # last written (the view while the camera stands, lights, materials) are not sent.
+            if written.get(name) != data:
+                written[name] = data
+                uniform = uniforms.get(name)
+                if uniform is not None:  # a term the compiler removed has no uniform
+                    uniform.write(data)
+        if own:
+            program = setup.program
+            for name, value in own.items():
+                program[name].value = value
         texture = material.texture
-        if texture is not None:  # unit 0: the material's texture
-            if self._bound_texture is not texture:  # consecutive draws of one texture bind it once
-                self._textures.bind(texture, 0)
-                self._bound_texture = texture
-            write("u_texture", _UNIT_0)
+        if texture is not None and self._bound_texture is not texture:  # unit 0; consecutive draws bind once
+            self._textures.bind(texture, 0)
+            self._bound_texture = texture
         if draw.shadow_map is not None:  # unit 1: the light's shadow map (a depth texture, compared)
             for name, data in self.shadow_maps.use(draw.shadow_map, SHADOW_MAP_UNIT):
-                write(name, data)
+                setup.write(name, data)
+        vao, gpu = setup.vao, setup.gpu
         if draw.blend:  # over what is drawn already; hidden by it where nearer, but not hiding
             self.ctx.enable(moderngl.BLEND)
             self.ctx.blend_func = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA)
@@ -638,16 +658,29 @@ class Executor:
                 return setup
             vao, gpu = self._vao(mesh, program_key)
             setup = _DrawSetup(origin, program, members, self._uniform_writer(program_key, program, members),
-                               _moved_key(origin), vao, gpu, "m_normal" in members)
+                               _moved_key(origin), vao, gpu, "m_normal" in members,
+                               self._uniforms(program_key), self._written.setdefault(program_key, {}))
             self._setups[moved_key] = setup
             return setup
         vao, gpu = self._vao(drawn, program_key)
         if len(self._setups) >= self.SETUPS_KEPT:  # new meshes every frame (a trail): start again
             self._setups.clear()
         setup = _DrawSetup(mesh, program, members, self._uniform_writer(program_key, program, members), _mesh_key(drawn), vao, gpu,
-                           "m_normal" in members)
+                           "m_normal" in members, self._uniforms(program_key), self._written.setdefault(program_key, {}))
         self._setups[(program_key, id(mesh))] = setup
         return setup
+
+    @staticmethod
+    def _material_constants(material: Material, lit: bool) -> tuple[tuple[str, bytes], ...]:
+        """The uniform bytes a draw of ``material`` writes that no position changes: its colour,
+        (lit) the coefficients of the course's formula, the alpha cutoff, the texture's unit."""
+        constants = [("u_color", _color_bytes(material.color))]
+        if lit:
+            constants += _material_bytes(material)
+        constants.append(("u_alpha_cutoff", _float_bytes(material.alpha_cutoff)))
+        if material.texture is not None:
+            constants.append(("u_texture", _UNIT_0))
+        return tuple(constants)
 
     @staticmethod
     def _model_bytes(model: np.ndarray, normal: bool) -> tuple[bytes, bytes | None]:
