@@ -782,9 +782,11 @@ def eye_position(view: np.ndarray) -> np.ndarray:
 
 
 #: Pass kinds whose runners leave GL state as :func:`glsandbox.gl.passes.restore_state` sets it,
-#: but for culling (:meth:`Executor._set_culling`): a clear, and a draw pass (its blended draws
-#: put blending and depth writes back).
-_STATE_KEEPING = frozenset({"clear", "draw"})
+#: but for culling (:meth:`Executor._set_culling`): a clear, a draw pass (its blended draws
+#: put blending and depth writes back) and an overlay pass (:meth:`OverlayDrawer.draw` puts
+#: blending and the scissor back, and switches off only the depth test, which every pass
+#: sets for itself, and culling, which restore_state leaves off).
+_STATE_KEEPING = frozenset({"clear", "draw", "overlay"})
 
 #: One runner per pass kind (:data:`glsandbox.plan.PASS_KINDS`); a new kind adds
 #: its entry here and its describer in :data:`glsandbox.plan.PASS_DESCRIBERS`.
