@@ -373,15 +373,18 @@ class Executor:
         key = _mesh_key(mesh, arrays)
         gpu = self._meshes.get(key)
         if gpu is None:
-            arrays = arrays or _gpu_arrays(mesh)
-            index_array = arrays.pop("indices", None)
-            buffers = {attr: self.ctx.buffer(array) for attr, array in arrays.items()}
-            index = None if index_array is None else self.ctx.buffer(index_array)
-            del arrays, index_array
-            gpu = _GpuMesh(buffers, index, _MODES[mesh.mode], mesh.element_count)
-            self._meshes[key] = gpu
+            gpu = self._meshes[key] = self._upload(mesh, arrays or _gpu_arrays(mesh))
         self._mesh_last_frame[key] = self._frame
         return key, gpu
+
+    def _upload(self, mesh: Mesh, arrays: dict[str, np.ndarray], moving: bool = False) -> _GpuMesh:
+        """GPU buffers of ``arrays`` (:func:`_gpu_arrays` of ``mesh``); ``moving``: the positions
+        are rewritten each frame (a dynamic buffer, and the mesh's positions remembered)."""
+        index_array = arrays.pop("indices", None)
+        buffers = {attr: self.ctx.buffer(array, dynamic=moving and attr == "in_position")
+                   for attr, array in arrays.items()}
+        index = None if index_array is None else self.ctx.buffer(index_array)
+        return _GpuMesh(buffers, index, _MODES[mesh.mode], mesh.element_count, mesh.positions if moving else None)
 
     def _moved_gpu_mesh(self, mesh: Mesh, origin: Mesh) -> tuple[tuple[str, str], _GpuMesh]:
         """A moved mesh (:func:`glsandbox.scene.moved_mesh`): the buffers of the mesh it was moved
@@ -390,11 +393,7 @@ class Executor:
         key = _moved_key(origin)
         gpu = self._meshes.get(key)
         if gpu is None:
-            arrays = _gpu_arrays(mesh)
-            index_array = arrays.pop("indices", None)
-            buffers = {attr: self.ctx.buffer(array, dynamic=attr == "in_position") for attr, array in arrays.items()}
-            index = None if index_array is None else self.ctx.buffer(index_array)
-            gpu = self._meshes[key] = _GpuMesh(buffers, index, _MODES[mesh.mode], mesh.element_count, mesh.positions)
+            gpu = self._meshes[key] = self._upload(mesh, _gpu_arrays(mesh), moving=True)
         elif gpu.positions is not mesh.positions:
             gpu.buffers["in_position"].write(np.ascontiguousarray(mesh.positions, dtype="f4"))
             gpu.positions = mesh.positions
@@ -474,6 +473,10 @@ class Executor:
                 try:
                     runner(self, frame, step, self._frame_camera(frame, step))
                     restored = step.kind in _STATE_KEEPING
+                    changed = _PASS_CHANGES.get(step.kind)
+                    if changed is not None:  # a planar pass: only what it changes is put back
+                        gl_passes.restore_state(self.ctx, self.raw, changed)
+                        restored = True
                 finally:
                     if restored:
                         self._set_culling(False, "ccw")
@@ -605,6 +608,8 @@ class Executor:
                 values += (("u_light_pos", light_pos), ("u_light_color", light_color))
         constants = setup.constants.get(id(material))
         if constants is None or constants[0] is not material:
+            if len(setup.constants) >= 64:  # materials made anew each frame (a planar shadow's): start again
+                setup.constants.clear()
             constants = setup.constants[id(material)] = (material, self._material_constants(material, lit))
         written, uniforms = setup.written, setup.uniforms
         for name, data in (*values, *constants[1]):
@@ -787,6 +792,12 @@ def eye_position(view: np.ndarray) -> np.ndarray:
 #: blending and the scissor back, and switches off only the depth test, which every pass
 #: sets for itself, and culling, which restore_state leaves off).
 _STATE_KEEPING = frozenset({"clear", "draw", "overlay"})
+#: The planar passes (:mod:`glsandbox.gl.planar`) and the groups of
+#: :func:`~glsandbox.gl.passes.restore_state` each changes (culling besides, through
+#: :meth:`Executor._set_culling`): after one, only those are put back.
+_PASS_CHANGES = {"mark_mirror": frozenset({"stencil", "masks"}), "reflection": frozenset({"stencil"}),
+                 "mirror_surface": frozenset({"blend"}),
+                 "planar_shadow": frozenset({"stencil", "masks", "blend", "offset"})}
 
 #: One runner per pass kind (:data:`glsandbox.plan.PASS_KINDS`); a new kind adds
 #: its entry here and its describer in :data:`glsandbox.plan.PASS_DESCRIBERS`.
