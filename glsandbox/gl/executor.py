@@ -725,10 +725,11 @@ class Executor:
         return cached[1], cached[2]
 
     def _unbind_texture(self) -> None:
-        """Forget which material texture is on unit 0 (the overlays and the next user of the
-        context bind their own there): the next draw of a texture binds it again. The filter
-        and wrap are the texture's own (:meth:`TextureCache.bind`): no sampler object is left."""
-        self._bound_texture = None
+        """Leave texture unit 0 without the frame's sampler object (the overlays and the next user
+        of the context see plain texture state); once per frame, not per draw."""
+        if self._bound_texture is not None:
+            self._textures.unbind(0)
+            self._bound_texture = None
 
     def _traced_before(self, frame: FrameState, step: Pass, camera: PassCamera | None) -> None:
         """A ``trace`` pass is run before the executor, by :func:`glsandbox.frame.trace_viewports`

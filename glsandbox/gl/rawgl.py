@@ -35,7 +35,6 @@ GL_FRAMEBUFFER_ATTACHMENT_DEPTH_SIZE = 0x8216
 GL_FRAMEBUFFER_ATTACHMENT_STENCIL_SIZE = 0x8217
 GL_DITHER = 0x0BD0
 GL_STENCIL_TEST = 0x0B90
-GL_TEXTURE_2D = 0x0DE1
 GL_TEXTURE_WRAP_S = 0x2802
 GL_TEXTURE_WRAP_T = 0x2803
 # Stencil, depth and clip state (the mirror and shadow passes, glsandbox.gl.planar; reverse-Z, glsandbox.gl.depth).
@@ -90,7 +89,6 @@ _SIGNATURES: dict[str, tuple] = {
     "glClearStencil": (_VOID, _INT),
     "glClear": (_VOID, _UINT),
     "glSamplerParameteri": (_VOID, _UINT, _UINT, _INT),
-    "glTexParameteri": (_VOID, _UINT, _UINT, _INT),
     "glActiveTexture": (_VOID, _UINT),
     "glColorMask": (_VOID, ctypes.c_ubyte, ctypes.c_ubyte, ctypes.c_ubyte, ctypes.c_ubyte),
     "glDepthMask": (_VOID, ctypes.c_ubyte),
@@ -180,11 +178,11 @@ class RawGL:
         self.glBindFramebuffer(GL_FRAMEBUFFER, old)
         return bits[0], bits[1]
 
-    def texture_wrap(self, mode: int) -> None:
-        """Set the s and t wrap modes of the 2D texture bound to the active unit (moderngl
-        cannot set ``GL_MIRRORED_REPEAT``)."""
-        self.glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, mode)
-        self.glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, mode)
+    def sampler_wrap(self, sampler: int, mode: int) -> None:
+        """Set a sampler object's s and t wrap modes (moderngl cannot set
+        ``GL_MIRRORED_REPEAT``)."""
+        self.glSamplerParameteri(sampler, GL_TEXTURE_WRAP_S, mode)
+        self.glSamplerParameteri(sampler, GL_TEXTURE_WRAP_T, mode)
 
     def sampler_bindings(self, units: int = 4) -> tuple[int, ...]:
         """The sampler object bound to each of the first ``units`` texture units (0: none, the

@@ -1,13 +1,11 @@
 """GPU textures and samplers: upload once, bind per draw.
 
 Course section "Texture Mapping": the pixel shader reads the texture through
-a sampler state (the course's ``g_pSamplerLinear``). A texture is uploaded once
-per content (a built-in image by name, a file by path, size and modification
-time); the filter and wrap a draw asks for are set on the texture itself, only
-when they differ from the ones it holds, so the same image is drawn with any
-filter, which is what the lesson compares. (Sampler objects would say the same,
-but on llvmpipe a draw that changes texture under a bound sampler object costs
-about 30 us more of the main thread: issue 24.)
+a sampler state (the course's ``g_pSamplerLinear``). Here the image and the
+sampler are separate GL objects too: a texture is uploaded once per content
+(a built-in image by name, a file by path, size and modification time) and
+a sampler object is made once per (filter, wrap); binding both to unit 0
+draws the same image with any filter, which is what the lesson compares.
 
 Rows are uploaded top row first, so texture coordinate t = 0 is the top of
 the picture: the course's DirectX uv, with v growing downwards, works as is.
@@ -51,7 +49,7 @@ class TextureCache:
         self.host = host
         self.ctx = host.ctx
         self._textures: dict[tuple, moderngl.Texture] = {}
-        self._sampling: dict[int, tuple[str, str]] = {}  # (filter, wrap) each texture holds, by its GL name
+        self._samplers: dict[tuple[str, str], moderngl.Sampler] = {}
 
     @property
     def max_size(self) -> int:
@@ -96,21 +94,32 @@ class TextureCache:
             texture.write(np.ascontiguousarray(image).tobytes(), level=level)
         return texture
 
+    def sampler(self, spec: Texture) -> moderngl.Sampler:
+        """The sampler object for ``(spec.filter, spec.wrap)``."""
+        key = (spec.filter, spec.wrap)
+        sampler = self._samplers.get(key)
+        if sampler is None:
+            anisotropy = min(ANISOTROPY, float(self.ctx.max_anisotropy)) if spec.filter == "anisotropic" else 1.0
+            sampler = self.ctx.sampler(filter=FILTERS[spec.filter], anisotropy=anisotropy)
+            # moderngl 5.13 keeps the sampler's GL name in ``_glo`` (no public ``glo``).
+            self.host.raw.sampler_wrap(sampler._glo, WRAPS[spec.wrap])
+            self._samplers[key] = sampler
+        return sampler
+
     def bind(self, spec: Texture, unit: int = 0) -> None:
-        """Bind the texture to texture unit ``unit``, sampled with ``spec``'s filter and wrap."""
+        """Bind the texture and its sampler to texture unit ``unit``."""
         texture = self.texture(spec)
-        texture.use(unit)  # the active unit is ``unit`` now: glTexParameteri sets this texture's
-        sampling = (spec.filter, spec.wrap)
-        if self._sampling.get(texture.glo) != sampling:
-            texture.filter = FILTERS[spec.filter]
-            texture.anisotropy = min(ANISOTROPY, float(self.ctx.max_anisotropy)) \
-                if spec.filter == "anisotropic" else 1.0
-            texture.use(unit)  # moderngl set those on its own scratch unit
-            self.host.raw.texture_wrap(WRAPS[spec.wrap])
-            self._sampling[texture.glo] = sampling
+        self.sampler(spec).use(unit)
+        texture.use(unit)
+
+    def unbind(self, unit: int = 0) -> None:
+        """Unbind the sampler object, so later draws see plain texture state."""
+        self.ctx.clear_samplers(unit, unit + 1)
 
     def release(self) -> None:
         for texture in self._textures.values():
             texture.release()
+        for sampler in self._samplers.values():
+            sampler.release()
         self._textures.clear()
-        self._sampling.clear()
+        self._samplers.clear()
