@@ -21,7 +21,7 @@ from glsandbox.planar import shadow_casters
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh
 from glsandbox.overlay import Overlay
-from glsandbox.scene import Camera, Node, Scene
+from glsandbox.scene import Camera, Color, Material, Node, Scene
 from glsandbox.shadowmap import casters, casting_light, receivers
 
 
@@ -725,6 +725,29 @@ def cutout_shadow(material: Any) -> float | None:
     return material.alpha_cutoff / alpha
 
 
+def caster_program(node: Node, whole: ProgramVariant) -> ProgramVariant | None:
+    """The program a caster is drawn with into a planar shadow or a shadow map: ``whole`` (its
+    whole shape), :data:`CUTOUT_SHADOW_PROGRAM` for a textured cut-out (its drawn texels only),
+    or None for a caster that casts nothing: a blended part (light passes it as a camera ray
+    does, glsandbox draws no partial shadows) or a cut-out cut away everywhere. The ray
+    engines' shadow rays follow the same rule (:mod:`glsandbox.raytrace.world`)."""
+    material = node.material
+    if material.alpha_mode == "blend":
+        return None
+    cut = cutout_shadow(material) if node.mesh.uvs is not None or material.texture is None else None
+    if cut == math.inf:
+        return None
+    return whole if cut is None else CUTOUT_SHADOW_PROGRAM
+
+
+def cutout_caster_material(material: Material, color: Color) -> Material:
+    """What a caster drawn with :data:`CUTOUT_SHADOW_PROGRAM` is drawn with: one flat ``color``,
+    the part's texture, and the cutoff its texels' alpha must reach (:func:`cutout_shadow`)."""
+    cutoff = cutout_shadow(material)
+    return Material(color=color, texture=material.texture, alpha_mode="mask",
+                    alpha_cutoff=float(cutoff) if cutoff is not None else 0.0)
+
+
 def _has_planar_effects(scene: Scene) -> bool:
     return scene.mirror is not None or scene.planar_shadow is not None
 
@@ -799,11 +822,9 @@ def planar_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
         for name in casting.kept:
             if not nodes[name].shown_in(index):
                 continue
-            cut = cutout_shadow(nodes[name].material) if nodes[name].mesh.uvs is not None or \
-                nodes[name].material.texture is None else None
-            if cut == math.inf:
-                continue  # cut out everywhere: drawn nowhere, it casts nothing either
-            variant = PLANAR_SHADOW_PROGRAM if cut is None else CUTOUT_SHADOW_PROGRAM
+            variant = caster_program(nodes[name], PLANAR_SHADOW_PROGRAM)
+            if variant is None:
+                continue  # blended, or cut out everywhere: it casts nothing
             programs.add(variant)
             draws.append(Draw(name, variant.key, False))
         passes.append(Pass("planar_shadow", index, draws=tuple(draws), depth_test=True,
@@ -833,7 +854,8 @@ def describe_planar_pass(step: Pass) -> str:
 
 #: The texture unit a receiver's shadow map is bound to (unit 0 is the material's texture).
 SHADOW_MAP_UNIT = 1
-#: Casters are drawn into the map with the flat program; only their depth is kept.
+#: Casters are drawn into the map with the flat program (a textured cut-out with
+#: :data:`CUTOUT_SHADOW_PROGRAM`, a blended one not at all: :func:`caster_program`); only their depth is kept.
 DEPTH_PROGRAM = ProgramVariant("basic", (("SOLID_COLOR", ""),))
 
 
@@ -846,11 +868,14 @@ def shadow_map_passes(scene: Scene, programs: set[ProgramVariant]) -> tuple[list
         return [], None
     shadow = scene.lights[light].shadow
     assert shadow is not None
-    draws = tuple(Draw(node.name, DEPTH_PROGRAM.key, node.cull_back_faces) for node in casters(scene))
-    if draws:
-        programs.add(DEPTH_PROGRAM)
+    draws = []
+    for node in casters(scene):
+        variant = caster_program(node, DEPTH_PROGRAM)  # a cut-out's depth only where it is drawn
+        if variant is not None:
+            programs.add(variant)
+            draws.append(Draw(node.name, variant.key, node.cull_back_faces))
     detail = f"{shadow.size}x{shadow.size} depth 24, perspective {shadow.fov:g}°"
-    return [Pass("shadow_map", -1, clear_depth=True, draws=draws, depth_test=True, detail=detail,
+    return [Pass("shadow_map", -1, clear_depth=True, draws=tuple(draws), depth_test=True, detail=detail,
                  target=f"shadow map {light}", camera=f"light {light}")], light
 
 

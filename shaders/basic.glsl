@@ -4,9 +4,9 @@
 // Tutorial 04 cube). TEXTURED multiplies by the texture on unit 0 at the
 // mesh's uv (course section "Texture Mapping"). ALPHA_MASK discards a
 // fragment whose alpha is below u_alpha_cutoff (a model file's cut-outs).
-// CUTOUT_SHADOW (with TEXTURED and ALPHA_MASK): a cut-out's planar shadow,
-// the flat colour where the texture's alpha reaches the cutoff, nothing
-// where the part is cut out.
+// CUTOUT_SHADOW (with TEXTURED and ALPHA_MASK): a cut-out's planar shadow
+// (or its depth in a shadow map), the flat colour where the texture's alpha
+// reaches the cutoff, nothing where the part is cut out.
 
 #if defined(VERTEX_SHADER)
 #include "common/transform.glsl"

@@ -16,10 +16,13 @@
 // larger one in RGBA32F textures read with texelFetch (u_nodes, u_tris).
 //
 // Variants: NUM_LIGHTS (the light loop), NUM_TEXTURES (0..4 samplers),
-// SHADOWS (shadow rays), REFLECT (reflection bounces and passes through
+// SHADOWS (shadow rays; CUTOUT_SHADOWS: some textured cut-out, whose shadow
+// rays read its texels), REFLECT (reflection bounces and passes through
 // see-through surfaces: some node reflects, is a cut-out or is blended, and
 // max_depth > 0), HAS_MESHES, HAS_SHAPES (some analytic node) and
-// HAS_<KIND> per analytic kind (HAS_SPHERE, HAS_CYLINDER), VERTEX_COLORS (a node uses
+// HAS_<KIND> per analytic kind (HAS_SPHERE, HAS_CYLINDER), TWO_SIDED (a node is lit
+// on both sides), SEE_THROUGH (a node is a cut-out or blended), SIMPLE_OFFSET
+// (the teaching variant of the secondary rays' offset), VERTEX_COLORS (a node uses
 // them); SCENE_NODES (the scene's node list, see nearest()) with
 // NODE_COUNT and TRI_COUNT for a small scene, whose records are in the
 // uniform block.
@@ -55,8 +58,7 @@ uniform vec3 u_background;  // the viewport's clear colour
 uniform int u_max_depth;    // reflection bounces (REFLECT: > 0)
 uniform int u_cull;         // -1: per node (as the rasterizer), 0: never, 1: always
 uniform bool u_aabb;
-uniform bool u_simple_offset;  // the teaching variant: offset u_offset * max(1, max|P|), not the error bound
-uniform float u_offset;
+uniform float u_offset;     // SIMPLE_OFFSET (the teaching variant): offset u_offset * max(1, max|P|), not the error bound
 #if NUM_LIGHTS > 0
 uniform vec3 u_light_pos[NUM_LIGHTS];
 uniform vec3 u_light_color[NUM_LIGHTS];
@@ -75,6 +77,17 @@ uniform sampler2D u_tex2;
 uniform sampler2D u_tex3;
 #endif
 out vec4 frag_color;
+
+// The general program's node counts: literals from the host (gpu.py), so a
+// scene of one mesh node (a model) runs its node loop as straight code: a
+// loop whose bound is a uniform cost about 15% of a primary frame of a
+// 1,000-triangle model on llvmpipe, before any BVH work.
+#ifndef MESH_NODES
+#define MESH_NODES u_mesh_count
+#endif
+#ifndef SHAPE_NODES
+#define SHAPE_NODES u_shape_count
+#endif
 
 #if defined(SCENE_NODES)
 layout(std140) uniform SceneData {
@@ -96,6 +109,18 @@ vec4 tri_rec(int k, int r) { return record(u_tris, k * TRI_RECORDS + r); }
 
 #ifndef BVH
 #define BVH 0
+#endif
+#ifndef CUTOUT_SHADOWS
+#define CUTOUT_SHADOWS 0
+#endif
+#if SHADOWS && CUTOUT_SHADOWS
+// A textured cut-out blocks a shadow ray only on a drawn texel (shadow_texel,
+// below); the BVH's any-hit walk asks it for the node g_shadow_node.
+bool shadow_texel(int k, int j, float t, vec2 bary, vec3 o, vec3 d);
+int g_shadow_node = -1;
+#define BVH_ANY_ACCEPT(index, t, uv) shadow_texel(g_shadow_node, index, t, uv, o, d)
+#else
+#define shadow_texel(k, j, t, bary, o, d) true
 #endif
 #if BVH
 // Mesh nodes traced through their BVHs (gpu.py packs one per mesh node into
@@ -283,7 +308,7 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
     // and within a node to the first triangle.
     float best_order = 1e9;
 #if HAS_MESHES && BVH
-    for (int k = 0; k < u_mesh_count; ++k) {
+    for (int k = 0; k < MESH_NODES; ++k) {
         BvhHit h = bvh_closest_at(bvh_root(k), o, d, best, node_cull(node_rec(k, NODE_BOX_MAX)));
         if (h.overflow) g_overflow = true;
         if (h.index >= 0 && h.t < best) {
@@ -291,7 +316,7 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
         }
     }
 #elif HAS_MESHES
-    for (int k = 0; k < u_mesh_count; ++k) {
+    for (int k = 0; k < MESH_NODES; ++k) {
         vec4 r0 = node_rec(k, NODE_BOX_MIN);
         vec4 r1 = node_rec(k, NODE_BOX_MAX);
         if (u_aabb && !slab(o, inv_d, r0.xyz, r1.xyz, best)) continue;
@@ -308,7 +333,7 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
     }
 #endif
 #if HAS_SHAPES
-    for (int k = u_mesh_count; k < u_mesh_count + u_shape_count; ++k) {
+    for (int k = MESH_NODES; k < MESH_NODES + SHAPE_NODES; ++k) {
         vec4 r0 = node_rec(k, NODE_BOX_MIN);
         vec4 r1 = node_rec(k, NODE_BOX_MAX);
         if (u_aabb && !slab(o, inv_d, r0.xyz, r1.xyz, best)) continue;
@@ -337,10 +362,14 @@ bool occluded(vec3 o, vec3 d, int light) {
     // none where the compiler unrolls the light loop.
 #define MESH(k, start, cull, lamps) if (((lamps >> light) & 1) == 0) { \
         int stop = start + box_count(k, o, inv_d, 1.0); \
-        for (int j = start; j < stop && !hit; ++j) hit = triangle_t(j, wr, cull != 0, uv) < 1.0; \
+        for (int j = start; j < stop && !hit; ++j) { \
+            float t = triangle_t(j, wr, cull != 0, uv); \
+            hit = t < 1.0 && shadow_texel(k, j, t, uv, o, d); \
+        } \
     }
-#define TRI(k, j, cull, lamps) if (((lamps >> light) & 1) == 0) { \
-        hit = hit || triangle_t(j, wr, cull != 0, uv) < 1.0; \
+#define TRI(k, j, cull, lamps) if (((lamps >> light) & 1) == 0 && !hit) { \
+        float t = triangle_t(j, wr, cull != 0, uv); \
+        hit = t < 1.0 && shadow_texel(k, j, t, uv, o, d); \
     }
 #define SHAPE(k, kind, cull, lamps) if (((lamps >> light) & 1) == 0) { \
         hit = hit || shape_t(kind, to_object(k, o, 1.0), to_object(k, d, 0.0), cull != 0) < 1.0; \
@@ -352,15 +381,18 @@ bool occluded(vec3 o, vec3 d, int light) {
     return hit;
 #else
 #if HAS_MESHES && BVH
-    for (int k = 0; k < u_mesh_count; ++k) {
+    for (int k = 0; k < MESH_NODES; ++k) {
         if (((int(node_rec(k, NODE_EXTRA).z) >> light) & 1) != 0) continue;
+#if CUTOUT_SHADOWS
+        g_shadow_node = k;
+#endif
         bool overflow;
         bool blocked = bvh_any_at(bvh_root(k), o, d, 1.0, node_cull(node_rec(k, NODE_BOX_MAX)), overflow);
         if (overflow) g_overflow = true;
         if (blocked) return true;
     }
 #elif HAS_MESHES
-    for (int k = 0; k < u_mesh_count; ++k) {
+    for (int k = 0; k < MESH_NODES; ++k) {
         vec4 r0 = node_rec(k, NODE_BOX_MIN);
         vec4 r1 = node_rec(k, NODE_BOX_MAX);
         if (((int(node_rec(k, NODE_EXTRA).z) >> light) & 1) != 0) continue;
@@ -370,12 +402,13 @@ bool occluded(vec3 o, vec3 d, int light) {
         int start = int(r2.x);
         int stop = start + int(r2.y);
         for (int j = start; j < stop; ++j) {
-            if (triangle_t(j, wr, cull, uv) < 1.0) return true;
+            float t = triangle_t(j, wr, cull, uv);
+            if (t < 1.0 && shadow_texel(k, j, t, uv, o, d)) return true;
         }
     }
 #endif
 #if HAS_SHAPES
-    for (int k = u_mesh_count; k < u_mesh_count + u_shape_count; ++k) {
+    for (int k = MESH_NODES; k < MESH_NODES + SHAPE_NODES; ++k) {
         vec4 r0 = node_rec(k, NODE_BOX_MIN);
         vec4 r1 = node_rec(k, NODE_BOX_MAX);
         if (((int(node_rec(k, NODE_EXTRA).z) >> light) & 1) != 0) continue;
@@ -466,10 +499,13 @@ void surface(int k, int j, float t, vec2 bary, vec3 o, vec3 d, out vec3 p, out v
         vec3 w = vec3(1.0 - bary.x - bary.y, bary.x, bary.y);
         vec4 a = tri_rec(j, TRI_NORMAL), b = tri_rec(j, TRI_NORMAL + 1), c = tri_rec(j, TRI_NORMAL + 2);
         n = w.x * a.xyz + w.y * b.xyz + w.z * c.xyz;
+#if TWO_SIDED
         // Two-sided: a back face seen (the ray along the face normal (V1-V0) x (V2-V0), the
-        // rasterizer's !gl_FrontFacing) is lit as its other side.
+        // rasterizer's !gl_FrontFacing) is lit as its other side. Compiled out where no node
+        // is: on llvmpipe its mere presence cost 6% of a phong frame, run or not.
         vec3 v0 = tri_rec(j, TRI_V0).xyz;
         if ((flags & 2) != 0 && dot(cross(tri_rec(j, TRI_V1).xyz - v0, tri_rec(j, TRI_V2).xyz - v0), d) > 0.0) n = -n;
+#endif
 #if VERTEX_COLORS || NUM_TEXTURES > 0
         vec4 ca = tri_rec(j, TRI_COLOR), cb = tri_rec(j, TRI_COLOR + 1), cc = tri_rec(j, TRI_COLOR + 2);
         uv = w.x * vec2(a.w, b.w) + w.y * vec2(c.w, ca.w) + w.z * vec2(cb.w, cc.w);
@@ -503,6 +539,22 @@ float coverage(int k, float alpha) {
     int mode = int(look.y);
     return mode == 1 ? (alpha >= look.z ? 1.0 : 0.0) : mode == 2 ? alpha : 1.0;
 }
+
+#if SHADOWS && CUTOUT_SHADOWS
+// Whether shadow ray o + t d (0 < t < 1) meeting node k's triangle j at `bary`
+// is blocked there (numpy_engine._drawn_texels): anywhere on an opaque node,
+// on a cut-out only where it is drawn, its alpha (surface's: the colour's
+// times the texel's) at or above the cutoff. The rasterizer's planar shadow
+// and shadow map discard the same texels.
+bool shadow_texel(int k, int j, float t, vec2 bary, vec3 o, vec3 d) {
+    vec4 look = node_rec(k, NODE_LOOK);  // alpha, alpha mode, cutoff, flags
+    if (int(look.y) != 1) return true;
+    vec3 p, n, base;
+    float alpha;
+    surface(k, j, t, bary, o, d, p, n, base, alpha);
+    return alpha >= look.z;
+}
+#endif
 
 // Where secondary rays start (pbrt-v4, "Robust spawned ray origins"): the
 // hit point with a bound `err` on its rounding error per component, and the
@@ -549,11 +601,11 @@ float next_float(float x, float dir) {
 // `towards` on (as the numpy engine's _offset, which says why).
 vec3 offset_point(Spawn s, vec3 n, vec3 towards) {
     vec3 offset;
-    if (u_simple_offset) {
-        offset = u_offset * max(1.0, max(max(abs(s.p.x), abs(s.p.y)), abs(s.p.z))) * s.ng;
-    } else {
-        offset = dot(abs(s.ng), s.err) * s.ng;
-    }
+#if SIMPLE_OFFSET
+    offset = u_offset * max(1.0, max(max(abs(s.p.x), abs(s.p.y)), abs(s.p.z))) * s.ng;
+#else
+    offset = dot(abs(s.ng), s.err) * s.ng;
+#endif
     if ((dot(n, towards) < 0.0) != (dot(s.ng, n) < 0.0)) offset = -offset;
     vec3 q = s.p + offset;
     return vec3(next_float(q.x, offset.x), next_float(q.y, offset.y), next_float(q.z, offset.z));
@@ -605,6 +657,7 @@ void main() {
         Spawn at = spawn_at(j, t, bary, o, d, n);
         vec3 local = shade(k, p, n, base, d, at);
         bool last = depth >= u_max_depth;
+#if SEE_THROUGH
         // A see-through surface passes the ray on straight, weighted 1 - a; it does not
         // also reflect (numpy_engine._trace). At the last bounce its own colour stands in.
         float a = last ? 1.0 : coverage(k, alpha);
@@ -615,6 +668,10 @@ void main() {
             weight *= 1.0 - a;
             continue;
         }
+#else  // every surface opaque: coverage 1
+        float r = last ? 0.0 : node_rec(k, NODE_EXTRA).x;
+        color += weight * (1.0 - r) * local;
+#endif
         if (r <= 0.0) break;
         vec3 reflected = d - 2.0 * dot(d, n) * n;  // Yansıma vektörü
         o = offset_point(at, n, -d);

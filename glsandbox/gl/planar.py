@@ -26,7 +26,7 @@ import numpy as np
 from glsandbox import transforms
 from glsandbox.gl import rawgl
 from glsandbox.gl.passes import FrameState
-from glsandbox.plan import CUTOUT_SHADOW_PROGRAM, Draw, Pass, StencilState, cutout_shadow
+from glsandbox.plan import CUTOUT_SHADOW_PROGRAM, Draw, Pass, StencilState, cutout_caster_material
 from glsandbox.planar import Mirror
 from glsandbox.scene import Light, Material, Node
 
@@ -157,7 +157,5 @@ def planar_shadow(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any
         node = nodes[draw.node]
         material = flat
         if draw.program == CUTOUT_SHADOW_PROGRAM.key:  # a cut-out: its texture's alpha, the part's cutoff
-            cutoff = cutout_shadow(node.material)
-            material = Material(color=shadow.color, texture=node.material.texture, alpha_mode="mask",
-                                alpha_cutoff=float(cutoff) if cutoff is not None else 0.0)
+            material = cutout_caster_material(node.material, shadow.color)
         drawer.draw_node(node, draw, camera, model=flatten @ node.model, material=material)

@@ -22,7 +22,7 @@ import numpy as np
 from glsandbox import transforms
 from glsandbox.gl import depth as gl_depth
 from glsandbox.gl.passes import FrameState
-from glsandbox.plan import Pass
+from glsandbox.plan import CUTOUT_SHADOW_PROGRAM, Pass, cutout_caster_material
 from glsandbox.scene import ShadowMap
 from glsandbox.shadowmap import light_camera
 
@@ -102,7 +102,12 @@ def run_shadow_map_pass(executor: Any, frame: FrameState, step: Pass, camera: An
         ctx.enable(moderngl.DEPTH_TEST)
         pass_camera = executor.pass_camera(view, proj)
         for draw in step.draws:
-            executor.draw_node(frame.nodes[draw.node], draw, pass_camera)
+            node = frame.nodes[draw.node]
+            if draw.program == CUTOUT_SHADOW_PROGRAM.key:  # a cut-out: depth only where its texels are drawn
+                executor.draw_node(node, draw, pass_camera, material=cutout_caster_material(node.material,
+                                                                                               node.material.color))
+            else:
+                executor.draw_node(node, draw, pass_camera)
     finally:
         gl_depth.begin_depth_mode(ctx, executor.raw, scene)
         frame.framebuffer.use()

@@ -33,6 +33,20 @@ triangles all fall into one bin (all centroids in one point) is cut in half
 by count. The boxes used for binning are the heuristic's; the stored node
 boxes are recomputed exactly from the triangles at the end, leaves first.
 
+Small nodes: the full sweep
+---------------------------
+Bins pay off on big nodes. On a node of a few dozen triangles sixteen bins
+per axis cost as much as the triangles and still see only sixteen cuts, so
+nodes of at most :data:`SMALL` triangles are finished differently
+(``_split_small``): along each axis the node's triangles are sorted by
+centroid and *every* cut between them is scored, the boxes of the first
+``i`` triangles and of the rest being running minima and maxima of the
+sorted boxes (the "full sweep" SAH, MacDonald & Booth's original). The small
+nodes lie one per column of a padded ``(width, nodes)`` array, so each step
+of the running boxes is one numpy call over all of them. Where no cut gains
+(slivers sharing one box), the cut is a multiple of ``leaf_size`` near the
+middle: the subtree then ends in full leaves, the fewest boxes.
+
 Layout (flat arrays, what :mod:`glsandbox.raytrace.gpu_bvh` uploads)
 ------------------------------------------------------------------
 Node ``i`` has the box ``node_min[i] .. node_max[i]`` (float64, exact: the
@@ -99,6 +113,13 @@ SAMPLE: int = 1024
 CENTROID_RANGE: float = 0.5
 #: A node whose best SAH cut costs at least this share of ``N·A(node)`` is cut evenly by count instead.
 NO_GAIN: float = 0.99
+#: Nodes of at most this many triangles are split by the full SAH sweep (``_split_small``), not binned.
+SMALL: int = 64
+#: Padded slots (nodes × width) that ``_split_small`` scores in one batch: about a few MB of boxes each.
+SMALL_CHUNK: int = 1 << 16
+#: The widths ``_split_small`` pads nodes to (powers of two and halfway between: at most a third wasted),
+#: up to 64: SMALL and leaf_size (1..64) at most.
+WIDTHS = np.array([2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64])
 #: BVHs kept by :func:`bvh_for_triangles` / :func:`bvh_for_mesh`.
 CACHE_SIZE: int = 16
 
@@ -212,65 +233,117 @@ def _build_bvh(v0: ArrayLike, v1: ArrayLike, v2: ArrayLike, *, leaf_size: int = 
     hi = np.maximum(np.maximum(a, b), c)
     if keep.size < total:
         a, b, c, lo, hi = (np.take(x, keep, axis=0) for x in (a, b, c, lo, hi))
-    # The binning works on float32 copies, one row per quantity (centroid,
-    # box min, box max; x, y, z each): the SAH is a heuristic, and half the
-    # bytes make its scattered reads faster. The stored boxes are exact
-    # float64, computed from the triangles at the end.
-    rows = np.empty((9, keep.size), dtype=np.float32)
-    rows[0:3] = ((lo + hi) * 0.5).T
-    rows[3:6] = lo.T
-    rows[6:9] = hi.T
-    leaf_of, leaf_rank, first, count, levels = _split_levels(rows, int(leaf_size), int(bins))
+    # The splitting works on float32 copies of the triangles' boxes, one row
+    # per quantity (box min, box max; x, y, z each): the SAH is a heuristic,
+    # and half the bytes make its scattered reads faster. The stored boxes
+    # are exact float64, computed from the triangles at the end.
+    rows = np.empty((6, keep.size), dtype=np.float32)
+    rows[0:3] = lo.T
+    rows[3:6] = hi.T
+    tree = _Tree(keep.size)
+    small = _split_levels(rows, tree, int(leaf_size), int(bins))
+    _split_small(tree, small, int(leaf_size))
+    first, count = tree.arrays()
     # The triangles leaf after leaf: a leaf's first slot plus the place within it.
     leaves = np.flatnonzero(count)
     offsets = np.zeros(count.shape[0], dtype=np.int64)
     offsets[leaves[1:]] = np.cumsum(count[leaves][:-1])
     first[leaves] = offsets[leaves]
     order = np.empty(keep.size, dtype=np.int64)
-    order[offsets[leaf_of] + leaf_rank] = np.arange(keep.size)
+    order[offsets[tree.leaf_of] + tree.leaf_rank] = np.arange(keep.size)
     a, b, c = (np.take(x, order, axis=0) for x in (a, b, c))  # np.take: several times faster than x[order] here
     node_min, node_max = _exact_boxes(np.minimum(np.minimum(a, b), c), np.maximum(np.maximum(a, b), c), first, count,
-                                      leaves, levels)
-    return BVH(node_min, node_max, first, count, a, b, c, keep[order].astype(np.int64),
-               len(levels), total)
+                                      leaves, tree.levels)
+    return BVH(node_min, node_max, first, count, a, b, c, keep[order].astype(np.int64), tree.depth, total)
 
 
-def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
+class _Tree:
+    """The nodes made so far, level after level (children always in pairs, numbered in order):
+    ``first`` and ``count`` per level, each triangle's leaf and its place in it."""
+
+    def __init__(self, triangles: int) -> None:
+        self.leaf_of = np.zeros(triangles, dtype=np.int64)
+        self.leaf_rank = np.arange(triangles)  # each triangle's place within its leaf
+        self.levels: list[NDArray[np.int64]] = [np.zeros(1, dtype=np.int64)]  # the nodes made at each step
+        self.firsts: list[NDArray[np.int64]] = [np.zeros(1, dtype=np.int64)]
+        self.counts: list[NDArray[np.int64]] = [np.array([triangles], dtype=np.int64)]
+        self.next_id = 1
+        self.depth = 1  # nodes on the longest path from the root to a leaf
+        self._parents: list[NDArray[np.int64]] = []  # inner nodes made after the level arrays were written
+        self._lefts: list[NDArray[np.int64]] = []
+
+    def children(self, parents: NDArray[np.int64], child_count: NDArray[np.int64], leaf_size: int
+                 ) -> tuple[NDArray[np.int64], NDArray[np.bool_]]:
+        """Number the pairs of children of ``parents`` (``child_count``: left, right, left, ...):
+        the children's ids and which of them are leaves."""
+        ids = self.next_id + np.arange(child_count.size, dtype=np.int64)
+        self.next_id += child_count.size
+        is_leaf = child_count <= leaf_size
+        level_count = np.where(is_leaf, child_count, 0)
+        self._parents.append(parents)
+        self._lefts.append(ids[0::2])
+        self.levels.append(ids)
+        self.firsts.append(np.zeros(ids.size, dtype=np.int64))
+        self.counts.append(level_count)
+        return ids, is_leaf
+
+    def arrays(self) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+        """``first`` (an inner node's left child) and ``count`` (a leaf's triangles, 0 for inner nodes)."""
+        first = np.concatenate(self.firsts)
+        count = np.concatenate(self.counts)
+        if self._parents:
+            parents = np.concatenate(self._parents)
+            first[parents] = np.concatenate(self._lefts)
+            count[parents] = 0
+        return first, count
+
+
+def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bins: int
                   ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.int64],
-                             list[NDArray[np.int64]]]:
-    """The breadth-first binned-SAH splitting (see the module docstring).
+                             NDArray[np.float32]]:
+    """The breadth-first binned-SAH splitting of the nodes of more than :data:`SMALL` triangles
+    (see the module docstring).
 
-    ``rows`` is ``(9, K)``: centroid, box min and box max of each triangle.
-    Returns each triangle's leaf and its place in it, ``first`` (an inner node's left child),
-    ``count`` (a leaf's triangles, 0 for inner nodes) and the nodes made at
-    each level, root first.
+    ``rows`` is ``(6, K)``: box min and box max of each triangle (left as it is).
+    Records the nodes in ``tree``; returns the nodes of at most :data:`SMALL`
+    triangles still to split (:func:`_split_small`): their triangles (grouped
+    by node), their ids, triangle counts and depths, and the triangles' boxes
+    (``(6, …)``, in the same order).
 
-    The triangles still to split are kept grouped by node (``rows`` columns
+    The triangles still to split are kept grouped by node (``cols`` columns
     in node order, ``counts`` per node), so per-node values reach their
     triangles by ``np.repeat`` and the scattered bin updates stay local in
     memory; each level partitions every node's columns into its two
     children's in one pass (a counting sort: no ``argsort`` per level).
     """
     k = rows.shape[1]
-    leaf_of = np.zeros(k, dtype=np.int64)
-    leaf_rank = np.arange(k)  # each triangle's place within its leaf
-    firsts: list[NDArray[np.int64]] = [np.zeros(1, dtype=np.int64)]
-    counts_of: list[NDArray[np.int64]] = [np.array([k], dtype=np.int64)]
-    levels = [np.zeros(1, dtype=np.int64)]
+    small = max(SMALL, leaf_size)
+    none = np.zeros(0, dtype=np.int64)
     if k <= leaf_size:
-        return leaf_of, leaf_rank, firsts[0], counts_of[0], levels
+        return none, none, none, none, rows[:, :0]
+    if k <= small:
+        tree.counts[0][0] = 0
+        return (np.arange(k), np.zeros(1, dtype=np.int64), np.array([k], dtype=np.int64), np.ones(1, dtype=np.int64),
+                rows)
+    small_tris, small_ids, small_counts, small_depth, small_boxes = [], [], [], [], []
     tris = np.arange(k)  # the caller's triangle of each column
-    # Two flat buffers the columns are moved between, level after level: a fresh 36 bytes per
+    cols = rows.copy()  # the open triangles' boxes, grouped by node
+    # Two flat buffers the columns are moved between, level after level: a fresh 24 bytes per
     # triangle each level would be fresh pages for the kernel to zero and map each time.
-    spare = np.empty(rows.size, dtype=np.float32)
+    spare = np.empty(cols.size, dtype=np.float32)
+    centre = np.empty((3, k), dtype=np.float32)
+    bin_keys = np.empty((3, k), dtype=np.int64)  # made once: fresh pages each level cost more than the casts
     counts = np.array([k], dtype=np.int64)  # columns per open node, in column order
-    box_lo = rows[3:6].min(axis=1)[None, :].astype(np.float64)  # the open nodes' binning boxes
-    box_hi = rows[6:9].max(axis=1)[None, :].astype(np.float64)
-    open_pos = np.zeros(1, dtype=np.int64)  # where the open nodes are in their level's arrays
-    next_id = 1
+    box_lo = rows[0:3].min(axis=1)[None, :].astype(np.float64)  # the open nodes' binning boxes
+    box_hi = rows[3:6].max(axis=1)[None, :].astype(np.float64)
+    open_ids = np.zeros(1, dtype=np.int64)  # the open nodes' ids
+    level = 1
     while counts.size:
         n = counts.size
         width = tris.size
+        cen = centre[:, :width]
+        np.add(cols[0:3], cols[3:6], out=cen)
+        cen *= np.float32(0.5)
         # Bins per node: max_bins, fewer once nodes are small (about one per
         # triangle), so the per-bin work never exceeds the per-triangle work.
         bins = int(min(max_bins, max(4, 1 << int(np.log2(max(1, width // n))))))
@@ -282,18 +355,25 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
         # box, and only the stragglers could be cut off, one level each (a fan
         # of 1M triangles was 5,470 levels deep).
         starts = np.cumsum(counts) - counts
-        centre_lo = np.minimum.reduceat(rows[0:3], starts, axis=1).T.astype(np.float64)
-        centre_hi = np.maximum.reduceat(rows[0:3], starts, axis=1).T.astype(np.float64)
+        centre_lo = np.minimum.reduceat(cen, starts, axis=1).T.astype(np.float64)
+        centre_hi = np.maximum.reduceat(cen, starts, axis=1).T.astype(np.float64)
         bunched = (centre_hi - centre_lo) < CENTROID_RANGE * (box_hi - box_lo)
         box_lo = np.where(bunched, centre_lo, box_lo)
         box_hi = np.where(bunched, centre_hi, box_hi)
         extent = box_hi - box_lo
         scale = np.where(extent > 0.0, bins * (1.0 - 1e-6) / np.where(extent > 0.0, extent, 1.0), 0.0)
-        rel = rows[0:3] - np.repeat(box_lo.T.astype(np.float32), counts, axis=1)
-        rel *= np.repeat(scale.T.astype(np.float32), counts, axis=1)
-        bin_of = np.clip(rel, 0, bins - 1, out=rel).astype(np.int32)  # (3, width)
-        del rel
+        # Each column's bin on each axis, as a key node-major over the level: node i's bins are
+        # i·B .. i·B + B − 1.
         node_key = np.repeat(np.arange(n, dtype=np.int64) * bins, counts)
+        bin_key = bin_keys[:, :width]
+        rel = np.empty(width, dtype=np.float32)
+        for axis in range(3):  # one row at a time: np.repeat of a 1-D array is a plain copy loop
+            np.subtract(cen[axis], np.repeat(box_lo[:, axis].astype(np.float32), counts), out=rel)
+            rel *= np.repeat(scale[:, axis].astype(np.float32), counts)
+            np.clip(rel, 0, bins - 1, out=rel)
+            bin_key[axis] = rel
+            bin_key[axis] += node_key
+        del rel
         best_cost = np.full(n, np.inf)
         best_axis = np.zeros(n, dtype=np.int64)
         best_cut = np.ones(n, dtype=np.int64)
@@ -312,18 +392,20 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
         # 2·SAMPLE triangles use them all.
         stride = np.maximum(1, counts // SAMPLE)
         if stride.max() > 1:
-            rank = np.arange(width) - np.repeat(np.cumsum(counts) - counts, counts)
-            sample = np.flatnonzero(rank % np.repeat(stride, counts) == 0)
-            box_rows = np.take(rows[3:9], sample, axis=1)
-            box_key, box_bins = node_key[sample], np.take(bin_of, sample, axis=1)
+            # Node i's sampled columns: starts[i] + stride[i]·q for q = 0 .. ceil(counts[i] / stride[i]) − 1.
+            taken = -(-counts // stride)
+            q = np.arange(taken.sum()) - np.repeat(np.cumsum(taken) - taken, taken)
+            sample = np.repeat(starts, taken) + q * np.repeat(stride, taken)
+            box_rows = np.take(cols, sample, axis=1)
+            box_keys = np.take(bin_key, sample, axis=1)
         else:
-            box_rows, box_key, box_bins = rows[3:9], node_key, bin_of
+            box_rows, box_keys = cols, bin_key
+        node_lo = node_hi = None
         for axis in range(3):
-            key = node_key + bin_of[axis]  # node-major: node i's bins are i·B .. i·B + B − 1
-            cnt = np.bincount(key, minlength=n * bins).reshape(n, bins)
+            cnt = np.bincount(bin_key[axis], minlength=n * bins).reshape(n, bins)
             blo = np.full((3, n * bins), np.inf, dtype=np.float32)
             bhi = np.full((3, n * bins), -np.inf, dtype=np.float32)
-            key = box_key + box_bins[axis]
+            key = box_keys[axis]
             for j in range(3):
                 np.minimum.at(blo[j], key, box_rows[j])
                 np.maximum.at(bhi[j], key, box_rows[3 + j])
@@ -334,6 +416,8 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
             # the SAH cost N_left·A_left + N_right·A_right of each cut.
             llo, lhi = _sweep(blo3, bhi3, forward=True)
             rlo, rhi = _sweep(blo3, bhi3, forward=False)
+            if node_lo is None:  # all the bins: the node's (sampled) box
+                node_lo, node_hi = llo[:, -1], lhi[:, -1]
             n_left = np.cumsum(cnt.T[:-1], axis=0)
             n_right = counts - n_left
             sah = n_left * _half_area(llo[:, :-1], lhi[:, :-1]) + n_right * _half_area(rlo[:, 1:], rhi[:, 1:])
@@ -365,8 +449,6 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
         # No gain: when the best cut costs about what the node itself does (N·A: every child box
         # as big as the parent's), the SAH would peel a few triangles off per level and the tree
         # grow as deep as the node is large. The most even cut by count keeps the depth logarithmic.
-        node_lo = np.minimum.reduceat(rows[3:6], starts, axis=1)
-        node_hi = np.maximum.reduceat(rows[6:9], starts, axis=1)
         parent_cost = counts * _half_area(node_lo, node_hi).astype(np.float64)
         no_gain = np.flatnonzero(np.isfinite(best_cost) & (best_cost >= NO_GAIN * parent_cost)
                                  & (even_gap < np.iinfo(np.int64).max))
@@ -383,8 +465,8 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
             child_hi = np.where(empty[:, :, None], box_hi[:, None, :], child_hi)
         # Each column's side (True: the right child) on its node's chosen axis.
         columns = np.arange(width)
-        chosen = np.take(bin_of.reshape(-1), np.repeat(best_axis * width, counts) + columns)
-        right = chosen >= np.repeat(best_cut, counts)
+        chosen = np.take(bin_keys.reshape(-1), np.repeat(best_axis * k, counts) + columns)  # row stride: k
+        right = chosen >= np.repeat(nodes * bins + best_cut, counts)
         del chosen
         stuck = np.flatnonzero(~np.isfinite(best_cost))
         if stuck.size:
@@ -395,21 +477,12 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
             right[where] = (rank >= np.repeat(counts // 2, counts))[where]
             child_lo[stuck] = box_lo[stuck][:, None, :]
             child_hi[stuck] = box_hi[stuck][:, None, :]
-        # Children in pairs: open node i gets next_id + 2i (left) and + 2i + 1.
+        # Children in pairs: open node i gets the ids of children 2i (left) and 2i + 1.
         child = 2 * np.repeat(nodes, counts) + right
         child_count = np.bincount(child, minlength=2 * n)
-        child_ids = next_id + np.arange(2 * n, dtype=np.int64)
-        level_first = np.zeros(2 * n, dtype=np.int64)
-        level_count = np.zeros(2 * n, dtype=np.int64)
-        next_id += 2 * n
-        is_leaf = child_count <= leaf_size
-        level_count[is_leaf] = child_count[is_leaf]
-        # The parents: inner nodes pointing at their left child.
-        firsts[-1][open_pos] = child_ids[0::2]
-        counts_of[-1][open_pos] = 0
-        firsts.append(level_first)
-        counts_of.append(level_count)
-        levels.append(child_ids)
+        child_ids, is_leaf = tree.children(open_ids, child_count, leaf_size)
+        level += 1
+        tree.depth = level
         # Each column's rank within its child (lefts keep their order, rights
         # too): with the child's start, its place in the partition below.
         # A right column's rank is the rights before it less the rights before its node's first
@@ -424,31 +497,190 @@ def _split_levels(rows: NDArray[np.float32], leaf_size: int, max_bins: int
         rank = np.subtract(columns, rights_before, out=columns)  # lefts in columns [0, i)
         np.copyto(rank, rights_before, where=right)
         rank -= offset[child]
+        # Leaves and small children (SMALL triangles at most) leave the level loop here: a leaf's
+        # triangles get their places, a small child's go on to _split_small in child order.
+        is_small = ~is_leaf & (child_count <= small)
+        done = is_leaf | is_small
+        tri_done = done[child]
         tri_leaf = is_leaf[child]
+        leaf_of = tree.leaf_of
         leaf_of[tris[tri_leaf]] = child_ids[child[tri_leaf]]
-        leaf_rank[tris[tri_leaf]] = rank[tri_leaf]
+        tree.leaf_rank[tris[tri_leaf]] = rank[tri_leaf]
+        if is_small.any():
+            smalls = np.flatnonzero(is_small)
+            small_ids.append(child_ids[smalls])
+            small_counts.append(child_count[smalls])
+            small_depth.append(np.full(smalls.size, level, dtype=np.int64))
+            tri_small = np.flatnonzero(is_small[child])
+            grouped = np.empty(tri_small.size, dtype=np.int64)  # their columns, node after node
+            small_start = np.zeros(2 * n, dtype=np.int64)
+            small_start[smalls] = np.cumsum(child_count[smalls]) - child_count[smalls]
+            grouped[small_start[child[tri_small]] + rank[tri_small]] = tri_small
+            small_tris.append(tris[grouped])
+            small_boxes.append(np.take(cols, grouped, axis=1))
         # Partition the open columns into the children that stay open (a
         # stable counting sort, no argsort).
-        kept_children = np.flatnonzero(~is_leaf)
+        kept_children = np.flatnonzero(~done)
         if kept_children.size == 0:
             break
         new_counts = child_count[kept_children]
         child_start = np.zeros(2 * n, dtype=np.int64)
         child_start[kept_children] = np.cumsum(new_counts) - new_counts
-        keep = np.flatnonzero(~tri_leaf)
+        keep = np.flatnonzero(~tri_done)
         dest = child_start[child[keep]] + rank[keep]
         source = np.empty(keep.size, dtype=np.int64)
         source[dest] = keep
-        moved = spare[:9 * source.size].reshape(9, source.size)
-        np.take(rows, source, axis=1, out=moved, mode="clip")  # "clip": unbuffered (all in range)
-        spare = rows.base if rows.base is not None and rows.base.ndim == 1 else rows.reshape(-1)
-        rows = moved
+        moved = spare[:6 * source.size].reshape(6, source.size)
+        np.take(cols, source, axis=1, out=moved, mode="clip")  # "clip": unbuffered (all in range)
+        spare = cols.base if cols.base is not None and cols.base.ndim == 1 else cols.reshape(-1)
+        cols = moved
         tris = tris[source]
         counts = new_counts
-        open_pos = kept_children
+        open_ids = child_ids[kept_children]
         box_lo = child_lo.reshape(2 * n, 3)[kept_children]
         box_hi = child_hi.reshape(2 * n, 3)[kept_children]
-    return leaf_of, leaf_rank, np.concatenate(firsts), np.concatenate(counts_of), levels
+    if not small_ids:
+        return none, none, none, none, rows[:, :0]
+    return (np.concatenate(small_tris), np.concatenate(small_ids), np.concatenate(small_counts),
+            np.concatenate(small_depth), np.concatenate(small_boxes, axis=1))
+
+
+def _box_half_area(box: NDArray[np.float32]) -> NDArray[np.float32]:
+    """Half the surface area of boxes stored as ``(6, ...)``: ``min x, y, z, −max x, y, z``
+    (an empty box, all ``inf``, has 0)."""
+    e = box[0:3] + box[3:6]  # min − max: minus the extent
+    np.minimum(e, np.float32(0.0), out=e)
+    result: NDArray[np.float32] = e[0] * e[1]
+    result += e[1] * e[2]
+    result += e[2] * e[0]
+    return result
+
+
+def _split_small(tree: _Tree, small: tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64],
+                                           NDArray[np.int64], NDArray[np.float32]], leaf_size: int) -> None:
+    """Split the nodes of at most :data:`SMALL` triangles down to leaves by the *full* SAH sweep.
+
+    Binning pays off on big nodes; on a node of a few dozen triangles the
+    bins cost as much as the triangles and see less. Here every cut of a
+    node is scored: along each axis its triangles are sorted by centroid
+    (``argsort`` of short rows), and the boxes of the first ``i`` and of the
+    rest, for every ``i``, are running minima and maxima of the sorted
+    boxes. The nodes are laid out one per column of a ``(w, n)`` array,
+    padded to a power of two ``w`` (nodes of similar size together), so each
+    step of the running boxes is one numpy call over all the nodes.
+    """
+    caller, ids, counts, depths, boxes = small
+    if ids.size == 0:
+        return
+    # (6, K + 1) float32: min x, y, z and minus max x, y, z of each triangle (running boxes are then
+    # running minima only), and last an empty box (all inf) that pads the nodes' columns.
+    tris = np.arange(caller.size)  # indices into table, node after node
+    table = np.empty((6, caller.size + 1), dtype=np.float32)
+    table[0:3, :-1] = boxes[0:3]
+    np.negative(boxes[3:6], out=table[3:6, :-1])
+    table[:, -1] = np.inf
+    while ids.size:
+        starts = np.cumsum(counts) - counts
+        width_class = WIDTHS[np.searchsorted(WIDTHS, counts)]  # the narrowest padding that holds the node
+        out_tris, out_cuts, order_nodes = [], [], []
+        for w in np.unique(width_class):
+            members = np.flatnonzero(width_class == w)
+            for part in range(0, members.size, max(1, SMALL_CHUNK // int(w))):
+                sel = members[part:part + max(1, SMALL_CHUNK // int(w))]
+                sorted_tris, cut = _small_cuts(table, tris, starts[sel], counts[sel], int(w), leaf_size)
+                out_tris.append(sorted_tris)
+                out_cuts.append(cut)
+                order_nodes.append(sel)
+        sel = np.concatenate(order_nodes)
+        cut = np.concatenate(out_cuts)
+        tris = np.concatenate(out_tris)
+        m = counts[sel]
+        child_count = np.empty(2 * sel.size, dtype=np.int64)
+        child_count[0::2] = cut
+        child_count[1::2] = m - cut
+        child_ids, is_leaf = tree.children(ids[sel], child_count, leaf_size)
+        child_depth = np.repeat(depths[sel] + 1, 2)
+        tree.depth = max(tree.depth, int(child_depth.max()))
+        child = np.repeat(np.arange(child_count.size), child_count)
+        rank = np.arange(tris.size) - np.repeat(np.cumsum(child_count) - child_count, child_count)
+        tri_leaf = is_leaf[child]
+        tree.leaf_of[caller[tris[tri_leaf]]] = child_ids[child[tri_leaf]]
+        tree.leaf_rank[caller[tris[tri_leaf]]] = rank[tri_leaf]
+        tris = tris[~tri_leaf]
+        ids = child_ids[~is_leaf]
+        counts = child_count[~is_leaf]
+        depths = child_depth[~is_leaf]
+
+
+def _small_cuts(table: NDArray[np.float32], tris: NDArray[np.int64], starts: NDArray[np.int64],
+                counts: NDArray[np.int64], w: int, leaf_size: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """The best cut of each of ``r`` nodes (triangles ``tris[starts[j] : starts[j] + counts[j]]``,
+    at most ``w`` each): their triangles in the chosen order (left child first, node after node)
+    and the left child's triangle count."""
+    r = counts.size
+    slot = np.arange(w)[:, None]
+    valid = slot < counts  # (w, r): slot i of node j holds a triangle
+    tri = np.where(valid, tris[np.minimum(starts + slot, tris.size - 1)], table.shape[1] - 1)  # (w, r)
+    boxes = np.take(table, tri, axis=1)  # (6, w, r); padding: the empty box, no effect on running minima
+    # Sort keys: twice the centroid, its float32 bits made an int32 of the same order (a negative
+    # float's magnitude bits flipped), then the slot in the low bits: np.sort of int64 keys is
+    # several times faster than np.argsort of floats, and the slot is read back from the key.
+    with np.errstate(invalid="ignore"):
+        centre = boxes[0:3] - boxes[3:6]  # (3, w, r); padding: NaN
+    bits = centre.view(np.int32)
+    bits ^= (bits >> 31) & np.int32(0x7FFFFFFF)
+    bits[:, ~valid] = np.iinfo(np.int32).max  # padding sorts last
+    shift = int(w - 1).bit_length()
+    flat = boxes.reshape(6, w * r)
+    cuts = np.arange(1, w, dtype=np.float32)[:, None]  # cut i: sorted triangles [0, i) go left
+    no_cut = cuts >= counts  # (w − 1, r)
+    columns = np.arange(r)
+    orders = []
+    costs = np.empty((3, r), dtype=np.float32)
+    best = np.empty((3, r), dtype=np.int64)
+    middle = np.empty((3, r), dtype=np.float32)
+    # The even cut of a node with no SAH gain: a multiple of leaf_size near the middle, so that its
+    # subtree ends in full leaves (ceil(N / leaf_size) of them, the fewest boxes).
+    half = np.clip(leaf_size * np.rint(counts / (2 * leaf_size)).astype(np.int64), 1, counts - 1)
+    size = counts.astype(np.float32)
+    parent = None
+    for axis in range(3):
+        keys = bits[axis].T.astype(np.int64)  # (r, w)
+        keys <<= shift
+        keys |= slot.T
+        keys.sort(axis=1)
+        order = keys & ((1 << shift) - 1)  # (r, w): node j's slots by centroid
+        orders.append(order)
+        sweep = np.take(flat, order.T * r + columns, axis=1)  # (6, w, r): the boxes in that order
+        back = sweep.copy()
+        for i in range(1, w):  # boxes of the first i + 1
+            np.minimum(sweep[:, i - 1], sweep[:, i], out=sweep[:, i])
+        for i in range(w - 2, -1, -1):  # boxes of slots i ..
+            np.minimum(back[:, i + 1], back[:, i], out=back[:, i])
+        if parent is None:
+            parent = size * _box_half_area(sweep[:, w - 1])
+        sah = _box_half_area(sweep[:, :-1])
+        sah *= cuts
+        right = _box_half_area(back[:, 1:])
+        right *= size - cuts
+        sah += right
+        sah[no_cut] = np.inf
+        pick = np.argmin(sah.T, axis=1)
+        best[axis] = pick + 1
+        costs[axis] = sah[pick, columns]
+        middle[axis] = sah[half - 1, columns]
+    axis = np.argmin(costs, axis=0)
+    cut = best[axis, columns]
+    # No gain (the best cut costs about N·A: slivers sharing one box): the most even cut by count,
+    # on the axis where it costs least, keeps the depth logarithmic (as in _split_levels).
+    no_gain = costs[axis, columns] >= NO_GAIN * parent
+    if no_gain.any():
+        even_axis = np.argmin(middle, axis=0)
+        axis = np.where(no_gain, even_axis, axis)
+        cut = np.where(no_gain, half, cut)
+    chosen = np.where(axis[:, None] == 0, orders[0], np.where(axis[:, None] == 1, orders[1], orders[2]))  # (r, w)
+    sorted_tri = tri.T.reshape(-1)[chosen + columns[:, None] * w]  # (r, w)
+    return sorted_tri[valid.T], cut
 
 
 def sah_cost(bvh: BVH) -> float:

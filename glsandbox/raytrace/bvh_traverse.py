@@ -56,7 +56,11 @@ from glsandbox.raytrace.bvh import BVH
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.watertight import RaySetup, nondegenerate, ray_setup, watertight_pairs
 
-__all__ = ["BOX_PAD", "RAY_BLOCK", "Hits", "TraversalCounts", "any_hit", "closest_hit", "closest_hit_brute_force"]
+#: An any-hit filter: ``(rays, triangles, t) -> which hits count`` (bool per hit).
+Accept = Callable[[NDArray[np.intp], NDArray[np.intp], NDArray[np.float64]], NDArray[np.bool_]]
+
+__all__ = ["BOX_PAD", "RAY_BLOCK", "Accept", "Hits", "TraversalCounts", "any_hit", "closest_hit",
+           "closest_hit_brute_force"]
 
 #: Relative widening of every box in the slab test (see the module docstring).
 BOX_PAD: float = 2.0**-40
@@ -370,11 +374,16 @@ def closest_hit(bvh: BVH, origins: ArrayLike, directions: ArrayLike, t_max: Arra
 
 
 def any_hit(bvh: BVH, origins: ArrayLike, directions: ArrayLike, t_max: ArrayLike = 1.0, *,
-            cull_backfaces: bool = False, counts: TraversalCounts | None = None) -> NDArray[np.bool_]:
+            cull_backfaces: bool = False, counts: TraversalCounts | None = None,
+            accept: Accept | None = None) -> NDArray[np.bool_]:
     """Whether anything is hit with ``0 < t < t_max`` (the course's Gölge testi: a shadow
     ray from ``P`` towards the light ``L`` with ``d = L − P`` and ``t_max = 1``).
     A ray stops at its first hit, in whatever order the tree gives. ``counts``
-    adds up the box and triangle tests done."""
+    adds up the box and triangle tests done.
+
+    ``accept(rays, triangles, t)`` (an any-hit filter, as Embree's): which of the
+    hits found (rays' indices, the caller's triangle indices, their ``t``) count; a
+    ray whose hits are all refused walks on (a cut-out's transparent texels)."""
     o, d, limit = _rays(origins, directions, t_max)
     n = d.shape[0]
     found = np.zeros(n, dtype=bool)
@@ -388,13 +397,16 @@ def any_hit(bvh: BVH, origins: ArrayLike, directions: ArrayLike, t_max: ArrayLik
         done = np.zeros(block.n, dtype=bool)
 
         def leaves(rays: NDArray[np.intp], nodes: NDArray[np.intp], block: _Block = block,
-                   done: NDArray[np.bool_] = done) -> None:
+                   done: NDArray[np.bool_] = done, lo: int = lo) -> None:
             rr, slots = _leaf_pairs(bvh, rays, nodes)
             t, _, _ = watertight_pairs(block.setup, rr, *block.boxes.corners, slots, cull, barycentrics=False,
                                    relative=block.boxes.relative)
             if counts is not None:
                 counts.triangles += rr.size
-            done[rr[t < block.limit[rr]]] = True
+            hit = np.flatnonzero(t < block.limit[rr])
+            if accept is not None and hit.size:
+                hit = hit[accept(rr[hit] + lo, bvh.tri_index[slots[hit]], t[hit])]
+            done[rr[hit]] = True
 
         _traverse(bvh, block, counts, block.limit, True, leaves, done)
         found[part] = done

@@ -38,7 +38,9 @@ So what a scene cannot reach is compiled out rather than branched around:
 ``SHADOWS`` (shadow rays), ``REFLECT`` (the bounce loop: some node reflects
 and ``max_depth > 0``), ``HAS_MESHES``, ``HAS_SHAPES`` (analytic nodes), one
 ``HAS_<KIND>`` per analytic :class:`~glsandbox.raytrace.world.NodeKind` and
-``VERTEX_COLORS`` switch code on.
+``VERTEX_COLORS``, ``TWO_SIDED`` (a node lit on both sides), ``SEE_THROUGH``
+(a cut-out or blended node) and ``SIMPLE_OFFSET`` (the teaching variant of
+the secondary rays' offset) switch code on.
 
 A small scene, at most :data:`UNROLL_NODES` nodes of which at most
 :data:`UNROLL_LOOPS` have more than :data:`UNROLL_TRIS` triangles, its
@@ -53,7 +55,10 @@ of a node of at most :data:`UNROLL_TRIS`, tested without a loop) or
 record slot, triangle range, one-sidedness and lamp bits as literals, so
 its records are read at constant indices. Any larger scene gets the
 general program: a loop over the node records and, inside it, over each
-node's triangles. Unrolling is paid in compile time (Mesa's shader cache
+node's triangles; its node counts come as literals (``MESH_NODES``,
+``SHAPE_NODES``), so a model's one mesh node runs as straight code (a loop
+bounded by a uniform measured about 15% of a 1,000-triangle model's primary
+frame). Unrolling is paid in compile time (Mesa's shader cache
 is off): it grows exponentially with the number of triangle
 loops, which the bounds keep near a second; a lesson's first render, which
 compiles its variant, takes 0.4 to 0.9 s. In both programs shadow rays stop
@@ -89,7 +94,10 @@ BVHs packed into one node/triangle texture pair with their indices offset
 bounded by ``BVH_MAX_STEPS`` (:func:`bvh_step_cap`: what the loop limit
 leaves after the other loops, shared by every ray of a pixel and every mesh
 node). A ray that reaches the bound writes alpha 0, and the render raises
-:class:`RayTraceError` instead of returning the picture. Scenes whose mesh
+:class:`RayTraceError` instead of returning the picture. A scene with such a
+mesh node builds its BVHs when it is uploaded and then keeps of its World only
+the nodes, lights and textures (the textures hold what the shader reads of
+the triangles): a 1M-triangle model's frame keeps about 200 MiB, not 820. Scenes whose mesh
 nodes all have at most :data:`BVH_TRIANGLES` triangles (the cubes, quads and
 floors of most lessons) keep the scan, which tests its triangles with the
 same watertight test (``shaders/common/watertight.glsl``; the triangle
@@ -116,7 +124,7 @@ except on a few pixels where a ray grazes an edge or a shadow boundary
 
 from __future__ import annotations
 
-import math
+import hashlib
 import sys
 
 import moderngl
@@ -173,6 +181,12 @@ BVH_STEP_CAP: int | None = None
 #: shadow+bounce): 32 triangles scan 0.033/0.045 s vs BVH 0.054/0.087 s; 72: 0.060/0.114
 #: vs 0.058/0.093; 128: 0.098/0.148 vs 0.063/0.098; 1,058: 1.43/2.22 vs 0.082/0.179.
 BVH_TRIANGLES = 64
+#: Triangles per leaf of the gpu engine's BVHs (bvh.py's default is 4): each walk
+#: iteration tests one triangle while the walk moves one node, so smaller leaves
+#: keep the two in step. Measured (CPU time, 800x600, primary / shadow+bounce,
+#: against 4): 2 took 0.96/0.94x on the 1k terrain, 0.99/1.00x on the bunny,
+#: 0.97/0.97x on 100k; 1 took 1.04-1.09x of 2's, 3 0.98-1.03x, 8 1.07-1.15x of 4's.
+BVH_LEAF_SIZE = 2
 #: A BVH render is refused when the budget leaves a ray fewer steps than this.
 BVH_MIN_STEPS = 256
 
@@ -238,15 +252,6 @@ def _at_least_one(rows: NDArray[np.float32]) -> NDArray[np.float32]:
     return rows if rows.shape[0] else np.zeros((1, 4), dtype=np.float32)
 
 
-def _records(rows: NDArray[np.float32]) -> tuple[tuple[int, int], bytes]:
-    """Pad ``(n, 4)`` float32 records to a ``TEX_WIDTH``-wide texture: (size, data)."""
-    count = max(1, rows.shape[0])
-    height = math.ceil(count / TEX_WIDTH)
-    data = np.zeros((height * TEX_WIDTH, 4), dtype=np.float32)
-    data[: rows.shape[0]] = rows
-    return (TEX_WIDTH, height), data.tobytes()
-
-
 #: The warnings already printed by this process (once per run, not per frame).
 _WARNED: set[str] = set()
 
@@ -292,7 +297,9 @@ def pack_triangles(world: World, anchor: NDArray[np.float64] | None = None) -> N
     relative to ``anchor`` (see :func:`world_anchor`)."""
     anchor = np.zeros(3) if anchor is None else anchor
     m = world.triangle_count
-    rec = np.zeros((m, TRI_RECORDS, 4), dtype=np.float64)
+    # Filled in float32 directly (each value rounded once, as a float64 array cast
+    # afterwards would): a 1M-triangle model's records are 144 MB, not 288 + 144.
+    rec = np.zeros((m, TRI_RECORDS, 4), dtype=np.float32)
     # The corners themselves, not v0 and two edges: the watertight test needs a
     # corner shared by two triangles to be the same three floats in both.
     ok = nondegenerate(world.v0, world.v1, world.v2)  # the BVH's rule: a triangle without area is never hit
@@ -305,7 +312,7 @@ def pack_triangles(world: World, anchor: NDArray[np.float64] | None = None) -> N
         rec[:, TRI["color"] + k, :3] = world.colors[:, k]
     flat_uv = world.uvs.reshape(m, 6)  # uv0.x, uv0.y, uv1.x, uv1.y, uv2.x, uv2.y
     rec[:, TRI["normal"]:TRI["color"] + 3, 3] = flat_uv
-    return rec.reshape(-1, 4).astype(np.float32)
+    return rec.reshape(-1, 4)
 
 
 def node_order(world: World) -> list[int]:
@@ -361,6 +368,24 @@ def _same_key(a: tuple[object, ...] | None, b: tuple[object, ...]) -> bool:
         return False
 
 
+def _records_digest(tris: NDArray[np.float32], nodes: NDArray[np.float32]) -> bytes:
+    """A blake2b digest of the packed records (equal records, equal digests)."""
+    h = hashlib.blake2b(digest_size=20)
+    for rows in (tris, nodes):
+        h.update(np.int64(rows.shape[0]).tobytes())
+        h.update(np.ascontiguousarray(rows).data)
+    return h.digest()
+
+
+def _drop_triangle_arrays(world: World, corners: bool) -> None:
+    """Empty ``world``'s per-triangle shading arrays (normals, uvs, colours) and, with
+    ``corners``, its corners too (an upload's own World, once its textures hold them)."""
+    world.normals, world.uvs, world.colors = np.zeros((0, 3, 3)), np.zeros((0, 3, 2)), np.zeros((0, 3, 3))
+    if corners:
+        world.v0 = world.v1 = world.v2 = np.zeros((0, 3))
+        world.tri_node = np.zeros(0, dtype=np.intp)
+
+
 class _Uploaded:
     """One scene's World on the context: its records and images, kept between renders.
 
@@ -378,8 +403,11 @@ class _Uploaded:
         #: Every uploaded position is relative to this point (:func:`world_anchor`; the
         #: origin for ``relative=False``, world-space float32, what the tradeoffs knob shows).
         self.anchor = world_anchor(world) if relative else np.zeros(3)
-        self.tris = pack_triangles(world, self.anchor)
-        self.nodes = pack_nodes(world, self.anchor)
+        tris = pack_triangles(world, self.anchor)
+        nodes = pack_nodes(world, self.anchor)
+        #: What the records pack to (:meth:`same_data`), not the records themselves: a
+        #: 1M-triangle model's are 144 MB, and the texture holds them already.
+        self.digest = _records_digest(tris, nodes)
         self.mesh_count = sum(1 for node in world.nodes if node.kind.triangles)
         #: Analytic nodes (spheres, cylinders): the records after the mesh nodes'.
         self.shape_count = len(world.nodes) - self.mesh_count
@@ -390,26 +418,35 @@ class _Uploaded:
         self.large_mesh = max((node.count for node in world.nodes if node.kind.triangles),
                               default=0) > BVH_TRIANGLES
         self.unrolled = (not self.large_mesh and len(world.nodes) <= UNROLL_NODES and loops <= UNROLL_LOOPS
-                         and max(1, self.tris.shape[0]) + max(1, self.nodes.shape[0]) <= block_records)
+                         and max(1, tris.shape[0]) + max(1, nodes.shape[0]) <= block_records)
         self.block: moderngl.Buffer | None = None
         #: The BVH program's stack depth once its textures are uploaded (0: not yet).
         self.bvh_stack = 0
         #: Samplers by uniform name, in texture unit order.
         self.textures: dict[str, moderngl.Texture] = {}
         if self.unrolled:
-            self.block = ctx.buffer(np.concatenate([_at_least_one(self.nodes), _at_least_one(self.tris)]).tobytes())
+            self.block = ctx.buffer(np.concatenate([_at_least_one(nodes), _at_least_one(tris)]).tobytes())
         else:
-            for name, rows in (("u_tris", self.tris), ("u_nodes", self.nodes)):
-                tex_size, data = _records(rows)
-                texture = ctx.texture(tex_size, 4, data, dtype="f4")
-                texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
-                self.textures[name] = texture
+            from glsandbox.raytrace.gpu_bvh import _texture
+
+            for name, rows in (("u_tris", tris), ("u_nodes", nodes)):
+                self.textures[name] = _texture(ctx, _at_least_one(rows), TEX_WIDTH)
         for slot, (image, _wrap) in enumerate(world.textures):
             pixels = np.floor(image * 255.0 + 0.5).astype(np.uint8)
             h, w = pixels.shape[:2]
             texture = ctx.texture((w, h), 4, np.ascontiguousarray(pixels).tobytes())
             texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
             self.textures[f"u_tex{slot}"] = texture
+        del tris, nodes
+        if self.large_mesh:
+            # Every render of this scene traces its meshes through BVHs: build them now,
+            # and keep of the World (this upload's own) only what the renders read (its
+            # nodes, lights, textures): its per-triangle float64 arrays are 336 bytes a
+            # triangle, and the textures hold what the shader needs of them. The shading
+            # arrays go before the BVH is built, the corners after.
+            _drop_triangle_arrays(world, corners=False)
+            self.bvh_textures(ctx)
+            _drop_triangle_arrays(world, corners=True)
 
     def bvh_textures(self, ctx: moderngl.Context) -> int:
         """Upload (once) one BVH per mesh node, concatenated into one node/triangle
@@ -418,34 +455,36 @@ class _Uploaded:
         slot k's root). Returns the stack depth the shader needs."""
         if self.bvh_stack:
             return self.bvh_stack
-        from glsandbox.raytrace.bvh import bvh_for_triangles
-        from glsandbox.raytrace.gpu_bvh import TEX_WIDTH as BVH_TEX_WIDTH, _texture, pack_bvh
+        from glsandbox.raytrace.bvh import build_bvh
+        from glsandbox.raytrace.gpu_bvh import RECORD_TEXELS, TEX_WIDTH as BVH_TEX_WIDTH, _texture, pack_bvh
 
         world = self.world
         node_parts: list[NDArray[np.float32]] = []
         tri_parts: list[NDArray[np.float32]] = []
         roots: list[int] = []
-        node_offset = tri_offset = 0
+        record_offset = tri_offset = 0
         depth = 1
         for k in node_order(world)[: self.mesh_count]:
             node = world.nodes[k]
             stop = node.start + node.count
             rows = slice(node.start, stop)
-            bvh = bvh_for_triangles(world.v0[rows] - self.anchor, world.v1[rows] - self.anchor,
-                                    world.v2[rows] - self.anchor)
+            # Built, not taken from bvh.py's cache: these are anchor-relative triangles
+            # no other engine asks for, and the upload keeps what the shader needs.
+            bvh = build_bvh(world.v0[rows] - self.anchor, world.v1[rows] - self.anchor,
+                            world.v2[rows] - self.anchor, leaf_size=BVH_LEAF_SIZE)
             nodes, tris = pack_bvh(bvh)
-            nodes = nodes.reshape(-1, 2, 4).copy()
-            tris = tris.reshape(-1, 3, 4).copy()
-            leaf = nodes[:, 1, 3] > 0
-            nodes[:, 0, 3] += np.where(leaf, tri_offset, node_offset).astype(np.float32)
+            children = nodes.reshape(-1, 2, 4)  # (box min, ref), (box max, count) per child: a view
+            tris = tris.reshape(-1, 3, 4)
+            leaf = children[:, 1, 3] > 0
+            children[:, 0, 3] += np.where(leaf, tri_offset, record_offset).astype(np.float32)
             tris[:, 0, 3] += node.start
-            roots.append(node_offset)
-            node_offset += nodes.shape[0]
+            roots.append(record_offset)
+            record_offset += nodes.shape[0] // RECORD_TEXELS
             tri_offset += tris.shape[0]
             depth = max(depth, bvh.depth)
-            node_parts.append(nodes.reshape(-1, 4))
+            node_parts.append(nodes)
             tri_parts.append(tris.reshape(-1, 4))
-        if 2 * node_offset > (1 << 24) or 3 * tri_offset > (1 << 24):
+        if RECORD_TEXELS * record_offset > (1 << 24) or 3 * tri_offset > (1 << 24):
             raise RayTraceError(f"the gpu BVH holds at most {(1 << 24) // 3:,} triangles, this scene has {tri_offset:,}")
         self.textures["u_bvh_nodes"] = _texture(ctx, np.concatenate(node_parts), BVH_TEX_WIDTH)
         self.textures["u_bvh_tris"] = _texture(ctx, np.concatenate(tri_parts), BVH_TEX_WIDTH)
@@ -458,10 +497,16 @@ class _Uploaded:
     def defines(self, cull: bool | None) -> tuple[tuple[str, str], ...]:
         """The program variant's scene-shaped defines (see ``shaders/raytrace.glsl``)."""
         found = [("VERTEX_COLORS", str(int(any(node.mode == MODES["vertex_color"] or node.vertex_colors
-                                               for node in self.world.nodes))))]
+                                               for node in self.world.nodes)))),
+                 ("TWO_SIDED", str(int(any(node.two_sided for node in self.world.nodes)))),
+                 ("SEE_THROUGH", str(int(any(node.see_through for node in self.world.nodes))))]
+        if any(node.texel_shadow for node in self.world.nodes):  # shadow rays read a cut-out's texels
+            found.append(("CUTOUT_SHADOWS", "1"))
         if self.unrolled:
             found += [("SCENE_NODES", self.scene_nodes(cull)), ("NODE_COUNT", str(max(1, len(self.world.nodes)))),
                       ("TRI_COUNT", str(max(1, self.world.triangle_count)))]
+        else:  # the node loops' bounds as literals (see MESH_NODES in the shader)
+            found += [("MESH_NODES", str(self.mesh_count)), ("SHAPE_NODES", str(self.shape_count))]
         return tuple(found)
 
     def scene_nodes(self, cull: bool | None) -> str:
@@ -489,8 +534,8 @@ class _Uploaded:
         return (len(world.textures) == len(self.world.textures)
                 and all(a is b or np.array_equal(a, b) for (a, _), (b, _) in zip(world.textures, self.world.textures))
                 and [w for _, w in world.textures] == [w for _, w in self.world.textures]
-                and np.array_equal(pack_triangles(world, self.anchor_of(world)), self.tris)
-                and np.array_equal(pack_nodes(world, self.anchor_of(world)), self.nodes))
+                and _records_digest(pack_triangles(world, self.anchor_of(world)),
+                                    pack_nodes(world, self.anchor_of(world))) == self.digest)
 
     def anchor_of(self, world: World) -> NDArray[np.float64]:
         """Where ``world`` would be anchored in an upload like this one."""
@@ -601,7 +646,7 @@ class GpuTracer:
         lights = world.light_positions.shape[0]
         # The bounce loop only where some node reflects or lets rays through (a cut-out, a blend).
         reflect = max_depth > 0 and any(node.reflectivity > 0.0 or node.see_through for node in world.nodes)
-        scene_defines = uploaded.defines(cull_backfaces)
+        scene_defines = uploaded.defines(cull_backfaces) + (("SIMPLE_OFFSET", str(int(OFFSETS[offset]))),)
         use_bvh = False
         try:
             check_loop_budget(world, lights, bool(shadows), reflect, int(max_depth))
@@ -638,7 +683,7 @@ class GpuTracer:
             "u_eye": tuple(eye - uploaded.anchor), "u_half": (half_w, half_h), "u_background": tuple(world.background),
             "u_max_depth": int(max_depth),
             "u_cull": -1 if cull_backfaces is None else int(bool(cull_backfaces)), "u_aabb": bool(aabb),
-            "u_offset": SIMPLE_OFFSET, "u_simple_offset": OFFSETS[offset],
+            "u_offset": SIMPLE_OFFSET,
         }
         for name, value in values.items():
             if name in program:

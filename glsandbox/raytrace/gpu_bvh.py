@@ -4,8 +4,14 @@ and trace batches of rays with it (float32), to test the GLSL traversal against 
 Packing (the layout ``bvh.glsl`` documents): two RGBA32F textures
 :data:`TEX_WIDTH` texels wide, read with ``texelFetch``:
 
-- nodes, 2 texels each: ``(min.xyz, first)``, ``(max.xyz, count)``; the boxes
-  rounded *outwards* to float32 (a float64 box edge never moves inside);
+- nodes, one record of 4 texels per *inner* node holding its two children:
+  ``(min.xyz, ref)``, ``(max.xyz, count)`` for the left child, then the same for
+  the right one; ``ref`` is the child's record (an inner child, ``count`` 0) or
+  its first stored triangle (a leaf of ``count`` triangles). Record 0 describes
+  the root the same way (its first two texels; the other two unused). A visit
+  of an inner node is then 4 fetches for both children's boxes, and a leaf
+  needs no visit of its own. The boxes are rounded *outwards* to float32 (a
+  float64 box edge never moves inside);
 - triangles in the BVH's storage order, 3 texels each: ``(v0.xyz, caller's
   index)``, ``(v1.xyz, 0)``, ``(v2.xyz, 0)``.
 
@@ -45,7 +51,7 @@ from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.world import camera_basis
 from glsandbox.scene import Camera
 
-__all__ = ["EXACT_INTEGERS", "LOOP_LIMIT", "MAX_STEPS", "TEX_WIDTH", "GpuBVH", "GpuHits", "pack_bvh"]
+__all__ = ["EXACT_INTEGERS", "LOOP_LIMIT", "MAX_STEPS", "RECORD_TEXELS", "TEX_WIDTH", "GpuBVH", "GpuHits", "pack_bvh"]
 
 #: Texels per row of the node and triangle textures (``BVH_TEX_WIDTH`` in the shader).
 TEX_WIDTH: int = 4096
@@ -67,27 +73,45 @@ def _outward(values: NDArray[np.float64], down: bool) -> NDArray[np.float32]:
     return np.where(wrong, np.nextafter(rounded, towards), rounded).astype(np.float32)
 
 
+#: Texels per node record (``BVH_RECORD`` in ``bvh.glsl``): two children, two texels each.
+RECORD_TEXELS: int = 4
+
+
 def pack_bvh(bvh: BVH) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
-    """The node and triangle records of ``bvh`` as ``(texels, 4)`` float32 arrays (module docstring)."""
-    if bvh.node_total * 2 > EXACT_INTEGERS or bvh.triangle_count * 3 > EXACT_INTEGERS or \
+    """The node and triangle records of ``bvh`` as ``(texels, 4)`` float32 arrays (module docstring):
+    ``RECORD_TEXELS`` texels per record, record 0 the root, then one per inner node."""
+    inner = np.flatnonzero(bvh.node_count == 0) if not bvh.empty else np.zeros(0, dtype=np.int64)
+    if (inner.size + 1) * RECORD_TEXELS > EXACT_INTEGERS or bvh.triangle_count * 3 > EXACT_INTEGERS or \
             bvh.input_count > EXACT_INTEGERS:
         raise RayTraceError(f"the gpu BVH holds at most {EXACT_INTEGERS // 3:,} triangles and "
-                            f"{EXACT_INTEGERS // 2:,} nodes; this one has {bvh.triangle_count:,} and {bvh.node_total:,}")
-    nodes = np.zeros((bvh.node_total, 2, 4), dtype=np.float32)
+                            f"{EXACT_INTEGERS // RECORD_TEXELS:,} inner nodes; this one has "
+                            f"{bvh.triangle_count:,} and {inner.size:,}")
+    records = np.zeros((inner.size + 1, 2, 2, 4), dtype=np.float32)  # record, child, (min|max), xyzw
     tris = np.zeros((max(1, bvh.triangle_count), 3, 4), dtype=np.float32)
     if bvh.empty:
         # No triangles: a root leaf holding one zero-area triangle at the origin,
         # which the watertight test never hits (det = 0).
-        nodes[0, 1, 3] = 1
-        return nodes.reshape(-1, 4), tris.reshape(-1, 4)
-    nodes[:, 0, :3] = _outward(bvh.node_min, down=True)
-    nodes[:, 1, :3] = _outward(bvh.node_max, down=False)
-    nodes[:, 0, 3] = bvh.node_first
-    nodes[:, 1, 3] = bvh.node_count
+        records[0, 0, 1, 3] = 1
+        return records.reshape(-1, 4), tris.reshape(-1, 4)
+    record_of = np.zeros(bvh.node_total, dtype=np.int64)
+    record_of[inner] = np.arange(1, inner.size + 1)
+    lo = _outward(bvh.node_min, down=True)
+    hi = _outward(bvh.node_max, down=False)
+    ref = np.where(bvh.node_count == 0, record_of, bvh.node_first).astype(np.float32)
+
+    def child(slot: NDArray[np.int64] | int, nodes: NDArray[np.int64] | int, side: int) -> None:
+        records[slot, side, 0, :3] = lo[nodes]
+        records[slot, side, 0, 3] = ref[nodes]
+        records[slot, side, 1, :3] = hi[nodes]
+        records[slot, side, 1, 3] = bvh.node_count[nodes]
+
+    child(0, 0, 0)
+    child(record_of[inner], bvh.node_first[inner], 0)
+    child(record_of[inner], bvh.node_first[inner] + 1, 1)
     if bvh.triangle_count:
         tris[:, 0, :3], tris[:, 1, :3], tris[:, 2, :3] = bvh.v0, bvh.v1, bvh.v2
         tris[:, 0, 3] = bvh.tri_index
-    return nodes.reshape(-1, 4), tris.reshape(-1, 4)
+    return records.reshape(-1, 4), tris.reshape(-1, 4)
 
 
 @dataclass
@@ -125,11 +149,19 @@ def _check_overflow(overflow: NDArray[np.bool_], max_steps: int) -> None:
 
 
 def _texture(ctx: moderngl.Context, rows: NDArray[np.float32], width: int) -> moderngl.Texture:
-    """``(n, 4)`` float32 records as a ``width``-wide RGBA32F texture (zero-padded)."""
-    height = max(1, math.ceil(rows.shape[0] / width))
-    data = np.zeros((height * width, 4), dtype=np.float32)
-    data[: rows.shape[0]] = rows
-    texture = ctx.texture((width, height), 4, data.tobytes(), dtype="f4")
+    """``(n, 4)`` float32 records as a ``width``-wide RGBA32F texture, texel i at
+    ``(i % width, i // width)``: the full rows and the last, partial one written
+    straight from ``rows`` (no padded copy: a 1M-triangle model's records are 144 MB;
+    the texels past the last record are never read)."""
+    rows = np.ascontiguousarray(rows, dtype=np.float32)
+    count = rows.shape[0]
+    height = max(1, math.ceil(count / width))
+    texture = ctx.texture((width, height), 4, dtype="f4")
+    full = count // width
+    if full:
+        texture.write(rows[: full * width], viewport=(0, 0, width, full))
+    if count > full * width:
+        texture.write(rows[full * width:], viewport=(0, full, count - full * width, 1))
     texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
     return texture
 
@@ -149,6 +181,8 @@ class GpuBVH:
         #: The shader's stack: the ordered traversal pushes at most one entry per level.
         self.stack = max(2, bvh.depth + 1)
         self._programs: dict[tuple[bool, bool], tuple[moderngl.Program, moderngl.VertexArray]] = {}
+        #: The two float result targets and their framebuffer, kept for the last grid size.
+        self._target: tuple[tuple[int, int], list[moderngl.Texture], moderngl.Framebuffer] | None = None
         # A far point the padding rays of a grid start from, pointing away: they miss the root at once.
         root_hi = np.where(np.isfinite(bvh.node_max[0]), bvh.node_max[0], 0.0)
         self._away = root_hi + 1.0 + np.abs(root_hi)
@@ -168,27 +202,33 @@ class GpuBVH:
 
     def _draw(self, program: moderngl.Program, vao: moderngl.VertexArray, width: int, height: int,
               rays: dict[str, moderngl.Texture]) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
-        """One fragment per ray over a ``width x height`` grid: the two result targets, row 0 first."""
-        outputs = [self.ctx.texture((width, height), 4, dtype="f4") for _ in range(2)]
-        fbo = self.ctx.framebuffer(color_attachments=outputs)
-        try:
-            textures = {"u_bvh_nodes": self._nodes, "u_bvh_tris": self._tris, **rays}
-            self.ctx.clear_samplers(0, len(textures))  # their own NEAREST state, not a sampler left bound
-            for unit, (name, texture) in enumerate(textures.items()):
-                texture.use(unit)
-                if name in program:
-                    program[name].value = unit
-            fbo.use()
-            fbo.viewport = (0, 0, width, height)
-            self.ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
-            vao.render(moderngl.TRIANGLE_STRIP, vertices=4)
-            hit = np.frombuffer(fbo.read(components=4, attachment=0, dtype="f4"), dtype=np.float32)
-            info = np.frombuffer(fbo.read(components=4, attachment=1, dtype="f4"), dtype=np.float32)
-        finally:
-            fbo.release()
-            for texture in outputs:
-                texture.release()
+        """One fragment per ray over a ``width x height`` grid: the two result targets, row 0 first
+        (the targets are kept for the next call of the same size)."""
+        if self._target is None or self._target[0] != (width, height):
+            self._release_target()
+            outputs = [self.ctx.texture((width, height), 4, dtype="f4") for _ in range(2)]
+            self._target = ((width, height), outputs, self.ctx.framebuffer(color_attachments=outputs))
+        fbo = self._target[2]
+        textures = {"u_bvh_nodes": self._nodes, "u_bvh_tris": self._tris, **rays}
+        self.ctx.clear_samplers(0, len(textures))  # their own NEAREST state, not a sampler left bound
+        for unit, (name, texture) in enumerate(textures.items()):
+            texture.use(unit)
+            if name in program:
+                program[name].value = unit
+        fbo.use()
+        fbo.viewport = (0, 0, width, height)
+        self.ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
+        vao.render(moderngl.TRIANGLE_STRIP, vertices=4)
+        hit = np.frombuffer(fbo.read(components=4, attachment=0, dtype="f4"), dtype=np.float32)
+        info = np.frombuffer(fbo.read(components=4, attachment=1, dtype="f4"), dtype=np.float32)
         return hit.reshape(-1, 4), info.reshape(-1, 4)
+
+    def _release_target(self) -> None:
+        if self._target is not None:
+            self._target[2].release()
+            for texture in self._target[1]:
+                texture.release()
+            self._target = None
 
     def _run(self, origins: ArrayLike, directions: ArrayLike, t_max: ArrayLike, cull: bool, any_hit: bool
              ) -> tuple[NDArray[np.float32], NDArray[np.float32], int]:
@@ -273,5 +313,6 @@ class GpuBVH:
             vao.release()
             program.release()
         self._programs.clear()
+        self._release_target()
         self._nodes.release()
         self._tris.release()

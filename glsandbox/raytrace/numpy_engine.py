@@ -52,7 +52,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from glsandbox.raytrace.aabb import AABB, reciprocals
-from glsandbox.raytrace.bvh_traverse import TraversalCounts, any_hit, closest_hit
+from glsandbox.raytrace.bvh_traverse import Accept, TraversalCounts, any_hit, closest_hit
 from glsandbox.raytrace.bvh_world import NodeBVH, WorldBVH
 from glsandbox.raytrace.constants import (BVH_BOX_PAD_F64, LENGTH_TINY, OFFSETS, SIMPLE_OFFSET, RAY_POINT_GAMMA,
                                           TRIANGLE_POINT_GAMMA, UNIT_F64, gamma)
@@ -130,7 +130,9 @@ def _occluded(world: World, o: NDArray[np.float64], d: NDArray[np.float64], ligh
               aabb: bool, stats: RenderStats | None = None, bvh: WorldBVH | None = None) -> NDArray[np.bool_]:
     """Gölge testi for shadow rays towards light ``light``: whether each ray ``o + s·d``
     hits something at ``0 < s < 1`` (``d`` reaches the light at ``s = 1``, so an
-    occluder beyond the light never counts). The light's lamp is skipped.
+    occluder beyond the light never counts). The light's lamp is skipped, and so
+    are blended nodes; a textured cut-out occludes only at its drawn texels
+    (:func:`_drawn_texels`, an any-hit filter).
 
     With a BVH an any-hit query (a ray leaves at its first occluder); without one
     the nearest-hit scan cut at ``s = 1`` (what ``ray_acceleration`` counts)."""
@@ -185,6 +187,7 @@ def _top_level(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_m
         if light >= 0 and node.lamp_of >> light & 1:
             continue
         one_sided = bool(node.cull if cull is None else cull)
+        cut_out = light >= 0 and node.texel_shadow  # a shadow ray passes its cut-away texels
         # The rays still looking: all of them, or (any hit) those without an occluder yet.
         rays = np.flatnonzero(best_node < 0) if first else None
         ro = o if rays is None else _rows(o, rays)
@@ -201,7 +204,9 @@ def _top_level(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_m
                 continue
             counts = TraversalCounts()
             if first:
-                found = any_hit(entry.bvh, _rows(o, idx), d[idx], t_max, cull_backfaces=one_sided, counts=counts)
+                accept = _drawn_texels(world, k, _rows(o, idx), d[idx], t_max) if cut_out else None
+                found = any_hit(entry.bvh, _rows(o, idx), d[idx], t_max, cull_backfaces=one_sided, counts=counts,
+                                accept=accept)
                 best_node[idx[found]] = k
                 _add_counts(stats, counts)
                 continue
@@ -229,7 +234,14 @@ def _top_level(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_m
             continue
         if stats is not None:
             stats.tests += idx.size * max(node.count, 1)
-        t, j = _hit_node(world, k, _rows(o, idx), d[idx], one_sided)
+        if cut_out:  # every triangle, the nearest hit on a drawn texel
+            rows = slice(node.start, node.start + node.count)
+            t, j = nearest_watertight(world.v0[rows], world.v1[rows], world.v2[rows], _rows(o, idx), d[idx],
+                                      cull_backfaces=one_sided,
+                                      accept=_drawn_texels(world, k, _rows(o, idx), d[idx], t_max))
+            j = np.where(j >= 0, j + node.start, -1)
+        else:
+            t, j = _hit_node(world, k, _rows(o, idx), d[idx], one_sided)
         better = t < best_t[idx]
         sel = idx[better]
         best_t[sel] = t[better]
@@ -237,6 +249,26 @@ def _top_level(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_m
         best_tri[sel] = j[better]
     hit = best_node >= 0
     return _Hits(np.where(hit, best_t, np.inf), best_node, best_tri)
+
+
+def _drawn_texels(world: World, k: int, o: NDArray[np.float64], d: NDArray[np.float64], t_max: float) -> Accept:
+    """The any-hit filter of shadow rays ``o + s·d`` meeting the textured cut-out ``k``
+    (:attr:`~glsandbox.raytrace.world.NodeInfo.texel_shadow`): a hit before ``t_max``
+    counts only where the part is drawn, its alpha (the colour's times the texel's,
+    what :func:`_surface` gives the shading) at or above the cutoff; elsewhere the ray
+    goes on, as the rasterizer's planar shadow and shadow map discard those texels."""
+    node = world.nodes[k]
+
+    def accept(rays: NDArray[np.intp], triangles: NDArray[np.intp], t: NDArray[np.float64]) -> NDArray[np.bool_]:
+        ok = t < t_max
+        sel = np.flatnonzero(ok)
+        if sel.size:
+            hits = _Hits(t[sel], np.full(sel.size, k, dtype=np.intp), triangles[sel] + node.start)
+            alpha = _surface(world, hits, _rows(o, rays[sel]), d[rays[sel]], need_spawn=False)[3]
+            ok[sel] = alpha >= node.alpha_cutoff
+        return ok
+
+    return accept
 
 
 def _hit_node(world: World, k: int, o: NDArray[np.float64], d: NDArray[np.float64], one_sided: bool

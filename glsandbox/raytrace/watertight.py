@@ -44,6 +44,7 @@ rule, see :func:`nondegenerate`).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -222,13 +223,17 @@ def watertight_pairs(setup: RaySetup, rays: NDArray[np.intp], v0: NDArray[np.flo
 
 def nearest_watertight(v0: NDArray[np.float64], v1: NDArray[np.float64], v2: NDArray[np.float64],
                        origins: ArrayLike, directions: ArrayLike, cull_backfaces: bool = False,
-                       chunk_pairs: int = 1 << 14) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
+                       chunk_pairs: int = 1 << 14, accept: Callable[..., NDArray[np.bool_]] | None = None
+                       ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
     """Nearest hit of each ray over *every* triangle (no BVH): ``(t, index)``, ``(inf, −1)``
     for a miss, the lower index winning a tie (the course's ``min_indis``). The
     numpy engine's per-node scan (``bvh=False``): the watertight test, so a ray
     through a shared edge or vertex never slips through. Triangles without area
     (:func:`nondegenerate`) are never hit, as in the BVH. Pairs are tested a
-    block of rays at a time, about ``chunk_pairs`` pairs a block."""
+    block of rays at a time, about ``chunk_pairs`` pairs a block.
+
+    ``accept(rays, triangles, t)``: which hits count (the any-hit filter of
+    :func:`~glsandbox.raytrace.bvh_traverse.any_hit`); the nearest of those wins."""
     o, d = broadcast_rays(origins, directions)
     n, m = d.shape[0], v0.shape[0]
     best_t = np.full(n, np.inf)
@@ -242,6 +247,11 @@ def nearest_watertight(v0: NDArray[np.float64], v1: NDArray[np.float64], v2: NDA
         rays = np.arange(lo, min(n, lo + step))
         t, _, _ = watertight_pairs(setup, np.repeat(rays, keep.size), v0, v1, v2, np.tile(keep, rays.size),
                                    cull_backfaces, barycentrics=False)
+        if accept is not None:
+            hit = np.flatnonzero(np.isfinite(t))
+            if hit.size:
+                refused = hit[~accept(np.repeat(rays, keep.size)[hit], np.tile(keep, rays.size)[hit], t[hit])]
+                t[refused] = np.inf
         t = t.reshape(rays.size, keep.size)
         j = np.argmin(t, axis=1)  # the first minimum: the lowest index on a tie
         best_t[rays] = t[np.arange(rays.size), j]

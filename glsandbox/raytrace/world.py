@@ -32,7 +32,15 @@ once per viewport by :func:`build_world` from the *same*
   An unlit node (``solid``/``vertex_color``) whose box holds a light is that
   light's lamp (the lessons draw each light as a small cube around it) and
   casts no shadow *for that light*; otherwise every shadow ray would enter
-  the lamp. Lit nodes always cast shadows.
+  the lamp. Lit nodes cast shadows, as the rasterizer's planar shadow and
+  shadow map draw them (:func:`glsandbox.plan.caster_program`): a blended
+  node casts none (light passes it as a camera ray does), a cut-out only
+  through its drawn texels (:attr:`NodeInfo.texel_shadow`: a shadow ray
+  meeting a texel whose alpha is below the cutoff goes on), and a cut-out
+  whose colour's alpha is below its cutoff (cut out everywhere) none. A
+  textured cut-out is traced as its triangles even where it tessellates a
+  sphere or cylinder: the analytic kinds give a ray's nearest hit only, and a
+  shadow ray must see every texel it passes.
 
 Primary rays (course section "Bakış noktası, görüntü düzlemi GD(x,y)")
 ---------------------------------------------------------------------
@@ -211,6 +219,20 @@ class NodeInfo:
         continue such a ray behind it (:func:`coverage`)."""
         return self.alpha_mode != ALPHA_CODES["opaque"]
 
+    @property
+    def casts_no_shadow(self) -> bool:
+        """A blended node (shadow rays pass it as camera rays do, and the rasterizer's
+        shadows leave it out too), or a cut-out cut away everywhere (its colour's alpha,
+        the most its texels can reach, below its cutoff)."""
+        return self.alpha_mode == ALPHA_CODES["blend"] or (self.alpha_mode == ALPHA_CODES["mask"]
+                                                           and self.alpha < self.alpha_cutoff)
+
+    @property
+    def texel_shadow(self) -> bool:
+        """A textured cut-out: a shadow ray is blocked by it only where its alpha (the
+        colour's times the texel's, as shading reads it) reaches the cutoff."""
+        return self.alpha_mode == ALPHA_CODES["mask"] and self.texture >= 0 and not self.casts_no_shadow
+
 
 @dataclass
 class World:
@@ -346,7 +368,9 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
         )
         # A model that flattens the node (a scale of 0, or below MIN_SCALE) has no usable inverse.
         invertible = transforms.smallest_scale(model) >= MIN_SCALE
-        kind = analytic_kind(mesh) if analytic_spheres and invertible else None
+        # A textured cut-out stays triangles: its shadow rays test every texel they pass.
+        cut_out = material.alpha_mode == "mask" and tex >= 0
+        kind = analytic_kind(mesh) if analytic_spheres and invertible and not cut_out else None
         if kind is not None:
             lo, hi = kind.own_box
             corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
@@ -376,7 +400,7 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
         start += len(tri)
     lights = scene.lights
     for info in nodes:
-        if info.see_through:  # cut-outs and glass cast no shadow (the rasterizer draws none)
+        if info.casts_no_shadow:  # blended, or cut out everywhere (as the rasterizer's shadows)
             info.lamp_of = (1 << len(lights)) - 1
             continue
         for i, light in enumerate(lights):

@@ -4,11 +4,14 @@
 // glsandbox.raytrace.bvh.BVH into two RGBA32F textures read with texelFetch,
 // texel i at (i % BVH_TEX_WIDTH, i / BVH_TEX_WIDTH):
 //
-//   u_bvh_nodes  2 texels per node i:  2i   = (box min xyz, first)
-//                                      2i+1 = (box max xyz, count)
-//                count == 0: an inner node, children first and first + 1;
-//                count >  0: a leaf of stored triangles first .. first+count-1.
-//                Boxes are rounded outwards to float32. Node 0 is the root.
+//   u_bvh_nodes  4 texels per record r: its two children, each as
+//                (box min xyz, ref), (box max xyz, count):
+//                count == 0: an inner child, whose own children are in record ref;
+//                count >  0: a leaf of stored triangles ref .. ref+count-1.
+//                Record 0 holds the root in its first two texels. A visit of an
+//                inner node reads both children's boxes (4 fetches) and a leaf
+//                is never visited on its own: its range comes with its box.
+//                Boxes are rounded outwards to float32.
 //   u_bvh_tris   3 texels per stored triangle k: 3k = (v0 xyz, caller's index),
 //                3k+1 = (v1 xyz, 0), 3k+2 = (v2 xyz, 0).
 // Integers are stored as floats: exact up to 2^24 (the host checks).
@@ -20,8 +23,9 @@
 // iterations IN TOTAL, silently: sequential loops and nested loops share one
 // counter (measured: two loops of 40,000 ran 40,000 and 25,534). A ray that
 // needed more would just lose triangles. So the traversal is ONE loop whose
-// every iteration is one unit of work (visiting an inner node: its two
-// children's boxes; or testing one triangle of a leaf), bounded by
+// every iteration is one unit of work (taking the next subtree off the stack
+// and visiting it: its two children's boxes; or testing one triangle of a
+// leaf), bounded by
 // BVH_MAX_STEPS, far below the limit. A ray that reaches the bound (or
 // would overflow the stack) is not finished: the result says so
 // (BvhHit.overflow) and the host raises instead of using it. A shader that
@@ -46,6 +50,12 @@
 #endif
 #ifndef BVH_PAD
 #define BVH_PAD 3.814697265625e-06
+#endif
+// BVH_ANY_ACCEPT(index, t, uv): whether bvh_any counts a hit (an any-hit
+// filter, as Embree's; `o`, `d` are the ray's): every hit unless the
+// includer defines it (the ray tracer's cut-out shadows).
+#ifndef BVH_ANY_ACCEPT
+#define BVH_ANY_ACCEPT(index, t, uv) true
 #endif
 #include "common/watertight.glsl"
 
@@ -78,18 +88,30 @@ BvhRay bvh_ray(vec3 o, vec3 d) {
     return r;
 }
 
-// The slab test against node `node`'s box (Hızlandırma: AABB): the ray is in
-// the box between the largest entry and the smallest exit. `near` is the entry.
-bool bvh_box(BvhRay r, int node, float limit, out float near) {
-    vec3 lo = bvh_texel(u_bvh_nodes, 2 * node).xyz - r.pad;
-    vec3 hi = bvh_texel(u_bvh_nodes, 2 * node + 1).xyz + r.pad;
-    vec3 ta = (lo - r.w.o) * r.w.inv_d;
-    vec3 tb = (hi - r.w.o) * r.w.inv_d;
+// The slab test against child `side` (0 or 1) of record `rec` (Hızlandırma: AABB):
+// the ray is in the box between the largest entry and the smallest exit. `near`
+// is the entry; `entry` what the traversal holds for the child (bvh_entry).
+bool bvh_child(BvhRay r, int rec, int side, float limit, out float near, out int entry) {
+    vec4 lo = bvh_texel(u_bvh_nodes, 4 * rec + 2 * side);
+    vec4 hi = bvh_texel(u_bvh_nodes, 4 * rec + 2 * side + 1);
+    vec3 ta = (lo.xyz - r.pad - r.w.o) * r.w.inv_d;
+    vec3 tb = (hi.xyz + r.pad - r.w.o) * r.w.inv_d;
     vec3 tn = min(ta, tb);
     vec3 tf = max(ta, tb);
     near = max(max(tn.x, tn.y), tn.z);
     float far = min(min(tf.x, tf.y), tf.z);
+    int count = int(hi.w);
+    // An inner child: its record (>= 0). A leaf: -2 - (first * 64 + count - 1)
+    // (leaves hold 1..64 triangles, first < 2^24: within an int). -1: nothing.
+    entry = count > 0 ? -2 - (int(lo.w) * 64 + count - 1) : int(lo.w);
     return near <= far && far >= 0.0 && near <= limit;
+}
+
+// A leaf entry's triangle range.
+void bvh_leaf(int entry, out int first, out int stop) {
+    int code = -2 - entry;
+    first = code / 64;
+    stop = first + code % 64 + 1;
 }
 
 // The watertight test against stored triangle k: t (or -1.0 for a miss),
@@ -103,9 +125,15 @@ float bvh_triangle(BvhRay r, int k, bool cull, out int index, out vec2 uv) {
 
 // The nearest hit with 0 < t < t_max: an ordered, stackful traversal (the
 // nearer child first, the other pushed with its entry distance so it can be
-// skipped once a nearer hit is known), one unit of work per loop iteration.
-// bvh_closest_at / bvh_any_at start at node `root` (several BVHs concatenated in
-// one texture pair, their indices offset); bvh_closest / bvh_any at node 0.
+// skipped once a nearer hit is known). On 8-wide SIMD every loop iteration
+// runs all of its code under masks, so each iteration does two things at
+// once: it tests one triangle of the current leaf, and it takes the walk one
+// node further (pops the next subtree, skipped if it starts beyond the best
+// hit, and visits it: both children's boxes). A leaf the walk comes to waits
+// (one at most: the walk pauses meanwhile) until the current one is done. The
+// walk may so run one leaf ahead of the best hit, which only skips less.
+// bvh_closest_at / bvh_any_at start at record `root` (several BVHs concatenated
+// in one texture pair, their indices offset); bvh_closest / bvh_any at record 0.
 BvhHit bvh_closest_at(int root, vec3 o, vec3 d, float t_max, bool cull) {
     BvhHit hit = BvhHit(t_max, -1, vec2(0.0), false, 0);
     BvhRay r = bvh_ray(o, d);
@@ -113,10 +141,12 @@ BvhHit bvh_closest_at(int root, vec3 o, vec3 d, float t_max, bool cull) {
     float stack_near[BVH_STACK];
     int sp = 0;
     float near;
-    int node = bvh_box(r, root, t_max, near) ? root : -1;
+    int node;
+    if (!bvh_child(r, root, 0, t_max, near, node)) node = -1;
+    int waiting = -1;  // a leaf entry waiting for the current leaf to be done
     int tri = 0;
     int tri_end = 0;
-    bool finished = node < 0;
+    bool finished = node == -1;
     for (int step = 0; step < BVH_MAX_STEPS && !finished; ++step) {
         hit.steps = step + 1;
         if (tri < tri_end) {  // one triangle of the current leaf
@@ -129,52 +159,56 @@ BvhHit bvh_closest_at(int root, vec3 o, vec3 d, float t_max, bool cull) {
                 hit.uv = uv;
             }
             ++tri;
-            continue;
         }
-        if (node < 0) {  // pop the next subtree still worth entering
-            if (sp == 0) { finished = true; continue; }
-            --sp;
-            if (stack_near[sp] <= hit.t) node = stack[sp];
-            continue;
+        if (waiting == -1) {  // the walk: one node further
+            if (node == -1 && sp > 0) {  // pop the next subtree, skipped if it starts beyond the best hit
+                --sp;
+                node = stack_near[sp] <= hit.t ? stack[sp] : -1;
+            }
+            if (node >= 0) {  // an inner node: both children's boxes
+                float near_l, near_r;
+                int left, right;
+                bool hit_l = bvh_child(r, node, 0, hit.t, near_l, left);
+                bool hit_r = bvh_child(r, node, 1, hit.t, near_r, right);
+                if (hit_l && hit_r) {
+                    if (sp == BVH_STACK) { hit.overflow = true; break; }  // never drop a subtree silently
+                    bool left_first = near_l <= near_r;
+                    stack[sp] = left_first ? right : left;
+                    stack_near[sp] = left_first ? near_r : near_l;
+                    ++sp;
+                    node = left_first ? left : right;
+                } else {
+                    node = hit_l ? left : (hit_r ? right : -1);
+                }
+            }
+            if (node < -1) {
+                waiting = node;
+                node = -1;
+            }
         }
-        vec4 lo = bvh_texel(u_bvh_nodes, 2 * node);
-        int count = int(bvh_texel(u_bvh_nodes, 2 * node + 1).w);
-        int first = int(lo.w);
-        if (count > 0) {  // a leaf: its triangles in the next iterations
-            tri = first;
-            tri_end = first + count;
-            node = -1;
-            continue;
+        if (waiting != -1 && tri >= tri_end) {  // the waiting leaf's triangles from the next iteration
+            bvh_leaf(waiting, tri, tri_end);
+            waiting = -1;
         }
-        float near_l, near_r;
-        bool hit_l = bvh_box(r, first, hit.t, near_l);
-        bool hit_r = bvh_box(r, first + 1, hit.t, near_r);
-        if (hit_l && hit_r) {
-            if (sp == BVH_STACK) { hit.overflow = true; break; }  // never drop a subtree silently
-            bool left_first = near_l <= near_r;
-            stack[sp] = left_first ? first + 1 : first;
-            stack_near[sp] = left_first ? near_r : near_l;
-            ++sp;
-            node = left_first ? first : first + 1;
-        } else {
-            node = hit_l ? first : (hit_r ? first + 1 : -1);
-        }
+        finished = tri >= tri_end && waiting == -1 && node == -1 && sp == 0;
     }
     if (!finished) hit.overflow = true;
     return hit;
 }
 
 // Whether anything is hit with 0 < t < t_max (a shadow ray): the same walk,
-// ending at the first hit. Unfinished rays set `overflow`.
+// unordered, ending at the first hit. Unfinished rays set `overflow`.
 bool bvh_any_at(int root, vec3 o, vec3 d, float t_max, bool cull, out bool overflow) {
     BvhRay r = bvh_ray(o, d);
     int stack[BVH_STACK];
     int sp = 0;
     float near;
-    int node = bvh_box(r, root, t_max, near) ? root : -1;
+    int node;
+    if (!bvh_child(r, root, 0, t_max, near, node)) node = -1;
+    int waiting = -1;
     int tri = 0;
     int tri_end = 0;
-    bool finished = node < 0;
+    bool finished = node == -1;
     bool found = false;
     overflow = false;
     for (int step = 0; step < BVH_MAX_STEPS && !finished; ++step) {
@@ -182,34 +216,34 @@ bool bvh_any_at(int root, vec3 o, vec3 d, float t_max, bool cull, out bool overf
             int index;
             vec2 uv;
             float t = bvh_triangle(r, tri, cull, index, uv);
-            if (t > 0.0 && t < t_max) { found = true; finished = true; }
+            found = t > 0.0 && t < t_max && BVH_ANY_ACCEPT(index, t, uv);
             ++tri;
-            continue;
         }
-        if (node < 0) {
-            if (sp == 0) { finished = true; continue; }
-            node = stack[--sp];
-            continue;
+        if (waiting == -1) {
+            if (node == -1 && sp > 0) node = stack[--sp];
+            if (node >= 0) {
+                float near_l, near_r;
+                int left, right;
+                bool hit_l = bvh_child(r, node, 0, t_max, near_l, left);
+                bool hit_r = bvh_child(r, node, 1, t_max, near_r, right);
+                if (hit_l && hit_r) {
+                    if (sp == BVH_STACK) { overflow = true; break; }
+                    stack[sp++] = right;
+                    node = left;
+                } else {
+                    node = hit_l ? left : (hit_r ? right : -1);
+                }
+            }
+            if (node < -1) {
+                waiting = node;
+                node = -1;
+            }
         }
-        vec4 lo = bvh_texel(u_bvh_nodes, 2 * node);
-        int count = int(bvh_texel(u_bvh_nodes, 2 * node + 1).w);
-        int first = int(lo.w);
-        if (count > 0) {
-            tri = first;
-            tri_end = first + count;
-            node = -1;
-            continue;
+        if (waiting != -1 && tri >= tri_end) {
+            bvh_leaf(waiting, tri, tri_end);
+            waiting = -1;
         }
-        float near_l, near_r;
-        bool hit_l = bvh_box(r, first, t_max, near_l);
-        bool hit_r = bvh_box(r, first + 1, t_max, near_r);
-        if (hit_l && hit_r) {
-            if (sp == BVH_STACK) { overflow = true; break; }
-            stack[sp++] = first + 1;
-            node = first;
-        } else {
-            node = hit_l ? first : (hit_r ? first + 1 : -1);
-        }
+        finished = found || (tri >= tri_end && waiting == -1 && node == -1 && sp == 0);
     }
     if (!finished) overflow = true;
     return found;

@@ -48,7 +48,11 @@
 struct WtRay {
     vec3 o;
     vec3 inv_d;     // for slab tests (zero components made tiny: no NaN)
-    mat3 m;         // permute then shear: m (V - O) = (x - sx z, y - sy z, sz z) on the axes kx, ky, kz
+    // The permutation and the shear (steps 1 and 2): a corner V becomes
+    // (x - sx z, y - sy z, sz z) of P = V - O taken on the axes kx, ky, kz.
+    bvec3 pick0;    // (kx, ky, kz) == 0
+    bvec3 pick1;    // (kx, ky, kz) == 1
+    vec3 s;         // sx, sy, sz
 };
 
 WtRay wt_ray(vec3 o, vec3 d) {
@@ -59,19 +63,27 @@ WtRay wt_ray(vec3 o, vec3 d) {
     int kx = kz == 2 ? 0 : kz + 1;
     int ky = kx == 2 ? 0 : kx + 1;
     if (d[kz] < 0.0) { int k = kx; kx = ky; ky = k; }  // keep the winding
-    float sx = d[kx] / d[kz], sy = d[ky] / d[kz], sz = 1.0 / d[kz];
-    // The permutation and the shear as one matrix, so a triangle's corners
-    // need no per-lane vector indexing (slow on llvmpipe). A corner shared by
+    r.s = vec3(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
+    // The permutation as two masks, so a triangle's corners need no per-lane
+    // vector indexing (slow on llvmpipe), only selects. A corner shared by
     // two triangles still gets the same numbers in both, which is all the
     // watertight argument needs of them.
-    vec3 ex = vec3(equal(ivec3(kx), ivec3(0, 1, 2)));
-    vec3 ey = vec3(equal(ivec3(ky), ivec3(0, 1, 2)));
-    vec3 ez = vec3(equal(ivec3(kz), ivec3(0, 1, 2)));
-    r.m = transpose(mat3(ex - sx * ez, ey - sy * ez, sz * ez));
+    r.pick0 = equal(ivec3(kx, ky, kz), ivec3(0));
+    r.pick1 = equal(ivec3(kx, ky, kz), ivec3(1));
     vec3 safe = mix(d, mix(vec3(-DIRECTION_TINY), vec3(DIRECTION_TINY), greaterThanEqual(d, vec3(0.0))),
                     lessThan(ad, vec3(DIRECTION_TINY)));
     r.inv_d = 1.0 / safe;
     return r;
+}
+
+// A corner in ray space: P = V - O permuted to (P[kx], P[ky], P[kz]) by
+// selects, then sheared. (The same floats as the permutation-and-shear
+// matrix this replaced, whose rows add 1 P[kx], -sx P[kz] and 0 P[ky]: the
+// 1 and 0 products and the sum with 0 are exact; the selects are cheaper.)
+vec3 wt_corner(WtRay r, vec3 v) {
+    vec3 p = v - r.o;
+    vec3 q = mix(mix(vec3(p.z), vec3(p.y), r.pick1), vec3(p.x), r.pick0);
+    return vec3(q.x - r.s.x * q.z, q.y - r.s.y * q.z, r.s.z * q.z);
 }
 
 // E(p, q) = px qy - py qx, recomputed exactly when it rounds to 0.
@@ -86,9 +98,9 @@ float wt_edge(float px, float py, float qx, float qy) {
 // The test against the triangle v0 v1 v2: t (or -1.0 for a miss) and the
 // barycentrics uv (P = V0 + u (V1 - V0) + v (V2 - V0)).
 float wt_triangle(WtRay r, vec3 v0, vec3 v1, vec3 v2, bool cull, out vec2 uv) {
-    vec3 a = r.m * (v0 - r.o);  // (sheared x, sheared y, sz z) of each corner
-    vec3 b = r.m * (v1 - r.o);
-    vec3 c = r.m * (v2 - r.o);
+    vec3 a = wt_corner(r, v0);  // (sheared x, sheared y, sz z) of each corner
+    vec3 b = wt_corner(r, v1);
+    vec3 c = wt_corner(r, v2);
     float u = wt_edge(c.x, c.y, b.x, b.y);  // the weight of V0
     float v = wt_edge(a.x, a.y, c.x, c.y);  // of V1
     float w = wt_edge(b.x, b.y, a.x, a.y);  // of V2

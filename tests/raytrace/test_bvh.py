@@ -78,6 +78,11 @@ def check_structure(bvh: BVH, a: np.ndarray, b: np.ndarray, c: np.ndarray, leaf_
         assert np.all(bvh.node_max[child] <= bvh.node_max[inner])
     reached = np.concatenate([[0], left, left + 1])
     assert np.array_equal(np.sort(reached), np.arange(bvh.node_total))
+    # depth: the nodes on the longest path from the root (the GPU traversal's stack is sized by it).
+    level = np.ones(bvh.node_total, dtype=np.int64)
+    for k in inner:  # in id order: a parent before its children
+        level[bvh.node_first[k]] = level[bvh.node_first[k] + 1] = level[k] + 1
+    assert bvh.depth == level.max()
     if ok.any():
         np.testing.assert_array_equal(bvh.node_min[0], np.minimum(np.minimum(a[ok], b[ok]), c[ok]).min(axis=0))
 
@@ -90,6 +95,14 @@ def test_every_triangle_is_in_exactly_one_leaf_and_children_lie_inside_parents(s
     bvh = build_bvh(a, b, c, leaf_size=leaf_size)
     assert bvh.input_count == count
     check_structure(bvh, a, b, c, leaf_size)
+
+
+@pytest.mark.parametrize("leaf_size", [33, 64])
+def test_leaves_as_big_as_the_small_node_limit(leaf_size: int) -> None:
+    # Nodes of up to bvh.SMALL triangles are split by the full sweep; a leaf size at or above it
+    # leaves that phase nothing (or everything) to do.
+    a, b, c = soup(7, 1500)
+    check_structure(build_bvh(a, b, c, leaf_size=leaf_size), a, b, c, leaf_size)
 
 
 def test_triangles_that_no_cut_separates_are_split_by_count() -> None:

@@ -187,9 +187,20 @@ def test_an_empty_bvh_is_missed_and_float32_boxes_contain_the_float64_ones(ctx) 
     a, b, c = mesh_world_triangles(meshgen.rock(3), np.diag([3.3, 1.7, 0.9, 1.0]))
     bvh = build_bvh(a, b, c)
     nodes, tris = pack_bvh(bvh)
-    assert np.all(nodes[0::2, :3].astype(np.float64) <= bvh.node_min)
-    assert np.all(nodes[1::2, :3].astype(np.float64) >= bvh.node_max)
-    np.testing.assert_array_equal(nodes[0::2, 3], bvh.node_first)
+    # Record 0 holds the root; record r >= 1 the two children of the r-th inner node.
+    records = nodes.reshape(-1, 2, 2, 4)
+    entries = np.concatenate([records[:1, 0], records[1:].reshape(-1, 2, 4)])
+    inner = np.flatnonzero(bvh.node_count == 0)
+    order = np.concatenate([[0], np.stack([bvh.node_first[inner], bvh.node_first[inner] + 1], axis=1).reshape(-1)])
+    assert entries.shape[0] == bvh.node_total == order.size
+    assert np.all(entries[:, 0, :3].astype(np.float64) <= bvh.node_min[order])
+    assert np.all(entries[:, 1, :3].astype(np.float64) >= bvh.node_max[order])
+    np.testing.assert_array_equal(entries[:, 1, 3], bvh.node_count[order])
+    leaf = bvh.node_count[order] > 0
+    np.testing.assert_array_equal(entries[leaf, 0, 3], bvh.node_first[order][leaf])
+    record_of = np.zeros(bvh.node_total, dtype=np.int64)
+    record_of[inner] = np.arange(1, inner.size + 1)
+    np.testing.assert_array_equal(entries[~leaf, 0, 3], record_of[order[~leaf]])
     np.testing.assert_array_equal(tris[0::3, 3], bvh.tri_index)
 
 
