@@ -79,15 +79,18 @@ def text_image(rows: Sequence[str | Sequence[str]], *, color: RGBA = TEXT_COLOR,
     return _text_image(key, color, panel, padding, line_gap, column_gap)
 
 
+@lru_cache(maxsize=1024)
+def _text_width(text: str) -> int:
+    """A string's width in pixels in the panel font: the numbers of a matrix panel
+    recur from frame to frame, so each is measured once."""
+    return int(np.ceil(ImageDraw.Draw(Image.new("RGBA", (1, 1))).textlength(text, font=_font())))
+
+
 @lru_cache(maxsize=128)
 def _text_image(rows: tuple[str | tuple[str, ...], ...], color: RGBA, panel: RGBA,
                 padding: int, line_gap: int, column_gap: int) -> np.ndarray:
     font = _font()
-    draw_probe = ImageDraw.Draw(Image.new("RGBA", (1, 1)))
-
-    def width(text: str) -> int:
-        return int(np.ceil(draw_probe.textlength(text, font=font)))
-
+    width = _text_width
     ascent, descent = font.getmetrics() if hasattr(font, "getmetrics") else (10, 2)
     line_h = ascent + descent
     cells = [r for r in rows if not isinstance(r, str)]

@@ -596,6 +596,13 @@ class Motion:
     lights: Mapping[int, tuple[float, float, float]] = field(default_factory=dict)
     #: A camera replacing the scene's (the window's camera keys, :meth:`glsandbox.camera.CameraInput.apply`).
     camera: Camera | None = None
+    #: New vertex positions of nodes' meshes, by node name: the same number of vertices, every
+    #: other array and the indices as built (transform_order's trail). The renderer writes
+    #: them into the mesh's own vertex buffer instead of uploading a new mesh.
+    positions: Mapping[str, Any] = field(default_factory=dict)
+    #: New images of overlays, by overlay name (a panel whose numbers change); the renderer
+    #: writes them into the overlay's texture.
+    overlays: Mapping[str, Any] = field(default_factory=dict)
 
 
 def _copy_with(obj: Any, **changes: Any) -> Any:
@@ -607,6 +614,30 @@ def _copy_with(obj: Any, **changes: Any) -> Any:
     return new
 
 
+def moved_mesh(mesh: Mesh, positions: Any) -> Mesh:
+    """``mesh`` with new vertex positions (as many as it has, finite), the rest its own; it
+    remembers the mesh it was moved from (:func:`mesh_origin`), so that the renderer writes
+    the positions into that mesh's vertex buffer, not a new one each frame."""
+    array = np.asarray(positions)
+    if array.shape != mesh.positions.shape or array.dtype.kind not in "iuf":
+        raise SandboxError(f"mesh {mesh.name!r}: moved positions must be a {mesh.positions.shape} array of "
+                           f"numbers like the mesh's, got shape {array.shape} of {array.dtype}")
+    if not np.isfinite(array).all():
+        row = int(np.argwhere(~np.isfinite(array))[0][0])
+        raise SandboxError(f"mesh {mesh.name!r}: moved positions[{row}] is not finite: {plain(array[row])}")
+    if array is positions and array.flags.writeable:
+        array = array.copy()  # the mesh keeps its own, read-only as every mesh's arrays
+    array.flags.writeable = False
+    origin = mesh_origin(mesh) or mesh
+    # analytic: the exact shape the built triangles tessellate; moved ones tessellate none.
+    return _copy_with(mesh, positions=array, analytic=None, _moved_from=origin)
+
+
+def mesh_origin(mesh: Mesh) -> Mesh | None:
+    """The mesh ``mesh`` was moved from by :func:`moved_mesh` (None: it was made as it is)."""
+    return mesh.__dict__.get("_moved_from")
+
+
 def moved_scene(scene: Scene, motion: Motion) -> Scene:
     """``scene`` with ``motion`` applied: the moved nodes and lights are new objects, each new
     value checked as the dataclasses check it (a model matrix of 4x4 bounded numbers, at
@@ -615,24 +646,37 @@ def moved_scene(scene: Scene, motion: Motion) -> Scene:
     remembers ``scene`` (:func:`scene_origin`): the renderers keep what they derived from
     it (the plan, per-draw uniform bytes) while only positions change."""
     origin = scene_origin(scene) or scene
-    nodes, lights = scene.nodes, scene.lights
-    if motion.models:
-        models = dict(motion.models)
+    nodes, lights, overlays = scene.nodes, scene.lights, scene.overlays
+    if motion.models or motion.positions:
+        models, positions = dict(motion.models), dict(motion.positions)
         moved = []
         for node in nodes:
-            model = models.get(node.name)
-            if model is None:
+            model, points = models.get(node.name), positions.get(node.name)
+            if model is None and points is None:
                 moved.append(node)
                 continue
-            matrix = check_node_model(node.name, model)
-            if node.material.lit:
-                check_lit_model(node.name, matrix)
-            moved.append(_copy_with(node, model=model))
-        unknown = set(models) - {node.name for node in nodes}
+            changes: dict[str, Any] = {}
+            if model is not None:
+                matrix = check_node_model(node.name, model)
+                if node.material.lit:
+                    check_lit_model(node.name, matrix)
+                changes["model"] = model
+            if points is not None:
+                changes["mesh"] = moved_mesh(node.mesh, points)
+            moved.append(_copy_with(node, **changes))
+        unknown = (set(models) | set(positions)) - {node.name for node in nodes}
         if unknown:
             raise SandboxError(f"scene {scene.name!r}: the motion moves {', '.join(map(repr, sorted(unknown)))}, "
                                f"which is not a node of the scene")
         nodes = tuple(moved)
+    if motion.overlays:
+        images = dict(motion.overlays)
+        unknown = set(images) - {overlay.name for overlay in overlays}
+        if unknown:
+            raise SandboxError(f"scene {scene.name!r}: the motion changes overlay "
+                               f"{', '.join(map(repr, sorted(unknown)))}, which is not an overlay of the scene")
+        overlays = tuple(Overlay(o.name, images[o.name], o.viewport, o.position) if o.name in images else o
+                         for o in overlays)
     if motion.lights:
         lights = list(lights)
         for index, position in motion.lights.items():
@@ -646,7 +690,7 @@ def moved_scene(scene: Scene, motion: Motion) -> Scene:
         if not isinstance(motion.camera, Camera):
             raise SandboxError(f"scene {scene.name!r}: the motion's camera must be a Camera, got {plain(motion.camera)}")
         camera = motion.camera
-    return _copy_with(scene, nodes=nodes, lights=lights, camera=camera, _moved_from=origin)
+    return _copy_with(scene, nodes=nodes, lights=lights, camera=camera, overlays=overlays, _moved_from=origin)
 
 
 def scene_origin(scene: Scene) -> Scene | None:

@@ -35,13 +35,14 @@ order and Tab switches to the split view of all six (``--set view=split``).
 
 from __future__ import annotations
 
+import functools
 import math
 import sys
 
 import numpy as np
 
 import glsandbox
-from glsandbox import Camera, Lesson, Material, Node, Overlay, Param, Scene, Viewport, register, text_image
+from glsandbox import Camera, Lesson, Material, Motion, Node, Overlay, Param, Scene, Viewport, register, text_image
 from glsandbox import camera as course_camera
 from glsandbox import geometry, transforms
 
@@ -100,6 +101,7 @@ def order_classes(angle: float) -> list[list[str]]:
     return groups
 
 
+@functools.lru_cache(maxsize=len(transforms.ORDERS))
 def motion(order: str) -> str:
     """What the cube does under ``order``, measured from the matrices: orbit or spin in place."""
     centre = [transforms.transform_points(second_cube_model(order, a), np.zeros((1, 3)))[0] for a in (0.0, 1.0)]
@@ -144,11 +146,16 @@ def figures_panel() -> np.ndarray:
     ])
 
 
-def trail_mesh(order: str, angle: float, span: float) -> geometry.Mesh:
-    """The top corner's path while R went from ``angle - span`` to ``angle``, as a line strip."""
+def trail_points(order: str, angle: float, span: float) -> np.ndarray:
+    """The top corner's positions while R went from ``angle - span`` to ``angle``, (N, 3)."""
     models = second_cube_models(order, np.linspace(angle - span, angle, TRAIL_SAMPLES))
     corner = models @ np.append(TRAIL_POINT, 1.0)  # (N, 4): the corner under each model
-    return geometry.Mesh(f"trail_{order}", corner[:, :3] / corner[:, 3:], mode="line_strip")
+    return corner[:, :3] / corner[:, 3:]
+
+
+def trail_mesh(order: str, angle: float, span: float) -> geometry.Mesh:
+    """The top corner's path (:func:`trail_points`) as a line strip."""
+    return geometry.Mesh(f"trail_{order}", trail_points(order, angle, span), mode="line_strip")
 
 
 @register
@@ -184,9 +191,29 @@ class TransformOrder(Lesson):
             return True
         return False
 
+    def motion(self) -> Motion:
+        """Time turns both cubes, moves the trail's points along (the trail keeps its vertex
+        count, so its buffer is rewritten in place) and changes the matrix panel's numbers."""
+        split = self.values["view"] == "split"
+        orders = transforms.ORDERS if split else (transforms.parse_order(self.values["order"]),)
+        span = float(self.values["trail"])
+        trail = bool(self.values["overlay"]) and span > 0.0
+        models, positions = {"centre": self._centre_model()}, {}
+        for order in orders:
+            suffix = f"_{order}" if split else ""
+            models[f"second{suffix}"] = second_cube_model(order, self.angle)
+            if trail:
+                positions[f"trail{suffix}"] = trail_points(order, self.angle, span)
+        overlays = {}
+        if self.values["overlay"] and not split:
+            overlays["matrix"] = matrix_panel(orders[0], self.angle)
+        return Motion(models=models, positions=positions, overlays=overlays)
+
+    def _centre_model(self) -> np.ndarray:
+        return transforms.rotate_y(-float(self.values["spin"]) * self.time)
+
     def _centre_cube(self) -> Node:
-        spin = transforms.rotate_y(-float(self.values["spin"]) * self.time)
-        return Node("centre", geometry.cube(), spin, Material(shading="vertex_color"))
+        return Node("centre", geometry.cube(), self._centre_model(), Material(shading="vertex_color"))
 
     def _order_nodes(self, order: str, viewport: int | None) -> list[Node]:
         views = None if viewport is None else (viewport,)

@@ -12,7 +12,7 @@ import hashlib
 import struct
 import weakref
 from collections.abc import Callable, Collection, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import moderngl
@@ -29,7 +29,7 @@ from glsandbox.gl.target import clear_opaque
 from glsandbox.gl.textures import TextureCache
 from glsandbox.gl.passes import FrameState, PassRunner
 from glsandbox.plan import SHADOW_MAP_UNIT, Draw, Pass, Plan, ProgramVariant, plan as make_plan
-from glsandbox.scene import Light, Material, Node, Scene
+from glsandbox.scene import Light, Material, Node, Scene, mesh_origin
 
 _MODES = {"triangles": moderngl.TRIANGLES, "triangle_strip": moderngl.TRIANGLE_STRIP,
           "lines": moderngl.LINES, "line_strip": moderngl.LINE_STRIP}
@@ -63,6 +63,18 @@ def _mesh_key(mesh: Mesh, arrays: dict[str, np.ndarray] | None = None) -> tuple[
             digest.update(array)  # the array's memory as it is: no copy
         digest.update(mesh.mode.encode())
         key = _MESH_KEYS[mesh] = (mesh.name, digest.hexdigest())
+    return key
+
+
+#: The GPU key of each mesh moved by a lesson's Motion (``Motion.positions``): its own buffers,
+#: shared with no mesh of equal content, since the positions are written into them every frame.
+_MOVED_KEYS: weakref.WeakKeyDictionary[Mesh, tuple[str, str]] = weakref.WeakKeyDictionary()
+
+
+def _moved_key(origin: Mesh) -> tuple[str, str]:
+    key = _MOVED_KEYS.get(origin)
+    if key is None:
+        key = _MOVED_KEYS[origin] = (origin.name, f"moved-{len(_MOVED_KEYS)}-{id(origin):x}")
     return key
 
 
@@ -198,6 +210,7 @@ class _GpuMesh:
     index: moderngl.Buffer | None
     mode: int
     count: int
+    positions: np.ndarray | None = None  # a moved mesh's: the positions its buffer holds now
 
 
 @dataclass
@@ -212,6 +225,12 @@ class _DrawSetup:
     vao: moderngl.VertexArray
     gpu: _GpuMesh
     normal: bool  # the program reads m_normal
+    # The program's uniforms by name, and the bytes last written into each (the program's
+    # entry of Executor._written): draw_node's loop writes only what changed.
+    uniforms: dict[str, moderngl.Uniform] = field(default_factory=dict)
+    written: dict[str, bytes] = field(default_factory=dict)
+    # Per material drawn with it (by id, the object kept to check): its constant uniform bytes.
+    constants: dict[int, tuple[Material, tuple[tuple[str, bytes], ...]]] = field(default_factory=dict)
 
 
 class Executor:
@@ -347,17 +366,37 @@ class Executor:
         return values
 
     def _gpu_mesh(self, mesh: Mesh) -> tuple[tuple[str, str], _GpuMesh]:
+        origin = mesh_origin(mesh)
+        if origin is not None:
+            return self._moved_gpu_mesh(mesh, origin)
         arrays = None if mesh in _MESH_KEYS else _gpu_arrays(mesh)  # made once for the digest and the upload
         key = _mesh_key(mesh, arrays)
         gpu = self._meshes.get(key)
         if gpu is None:
-            arrays = arrays or _gpu_arrays(mesh)
-            index_array = arrays.pop("indices", None)
-            buffers = {attr: self.ctx.buffer(array) for attr, array in arrays.items()}
-            index = None if index_array is None else self.ctx.buffer(index_array)
-            del arrays, index_array
-            gpu = _GpuMesh(buffers, index, _MODES[mesh.mode], mesh.element_count)
-            self._meshes[key] = gpu
+            gpu = self._meshes[key] = self._upload(mesh, arrays or _gpu_arrays(mesh))
+        self._mesh_last_frame[key] = self._frame
+        return key, gpu
+
+    def _upload(self, mesh: Mesh, arrays: dict[str, np.ndarray], moving: bool = False) -> _GpuMesh:
+        """GPU buffers of ``arrays`` (:func:`_gpu_arrays` of ``mesh``); ``moving``: the positions
+        are rewritten each frame (a dynamic buffer, and the mesh's positions remembered)."""
+        index_array = arrays.pop("indices", None)
+        buffers = {attr: self.ctx.buffer(array, dynamic=moving and attr == "in_position")
+                   for attr, array in arrays.items()}
+        index = None if index_array is None else self.ctx.buffer(index_array)
+        return _GpuMesh(buffers, index, _MODES[mesh.mode], mesh.element_count, mesh.positions if moving else None)
+
+    def _moved_gpu_mesh(self, mesh: Mesh, origin: Mesh) -> tuple[tuple[str, str], _GpuMesh]:
+        """A moved mesh (:func:`glsandbox.scene.moved_mesh`): the buffers of the mesh it was moved
+        from, its own, with ``mesh``'s positions written into the position buffer where they
+        are not the ones it holds (once per frame however many passes draw it)."""
+        key = _moved_key(origin)
+        gpu = self._meshes.get(key)
+        if gpu is None:
+            gpu = self._meshes[key] = self._upload(mesh, _gpu_arrays(mesh), moving=True)
+        elif gpu.positions is not mesh.positions:
+            gpu.buffers["in_position"].write(np.ascontiguousarray(mesh.positions, dtype="f4"))
+            gpu.positions = mesh.positions
         self._mesh_last_frame[key] = self._frame
         return key, gpu
 
@@ -434,6 +473,10 @@ class Executor:
                 try:
                     runner(self, frame, step, self._frame_camera(frame, step))
                     restored = step.kind in _STATE_KEEPING
+                    changed = _PASS_CHANGES.get(step.kind)
+                    if changed is not None:  # a planar pass: only what it changes is put back
+                        gl_passes.restore_state(self.ctx, self.raw, changed)
+                        restored = True
                 finally:
                     if restored:
                         self._set_culling(False, "ccw")
@@ -520,6 +563,12 @@ class Executor:
             names = self._member_names[program_key] = frozenset(self._programs[program_key][1])
         return names
 
+    def _uniforms(self, program_key: str) -> dict[str, moderngl.Uniform]:
+        """A program's uniforms by name (its other members are attributes)."""
+        program = self._programs[program_key][1]
+        return {name: member for name in self._members(program_key)
+                if isinstance(member := program[name], moderngl.Uniform)}
+
     def draw_node(self, node: Node, draw: Draw, camera: PassCamera, *, model: np.ndarray | None = None,
                   front_face: str = "ccw", lights: tuple[Light, ...] | None = None,
                   material: Material | None = None) -> None:
@@ -539,40 +588,50 @@ class Executor:
             own = self._check_user_draw(user, self._programs[draw.program][1], self._members(draw.program), node)
             self._user_nodes.setdefault(draw.program, {})[node.name] = node
         setup = self._draw_setup(draw.program, node.mesh)
-        program, members, write = setup.program, setup.members, setup.write
         self._mesh_last_frame[setup.mesh_key] = self._frame
-        vao, gpu = setup.vao, setup.gpu
         model = node.model if model is None else model
         material = node.material if material is None else material
-        self._set_culling(draw.cull_back_faces, front_face)
+        if (draw.cull_back_faces, front_face) != self._culling:
+            self._set_culling(draw.cull_back_faces, front_face)
         model_bytes, normal_bytes = self._model_bytes(model, setup.normal)
-        write("m_model", model_bytes)
-        write("m_view", camera.view_bytes)
-        write("m_proj", camera.proj_bytes)
-        write("u_color", _color_bytes(material.color))
+        # What this draw writes: the matrices, then (lit) the eye and the lights, then the
+        # material's constants (made once per material and program, _material_constants).
+        values = [("m_model", model_bytes), ("m_view", camera.view_bytes), ("m_proj", camera.proj_bytes)]
         if normal_bytes is not None:
-            write("m_normal", normal_bytes)
-        if material.lit or user is not None:  # a node's own shader may light itself whatever the shading
-            write("u_eye", camera.eye_bytes)
+            values.append(("m_normal", normal_bytes))
+        lit = material.lit or user is not None  # a node's own shader may light itself whatever the shading
+        if lit:
+            values.append(("u_eye", camera.eye_bytes))
             frame_lights = self._lights if lights is None else lights
             if frame_lights:  # with none, the shader's arrays do not exist (NUM_LIGHTS 0)
                 light_pos, light_color = self._light_bytes(frame_lights)
-                write("u_light_pos", light_pos)
-                write("u_light_color", light_color)
-            for name, data in _material_bytes(material):
-                write(name, data)
-        for name, value in own.items():
-            program[name].value = value
-        write("u_alpha_cutoff", _float_bytes(material.alpha_cutoff))
+                values += (("u_light_pos", light_pos), ("u_light_color", light_color))
+        constants = setup.constants.get(id(material))
+        if constants is None or constants[0] is not material:
+            if len(setup.constants) >= 64:  # materials made anew each frame (a planar shadow's): start again
+                setup.constants.clear()
+            constants = setup.constants[id(material)] = (material, self._material_constants(material, lit))
+        written, uniforms = setup.written, setup.uniforms
+        for name, data in (*values, *constants[1]):
+            # A program keeps its uniform values between draws and frames: bytes equal to the
+            # last written (the view while the camera stands, lights, materials) are not sent.
+            if written.get(name) != data:
+                written[name] = data
+                uniform = uniforms.get(name)
+                if uniform is not None:  # a term the compiler removed has no uniform
+                    uniform.write(data)
+        if own:
+            program = setup.program
+            for name, value in own.items():
+                program[name].value = value
         texture = material.texture
-        if texture is not None:  # unit 0: the material's texture
-            if self._bound_texture is not texture:  # consecutive draws of one texture bind it once
-                self._textures.bind(texture, 0)
-                self._bound_texture = texture
-            write("u_texture", _UNIT_0)
+        if texture is not None and self._bound_texture is not texture:  # unit 0; consecutive draws bind once
+            self._textures.bind(texture, 0)
+            self._bound_texture = texture
         if draw.shadow_map is not None:  # unit 1: the light's shadow map (a depth texture, compared)
             for name, data in self.shadow_maps.use(draw.shadow_map, SHADOW_MAP_UNIT):
-                write(name, data)
+                setup.write(name, data)
+        vao, gpu = setup.vao, setup.gpu
         if draw.blend:  # over what is drawn already; hidden by it where nearer, but not hiding
             self.ctx.enable(moderngl.BLEND)
             self.ctx.blend_func = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA)
@@ -594,13 +653,39 @@ class Executor:
         program = self._programs[program_key][1]
         members = self._members(program_key)
         drawn = with_face_normals(mesh) if mesh.normals is None and "in_normal" in members else mesh
+        origin = mesh_origin(mesh)
+        if origin is not None and drawn is mesh:  # (face normals made for a moved mesh: a mesh of its own)
+            # A moved mesh: the setup of the mesh it was moved from, this frame's positions in its buffer.
+            moved_key = (program_key + "#moved", id(origin))  # apart from a setup of ``origin`` itself
+            setup = self._setups.get(moved_key)
+            if setup is not None and setup.source is origin:
+                self._moved_gpu_mesh(mesh, origin)
+                return setup
+            vao, gpu = self._vao(mesh, program_key)
+            setup = _DrawSetup(origin, program, members, self._uniform_writer(program_key, program, members),
+                               _moved_key(origin), vao, gpu, "m_normal" in members,
+                               self._uniforms(program_key), self._written.setdefault(program_key, {}))
+            self._setups[moved_key] = setup
+            return setup
         vao, gpu = self._vao(drawn, program_key)
         if len(self._setups) >= self.SETUPS_KEPT:  # new meshes every frame (a trail): start again
             self._setups.clear()
         setup = _DrawSetup(mesh, program, members, self._uniform_writer(program_key, program, members), _mesh_key(drawn), vao, gpu,
-                           "m_normal" in members)
+                           "m_normal" in members, self._uniforms(program_key), self._written.setdefault(program_key, {}))
         self._setups[(program_key, id(mesh))] = setup
         return setup
+
+    @staticmethod
+    def _material_constants(material: Material, lit: bool) -> tuple[tuple[str, bytes], ...]:
+        """The uniform bytes a draw of ``material`` writes that no position changes: its colour,
+        (lit) the coefficients of the course's formula, the alpha cutoff, the texture's unit."""
+        constants = [("u_color", _color_bytes(material.color))]
+        if lit:
+            constants += _material_bytes(material)
+        constants.append(("u_alpha_cutoff", _float_bytes(material.alpha_cutoff)))
+        if material.texture is not None:
+            constants.append(("u_texture", _UNIT_0))
+        return tuple(constants)
 
     @staticmethod
     def _model_bytes(model: np.ndarray, normal: bool) -> tuple[bytes, bytes | None]:
@@ -703,9 +788,17 @@ def eye_position(view: np.ndarray) -> np.ndarray:
 
 
 #: Pass kinds whose runners leave GL state as :func:`glsandbox.gl.passes.restore_state` sets it,
-#: but for culling (:meth:`Executor._set_culling`): a clear, and a draw pass (its blended draws
-#: put blending and depth writes back).
-_STATE_KEEPING = frozenset({"clear", "draw"})
+#: but for culling (:meth:`Executor._set_culling`): a clear, a draw pass (its blended draws
+#: put blending and depth writes back) and an overlay pass (:meth:`OverlayDrawer.draw` puts
+#: blending and the scissor back, and switches off only the depth test, which every pass
+#: sets for itself, and culling, which restore_state leaves off).
+_STATE_KEEPING = frozenset({"clear", "draw", "overlay"})
+#: The planar passes (:mod:`glsandbox.gl.planar`) and the groups of
+#: :func:`~glsandbox.gl.passes.restore_state` each changes (culling besides, through
+#: :meth:`Executor._set_culling`): after one, only those are put back.
+_PASS_CHANGES = {"mark_mirror": frozenset({"stencil", "masks"}), "reflection": frozenset({"stencil"}),
+                 "mirror_surface": frozenset({"blend"}),
+                 "planar_shadow": frozenset({"stencil", "masks", "blend", "offset"})}
 
 #: One runner per pass kind (:data:`glsandbox.plan.PASS_KINDS`); a new kind adds
 #: its entry here and its describer in :data:`glsandbox.plan.PASS_DESCRIBERS`.

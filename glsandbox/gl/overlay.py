@@ -10,8 +10,6 @@ blending: ``rgb = a*src + (1-a)*dst``. The frame's alpha is not written
 
 from __future__ import annotations
 
-import hashlib
-
 import moderngl
 import numpy as np
 
@@ -25,29 +23,29 @@ class OverlayDrawer:
 
     def __init__(self, ctx: moderngl.Context) -> None:
         self.ctx = ctx
-        # name -> (content digest, texture, the image last uploaded)
-        self._textures: dict[str, tuple[str, moderngl.Texture, np.ndarray]] = {}
+        # name -> (texture, the image it holds: the array last drawn under that name)
+        self._textures: dict[str, tuple[moderngl.Texture, np.ndarray]] = {}
         self._vao: tuple[int, moderngl.VertexArray] | None = None
 
     def _texture(self, overlay: Overlay) -> moderngl.Texture:
         entry = self._textures.get(overlay.name)
-        if entry is not None and entry[2] is overlay.image and not overlay.image.flags.writeable:
-            return entry[1]  # the same read-only array as last time (a panel made once): nothing to hash
-        image = np.ascontiguousarray(overlay.image, dtype=np.uint8)
-        digest = hashlib.blake2b(image.tobytes(), digest_size=12).hexdigest() + str(image.shape)
-        if entry is not None and entry[0] == digest:
-            self._textures[overlay.name] = (digest, entry[1], overlay.image)
-            return entry[1]
+        image = overlay.image  # read-only (Overlay makes it so)
+        if entry is not None and entry[1] is image:
+            return entry[0]  # the same array as last time (a panel made once): nothing to compare
+        if entry is not None and entry[1].shape == image.shape and np.array_equal(entry[1], image):
+            self._textures[overlay.name] = (entry[0], image)  # equal pixels in a new array: nothing to upload
+            return entry[0]
         h, w = image.shape[:2]
-        if entry is not None and entry[1].size == (w, h):
-            texture = entry[1]
-            texture.write(image.tobytes(), alignment=1)
+        data = np.ascontiguousarray(image, dtype=np.uint8)
+        if entry is not None and entry[0].size == (w, h):
+            texture = entry[0]
+            texture.write(data, alignment=1)  # a label whose text changes: the same texture, new texels
         else:
             if entry is not None:
-                entry[1].release()
-            texture = self.ctx.texture((w, h), 4, image.tobytes(), alignment=1)
+                entry[0].release()
+            texture = self.ctx.texture((w, h), 4, data, alignment=1)
             texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        self._textures[overlay.name] = (digest, texture, overlay.image)
+        self._textures[overlay.name] = (texture, image)
         return texture
 
     def _vertex_array(self, program: moderngl.Program) -> moderngl.VertexArray:
@@ -82,7 +80,7 @@ class OverlayDrawer:
             self.ctx.blend_func = moderngl.DEFAULT_BLENDING
 
     def release(self) -> None:
-        for _, texture, _ in self._textures.values():
+        for texture, _ in self._textures.values():
             texture.release()
         self._textures.clear()
         if self._vao is not None:

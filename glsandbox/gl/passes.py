@@ -40,19 +40,29 @@ class PassRunner(Protocol):
     def __call__(self, executor: Any, frame: FrameState, step: Pass, camera: Any) -> None: ...
 
 
-def restore_state(ctx: moderngl.Context, raw: rawgl.RawGL) -> None:
+#: The groups of state :func:`restore_state` puts back.
+STATE_PARTS = frozenset({"stencil", "masks", "blend", "offset", "cull"})
+
+
+def restore_state(ctx: moderngl.Context, raw: rawgl.RawGL, parts: frozenset[str] = STATE_PARTS) -> None:
     """The state every pass assumes: no stencil test, stencil and depth
     writes on, colour writes on but alpha (the frame's rule,
     :data:`~glsandbox.gl.target.FRAME_COLOR_MASK`: frames stay opaque), no
-    blending, no polygon offset, no culling, counter-clockwise front faces."""
-    raw.glDisable(rawgl.GL_STENCIL_TEST)
-    raw.glStencilMask(0xFF)
-    raw.glStencilFunc(rawgl.GL_ALWAYS, 0, 0xFF)
-    raw.glStencilOp(rawgl.GL_KEEP, rawgl.GL_KEEP, rawgl.GL_KEEP)
-    raw.glColorMask(*FRAME_COLOR_MASK)
-    raw.glDepthMask(1)
-    ctx.disable(moderngl.BLEND)
-    ctx.blend_func = moderngl.DEFAULT_BLENDING
-    ctx.polygon_offset = (0.0, 0.0)
-    ctx.disable(moderngl.CULL_FACE)
-    ctx.front_face = "ccw"
+    blending, no polygon offset, no culling, counter-clockwise front faces.
+    ``parts`` (of :data:`STATE_PARTS`): only those groups, for a pass known to change no other."""
+    if "stencil" in parts:
+        raw.glDisable(rawgl.GL_STENCIL_TEST)
+        raw.glStencilMask(0xFF)
+        raw.glStencilFunc(rawgl.GL_ALWAYS, 0, 0xFF)
+        raw.glStencilOp(rawgl.GL_KEEP, rawgl.GL_KEEP, rawgl.GL_KEEP)
+    if "masks" in parts:
+        raw.glColorMask(*FRAME_COLOR_MASK)
+        raw.glDepthMask(1)
+    if "blend" in parts:
+        ctx.disable(moderngl.BLEND)
+        ctx.blend_func = moderngl.DEFAULT_BLENDING
+    if "offset" in parts:
+        ctx.polygon_offset = (0.0, 0.0)
+    if "cull" in parts:
+        ctx.disable(moderngl.CULL_FACE)
+        ctx.front_face = "ccw"

@@ -25,7 +25,8 @@ from glsandbox.scene import Camera, Light, Material, Motion, Node, Scene, moved_
 TIMES = (0.0, 0.37, 1.9, 7.3)
 #: The settings each lesson is checked with besides its defaults (the bench's shadow-map frame).
 EXTRA_SETTINGS = {"shadow_map": ({"show": "map"},), "phong": ({"lights": 1, "shading": "gouraud"},),
-                  "mirror": ({"light": "directional", "shadow": "double_blend"},)}
+                  "mirror": ({"light": "directional", "shadow": "double_blend"},),
+                  "transform_order": ({"view": "split"}, {"order": "RTS", "overlay": False})}
 
 
 def moving_lessons() -> list[tuple[str, dict]]:
@@ -44,17 +45,21 @@ def assert_same_scene(moved: Scene, built: Scene) -> None:
     for a, b in zip(moved.nodes, built.nodes):
         assert np.array_equal(np.asarray(a.model), np.asarray(b.model)), a.name
         assert a.material == b.material and a.mesh.name == b.mesh.name, a.name
+        assert np.array_equal(a.mesh.positions, b.mesh.positions), a.name  # a trail moves its points
         assert (a.cull_back_faces, a.viewports, a.casts_shadow, a.receives_shadow) == \
             (b.cull_back_faces, b.viewports, b.casts_shadow, b.receives_shadow), a.name
     assert moved.lights == built.lights
     assert (moved.camera, moved.viewports, moved.mirror, moved.planar_shadow, moved.depth_mode, moved.plan_mode) == \
         (built.camera, built.viewports, built.mirror, built.planar_shadow, built.depth_mode, built.plan_mode)
     assert [o.name for o in moved.overlays] == [o.name for o in built.overlays]
+    for a, b in zip(moved.overlays, built.overlays):
+        assert np.array_equal(a.image, b.image) and (a.viewport, a.position) == (b.viewport, b.position), a.name
 
 
 def test_the_course_lessons_that_move_declare_it():
     names = {name for name, _ in moving_lessons()}
-    assert {"clear_and_swap", "triangle", "indexed_cube", "phong", "texture", "mirror", "shadow_map"} <= names
+    assert {"clear_and_swap", "triangle", "indexed_cube", "phong", "texture", "mirror", "shadow_map",
+            "transform_order"} <= names
 
 
 @pytest.mark.parametrize(("name", "settings"), moving_lessons(), ids=lambda v: str(v) if v else "")
@@ -80,7 +85,7 @@ def test_a_changed_value_builds_the_scene_again():
 
 
 def test_a_lesson_without_motion_is_built_every_frame():
-    lesson = find_lesson("transform_order")()
+    lesson = find_lesson("model")()
     assert lesson.motion() is None
     assert scene_origin(lesson.scene()) is None
 
@@ -108,9 +113,13 @@ def test_moved_scene_changes_only_what_moves():
     (Motion(models={"flat": np.eye(3)}), "node 'flat': model matrix must be 4x4"),
     (Motion(lights={1: (0.0, 0.0, 0.0)}), "moves light 1, and the scene has 1"),
     (Motion(lights={0: (0.0, float("inf"), 0.0)}), "light position"),
+    (Motion(positions={"flat": np.zeros((3, 3))}), "mesh 'cube': moved positions must be a (8, 3) array"),
+    (Motion(positions={"flat": np.full((8, 3), np.nan)}), "mesh 'cube': moved positions[0] is not finite"),
+    (Motion(positions={"ghost": np.zeros((8, 3))}), "'ghost', which is not a node"),
+    (Motion(overlays={"label": np.zeros((2, 2, 4), np.uint8)}), "overlay 'label', which is not an overlay"),
 ])
 def test_moved_scene_checks_what_moves(motion, message):
-    with pytest.raises(SandboxError, match=message.replace("(", r"\(")):
+    with pytest.raises(SandboxError, match=message.replace("(", r"\(").replace(")", r"\)").replace("[0]", r"\[0\]")):
         moved_scene(_lit_scene(), motion)
 
 
@@ -185,3 +194,45 @@ def test_a_model_array_changed_in_place_is_drawn_where_it_is_now(gl):
                                                    Material(shading="vertex_color")),),
                                   camera=Camera(eye=(0.0, 0.0, 8.0))), SIZE).image
     assert np.array_equal(moved, fresh)
+
+
+def _trail_scene(points: np.ndarray) -> Scene:
+    line = geometry.Mesh("trail", points, mode="line_strip")
+    return Scene("trail", nodes=(Node("trail", line, material=Material((1.0, 0.8, 0.1, 1.0)), cull_back_faces=False),
+                                 Node("copy", geometry.Mesh("trail", points.copy(), mode="line_strip"),
+                                      np.diag([1.0, -1.0, 1.0, 1.0]), Material((0.2, 1.0, 0.3, 1.0)),
+                                      cull_back_faces=False)),
+                 camera=Camera(eye=(0.0, 0.0, 6.0)))
+
+
+def test_a_moved_mesh_is_rewritten_in_its_own_buffer(gl):
+    """Motion.positions: the trail's points move each frame in one vertex buffer, not a new mesh per
+    frame; a node of the same content (sharing buffers with the built mesh) keeps its own points."""
+    t = np.linspace(0.0, 3.0, 32)
+    start = np.stack([np.cos(t), np.sin(t), 0.0 * t], 1)
+    scene = _trail_scene(start)
+    gl.render_scene(scene, SIZE)
+    meshes = gl.executor.mesh_count
+    for turn in (0.4, 1.1, 2.5):
+        points = start @ np.array([[np.cos(turn), -np.sin(turn), 0.0], [np.sin(turn), np.cos(turn), 0.0], [0, 0, 1]])
+        moved = moved_scene(scene, Motion(positions={"trail": points}))
+        assert moved.nodes[1] is scene.nodes[1] and moved.nodes[0].mesh.positions is not points  # its own copy
+        kept = gl.render_scene(moved, SIZE).image.copy()
+        fresh = gl.render_scene(replace(_trail_scene(start), nodes=(
+            replace(scene.nodes[0], mesh=geometry.Mesh("trail", points, mode="line_strip")), scene.nodes[1])),
+            SIZE).image
+        assert np.array_equal(kept, fresh), turn
+        assert not np.array_equal(kept, gl.render_scene(scene, SIZE).image)
+    # The built scene and each fresh one: one shared content mesh apiece (3 turns); the moved frames
+    # added one buffer set, written in place three times.
+    assert gl.executor.mesh_count == meshes + 3 + 1
+
+
+def test_a_moved_overlay_shows_its_new_image(gl):
+    from glsandbox import Overlay, text_image
+
+    scene = Scene("panel", overlays=(Overlay("label", text_image(["0 deg"])),))
+    gl.render_scene(scene, SIZE)
+    moved = moved_scene(scene, Motion(overlays={"label": text_image(["90 deg"])}))
+    fresh = Scene("panel", overlays=(Overlay("label", text_image(["90 deg"])),))
+    assert np.array_equal(gl.render_scene(moved, SIZE).image, gl.render_scene(fresh, SIZE).image)

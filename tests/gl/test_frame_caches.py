@@ -74,3 +74,30 @@ def test_a_frame_writes_only_the_uniforms_that_changed(gl, uniform_writes) -> No
     assert set(uniform_writes) - PER_DRAW == {"u_light_pos"}
     # Once per program that draws lit nodes, not once per lit draw.
     assert uniform_writes.count("u_light_pos") == len({draw.program for draw in lit}) < len(lit)
+
+
+def test_a_texture_drawn_with_another_filter_is_sampled_with_it(gl) -> None:
+    """The filter and wrap are set on the texture itself, only when they change: one image drawn
+    nearest, then trilinear and mirrored, then nearest again, each frame as a fresh renderer draws it;
+    and in one frame two nodes sharing the image with two filters."""
+    from glsandbox import geometry
+    from glsandbox.scene import Camera, Material, Node, Scene, Texture
+
+    camera = Camera(eye=(0.0, 1.0, 2.5), target=(0.0, 0.0, -2.0))
+    plane = geometry.plane(4.0)
+
+    def scene(*samplings: tuple[str, str]) -> Scene:
+        nodes = tuple(Node(f"floor{i}", plane, np.diag([1.0, 1.0, 1.0, 1.0]) if i == 0 else
+                           np.array([[1.0, 0, 0, 0], [0, 1, 0, 0.5], [0, 0, 1, -4.0], [0, 0, 0, 1]]),
+                           Material(texture=Texture("checker", filter=f, wrap=w)))
+                      for i, (f, w) in enumerate(samplings))
+        return Scene("sampling", nodes=nodes, camera=camera)
+
+    nearest, smooth = ("nearest", "repeat"), ("mip_linear", "mirrored")
+    frames = {}
+    for sampling in (nearest, smooth, nearest, smooth):
+        image = gl.render_scene(scene(sampling), SIZE).image.copy()
+        assert np.array_equal(image, frames.setdefault(sampling, fresh_frame(gl, scene(sampling)))), sampling
+    assert not np.array_equal(frames[nearest], frames[smooth])
+    both = scene(nearest, smooth)
+    assert np.array_equal(gl.render_scene(both, SIZE).image, fresh_frame(gl, both))
