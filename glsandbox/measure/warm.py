@@ -140,6 +140,12 @@ def open_template(backend: str | None, sizes: Iterable[tuple[int, int]]):
     driver, a descriptor or a thread a fork cannot copy). Call only in a process that exists to be
     the template: a context that fails the checks stays open in it."""
     os.environ["LP_NUM_THREADS"] = "0"  # llvmpipe: no rasterizer threads (read when the context opens)
+    # No on-disk shader cache in a template: its writes go through Mesa's cache thread (disk$N),
+    # which a fork does not copy, so a child compiling a shader no process had compiled before
+    # queued its cache write for a thread that does not exist and hung until its time limit
+    # (a student's own shader file graded TIMEOUT). The built-in programs are compiled by the
+    # warm-up below and inherited by every fork; only a submission's new shaders compile in it.
+    os.environ["MESA_SHADER_CACHE_DISABLE"] = "true"
     threads, descriptors, shared = set(_threads()), _descriptors(), _shared_writable()
     try:
         from glsandbox.frame import HeadlessRenderer

@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import json
 import re
+import uuid
 from pathlib import Path
 
 import numpy as np
@@ -200,7 +201,8 @@ def test_a_shader_that_does_not_compile_is_broken_and_the_others_go_on(tmp_path:
 def test_submissions_with_their_own_shader_files(tmp_path: Path, gl) -> None:
     """A teacher's folder where each student's scene draws its ball with the student's own
     shader file: the reference student's passes, a shader computing another colour fails,
-    one that does not compile is BROKEN naming the student's file and line."""
+    one that does not compile is BROKEN naming the student's file and line. The shaders are new to
+    Mesa's on-disk cache: a renderer forked from the warm template once hung writing to it (TIMEOUT)."""
     subs = tmp_path / "subs"
     scene = ('name = "ball"\n[camera]\neye = [0, 0, 4]\n[[lights]]\nposition = [1, 2, 4]\n'
              '[[nodes]]\nname = "ball"\nmesh = "sphere"\nshading = "phong"\nshader = "ball.glsl"\n'
@@ -215,9 +217,10 @@ def test_submissions_with_their_own_shader_files(tmp_path: Path, gl) -> None:
     shaders = {"a_ann": body.replace("COLOR", "u_color.rgb"),
                "b_ben": body.replace("COLOR", "vec3(0.2, 1.0, 0.2)"),
                "c_cem": body.replace("COLOR", "u_color.rgb").replace("frag_color = vec4", "frag_colour = vec4")}
+    fresh = f"// {uuid.uuid4().hex}\n"  # no process has compiled these shaders before (Mesa's cache misses)
     for student, text in shaders.items():
         lesson_file(subs / student, "ball.toml", scene)
-        (subs / student / "ball.glsl").write_text(text)
+        (subs / student / "ball.glsl").write_text(text + fresh)
     ref = tmp_path / "ref.png"
     proc = glsandbox("check", str(subs / "a_ann" / "ball.toml"), "--golden", str(ref), "--update", "--size", SIZE)
     assert proc.returncode == 0, proc.stderr
