@@ -364,23 +364,41 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         box_hi = np.where(bunched, centre_hi, box_hi)
         extent = box_hi - box_lo
         scale = np.where(extent > 0.0, bins * (1.0 - 1e-6) / np.where(extent > 0.0, extent, 1.0), 0.0)
-        # Each column's bin on each axis, as a key node-major over the level: node i's bins are
-        # i·B .. i·B + B − 1.
-        node_of = np.repeat(np.arange(n, dtype=np.int64), counts)  # each column's node
-        node_key = node_of * bins
-        bin_key = bin_keys[:3 * width].reshape(3, width)
-        bin_row = bin_rows[:3 * width].reshape(3, width)
-        rel = np.empty(width, dtype=np.float32)
+        # A big node is binned from every stride-th of its triangles (about
+        # SAMPLE of them): its bins' counts (scaled by stride) and boxes are the
+        # heuristic's estimate of the children's sizes and areas, which picks
+        # the axis; the exact counts on that axis then pick the cut (below).
+        # Nodes of up to 2·SAMPLE triangles use them all: their counts are exact.
+        stride = np.maximum(1, counts // SAMPLE)
+        sampled = bool(stride.max() > 1)
+        if sampled:
+            # Node i's sampled columns: starts[i] + stride[i]·q for q = 0 .. ceil(counts[i] / stride[i]) − 1.
+            taken = -(-counts // stride)
+            q = np.arange(taken.sum()) - np.repeat(np.cumsum(taken) - taken, taken)
+            sample = np.repeat(starts, taken) + q * np.repeat(stride, taken)
+            box_rows = np.take(cols, sample, axis=1)
+            bin_cen = np.take(cen, sample, axis=1)
+            del q, sample
+        else:
+            taken = counts
+            box_rows, bin_cen = cols, cen
+        binned = bin_cen.shape[1]
+        # Each binned column's bin on each axis, as a key node-major over the level: node i's
+        # bins are i·B .. i·B + B − 1.
+        node_key = np.repeat(np.arange(n, dtype=np.int64) * bins, taken)
+        bin_key = bin_keys[:3 * binned].reshape(3, binned)
+        bin_row = bin_rows[:3 * binned].reshape(3, binned)
+        rel = np.empty(binned, dtype=np.float32)
         for axis in range(3):  # one row at a time: np.repeat of a 1-D array is a plain copy loop
             # (2c − 2·lo)·(scale / 2): the same float32 value as (c − lo)·scale (halving and
             # doubling are exact), from the doubled centroids.
-            np.subtract(cen[axis], np.repeat((2.0 * box_lo[:, axis]).astype(np.float32), counts), out=rel)
-            rel *= np.repeat((0.5 * scale[:, axis]).astype(np.float32), counts)
+            np.subtract(bin_cen[axis], np.repeat((2.0 * box_lo[:, axis]).astype(np.float32), taken), out=rel)
+            rel *= np.repeat((0.5 * scale[:, axis]).astype(np.float32), taken)
             np.clip(rel, 0, bins - 1, out=rel)
             bin_row[axis] = rel
             bin_key[axis] = bin_row[axis]
             bin_key[axis] += node_key
-        del rel
+        del rel, node_key
         best_cost = np.full(n, np.inf)
         best_axis = np.zeros(n, dtype=np.int64)
         best_cut = np.ones(n, dtype=np.int64)
@@ -388,31 +406,21 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         child_hi = np.empty((n, 2, 3))
         nodes = np.arange(n)
         # The most even cut by count over all axes: used where no SAH cut gains (below).
-        even_gap = np.full(n, np.iinfo(np.int64).max)
+        even_gap = np.full(n, np.inf)
         even_axis = np.zeros(n, dtype=np.int64)
         even_cut = np.ones(n, dtype=np.int64)
         even_lo = np.empty((n, 2, 3))
         even_hi = np.empty((n, 2, 3))
-        # A big node's bin boxes come from every stride-th of its triangles
-        # (about SAMPLE of them): the boxes are only the heuristic's estimate
-        # of the children's areas (bin counts are exact). Nodes of up to
-        # 2·SAMPLE triangles use them all.
-        stride = np.maximum(1, counts // SAMPLE)
-        if stride.max() > 1:
-            # Node i's sampled columns: starts[i] + stride[i]·q for q = 0 .. ceil(counts[i] / stride[i]) − 1.
-            taken = -(-counts // stride)
-            q = np.arange(taken.sum()) - np.repeat(np.cumsum(taken) - taken, taken)
-            sample = np.repeat(starts, taken) + q * np.repeat(stride, taken)
-            box_rows = np.take(cols, sample, axis=1)
-            box_keys = np.take(bin_key, sample, axis=1)
-        else:
-            box_rows, box_keys = cols, bin_key
+        to_counts = (counts / taken)[:, None] if sampled else None  # a sampled bin's count: stride × its own
         node_lo = node_hi = None
+        sweeps, areas = [], []  # per axis: the running boxes and the cuts' half areas (left, right)
         for axis in range(3):
             cnt = np.bincount(bin_key[axis], minlength=n * bins).reshape(n, bins)
+            if to_counts is not None:
+                cnt = cnt * to_counts
             blo = np.full((3, n * bins), np.inf, dtype=np.float32)
             bhi = np.full((3, n * bins), -np.inf, dtype=np.float32)
-            key = box_keys[axis]
+            key = bin_key[axis]
             for j in range(3):
                 np.minimum.at(blo[j], key, box_rows[j])
                 np.maximum.at(bhi[j], key, box_rows[3 + j])
@@ -427,11 +435,15 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
                 node_lo, node_hi = llo[:, -1], lhi[:, -1]
             n_left = np.cumsum(cnt.T[:-1], axis=0)
             n_right = counts - n_left
-            sah = n_left * _half_area(llo[:, :-1], lhi[:, :-1]) + n_right * _half_area(rlo[:, 1:], rhi[:, 1:])
+            area_left, area_right = _half_area(llo[:, :-1], lhi[:, :-1]), _half_area(rlo[:, 1:], rhi[:, 1:])
+            if sampled:
+                sweeps.append((llo, lhi, rlo, rhi))
+                areas.append((area_left, area_right))
+            sah = n_left * area_left + n_right * area_right
             sah = np.where((n_left > 0) & (n_right > 0), sah, np.inf)  # a cut must leave both sides something
             cut = np.argmin(sah, axis=0)  # the best cut on this axis, minus one
             cost = sah[cut, nodes]
-            gap = np.where((n_left > 0) & (n_right > 0), np.abs(2 * n_left - counts), np.iinfo(np.int64).max)
+            gap = np.where((n_left > 0) & (n_right > 0), np.abs(2 * n_left - counts), np.inf)
             even = np.argmin(gap, axis=0)
             evener = np.flatnonzero(gap[even, nodes] < even_gap)
             if evener.size:
@@ -458,7 +470,7 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         # grow as deep as the node is large. The most even cut by count keeps the depth logarithmic.
         parent_cost = counts * _half_area(node_lo, node_hi).astype(np.float64)
         no_gain = np.flatnonzero(np.isfinite(best_cost) & (best_cost >= NO_GAIN * parent_cost)
-                                 & (even_gap < np.iinfo(np.int64).max))
+                                 & np.isfinite(even_gap))
         if no_gain.size:
             best_axis[no_gain] = even_axis[no_gain]
             best_cut[no_gain] = even_cut[no_gain]
@@ -474,10 +486,36 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         # (Byte rows: the column's bin on each axis, its node's axis and cut repeated per column.)
         axis_of = np.repeat(best_axis.astype(np.uint8), counts)
         cut_of = np.repeat(best_cut.astype(np.uint8), counts)
-        right = np.greater_equal(bin_row[2], cut_of)
-        np.copyto(right, np.greater_equal(bin_row[1], cut_of), where=axis_of == 1)
-        np.copyto(right, np.greater_equal(bin_row[0], cut_of), where=axis_of == 0)
-        del axis_of, cut_of
+        node_of = np.repeat(nodes, counts)  # each column's node
+        if sampled:
+            # Only the chosen axis's bin of every column, by the same float32 steps as above; its
+            # exact counts then pick the cut on that axis (the sample chose the axis).
+            rel = np.where(axis_of == 0, cen[0], np.where(axis_of == 1, cen[1], cen[2]))
+            rel -= np.repeat((2.0 * box_lo[nodes, best_axis]).astype(np.float32), counts)
+            rel *= np.repeat((0.5 * scale[nodes, best_axis]).astype(np.float32), counts)
+            np.clip(rel, 0, bins - 1, out=rel)
+            chosen_bin = rel.astype(np.uint8)
+            del rel
+            exact = np.bincount(node_of * bins + chosen_bin, minlength=n * bins).reshape(n, bins)
+            best_cut = _exact_cut(exact, counts, best_axis, best_cut, no_gain, areas)
+            cut_of = np.repeat(best_cut.astype(np.uint8), counts)
+            right = np.greater_equal(chosen_bin, cut_of)
+            del chosen_bin
+            moved_cut = np.flatnonzero(np.isfinite(best_cost))
+            if moved_cut.size:
+                ax, cb = best_axis[moved_cut], best_cut[moved_cut] - 1
+                for j, (llo, lhi, rlo, rhi) in enumerate(sweeps):  # the children's boxes at the new cut
+                    on = moved_cut[ax == j]
+                    cj = cb[ax == j]
+                    child_lo[on, 0] = llo[:, cj, on].T
+                    child_hi[on, 0] = lhi[:, cj, on].T
+                    child_lo[on, 1] = rlo[:, cj + 1, on].T
+                    child_hi[on, 1] = rhi[:, cj + 1, on].T
+        else:
+            right = np.greater_equal(bin_row[2], cut_of)
+            np.copyto(right, np.greater_equal(bin_row[1], cut_of), where=axis_of == 1)
+            np.copyto(right, np.greater_equal(bin_row[0], cut_of), where=axis_of == 0)
+        del axis_of, cut_of, sweeps, areas
         stuck = np.flatnonzero(~np.isfinite(best_cost))
         if stuck.size:
             # No cut separates them (every centroid in one bin on every axis):
@@ -556,6 +594,28 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         return none, none, none, none, rows[:, :0]
     return (np.concatenate(small_tris), np.concatenate(small_ids), np.concatenate(small_counts),
             np.concatenate(small_depth), np.concatenate(small_boxes, axis=1))
+
+
+def _exact_cut(exact: NDArray[np.int64], counts: NDArray[np.int64], axis: NDArray[np.int64], cut: NDArray[np.int64],
+               no_gain: NDArray[np.int64], areas: list[tuple[NDArray[np.float32], NDArray[np.float32]]]
+               ) -> NDArray[np.int64]:
+    """The cut (first bin on the right) of each node on its chosen ``axis`` from its exact bin
+    counts there (``exact``, ``(n, B)``): the cheapest by the SAH with the sampled bins' areas,
+    or the most even by count for the ``no_gain`` nodes; ``cut`` where no cut leaves both
+    sides something."""
+    nodes = np.arange(counts.size)
+    area_left = np.stack([a[0] for a in areas])[axis, :, nodes].T  # (B − 1, n)
+    area_right = np.stack([a[1] for a in areas])[axis, :, nodes].T
+    n_left = np.cumsum(exact.T[:-1], axis=0)
+    n_right = counts - n_left
+    both = (n_left > 0) & (n_right > 0)
+    sah = np.where(both, n_left * area_left + n_right * area_right, np.inf)
+    best = np.argmin(sah, axis=0) + 1
+    if no_gain.size:
+        gap = np.where(both, np.abs(2 * n_left - counts), np.iinfo(np.int64).max)
+        best[no_gain] = np.argmin(gap[:, no_gain], axis=0) + 1
+    result: NDArray[np.int64] = np.where(both.any(axis=0), best, cut)
+    return result
 
 
 def _box_half_area(box: NDArray[np.float32]) -> NDArray[np.float32]:
