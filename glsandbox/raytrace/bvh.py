@@ -108,6 +108,9 @@ LEAF_SIZE: int = 4
 BINS: int = 16
 #: Triangles of a node whose boxes the SAH bins (a big node's are sampled, see ``_split_levels``).
 SAMPLE: int = 1024
+#: Nodes of at least this many triangles are binned from their sample alone, counts too (``_split_levels``):
+#: the big top levels of a large model (below it, counts are exact and only the boxes sampled).
+SAMPLED_ONLY: int = 8 * SAMPLE
 #: An axis whose triangle centroids span less than this share of the node's binning range is
 #: binned over the centroids' own range instead (``_split_levels``).
 CENTROID_RANGE: float = 0.5
@@ -169,13 +172,21 @@ class BVH:
 
 def _triangle_arrays(v0: ArrayLike, v1: ArrayLike, v2: ArrayLike
                      ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """The corners as contiguous float64 ``(M, 3)`` arrays (their finiteness: :func:`_check_finite`)."""
     arrays = tuple(np.ascontiguousarray(np.asarray(v, dtype=np.float64)) for v in (v0, v1, v2))
     a, b, c = arrays
     if a.ndim != 2 or a.shape[1:] != (3,) or a.shape != b.shape or a.shape != c.shape:
         raise RayTraceError(f"triangle corners must be three (M, 3) arrays, got {a.shape}, {b.shape}, {c.shape}")
-    if not (np.isfinite(a).all() and np.isfinite(b).all() and np.isfinite(c).all()):
-        raise RayTraceError("triangle vertices must be finite (a NaN or infinite coordinate)")
     return a, b, c
+
+
+def _check_finite(lo: NDArray[np.float64], hi: NDArray[np.float64]) -> None:
+    """Raise unless every corner is finite, from the triangles' boxes ``lo = min(a, b, c)`` and
+    ``hi = max(a, b, c)`` (two reductions, no mask): a NaN corner makes both NaN (np.minimum and
+    np.maximum pass NaN on), −inf makes ``lo`` −inf and +inf makes ``hi`` +inf; ``lo`` is +inf only
+    where ``hi`` is too. So all corners are finite exactly when ``lo.min()`` and ``hi.max()`` are."""
+    if lo.size and not (np.isfinite(lo.min()) and np.isfinite(hi.max())):
+        raise RayTraceError("triangle vertices must be finite (a NaN or infinite coordinate)")
 
 
 def _empty_bvh(count: int) -> BVH:
@@ -226,11 +237,12 @@ def _build_bvh(v0: ArrayLike, v1: ArrayLike, v2: ArrayLike, *, leaf_size: int = 
         raise RayTraceError(f"leaf_size must be in 1..64 and bins in 2..64, got {leaf_size} and {bins}")
     a, b, c = _triangle_arrays(v0, v1, v2)
     total = a.shape[0]
+    lo = np.minimum(np.minimum(a, b), c)
+    hi = np.maximum(np.maximum(a, b), c)
+    _check_finite(lo, hi)
     keep = np.flatnonzero(nondegenerate(a, b, c))
     if keep.size == 0:
         return _empty_bvh(total)
-    lo = np.minimum(np.minimum(a, b), c)
-    hi = np.maximum(np.maximum(a, b), c)
     if keep.size < total:
         a, b, c, lo, hi = (np.take(x, keep, axis=0) for x in (a, b, c, lo, hi))
     # The splitting works on float32 copies of the triangles' boxes, one row
@@ -251,9 +263,9 @@ def _build_bvh(v0: ArrayLike, v1: ArrayLike, v2: ArrayLike, *, leaf_size: int = 
     first[leaves] = offsets[leaves]
     order = np.empty(keep.size, dtype=np.int64)
     order[offsets[tree.leaf_of] + tree.leaf_rank] = np.arange(keep.size)
-    a, b, c = (np.take(x, order, axis=0) for x in (a, b, c))  # np.take: several times faster than x[order] here
-    node_min, node_max = _exact_boxes(np.minimum(np.minimum(a, b), c), np.maximum(np.maximum(a, b), c), first, count,
-                                      leaves, tree.levels)
+    # np.take: several times faster than x[order] here; the triangles' exact boxes are lo and hi reordered.
+    a, b, c, lo, hi = (np.take(x, order, axis=0) for x in (a, b, c, lo, hi))
+    node_min, node_max = _exact_boxes(lo, hi, first, count, leaves, tree.levels)
     return BVH(node_min, node_max, first, count, a, b, c, keep[order].astype(np.int64), tree.depth, total)
 
 
@@ -364,21 +376,22 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         box_hi = np.where(bunched, centre_hi, box_hi)
         extent = box_hi - box_lo
         scale = np.where(extent > 0.0, bins * (1.0 - 1e-6) / np.where(extent > 0.0, extent, 1.0), 0.0)
-        # A big node is binned from every stride-th of its triangles (about
-        # SAMPLE of them): its bins' counts (scaled by stride) and boxes are the
-        # heuristic's estimate of the children's sizes and areas, which picks
-        # the axis; the exact counts on that axis then pick the cut (below).
-        # Nodes of up to 2·SAMPLE triangles use them all: their counts are exact.
+        # A node of SAMPLED_ONLY triangles or more is binned from every stride-th
+        # of its triangles (about SAMPLE of them): its bins' counts (scaled by
+        # stride) and boxes are the heuristic's estimate of the children's sizes
+        # and areas, which picks the axis; the exact counts on that axis then
+        # pick the cut (below). Smaller nodes bin all their triangles (exact
+        # counts) and, over 2·SAMPLE of them, take the bins' boxes from every
+        # stride-th (the boxes are only the estimate of the children's areas).
         stride = np.maximum(1, counts // SAMPLE)
-        sampled = bool(stride.max() > 1)
+        sampled = bool(counts.max() >= SAMPLED_ONLY)
         if sampled:
-            # Node i's sampled columns: starts[i] + stride[i]·q for q = 0 .. ceil(counts[i] / stride[i]) − 1.
-            taken = -(-counts // stride)
-            q = np.arange(taken.sum()) - np.repeat(np.cumsum(taken) - taken, taken)
-            sample = np.repeat(starts, taken) + q * np.repeat(stride, taken)
+            bin_stride = np.where(counts >= SAMPLED_ONLY, stride, 1)
+            taken = -(-counts // bin_stride)
+            sample = _every(starts, taken, bin_stride)
             box_rows = np.take(cols, sample, axis=1)
             bin_cen = np.take(cen, sample, axis=1)
-            del q, sample
+            del sample
         else:
             taken = counts
             box_rows, bin_cen = cols, cen
@@ -411,6 +424,13 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         even_cut = np.ones(n, dtype=np.int64)
         even_lo = np.empty((n, 2, 3))
         even_hi = np.empty((n, 2, 3))
+        box_stride = np.where(counts >= SAMPLED_ONLY, 1, stride)
+        box_keys = bin_key
+        if box_stride.max() > 1:
+            box_sample = _every(np.cumsum(taken) - taken, -(-taken // box_stride), box_stride)
+            box_rows = np.take(box_rows, box_sample, axis=1)
+            box_keys = np.take(bin_key, box_sample, axis=1)
+            del box_sample
         to_counts = (counts / taken)[:, None] if sampled else None  # a sampled bin's count: stride × its own
         node_lo = node_hi = None
         sweeps, areas = [], []  # per axis: the running boxes and the cuts' half areas (left, right)
@@ -420,7 +440,7 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
                 cnt = cnt * to_counts
             blo = np.full((3, n * bins), np.inf, dtype=np.float32)
             bhi = np.full((3, n * bins), -np.inf, dtype=np.float32)
-            key = bin_key[axis]
+            key = box_keys[axis]
             for j in range(3):
                 np.minimum.at(blo[j], key, box_rows[j])
                 np.maximum.at(bhi[j], key, box_rows[3 + j])
@@ -476,12 +496,6 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
             best_cut[no_gain] = even_cut[no_gain]
             child_lo[no_gain] = even_lo[no_gain]
             child_hi[no_gain] = even_hi[no_gain]
-        # A child whose sampled triangles were none of its own has no box:
-        # bin it over its parent's.
-        empty = np.logical_not(np.logical_and(np.isfinite(child_lo).all(axis=2), np.isfinite(child_hi).all(axis=2)))
-        if empty.any():
-            child_lo = np.where(empty[:, :, None], box_lo[:, None, :], child_lo)
-            child_hi = np.where(empty[:, :, None], box_hi[:, None, :], child_hi)
         # Each column's side (True: the right child) on its node's chosen axis.
         # (Byte rows: the column's bin on each axis, its node's axis and cut repeated per column.)
         axis_of = np.repeat(best_axis.astype(np.uint8), counts)
@@ -516,6 +530,12 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
             np.copyto(right, np.greater_equal(bin_row[1], cut_of), where=axis_of == 1)
             np.copyto(right, np.greater_equal(bin_row[0], cut_of), where=axis_of == 0)
         del axis_of, cut_of, sweeps, areas
+        # A child whose sampled triangles were none of its own (at the cut picked from exact counts too) has no box:
+        # bin it over its parent's.
+        empty = np.logical_not(np.logical_and(np.isfinite(child_lo).all(axis=2), np.isfinite(child_hi).all(axis=2)))
+        if empty.any():
+            child_lo = np.where(empty[:, :, None], box_lo[:, None, :], child_lo)
+            child_hi = np.where(empty[:, :, None], box_hi[:, None, :], child_hi)
         stuck = np.flatnonzero(~np.isfinite(best_cost))
         if stuck.size:
             # No cut separates them (every centroid in one bin on every axis):
@@ -594,6 +614,14 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         return none, none, none, none, rows[:, :0]
     return (np.concatenate(small_tris), np.concatenate(small_ids), np.concatenate(small_counts),
             np.concatenate(small_depth), np.concatenate(small_boxes, axis=1))
+
+
+def _every(starts: NDArray[np.int64], taken: NDArray[np.int64], stride: NDArray[np.int64]) -> NDArray[np.int64]:
+    """Column indices: node i's ``starts[i] + stride[i]·q`` for ``q = 0 .. taken[i] − 1``, node after node."""
+    q = np.arange(taken.sum()) - np.repeat(np.cumsum(taken) - taken, taken)
+    q *= np.repeat(stride, taken)
+    q += np.repeat(starts, taken)
+    return q
 
 
 def _exact_cut(exact: NDArray[np.int64], counts: NDArray[np.int64], axis: NDArray[np.int64], cut: NDArray[np.int64],

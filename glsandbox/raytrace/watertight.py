@@ -52,7 +52,6 @@ from numpy.typing import ArrayLike, NDArray
 
 from glsandbox.raytrace.base import broadcast_rays
 from glsandbox.raytrace.triangle import DEGENERATE_SIN, watertight_t_bound
-from glsandbox.raytrace.vec import cross, length
 
 __all__ = ["RaySetup", "nearest_watertight", "nondegenerate", "ray_setup", "watertight_pairs"]
 
@@ -123,9 +122,31 @@ def ray_setup(origins: ArrayLike, directions: ArrayLike) -> RaySetup:
 def nondegenerate(v0: NDArray[np.float64], v1: NDArray[np.float64], v2: NDArray[np.float64]) -> NDArray[np.bool_]:
     """``(M,)``: the triangles with area, ``|e1 × e2| > DEGENERATE_SIN·|e1|·|e2|``
     (exactly the rule of :class:`~glsandbox.raytrace.triangle.TriangleBatch`)."""
-    e1 = v1 - v0
-    e2 = v2 - v0
-    result: NDArray[np.bool_] = length(cross(e1, e2)) > DEGENERATE_SIN * length(e1) * length(e2)
+    # The same float64 steps as ``length(cross(e1, e2)) > DEGENERATE_SIN * length(e1) * length(e2)``
+    # (so the same triangles), on one contiguous row per component and reused buffers: the
+    # BVH build runs this over a million triangles.
+    e1 = np.asarray(np.subtract(v1, v0), dtype=np.float64).T.copy()  # (3, M)
+    e2 = np.asarray(np.subtract(v2, v0), dtype=np.float64).T.copy()
+    t = np.empty_like(e1[0])
+    cx = np.multiply(e1[1], e2[2])  # R1y·R2z − R1z·R2y, then the other two components (vec.cross)
+    cx -= np.multiply(e1[2], e2[1], out=t)
+    cy = np.multiply(e1[2], e2[0])
+    cy -= np.multiply(e1[0], e2[2], out=t)
+    cz = np.multiply(e1[0], e2[1])
+    cz -= np.multiply(e1[1], e2[0], out=t)
+
+    def norm(x: NDArray[np.float64], y: NDArray[np.float64], z: NDArray[np.float64],
+             out: NDArray[np.float64]) -> NDArray[np.float64]:  # sqrt(x² + y² + z²) into out, as vec.length
+        np.multiply(x, x, out=out)
+        out += np.multiply(y, y, out=t)
+        out += np.multiply(z, z, out=t)
+        return np.sqrt(out, out=out)
+
+    area = norm(cx, cy, cz, cx)  # |e1 × e2| (cx is read before it is overwritten)
+    bound = norm(e1[0], e1[1], e1[2], cy)
+    bound *= DEGENERATE_SIN
+    bound *= norm(e2[0], e2[1], e2[2], cz)
+    result: NDArray[np.bool_] = area > bound
     return result
 
 
