@@ -156,6 +156,13 @@ float triangle_t(int k, WtRay r, bool cull, out vec2 uv) {
     return t > 0.0 ? t : INF;
 }
 
+// triangle_t for the unrolled scan: INF for a miss (wt_hit accepts only
+// t above its error bound, which is >= 0, so that is t > 0.0 too) and the
+// undivided barycentrics vwd (uv = vwd.xy / vwd.z, divided once per ray).
+float triangle_hit(int k, WtRay r, bool cull, out vec3 vwd) {
+    return wt_hit(r, tri_rec(k, TRI_V0).xyz, tri_rec(k, TRI_V1).xyz, tri_rec(k, TRI_V2).xyz, cull, INF, vwd);
+}
+
 // Işın-Küre kesim testi in the unit sphere's own space, the numerically
 // stable form (Ray Tracing Gems ch. 7): discriminant from the vector
 // h = l − (b/a)d, roots q/a and c/q without cancellation.
@@ -283,16 +290,17 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
     // record slot, triangles, one-sidedness and lamp bits as literals, so
     // node records are read at constant indices, and a strict `<` gives
     // ties to the earlier node and triangle (min_indis).
+    vec3 vwd, hit_vwd = vec3(0.0, 0.0, 1.0);
 #define MESH(k, start, cull, lamps) { \
         int stop = start + box_count(k, o, inv_d, best); \
         for (int j = start; j < stop; ++j) { \
-            float t = triangle_t(j, wr, cull != 0, uv); \
-            if (t < best) { best = t; hit_node = k; hit_tri = j; hit_uv = uv; } \
+            float t = triangle_hit(j, wr, cull != 0, vwd); \
+            if (t < best) { best = t; hit_node = k; hit_tri = j; hit_vwd = vwd; } \
         } \
     }
 #define TRI(k, j, cull, lamps) { \
-        float t = triangle_t(j, wr, cull != 0, uv); \
-        if (t < best) { best = t; hit_node = k; hit_tri = j; hit_uv = uv; } \
+        float t = triangle_hit(j, wr, cull != 0, vwd); \
+        if (t < best) { best = t; hit_node = k; hit_tri = j; hit_vwd = vwd; } \
     }
 #define SHAPE(k, kind, cull, lamps) { \
         float t = shape_t(kind, to_object(k, o, 1.0), to_object(k, d, 0.0), cull != 0); \
@@ -302,6 +310,7 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
 #undef TRI
 #undef MESH
 #undef SHAPE
+    hit_uv = hit_vwd.xy / hit_vwd.z;  // a sphere's is unused
 #else
     // Any number of nodes: mesh nodes, then sphere nodes, in two loops over
     // the records; an equal t goes to the node first in scene order (r2.z),
@@ -358,18 +367,19 @@ bool occluded(vec3 o, vec3 d, int light) {
     vec2 uv;
 #if defined(SCENE_NODES)
     bool hit = false;
+    vec3 vwd;
     // The lamp bits are literals: the lamp test is one comparison per node,
     // none where the compiler unrolls the light loop.
 #define MESH(k, start, cull, lamps) if (((lamps >> light) & 1) == 0) { \
         int stop = start + box_count(k, o, inv_d, 1.0); \
         for (int j = start; j < stop && !hit; ++j) { \
-            float t = triangle_t(j, wr, cull != 0, uv); \
-            hit = t < 1.0 && shadow_texel(k, j, t, uv, o, d); \
+            float t = triangle_hit(j, wr, cull != 0, vwd); \
+            hit = t < 1.0 && shadow_texel(k, j, t, vwd.xy / vwd.z, o, d); \
         } \
     }
 #define TRI(k, j, cull, lamps) if (((lamps >> light) & 1) == 0 && !hit) { \
-        float t = triangle_t(j, wr, cull != 0, uv); \
-        hit = t < 1.0 && shadow_texel(k, j, t, uv, o, d); \
+        float t = triangle_hit(j, wr, cull != 0, vwd); \
+        hit = t < 1.0 && shadow_texel(k, j, t, vwd.xy / vwd.z, o, d); \
     }
 #define SHAPE(k, kind, cull, lamps) if (((lamps >> light) & 1) == 0) { \
         hit = hit || shape_t(kind, to_object(k, o, 1.0), to_object(k, d, 0.0), cull != 0) < 1.0; \
