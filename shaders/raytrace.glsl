@@ -283,7 +283,7 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
     vec2 uv;
 #if defined(SCENE_NODES)
     // The node list unrolled, in scene order: SCENE_NODES is a sequence of
-    // MESH(k, start, cull, lamps) (a loop over the node's triangles from
+    // MESH(k, start, count, cull, lamps) (a loop over the node's triangles from
     // `start`), TRI(k, j, cull, lamps) (one triangle of a node too small to
     // be worth a loop, gpu.UNROLL_TRIS) and SHAPE(k, kind, cull, lamps) (an
     // analytic node, its KIND_* a literal), with the
@@ -291,11 +291,31 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
     // node records are read at constant indices, and a strict `<` gives
     // ties to the earlier node and triangle (min_indis).
     vec3 vwd, hit_vwd = vec3(0.0, 0.0, 1.0);
-#define MESH(k, start, cull, lamps) { \
+#define MESH(k, start, count, cull, lamps) { \
         int stop = start + box_count(k, o, inv_d, best); \
         for (int j = start; j < stop; ++j) { \
             float t = triangle_hit(j, wr, cull != 0, vwd); \
             if (t < best) { best = t; hit_node = k; hit_tri = j; hit_vwd = vwd; } \
+        } \
+    }
+    // RUN_BEGIN RUN_NODE(..)... RUN_LOOP RUN_PICK(..)... RUN_END: a run of
+    // consecutive looped nodes whose triangles follow each other
+    // (gpu.py's scene_nodes), one loop over the triangles from the first
+    // node whose box the ray meets to the end of the last. llvmpipe runs a
+    // loop's first pass for all 8 lanes even when none is in it, so a group
+    // that misses every box pays one masked pass for the run, not one per
+    // node. The loop runs in triangle order, which is scene order, so a
+    // strict `<` still gives ties to the earlier node and triangle; the
+    // triangles of a node between two met ones are tested too (a superset:
+    // the nearest hit is the same).
+#define RUN_BEGIN { int lo = TRI_COUNT, hi = 0;
+#define RUN_NODE(k, start, count, cull, lamps) \
+        if (box_count(k, o, inv_d, best) > 0) { lo = min(lo, start); hi = start + count; }
+#define RUN_LOOP for (int j = lo; j < hi; ++j) { int node = -1; bool one_sided = false;
+#define RUN_PICK(k, start, count, cull, lamps) if (j >= start) { node = k; one_sided = cull != 0; }
+#define RUN_END \
+            float t = triangle_hit(j, wr, one_sided, vwd); \
+            if (t < best) { best = t; hit_node = node; hit_tri = j; hit_vwd = vwd; } \
         } \
     }
 #define TRI(k, j, cull, lamps) { \
@@ -310,6 +330,11 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
 #undef TRI
 #undef MESH
 #undef SHAPE
+#undef RUN_BEGIN
+#undef RUN_NODE
+#undef RUN_LOOP
+#undef RUN_PICK
+#undef RUN_END
     hit_uv = hit_vwd.xy / hit_vwd.z;  // a sphere's is unused
 #else
     // Any number of nodes: mesh nodes, then sphere nodes, in two loops over
@@ -370,11 +395,24 @@ bool occluded(vec3 o, vec3 d, int light) {
     vec3 vwd;
     // The lamp bits are literals: the lamp test is one comparison per node,
     // none where the compiler unrolls the light loop.
-#define MESH(k, start, cull, lamps) if (((lamps >> light) & 1) == 0) { \
+#define MESH(k, start, count, cull, lamps) if (((lamps >> light) & 1) == 0) { \
         int stop = start + box_count(k, o, inv_d, 1.0); \
         for (int j = start; j < stop && !hit; ++j) { \
             float t = triangle_hit(j, wr, cull != 0, vwd); \
             hit = t < 1.0 && shadow_texel(k, j, t, vwd.xy / vwd.z, o, d); \
+        } \
+    }
+    // A run (see nearest()) without the light's own lamp: its box counts as
+    // missed, and its triangles, where the loop passes through them, do not block.
+#define RUN_BEGIN { int lo = TRI_COUNT, hi = 0;
+#define RUN_NODE(k, start, count, cull, lamps) \
+        if (((lamps >> light) & 1) == 0 && box_count(k, o, inv_d, 1.0) > 0) { lo = min(lo, start); hi = start + count; }
+#define RUN_LOOP for (int j = lo; j < hi && !hit; ++j) { int node = -1; bool one_sided = false; bool lamp = false;
+#define RUN_PICK(k, start, count, cull, lamps) \
+        if (j >= start) { node = k; one_sided = cull != 0; lamp = ((lamps >> light) & 1) != 0; }
+#define RUN_END \
+            float t = triangle_hit(j, wr, one_sided, vwd); \
+            hit = !lamp && t < 1.0 && shadow_texel(node, j, t, vwd.xy / vwd.z, o, d); \
         } \
     }
 #define TRI(k, j, cull, lamps) if (((lamps >> light) & 1) == 0 && !hit) { \
@@ -388,6 +426,11 @@ bool occluded(vec3 o, vec3 d, int light) {
 #undef TRI
 #undef MESH
 #undef SHAPE
+#undef RUN_BEGIN
+#undef RUN_NODE
+#undef RUN_LOOP
+#undef RUN_PICK
+#undef RUN_END
     return hit;
 #else
 #if HAS_MESHES && BVH

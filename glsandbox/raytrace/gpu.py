@@ -514,15 +514,33 @@ class _Uploaded:
         ``MESH(slot, start, count, cull, lamps)`` or ``SHAPE(slot, KIND_<NAME>, cull, lamps)``,
         ``cull`` resolved from the render's ``cull_backfaces`` (None: the node's own)."""
         slots = {k: slot for slot, k in enumerate(node_order(self.world))}
-        parts = []
+        parts: list[str] = []
+        run: list[str] = []  # consecutive looped nodes whose triangles follow each other
+        end = -1
+
+        def close_run() -> None:
+            if len(run) == 1:
+                parts.append(f"MESH{run[0]}")
+            elif run:
+                parts.append("RUN_BEGIN " + " ".join(f"RUN_NODE{r}" for r in run) + " RUN_LOOP "
+                             + " ".join(f"RUN_PICK{r}" for r in run) + " RUN_END")
+            run.clear()
+
         for k, node in enumerate(self.world.nodes):
             one_sided = int(node.cull if cull is None else cull)
+            if node.kind.triangles and node.count > UNROLL_TRIS:
+                if node.start != end:
+                    close_run()
+                run.append(f"({slots[k]},{node.start},{node.count},{one_sided},{node.lamp_of})")
+                end = node.start + node.count
+                continue
+            close_run()
+            end = -1
             if not node.kind.triangles:
                 parts.append(f"SHAPE({slots[k]},KIND_{node.kind.name},{one_sided},{node.lamp_of})")
-            elif node.count <= UNROLL_TRIS:
-                parts += [f"TRI({slots[k]},{j},{one_sided},{node.lamp_of})" for j in range(node.start, node.start + node.count)]
             else:
-                parts.append(f"MESH({slots[k]},{node.start},{one_sided},{node.lamp_of})")
+                parts += [f"TRI({slots[k]},{j},{one_sided},{node.lamp_of})" for j in range(node.start, node.start + node.count)]
+        close_run()
         return " ".join(parts)
 
     def same_data(self, world: World) -> bool:
