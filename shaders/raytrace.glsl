@@ -322,12 +322,25 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
         float t = triangle_hit(j, wr, cull != 0, vwd); \
         if (t < best) { best = t; hit_node = k; hit_tri = j; hit_vwd = vwd; } \
     }
+    // PAIR(k, j, cull, lamps, s0, s1, s2, fresh): triangles j and j + 1 of a
+    // node (a quad) sharing two corners: j + 1's corner m is j's corner s_m,
+    // or (s_m == 3) its own record TRI_V0 + fresh. Shared corners are the
+    // same floats, so transforming them once gives the same test.
+#define PAIR(k, j, cull, lamps, s0, s1, s2, fresh) { \
+        vec3 c[4] = vec3[4](wt_corner(wr, tri_rec(j, TRI_V0).xyz), wt_corner(wr, tri_rec(j, TRI_V1).xyz), \
+                            wt_corner(wr, tri_rec(j, TRI_V2).xyz), wt_corner(wr, tri_rec(j + 1, TRI_V0 + fresh).xyz)); \
+        float t = wt_hit_corners(c[0], c[1], c[2], cull != 0, INF, vwd); \
+        if (t < best) { best = t; hit_node = k; hit_tri = j; hit_vwd = vwd; } \
+        t = wt_hit_corners(c[s0], c[s1], c[s2], cull != 0, INF, vwd); \
+        if (t < best) { best = t; hit_node = k; hit_tri = j + 1; hit_vwd = vwd; } \
+    }
 #define SHAPE(k, kind, cull, lamps) { \
         float t = shape_t(kind, to_object(k, o, 1.0), to_object(k, d, 0.0), cull != 0); \
         if (t < best) { best = t; hit_node = k; hit_tri = -1; } \
     }
     SCENE_NODES
 #undef TRI
+#undef PAIR
 #undef MESH
 #undef SHAPE
 #undef RUN_BEGIN
@@ -419,11 +432,22 @@ bool occluded(vec3 o, vec3 d, int light) {
         float t = triangle_hit(j, wr, cull != 0, vwd); \
         hit = t < 1.0 && shadow_texel(k, j, t, vwd.xy / vwd.z, o, d); \
     }
+#define PAIR(k, j, cull, lamps, s0, s1, s2, fresh) if (((lamps >> light) & 1) == 0 && !hit) { \
+        vec3 c[4] = vec3[4](wt_corner(wr, tri_rec(j, TRI_V0).xyz), wt_corner(wr, tri_rec(j, TRI_V1).xyz), \
+                            wt_corner(wr, tri_rec(j, TRI_V2).xyz), wt_corner(wr, tri_rec(j + 1, TRI_V0 + fresh).xyz)); \
+        float t = wt_hit_corners(c[0], c[1], c[2], cull != 0, INF, vwd); \
+        hit = t < 1.0 && shadow_texel(k, j, t, vwd.xy / vwd.z, o, d); \
+        if (!hit) { \
+            t = wt_hit_corners(c[s0], c[s1], c[s2], cull != 0, INF, vwd); \
+            hit = t < 1.0 && shadow_texel(k, j + 1, t, vwd.xy / vwd.z, o, d); \
+        } \
+    }
 #define SHAPE(k, kind, cull, lamps) if (((lamps >> light) & 1) == 0) { \
         hit = hit || shape_t(kind, to_object(k, o, 1.0), to_object(k, d, 0.0), cull != 0) < 1.0; \
     }
     SCENE_NODES
 #undef TRI
+#undef PAIR
 #undef MESH
 #undef SHAPE
 #undef RUN_BEGIN

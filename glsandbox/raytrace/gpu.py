@@ -539,9 +539,29 @@ class _Uploaded:
             if not node.kind.triangles:
                 parts.append(f"SHAPE({slots[k]},KIND_{node.kind.name},{one_sided},{node.lamp_of})")
             else:
-                parts += [f"TRI({slots[k]},{j},{one_sided},{node.lamp_of})" for j in range(node.start, node.start + node.count)]
+                pair = self._shared_corners(node.start) if node.count == 2 else None
+                if pair is not None:
+                    parts.append(f"PAIR({slots[k]},{node.start},{one_sided},{node.lamp_of},{pair})")
+                else:
+                    parts += [f"TRI({slots[k]},{j},{one_sided},{node.lamp_of})"
+                              for j in range(node.start, node.start + node.count)]
         close_run()
         return " ".join(parts)
+
+    def _shared_corners(self, j: int) -> str | None:
+        """``s0,s1,s2,fresh`` of the shader's ``PAIR`` when triangle ``j + 1`` has two corners
+        exactly equal to corners of triangle ``j`` (a quad): for each of its corners, the
+        index of the equal corner of ``j`` or 3, and which of its own corners is the other.
+        Equal float64 corners pack to equal float32 corners, so the shader may share them."""
+        w = self.world
+        first = [w.v0[j], w.v1[j], w.v2[j]]
+        picks = []
+        for m, corner in enumerate((w.v0[j + 1], w.v1[j + 1], w.v2[j + 1])):
+            same = [i for i, v in enumerate(first) if np.array_equal(v, corner)]
+            picks.append(same[0] if same else 3)
+        if picks.count(3) != 1:
+            return None
+        return ",".join(map(str, picks)) + f",{picks.index(3)}"
 
     def same_data(self, world: World) -> bool:
         """Whether ``world`` packs to exactly what is uploaded (then the upload can be kept)."""

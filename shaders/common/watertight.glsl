@@ -101,10 +101,9 @@ float wt_edge(float px, float py, float qx, float qy) {
 // nearest hit's vwd and divides once at the end: the same floats as dividing
 // per triangle, without two divisions in every test (about 5% of a frame on
 // llvmpipe, which runs each test for all 8 lanes).
-float wt_hit(WtRay r, vec3 v0, vec3 v1, vec3 v2, bool cull, float miss, out vec3 vwd) {
-    vec3 a = wt_corner(r, v0);  // (sheared x, sheared y, sz z) of each corner
-    vec3 b = wt_corner(r, v1);
-    vec3 c = wt_corner(r, v2);
+// wt_hit_corners takes the corners already in ray space (wt_corner): two
+// triangles sharing a vertex can then transform it once.
+float wt_hit_corners(vec3 a, vec3 b, vec3 c, bool cull, float miss, out vec3 vwd) {
     float u = wt_edge(c.x, c.y, b.x, b.y);  // the weight of V0
     float v = wt_edge(a.x, a.y, c.x, c.y);  // of V1
     float w = wt_edge(b.x, b.y, a.x, a.y);  // of V2
@@ -125,6 +124,11 @@ float wt_hit(WtRay r, vec3 v0, vec3 v1, vec3 v2, bool cull, float miss, out vec3
     float max_e = max(max(abs(u), abs(v)), abs(w));
     float delta_t = 3.0 * (GAMMA3 * max_e * max_z + delta_e * max_z + delta_z * max_e) / abs(det);
     return t > delta_t ? t : miss;
+}
+
+float wt_hit(WtRay r, vec3 v0, vec3 v1, vec3 v2, bool cull, float miss, out vec3 vwd) {
+    // (sheared x, sheared y, sz z) of each corner
+    return wt_hit_corners(wt_corner(r, v0), wt_corner(r, v1), wt_corner(r, v2), cull, miss, vwd);
 }
 
 // wt_hit with the barycentrics divided out: t (or -1.0 for a miss) and uv.
