@@ -95,14 +95,12 @@ float wt_edge(float px, float py, float qx, float qy) {
     return e;
 }
 
-// The test against the triangle v0 v1 v2: t (or `miss` for a miss) and
-// vwd = (v, w, det), the barycentrics before their division:
-// uv = vwd.xy / vwd.z (P = V0 + u (V1 - V0) + v (V2 - V0)). A scan keeps the
-// nearest hit's vwd and divides once at the end: the same floats as dividing
-// per triangle, without two divisions in every test (about 5% of a frame on
-// llvmpipe, which runs each test for all 8 lanes).
-// wt_hit_corners takes the corners already in ray space (wt_corner): two
-// triangles sharing a vertex can then transform it once.
+// The test against the triangle whose corners a, b, c are already in ray
+// space (wt_corner; two triangles sharing a vertex can transform it once):
+// t (or `miss` for a miss) and vwd = (v, w, det), the barycentrics before
+// their division: uv = vwd.xy / vwd.z (P = V0 + u (V1 - V0) + v (V2 - V0)).
+// A scan keeps the nearest hit's vwd and divides once at the end: the same
+// floats as dividing per triangle, without two divisions in every test.
 float wt_hit_corners(vec3 a, vec3 b, vec3 c, bool cull, float miss, out vec3 vwd) {
     float u = wt_edge(c.x, c.y, b.x, b.y);  // the weight of V0
     float v = wt_edge(a.x, a.y, c.x, c.y);  // of V1
@@ -126,8 +124,8 @@ float wt_hit_corners(vec3 a, vec3 b, vec3 c, bool cull, float miss, out vec3 vwd
     return t > delta_t ? t : miss;
 }
 
+// The same against the triangle v0 v1 v2.
 float wt_hit(WtRay r, vec3 v0, vec3 v1, vec3 v2, bool cull, float miss, out vec3 vwd) {
-    // (sheared x, sheared y, sz z) of each corner
     return wt_hit_corners(wt_corner(r, v0), wt_corner(r, v1), wt_corner(r, v2), cull, miss, vwd);
 }
 
