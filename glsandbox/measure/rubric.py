@@ -24,7 +24,6 @@ Every mistake in the file is one line naming the file, the check and the key.
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -111,6 +110,8 @@ _CHECK_KEYS = {"name", "golden", "points", "set", "size", "samples", "renderer",
 
 def load_rubric(path: Path) -> Rubric:
     """Read and check a grading file; every mistake is one :class:`SandboxError` naming the file and key."""
+    import tomllib  # only grading reads TOML: `render --size` uses this module's parse_size_text
+
     raw = read_user_file(path, "rubric", "a .toml grading file")
     try:
         data = tomllib.loads(raw.decode("utf-8"))
