@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from glsandbox.errors import SandboxError
+from glsandbox.errors import SandboxError, parse_size_text
 from glsandbox.files import save_png, write_text
 from glsandbox.frame import DEFAULT_SIZE, Frame, HeadlessRenderer, with_samples
 from glsandbox.gl.context import BACKENDS
@@ -102,8 +102,6 @@ def write_png(image: np.ndarray, out: Path) -> None:
 
 def parse_size(text: str) -> tuple[int, int]:
     """``WxH`` -> (W, H), refusing anything else with the value named."""
-    from glsandbox.measure.rubric import parse_size_text
-
     return parse_size_text(text, "--size")
 
 
