@@ -25,14 +25,14 @@ The layers below (the README's "How it works" table) import downwards only;
 :func:`run` is the one door up to the command line, opened when called.
 """
 
-from glsandbox import camera, geometry, meshgen, transforms
+import importlib
+
+from glsandbox import camera, geometry, transforms
 from glsandbox.planar import Mirror, PlanarShadow
 from glsandbox.errors import SandboxError
 from glsandbox.version import __version__
 from glsandbox.geometry import Mesh
-from glsandbox.images import check_texture_source
 from glsandbox.lesson import Lesson, Param, register
-from glsandbox.meshfile import Model, fit_mesh, load_mesh, load_model
 from glsandbox.overlay import Overlay, text_image
 from glsandbox.scene import (
     COURSE_BLUE,
@@ -59,6 +59,33 @@ __all__ = [
     "__version__", "camera", "check_texture_source", "fit_mesh", "geometry", "load_mesh", "load_model", "meshgen", "register", "run",
     "show", "text_image", "transforms", "view", "widget",
 ]
+
+
+# Names whose modules a plain ``glsandbox render`` does not need (model files, the model
+# generators, texture checks): imported on first use (PEP 562), so a cold start skips them.
+_LAZY = {
+    "meshgen": ("glsandbox.meshgen", None),
+    "check_texture_source": ("glsandbox.images", "check_texture_source"),
+    "Model": ("glsandbox.meshfile", "Model"),
+    "fit_mesh": ("glsandbox.meshfile", "fit_mesh"),
+    "load_mesh": ("glsandbox.meshfile", "load_mesh"),
+    "load_model": ("glsandbox.meshfile", "load_model"),
+}
+
+
+def __getattr__(name: str) -> object:
+    try:
+        module_name, attribute = _LAZY[name]
+    except KeyError:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None
+    module = importlib.import_module(module_name)
+    value = module if attribute is None else getattr(module, attribute)
+    globals()[name] = value  # later look-ups skip this hook
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))
 
 
 def run(lesson_cls: type[Lesson], argv: list[str] | None = None) -> int:

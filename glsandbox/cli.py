@@ -11,7 +11,6 @@ print ``error: <one line>`` and exit with status 2.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import shlex
 import sys
@@ -23,8 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from glsandbox.course_page import course_page
-from glsandbox.errors import SandboxError
+from glsandbox.errors import SandboxError, parse_size_text
 from glsandbox.files import save_png, write_text
 from glsandbox.frame import DEFAULT_SIZE, Frame, HeadlessRenderer, with_samples
 from glsandbox.gl.context import BACKENDS
@@ -104,8 +102,6 @@ def write_png(image: np.ndarray, out: Path) -> None:
 
 def parse_size(text: str) -> tuple[int, int]:
     """``WxH`` -> (W, H), refusing anything else with the value named."""
-    from glsandbox.measure.rubric import parse_size_text
-
     return parse_size_text(text, "--size")
 
 
@@ -240,6 +236,10 @@ def cmd_tour(args: argparse.Namespace) -> int:
     summary = {"size": list(size), "samples": args.samples, "backend": backend, "renderer": renderer_name,
                "folder": None if args.lessons is None else str(args.lessons),
                "seconds": round(time.perf_counter() - started, 3), "lessons": results}
+    import json
+
+    from glsandbox.course_page import course_page  # the tour's gallery page
+
     for name, text in (("tour.json", json.dumps(summary, indent=2) + "\n"), ("index.html", course_page(summary))):
         try:
             write_text(out / name, text)

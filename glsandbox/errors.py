@@ -101,3 +101,15 @@ def check_numbers(value: object, what: str, counts: tuple[int, ...] = (3,), low:
         if not low <= float(item) <= high:
             raise SandboxError(f"{what} must lie within {low:g}..{high:g}, got {plain(value)}")
     return tuple(float(v) for v in items)
+
+
+def parse_size_text(text: str, where: str) -> tuple[int, int]:
+    """``WxH`` -> (W, H), refusing anything else with ``where`` named (``--size``, a rubric's ``size``)."""
+    w, sep, h = str(text).lower().partition("x")
+    try:
+        size = (int(w), int(h))
+    except ValueError:
+        size = (0, 0)
+    if not sep or size[0] <= 0 or size[1] <= 0 or max(size) > 16384:
+        raise SandboxError(f"{where} {text!r}: expected WIDTHxHEIGHT with positive integers, e.g. 640x480")
+    return size

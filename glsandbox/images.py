@@ -18,7 +18,7 @@ import warnings
 from pathlib import Path
 
 import numpy as np
-from PIL import Image, ImageDraw, ImageFont, UnidentifiedImageError
+from PIL import Image, UnidentifiedImageError
 
 from glsandbox.errors import SandboxError
 from glsandbox.files import open_user_file
@@ -69,6 +69,8 @@ def labels(size: int = 256) -> np.ndarray:
     picture once; the labels tell which corner of the face got which uv, and
     the colours let tests check the mapping without reading text.
     """
+    from PIL import ImageDraw, ImageFont  # drawing and fonts: only the labels texture needs them
+
     image = Image.new("RGB", (size, size))
     draw = ImageDraw.Draw(image)
     half = size // 2

@@ -8,7 +8,6 @@ so it renders the same moment exactly, headless or in a window.
 
 from __future__ import annotations
 
-import difflib
 import importlib
 import importlib.util
 import inspect
@@ -413,6 +412,8 @@ def built_scene(lesson: Lesson) -> Scene:
 
 def unknown_param_message(lesson: type[Lesson] | Lesson, key: str, flag: str = "--set") -> str:
     names = [p.name for p in lesson.all_params()]
+    import difflib  # only a misspelt name needs it
+
     close = difflib.get_close_matches(key, names, n=1)
     hint = f"; did you mean {close[0]!r}?" if close else ""
     return f"{flag} {key}: {lesson.name} has no parameter {key!r}{hint} (parameters: {', '.join(names)})"
@@ -527,6 +528,8 @@ def find_lesson(name_or_path: str) -> type[Lesson]:
     lessons_by_name = {cls.name: cls for cls in all_lessons()}
     if name_or_path in lessons_by_name:
         return lessons_by_name[name_or_path]
+    import difflib  # only a misspelt name needs it
+
     close = difflib.get_close_matches(name_or_path, list(lessons_by_name), n=1, cutoff=0.4)
     hint = f"; did you mean {close[0]!r}?" if close else ""
     raise SandboxError(f"unknown lesson {name_or_path!r}{hint} (see glsandbox list)")

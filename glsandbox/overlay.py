@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
-from PIL import Image, ImageDraw, ImageFont
+from PIL import Image
 
 from glsandbox.errors import SandboxError
 
@@ -62,6 +62,8 @@ class Overlay:
 
 @lru_cache(maxsize=1)
 def _font() -> ImageFont.ImageFont | ImageFont.FreeTypeFont:
+    from PIL import ImageFont  # imported when text is drawn: a cold start without an overlay skips it
+
     return ImageFont.load_default()
 
 
@@ -83,12 +85,16 @@ def text_image(rows: Sequence[str | Sequence[str]], *, color: RGBA = TEXT_COLOR,
 def _text_width(text: str) -> int:
     """A string's width in pixels in the panel font: the numbers of a matrix panel
     recur from frame to frame, so each is measured once."""
+    from PIL import ImageDraw
+
     return int(np.ceil(ImageDraw.Draw(Image.new("RGBA", (1, 1))).textlength(text, font=_font())))
 
 
 @lru_cache(maxsize=128)
 def _text_image(rows: tuple[str | tuple[str, ...], ...], color: RGBA, panel: RGBA,
                 padding: int, line_gap: int, column_gap: int) -> np.ndarray:
+    from PIL import ImageDraw
+
     font = _font()
     width = _text_width
     ascent, descent = font.getmetrics() if hasattr(font, "getmetrics") else (10, 2)

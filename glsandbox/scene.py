@@ -7,7 +7,6 @@ down -z); see :mod:`glsandbox.transforms` for the course's DirectX form.
 
 from __future__ import annotations
 
-import hashlib
 import math
 import os
 import re
@@ -197,6 +196,8 @@ def _image_digest(image: np.ndarray) -> str:
     if entry is not None and entry[0]() is image:
         return entry[1]
     shape = np.asarray(image.shape, dtype=np.int64).tobytes()
+    import hashlib  # only image textures are hashed (loads OpenSSL): lessons without one skip it
+
     digest = hashlib.blake2b(shape + image.tobytes(), digest_size=12).hexdigest()
     _IMAGE_DIGESTS[key] = (weakref.ref(image, lambda _: _IMAGE_DIGESTS.pop(key, None)), digest)
     return digest

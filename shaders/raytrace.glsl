@@ -156,6 +156,13 @@ float triangle_t(int k, WtRay r, bool cull, out vec2 uv) {
     return t > 0.0 ? t : INF;
 }
 
+// triangle_t for the unrolled scan: INF for a miss (wt_hit accepts only
+// t above its error bound, which is >= 0, so that is t > 0.0 too) and the
+// undivided barycentrics vwd (uv = vwd.xy / vwd.z, divided once per ray).
+float triangle_hit(int k, WtRay r, bool cull, out vec3 vwd) {
+    return wt_hit(r, tri_rec(k, TRI_V0).xyz, tri_rec(k, TRI_V1).xyz, tri_rec(k, TRI_V2).xyz, cull, INF, vwd);
+}
+
 // Işın-Küre kesim testi in the unit sphere's own space, the numerically
 // stable form (Ray Tracing Gems ch. 7): discriminant from the vector
 // h = l − (b/a)d, roots q/a and c/q without cancellation.
@@ -276,23 +283,56 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
     vec2 uv;
 #if defined(SCENE_NODES)
     // The node list unrolled, in scene order: SCENE_NODES is a sequence of
-    // MESH(k, start, cull, lamps) (a loop over the node's triangles from
+    // MESH(k, start, count, cull, lamps) (a loop over the node's triangles from
     // `start`), TRI(k, j, cull, lamps) (one triangle of a node too small to
     // be worth a loop, gpu.UNROLL_TRIS) and SHAPE(k, kind, cull, lamps) (an
     // analytic node, its KIND_* a literal), with the
     // record slot, triangles, one-sidedness and lamp bits as literals, so
     // node records are read at constant indices, and a strict `<` gives
     // ties to the earlier node and triangle (min_indis).
-#define MESH(k, start, cull, lamps) { \
+    vec3 vwd, hit_vwd = vec3(0.0, 0.0, 1.0);
+#define MESH(k, start, count, cull, lamps) { \
         int stop = start + box_count(k, o, inv_d, best); \
         for (int j = start; j < stop; ++j) { \
-            float t = triangle_t(j, wr, cull != 0, uv); \
-            if (t < best) { best = t; hit_node = k; hit_tri = j; hit_uv = uv; } \
+            float t = triangle_hit(j, wr, cull != 0, vwd); \
+            if (t < best) { best = t; hit_node = k; hit_tri = j; hit_vwd = vwd; } \
+        } \
+    }
+    // RUN_BEGIN RUN_NODE(..)... RUN_LOOP RUN_PICK(..)... RUN_END: a run of
+    // consecutive looped nodes whose triangles follow each other
+    // (gpu.py's scene_nodes), one loop over the triangles from the first
+    // node whose box the ray meets to the end of the last. llvmpipe runs a
+    // loop's first pass for all 8 lanes even when none is in it, so a group
+    // that misses every box pays one masked pass for the run, not one per
+    // node. The loop runs in triangle order, which is scene order, so a
+    // strict `<` still gives ties to the earlier node and triangle; the
+    // triangles of a node between two met ones are tested too (a superset:
+    // the nearest hit is the same).
+#define RUN_BEGIN { int lo = TRI_COUNT, hi = 0;
+#define RUN_NODE(k, start, count, cull, lamps) \
+        if (box_count(k, o, inv_d, best) > 0) { lo = min(lo, start); hi = start + count; }
+#define RUN_LOOP for (int j = lo; j < hi; ++j) { int node = -1; bool one_sided = false;
+#define RUN_PICK(k, start, count, cull, lamps) if (j >= start) { node = k; one_sided = cull != 0; }
+#define RUN_END \
+            float t = triangle_hit(j, wr, one_sided, vwd); \
+            if (t < best) { best = t; hit_node = node; hit_tri = j; hit_vwd = vwd; } \
         } \
     }
 #define TRI(k, j, cull, lamps) { \
-        float t = triangle_t(j, wr, cull != 0, uv); \
-        if (t < best) { best = t; hit_node = k; hit_tri = j; hit_uv = uv; } \
+        float t = triangle_hit(j, wr, cull != 0, vwd); \
+        if (t < best) { best = t; hit_node = k; hit_tri = j; hit_vwd = vwd; } \
+    }
+    // PAIR(k, j, cull, lamps, s0, s1, s2, fresh): triangles j and j + 1 of a
+    // node (a quad) sharing two corners: j + 1's corner m is j's corner s_m,
+    // or (s_m == 3) its own record TRI_V0 + fresh. Shared corners are the
+    // same floats, so transforming them once gives the same test.
+#define PAIR(k, j, cull, lamps, s0, s1, s2, fresh) { \
+        vec3 c[4] = vec3[4](wt_corner(wr, tri_rec(j, TRI_V0).xyz), wt_corner(wr, tri_rec(j, TRI_V1).xyz), \
+                            wt_corner(wr, tri_rec(j, TRI_V2).xyz), wt_corner(wr, tri_rec(j + 1, TRI_V0 + fresh).xyz)); \
+        float t = wt_hit_corners(c[0], c[1], c[2], cull != 0, INF, vwd); \
+        if (t < best) { best = t; hit_node = k; hit_tri = j; hit_vwd = vwd; } \
+        t = wt_hit_corners(c[s0], c[s1], c[s2], cull != 0, INF, vwd); \
+        if (t < best) { best = t; hit_node = k; hit_tri = j + 1; hit_vwd = vwd; } \
     }
 #define SHAPE(k, kind, cull, lamps) { \
         float t = shape_t(kind, to_object(k, o, 1.0), to_object(k, d, 0.0), cull != 0); \
@@ -300,8 +340,15 @@ float nearest(vec3 o, vec3 d, out int hit_node, out int hit_tri, out vec2 hit_uv
     }
     SCENE_NODES
 #undef TRI
+#undef PAIR
 #undef MESH
 #undef SHAPE
+#undef RUN_BEGIN
+#undef RUN_NODE
+#undef RUN_LOOP
+#undef RUN_PICK
+#undef RUN_END
+    hit_uv = hit_vwd.xy / hit_vwd.z;  // a sphere's is unused
 #else
     // Any number of nodes: mesh nodes, then sphere nodes, in two loops over
     // the records; an equal t goes to the node first in scene order (r2.z),
@@ -358,26 +405,56 @@ bool occluded(vec3 o, vec3 d, int light) {
     vec2 uv;
 #if defined(SCENE_NODES)
     bool hit = false;
+    vec3 vwd;
     // The lamp bits are literals: the lamp test is one comparison per node,
     // none where the compiler unrolls the light loop.
-#define MESH(k, start, cull, lamps) if (((lamps >> light) & 1) == 0) { \
+#define MESH(k, start, count, cull, lamps) if (((lamps >> light) & 1) == 0) { \
         int stop = start + box_count(k, o, inv_d, 1.0); \
         for (int j = start; j < stop && !hit; ++j) { \
-            float t = triangle_t(j, wr, cull != 0, uv); \
-            hit = t < 1.0 && shadow_texel(k, j, t, uv, o, d); \
+            float t = triangle_hit(j, wr, cull != 0, vwd); \
+            hit = t < 1.0 && shadow_texel(k, j, t, vwd.xy / vwd.z, o, d); \
+        } \
+    }
+    // A run (see nearest()) without the light's own lamp: its box counts as
+    // missed, and its triangles, where the loop passes through them, do not block.
+#define RUN_BEGIN { int lo = TRI_COUNT, hi = 0;
+#define RUN_NODE(k, start, count, cull, lamps) \
+        if (((lamps >> light) & 1) == 0 && box_count(k, o, inv_d, 1.0) > 0) { lo = min(lo, start); hi = start + count; }
+#define RUN_LOOP for (int j = lo; j < hi && !hit; ++j) { int node = -1; bool one_sided = false; bool lamp = false;
+#define RUN_PICK(k, start, count, cull, lamps) \
+        if (j >= start) { node = k; one_sided = cull != 0; lamp = ((lamps >> light) & 1) != 0; }
+#define RUN_END \
+            float t = triangle_hit(j, wr, one_sided, vwd); \
+            hit = !lamp && t < 1.0 && shadow_texel(node, j, t, vwd.xy / vwd.z, o, d); \
         } \
     }
 #define TRI(k, j, cull, lamps) if (((lamps >> light) & 1) == 0 && !hit) { \
-        float t = triangle_t(j, wr, cull != 0, uv); \
-        hit = t < 1.0 && shadow_texel(k, j, t, uv, o, d); \
+        float t = triangle_hit(j, wr, cull != 0, vwd); \
+        hit = t < 1.0 && shadow_texel(k, j, t, vwd.xy / vwd.z, o, d); \
+    }
+#define PAIR(k, j, cull, lamps, s0, s1, s2, fresh) if (((lamps >> light) & 1) == 0 && !hit) { \
+        vec3 c[4] = vec3[4](wt_corner(wr, tri_rec(j, TRI_V0).xyz), wt_corner(wr, tri_rec(j, TRI_V1).xyz), \
+                            wt_corner(wr, tri_rec(j, TRI_V2).xyz), wt_corner(wr, tri_rec(j + 1, TRI_V0 + fresh).xyz)); \
+        float t = wt_hit_corners(c[0], c[1], c[2], cull != 0, INF, vwd); \
+        hit = t < 1.0 && shadow_texel(k, j, t, vwd.xy / vwd.z, o, d); \
+        if (!hit) { \
+            t = wt_hit_corners(c[s0], c[s1], c[s2], cull != 0, INF, vwd); \
+            hit = t < 1.0 && shadow_texel(k, j + 1, t, vwd.xy / vwd.z, o, d); \
+        } \
     }
 #define SHAPE(k, kind, cull, lamps) if (((lamps >> light) & 1) == 0) { \
         hit = hit || shape_t(kind, to_object(k, o, 1.0), to_object(k, d, 0.0), cull != 0) < 1.0; \
     }
     SCENE_NODES
 #undef TRI
+#undef PAIR
 #undef MESH
 #undef SHAPE
+#undef RUN_BEGIN
+#undef RUN_NODE
+#undef RUN_LOOP
+#undef RUN_PICK
+#undef RUN_END
     return hit;
 #else
 #if HAS_MESHES && BVH

@@ -24,12 +24,11 @@ Every mistake in the file is one line naming the file, the check and the key.
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from glsandbox.errors import SandboxError
+from glsandbox.errors import SandboxError, parse_size_text
 from glsandbox.files import read_user_file
 from glsandbox.measure.golden import DEFAULT_MAX_BAD_SHARE, DEFAULT_THRESHOLD
 
@@ -93,24 +92,14 @@ def parse_tolerances(items: list[str] | tuple[str, ...]) -> dict[str, float]:
     return tolerances
 
 
-def parse_size_text(text: str, where: str) -> tuple[int, int]:
-    """``WxH`` -> (W, H), refusing anything else with ``where`` named."""
-    w, sep, h = str(text).lower().partition("x")
-    try:
-        size = (int(w), int(h))
-    except ValueError:
-        size = (0, 0)
-    if not sep or size[0] <= 0 or size[1] <= 0 or max(size) > 16384:
-        raise SandboxError(f"{where} {text!r}: expected WIDTHxHEIGHT with positive integers, e.g. 640x480")
-    return size
-
-
 _TOP_KEYS = {"timeout", "memory", "check"}
 _CHECK_KEYS = {"name", "golden", "points", "set", "size", "samples", "renderer", "tolerance", "hidden"}
 
 
 def load_rubric(path: Path) -> Rubric:
     """Read and check a grading file; every mistake is one :class:`SandboxError` naming the file and key."""
+    import tomllib  # only grading reads TOML
+
     raw = read_user_file(path, "rubric", "a .toml grading file")
     try:
         data = tomllib.loads(raw.decode("utf-8"))

@@ -140,11 +140,12 @@ def open_template(backend: str | None, sizes: Iterable[tuple[int, int]]):
     driver, a descriptor or a thread a fork cannot copy). Call only in a process that exists to be
     the template: a context that fails the checks stays open in it."""
     os.environ["LP_NUM_THREADS"] = "0"  # llvmpipe: no rasterizer threads (read when the context opens)
-    # No on-disk shader cache in a template: its writes go through Mesa's cache thread (disk$N),
-    # which a fork does not copy, so a child compiling a shader no process had compiled before
-    # queued its cache write for a thread that does not exist and hung until its time limit
-    # (a student's own shader file graded TIMEOUT). The built-in programs are compiled by the
-    # warm-up below and inherited by every fork; only a submission's new shaders compile in it.
+    # No on-disk shader cache in a template. Mesa's cache thread (disk$N) waits on a condition
+    # variable; a fork copies that waiter's state but not the thread, so the first cache write in
+    # a child (a shader no process had compiled before: a student's own shader file) signalled a
+    # condition variable whose copied waiter never answers, and the child hung until its time
+    # limit (graded TIMEOUT). The warm-up below compiles the built-in programs every fork
+    # inherits; a submission's other programs compile in its child (about 10-20 ms each here).
     os.environ["MESA_SHADER_CACHE_DISABLE"] = "true"
     threads, descriptors, shared = set(_threads()), _descriptors(), _shared_writable()
     try:

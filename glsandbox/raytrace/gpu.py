@@ -514,16 +514,54 @@ class _Uploaded:
         ``MESH(slot, start, count, cull, lamps)`` or ``SHAPE(slot, KIND_<NAME>, cull, lamps)``,
         ``cull`` resolved from the render's ``cull_backfaces`` (None: the node's own)."""
         slots = {k: slot for slot, k in enumerate(node_order(self.world))}
-        parts = []
+        parts: list[str] = []
+        run: list[str] = []  # consecutive looped nodes whose triangles follow each other
+        end = -1
+
+        def close_run() -> None:
+            if len(run) == 1:
+                parts.append(f"MESH{run[0]}")
+            elif run:
+                parts.append("RUN_BEGIN " + " ".join(f"RUN_NODE{r}" for r in run) + " RUN_LOOP "
+                             + " ".join(f"RUN_PICK{r}" for r in run) + " RUN_END")
+            run.clear()
+
         for k, node in enumerate(self.world.nodes):
             one_sided = int(node.cull if cull is None else cull)
+            if node.kind.triangles and node.count > UNROLL_TRIS:
+                if node.start != end:
+                    close_run()
+                run.append(f"({slots[k]},{node.start},{node.count},{one_sided},{node.lamp_of})")
+                end = node.start + node.count
+                continue
+            close_run()
+            end = -1
             if not node.kind.triangles:
                 parts.append(f"SHAPE({slots[k]},KIND_{node.kind.name},{one_sided},{node.lamp_of})")
-            elif node.count <= UNROLL_TRIS:
-                parts += [f"TRI({slots[k]},{j},{one_sided},{node.lamp_of})" for j in range(node.start, node.start + node.count)]
             else:
-                parts.append(f"MESH({slots[k]},{node.start},{one_sided},{node.lamp_of})")
+                pair = self._shared_corners(node.start) if node.count == 2 else None
+                if pair is not None:
+                    parts.append(f"PAIR({slots[k]},{node.start},{one_sided},{node.lamp_of},{pair})")
+                else:
+                    parts += [f"TRI({slots[k]},{j},{one_sided},{node.lamp_of})"
+                              for j in range(node.start, node.start + node.count)]
+        close_run()
         return " ".join(parts)
+
+    def _shared_corners(self, j: int) -> str | None:
+        """``s0,s1,s2,fresh`` of the shader's ``PAIR`` when triangle ``j + 1`` has two corners
+        exactly equal to corners of triangle ``j`` (a quad): for each of its corners, the
+        index of the equal corner of ``j`` or 3, and which of its own corners is the other.
+        Equal float64 corners pack to equal float32 corners, so the shader may share them."""
+        w = self.world
+        first = [w.v0[j], w.v1[j], w.v2[j]]
+        picks = []
+        for m, corner in enumerate((w.v0[j + 1], w.v1[j + 1], w.v2[j + 1])):
+            same = [i for i, v in enumerate(first) if np.array_equal(v, corner)]
+            picks.append(same[0] if same else 3)
+        if picks.count(3) != 1:
+            return None
+        return ",".join(map(str, picks)) + f",{picks.index(3)}"
 
     def same_data(self, world: World) -> bool:
         """Whether ``world`` packs to exactly what is uploaded (then the upload can be kept)."""

@@ -95,20 +95,21 @@ float wt_edge(float px, float py, float qx, float qy) {
     return e;
 }
 
-// The test against the triangle v0 v1 v2: t (or -1.0 for a miss) and the
-// barycentrics uv (P = V0 + u (V1 - V0) + v (V2 - V0)).
-float wt_triangle(WtRay r, vec3 v0, vec3 v1, vec3 v2, bool cull, out vec2 uv) {
-    vec3 a = wt_corner(r, v0);  // (sheared x, sheared y, sz z) of each corner
-    vec3 b = wt_corner(r, v1);
-    vec3 c = wt_corner(r, v2);
+// The test against the triangle whose corners a, b, c are already in ray
+// space (wt_corner; two triangles sharing a vertex can transform it once):
+// t (or `miss` for a miss) and vwd = (v, w, det), the barycentrics before
+// their division: uv = vwd.xy / vwd.z (P = V0 + u (V1 - V0) + v (V2 - V0)).
+// A scan keeps the nearest hit's vwd and divides once at the end: the same
+// floats as dividing per triangle, without two divisions in every test.
+float wt_hit_corners(vec3 a, vec3 b, vec3 c, bool cull, float miss, out vec3 vwd) {
     float u = wt_edge(c.x, c.y, b.x, b.y);  // the weight of V0
     float v = wt_edge(a.x, a.y, c.x, c.y);  // of V1
     float w = wt_edge(b.x, b.y, a.x, a.y);  // of V2
     bool negative = u < 0.0 || v < 0.0 || w < 0.0;
     bool positive = u > 0.0 || v > 0.0 || w > 0.0;
     float det = u + v + w;
-    uv = vec2(v, w) / det;
-    if ((cull ? negative : (negative && positive)) || det == 0.0) return -1.0;
+    vwd = vec3(v, w, det);
+    if ((cull ? negative : (negative && positive)) || det == 0.0) return miss;
     float t = (u * a.z + v * b.z + w * c.z) / det;
     // pbrt-v4's bound on t's rounding error: accept only t above it.
     float max_z = max(max(abs(a.z), abs(b.z)), abs(c.z));
@@ -120,6 +121,19 @@ float wt_triangle(WtRay r, vec3 v0, vec3 v1, vec3 v2, bool cull, out vec2 uv) {
     float delta_e = 2.0 * (GAMMA2 * max_x * max_y + delta_y * max_x + delta_x * max_y);
     float max_e = max(max(abs(u), abs(v)), abs(w));
     float delta_t = 3.0 * (GAMMA3 * max_e * max_z + delta_e * max_z + delta_z * max_e) / abs(det);
-    return t > delta_t ? t : -1.0;
+    return t > delta_t ? t : miss;
+}
+
+// The same against the triangle v0 v1 v2.
+float wt_hit(WtRay r, vec3 v0, vec3 v1, vec3 v2, bool cull, float miss, out vec3 vwd) {
+    return wt_hit_corners(wt_corner(r, v0), wt_corner(r, v1), wt_corner(r, v2), cull, miss, vwd);
+}
+
+// wt_hit with the barycentrics divided out: t (or -1.0 for a miss) and uv.
+float wt_triangle(WtRay r, vec3 v0, vec3 v1, vec3 v2, bool cull, out vec2 uv) {
+    vec3 vwd;
+    float t = wt_hit(r, v0, v1, v2, cull, -1.0, vwd);
+    uv = vwd.xy / vwd.z;
+    return t;
 }
 #endif

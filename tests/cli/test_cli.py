@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from support import REPO_ROOT as REPO
-from support import EXAMPLES_DIR, SPIN, assert_user_error, glsandbox, not_blank, run_cli
+from support import EXAMPLES_DIR, SPIN, assert_user_error, glsandbox, need, not_blank, run_cli
 
 from glsandbox.files import load_png
 from glsandbox.lesson import find_lesson
@@ -218,3 +218,34 @@ def test_tour_lessons_dir_renders_each_file_and_goes_on_past_a_broken_one(tmp_pa
     assert not_blank(load_png(out / "room.png")) and load_png(out / "spin.png").shape == (48, 64, 4)
     assert "[1/3] broken: FAILED" in proc.stderr and "[3/3] spin: ok" in proc.stderr
     assert_user_error(run_cli("tour", "--lessons", str(tmp_path / "none"), "--out", str(out)), "not a folder")
+
+
+# What a plain `glsandbox render` leaves out of its cold start (issue 24: start-up <= 1.2x a raw
+# ModernGL script): each is imported where it is used, and an eager import anywhere on the render
+# path (glsandbox/__init__, scene, overlay, cli, lesson, ...) brings it back into sys.modules here.
+LAZY_AT_RENDER = ("glsandbox.meshfile", "glsandbox.meshgen", "glsandbox.meshlooks", "glsandbox.course_page",
+                  "glsandbox.measure.rubric", "glsandbox.measure.golden", "glsandbox.window", "glsandbox.raytrace",
+                  "trimesh", "tqdm", "imgui", "PIL.ImageDraw", "PIL.ImageFont", "tomllib", "difflib", "json", "html")
+
+
+@pytest.mark.slow  # a subprocess: a cold start is the point
+def test_plain_render_does_not_import_what_it_does_not_use(tmp_path: Path) -> None:
+    out = tmp_path / "cube.png"
+    code = ("import sys\n"
+            "before = set(sys.modules)\n"  # the interpreter's own start-up
+            "from glsandbox.cli import main\n"
+            f"sys.argv = ['glsandbox', 'render', 'indexed_cube', '--size', '64x48', '--out', {str(out)!r}]\n"
+            "try:\n    main()\nexcept SystemExit as exc:\n    code = exc.code\nelse:\n    code = 0\n"
+            "loaded = sorted(set(sys.modules) - before)\n"
+            "import json\n"  # for this report only, after the list is taken
+            "print(json.dumps({'code': code, 'loaded': loaded}))\n")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO, timeout=180)
+    assert proc.returncode == 0, proc.stderr
+    report = json.loads(proc.stdout.strip().splitlines()[-1])
+    if report["code"] != 0:
+        need("a GL backend", proc.stderr.strip())
+    assert out.exists()
+    loaded = set(report["loaded"])
+    assert "glsandbox.frame" in loaded and "moderngl" in loaded  # it did render
+    eager = sorted(m for m in loaded if m in LAZY_AT_RENDER or m.startswith(tuple(f"{n}." for n in LAZY_AT_RENDER)))
+    assert not eager, f"imported by a plain render though it does not use them: {eager}"

@@ -79,3 +79,50 @@ def test_a_sampler_object_left_bound_on_the_context_changes_nothing(gl) -> None:
         ctx.clear_samplers(0, gpu_engine.MAX_TEXTURES)
         sampler.release()
         bvh.release()
+
+
+def row_of_cubes_scene() -> Scene:
+    """A floor quad (two triangles sharing two corners: the scan's PAIR) and three cubes
+    in a row (consecutive looped nodes: one RUN), the middle one the light's lamp, the
+    last one a mirror."""
+    from glsandbox import geometry
+
+    def at(x: float, y: float, scale: float) -> np.ndarray:
+        m = np.diag([scale, scale, scale, 1.0])
+        m[:3, 3] = (x, y, 0.0)
+        return m
+
+    floor = np.diag([4.0, 1.0, 4.0, 1.0])
+    floor[1, 3] = -0.5
+    lit = Material(color=(0.8, 0.6, 0.4, 1.0), shading="phong")
+    nodes = (Node("floor", geometry.plane(), floor, lit),
+             Node("left", geometry.cube(), at(-1.2, 0.0, 0.5), lit),
+             Node("lamp", geometry.cube(), at(0.0, 1.2, 0.2), Material(color=(1.0, 1.0, 0.9, 1.0), shading="solid")),
+             Node("right", geometry.cube(), at(1.2, 0.0, 0.5), Material(color=(0.5, 0.7, 0.9, 1.0), shading="phong",
+                                                                       reflectivity=0.5)))
+    return Scene("row", nodes=nodes, camera=Camera(eye=(0.5, 1.5, 4.0), target=(0.0, 0.0, 0.0)),
+                 lights=(Light((0.0, 1.2, 0.0)),), clear_color=(0.1, 0.1, 0.1, 1.0))
+
+
+def test_the_unrolled_scan_draws_what_the_node_loops_draw(gl, monkeypatch) -> None:
+    """The small-scene program merges consecutive cubes into one triangle loop (a lamp
+    among them left out of its light's shadow rays) and shares a quad's corners; the
+    general program loops over every node and triangle. Same float32 tests: the same
+    pixels, shadows and a mirror bounce included."""
+    scene = row_of_cubes_scene()
+    world = build_world(scene, 0)
+    assert [node.lamp_of for node in world.nodes] == [0, 0, 1, 0]
+    size = (160, 120)
+    options = dict(shadows=True, max_depth=1)
+    tracer = gpu_engine.gpu_tracer(gl.host.ctx)
+    tracer.forget_scenes()
+    unrolled = render(scene, size, "gpu", ctx=gl.host.ctx, **options)
+    assert all(upload.unrolled for upload in tracer._scenes)
+    tracer.forget_scenes()
+    monkeypatch.setattr(gpu_engine, "UNROLL_NODES", 0)  # the general program
+    looped = render(scene, size, "gpu", ctx=gl.host.ctx, **options)
+    assert not any(upload.unrolled for upload in tracer._scenes)
+    tracer.forget_scenes()
+    shadowed = (unrolled[..., :3].astype(int).sum(axis=-1) < 120) & (unrolled[..., :3] != 25).any(axis=-1)
+    assert shadowed.sum() > 50  # the cubes cast shadows on the floor
+    assert np.array_equal(unrolled, looped)
