@@ -436,8 +436,6 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         sweeps, areas = [], []  # per axis: the running boxes and the cuts' half areas (left, right)
         for axis in range(3):
             cnt = np.bincount(bin_key[axis], minlength=n * bins).reshape(n, bins)
-            if to_counts is not None:
-                cnt = cnt * to_counts
             blo = np.full((3, n * bins), np.inf, dtype=np.float32)
             bhi = np.full((3, n * bins), -np.inf, dtype=np.float32)
             key = box_keys[axis]
@@ -454,16 +452,21 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
             if node_lo is None:  # all the bins: the node's (sampled) box
                 node_lo, node_hi = llo[:, -1], lhi[:, -1]
             n_left = np.cumsum(cnt.T[:-1], axis=0)
+            # Both sides something, from the binned columns' own (integer) counts: scaled ones
+            # round, and a side of none could look like a sliver of one.
+            both = (n_left > 0) & (n_left < taken)
+            if to_counts is not None:
+                n_left = n_left * to_counts.T
             n_right = counts - n_left
             area_left, area_right = _half_area(llo[:, :-1], lhi[:, :-1]), _half_area(rlo[:, 1:], rhi[:, 1:])
             if sampled:
                 sweeps.append((llo, lhi, rlo, rhi))
                 areas.append((area_left, area_right))
             sah = n_left * area_left + n_right * area_right
-            sah = np.where((n_left > 0) & (n_right > 0), sah, np.inf)  # a cut must leave both sides something
+            sah = np.where(both, sah, np.inf)  # a cut must leave both sides something
             cut = np.argmin(sah, axis=0)  # the best cut on this axis, minus one
             cost = sah[cut, nodes]
-            gap = np.where((n_left > 0) & (n_right > 0), np.abs(2 * n_left - counts), np.inf)
+            gap = np.where(both, np.abs(2 * n_left - counts), np.inf)
             even = np.argmin(gap, axis=0)
             evener = np.flatnonzero(gap[even, nodes] < even_gap)
             if evener.size:
