@@ -128,6 +128,13 @@ def mirror_surface(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: An
         drawer.draw_node(frame.nodes[draw.node], draw, camera)
 
 
+@functools.lru_cache(maxsize=16)
+def _flat_material(color: tuple[float, ...]) -> Material:
+    """The planar shadow's material, one object per colour: the executor keeps what it prepared
+    for a draw while its material is the same object (Materials are immutable)."""
+    return Material(color=color)
+
+
 def planar_shadow(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any) -> None:
     """The casters flattened by the lifted shadow matrix, dark and blended.
 
@@ -152,7 +159,7 @@ def planar_shadow(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any
         sign = 1.0 if scene.depth_mode == "reverse_z" else -1.0
         ctx.polygon_offset = (sign, sign)
     flatten = shadow.matrix()
-    flat = Material(color=shadow.color)  # one colour, unlit, untextured
+    flat = _flat_material(shadow.color)  # one colour, unlit, untextured
     for draw in step.draws:  # drawn without culling, as the plan says
         node = nodes[draw.node]
         material = flat
