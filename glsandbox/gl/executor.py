@@ -138,17 +138,29 @@ def _eye_bytes(view: bytes) -> bytes:
     return eye_position(np.frombuffer(view).reshape(4, 4)).astype("f4").tobytes()
 
 
-@functools.lru_cache(maxsize=1024)
-def _model_matrix_bytes(model: bytes) -> bytes:
-    """``m_model``'s uniform bytes (float32, column-major) for a float64 model matrix given as bytes."""
-    return transforms.gl_bytes(np.frombuffer(model).reshape(4, 4))
+#: ``m_model``'s and ``m_normal``'s uniform bytes by the float64 model matrix's bytes (see
+#: :meth:`Executor.draw_node`): a node that does not move converts its matrix, and inverts it,
+#: once; an array changed in place between frames has other bytes, so it is converted again.
+_MODEL_BYTES: dict[bytes, bytes] = {}
+_NORMAL_BYTES: dict[bytes, bytes] = {}
+#: Entries each of those keeps; past it, it starts again (a moving node adds one per frame).
+_MATRICES_KEPT = 1024
 
 
-@functools.lru_cache(maxsize=1024)
-def _normal_matrix_bytes(model: bytes) -> bytes:
-    """The normal matrix's uniform bytes for a float64 model matrix given as
-    bytes: models that do not move (walls, floors) skip the inverse each frame."""
-    return transforms.gl_bytes(transforms.normal_matrix(np.frombuffer(model).reshape(4, 4)))
+def _model_matrix_bytes(content: bytes, matrix: np.ndarray) -> bytes:
+    """``m_model``'s uniform bytes (float32, column-major) of ``matrix`` (float64, whose bytes are ``content``)."""
+    if len(_MODEL_BYTES) >= _MATRICES_KEPT:
+        _MODEL_BYTES.clear()
+    data = _MODEL_BYTES[content] = transforms.gl_bytes(matrix)
+    return data
+
+
+def _normal_matrix_bytes(content: bytes, matrix: np.ndarray) -> bytes:
+    """The normal matrix's uniform bytes of ``matrix`` (float64, whose bytes are ``content``)."""
+    if len(_NORMAL_BYTES) >= _MATRICES_KEPT:
+        _NORMAL_BYTES.clear()
+    data = _NORMAL_BYTES[content] = transforms.gl_bytes(transforms.normal_matrix(matrix))
+    return data
 
 
 @dataclass(frozen=True)
@@ -229,11 +241,39 @@ class _DrawSetup:
     # entry of Executor._written): draw_node's loop writes only what changed.
     uniforms: dict[str, moderngl.Uniform] = field(default_factory=dict)
     written: dict[str, bytes] = field(default_factory=dict)
+    # (id of the constants the program held, id of a draw's): (those, these, what the draw writes).
+    changes: dict[tuple[int, int], tuple] = field(default_factory=dict)
 
 
 #: A key of a program's ``written`` dict that names no uniform: the constants tuple of the
 #: prepared draw that wrote its material's uniforms last (see :meth:`Executor.draw_node`).
 _CONSTANTS = "#constants"
+
+
+#: The PassCamera whose view and projection a program holds (its ``written`` dict's key, like
+#: :data:`_CONSTANTS`): draws through the same camera skip comparing them.
+_CAMERA = "#camera"
+#: Constants' changes kept per set-up (see :func:`_constants_change`); past this many, it starts again.
+_CHANGES_KEPT = 256
+
+
+def _constants_change(setup: _DrawSetup, last: tuple | None,
+                      constants: tuple[tuple[str, bytes], ...]) -> tuple[tuple[str, bytes], ...]:
+    """What a draw of ``setup`` writes of its material's ``constants`` when the program holds ``last``'s
+    (the constants tuple a draw wrote last; None: not known): the entries whose bytes differ, found once
+    per pair of tuples (walls of one program that differ only in colour write ``u_color`` alone)."""
+    if last is None:
+        written = setup.written
+        return tuple((name, data) for name, data in constants if written.get(name) != data)
+    key = (id(last), id(constants))
+    kept = setup.changes.get(key)
+    if kept is None or kept[0] is not last or kept[1] is not constants:  # (the entry holds both: ids stay theirs)
+        held = dict(last)
+        if len(setup.changes) >= _CHANGES_KEPT:
+            setup.changes.clear()
+        kept = setup.changes[key] = (last, constants, tuple((name, data) for name, data in constants
+                                                            if held.get(name) != data))
+    return kept[2]
 
 
 def _put(written: dict, uniforms: dict[str, moderngl.Uniform], name: str, data: bytes) -> None:
@@ -311,6 +351,7 @@ class Executor:
         self._culling: tuple[bool, str] | None = None  # what _set_culling set last (None: not known)
         self._bound_texture: object | None = None  # the material texture on unit 0 in this frame
         self._clear_depth = 1.0  # 0 with reverse-Z (glsandbox.gl.depth)
+        self._pass_rect: tuple[int, int, int, int] | None = None  # the pass's viewport in pixels (see render)
         self.shadow_maps = gl_shadowmap.ShadowMaps(self.ctx)  # the lights' depth textures
 
     # --- resources ----------------------------------------------------------
@@ -496,7 +537,8 @@ class Executor:
         framebuffer.use()
         self._culling = None  # not known: the first draw sets it
         ctx, raw = self.ctx, self.raw
-        gl_depth.begin_depth_mode(ctx, raw, scene)
+        if prepared.reverse_z:
+            gl_depth.begin_depth_mode(ctx, raw, scene)
         # The state groups of gl.passes.restore_state that a pass left changed. Every pass starts
         # from that state but for the groups it sets wholly itself before drawing (a stencil pass
         # its stencil, a blended pass its blending): only the others are put back before it runs,
@@ -510,7 +552,7 @@ class Executor:
                     if pending:
                         gl_passes.restore_state(ctx, raw, pending)
                         changed = changed & sets
-                camera = None
+                camera, self._pass_rect = None, rect
                 if viewport is not None:  # a frame pass through a viewport: its rectangle, depth test and camera
                     framebuffer.viewport = rect
                     self._set_depth(step.depth_test)
@@ -536,14 +578,18 @@ class Executor:
             # object left on unit 0 overrides the state of every texture later bound there,
             # and a mipmapped filter makes the gpu ray engine's data textures incomplete
             # (texelFetch then reads zeros) on a context the next user shares.
-            gl_depth.end_depth_mode(ctx, raw, scene)
-            self._unbind_texture()
-            self._set_depth(False)  # the depth test a pass switched on, also when it raised
+            if prepared.reverse_z:
+                gl_depth.end_depth_mode(ctx, raw, scene)
+            if self._bound_texture is not None:
+                self._unbind_texture()
+            ctx.disable(moderngl.DEPTH_TEST)  # the depth test a pass switched on, also when it raised
         if changed:
             gl_passes.restore_state(ctx, raw, changed)
-        self._set_culling(False, "ccw")
+        if self._culling != _NO_CULLING:
+            self._set_culling(False, "ccw")
         framebuffer.viewport = (0, 0, *size)
-        self._release_stale_meshes()
+        if len(self._meshes) > self.MESH_LIMIT:
+            self._release_stale_meshes()
         return frame_plan
 
     def _prepare_frame(self, scene: Scene, frame_plan: Plan, size: tuple[int, int]) -> _PreparedFrame:
@@ -566,15 +612,15 @@ class Executor:
             runner = PASS_RUNNERS.get(step.kind)
             if runner is None:
                 raise SandboxError(f"pass kind {step.kind!r} has no runner (gl.executor.PASS_RUNNERS)")
-            viewport = rect = None
+            viewport = None
+            rect = scene.viewports[step.viewport].pixels(*size) if 0 <= step.viewport < len(scene.viewports) else None
             if step.target == "frame" and step.camera == "viewport":
                 viewport = scene.viewports[step.viewport]
-                rect = viewport.pixels(*size)
             habits = _PASS_STATE.get(step.kind)
             sets, changes = habits(step) if habits is not None else (frozenset(), None)
             passes.append((runner, step, viewport, rect, sets, changes))
         prepared = _PreparedFrame(frame_plan, scene.viewports, size, scene.uniform_overrides, self._programs,
-                                  gl_depth.clear_depth_value(scene), tuple(passes))
+                                  gl_depth.clear_depth_value(scene), scene.depth_mode == "reverse_z", tuple(passes))
         if len(self._prepared_frames) >= 16:  # a live compare draws a few plans by turns; more: start again
             self._prepared_frames.clear()
         self._prepared_frames[id(frame_plan)] = prepared
@@ -600,7 +646,7 @@ class Executor:
 
     def _clear(self, frame: FrameState, step: Pass, camera: PassCamera | None) -> None:
         framebuffer = frame.framebuffer
-        rect = frame.scene.viewports[step.viewport].pixels(*frame.size)
+        rect = self._pass_rect or frame.scene.viewports[step.viewport].pixels(*frame.size)
         r, g, b, _ = step.clear_color or (0.0, 0.0, 0.0, 0.0)
         # Frames are opaque whatever the clear colour's alpha (glsandbox.gl.target).
         clear_opaque(framebuffer, (r, g, b), self._clear_depth, rect)
@@ -612,14 +658,17 @@ class Executor:
         differs from what the executor set last in this pass (GL keeps it; draws of one
         pass mostly share it). Only the executor changes culling within a pass."""
         state = (cull, front_face)
-        if state == self._culling:
+        known = self._culling
+        if state == known:
             return
-        if cull:
-            self.ctx.enable(moderngl.CULL_FACE)
-            self.ctx.cull_face = "back"
-        else:
-            self.ctx.disable(moderngl.CULL_FACE)
-        self.ctx.front_face = front_face
+        if known is None or known[0] != cull:
+            if cull:
+                self.ctx.enable(moderngl.CULL_FACE)
+                self.ctx.cull_face = "back"
+            else:
+                self.ctx.disable(moderngl.CULL_FACE)
+        if known is None or known[1] != front_face:
+            self.ctx.front_face = front_face
         self._culling = state
 
     def _set_depth(self, on: bool) -> None:
@@ -681,16 +730,19 @@ class Executor:
         # (a program keeps its uniform values between draws and frames): the matrices, then
         # (lit) the eye and the lights, then the material's constants.
         written, uniforms = setup.written, setup.uniforms
-        content = np.asarray(node.model if model is None else model, dtype=np.float64).tobytes()
-        data = _model_matrix_bytes(content)
+        matrix = np.asarray(node.model if model is None else model, dtype=np.float64)
+        content = matrix.tobytes()
+        data = _MODEL_BYTES.get(content) or _model_matrix_bytes(content, matrix)
         if written.get("m_model") != data:
             _put(written, uniforms, "m_model", data)
-        if camera.view_bytes != written.get("m_view"):
-            _put(written, uniforms, "m_view", camera.view_bytes)
-        if camera.proj_bytes != written.get("m_proj"):
-            _put(written, uniforms, "m_proj", camera.proj_bytes)
+        if written.get(_CAMERA) is not camera:  # (a pass's draws share its camera)
+            if camera.view_bytes != written.get("m_view"):
+                _put(written, uniforms, "m_view", camera.view_bytes)
+            if camera.proj_bytes != written.get("m_proj"):
+                _put(written, uniforms, "m_proj", camera.proj_bytes)
+            written[_CAMERA] = camera
         if setup.normal:
-            data = _normal_matrix_bytes(content)
+            data = _NORMAL_BYTES.get(content) or _normal_matrix_bytes(content, matrix)
             if written.get("m_normal") != data:
                 _put(written, uniforms, "m_normal", data)
         if step.lit:
@@ -699,16 +751,18 @@ class Executor:
                 _put(written, uniforms, "u_eye", data)
             frame_lights = self._lights if lights is None else lights
             if frame_lights:  # with none, the shader's arrays do not exist (NUM_LIGHTS 0)
-                light_pos, light_color = self._light_bytes(frame_lights)
+                cached = self._lights_cache
+                light_pos, light_color = cached[1:] if cached is not None and cached[0] is frame_lights else \
+                    self._light_bytes(frame_lights)
                 if written.get("u_light_pos") != light_pos:
                     _put(written, uniforms, "u_light_pos", light_pos)
                 if written.get("u_light_color") != light_color:
                     _put(written, uniforms, "u_light_color", light_color)
         constants = step.constants
-        if written.get(_CONSTANTS) is not constants:  # another material's were written since
-            for name, data in constants:
-                if written.get(name) != data:
-                    _put(written, uniforms, name, data)
+        last = written.get(_CONSTANTS)
+        if last is not constants:  # another material's were written since: only the bytes that differ
+            for name, data in _constants_change(setup, last, constants):
+                _put(written, uniforms, name, data)
             written[_CONSTANTS] = constants
         if own:
             program = setup.program
@@ -801,8 +855,10 @@ class Executor:
         :func:`~glsandbox.transforms.normal_matrix`), looked up by the matrix's content: a node
         that does not move converts its matrix once, not every frame, and an array changed in
         place between frames is converted again (no stale matrix)."""
-        content = np.asarray(model, dtype=np.float64).tobytes()
-        return _model_matrix_bytes(content), _normal_matrix_bytes(content) if normal else None
+        matrix = np.asarray(model, dtype=np.float64)
+        content = matrix.tobytes()
+        return (_MODEL_BYTES.get(content) or _model_matrix_bytes(content, matrix),
+                (_NORMAL_BYTES.get(content) or _normal_matrix_bytes(content, matrix)) if normal else None)
 
     def _uniform_writer(self, program_key: str, program: moderngl.Program,
                         members: Collection[str]) -> Callable[[str, bytes], None]:
@@ -941,6 +997,7 @@ class _PreparedFrame:
     overrides: Mapping[str, object]
     programs: dict
     clear_depth: float
+    reverse_z: bool  # the frame's depth mode is begun and ended (glsandbox.gl.depth)
     passes: tuple[tuple[PassRunner, Pass, object, tuple[int, int, int, int] | None, frozenset[str],
                         frozenset[str] | None], ...]
 
