@@ -253,6 +253,8 @@ _CONSTANTS = "#constants"
 #: The PassCamera whose view and projection a program holds (its ``written`` dict's key, like
 #: :data:`_CONSTANTS`): draws through the same camera skip comparing them.
 _CAMERA = "#camera"
+#: The PassCamera whose eye position a program holds (lit draws only write it).
+_EYE = "#eye"
 #: Constants' changes kept per set-up (see :func:`_constants_change`); past this many, it starts again.
 _CHANGES_KEPT = 256
 
@@ -746,9 +748,11 @@ class Executor:
             if written.get("m_normal") != data:
                 _put(written, uniforms, "m_normal", data)
         if step.lit:
-            data = camera.eye_bytes
-            if written.get("u_eye") != data:
-                _put(written, uniforms, "u_eye", data)
+            if written.get(_EYE) is not camera:
+                data = camera.eye_bytes
+                if written.get("u_eye") != data:
+                    _put(written, uniforms, "u_eye", data)
+                written[_EYE] = camera
             frame_lights = self._lights if lights is None else lights
             if frame_lights:  # with none, the shader's arrays do not exist (NUM_LIGHTS 0)
                 cached = self._lights_cache
