@@ -347,7 +347,8 @@ class Executor:
         self._overlays: OverlayDrawer | None = None  # made on the first overlay pass
         self._textures = TextureCache(host)
         self._lights: tuple[Light, ...] = ()  # the lights of the frame being drawn (draw_node's default)
-        self._lights_cache: tuple[tuple[Light, ...], bytes, bytes] | None = None
+        # u_light_pos and u_light_color bytes by id of the lights tuple (the tuple kept to check): see _light_bytes.
+        self._lights_cache: dict[int, tuple[tuple[Light, ...], bytes, bytes]] = {}
         # The uniform bytes last written into each program (by program key): see _uniform_writer.
         self._written: dict[str, dict[str, bytes]] = {}
         self._culling: tuple[bool, str] | None = None  # what _set_culling set last (None: not known)
@@ -755,7 +756,7 @@ class Executor:
                 written[_EYE] = camera
             frame_lights = self._lights if lights is None else lights
             if frame_lights:  # with none, the shader's arrays do not exist (NUM_LIGHTS 0)
-                cached = self._lights_cache
+                cached = self._lights_cache.get(id(frame_lights))
                 light_pos, light_color = cached[1:] if cached is not None and cached[0] is frame_lights else \
                     self._light_bytes(frame_lights)
                 if written.get("u_light_pos") != light_pos:
@@ -884,12 +885,16 @@ class Executor:
         return write
 
     def _light_bytes(self, lights: tuple[Light, ...]) -> tuple[bytes, bytes]:
-        """``u_light_pos`` and ``u_light_color`` bytes of ``lights``, made once per frame (and once
-        per pass that reflects them): every lit draw of the frame writes the same ones."""
-        cached = self._lights_cache
+        """``u_light_pos`` and ``u_light_color`` bytes of ``lights``, made once per lights tuple: every
+        lit draw of a frame writes the same ones, and lights that do not move (the scene's, and
+        the mirror's reflected ones) keep them from frame to frame."""
+        cached = self._lights_cache.get(id(lights))
         if cached is None or cached[0] is not lights:
-            cached = self._lights_cache = (lights, np.array([l.position for l in lights], dtype="f4").tobytes(),
-                                           np.array([l.color for l in lights], dtype="f4").tobytes())
+            if len(self._lights_cache) >= 8:  # lights that move make a tuple a frame
+                self._lights_cache.clear()
+            cached = self._lights_cache[id(lights)] = (
+                lights, np.array([l.position for l in lights], dtype="f4").tobytes(),
+                np.array([l.color for l in lights], dtype="f4").tobytes())
         return cached[1], cached[2]
 
     def _unbind_texture(self) -> None:
