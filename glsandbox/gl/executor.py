@@ -239,7 +239,7 @@ class _DrawSetup:
     normal: bool  # the program reads m_normal
     # The program's uniforms by name, and the bytes last written into each (the program's
     # entry of Executor._written): draw_node's loop writes only what changed.
-    uniforms: dict[str, moderngl.Uniform] = field(default_factory=dict)
+    uniforms: dict[str, moderngl.Uniform] = field(default_factory=dict)  # a _Uniforms
     written: dict[str, bytes] = field(default_factory=dict)
     # (id of the constants the program held, id of a draw's): (those, these, what the draw writes).
     changes: dict[tuple[int, int], tuple] = field(default_factory=dict)
@@ -278,13 +278,19 @@ def _constants_change(setup: _DrawSetup, last: tuple | None,
     return kept[2]
 
 
-def _put(written: dict, uniforms: dict[str, moderngl.Uniform], name: str, data: bytes) -> None:
-    """Write ``data`` into the program's uniform ``name`` (where the compiler kept it) and
-    remember it as the program's value."""
-    written[name] = data
-    uniform = uniforms.get(name)
-    if uniform is not None:  # a term the compiler removed has no uniform
-        uniform.write(data)
+class _NoUniform:
+    """What :class:`_Uniforms` gives for a name the program lacks (a term the compiler removed)."""
+
+    @staticmethod
+    def write(data: bytes) -> None:
+        pass
+
+
+class _Uniforms(dict):
+    """A program's uniforms by name; a name it lacks gives :class:`_NoUniform` (nothing written)."""
+
+    def __missing__(self, name: str) -> type[_NoUniform]:
+        return _NoUniform
 
 
 class _DrawStep:
@@ -689,11 +695,11 @@ class Executor:
             names = self._member_names[program_key] = frozenset(self._programs[program_key][1])
         return names
 
-    def _uniforms(self, program_key: str) -> dict[str, moderngl.Uniform]:
+    def _uniforms(self, program_key: str) -> _Uniforms:
         """A program's uniforms by name (its other members are attributes)."""
         program = self._programs[program_key][1]
-        return {name: member for name in self._members(program_key)
-                if isinstance(member := program[name], moderngl.Uniform)}
+        return _Uniforms({name: member for name in self._members(program_key)
+                          if isinstance(member := program[name], moderngl.Uniform)})
 
     def draw_node(self, node: Node, draw: Draw, camera: PassCamera, *, model: np.ndarray | None = None,
                   front_face: str = "ccw", lights: tuple[Light, ...] | None = None,
@@ -731,28 +737,34 @@ class Executor:
             self._set_culling(draw.cull_back_faces, front_face)
         # What this draw writes, each only where its bytes differ from the program's last
         # (a program keeps its uniform values between draws and frames): the matrices, then
-        # (lit) the eye and the lights, then the material's constants.
+        # (lit) the eye and the lights, then the material's constants. A uniform the compiler
+        # removed (a term switched off) is remembered as written and writes nothing (_Uniforms).
         written, uniforms = setup.written, setup.uniforms
         matrix = np.asarray(node.model if model is None else model, dtype=np.float64)
         content = matrix.tobytes()
         data = _MODEL_BYTES.get(content) or _model_matrix_bytes(content, matrix)
         if written.get("m_model") != data:
-            _put(written, uniforms, "m_model", data)
+            written["m_model"] = data
+            uniforms["m_model"].write(data)
         if written.get(_CAMERA) is not camera:  # (a pass's draws share its camera)
             if camera.view_bytes != written.get("m_view"):
-                _put(written, uniforms, "m_view", camera.view_bytes)
+                written["m_view"] = camera.view_bytes
+                uniforms["m_view"].write(camera.view_bytes)
             if camera.proj_bytes != written.get("m_proj"):
-                _put(written, uniforms, "m_proj", camera.proj_bytes)
+                written["m_proj"] = camera.proj_bytes
+                uniforms["m_proj"].write(camera.proj_bytes)
             written[_CAMERA] = camera
         if setup.normal:
             data = _NORMAL_BYTES.get(content) or _normal_matrix_bytes(content, matrix)
             if written.get("m_normal") != data:
-                _put(written, uniforms, "m_normal", data)
+                written["m_normal"] = data
+                uniforms["m_normal"].write(data)
         if step.lit:
             if written.get(_EYE) is not camera:
                 data = camera.eye_bytes
                 if written.get("u_eye") != data:
-                    _put(written, uniforms, "u_eye", data)
+                    written["u_eye"] = data
+                    uniforms["u_eye"].write(data)
                 written[_EYE] = camera
             frame_lights = self._lights if lights is None else lights
             if frame_lights:  # with none, the shader's arrays do not exist (NUM_LIGHTS 0)
@@ -760,14 +772,17 @@ class Executor:
                 light_pos, light_color = cached[1:] if cached is not None and cached[0] is frame_lights else \
                     self._light_bytes(frame_lights)
                 if written.get("u_light_pos") != light_pos:
-                    _put(written, uniforms, "u_light_pos", light_pos)
+                    written["u_light_pos"] = light_pos
+                    uniforms["u_light_pos"].write(light_pos)
                 if written.get("u_light_color") != light_color:
-                    _put(written, uniforms, "u_light_color", light_color)
+                    written["u_light_color"] = light_color
+                    uniforms["u_light_color"].write(light_color)
         constants = step.constants
         last = written.get(_CONSTANTS)
         if last is not constants:  # another material's were written since: only the bytes that differ
             for name, data in _constants_change(setup, last, constants):
-                _put(written, uniforms, name, data)
+                written[name] = data
+                uniforms[name].write(data)
             written[_CONSTANTS] = constants
         if own:
             program = setup.program
