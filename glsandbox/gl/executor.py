@@ -241,8 +241,6 @@ class _DrawSetup:
     # entry of Executor._written): draw_node's loop writes only what changed.
     uniforms: dict[str, moderngl.Uniform] = field(default_factory=dict)  # a _Uniforms
     written: dict[str, bytes] = field(default_factory=dict)
-    # (id of the constants the program held, id of a draw's): (those, these, what the draw writes).
-    changes: dict[tuple[int, int], tuple] = field(default_factory=dict)
 
 
 #: A key of a program's ``written`` dict that names no uniform: the constants tuple of the
@@ -255,27 +253,13 @@ _CONSTANTS = "#constants"
 _CAMERA = "#camera"
 #: The PassCamera whose eye position a program holds (lit draws only write it).
 _EYE = "#eye"
-#: Constants' changes kept per set-up (see :func:`_constants_change`); past this many, it starts again.
-_CHANGES_KEPT = 256
-
-
-def _constants_change(setup: _DrawSetup, last: tuple | None,
+def _constants_change(written: dict[str, bytes], last: tuple | None,
                       constants: tuple[tuple[str, bytes], ...]) -> tuple[tuple[str, bytes], ...]:
-    """What a draw of ``setup`` writes of its material's ``constants`` when the program holds ``last``'s
-    (the constants tuple a draw wrote last; None: not known): the entries whose bytes differ, found once
-    per pair of tuples (walls of one program that differ only in colour write ``u_color`` alone)."""
-    if last is None:
-        written = setup.written
-        return tuple((name, data) for name, data in constants if written.get(name) != data)
-    key = (id(last), id(constants))
-    kept = setup.changes.get(key)
-    if kept is None or kept[0] is not last or kept[1] is not constants:  # (the entry holds both: ids stay theirs)
-        held = dict(last)
-        if len(setup.changes) >= _CHANGES_KEPT:
-            setup.changes.clear()
-        kept = setup.changes[key] = (last, constants, tuple((name, data) for name, data in constants
-                                                            if held.get(name) != data))
-    return kept[2]
+    """What a draw writes of its material's ``constants`` into a program that holds ``last``'s (the
+    constants a draw wrote last; None: not known, so the program's ``written`` bytes are compared):
+    the entries whose bytes differ (walls of one program that differ only in colour: ``u_color``)."""
+    held = written if last is None else dict(last)
+    return tuple((name, data) for name, data in constants if held.get(name) != data)
 
 
 class _NoUniform:
@@ -301,7 +285,7 @@ class _DrawStep:
     writes only the model matrix and what moved; any other draw prepares a step anew."""
 
     __slots__ = ("draw", "material", "front_face", "mesh", "origin", "setup", "user", "culling", "lit",
-                 "constants")
+                 "constants", "changes")
 
     def __init__(self, draw: Draw, material: Material, front_face: str, mesh: Mesh, origin: Mesh | None,
                  setup: _DrawSetup, user: UserProgram | None, lit: bool,
@@ -311,6 +295,8 @@ class _DrawStep:
         self.origin = origin  # a moved mesh's origin: another moved copy of it keeps the step
         self.setup, self.user, self.lit, self.constants = setup, user, lit, constants
         self.culling = (draw.cull_back_faces, front_face)
+        # By id of the constants a program held before this draw: (those, the entries this draw writes).
+        self.changes: dict[int, tuple[tuple, tuple[tuple[str, bytes], ...]]] = {}
 
 
 class Executor:
@@ -780,7 +766,14 @@ class Executor:
         constants = step.constants
         last = written.get(_CONSTANTS)
         if last is not constants:  # another material's were written since: only the bytes that differ
-            for name, data in _constants_change(setup, last, constants):
+            change = step.changes.get(id(last))  # found once per material written before this one
+            if change is None or change[0] is not last:  # (the entry holds ``last``: its id stays its own)
+                if len(step.changes) >= 16:
+                    step.changes.clear()
+                change = (last, _constants_change(written, last, constants))
+                if last is not None:
+                    step.changes[id(last)] = change
+            for name, data in change[1]:
                 written[name] = data
                 uniforms[name].write(data)
             written[_CONSTANTS] = constants
