@@ -91,10 +91,26 @@ def reflected_lights(lights: tuple[Light, ...], reflection: np.ndarray) -> tuple
                  for l in lights)
 
 
-@functools.lru_cache(maxsize=16)
+#: The last lights reflected: (lights, mirror, their reflections), see :func:`_mirrored_lights`.
+_LAST_MIRRORED: list[tuple[tuple[Light, ...], Mirror, tuple[Light, ...]]] = []
+
+
 def _mirrored_lights(lights: tuple[Light, ...], mirror: Mirror) -> tuple[Light, ...]:
-    """:func:`reflected_lights` through ``mirror``, once per set of lights (Lights and Mirrors are
-    immutable and compare by value): lights that do not move are reflected once, not every frame."""
+    """:func:`reflected_lights` through ``mirror``, once per set of lights: lights that do not move
+    are reflected once, not every frame. The same objects as last time (a scene moved only by time
+    keeps its lights tuple and mirror) are found without hashing them; others by value (Lights and
+    Mirrors are immutable and compare by value)."""
+    if _LAST_MIRRORED:
+        last_lights, last_mirror, reflected = _LAST_MIRRORED[0]
+        if last_lights is lights and last_mirror is mirror:
+            return reflected
+    reflected = _mirrored_by_value(lights, mirror)
+    _LAST_MIRRORED[:] = [(lights, mirror, reflected)]
+    return reflected
+
+
+@functools.lru_cache(maxsize=16)
+def _mirrored_by_value(lights: tuple[Light, ...], mirror: Mirror) -> tuple[Light, ...]:
     return reflected_lights(lights, mirror.matrix())
 
 
