@@ -615,8 +615,7 @@ def _copy_with(obj: Any, **changes: Any) -> Any:
     """A frozen dataclass ``obj`` with ``changes``, without running its ``__post_init__`` again:
     the caller has checked the changed fields (the others were checked when ``obj`` was made)."""
     new = object.__new__(type(obj))
-    new.__dict__.update(obj.__dict__)
-    new.__dict__.update(changes)
+    new.__dict__.update({**obj.__dict__, **changes})
     return new
 
 
@@ -651,14 +650,14 @@ def moved_scene(scene: Scene, motion: Motion) -> Scene:
     bounded numbers); every other part is the same object as in ``scene``. The result
     remembers ``scene`` (:func:`scene_origin`): the renderers keep what they derived from
     it (the plan, per-draw uniform bytes) while only positions change."""
-    origin = scene_origin(scene) or scene
+    origin = scene.__dict__.get("_moved_from") or scene  # (scene_origin, inline: this runs every frame)
     nodes, lights, overlays = scene.nodes, scene.lights, scene.overlays
     models, positions = motion.models, motion.positions
     if models or positions:
         names = origin.__dict__.get("_node_names")  # the same in every scene moved from ``origin``
         if names is None:
             names = origin.__dict__["_node_names"] = frozenset(node.name for node in origin.nodes)
-        if not (models.keys() <= names and positions.keys() <= names):
+        if not names.issuperset(models) or (positions and not names.issuperset(positions)):
             unknown = (set(models) | set(positions)) - names
             raise SandboxError(f"scene {scene.name!r}: the motion moves {', '.join(map(repr, sorted(unknown)))}, "
                                f"which is not a node of the scene")
