@@ -36,6 +36,7 @@ saying how many rays were cut off, rather than return hits that may be wrong.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import moderngl
@@ -150,18 +151,36 @@ def _check_overflow(overflow: NDArray[np.bool_], max_steps: int) -> None:
 
 def _texture(ctx: moderngl.Context, rows: NDArray[np.float32], width: int) -> moderngl.Texture:
     """``(n, 4)`` float32 records as a ``width``-wide RGBA32F texture, texel i at
-    ``(i % width, i // width)``: the full rows and the last, partial one written
-    straight from ``rows`` (no padded copy: a 1M-triangle model's records are 144 MB;
-    the texels past the last record are never read)."""
-    rows = np.ascontiguousarray(rows, dtype=np.float32)
-    count = rows.shape[0]
+    ``(i % width, i // width)`` (:func:`texture_from_chunks` with one chunk)."""
+    return texture_from_chunks(ctx, (rows,), rows.shape[0], width)
+
+
+def texture_from_chunks(ctx: moderngl.Context, chunks: Iterable[NDArray[np.float32]], count: int,
+                        width: int) -> moderngl.Texture:
+    """``count`` float32 records (texels) arriving as ``(k, 4)`` chunks, in order, as a
+    ``width``-wide RGBA32F texture, texel i at ``(i % width, i // width)``. Each chunk's full
+    rows are written straight from it (no padded copy of the whole: a 1M-triangle model's
+    records are 144 MB, and the texture holds a copy), a partial row carried to the next
+    chunk; the texels past the last record are never read."""
     height = max(1, math.ceil(count / width))
     texture = ctx.texture((width, height), 4, dtype="f4")
-    full = count // width
-    if full:
-        texture.write(rows[: full * width], viewport=(0, 0, width, full))
-    if count > full * width:
-        texture.write(rows[full * width:], viewport=(0, full, count - full * width, 1))
+    row, written = 0, 0
+    carry = np.zeros((0, 4), dtype=np.float32)
+    for chunk in chunks:
+        chunk = np.ascontiguousarray(chunk, dtype=np.float32)
+        written += chunk.shape[0]
+        if carry.shape[0]:
+            chunk = np.concatenate([carry, chunk])
+        full = chunk.shape[0] // width
+        if full:
+            texture.write(chunk[: full * width], viewport=(0, row, width, full))
+            row += full
+        carry = chunk[full * width:]
+    if carry.shape[0]:
+        texture.write(carry, viewport=(0, row, carry.shape[0], 1))
+    if written != count:
+        texture.release()
+        raise ValueError(f"texture_from_chunks: {written} records given, {count} announced")
     texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
     return texture
 
