@@ -54,7 +54,9 @@ from glsandbox.scene import Camera
 
 __all__ = ["EXACT_INTEGERS", "LOOP_LIMIT", "MAX_STEPS", "RECORD_TEXELS", "TEX_WIDTH", "GpuBVH", "GpuHits", "pack_bvh"]
 
-#: Texels per row of the node and triangle textures (``BVH_TEX_WIDTH`` in the shader).
+#: Texels per row of the node and triangle textures (``BVH_TEX_WIDTH`` in the shader): a power of
+#: two (the shader takes a texel's row and column with a shift and a mask, and a node record's
+#: 4 texels stay in one row).
 TEX_WIDTH: int = 4096
 #: Node visits plus triangle tests one ray may use (``BVH_MAX_STEPS``).
 MAX_STEPS: int = 8192
