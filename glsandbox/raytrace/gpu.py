@@ -295,10 +295,12 @@ def world_anchor(world: World) -> NDArray[np.float64]:
 
 
 def pack_triangles(world: World, anchor: NDArray[np.float64] | None = None,
-                   rows: slice = slice(None)) -> NDArray[np.float32]:
+                   rows: slice = slice(None), ok: NDArray[np.bool_] | None = None) -> NDArray[np.float32]:
     """``TRI_RECORDS`` vec4 per triangle (layout in ``shaders/raytrace.glsl``), positions
     relative to ``anchor`` (see :func:`world_anchor`); ``rows``: only those triangles
-    (:func:`triangle_chunks` packs a large World a slice at a time)."""
+    (:func:`triangle_chunks` packs a large World a slice at a time); ``ok``: every
+    triangle's :func:`~glsandbox.raytrace.watertight.nondegenerate`, where it was taken
+    before the corners were moved (else it is taken here)."""
     anchor = np.zeros(3) if anchor is None else anchor
     v0w, v1w, v2w = world.v0[rows], world.v1[rows], world.v2[rows]
     m = v0w.shape[0]
@@ -307,7 +309,8 @@ def pack_triangles(world: World, anchor: NDArray[np.float64] | None = None,
     rec = np.zeros((m, TRI_RECORDS, 4), dtype=np.float32)
     # The corners themselves, not v0 and two edges: the watertight test needs a
     # corner shared by two triangles to be the same three floats in both.
-    ok = nondegenerate(v0w, v1w, v2w)  # the BVH's rule: a triangle without area is never hit
+    # The BVH's rule: a triangle without area is never hit.
+    ok = nondegenerate(v0w, v1w, v2w) if ok is None else ok[rows]
     v0 = v0w - anchor
     rec[:, TRI["v0"], :3] = v0
     rec[:, TRI["v1"], :3] = np.where(ok[:, None], v1w - anchor, v0)  # degenerate: one point, det = 0
@@ -326,13 +329,14 @@ def pack_triangles(world: World, anchor: NDArray[np.float64] | None = None,
 PACK_CHUNK = 1 << 16
 
 
-def triangle_chunks(world: World, anchor: NDArray[np.float64] | None = None) -> Iterator[NDArray[np.float32]]:
+def triangle_chunks(world: World, anchor: NDArray[np.float64] | None = None,
+                    ok: NDArray[np.bool_] | None = None) -> Iterator[NDArray[np.float32]]:
     """:func:`pack_triangles` of ``world`` in slices of :data:`PACK_CHUNK` triangles, in order:
     a large model is uploaded and digested without its whole records in memory at once
     (a 1M-triangle model's are 144 MB, and the texture holds a copy of them)."""
     m = world.triangle_count
     for start in range(0, m, PACK_CHUNK):
-        yield pack_triangles(world, anchor, slice(start, min(m, start + PACK_CHUNK)))
+        yield pack_triangles(world, anchor, slice(start, min(m, start + PACK_CHUNK)), ok)
 
 
 def node_order(world: World) -> list[int]:
@@ -485,9 +489,27 @@ class _Uploaded:
         #: What the records pack to (:meth:`same_data`), not the records themselves: a
         #: 1M-triangle model's are 144 MB, and the texture holds them already.
         digest = _RecordsDigest(tri_rows)
+        anchor, ok = self.anchor, None
+        if self.large_mesh:
+            # Every render of this scene traces its meshes through BVHs: build them first,
+            # and keep of the World (this upload's own) only what the renders read (its
+            # nodes, lights, textures): its per-triangle float64 arrays are 200 bytes a
+            # triangle, and the textures hold what the shader needs of them. The build
+            # moves the corners to the anchor in place (no copy of them beside the build's
+            # own arrays), so the triangle records are packed afterwards from the moved
+            # corners (anchor 0: x - 0 is x) with the degenerate rule taken before the
+            # move. In this order the BVH build's working arrays meet the World's shading
+            # arrays, not the triangle texture (which is larger).
+            world.tri_node = np.zeros(0, dtype=np.intp)
+            ok = np.concatenate([np.zeros(0, dtype=bool), *(
+                nondegenerate(world.v0[start:start + PACK_CHUNK], world.v1[start:start + PACK_CHUNK],
+                              world.v2[start:start + PACK_CHUNK]) for start in range(0, world.triangle_count, PACK_CHUNK))])
+            self.bvh_textures(ctx, own_corners=True)
+            _return_freed_memory()  # the build's freed arrays, before the triangle texture is allocated
+            anchor = np.zeros(3)
         if self.unrolled:
             tris = np.concatenate([np.zeros((0, 4), dtype=np.float32),
-                                   *digest.passing(triangle_chunks(world, self.anchor))])
+                                   *digest.passing(triangle_chunks(world, anchor))])
             self.block = ctx.buffer(np.concatenate([_at_least_one(nodes), _at_least_one(tris)]).tobytes())
             del tris
         else:
@@ -495,7 +517,7 @@ class _Uploaded:
 
             # Packed and written a chunk at a time (:func:`triangle_chunks`): the records
             # never exist whole on the host, only in the texture.
-            chunks = digest.passing(triangle_chunks(world, self.anchor))
+            chunks = digest.passing(triangle_chunks(world, anchor, ok))
             self.textures["u_tris"] = texture_from_chunks(ctx, chunks if tri_rows else (np.zeros((1, 4), np.float32),),
                                                           max(1, tri_rows), TEX_WIDTH)
             self.textures["u_nodes"] = texture_from_chunks(ctx, (_at_least_one(nodes),), max(1, nodes.shape[0]),
@@ -509,14 +531,7 @@ class _Uploaded:
             self.textures[f"u_tex{slot}"] = texture
         del nodes
         if self.large_mesh:
-            # Every render of this scene traces its meshes through BVHs: build them now,
-            # and keep of the World (this upload's own) only what the renders read (its
-            # nodes, lights, textures): its per-triangle float64 arrays are 336 bytes a
-            # triangle, and the textures hold what the shader needs of them. The shading
-            # arrays go before the BVH is built, the corners after (moved to the anchor
-            # in place for the build: they are not read again).
-            _drop_triangle_arrays(world, corners=False)
-            self.bvh_textures(ctx, own_corners=True)
+            del ok
             _drop_triangle_arrays(world, corners=True)
             _return_freed_memory()
 
