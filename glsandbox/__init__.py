@@ -27,7 +27,7 @@ The layers below (the README's "How it works" table) import downwards only;
 
 import importlib
 
-from glsandbox import camera, geometry, transforms
+from glsandbox import geometry, transforms
 from glsandbox.planar import Mirror, PlanarShadow
 from glsandbox.errors import SandboxError
 from glsandbox.version import __version__
@@ -62,8 +62,10 @@ __all__ = [
 
 
 # Names whose modules a plain ``glsandbox render`` does not need (model files, the model
-# generators, texture checks): imported on first use (PEP 562), so a cold start skips them.
+# generators, texture checks, the window's camera controls): imported on first use (PEP 562),
+# so a cold start skips them.
 _LAZY = {
+    "camera": ("glsandbox.camera", None),
     "meshgen": ("glsandbox.meshgen", None),
     "check_texture_source": ("glsandbox.images", "check_texture_source"),
     "Model": ("glsandbox.meshfile", "Model"),
