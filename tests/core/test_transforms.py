@@ -56,7 +56,8 @@ def test_look_at_and_perspective_are_pyrrs_matrices_bit_for_bit() -> None:
         import pyrr
 
     rng = np.random.default_rng(24)
-    cameras = [((0.0, 3.0, 10.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0)), ((0.0, 1.5, -5.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0))]
+    cameras = [((0.0, 3.0, 10.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0)),
+               ((0.0, 1.5, -5.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0))]
     cameras += [tuple(tuple(rng.normal(size=3) * scale) for scale in (50.0, 5.0, 1.0)) for _ in range(300)]
     for eye, target, up in cameras:
         ours = transforms.look_at(eye, target, up)
