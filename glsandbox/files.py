@@ -23,11 +23,13 @@ import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
-from typing import BinaryIO
+from typing import TYPE_CHECKING, BinaryIO
 
 import numpy as np
-import numpy.typing as npt
 from PIL import Image
+
+if TYPE_CHECKING:  # annotations only: numpy.typing is not imported at run time (a cold start, issue 24)
+    import numpy.typing as npt
 
 from glsandbox.errors import SandboxError
 
