@@ -50,7 +50,7 @@ def mitsuba_missing() -> str | None:
     except Exception as error:  # Dr.Jit raises RuntimeError/ImportError kinds that vary by version
         first = (str(error).strip().splitlines() or [type(error).__name__])[0]
         return (f"mitsuba's {VARIANT} cannot run: {first} (it needs libLLVM: Debian/Ubuntu "
-                "`apt-get install libllvm15`, or DRJIT_LIBLLVM_PATH=/path/to/libLLVM.so)")
+                "`apt-get install libllvm15`, or DRJIT_LIBLLVM_PATH)")
     return None
 
 
