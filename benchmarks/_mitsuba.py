@@ -97,7 +97,7 @@ class MitsubaCaster:
             keep = np.array([not world.nodes[k].lamp_of >> index & 1 for k in world.tri_node], dtype=bool)
             occluders = self.scene if keep.all() else _mesh_scene(mi, triangles[keep]) if keep.any() else None
             position = mi.Point3f(*(float(np.float32(c)) for c in light))
-            dr.make_opaque(position)
+            dr.make_opaque(position)  # a literal would make the second cast's kernel differ from the first's
             self.lights.append((position, occluders))
         self.max_depth = max_depth
         eye, dirs = camera_rays(scene.viewports[0].camera or scene.camera, *size)  # type: ignore[attr-defined]
@@ -120,6 +120,8 @@ class MitsubaCaster:
         rays = dr.zeros(mi.UInt32, count)
         for depth in range(self.max_depth + 1):
             rays += dr.select(active, 1, 0)
+            # Minimal: t, the hit point and the geometric normal (what Embree's side gets: tfar, Ng);
+            # coherent: the primary rays leave one eye in pixel order.
             si = self.scene.ray_intersect(mi.Ray3f(o, d), ray_flags=mi.RayFlags.Minimal, coherent=depth == 0,
                                           active=active)
             active &= si.is_valid()
