@@ -1,8 +1,8 @@
 """Mitsuba 3 (its ``llvm_ad_rgb`` variant) casting the rays the engines cast, for the model rows.
 
 Optional, like Embree: ``uv run --group bench --group mitsuba glsandbox bench``. Mitsuba's
-LLVM variants compile their kernels with Dr.Jit at run time and need ``libLLVM`` for that
-(Debian/Ubuntu: ``libllvm15``, already there where Mesa's llvmpipe runs; elsewhere Dr.Jit
+LLVM variants compile their kernels with Dr.Jit at run time and need ``libLLVM`` 15 or newer
+for that (Debian/Ubuntu: ``libllvm15``, which Debian 12's Mesa installs for llvmpipe; elsewhere Dr.Jit
 reads its path from ``DRJIT_LIBLLVM_PATH``). Without either, :func:`mitsuba_missing` says why.
 
 :class:`MitsubaCaster` casts exactly the rays :class:`raytrace.EmbreeCaster` casts (the same
@@ -49,8 +49,8 @@ def mitsuba_missing() -> str | None:
             return f"mitsuba's {VARIANT} computed a wrong sum"
     except Exception as error:  # Dr.Jit raises RuntimeError/ImportError kinds that vary by version
         first = (str(error).strip().splitlines() or [type(error).__name__])[0]
-        return (f"mitsuba's {VARIANT} cannot run: {first} (it needs libLLVM: Debian/Ubuntu "
-                "`apt-get install libllvm15`, or DRJIT_LIBLLVM_PATH)")
+        return (f"mitsuba's {VARIANT} cannot run: {first} (it needs libLLVM 15 or newer: Debian/"
+                "Ubuntu `apt-get install libllvm15`, or DRJIT_LIBLLVM_PATH)")
     return None
 
 
@@ -130,7 +130,8 @@ class MitsubaCaster:
             point = o + si.t * d  # as Embree's side computes it: origin + tfar·direction
             normal = si.n
             # The engines' simple offset (constants.SIMPLE_OFFSET·max(1, max|P_i|)) along ±n.
-            # (dr.select, not dr.maximum: libLLVM 14/15 cannot compile Dr.Jit's llvm.maximum on x86.)
+            # (dr.select, not dr.maximum: libLLVM 15 aborts the process on Dr.Jit's llvm.maximum on x86,
+            # "Cannot select fmaximum"; Mitsuba's own integrators hit the same with fminimum there.)
             largest = _larger(_larger(dr.abs(point.x), dr.abs(point.y)), dr.abs(point.z))
             scale = SIMPLE_OFFSET * _larger(largest, 1.0)
             lit = active & dr.gather(mi.Bool, self.lit, si.prim_index, active)
