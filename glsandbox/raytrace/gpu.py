@@ -506,9 +506,9 @@ class _Uploaded:
             # move. In this order the BVH build's working arrays meet the World's shading
             # arrays, not the triangle texture (which is larger).
             world.tri_node = np.zeros(0, dtype=np.intp)
-            ok = np.concatenate([np.zeros(0, dtype=bool), *(
-                nondegenerate(world.v0[start:start + PACK_CHUNK], world.v1[start:start + PACK_CHUNK],
-                              world.v2[start:start + PACK_CHUNK]) for start in range(0, world.triangle_count, PACK_CHUNK))])
+            slices = [slice(start, start + PACK_CHUNK) for start in range(0, world.triangle_count, PACK_CHUNK)]
+            ok = np.concatenate([np.zeros(0, dtype=bool),
+                                 *(nondegenerate(world.v0[at], world.v1[at], world.v2[at]) for at in slices)])
             self.bvh_textures(ctx, own_corners=True)
             _return_freed_memory()  # the build's freed arrays, before the triangle texture is allocated
             anchor = np.zeros(3)
@@ -550,7 +550,8 @@ class _Uploaded:
         if self.bvh_stack:
             return self.bvh_stack
         from glsandbox.raytrace.bvh import build_bvh
-        from glsandbox.raytrace.gpu_bvh import RECORD_TEXELS, TEX_WIDTH as BVH_TEX_WIDTH, _texture, pack_bvh, texture_from_chunks
+        from glsandbox.raytrace.gpu_bvh import RECORD_TEXELS, TEX_WIDTH as BVH_TEX_WIDTH, _texture, pack_bvh
+        from glsandbox.raytrace.gpu_bvh import texture_from_chunks
 
         world = self.world
         node_parts: list[NDArray[np.float32]] = []
@@ -676,7 +677,8 @@ class _Uploaded:
         return (len(world.textures) == len(self.world.textures)
                 and all(a is b or np.array_equal(a, b) for (a, _), (b, _) in zip(world.textures, self.world.textures))
                 and [w for _, w in world.textures] == [w for _, w in self.world.textures]
-                and _records_digest(world, self.anchor_of(world), pack_nodes(world, self.anchor_of(world))) == self.digest)
+                and _records_digest(world, self.anchor_of(world),
+                                    pack_nodes(world, self.anchor_of(world))) == self.digest)
 
     def anchor_of(self, world: World) -> NDArray[np.float64]:
         """Where ``world`` would be anchored in an upload like this one."""
