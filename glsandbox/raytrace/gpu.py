@@ -100,8 +100,9 @@ the nodes, lights and textures (the textures hold what the shader reads of
 the triangles): a 1M-triangle model's frame keeps about 170 MiB over the model
 (resident, measured), not 820. The upload builds the BVHs first, then packs the
 triangle records a chunk at a time straight into their texture (never whole on
-the host), and hands the freed heap back: its peak is the World (about 180 MiB
-for 1M triangles) plus the BVH build's own working arrays. Scenes whose mesh
+the host), and hands the freed heap back: its peak is what the build meets of
+the World (the corners and float32 normals, about 105 MiB for 1M triangles)
+plus the BVH build's own working arrays. Scenes whose mesh
 nodes all have at most :data:`BVH_TRIANGLES` triangles (the cubes, quads and
 floors of most lessons) keep the scan, which tests its triangles with the
 same watertight test (``shaders/common/watertight.glsl``; the triangle
@@ -506,6 +507,15 @@ class _Uploaded:
             # move. In this order the BVH build's working arrays meet the World's shading
             # arrays, not the triangle texture (which is larger).
             world.tri_node = np.zeros(0, dtype=np.intp)
+            # The shading arrays as the float32 their records hold (the same one rounding the
+            # packing does), so that the build meets half their bytes; a view (no vertex
+            # colours) stays one. Without a texture no uv is ever read (sample_texture):
+            # their records hold zeros.
+            world.normals = world.normals.astype(np.float32)
+            world.uvs = world.uvs.astype(np.float32) if world.textures else \
+                np.broadcast_to(np.zeros((1, 3, 2), dtype=np.float32), world.uvs.shape)
+            if world.colors.strides[0] != 0:
+                world.colors = world.colors.astype(np.float32)
             slices = [slice(start, start + PACK_CHUNK) for start in range(0, world.triangle_count, PACK_CHUNK)]
             ok = np.concatenate([np.zeros(0, dtype=bool),
                                  *(nondegenerate(world.v0[at], world.v1[at], world.v2[at]) for at in slices)])
