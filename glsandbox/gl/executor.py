@@ -257,6 +257,7 @@ _CONSTANTS = "#constants"
 #: The PassCamera whose view and projection a program holds (its ``written`` dict's key, like
 #: :data:`_CONSTANTS`): draws through the same camera skip comparing them.
 _CAMERA = "#camera"
+_FLOAT64 = np.dtype(np.float64)
 #: The PassCamera whose eye position a program holds (lit draws only write it).
 _EYE = "#eye"
 def _constants_change(written: dict[str, bytes], last: tuple | None,
@@ -291,7 +292,7 @@ class _DrawStep:
     writes only the model matrix and what moved; any other draw prepares a step anew."""
 
     __slots__ = ("draw", "material", "front_face", "mesh", "origin", "setup", "user", "culling", "lit",
-                 "constants", "changes")
+                 "constants", "change", "lights")
 
     def __init__(self, draw: Draw, material: Material, front_face: str, mesh: Mesh, origin: Mesh | None,
                  setup: _DrawSetup, user: UserProgram | None, lit: bool,
@@ -301,8 +302,11 @@ class _DrawStep:
         self.origin = origin  # a moved mesh's origin: another moved copy of it keeps the step
         self.setup, self.user, self.lit, self.constants = setup, user, lit, constants
         self.culling = (draw.cull_back_faces, front_face)
-        # By id of the constants a program held before this draw: (those, the entries this draw writes).
-        self.changes: dict[int, tuple[tuple, tuple[tuple[str, bytes], ...]]] = {}
+        # The constants a program held before this draw last time, and the entries it wrote then (a
+        # kept plan draws in the same order every frame: the same ones again).
+        self.change: tuple[tuple | None, tuple[tuple[str, bytes], ...]] = (None, ())
+        # The lights this draw was lit by last, and their uniform bytes.
+        self.lights: tuple[tuple[Light, ...] | None, bytes, bytes] = (None, b"", b"")
 
 
 class Executor:
@@ -732,7 +736,9 @@ class Executor:
         # (lit) the eye and the lights, then the material's constants. A uniform the compiler
         # removed (a term switched off) is remembered as written and writes nothing (_Uniforms).
         written, uniforms = setup.written, setup.uniforms
-        matrix = np.asarray(node.model if model is None else model, dtype=np.float64)
+        matrix = node.model if model is None else model
+        if type(matrix) is not np.ndarray or matrix.dtype != _FLOAT64:
+            matrix = np.asarray(matrix, dtype=np.float64)
         content = matrix.tobytes()
         data = _MODEL_BYTES.get(content) or _model_matrix_bytes(content, matrix)
         if written.get("m_model") != data:
@@ -760,9 +766,9 @@ class Executor:
                 written[_EYE] = camera
             frame_lights = self._lights if lights is None else lights
             if frame_lights:  # with none, the shader's arrays do not exist (NUM_LIGHTS 0)
-                cached = self._lights_cache.get(id(frame_lights))
-                light_pos, light_color = cached[1:] if cached is not None and cached[0] is frame_lights else \
-                    self._light_bytes(frame_lights)
+                if step.lights[0] is not frame_lights:  # (lights that do not move: the same tuple every frame)
+                    step.lights = (frame_lights, *self._light_bytes(frame_lights))
+                _, light_pos, light_color = step.lights
                 if written.get("u_light_pos") != light_pos:
                     written["u_light_pos"] = light_pos
                     uniforms["u_light_pos"].write(light_pos)
@@ -772,13 +778,10 @@ class Executor:
         constants = step.constants
         last = written.get(_CONSTANTS)
         if last is not constants:  # another material's were written since: only the bytes that differ
-            change = step.changes.get(id(last))  # found once per material written before this one
-            if change is None or change[0] is not last:  # (the entry holds ``last``: its id stays its own)
-                if len(step.changes) >= 16:
-                    step.changes.clear()
+            change = step.change
+            if change[0] is not last or last is None:
                 change = (last, _constants_change(written, last, constants))
-                if last is not None:
-                    step.changes[id(last)] = change
+                step.change = change
             for name, data in change[1]:
                 written[name] = data
                 uniforms[name].write(data)
