@@ -252,14 +252,15 @@ class _DrawSetup:
 #: A key of a program's ``written`` dict that names no uniform: the constants tuple of the
 #: prepared draw that wrote its material's uniforms last (see :meth:`Executor.draw_node`).
 _CONSTANTS = "#constants"
-
-
 #: The PassCamera whose view and projection a program holds (its ``written`` dict's key, like
 #: :data:`_CONSTANTS`): draws through the same camera skip comparing them.
 _CAMERA = "#camera"
-_FLOAT64 = np.dtype(np.float64)
 #: The PassCamera whose eye position a program holds (lit draws only write it).
 _EYE = "#eye"
+#: A model matrix of this dtype is converted and compared as it is.
+_FLOAT64 = np.dtype(np.float64)
+
+
 def _constants_change(written: dict[str, bytes], last: tuple | None,
                       constants: tuple[tuple[str, bytes], ...]) -> tuple[tuple[str, bytes], ...]:
     """What a draw writes of its material's ``constants`` into a program that holds ``last``'s (the
@@ -532,7 +533,7 @@ class Executor:
         prepared = self._prepared_frames.get(id(frame_plan))
         if (prepared is None or prepared.plan is not frame_plan or prepared.viewports is not scene.viewports
                 or prepared.size != size or prepared.overrides is not scene.uniform_overrides
-                or prepared.programs is not self._programs):
+                or prepared.depth_mode != scene.depth_mode or prepared.programs is not self._programs):
             prepared = self._prepare_frame(scene, frame_plan, size)
         self._frame += 1
         self._overrides = scene.uniform_overrides
@@ -625,7 +626,8 @@ class Executor:
             sets, changes = habits(step) if habits is not None else (frozenset(), None)
             passes.append((runner, step, viewport, rect, sets, changes))
         prepared = _PreparedFrame(frame_plan, scene.viewports, size, scene.uniform_overrides, self._programs,
-                                  gl_depth.clear_depth_value(scene), scene.depth_mode == "reverse_z", tuple(passes))
+                                  scene.depth_mode, gl_depth.clear_depth_value(scene), scene.depth_mode == "reverse_z",
+                                  tuple(passes))
         if len(self._prepared_frames) >= 16:  # a live compare draws a few plans by turns; more: start again
             self._prepared_frames.clear()
         self._prepared_frames[id(frame_plan)] = prepared
@@ -660,8 +662,9 @@ class Executor:
 
     def _set_culling(self, cull: bool, front_face: str) -> None:
         """Back-face culling on or off, with the winding rule of front faces, set only where it
-        differs from what the executor set last in this pass (GL keeps it; draws of one
-        pass mostly share it). Only the executor changes culling within a pass."""
+        differs from what the executor set last in this frame (GL keeps it; draws mostly share it),
+        each part (on or off, the front face) only where it differs. Only the executor changes
+        culling within a frame (the overlay pass switches it off; :meth:`render` notes that)."""
         state = (cull, front_face)
         known = self._culling
         if state == known:
@@ -1022,6 +1025,7 @@ class _PreparedFrame:
     size: tuple[int, int]
     overrides: Mapping[str, object]
     programs: dict
+    depth_mode: str
     clear_depth: float
     reverse_z: bool  # the frame's depth mode is begun and ended (glsandbox.gl.depth)
     passes: tuple[tuple[PassRunner, Pass, object, tuple[int, int, int, int] | None, frozenset[str],
