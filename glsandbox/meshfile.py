@@ -73,7 +73,7 @@ from glsandbox.errors import SandboxError
 from glsandbox.files import open_user_file
 from glsandbox.geometry import Mesh
 from glsandbox.meshcheck import MEMORY_ENV, check_memory, checked_data, claimed_triangles
-from glsandbox.meshlooks import Look, file_warnings, is_closed, look_of
+from glsandbox.meshlooks import Look, file_warnings, is_closed, look_of, warning_data
 from glsandbox.meshnormals import face_geometry, normal_groups, row_ids, split_vertices
 from glsandbox.scene import Material, Node, Texture
 
@@ -250,16 +250,18 @@ def load_model(path: str | os.PathLike[str], *, fit: bool = False, normals: str 
     claimed = claimed_triangles(data, file_type)
     if claimed is not None:
         check_memory(p, claimed)  # before the reader makes a single array
-    scene = _trimesh_scene(p, data, file_type)
-    if file_type not in ("gltf", "glb", "obj"):
-        data = b""  # only a glTF's JSON and an OBJ's lines are read again (for what is not drawn)
+    said = warning_data(data, file_type)  # only a glTF's JSON and an OBJ's mtllib lines are read again
+    source = _Source(data, file_type)
+    del data  # the reader holds the file's only copy: an OBJ's text is dropped as trimesh copies it
+    scene = _trimesh_scene(p, source, file_type)
+    del source
     parts = _parts(p, scene)
     del scene
     gc.collect()  # trimesh's objects hold reference cycles: its copies of the data go now, not later
     triangles = sum(part.faces.shape[0] for part in parts)
     check_memory(p, triangles)  # the count itself, for a glTF whose count no header gives
     try:
-        model = _model(p, file_type, parts, bool(fit), normals, float(crease_angle), data)
+        model = _model(p, file_type, parts, bool(fit), normals, float(crease_angle), said)
     except MemoryError:
         raise SandboxError(f"model file {p}: out of memory making {triangles:,} triangles drawable (set "
                            f"{MEMORY_ENV} below the memory this machine has, so a model too big is refused "
@@ -331,8 +333,26 @@ def _reason(exc: BaseException) -> str:
     return text if len(text) <= 160 else text[:157] + "..."
 
 
-def _trimesh_scene(p: Path, data: bytes, file_type: str) -> Any:
-    """The file as a ``trimesh.Scene`` (every format becomes one), read from ``data``."""
+class _Source:
+    """The file's bytes as trimesh reads them: a binary file from memory; an OBJ as its text,
+    decoded here (:func:`glsandbox.meshcheck.checked_data` made it UTF-8, as trimesh would decode
+    it) and handed over at trimesh's one ``read()``: trimesh copies the text as it cleans it up,
+    and no copy of it is kept here (an OBJ's text is the reader's largest array)."""
+
+    def __init__(self, data: bytes, file_type: str) -> None:
+        self.text: str | None = data.decode("utf-8") if file_type == "obj" else None
+        self.stream = None if self.text is not None else io.BytesIO(data)
+
+    def reader(self) -> Any:
+        return self if self.text is not None else self.stream
+
+    def read(self, size: int = -1) -> str:  # trimesh's OBJ reader reads the whole text once
+        text, self.text = self.text or "", None
+        return text
+
+
+def _trimesh_scene(p: Path, source: _Source, file_type: str) -> Any:
+    """The file as a ``trimesh.Scene`` (every format becomes one), read from ``source``."""
     with _quiet():
         import trimesh  # only a model load pays for the import
         from trimesh.resolvers import FilePathResolver
@@ -352,8 +372,8 @@ def _trimesh_scene(p: Path, data: bytes, file_type: str) -> Any:
             resolver.file_path = _printable(resolver.file_path)
             loader = getattr(trimesh, "load_scene", None)
             if loader is not None:
-                return loader(io.BytesIO(data), file_type=file_type, resolver=resolver, process=False)
-            return trimesh.load(io.BytesIO(data), file_type=file_type, resolver=resolver, process=False,
+                return loader(source.reader(), file_type=file_type, resolver=resolver, process=False)
+            return trimesh.load(source.reader(), file_type=file_type, resolver=resolver, process=False,
                                 force="scene")
         except SandboxError:
             raise

@@ -67,7 +67,7 @@ PAIR_LIMIT = 64
 
 #: Faces worked on at once where a step needs several temporary arrays per face (bounds the
 #: memory a big model needs: a few megabytes per array, not one per triangle of the model).
-BLOCK_FACES = 1 << 16
+BLOCK_FACES = 1 << 13
 
 #: Pairs tested at once by the pairwise tier (bounds its temporary arrays).
 _PAIR_BLOCK = 1 << 21
