@@ -187,7 +187,12 @@ def row_ids(rows: NDArray[np.float64], ordered: bool = True) -> tuple[NDArray[np
         first[inverse] = np.arange(n)  # any row of each id: they are all the same, or a collision shows
     inverse = inverse.reshape(-1)
     del h
-    if not np.array_equal(bits[first[inverse]], bits):  # a collision: sort the rows themselves
+    # Every row against its id's representative: only the rows that are not their own (a row
+    # given once is its own), gathered with take (faster than fancy indexing).
+    others = first.take(inverse)
+    moved = np.flatnonzero(others != np.arange(n))
+    others = others.take(moved)
+    if not np.array_equal(bits.take(others, axis=0), bits.take(moved, axis=0)):  # a collision: sort the rows themselves
         _, first, inverse = np.unique(bits, axis=0, return_index=True, return_inverse=True)
         inverse = inverse.reshape(-1)
     return _by_first_appearance(first, inverse) if ordered else (inverse, first)
