@@ -72,7 +72,7 @@ from numpy.typing import NDArray
 from glsandbox.errors import SandboxError
 from glsandbox.files import open_user_file
 from glsandbox.geometry import Mesh
-from glsandbox.meshcheck import MEMORY_ENV, check_memory, checked_data, claimed_triangles
+from glsandbox.meshcheck import MEMORY_ENV, check_memory, checked_data, claimed_triangles, needed_bytes
 from glsandbox.meshlooks import Look, file_warnings, is_closed, look_of, warning_data
 from glsandbox.meshnormals import face_geometry, normal_groups, row_ids, split_vertices
 from glsandbox.scene import Material, Node, Texture
@@ -249,7 +249,7 @@ def load_model(path: str | os.PathLike[str], *, fit: bool = False, normals: str 
     data = checked_data(p, data, file_type)
     claimed = claimed_triangles(data, file_type)
     if claimed is not None:
-        check_memory(p, claimed)  # before the reader makes a single array
+        check_memory(p, claimed, needed_bytes(claimed, file_type, data))  # before the reader makes an array
     said = warning_data(data, file_type)  # only a glTF's JSON and an OBJ's mtllib lines are read again
     source = _Source(data, file_type)
     del data  # the reader holds the file's only copy: an OBJ's text is dropped as trimesh copies it

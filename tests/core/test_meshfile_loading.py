@@ -17,7 +17,8 @@ import trimesh
 
 from glsandbox import meshgen
 from glsandbox.errors import SandboxError
-from glsandbox.meshcheck import BYTES_PER_TRIANGLE, MEMORY_ENV
+from glsandbox.meshcheck import (BYTES_PER_TRIANGLE, MEMORY_ENV, OBJ_BYTES_PER_FILE_BYTE, OBJ_BYTES_PER_LINE,
+                                 needed_bytes)
 from glsandbox.meshfile import load_model
 from glsandbox.meshnormals import corner_normals, face_normals
 from support import assert_user_error, run_cli
@@ -173,6 +174,50 @@ def test_a_model_bigger_than_the_memory_limit_is_refused_before_loading(tmp_path
     assert f"{MEMORY_ENV}=" in text and str(path) in text
     monkeypatch.setenv(MEMORY_ENV, "1G")  # raised: it loads
     assert load_model(path).triangles == 10_000
+
+
+def test_an_obj_is_refused_by_what_its_text_needs(tmp_path: Path, monkeypatch) -> None:
+    # 10,000 triangles need 2.56 MB by their count; trimesh's parse of the 360 kB text of one triangle
+    # repeated (vertices too), 40,000 short lines, needs more: that is the figure checked and given.
+    path = write_repeated(tmp_path / "repeated.obj", 10_000)
+    data = path.read_bytes()
+    need = needed_bytes(10_000, "obj", data)
+    assert need == len(data) * OBJ_BYTES_PER_FILE_BYTE + (data.count(b"\n") + 1) * OBJ_BYTES_PER_LINE
+    assert need > 10_000 * BYTES_PER_TRIANGLE
+    monkeypatch.setenv(MEMORY_ENV, str((need + 10_000 * BYTES_PER_TRIANGLE) // 2))
+    with pytest.raises(SandboxError) as caught:
+        load_model(path)
+    text = str(caught.value)
+    assert "\n" not in text and "10,000 triangles" in text and f"{need / 1e6:.1f} MB" in text
+    monkeypatch.setenv(MEMORY_ENV, str(need))  # just enough: it loads
+    assert load_model(path).triangles == 10_000
+
+
+@pytest.mark.parametrize("kind", ["repeated", "normals"])
+def test_the_obj_memory_estimate_covers_what_trimesh_parses(tmp_path: Path, kind: str) -> None:
+    # The estimate of an OBJ's need (by its bytes and lines) against the traced peak of loading it:
+    # the text's parse is trimesh's, so a reader that grew would show here.
+    import tracemalloc
+
+    if kind == "repeated":
+        path, triangles = write_repeated(tmp_path / "repeated.obj", 20_000), 20_000
+    else:
+        sphere = trimesh.creation.icosphere(5)
+        normals = sphere.vertices / np.linalg.norm(sphere.vertices, axis=1, keepdims=True)
+        lines = [f"v {x:.6f} {y:.6f} {z:.6f}" for x, y, z in sphere.vertices]
+        lines += [f"vn {x:.6f} {y:.6f} {z:.6f}" for x, y, z in normals]
+        lines += [f"f {a}//{a} {b}//{b} {c}//{c}" for a, b, c in sphere.faces + 1]
+        path, triangles = tmp_path / "sphere.obj", len(sphere.faces)
+        path.write_text("\n".join(lines) + "\n")
+    load_model(path, crease_angle=31.0)  # the reader's imports, once
+    tracemalloc.start()
+    try:
+        assert load_model(path).triangles == triangles
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    need = needed_bytes(triangles, "obj", path.read_bytes())
+    assert peak <= need, f"{peak / triangles:.0f} bytes per triangle at the peak, {need / triangles:.0f} estimated"
 
 
 def test_the_memory_refusal_is_one_error_line_and_exit_2(tmp_path: Path) -> None:
