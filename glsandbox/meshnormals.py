@@ -131,8 +131,9 @@ def face_geometry(positions: NDArray[np.float64], tris: NDArray[np.intp], with_a
         area_sq = np.einsum("ij,ij->i", cross, cross)
         size = np.sqrt(area_sq)
         unit = faces[lo:lo + BLOCK_FACES]
-        unit[:] = 0.0  # a zero row stays zero
-        np.divide(cross, size[:, None], out=unit, where=size[:, None] > 0.0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            np.divide(cross, size[:, None], out=unit)
+        unit[size == 0.0] = 0.0  # a zero row stays zero (0/0 above)
         if flat is not None:
             longest = np.einsum("ij,ij->i", e01, e01)
             for e in (e12, e02):
@@ -283,7 +284,7 @@ def normal_groups(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: 
         ids, firsts = row_ids(faces, ordered=False)  # coplanar faces' corners at one position: one vertex
         return np.repeat(ids, 3), faces[firsts]
     pid = row_ids(positions, ordered=False)[0] if position_ids is None else position_ids
-    corner_pid = pid[tris.reshape(-1)]  # the welded position of each corner
+    corner_pid = pid.take(tris.reshape(-1))  # the welded position of each corner
     del pid
     npos = int(corner_pid.max()) + 1
     if mode == "smooth":
