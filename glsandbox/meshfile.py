@@ -43,8 +43,10 @@ needs more memory than ``GLSANDBOX_MODEL_MEMORY`` allows
 (:mod:`glsandbox.meshcheck`). Time and memory are linear in the triangles:
 normals and vertices are made by :mod:`glsandbox.meshnormals` (integer ids,
 no per-position square work), a glTF's nodes placed once each, the per-face
-steps done in blocks (about 155-190 bytes per triangle of numpy's arrays at the peak for a binary
-file; an OBJ's text costs trimesh's reader about 600 more). Loads are cached by (resolved path, modification
+steps done in blocks (about 155-190 bytes per triangle of numpy's arrays at the peak, from the parsed
+file to the first frame). An OBJ's text is trimesh's largest cost: its parse peaks at about 8 bytes
+per byte of the file (572 per triangle for the bunny with normals), so the text is handed to trimesh
+and no copy of it is kept here. Loads are cached by (resolved path, modification
 time, size, options): loading a file again returns the same :class:`Model`
 (and the same Mesh object, whose GPU buffers the executor keeps), until the
 file changes. trimesh's log messages and warnings are kept off stderr.
