@@ -51,9 +51,12 @@ integers, so no corner-sized float matrix is ever hashed.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import NDArray
+
+if TYPE_CHECKING:  # annotations only: numpy.typing is not imported at run time (a cold start, issue 24)
+    from numpy.typing import NDArray
 
 __all__ = ["BLOCK_FACES", "MODES", "PAIR_LIMIT", "corner_normals", "face_geometry", "face_normals", "normal_groups", "row_ids", "split_vertices",
            "unique_vertices"]

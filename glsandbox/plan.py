@@ -17,7 +17,6 @@ from typing import Any, Callable
 
 import numpy as np
 
-from glsandbox.planar import shadow_casters
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh
 from glsandbox.overlay import Overlay
@@ -444,6 +443,8 @@ def motion_decisions(scene: Scene) -> tuple:
     if shadow is not None:
         nodes = {node.name: node for node in scene.nodes}
         models = {name: (nodes[name].model, nodes[name].mesh.positions) for name in shadow.casters if name in nodes}
+        from glsandbox.planar import shadow_casters  # loaded already: the scene holds a PlanarShadow
+
         decisions.append(shadow_casters(shadow, models))
     return tuple(decisions)
 
@@ -833,6 +834,8 @@ def planar_passes(scene: Scene, index: int, programs: set[ProgramVariant]) -> li
     shadow = scene.planar_shadow
     if shadow is not None and shadow.receiver in nodes and nodes[shadow.receiver].shown_in(index):
         models = {name: (nodes[name].model, nodes[name].mesh.positions) for name in shadow.casters if name in nodes}
+        from glsandbox.planar import shadow_casters  # loaded already: the scene holds a PlanarShadow
+
         casting = shadow_casters(shadow, models)
         how = [f"lift {shadow.lift:g}"]
         if shadow.polygon_offset:

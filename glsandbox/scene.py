@@ -15,15 +15,17 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from glsandbox import transforms
-from glsandbox.planar import Mirror, PlanarShadow
 from glsandbox.errors import NUMBER_LIMIT, SandboxError, check_number, check_numbers, plain
 from glsandbox.geometry import Mesh
 from glsandbox.overlay import Overlay
+
+if TYPE_CHECKING:  # imported where a scene has a planar effect: a plain render skips it (a cold start, issue 24)
+    from glsandbox.planar import Mirror, PlanarShadow
 
 Color = tuple[float, float, float, float]
 
@@ -574,7 +576,12 @@ class Scene:
                 if not isinstance(item, kind):
                     raise SandboxError(f"scene {self.name!r}: {field_name}[{i}] must be a {kind.__name__}, "
                                        f"got {plain(item)}")
-        for field_name, kind in (("camera", Camera), ("mirror", Mirror), ("planar_shadow", PlanarShadow)):
+        checks: tuple[tuple[str, type], ...] = (("camera", Camera),)
+        if self.mirror is not None or self.planar_shadow is not None:
+            from glsandbox.planar import Mirror, PlanarShadow
+
+            checks += (("mirror", Mirror), ("planar_shadow", PlanarShadow))
+        for field_name, kind in checks:
             value = getattr(self, field_name)
             if not isinstance(value, kind) and (value is not None or field_name == "camera"):
                 raise SandboxError(f"scene {self.name!r}: {field_name} must be a {kind.__name__}, got {plain(value)}")

@@ -8,7 +8,6 @@ says and nothing more; choosing passes is :func:`glsandbox.plan.plan`'s job.
 from __future__ import annotations
 
 import functools
-import hashlib
 import struct
 import weakref
 from collections.abc import Callable, Collection, Mapping
@@ -30,6 +29,11 @@ from glsandbox.gl.textures import TextureCache
 from glsandbox.gl.passes import FrameState, PassRunner
 from glsandbox.plan import SHADOW_MAP_UNIT, Draw, Pass, Plan, ProgramVariant, plan as make_plan
 from glsandbox.scene import Light, Material, Node, Scene, mesh_origin
+
+try:  # hashlib.blake2b is this very type; importing hashlib loads OpenSSL too (~4 ms of every start, issue 24)
+    from _blake2 import blake2b
+except ImportError:  # a Python built without its own BLAKE2
+    from hashlib import blake2b
 
 _MODES = {"triangles": moderngl.TRIANGLES, "triangle_strip": moderngl.TRIANGLE_STRIP,
           "lines": moderngl.LINES, "line_strip": moderngl.LINE_STRIP}
@@ -57,7 +61,7 @@ def _mesh_key(mesh: Mesh, arrays: dict[str, np.ndarray] | None = None) -> tuple[
     object."""
     key = _MESH_KEYS.get(mesh)
     if key is None:
-        digest = hashlib.blake2b(digest_size=12)
+        digest = blake2b(digest_size=12)
         for name, array in (arrays if arrays is not None else _gpu_arrays(mesh)).items():
             digest.update(name.encode())
             digest.update(array)  # the array's memory as it is: no copy
@@ -206,6 +210,8 @@ def user_uniform_value(user: UserProgram, uniform: moderngl.Uniform, name: str, 
 
 @dataclass
 class _GpuMesh:
+    """A mesh's GPU buffers (shared by meshes that upload the same bytes), draw mode and element count."""
+
     buffers: dict[str, moderngl.Buffer]
     index: moderngl.Buffer | None
     mode: int

@@ -18,7 +18,7 @@ masks, so one 8-bit buffer serves both without a clear in between.
 from __future__ import annotations
 
 import functools
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 import moderngl
 import numpy as np
@@ -27,8 +27,10 @@ from glsandbox import transforms
 from glsandbox.gl import rawgl
 from glsandbox.gl.passes import FrameState
 from glsandbox.plan import CUTOUT_SHADOW_PROGRAM, Draw, Pass, StencilState, cutout_caster_material
-from glsandbox.planar import Mirror
 from glsandbox.scene import Light, Material, Node
+
+if TYPE_CHECKING:
+    from glsandbox.planar import Mirror
 
 
 class NodeDrawer(Protocol):
