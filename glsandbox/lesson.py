@@ -290,8 +290,14 @@ class Lesson:
         return moved_scene(scene, motion)
 
     def _still_key(self) -> tuple | None:
-        """Every value but ``time``, with its type (1, 1.0 and True stay apart), or None when one cannot be hashed."""
-        key = tuple([(name, type(value), value) for name, value in sorted(self.values.items()) if name != "time"])
+        """Every value but ``time``, with its type (1, 1.0 and True stay apart), or None when one cannot be hashed.
+
+        In the values' own order, unsorted (C calls only: this runs every frame): a lesson's values
+        keep the order its parameters gave them (:meth:`at` and the window's keys keep it), and
+        the same values in another order only build the scene once more."""
+        rest = {**self.values}
+        rest.pop("time", None)
+        key = (tuple(rest.items()), tuple(map(type, rest.values())))
         try:
             hash(key)
         except TypeError:

@@ -405,6 +405,23 @@ def check_node_model(name: str, model: object) -> np.ndarray:
     return matrix
 
 
+def check_moved_model(name: str, model: object, lit: bool) -> None:
+    """:func:`check_node_model` and, for a ``lit`` node, :func:`check_lit_model` of a moved node's
+    model (:func:`moved_scene`, every frame): a float 4x4 is read into Python floats once for
+    both; anything else, or a matrix failing either, gets their own checks and messages."""
+    matrix = np.asarray(model)
+    if matrix.shape == (4, 4) and matrix.dtype.kind == "f":
+        entries = matrix.ravel().tolist()
+        total = sum(entries)  # NaN or infinite where an entry is
+        if (total - total == 0.0 and -NUMBER_LIMIT <= min(entries) and max(entries) <= NUMBER_LIMIT
+                and (not lit or transforms.least_scale_bound(*entries[0:3], *entries[4:7], *entries[8:11])
+                     >= MIN_SCALE)):
+            return
+    matrix = check_node_model(name, model)
+    if lit:
+        check_lit_model(name, matrix)
+
+
 def check_lit_model(name: str, model: object) -> None:
     """A lit node's model must keep every direction at least :data:`MIN_SCALE` long: its normal
     matrix (the inverse transpose) then exists and stays within +-NUMBER_LIMIT."""
@@ -661,28 +678,42 @@ def moved_scene(scene: Scene, motion: Motion) -> Scene:
     nodes, lights, overlays = scene.nodes, scene.lights, scene.overlays
     models, positions = motion.models, motion.positions
     if models or positions:
-        names = origin.__dict__.get("_node_names")  # the same in every scene moved from ``origin``
-        if names is None:
-            names = origin.__dict__["_node_names"] = frozenset(node.name for node in origin.nodes)
-        if not names.issuperset(models) or (positions and not names.issuperset(positions)):
-            unknown = (set(models) | set(positions)) - names
+        # Where each name's nodes are (the same in every scene moved from ``origin``: a moved
+        # scene's nodes are its origin's, some replaced by moved copies, in the same order).
+        where = origin.__dict__.get("_node_indices")
+        if where is None:
+            where = {}
+            for i, node in enumerate(origin.nodes):
+                where[node.name] = (*where.get(node.name, ()), i)
+            origin.__dict__["_node_indices"] = where
+        if not where.keys() >= models.keys() or (positions and not where.keys() >= positions.keys()):
+            unknown = (set(models) | set(positions)) - where.keys()
             raise SandboxError(f"scene {scene.name!r}: the motion moves {', '.join(map(repr, sorted(unknown)))}, "
                                f"which is not a node of the scene")
-        moved = []
-        for node in nodes:
+        # Only the moved nodes are visited (in scene order: the first bad one is named), not every node.
+        touched: list[int] = []
+        for name in models:
+            touched += where[name]
+        for name in positions:
+            if name not in models:
+                touched += where[name]
+        touched.sort()
+        moved = list(nodes)
+        for i in touched:
+            node = nodes[i]
             model, points = models.get(node.name), positions.get(node.name)
-            if model is None and points is None:
-                moved.append(node)
+            if points is None:  # (the common case: a node turning)
+                if model is None:  # (a name given None: nothing moves)
+                    continue
+                check_moved_model(node.name, model, node.material.lit)
+                moved[i] = _copy_with(node, model=model)
                 continue
             changes: dict[str, Any] = {}
             if model is not None:
-                matrix = check_node_model(node.name, model)
-                if node.material.lit:
-                    check_lit_model(node.name, matrix)
+                check_moved_model(node.name, model, node.material.lit)
                 changes["model"] = model
-            if points is not None:
-                changes["mesh"] = moved_mesh(node.mesh, points)
-            moved.append(_copy_with(node, **changes))
+            changes["mesh"] = moved_mesh(node.mesh, points)
+            moved[i] = _copy_with(node, **changes)
         nodes = tuple(moved)
     if motion.overlays:
         images = dict(motion.overlays)

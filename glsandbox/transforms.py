@@ -83,7 +83,8 @@ def translate(x: float, y: float, z: float) -> Matrix:
 
 def scale(x: float, y: float, z: float) -> Matrix:
     """Non-uniform scale along the axes."""
-    return np.diag([float(x), float(y), float(z), 1.0])
+    # One np.array call (np.diag is Python around several numpy calls; lessons scale every frame).
+    return np.array([[float(x), 0, 0, 0], [0, float(y), 0, 0], [0, 0, float(z), 0], [0, 0, 0, 1]], dtype=np.float64)
 
 
 def rotate_x(angle: float) -> Matrix:
@@ -178,12 +179,19 @@ def scales_at_least(model: Matrix, bound: float) -> bool:
     ordinary model matrix) no singular value decomposition is needed."""
     # Nine Python floats: cheaper than numpy's det and einsum on a 3x3 (lessons move nodes
     # every frame, and each moved lit node is checked).
-    (a, b, c), (d, e, f), (g, h, i) = np.asarray(model, dtype=np.float64)[:3, :3].tolist()
-    frobenius2 = a * a + b * b + c * c + d * d + e * e + f * f + g * g + h * h + i * i
-    determinant = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
-    if frobenius2 > 0.0 and 2.0 * abs(determinant) / frobenius2 >= bound:
+    if least_scale_bound(*np.asarray(model, dtype=np.float64)[:3, :3].ravel().tolist()) >= bound:
         return True
     return smallest_scale(model) >= bound
+
+
+def least_scale_bound(a: float, b: float, c: float, d: float, e: float, f: float, g: float, h: float,
+                      i: float) -> float:
+    """2 |det A| / |A|²_F for the 3x3 block A = ((a, b, c), (d, e, f), (g, h, i)) given row by row:
+    a lower bound of its smallest singular value (see :func:`scales_at_least`; 0 for a zero block)."""
+    frobenius2 = a * a + b * b + c * c + d * d + e * e + f * f + g * g + h * h + i * i
+    if not frobenius2 > 0.0:
+        return 0.0
+    return 2.0 * abs(a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)) / frobenius2
 
 
 def transform_points(m: Matrix, points: np.ndarray) -> np.ndarray:

@@ -142,29 +142,40 @@ def _eye_bytes(view: bytes) -> bytes:
     return eye_position(np.frombuffer(view).reshape(4, 4)).astype("f4").tobytes()
 
 
-#: ``m_model``'s and ``m_normal``'s uniform bytes by the float64 model matrix's bytes (see
-#: :meth:`Executor.draw_node`): a node that does not move converts its matrix, and inverts it,
-#: once; an array changed in place between frames has other bytes, so it is converted again.
-_MODEL_BYTES: dict[bytes, bytes] = {}
-_NORMAL_BYTES: dict[bytes, bytes] = {}
-#: Entries each of those keeps; past it, it starts again (a moving node adds one per frame).
+#: Entries each of :data:`_MODEL_BYTES` and :data:`_NORMAL_BYTES` keeps; past it, it starts
+#: again (a moving node adds one per frame).
 _MATRICES_KEPT = 1024
 
 
-def _model_matrix_bytes(content: bytes, matrix: np.ndarray) -> bytes:
-    """``m_model``'s uniform bytes (float32, column-major) of ``matrix`` (float64, whose bytes are ``content``)."""
-    if len(_MODEL_BYTES) >= _MATRICES_KEPT:
-        _MODEL_BYTES.clear()
-    data = _MODEL_BYTES[content] = transforms.gl_bytes(matrix)
-    return data
+class _MatrixBytes(dict):
+    """Uniform bytes by the C-order bytes of a float64 4x4 model matrix, each made on its first
+    lookup (``cache[content]``: a plain subscript, no method call, for a matrix seen before)
+    by ``convert`` of the matrix read back from ``content``."""
+
+    def __init__(self, convert: Callable[[np.ndarray], bytes]) -> None:
+        super().__init__()
+        self.convert = convert
+
+    def __missing__(self, content: bytes) -> bytes:
+        if len(self) >= _MATRICES_KEPT:
+            self.clear()
+        data = self[content] = self.convert(np.frombuffer(content).reshape(4, 4))
+        return data
 
 
-def _normal_matrix_bytes(content: bytes, matrix: np.ndarray) -> bytes:
-    """The normal matrix's uniform bytes of ``matrix`` (float64, whose bytes are ``content``)."""
-    if len(_NORMAL_BYTES) >= _MATRICES_KEPT:
-        _NORMAL_BYTES.clear()
-    data = _NORMAL_BYTES[content] = transforms.gl_bytes(transforms.normal_matrix(matrix))
-    return data
+#: ``m_model``'s and ``m_normal``'s uniform bytes by the float64 model matrix's bytes (see
+#: :meth:`Executor.draw_node`): a node that does not move converts its matrix, and inverts it,
+#: once; an array changed in place between frames has other bytes, so it is converted again.
+_MODEL_BYTES = _MatrixBytes(transforms.gl_bytes)
+_NORMAL_BYTES = _MatrixBytes(lambda matrix: transforms.gl_bytes(transforms.normal_matrix(matrix)))
+
+
+class _Written(dict):
+    """The uniform bytes last written into one program, by uniform name (and the ``#`` keys
+    below); a name never written gives None (``written[name]``: a subscript, not a ``get`` call)."""
+
+    def __missing__(self, name: str) -> None:
+        return None
 
 
 @dataclass(frozen=True)
@@ -285,6 +296,13 @@ class _Uniforms(dict):
         return _NoUniform
 
 
+class _Steps(dict):
+    """The prepared draws by key (:attr:`Executor._steps`); a key not there gives None (a subscript per draw)."""
+
+    def __missing__(self, key: tuple[int, str]) -> None:
+        return None
+
+
 class _DrawStep:
     """One draw of a kept plan prepared once (issue 24's flat draw list): what
     :meth:`Executor.draw_node` found for ``draw`` drawn with ``material`` and ``front_face``
@@ -342,7 +360,7 @@ class Executor:
         self._setups: dict[tuple[str, int], _DrawSetup] = {}
         # The prepared draws of the plans drawn lately (see _DrawStep), by (id of the Draw, front
         # face); emptied with the set-ups whenever a VAO or a program is released.
-        self._steps: dict[tuple[int, str], _DrawStep] = {}
+        self._steps: dict[tuple[int, str], _DrawStep] = _Steps()
         # Pass cameras by the camera, the viewport's pixels and the depth mode (see _viewport_camera).
         self._cameras: dict[tuple[int, tuple[int, int, int, int], str], tuple[object, PassCamera]] = {}
         # What the frames of each plan drawn lately share (see _prepare_frame), by id of the plan.
@@ -353,7 +371,7 @@ class Executor:
         # u_light_pos and u_light_color bytes by id of the lights tuple (the tuple kept to check): see _light_bytes.
         self._lights_cache: dict[int, tuple[tuple[Light, ...], bytes, bytes]] = {}
         # The uniform bytes last written into each program (by program key): see _uniform_writer.
-        self._written: dict[str, dict[str, bytes]] = {}
+        self._written: dict[str, _Written] = {}
         self._culling: tuple[bool, str] | None = None  # what _set_culling set last (None: not known)
         self._bound_texture: object | None = None  # the material texture on unit 0 in this frame
         self._clear_depth = 1.0  # 0 with reverse-Z (glsandbox.gl.depth)
@@ -716,7 +734,7 @@ class Executor:
         if material is None:
             material = node.material
         key = (id(draw), front_face)
-        step = self._steps.get(key)
+        step = self._steps[key]
         if step is None or step.draw is not draw or step.material is not material:
             step = self._draw_step(key, node, draw, material, front_face)
         elif step.mesh is not node.mesh:
@@ -743,27 +761,27 @@ class Executor:
         if type(matrix) is not np.ndarray or matrix.dtype != _FLOAT64:
             matrix = np.asarray(matrix, dtype=np.float64)
         content = matrix.tobytes()
-        data = _MODEL_BYTES.get(content) or _model_matrix_bytes(content, matrix)
-        if written.get("m_model") != data:
+        data = _MODEL_BYTES[content]
+        if written["m_model"] != data:
             written["m_model"] = data
             uniforms["m_model"].write(data)
-        if written.get(_CAMERA) is not camera:  # (a pass's draws share its camera)
-            if camera.view_bytes != written.get("m_view"):
+        if written[_CAMERA] is not camera:  # (a pass's draws share its camera)
+            if camera.view_bytes != written["m_view"]:
                 written["m_view"] = camera.view_bytes
                 uniforms["m_view"].write(camera.view_bytes)
-            if camera.proj_bytes != written.get("m_proj"):
+            if camera.proj_bytes != written["m_proj"]:
                 written["m_proj"] = camera.proj_bytes
                 uniforms["m_proj"].write(camera.proj_bytes)
             written[_CAMERA] = camera
         if setup.normal:
-            data = _NORMAL_BYTES.get(content) or _normal_matrix_bytes(content, matrix)
-            if written.get("m_normal") != data:
+            data = _NORMAL_BYTES[content]
+            if written["m_normal"] != data:
                 written["m_normal"] = data
                 uniforms["m_normal"].write(data)
         if step.lit:
-            if written.get(_EYE) is not camera:
+            if written[_EYE] is not camera:
                 data = camera.eye_bytes
-                if written.get("u_eye") != data:
+                if written["u_eye"] != data:
                     written["u_eye"] = data
                     uniforms["u_eye"].write(data)
                 written[_EYE] = camera
@@ -772,14 +790,14 @@ class Executor:
                 if step.lights[0] is not frame_lights:  # (lights that do not move: the same tuple every frame)
                     step.lights = (frame_lights, *self._light_bytes(frame_lights))
                 _, light_pos, light_color = step.lights
-                if written.get("u_light_pos") != light_pos:
+                if written["u_light_pos"] != light_pos:
                     written["u_light_pos"] = light_pos
                     uniforms["u_light_pos"].write(light_pos)
-                if written.get("u_light_color") != light_color:
+                if written["u_light_color"] != light_color:
                     written["u_light_color"] = light_color
                     uniforms["u_light_color"].write(light_color)
         constants = step.constants
-        last = written.get(_CONSTANTS)
+        last = written[_CONSTANTS]
         if last is not constants:  # another material's were written since: only the bytes that differ
             change = step.change
             if change[0] is not last or last is None:
@@ -851,14 +869,14 @@ class Executor:
             vao, gpu = self._vao(mesh, program_key)
             setup = _DrawSetup(origin, program, members, self._uniform_writer(program_key, program, members),
                                _moved_key(origin), vao, gpu, "m_normal" in members,
-                               self._uniforms(program_key), self._written.setdefault(program_key, {}))
+                               self._uniforms(program_key), self._written.setdefault(program_key, _Written()))
             self._setups[moved_key] = setup
             return setup
         vao, gpu = self._vao(drawn, program_key)
         if len(self._setups) >= self.SETUPS_KEPT:  # new meshes every frame (a trail): start again
             self._setups.clear()
         setup = _DrawSetup(mesh, program, members, self._uniform_writer(program_key, program, members), _mesh_key(drawn), vao, gpu,
-                           "m_normal" in members, self._uniforms(program_key), self._written.setdefault(program_key, {}))
+                           "m_normal" in members, self._uniforms(program_key), self._written.setdefault(program_key, _Written()))
         self._setups[(program_key, id(mesh))] = setup
         return setup
 
@@ -882,8 +900,7 @@ class Executor:
         place between frames is converted again (no stale matrix)."""
         matrix = np.asarray(model, dtype=np.float64)
         content = matrix.tobytes()
-        return (_MODEL_BYTES.get(content) or _model_matrix_bytes(content, matrix),
-                (_NORMAL_BYTES.get(content) or _normal_matrix_bytes(content, matrix)) if normal else None)
+        return _MODEL_BYTES[content], _NORMAL_BYTES[content] if normal else None
 
     def _uniform_writer(self, program_key: str, program: moderngl.Program,
                         members: Collection[str]) -> Callable[[str, bytes], None]:
@@ -891,7 +908,7 @@ class Executor:
         uniform (a term the compiler removed has none) and they differ from what was written last.
         A program keeps its uniform values between draws and frames, so what does not change (the
         view while the camera stands, lights, materials, a wall's model) is written once."""
-        written = self._written.setdefault(program_key, {})
+        written = self._written.setdefault(program_key, _Written())
         uniforms: dict[str, moderngl.Uniform] = {}
 
         def write(name: str, data: bytes) -> None:
