@@ -423,30 +423,60 @@ def motion_decisions(scene: Scene) -> tuple:
     keeps or culls, and why (:func:`glsandbox.planar.shadow_casters`). Everything else of a
     plan depends on the scene's other parts. So two scenes that differ only in model
     matrices, light positions and cameras (:func:`glsandbox.scene.moved_scene`) and have
-    equal decisions have equal plans: the frame renderer keeps the plan between such frames."""
+    equal decisions have equal plans: the frame renderer keeps the plan between such frames.
+
+    Which nodes take part (blended ones per viewport, the casters) depends on none of what
+    moves, so a moved scene finds them once per scene it was moved from (every frame asks)."""
+    origin = scene.__dict__.get("_moved_from")  # (glsandbox.scene.scene_origin, inline)
+    parts = None if origin is None else origin.__dict__.get("_decision_parts")
+    if parts is None:
+        parts = _decision_parts(scene)
+        if origin is not None:
+            origin.__dict__["_decision_parts"] = parts
+    blended, reflected, casters = parts
+    nodes, viewports = scene.nodes, scene.viewports
     decisions: list[object] = []
-    glass = scene.mirror.node if scene.mirror is not None else None
-    blended = [node for node in scene.nodes if node.material.alpha_mode == "blend" and node.name != glass]
-    if blended:
-        for index, viewport in enumerate(scene.viewports):
-            shown = [(node, None) for node in blended if node.shown_in(index)]
-            decisions.append(tuple(node.name for node, _ in _farthest_first(shown, viewport.camera or scene.camera)))
-    mirror = scene.mirror
-    if mirror is not None:  # the blended nodes it reflects, in their order seen in it
-        reflected = [node for node in scene.nodes if node.name in mirror.reflected and node.material.alpha_mode == "blend"]
-        for index, viewport in enumerate(scene.viewports):
-            shown = [(node, None) for node in reflected if node.shown_in(index)]
-            if shown:
-                eye = _mirrored_eye(mirror, viewport.camera or scene.camera)
-                decisions.append(("mirror", tuple(node.name for node, _ in _farthest_first(shown, eye))))
+    for index, shown in blended:
+        pairs = [(nodes[i], None) for i in shown]
+        decisions.append(tuple(node.name for node, _ in _farthest_first(pairs, viewports[index].camera or scene.camera)))
+    for index, shown in reflected:  # the blended nodes the mirror reflects, in their order seen in it
+        eye = _mirrored_eye(scene.mirror, viewports[index].camera or scene.camera)
+        pairs = [(nodes[i], None) for i in shown]
+        decisions.append(("mirror", tuple(node.name for node, _ in _farthest_first(pairs, eye))))
     shadow = scene.planar_shadow
     if shadow is not None:
-        nodes = {node.name: node for node in scene.nodes}
-        models = {name: (nodes[name].model, nodes[name].mesh.positions) for name in shadow.casters if name in nodes}
+        models = {}
+        for name, i in casters:
+            node = nodes[i]
+            models[name] = (node.model, node.mesh.positions)
         from glsandbox.planar import shadow_casters  # loaded already: the scene holds a PlanarShadow
 
         decisions.append(shadow_casters(shadow, models))
     return tuple(decisions)
+
+
+def _decision_parts(scene: Scene) -> tuple[tuple, tuple, tuple]:
+    """The nodes :func:`motion_decisions` looks at, by index into ``scene.nodes``: per viewport
+    (every one, when any node is blended) the blended nodes it shows, per viewport showing
+    any the blended nodes the mirror reflects, and the planar shadow's casters (name, index
+    of the last node of that name) that are nodes of the scene."""
+    nodes = scene.nodes
+    glass = scene.mirror.node if scene.mirror is not None else None
+    blended = [i for i, node in enumerate(nodes) if node.material.alpha_mode == "blend" and node.name != glass]
+    by_viewport = tuple((index, tuple(i for i in blended if nodes[i].shown_in(index)))
+                        for index in range(len(scene.viewports))) if blended else ()
+    reflected_parts: tuple = ()
+    mirror = scene.mirror
+    if mirror is not None:
+        reflected = [i for i, node in enumerate(nodes)
+                     if node.name in mirror.reflected and node.material.alpha_mode == "blend"]
+        reflected_parts = tuple((index, shown) for index in range(len(scene.viewports))
+                                if (shown := tuple(i for i in reflected if nodes[i].shown_in(index))))
+    casters: tuple = ()
+    if scene.planar_shadow is not None:
+        last = {node.name: i for i, node in enumerate(nodes)}
+        casters = tuple((name, last[name]) for name in scene.planar_shadow.casters if name in last)
+    return by_viewport, reflected_parts, casters
 
 
 def _needs_depth(scene: Scene) -> bool:

@@ -18,7 +18,8 @@ import pytest
 from glsandbox import geometry
 from glsandbox.errors import SandboxError
 from glsandbox.lesson import all_lessons, find_lesson
-from glsandbox.plan import plan
+from glsandbox.planar import Mirror, PlanarShadow
+from glsandbox.plan import motion_decisions, plan
 from glsandbox.scene import Camera, Light, Material, Motion, Node, Scene, moved_scene, scene_origin
 
 #: Moments the frames are checked at (seconds): the first, and three that turn things well apart.
@@ -121,6 +122,44 @@ def test_moved_scene_changes_only_what_moves():
 def test_moved_scene_checks_what_moves(motion, message):
     with pytest.raises(SandboxError, match=message.replace("(", r"\(").replace(")", r"\)").replace("[0]", r"\[0\]")):
         moved_scene(_lit_scene(), motion)
+
+
+def test_moved_scene_moves_every_node_of_a_moved_name_in_scene_order():
+    """Nodes are found by name once per scene moved from; two nodes may share a name, and the
+    first bad one (in the scene's order) is named whatever order the motion lists them in."""
+    twice = Scene("s", nodes=(Node("a", geometry.cube()), Node("b", geometry.sphere()), Node("a", geometry.cube()),
+                              Node("c", geometry.cube())))
+    turned = np.diag([2.0, 3.0, 4.0, 1.0])
+    moved = moved_scene(twice, Motion(models={"a": turned}, positions={"c": geometry.cube().positions + 1.0}))
+    assert [n.name for n in moved.nodes] == ["a", "b", "a", "c"] and moved.nodes[1] is twice.nodes[1]
+    assert moved.nodes[0].model is turned and moved.nodes[2].model is turned
+    assert np.array_equal(moved.nodes[3].mesh.positions, twice.nodes[3].mesh.positions + 1.0)
+    again = moved_scene(moved, Motion(models={"b": np.eye(4)}))  # from the moved one: the same places
+    assert again.nodes[0] is moved.nodes[0] and again.nodes[1].model is not twice.nodes[1].model
+    with pytest.raises(SandboxError, match="node 'a'"):
+        moved_scene(twice, Motion(models={"c": np.full((4, 4), np.nan), "a": np.full((4, 4), np.nan)}))
+
+
+def test_a_moved_scenes_decisions_are_a_fresh_scenes():
+    """motion_decisions finds the blended nodes, the reflected ones and the casters once per scene
+    moved from; every moved scene decides as the same scene made anew (no origin) does."""
+    glass = Material(color=(0.2, 0.4, 1.0, 0.5), alpha_mode="blend")
+    scene = Scene("decide", nodes=(
+        Node("floor", geometry.plane(8.0)), Node("wall", geometry.plane(8.0), material=glass),
+        Node("a", geometry.cube(), material=glass), Node("b", geometry.cube(), material=glass),
+        Node("caster", geometry.cube())),
+        camera=Camera(eye=(0.0, 2.0, 10.0)),
+        mirror=Mirror("wall", (0.0, 0.0, 1.0, 5.0), ("a", "b", "caster")),
+        planar_shadow=PlanarShadow("floor", (0.0, 1.0, 0.0, 0.0), (0.0, 4.0, 0.0, 1.0), ("caster", "a")))
+    seen = set()
+    for z_a, y_caster in ((3.0, 1.0), (-2.0, 1.0), (3.0, 6.0), (-2.0, 6.0)):
+        ahead, lifted = np.eye(4), np.eye(4)
+        ahead[2, 3], lifted[1, 3] = z_a, y_caster
+        moved = moved_scene(scene, Motion(models={"a": ahead, "caster": lifted}))
+        decisions = motion_decisions(moved)
+        assert decisions == motion_decisions(replace(moved, name=moved.name))  # made anew: no origin
+        seen.add(decisions)
+    assert len(seen) == 4  # the order of a and b, and the caster culled above the light, both move
 
 
 def test_the_camera_keys_move_the_scene():
