@@ -35,7 +35,7 @@ from glsandbox.gl.target import OffscreenTarget
 from glsandbox.lesson import Lesson
 from glsandbox.overlay import Overlay
 from glsandbox.plan import TRACE_OPTIONS, Buffers, Plan, motion_decisions, plan, traced_image_name, traced_scene
-from glsandbox.scene import Scene, scene_origin
+from glsandbox.scene import Scene
 
 __all__ = ["DEFAULT_SIZE", "Frame", "FrameRenderer", "HeadlessRenderer", "InteractiveResolution",
            "LazyRenderer", "trace_viewports", "with_samples"]
@@ -181,7 +181,11 @@ class FrameRenderer:
         scene, and what a model file holds that is not drawn, is one ``warning:`` line
         each on stderr, once per run."""
         self.host.make_current()
-        traced = trace_viewports(scene, size, self.host.ctx, ray_resolution)
+        traced = scene
+        for vp in scene.viewports:  # (trace_viewports's own test, inline: a raster frame makes no call)
+            if vp.renderer != "raster":
+                traced = trace_viewports(scene, size, self.host.ctx, ray_resolution)
+                break
         raster_plan = self.plan(traced)
         target = self.target(size, raster_plan.buffers)
         self.executor.render(traced, target.framebuffer, size, raster_plan)
@@ -202,7 +206,7 @@ class FrameRenderer:
         the same scene when their :func:`~glsandbox.plan.motion_decisions` agree: the plan
         is then the same (blended order and planar shadow casters are its only parts that
         depend on positions). Any other scene is planned afresh."""
-        origin = scene_origin(scene)
+        origin = scene.__dict__.get("_moved_from")  # (scene_origin, inline: every frame)
         if origin is None:
             return plan(scene)
         decisions = motion_decisions(scene)
@@ -238,7 +242,10 @@ class HeadlessRenderer(FrameRenderer):
         super().__init__(open_context(backend))
 
     def render(self, lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: int = 0) -> Frame:
-        return self.render_scene(with_samples(lesson.scene(), samples), size)
+        scene = lesson.scene()
+        if samples != scene.samples:  # (equal: the scene's own, checked when it was made)
+            scene = with_samples(scene, samples)
+        return self.render_scene(scene, size)
 
     def close(self) -> None:
         super().close()
