@@ -67,6 +67,28 @@ def set_stencil(raw: rawgl.RawGL, stencil: StencilState) -> None:
 
 # --- the passes ------------------------------------------------------------------
 
+#: ``left @ model`` by (id of ``left``, the float64 model's bytes): (``left``, the product). A
+#: pass's matrix (the mirror's R, the shadow's) is kept by its immutable owner, so a node that does
+#: not move is reflected or flattened once, not every frame; one moved in place has other bytes.
+_PRODUCTS: dict[tuple[int, bytes], tuple[np.ndarray, np.ndarray]] = {}
+#: Entries :data:`_PRODUCTS` keeps; past it, it starts again (a moving node adds one per frame).
+_PRODUCTS_KEPT = 256
+
+
+def _times(left: np.ndarray, model: Any) -> np.ndarray:
+    """``left @ model`` (read-only), found again for a model of the same content."""
+    matrix = np.asarray(model, dtype=np.float64)
+    key = (id(left), matrix.tobytes())
+    kept = _PRODUCTS.get(key)
+    if kept is not None and kept[0] is left:  # (the entry holds ``left``: its id is not reused meanwhile)
+        return kept[1]
+    if len(_PRODUCTS) >= _PRODUCTS_KEPT:
+        _PRODUCTS.clear()
+    product = left @ matrix
+    product.setflags(write=False)
+    _PRODUCTS[key] = (left, product)
+    return product
+
 
 def mark_mirror(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any) -> None:
     """``MarkMirrorDSS``: the glass's visible pixels get the mirror bit.
@@ -133,7 +155,7 @@ def reflection(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any) -
     lights = _mirrored_lights(scene.lights, scene.mirror)
     for draw in step.draws:
         node = nodes[draw.node]
-        drawer.draw_node(node, draw, camera, model=reflection @ node.model, front_face="cw", lights=lights)
+        drawer.draw_node(node, draw, camera, model=_times(reflection, node.model), front_face="cw", lights=lights)
 
 
 def mirror_surface(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any) -> None:
@@ -183,4 +205,4 @@ def planar_shadow(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any
         material = flat
         if draw.program == CUTOUT_SHADOW_PROGRAM.key:  # a cut-out: its texture's alpha, the part's cutoff
             material = cutout_caster_material(node.material, shadow.color)
-        drawer.draw_node(node, draw, camera, model=flatten @ node.model, material=material)
+        drawer.draw_node(node, draw, camera, model=_times(flatten, node.model), material=material)

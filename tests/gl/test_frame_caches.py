@@ -146,3 +146,19 @@ def test_a_kept_plan_drawn_with_other_parts_draws_those_parts(gl) -> None:
             pictures.setdefault((name, size), image)
     for name in ("recolored", "retextured", "reshaped", "relit"):  # each change shows
         assert not np.array_equal(pictures[(name, SIZE)], pictures[("base", SIZE)]), name
+
+
+def test_a_reflected_and_flattened_node_moved_in_place_is_drawn_where_it_is_now(gl) -> None:
+    """The planar passes keep ``R @ model`` and the shadow's product by the model's content: a
+    model array changed in place between frames is reflected and flattened where it is now."""
+    from dataclasses import replace
+
+    scene = find_lesson("mirror")().scene()
+    model = np.array(next(n.model for n in scene.nodes if n.name == "cube"), dtype=np.float64)  # writable
+    held = replace(scene, nodes=tuple(replace(n, model=model) if n.name == "cube" else n for n in scene.nodes))
+    before = gl.render_scene(held, SIZE).image.copy()
+    model[0, 3] += 0.4  # the same array, moved along x
+    after = gl.render_scene(held, SIZE).image.copy()
+    assert not np.array_equal(before, after)
+    copied = replace(held, nodes=tuple(replace(n, model=model.copy()) if n.name == "cube" else n for n in held.nodes))
+    assert np.array_equal(after, fresh_frame(gl, copied))  # a new array: nothing kept can stand in for it
