@@ -25,8 +25,8 @@ Rows per model (``--quick``: the bunny only):
 Under the table: peak memory per triangle of a load and first frame, measured
 in a fresh process that has loaded and drawn the model once already (the
 context, shaders and reader's imports are not the model's), as its peak
-resident size (Linux: reset just before the second load) less what it held
-then; goal: at most 250 bytes. Beside it, from ``tracemalloc`` in a third
+resident size (Linux: reset just before the second load; :mod:`_memory`) less
+what it held then; goal: at most 250 bytes. Beside it, from ``tracemalloc`` in a third
 load, the peak and the held bytes of Python's and numpy's allocations (the
 reader's and glsandbox's arrays, not the GL driver's), and the loaded model's
 own arrays (what the load cache keeps). pymeshlab and embreex come with
@@ -203,17 +203,13 @@ sys.path.insert(0, {str(Path(__file__).resolve().parent)!r})
 import trimesh, glsandbox, glsandbox.meshfile
 from glsandbox.measure.bench import BenchEnv
 import model_load
-def status(key):
-    with open('/proc/self/status') as f:
-        return next(int(line.split()[1]) * 1024 for line in f if line.startswith(key))
+from _memory import peak_growth, peak_start
 env = BenchEnv()
 path = __import__('pathlib').Path({str(path)!r})
 model_load.glsandbox_load_and_draw(env, path)  # warm: the context, the shaders, the reader's imports
-with open('/proc/self/clear_refs', 'w') as f:
-    f.write('5')  # Linux: the peak resident size (VmHWM) starts again from the current one
-before = status('VmRSS:')
+start = peak_start()  # Linux: the peak resident size (VmHWM) starts again from the current one
 model_load.glsandbox_load_and_draw(env, path)  # a new crease angle: loaded and drawn again
-after = status('VmHWM:')
+grown = peak_growth(start)
 tracemalloc.start()  # a third time, traced (tracing's own records would swell the resident size above)
 model_load.glsandbox_load_and_draw(env, path)
 traced_held, traced_peak = tracemalloc.get_traced_memory()
@@ -222,7 +218,7 @@ model = glsandbox.meshfile.load_model(path, fit=True, crease_angle=30.0 + 1e-6)
 arrays = sum(a.nbytes for part in model.parts for a in (part.mesh.positions, part.mesh.indices, part.mesh.normals,
                                                          part.mesh.uvs, part.mesh.colors) if a is not None)
 t = model.triangles
-print(json.dumps([t, (after - before) / t, traced_peak / t, traced_held / t, arrays / t]))
+print(json.dumps([t, grown / t, traced_peak / t, traced_held / t, arrays / t]))
 """
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
     if done.returncode != 0:
