@@ -564,15 +564,18 @@ def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.floa
     lit = table.lit[hits.node]
     if lit.any():
         idx = np.nonzero(lit)[0]
-        nodes = hits.node[idx]
+        every = idx.size == lit.size  # every hit lit (a lit model): the arrays as they are, read only
+        pick = slice(None) if every else idx
+        nodes = hits.node[pick]
         ka = table.ka[nodes][:, None]
         kd = table.kd[nodes][:, None]
         ks = table.ks[nodes][:, None]
         shin = table.shininess[nodes]
         blinn = table.blinn[nodes]
-        p, nrm, mesh = point[idx], normal[idx], base[idx]
-        lit_spawn = spawn.subset(idx) if spawn is not None else None
-        to_eye = -d[idx] / length(d[idx])[:, None]
+        p, nrm, mesh = point[pick], normal[pick], base[pick]
+        lit_spawn = spawn if every or spawn is None else spawn.subset(idx)
+        dl = d[pick]
+        to_eye = -dl / length(dl)[:, None]
         total = np.zeros_like(mesh)
         for index, (light, light_color) in enumerate(zip(world.light_positions, world.light_colors)):
             to_light = light - p
@@ -597,7 +600,7 @@ def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.floa
                 blocked = _occluded(world, start, light - start, index, cull, aabb, stats, bvh)
                 lighting *= np.where(blocked, 0.0, 1.0)[:, None]  # in shadow only the ambient term stays
             total += np.minimum(ka * mesh + lighting, 1.0)
-        color[idx] = total
+        color[pick] = total
     return color, normal, alpha, spawn
 
 
