@@ -75,10 +75,14 @@ frame, another camera) builds nothing.
 from __future__ import annotations
 
 import hashlib
+import os
 import time
 import weakref
 from collections import OrderedDict
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -123,6 +127,12 @@ SMALL_CHUNK: int = 1 << 16
 #: The widths ``_split_small`` pads nodes to (powers of two and halfway between: at most a third wasted),
 #: up to 64: SMALL and leaf_size (1..64) at most.
 WIDTHS = np.array([2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64])
+#: Builds of at least this many triangles are split in parts, built in threads (``_split_tree``).
+PARALLEL_MIN: int = 1 << 17
+#: The parts: the subtrees of the first level's open nodes once there are this many, and the small nodes so far.
+PARTS: int = 4
+#: Most threads a build uses by default (fewer where the process may use fewer CPUs).
+THREADS: int = 4
 #: BVHs kept by :func:`bvh_for_triangles` / :func:`bvh_for_mesh`.
 CACHE_SIZE: int = 16
 
@@ -219,15 +229,18 @@ def _half_area(lo: NDArray[np.float32], hi: NDArray[np.float32]) -> NDArray[np.f
     return result
 
 
-def build_bvh(v0: ArrayLike, v1: ArrayLike, v2: ArrayLike, *, leaf_size: int = LEAF_SIZE, bins: int = BINS) -> BVH:
-    """:func:`_build_bvh`, its time kept in :attr:`BVH.build_seconds`."""
+def build_bvh(v0: ArrayLike, v1: ArrayLike, v2: ArrayLike, *, leaf_size: int = LEAF_SIZE, bins: int = BINS,
+              threads: int | None = None) -> BVH:
+    """:func:`_build_bvh`, its time kept in :attr:`BVH.build_seconds`. ``threads``: at most this many
+    threads (default: the usable CPUs, at most :data:`THREADS`); the tree is the same for any count."""
     start = time.perf_counter()
-    result = _build_bvh(v0, v1, v2, leaf_size=leaf_size, bins=bins)
+    result = _build_bvh(v0, v1, v2, leaf_size=leaf_size, bins=bins, threads=threads)
     object.__setattr__(result, "build_seconds", time.perf_counter() - start)  # frozen: set once, here
     return result
 
 
-def _build_bvh(v0: ArrayLike, v1: ArrayLike, v2: ArrayLike, *, leaf_size: int = LEAF_SIZE, bins: int = BINS) -> BVH:
+def _build_bvh(v0: ArrayLike, v1: ArrayLike, v2: ArrayLike, *, leaf_size: int = LEAF_SIZE, bins: int = BINS,
+               threads: int | None = None) -> BVH:
     """Build a BVH over the triangles ``v0[k], v1[k], v2[k]`` (``(M, 3)`` arrays) by binned SAH.
 
     Degenerate triangles are left out (no ray hits them); the others are
@@ -236,15 +249,36 @@ def _build_bvh(v0: ArrayLike, v1: ArrayLike, v2: ArrayLike, *, leaf_size: int = 
     if not 1 <= int(leaf_size) <= 64 or not 2 <= int(bins) <= 64:
         raise RayTraceError(f"leaf_size must be in 1..64 and bins in 2..64, got {leaf_size} and {bins}")
     a, b, c = _triangle_arrays(v0, v1, v2)
+    threads = _threads(threads)
+    if threads > 1 and a.shape[0] >= PARALLEL_MIN:
+        with ThreadPoolExecutor(max_workers=threads) as pool:
+            return _build(a, b, c, int(leaf_size), int(bins), pool)
+    return _build(a, b, c, int(leaf_size), int(bins), None)
+
+
+def _run(pool: ThreadPoolExecutor | None, jobs: list[Callable[[], Any]]) -> list[Any]:
+    """The jobs' results in order, the jobs run in ``pool``'s threads (None: here, one after another)."""
+    if pool is None:
+        return [job() for job in jobs]
+    return [done.result() for done in [pool.submit(job) for job in jobs]]
+
+
+def _build(a: NDArray[np.float64], b: NDArray[np.float64], c: NDArray[np.float64], leaf_size: int, bins: int,
+           pool: ThreadPoolExecutor | None) -> BVH:
+    """:func:`_build_bvh` of contiguous ``(M, 3)`` corners, big steps run in ``pool`` (None: none)."""
     total = a.shape[0]
+    # The degenerate test (elementwise), the second half of the triangles in a thread of its own.
+    half = total // 2 if pool else total
+    second = pool.submit(nondegenerate, a[half:], b[half:], c[half:]) if pool else None
     lo = np.minimum(np.minimum(a, b), c)
     hi = np.maximum(np.maximum(a, b), c)
     _check_finite(lo, hi)
-    keep = np.flatnonzero(nondegenerate(a, b, c))
+    kept = nondegenerate(a[:half], b[:half], c[:half])
+    keep = np.flatnonzero(kept if second is None else np.concatenate([kept, second.result()]))
     if keep.size == 0:
         return _empty_bvh(total)
     if keep.size < total:
-        a, b, c, lo, hi = (np.take(x, keep, axis=0) for x in (a, b, c, lo, hi))
+        a, b, c, lo, hi = _run(pool, [lambda x=x: np.take(x, keep, axis=0) for x in (a, b, c, lo, hi)])
     # The splitting works on float32 copies of the triangles' boxes, one row
     # per quantity (box min, box max; x, y, z each): the SAH is a heuristic,
     # and half the bytes make its scattered reads faster. The stored boxes
@@ -252,9 +286,8 @@ def _build_bvh(v0: ArrayLike, v1: ArrayLike, v2: ArrayLike, *, leaf_size: int = 
     rows = np.empty((6, keep.size), dtype=np.float32)
     rows[0:3] = lo.T
     rows[3:6] = hi.T
-    tree = _Tree(keep.size)
-    small = _split_levels(rows, tree, int(leaf_size), int(bins))
-    _split_small(tree, small, int(leaf_size))
+    tree = _split_tree(rows, leaf_size, bins, pool)
+    del rows
     first, count = tree.arrays()
     # The triangles leaf after leaf: a leaf's first slot plus the place within it.
     leaves = np.flatnonzero(count)
@@ -263,26 +296,60 @@ def _build_bvh(v0: ArrayLike, v1: ArrayLike, v2: ArrayLike, *, leaf_size: int = 
     first[leaves] = offsets[leaves]
     order = np.empty(keep.size, dtype=np.int64)
     order[offsets[tree.leaf_of] + tree.leaf_rank] = np.arange(keep.size)
-    # np.take: several times faster than x[order] here; the triangles' exact boxes are lo and hi reordered.
-    a, b, c, lo, hi = (np.take(x, order, axis=0) for x in (a, b, c, lo, hi))
-    node_min, node_max = _exact_boxes(lo, hi, first, count, leaves, tree.levels)
+    # np.take: several times faster than x[order] here; the triangles' exact boxes are lo and hi
+    # reordered, a leaf's box the min and max of its run of them.
+    starts = first[leaves]
+    a, b, c, leaf_min, leaf_max = _run(pool, [
+        lambda: np.take(a, order, axis=0), lambda: np.take(b, order, axis=0), lambda: np.take(c, order, axis=0),
+        lambda: np.minimum.reduceat(np.take(lo, order, axis=0), starts, axis=0),
+        lambda: np.maximum.reduceat(np.take(hi, order, axis=0), starts, axis=0)])
+    node_min, node_max = _exact_boxes(leaf_min, leaf_max, count, first, leaves, tree.levels)
     return BVH(node_min, node_max, first, count, a, b, c, keep[order].astype(np.int64), tree.depth, total)
 
 
 class _Tree:
     """The nodes made so far, level after level (children always in pairs, numbered in order):
-    ``first`` and ``count`` per level, each triangle's leaf and its place in it."""
+    ``first`` and ``count`` per level, each triangle's leaf and its place in it.
 
-    def __init__(self, triangles: int) -> None:
+    A *part* (:meth:`part`) numbers the nodes below some of the tree's nodes on its own (its
+    roots are its ids ``0 .. R − 1``), so that parts can be built at once in threads; each is then
+    :meth:`graft`-ed back, in a fixed order: the numbering does not depend on which thread ends first."""
+
+    def __init__(self, triangles: int, roots: int = 0) -> None:
         self.leaf_of = np.zeros(triangles, dtype=np.int64)
         self.leaf_rank = np.arange(triangles)  # each triangle's place within its leaf
-        self.levels: list[NDArray[np.int64]] = [np.zeros(1, dtype=np.int64)]  # the nodes made at each step
-        self.firsts: list[NDArray[np.int64]] = [np.zeros(1, dtype=np.int64)]
-        self.counts: list[NDArray[np.int64]] = [np.array([triangles], dtype=np.int64)]
-        self.next_id = 1
+        self.levels: list[NDArray[np.int64]] = []  # the nodes made at each step
+        self.firsts: list[NDArray[np.int64]] = []
+        self.counts: list[NDArray[np.int64]] = []
+        if not roots:  # the whole tree: its root, node 0
+            self.levels.append(np.zeros(1, dtype=np.int64))
+            self.firsts.append(np.zeros(1, dtype=np.int64))
+            self.counts.append(np.array([triangles], dtype=np.int64))
+        self.next_id = max(1, roots)
         self.depth = 1  # nodes on the longest path from the root to a leaf
         self._parents: list[NDArray[np.int64]] = []  # inner nodes made after the level arrays were written
         self._lefts: list[NDArray[np.int64]] = []
+
+    def part(self, roots: int) -> _Tree:
+        """An empty part below ``roots`` nodes of this tree (the triangles' leaf and rank arrays
+        shared: parts write disjoint triangles)."""
+        sub = _Tree(0, roots)
+        sub.leaf_of, sub.leaf_rank = self.leaf_of, self.leaf_rank
+        return sub
+
+    def graft(self, sub: _Tree, roots: NDArray[np.int64], tris: NDArray[np.int64]) -> None:
+        """Number the nodes of part ``sub`` after this tree's (its roots are ``roots``); ``tris``:
+        the triangles below them, whose leaves ``sub`` numbered on its own."""
+        r = roots.size
+        shift = self.next_id - r  # part node j >= r becomes node j + shift
+        self.next_id += sub.next_id - r
+        self.depth = max(self.depth, sub.depth)
+        self.levels += [ids + shift for ids in sub.levels]
+        self.firsts += sub.firsts
+        self.counts += sub.counts
+        self._lefts += [ids + shift for ids in sub._lefts]
+        self._parents += [np.where(p < r, roots[np.minimum(p, r - 1)], p + shift) for p in sub._parents]
+        self.leaf_of[tris] += shift  # a leaf is never a root (roots are nodes still to split)
 
     def children(self, parents: NDArray[np.int64], child_count: NDArray[np.int64], leaf_size: int
                  ) -> tuple[NDArray[np.int64], NDArray[np.bool_]]:
@@ -310,36 +377,117 @@ class _Tree:
         return first, count
 
 
-def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bins: int
-                  ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.int64],
-                             NDArray[np.float32]]:
-    """The breadth-first binned-SAH splitting of the nodes of more than :data:`SMALL` triangles
-    (see the module docstring).
+def _threads(threads: int | None) -> int:
+    """Threads for a build: ``threads``, or by default the CPUs this process may use, at most :data:`THREADS`."""
+    if threads is not None:
+        return max(1, int(threads))
+    try:
+        usable = len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        usable = os.cpu_count() or 1
+    return max(1, min(THREADS, usable))
 
-    ``rows`` is ``(6, K)``: box min and box max of each triangle (left as it is).
+
+def _split_tree(rows: NDArray[np.float32], leaf_size: int, bins: int, pool: ThreadPoolExecutor | None) -> _Tree:
+    """The tree over the triangles whose boxes are ``rows`` (``(6, K)``: min, max; left as they are).
+
+    Big nodes are binned level by level (:func:`_split_levels`), small ones
+    swept (:func:`_split_small`). A build of :data:`PARALLEL_MIN` triangles or
+    more is cut into parts once a level has :data:`PARTS` open nodes: each
+    open node's subtree is one part, the small nodes made so far another.
+    Every choice of the splitting is per node, so the parts build the same
+    tree as one pass would; they are built in ``pool``'s threads (numpy
+    releases the GIL in its loops over arrays) and numbered in a fixed order
+    (:meth:`_Tree.graft`), so the result is the same for any thread count.
+    """
+    k = rows.shape[1]
+    tree = _Tree(k)
+    small = max(SMALL, leaf_size)
+    if k <= leaf_size:
+        return tree
+    if k <= small:
+        tree.counts[0][0] = 0
+        one = np.ones(1, dtype=np.int64)
+        _split_small(tree, (np.arange(k), one - 1, one * k, one, rows), leaf_size)
+        return tree
+    start = _Open(np.arange(k), rows.copy(), np.array([k], dtype=np.int64),
+                  rows[0:3].min(axis=1)[None, :].astype(np.float64), rows[3:6].max(axis=1)[None, :].astype(np.float64),
+                  np.zeros(1, dtype=np.int64), 1)
+    if k < PARALLEL_MIN:
+        smalls, _ = _split_levels(start, tree, leaf_size, bins)
+        _split_small(tree, smalls, leaf_size)
+        return tree
+    smalls, rest = _split_levels(start, tree, leaf_size, bins, stop=PARTS)
+    del start
+    parts: list[tuple[NDArray[np.int64], NDArray[np.int64], int, Callable[[_Tree], None]]] = []
+    if rest is not None:
+        ends = np.cumsum(rest.counts)
+        for i in range(rest.counts.size):
+            def subtree(sub: _Tree, i: int = i) -> None:
+                found, _ = _split_levels(rest.part(slice(i, i + 1)), sub, leaf_size, bins)
+                _split_small(sub, found, leaf_size)
+            node_tris = rest.tris[int(ends[i] - rest.counts[i]):int(ends[i])]
+            parts.append((rest.ids[i:i + 1], node_tris, node_tris.size, subtree))
+    if smalls[1].size:
+        caller, ids, counts, depths, boxes = smalls
+        parts.append((ids, caller, caller.size, lambda sub: _split_small(
+            sub, (caller, np.arange(ids.size), counts, depths, boxes), leaf_size)))
+    subs = [tree.part(roots.size) for roots, _, _, _ in parts]
+    biggest_first = sorted(range(len(parts)), key=lambda j: -parts[j][2])  # the longest first: the threads end together
+    _run(pool, [lambda j=j: parts[j][3](subs[j]) for j in biggest_first])
+    for (roots, tris, _, _), sub in zip(parts, subs):
+        tree.graft(sub, roots, tris)
+    return tree
+
+
+class _Open(NamedTuple):
+    """Nodes still to bin (more than :data:`SMALL` triangles), their triangles grouped by node."""
+
+    tris: NDArray[np.int64]  # the caller's triangle of each column
+    cols: NDArray[np.float32]  # (6, width): the columns' boxes, min and max (contiguous)
+    counts: NDArray[np.int64]  # columns per node, in column order
+    box_lo: NDArray[np.float64]  # (n, 3): the nodes' binning boxes
+    box_hi: NDArray[np.float64]
+    ids: NDArray[np.int64]  # the nodes' ids
+    level: int  # the nodes' depth (1: the root)
+
+    def part(self, nodes: slice) -> _Open:
+        """Nodes ``nodes`` (a range) alone, numbered ``0 ..`` as the roots of a :meth:`_Tree.part`."""
+        starts = np.cumsum(self.counts) - self.counts
+        first = int(starts[nodes.start])
+        last = first + int(self.counts[nodes].sum())
+        counts = self.counts[nodes]
+        return _Open(self.tris[first:last], np.ascontiguousarray(self.cols[:, first:last]), counts,
+                     self.box_lo[nodes], self.box_hi[nodes], np.arange(counts.size), self.level)
+
+
+_Small = tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.float32]]
+
+
+def _split_levels(start: _Open, tree: _Tree, leaf_size: int, max_bins: int, stop: int = 0
+                  ) -> tuple[_Small, _Open | None]:
+    """The breadth-first binned-SAH splitting of the nodes of more than :data:`SMALL` triangles
+    (see the module docstring), from the open nodes ``start`` down, or only until a level has
+    ``stop`` open nodes or more (0: to the end).
+
     Records the nodes in ``tree``; returns the nodes of at most :data:`SMALL`
     triangles still to split (:func:`_split_small`): their triangles (grouped
     by node), their ids, triangle counts and depths, and the triangles' boxes
-    (``(6, …)``, in the same order).
+    (``(6, …)``, in the same order); and the nodes still open at ``stop`` (None at the end).
 
     The triangles still to split are kept grouped by node (``cols`` columns
     in node order, ``counts`` per node), so per-node values reach their
     triangles by ``np.repeat`` and the scattered bin updates stay local in
     memory; each level partitions every node's columns into its two
     children's in one pass (a counting sort: no ``argsort`` per level).
+    Every choice is per node (the bins per node are ``max_bins`` at every
+    level: open nodes hold more than SMALL ≥ 64 triangles), so the nodes of a
+    level may be split in separate calls with the same result.
     """
-    k = rows.shape[1]
     small = max(SMALL, leaf_size)
-    none = np.zeros(0, dtype=np.int64)
-    if k <= leaf_size:
-        return none, none, none, none, rows[:, :0]
-    if k <= small:
-        tree.counts[0][0] = 0
-        return (np.arange(k), np.zeros(1, dtype=np.int64), np.array([k], dtype=np.int64), np.ones(1, dtype=np.int64),
-                rows)
     small_tris, small_ids, small_counts, small_depth, small_boxes = [], [], [], [], []
-    tris = np.arange(k)  # the caller's triangle of each column
-    cols = rows.copy()  # the open triangles' boxes, grouped by node
+    tris, cols, counts, box_lo, box_hi, open_ids, level = start
+    k = tris.size
     # Two flat buffers the columns are moved between, level after level: a fresh 24 bytes per
     # triangle each level would be fresh pages for the kernel to zero and map each time.
     spare = np.empty(cols.size, dtype=np.float32)
@@ -348,12 +496,11 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
     centre = np.empty(3 * k, dtype=np.float32)
     bin_keys = np.empty(3 * k, dtype=np.int64)
     bin_rows = np.empty(3 * k, dtype=np.uint8)  # each column's bin on each axis (the key less its node's i·B)
-    counts = np.array([k], dtype=np.int64)  # columns per open node, in column order
-    box_lo = rows[0:3].min(axis=1)[None, :].astype(np.float64)  # the open nodes' binning boxes
-    box_hi = rows[3:6].max(axis=1)[None, :].astype(np.float64)
-    open_ids = np.zeros(1, dtype=np.int64)  # the open nodes' ids
-    level = 1
+    rest = None
     while counts.size:
+        if stop and counts.size >= stop:
+            rest = _Open(tris, cols, counts, box_lo, box_hi, open_ids, level)
+            break
         n = counts.size
         width = tris.size
         cen = centre[:3 * width].reshape(3, width)
@@ -555,7 +702,7 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         child_count = np.bincount(child, minlength=2 * n)
         child_ids, is_leaf = tree.children(open_ids, child_count, leaf_size)
         level += 1
-        tree.depth = level
+        tree.depth = max(tree.depth, level)
         # Each column's rank within its child (lefts keep their order, rights
         # too): with the child's start, its place in the partition below.
         # A right column's rank is the rights before it less the rights before its node's first
@@ -614,9 +761,10 @@ def _split_levels(rows: NDArray[np.float32], tree: _Tree, leaf_size: int, max_bi
         box_lo = child_lo.reshape(2 * n, 3)[kept_children]
         box_hi = child_hi.reshape(2 * n, 3)[kept_children]
     if not small_ids:
-        return none, none, none, none, rows[:, :0]
+        none = np.zeros(0, dtype=np.int64)
+        return (none, none, none, none, cols[:, :0]), rest
     return (np.concatenate(small_tris), np.concatenate(small_ids), np.concatenate(small_counts),
-            np.concatenate(small_depth), np.concatenate(small_boxes, axis=1))
+            np.concatenate(small_depth), np.concatenate(small_boxes, axis=1)), rest
 
 
 def _every(starts: NDArray[np.int64], taken: NDArray[np.int64], stride: NDArray[np.int64]) -> NDArray[np.int64]:
@@ -799,16 +947,16 @@ def sah_cost(bvh: BVH) -> float:
     return float((area * np.where(bvh.node_count == 0, 1, bvh.node_count)).sum() / area[0])
 
 
-def _exact_boxes(lo: NDArray[np.float64], hi: NDArray[np.float64], first: NDArray[np.int64],
-                 count: NDArray[np.int64], leaves: NDArray[np.int64], levels: list[NDArray[np.int64]]
+def _exact_boxes(leaf_min: NDArray[np.float64], leaf_max: NDArray[np.float64], count: NDArray[np.int64],
+                 first: NDArray[np.int64], leaves: NDArray[np.int64], levels: list[NDArray[np.int64]]
                  ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Exact float64 node boxes: leaves from their (stored, reordered) triangles'
-    boxes, then each level's inner nodes from their two children, deepest first."""
+    """Exact float64 node boxes: the leaves' (``leaf_min``, ``leaf_max``: the min and max of their
+    triangles' corners), then each level's inner nodes from their two children, deepest first."""
     total = count.shape[0]
     node_min = np.empty((total, 3))
     node_max = np.empty((total, 3))
-    node_min[leaves] = np.minimum.reduceat(lo, first[leaves], axis=0)
-    node_max[leaves] = np.maximum.reduceat(hi, first[leaves], axis=0)
+    node_min[leaves] = leaf_min
+    node_max[leaves] = leaf_max
     for ids in reversed(levels):
         inner = ids[count[ids] == 0]
         if inner.size:
