@@ -128,7 +128,7 @@ def test_a_build_in_parts_and_threads_is_the_tree_of_one_pass(monkeypatch) -> No
     c = c.copy()
     c[::9] = a[::9]  # degenerate: no area
     one_pass = build_bvh(a, b, c)
-    monkeypatch.setattr(bvh_module, "PARALLEL_MIN", 1_000)
+    monkeypatch.setattr(bvh_module, "PART_MIN", 1_000)
     built = [build_bvh(a, b, c, threads=n) for n in (1, 2, 3)]
     assert leaf_sets(built[0]) == leaf_sets(one_pass)
     assert built[0].node_total == one_pass.node_total and built[0].depth == one_pass.depth
