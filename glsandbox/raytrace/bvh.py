@@ -391,7 +391,7 @@ def _threads(threads: int | None) -> int:
 
 
 def _split_tree(rows: NDArray[np.float32], leaf_size: int, bins: int, pool: ThreadPoolExecutor | None) -> _Tree:
-    """The tree over the triangles whose boxes are ``rows`` (``(6, K)``: min, max; left as they are).
+    """The tree over the triangles whose boxes are ``rows`` (``(6, K)``: min, max; used as a buffer).
 
     Big nodes are binned level by level (:func:`_split_levels`), small ones
     swept (:func:`_split_small`). A node of :data:`PART_MIN` triangles or more
@@ -413,7 +413,7 @@ def _split_tree(rows: NDArray[np.float32], leaf_size: int, bins: int, pool: Thre
         one = np.ones(1, dtype=np.int64)
         _split_small(tree, (np.arange(k), one - 1, one * k, one, rows), leaf_size)
         return tree
-    start = _Open(np.arange(k), rows.copy(), np.array([k], dtype=np.int64),
+    start = _Open(np.arange(k), rows, np.array([k], dtype=np.int64),  # rows: overwritten from here on
                   rows[0:3].min(axis=1)[None, :].astype(np.float64), rows[3:6].max(axis=1)[None, :].astype(np.float64),
                   np.zeros(1, dtype=np.int64), 1)
     _split_part(start, tree, leaf_size, bins, pool)
