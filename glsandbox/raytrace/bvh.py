@@ -842,6 +842,13 @@ def _split_small(tree: _Tree, small: tuple[NDArray[np.int64], NDArray[np.int64],
     table[0:3, :-1] = boxes[0:3]
     np.negative(boxes[3:6], out=table[3:6, :-1])
     table[:, -1] = np.inf
+    # The sort keys of the triangles (and the padding): twice the centroid, its float32 bits made
+    # an int32 of the same order (a negative float's magnitude bits flipped); padding sorts last.
+    with np.errstate(invalid="ignore"):
+        keys = table[0:3] - table[3:6]  # min + max; padding: NaN
+    order_bits = keys.view(np.int32)
+    order_bits ^= (order_bits >> 31) & np.int32(0x7FFFFFFF)
+    order_bits[:, -1] = np.iinfo(np.int32).max
     while ids.size:
         starts = np.cumsum(counts) - counts
         width_class = WIDTHS[np.searchsorted(WIDTHS, counts)]  # the narrowest padding that holds the node
@@ -850,7 +857,7 @@ def _split_small(tree: _Tree, small: tuple[NDArray[np.int64], NDArray[np.int64],
             members = np.flatnonzero(width_class == w)
             for part in range(0, members.size, max(1, SMALL_CHUNK // int(w))):
                 sel = members[part:part + max(1, SMALL_CHUNK // int(w))]
-                sorted_tris, cut = _small_cuts(table, tris, starts[sel], counts[sel], int(w), leaf_size)
+                sorted_tris, cut = _small_cuts(table, order_bits, tris, starts[sel], counts[sel], int(w), leaf_size)
                 out_tris.append(sorted_tris)
                 out_cuts.append(cut)
                 order_nodes.append(sel)
@@ -875,26 +882,21 @@ def _split_small(tree: _Tree, small: tuple[NDArray[np.int64], NDArray[np.int64],
         depths = child_depth[~is_leaf]
 
 
-def _small_cuts(table: NDArray[np.float32], tris: NDArray[np.int64], starts: NDArray[np.int64],
-                counts: NDArray[np.int64], w: int, leaf_size: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+def _small_cuts(table: NDArray[np.float32], order_bits: NDArray[np.int32], tris: NDArray[np.int64],
+                starts: NDArray[np.int64], counts: NDArray[np.int64], w: int, leaf_size: int
+                ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """The best cut of each of ``r`` nodes (triangles ``tris[starts[j] : starts[j] + counts[j]]``,
-    at most ``w`` each): their triangles in the chosen order (left child first, node after node)
-    and the left child's triangle count."""
+    at most ``w`` each; boxes in ``table``, sort keys in ``order_bits``): their triangles in the
+    chosen order (left child first, node after node) and the left child's triangle count."""
     r = counts.size
     slot = np.arange(w)[:, None]
     valid = slot < counts  # (w, r): slot i of node j holds a triangle
     tri = np.where(valid, tris[np.minimum(starts + slot, tris.size - 1)], table.shape[1] - 1)  # (w, r)
-    boxes = np.take(table, tri, axis=1)  # (6, w, r); padding: the empty box, no effect on running minima
-    # Sort keys: twice the centroid, its float32 bits made an int32 of the same order (a negative
-    # float's magnitude bits flipped), then the slot in the low bits: np.sort of int64 keys is
+    # Sort keys: the centroid's order bits, then the slot in the low bits: np.sort of int64 keys is
     # several times faster than np.argsort of floats, and the slot is read back from the key.
-    with np.errstate(invalid="ignore"):
-        centre = boxes[0:3] - boxes[3:6]  # (3, w, r); padding: NaN
-    bits = centre.view(np.int32)
-    bits ^= (bits >> 31) & np.int32(0x7FFFFFFF)
-    bits[:, ~valid] = np.iinfo(np.int32).max  # padding sorts last
+    bits = np.take(order_bits, tri, axis=1)  # (3, w, r); padding sorts last
     shift = int(w - 1).bit_length()
-    flat = boxes.reshape(6, w * r)
+    flat_tri = tri.reshape(-1)
     cuts = np.arange(1, w, dtype=np.float32)[:, None]  # cut i: sorted triangles [0, i) go left
     no_cut = cuts >= counts  # (w − 1, r)
     columns = np.arange(r)
@@ -914,7 +916,8 @@ def _small_cuts(table: NDArray[np.float32], tris: NDArray[np.int64], starts: NDA
         keys.sort(axis=1)
         order = keys & ((1 << shift) - 1)  # (r, w): node j's slots by centroid
         orders.append(order)
-        sweep = np.take(flat, order.T * r + columns, axis=1)  # (6, w, r): the boxes in that order
+        # (6, w, r): the boxes in that order, padding the empty box (no effect on running minima).
+        sweep = np.take(table, flat_tri[order.T * r + columns], axis=1)
         back = np.empty_like(sweep)
         back[:, w - 1] = sweep[:, w - 1]
         for i in range(w - 2, -1, -1):  # boxes of slots i ..
