@@ -33,6 +33,21 @@ triangles all fall into one bin (all centroids in one point) is cut in half
 by count. The boxes used for binning are the heuristic's; the stored node
 boxes are recomputed exactly from the triangles at the end, leaves first.
 
+Parts and threads
+-----------------
+Every choice above is made per node, from the node's own triangles, so the
+nodes of a level can be split in separate calls and give the same tree. A
+node of at least :data:`PART_MIN` triangles is split level by level only
+until :data:`PARTS` nodes are open below it; each of their subtrees is then a
+*part* built on its own (and cut in parts again while it is that big), the
+small nodes made on the way one more (``_split_part``). A part's arrays are a
+fraction of the model's, so they stay in the CPU's caches (about 10% less CPU
+time on a million triangles), and the top's parts are built in threads (up to
+:data:`THREADS`, the CPUs the process may use; numpy lets go of the GIL in its
+loops over arrays): about half the wall-clock time on two cores. A part numbers
+its nodes from 0 and is grafted into the tree in a fixed order, so the arrays
+are the same for any number of threads.
+
 Small nodes: the full sweep
 ---------------------------
 Bins pay off on big nodes. On a node of a few dozen triangles sixteen bins
@@ -98,6 +113,7 @@ __all__ = [
     "CACHE_SIZE",
     "LEAF_SIZE",
     "build_bvh",
+    "build_threads",
     "bvh_for_mesh",
     "bvh_for_triangles",
     "clear_cache",
@@ -251,7 +267,7 @@ def _build_bvh(v0: ArrayLike, v1: ArrayLike, v2: ArrayLike, *, leaf_size: int = 
     if not 1 <= int(leaf_size) <= 64 or not 2 <= int(bins) <= 64:
         raise RayTraceError(f"leaf_size must be in 1..64 and bins in 2..64, got {leaf_size} and {bins}")
     a, b, c = _triangle_arrays(v0, v1, v2)
-    threads = _threads(threads)
+    threads = build_threads(threads)
     if threads > 1 and a.shape[0] >= PART_MIN:
         with ThreadPoolExecutor(max_workers=threads) as pool:
             return _build(a, b, c, int(leaf_size), int(bins), pool)
@@ -379,7 +395,7 @@ class _Tree:
         return first, count
 
 
-def _threads(threads: int | None) -> int:
+def build_threads(threads: int | None = None) -> int:
     """Threads for a build: ``threads``, or by default the CPUs this process may use, at most :data:`THREADS`."""
     if threads is not None:
         return max(1, int(threads))

@@ -11,7 +11,7 @@ import pytest
 
 from glsandbox import meshgen
 from glsandbox.raytrace import bvh as bvh_module
-from glsandbox.raytrace.bvh import LEAF_SIZE, SMALL, build_bvh, mesh_world_triangles, sah_cost
+from glsandbox.raytrace.bvh import LEAF_SIZE, SMALL, build_bvh, build_threads, mesh_world_triangles, sah_cost
 
 
 def fan(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -137,3 +137,8 @@ def test_a_build_in_parts_and_threads_is_the_tree_of_one_pass(monkeypatch) -> No
     for field in ("node_min", "node_max", "node_first", "node_count", "v0", "v1", "v2", "tri_index"):
         assert all(np.array_equal(getattr(built[0], field), getattr(other, field)) for other in built[1:]), field
     assert leaves_hold_every_triangle_once(built[1]) and built[1].triangle_count == one_pass.triangle_count
+
+
+def test_build_threads_are_the_usable_cpus_at_most_threads() -> None:
+    assert build_threads(3) == 3 and build_threads(0) == 1
+    assert 1 <= build_threads() <= bvh_module.THREADS
