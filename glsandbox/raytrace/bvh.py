@@ -583,8 +583,7 @@ def _split_levels(start: _Open, tree: _Tree, leaf_size: int, max_bins: int, stop
             rel *= np.repeat((0.5 * scale[:, axis]).astype(np.float32), taken)
             np.clip(rel, 0, bins - 1, out=rel)
             bin_row[axis] = rel
-            bin_key[axis] = bin_row[axis]
-            bin_key[axis] += node_key
+            np.add(bin_row[axis], node_key, out=bin_key[axis])
         del rel, node_key
         best_cost = np.full(n, np.inf)
         best_axis = np.zeros(n, dtype=np.int64)
@@ -681,7 +680,10 @@ def _split_levels(start: _Open, tree: _Tree, leaf_size: int, max_bins: int, stop
         if sampled:
             # Only the chosen axis's bin of every column, by the same float32 steps as above; its
             # exact counts then pick the cut on that axis (the sample chose the axis).
-            rel = np.where(axis_of == 0, cen[0], np.where(axis_of == 1, cen[1], cen[2]))
+            if (best_axis == best_axis[0]).all():  # one axis for all (the top levels: one or two nodes)
+                rel = cen[best_axis[0]].copy()
+            else:
+                rel = np.where(axis_of == 0, cen[0], np.where(axis_of == 1, cen[1], cen[2]))
             rel -= np.repeat((2.0 * box_lo[nodes, best_axis]).astype(np.float32), counts)
             rel *= np.repeat((0.5 * scale[nodes, best_axis]).astype(np.float32), counts)
             np.clip(rel, 0, bins - 1, out=rel)
