@@ -227,7 +227,13 @@ def _empty_bvh(count: int) -> BVH:
 def _sweep(lo: NDArray[np.float32], hi: NDArray[np.float32], forward: bool
            ) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
     """Running boxes over the bins of ``(3, B, n)`` arrays: bins ``0..s`` (forward)
-    or ``s..B−1`` (backward), one numpy call per bin on contiguous ``(3, n)`` slices."""
+    or ``s..B−1`` (backward), one numpy call per bin on contiguous ``(3, n)`` slices,
+    or for few nodes (the levels of a part's top) one ``accumulate`` per bound."""
+    if lo.shape[2] < 64:  # a call per bin costs more than the bins' work here
+        if forward:
+            return np.minimum.accumulate(lo, axis=1), np.maximum.accumulate(hi, axis=1)
+        return (np.minimum.accumulate(lo[:, ::-1], axis=1)[:, ::-1],
+                np.maximum.accumulate(hi[:, ::-1], axis=1)[:, ::-1])
     run_lo = lo.copy()
     run_hi = hi.copy()
     count = lo.shape[1]
