@@ -51,7 +51,7 @@ from raytrace import EMBREE_MISSING, MODES, embree_available, embree_side
 
 from glsandbox import Camera, Light, Material, Mesh, Node, Scene, load_model, meshgen
 from glsandbox.raytrace import render
-from glsandbox.raytrace.bvh import build_bvh, build_threads, bvh_for_triangles
+from glsandbox.raytrace.bvh import build_bvh, bvh_for_triangles
 from glsandbox.raytrace.bvh_traverse import closest_hit
 from glsandbox.raytrace.world import build_world, camera_rays
 
@@ -197,7 +197,7 @@ def cases(env: Any) -> list:
         def run(_: int) -> float:
             return build_bvh(*triangles(label)).build_seconds  # build_bvh: never the cached one
 
-        return Side(f"build_bvh (binned SAH, numpy, {build_threads()} threads)", run)
+        return Side("build_bvh (binned SAH, numpy, threads on idle CPUs)", run)
 
     def embree_build(label: str) -> Side:
         def run(_: int) -> None:

@@ -139,6 +139,6 @@ def test_a_build_in_parts_and_threads_is_the_tree_of_one_pass(monkeypatch) -> No
     assert leaves_hold_every_triangle_once(built[1]) and built[1].triangle_count == one_pass.triangle_count
 
 
-def test_build_threads_are_the_usable_cpus_at_most_threads() -> None:
+def test_build_threads_are_the_idle_usable_cpus_at_most_threads() -> None:
     assert build_threads(3) == 3 and build_threads(0) == 1
     assert 1 <= build_threads() <= bvh_module.THREADS
