@@ -744,10 +744,6 @@ def _split_levels(start: _Open, tree: _Tree, leaf_size: int, max_bins: int, stop
         child = node_of
         child *= 2
         child += right
-        child_count = np.bincount(child, minlength=2 * n)
-        child_ids, is_leaf = tree.children(open_ids, child_count, leaf_size)
-        level += 1
-        tree.depth = max(tree.depth, level)
         # Each column's rank within its child (lefts keep their order, rights
         # too): with the child's start, its place in the partition below.
         # A right column's rank is the rights before it less the rights before its node's first
@@ -757,6 +753,12 @@ def _split_levels(start: _Open, tree: _Tree, leaf_size: int, max_bins: int, stop
         np.cumsum(rights_before, out=rights_before)
         rights_before -= right  # rights in columns [0, i)
         at_start = rights_before[starts]
+        child_count = np.empty(2 * n, dtype=np.int64)  # a node's rights: those before the next node's less its own
+        child_count[1::2] = np.append(at_start[1:], rights_before[-1] + right[-1]) - at_start
+        np.subtract(counts, child_count[1::2], out=child_count[0::2])
+        child_ids, is_leaf = tree.children(open_ids, child_count, leaf_size)
+        level += 1
+        tree.depth = max(tree.depth, level)
         offset = np.empty(2 * n, dtype=np.int64)
         offset[0::2] = starts - at_start  # lefts before each node's first column
         offset[1::2] = at_start
