@@ -27,6 +27,13 @@ answer when the ray turns by a few float32 steps (:data:`EDGE_TURN`): there,
 float32 and float64 may rightly disagree. Any other differing pixel is a
 wrong hit or a hole.
 
+Beside the gpu engine's rows, when Mitsuba 3 is installed and its LLVM variant
+runs (the ``mitsuba`` group, which needs libLLVM: :mod:`benchmarks._mitsuba`), a
+``mitsuba`` row per model and mode: Mitsuba's ``llvm_ad_rgb`` casting exactly
+Embree's rays as one Dr.Jit wavefront, against Embree in the same run. Its first
+cast (the warm-up) compiles the kernel; the timed casts reuse it. Without it the
+rows are left out and a line under the table says why.
+
 A first row times building the BVH of the largest model (issue 11's goal: under
 2 s for 1M triangles) beside Embree building its own for the same triangles.
 
@@ -47,6 +54,7 @@ from typing import Any
 import numpy as np
 
 from _bunny import bunny_path
+from _mitsuba import mitsuba_missing, mitsuba_side
 from raytrace import EMBREE_MISSING, MODES, embree_available, embree_side
 
 from glsandbox import Camera, Light, Material, Mesh, Node, Scene, load_model, meshgen
@@ -61,6 +69,8 @@ SIZES = (1_000, 10_000, 100_000, 1_000_000)
 #: Issue 11's goals as time ratios against Embree.
 GOALS = {"gpu": 2.0, "numpy": 50.0}
 ENGINE_LABELS = {"gpu": "gpu engine (GLSL float32)", "numpy": "numpy engine (float64)"}
+MITSUBA_NOTE = ("ratio = Mitsuba time / Embree time for the same rays; kernel compiled at the warm-up, "
+                "not timed; Dr.Jit on all cores, the CPU column counts its main thread only")
 BACKGROUND = (1.0, 0.0, 1.0, 1.0)  # magenta: no shade of the grey model
 #: How far a ray is turned to test whether it lies within float32 of an edge:
 #: 8 float32 steps at 1 (2^-21 relative), in 8 directions around it.
@@ -158,6 +168,9 @@ def cases(env: Any) -> list:
         labels.insert(2, "bunny")
     elif bunny_path() is None:
         env.note(f"{GROUP}: the bunny skipped: pymeshlab not installed (uv run --group bench glsandbox bench)")
+    mitsuba_why = mitsuba_missing()
+    if mitsuba_why is not None:
+        env.note(f"{GROUP}: the Mitsuba rows skipped: {mitsuba_why}")
     references: dict[str, HitMiss] = {}
 
     def reference(label: str) -> HitMiss:
@@ -222,6 +235,10 @@ def cases(env: Any) -> list:
                 found.append(Case(GROUP, f"{name}, {mode}, {kind}", embree(label, mode), engine(label, mode, kind),
                                   repeat=1, unit="s", goal=GOALS[kind], compare=hit_miss(label),
                                   note="ratio = engine time / Embree time for the same rays"))
+            if mitsuba_why is None:
+                found.append(Case(GROUP, f"{name}, {mode}, mitsuba", embree(label, mode),
+                                  mitsuba_side(lambda label=label: model_scene(label), size, mode, BACKGROUND),
+                                  repeat=1, unit="s", compare=hit_miss(label), note=MITSUBA_NOTE))
     return found
 
 
@@ -267,5 +284,11 @@ def summarize(results: Sequence[Any]) -> list[str]:
         if pairs:
             text = ", ".join(f"{model} {factor:.2f}x" for model, factor in pairs)
             lines.append(f"{GROUP}: {kind} engine, shadow+bounce ratio / primary ratio: {text} (goal: within 2x)")
+    # The gpu engine against Mitsuba: their two ratios to Embree, each measured side by side with it.
+    versus = [f"{model} {mode} {ratios[model, mode, 'gpu'] / ratios[model, mode, 'mitsuba']:.1f}x"
+              for model, mode, kind in ratios if kind == "mitsuba" and (model, mode, "gpu") in ratios]
+    if versus:
+        lines.append(f"{GROUP}: gpu engine time / Mitsuba time (each ratio to Embree in its own rows): "
+                     + ", ".join(versus))
     return lines
 

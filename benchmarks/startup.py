@@ -2,8 +2,10 @@
 
 Cold start: ``glsandbox render indexed_cube`` at 800x600 vs the raw ModernGL
 script path of ``cube_frame.py --raw-once`` (context, resources, one frame,
-one PNG). The tour renders every lesson in one process; it has no baseline,
-its time is printed on its own.
+one PNG). The "extra CPU" column is the glsandbox process's CPU beyond the
+raw script's (user and system, all threads: the child processes' rusage),
+steadier than wall time on a busy machine. The tour renders every lesson in
+one process; it has no baseline, its time is printed on its own.
 """
 
 from __future__ import annotations

@@ -27,8 +27,7 @@ The layers below (the README's "How it works" table) import downwards only;
 
 import importlib
 
-from glsandbox import camera, geometry, transforms
-from glsandbox.planar import Mirror, PlanarShadow
+from glsandbox import geometry, transforms
 from glsandbox.errors import SandboxError
 from glsandbox.version import __version__
 from glsandbox.geometry import Mesh
@@ -62,8 +61,12 @@ __all__ = [
 
 
 # Names whose modules a plain ``glsandbox render`` does not need (model files, the model
-# generators, texture checks): imported on first use (PEP 562), so a cold start skips them.
+# generators, texture checks, the window's camera controls, the planar effects): imported on
+# first use (PEP 562), so a cold start skips them.
 _LAZY = {
+    "camera": ("glsandbox.camera", None),
+    "Mirror": ("glsandbox.planar", "Mirror"),
+    "PlanarShadow": ("glsandbox.planar", "PlanarShadow"),
     "meshgen": ("glsandbox.meshgen", None),
     "check_texture_source": ("glsandbox.images", "check_texture_source"),
     "Model": ("glsandbox.meshfile", "Model"),

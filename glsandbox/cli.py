@@ -490,8 +490,14 @@ def add_command(sub: argparse._SubParsersAction, name: str) -> argparse.Argument
                           formatter_class=argparse.RawDescriptionHelpFormatter)
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The command line's parser: every subcommand, or with ``command`` only that one (what a
+    command line naming it parses: the other nine cost argparse about 1.5 ms of a cold start,
+    issue 24; the one built is the same)."""
     from glsandbox.version import __version__
+
+    def wanted(name: str) -> bool:
+        return command is None or name == command
 
     parser = ArgumentParser(prog="glsandbox", description="A graphics course as runnable ModernGL lessons.",
                             epilog="glsandbox COMMAND --help says what a command does, with examples.")
@@ -499,11 +505,14 @@ def build_parser() -> argparse.ArgumentParser:
                         help="print glsandbox's version and exit")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    p = add_command(sub, "list")
-    p.add_argument("-v", "--verbose", action="store_true", help="also list each lesson's parameters")
-    p.set_defaults(func=cmd_list)
+    if wanted("list"):
+        p = add_command(sub, "list")
+        p.add_argument("-v", "--verbose", action="store_true", help="also list each lesson's parameters")
+        p.set_defaults(func=cmd_list)
 
     for name, func in (("run", cmd_run), ("render", cmd_render), ("plan", cmd_plan)):
+        if not wanted(name):
+            continue
         p = add_command(sub, name)
         p.add_argument("lesson", metavar="LESSON", help="a lesson name, a lesson .py file or a scene .toml file")
         add_render_options(p)
@@ -511,72 +520,80 @@ def build_parser() -> argparse.ArgumentParser:
             p.add_argument("--out", type=Path, required=True, help="the PNG file to write")
         p.set_defaults(func=func)
 
-    p = add_command(sub, "tour")
-    add_render_options(p, settings=False)  # --set is per lesson: tour refuses it
-    p.add_argument("--lessons", type=Path, default=None, metavar="DIR",
-                   help="the lesson files (.py, .toml) in DIR instead of the course's lessons")
-    p.add_argument("--out", type=Path, default=Path("out"), help="output folder (default out/)")
-    p.set_defaults(func=cmd_tour, settings=[])
+    if wanted("tour"):
+        p = add_command(sub, "tour")
+        add_render_options(p, settings=False)  # --set is per lesson: tour refuses it
+        p.add_argument("--lessons", type=Path, default=None, metavar="DIR",
+                       help="the lesson files (.py, .toml) in DIR instead of the course's lessons")
+        p.add_argument("--out", type=Path, default=Path("out"), help="output folder (default out/)")
+        p.set_defaults(func=cmd_tour, settings=[])
 
-    p = add_command(sub, "compare")
-    p.add_argument("lesson", metavar="LESSON", help="a lesson name, a lesson .py file or a scene .toml file")
-    p.add_argument("--vary", action="append", default=[], metavar="KEY=V1,V2,...",
-                   help="a parameter and its values, one tile each (twice: a grid)")
-    add_render_options(p)
-    p.add_argument("--out", type=Path, default=None, help="the PNG to write (default compare_LESSON.png)")
-    p.set_defaults(func=cmd_compare)
+    if wanted("compare"):
+        p = add_command(sub, "compare")
+        p.add_argument("lesson", metavar="LESSON", help="a lesson name, a lesson .py file or a scene .toml file")
+        p.add_argument("--vary", action="append", default=[], metavar="KEY=V1,V2,...",
+                       help="a parameter and its values, one tile each (twice: a grid)")
+        add_render_options(p)
+        p.add_argument("--out", type=Path, default=None, help="the PNG to write (default compare_LESSON.png)")
+        p.set_defaults(func=cmd_compare)
 
-    p = add_command(sub, "new")
-    p.add_argument("name", metavar="NAME", nargs="?", default=None,
-                   help="the lesson's name, a Python identifier (e.g. my_lesson)")
-    p.add_argument("--assignment", metavar="NAME", default=None,
-                   help="instead: a model answer NAME.py and a starting grading file NAME.grading.toml")
-    p.add_argument("--dir", type=Path, default=Path("."), help="the folder to write into (default: here)")
-    p.set_defaults(func=cmd_new)
+    if wanted("new"):
+        p = add_command(sub, "new")
+        p.add_argument("name", metavar="NAME", nargs="?", default=None,
+                       help="the lesson's name, a Python identifier (e.g. my_lesson)")
+        p.add_argument("--assignment", metavar="NAME", default=None,
+                       help="instead: a model answer NAME.py and a starting grading file NAME.grading.toml")
+        p.add_argument("--dir", type=Path, default=Path("."), help="the folder to write into (default: here)")
+        p.set_defaults(func=cmd_new)
 
-    p = add_command(sub, "check")
-    p.add_argument("lesson", metavar="LESSON_OR_DIR",
-                   help="a lesson name, .py or .toml file, or a folder of them (one line each, and a table)")
-    p.add_argument("--golden", type=Path, default=None, metavar="REF.png", help="the reference image")
-    p.add_argument("--rubric", type=Path, default=None, metavar="FILE.toml",
-                   help="a grading file: several checks, each with its golden, settings and points")
-    p.add_argument("--update", action="store_true",
-                   help="write the references when missing or different (a passing one is kept)")
-    p.add_argument("--tolerance", action="append", default=[], metavar="KEY=VALUE",
-                   help="threshold=LEVELS (default 2) or max_bad_share=FRACTION (default 0.0005); repeatable")
-    p.add_argument("--jobs", type=int, default=None, metavar="N",
-                   help="submissions graded at once (default: the number of cores)")
-    p.add_argument("--timeout", type=float, default=None, metavar="SECONDS",
-                   help="time for each picture of a submission (default 30)")
-    p.add_argument("--memory", type=int, default=None, metavar="MB",
-                   help="memory (address space) of each submission (default 2048)")
-    for kind, text in (("csv", "the figures as CSV"), ("json", "the figures as JSON"),
-                       ("html", "a page: a row per student with reference | submission | difference"),
-                       ("junit", "JUnit XML (what CI systems read)"),
-                       ("gradescope", "Gradescope's results.json")):
-        p.add_argument(f"--{kind}", type=Path, default=None, metavar="FILE", help=f"folder mode: {text}")
-    add_render_options(p, size_default="the reference's size")
-    p.set_defaults(func=cmd_check)
+    if wanted("check"):
+        p = add_command(sub, "check")
+        p.add_argument("lesson", metavar="LESSON_OR_DIR",
+                       help="a lesson name, .py or .toml file, or a folder of them (one line each, and a table)")
+        p.add_argument("--golden", type=Path, default=None, metavar="REF.png", help="the reference image")
+        p.add_argument("--rubric", type=Path, default=None, metavar="FILE.toml",
+                       help="a grading file: several checks, each with its golden, settings and points")
+        p.add_argument("--update", action="store_true",
+                       help="write the references when missing or different (a passing one is kept)")
+        p.add_argument("--tolerance", action="append", default=[], metavar="KEY=VALUE",
+                       help="threshold=LEVELS (default 2) or max_bad_share=FRACTION (default 0.0005); repeatable")
+        p.add_argument("--jobs", type=int, default=None, metavar="N",
+                       help="submissions graded at once (default: the number of cores)")
+        p.add_argument("--timeout", type=float, default=None, metavar="SECONDS",
+                       help="time for each picture of a submission (default 30)")
+        p.add_argument("--memory", type=int, default=None, metavar="MB",
+                       help="memory (address space) of each submission (default 2048)")
+        for kind, text in (("csv", "the figures as CSV"), ("json", "the figures as JSON"),
+                           ("html", "a page: a row per student with reference | submission | difference"),
+                           ("junit", "JUnit XML (what CI systems read)"),
+                           ("gradescope", "Gradescope's results.json")):
+            p.add_argument(f"--{kind}", type=Path, default=None, metavar="FILE", help=f"folder mode: {text}")
+        add_render_options(p, size_default="the reference's size")
+        p.set_defaults(func=cmd_check)
 
-    p = add_command(sub, "tradeoffs")
-    p.add_argument("--out", type=Path, default=Path("out/tradeoffs"), help="output folder (default out/tradeoffs)")
-    p.add_argument("--quick", action="store_true", help="a reduced set at a small size (for CI)")
-    p.add_argument("--runs", type=int, default=5, help="timed runs per setting (at least 5, default 5)")
-    p.add_argument("--knob", action="append", default=[], metavar="NAME", help="only this knob (repeatable)")
-    p.add_argument("--backend", default=None, help="GL backend (default: GLSANDBOX_BACKEND or auto)")
-    p.set_defaults(func=cmd_tradeoffs)
+    if wanted("tradeoffs"):
+        p = add_command(sub, "tradeoffs")
+        p.add_argument("--out", type=Path, default=Path("out/tradeoffs"), help="output folder (default out/tradeoffs)")
+        p.add_argument("--quick", action="store_true", help="a reduced set at a small size (for CI)")
+        p.add_argument("--runs", type=int, default=5, help="timed runs per setting (at least 5, default 5)")
+        p.add_argument("--knob", action="append", default=[], metavar="NAME", help="only this knob (repeatable)")
+        p.add_argument("--backend", default=None, help="GL backend (default: GLSANDBOX_BACKEND or auto)")
+        p.set_defaults(func=cmd_tradeoffs)
 
-    p = add_command(sub, "bench")
-    p.add_argument("--json", type=Path, default=None, metavar="FILE", help="also write the figures as JSON")
-    p.add_argument("--quick", action="store_true", help="fewer frames and rounds (a smoke run)")
-    p.add_argument("--only", action="append", default=[], metavar="NAME",
-                   help="only benchmarks whose name contains NAME (repeatable)")
-    p.set_defaults(func=cmd_bench)
+    if wanted("bench"):
+        p = add_command(sub, "bench")
+        p.add_argument("--json", type=Path, default=None, metavar="FILE", help="also write the figures as JSON")
+        p.add_argument("--quick", action="store_true", help="fewer frames and rounds (a smoke run)")
+        p.add_argument("--only", action="append", default=[], metavar="NAME",
+                       help="only benchmarks whose name contains NAME (repeatable)")
+        p.set_defaults(func=cmd_bench)
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    words = sys.argv[1:] if argv is None else argv
+    named = words[0] if words and words[0] in COMMANDS else None  # else: the whole parser (--help, a mistake)
+    args = build_parser(named).parse_args(argv)
     return run_guarded(lambda: args.func(args))
 
 

@@ -17,7 +17,8 @@ them:
 each problem is one :class:`SandboxError` naming the file and line. Then the
 **size**: the triangles the header says (PLY, OFF, binary STL, OBJ's ``f``
 lines) times :data:`BYTES_PER_TRIANGLE`, the peak a load and its first frame
-need, is checked against a limit *before* any array is made
+need (for an OBJ, at least what trimesh's parse of its text needs, by its bytes and lines:
+:func:`needed_bytes`), is checked against a limit *before* any array is made
 (:func:`check_memory`); a glTF's count is known only once read, and is
 checked then, before glsandbox's own arrays. The limit is three quarters of
 the memory the system has available, or the environment variable
@@ -32,11 +33,21 @@ from pathlib import Path
 
 from glsandbox.errors import SandboxError
 
-__all__ = ["BYTES_PER_TRIANGLE", "MEMORY_ENV", "check_memory", "checked_data", "claimed_triangles", "memory_limit"]
+__all__ = ["BYTES_PER_TRIANGLE", "MEMORY_ENV", "OBJ_BYTES_PER_FILE_BYTE", "OBJ_BYTES_PER_LINE", "check_memory",
+           "checked_data", "claimed_triangles", "memory_limit", "needed_bytes"]
 
 #: The memory a model needs per triangle to be loaded and drawn, at the peak (measured by
 #: ``glsandbox bench``'s model rows at 165-206 bytes for binary files; rounded up).
 BYTES_PER_TRIANGLE = 256
+
+#: An OBJ's text costs trimesh's reader, at its peak, this many bytes per byte of the file plus
+#: :data:`OBJ_BYTES_PER_LINE` per line (its copies of the text, and a Python string per line).
+#: Measured (traced peak of a load): 348 bytes per triangle for a triangle repeated, 36 bytes and 4
+#: lines each (this gives 384); 572 for the bunny's ``f a//a``, 69 bytes and 2 lines (600); 745 with
+#: uvs and normals, 95 bytes and 2.5 lines (820). Before glsandbox's own arrays exist, so an OBJ
+#: needs the larger of this and :data:`BYTES_PER_TRIANGLE` per triangle.
+OBJ_BYTES_PER_FILE_BYTE = 8
+OBJ_BYTES_PER_LINE = 24
 
 #: The environment variable that sets the memory a model may use (bytes, or ``512M``, ``8G``).
 MEMORY_ENV = "GLSANDBOX_MODEL_MEMORY"
@@ -58,7 +69,7 @@ def checked_data(p: Path, data: bytes, file_type: str) -> bytes:
             _check_ply_lines(p, data, header_end, elements)
     elif file_type == "off":
         _check_off(p, data)
-    elif file_type == "obj":
+    elif file_type == "obj" and not data.isascii():  # (ASCII is UTF-8: no decoding to find out)
         try:
             data.decode("utf-8")
         except UnicodeDecodeError:  # Latin-1 maps every byte to a character: always readable
@@ -98,10 +109,21 @@ def memory_limit() -> int:
     return int(_available_bytes() * AVAILABLE_SHARE)
 
 
-def check_memory(p: Path, triangles: int) -> None:
-    """Refuse a model whose triangles need more memory than :func:`memory_limit` allows: one line
-    with the count, the memory it needs, the limit and how to raise it."""
+def needed_bytes(triangles: int, file_type: str = "", data: bytes = b"") -> int:
+    """The memory loading and drawing a model needs at the peak: :data:`BYTES_PER_TRIANGLE` per
+    triangle, or for an OBJ (``data``: its text) trimesh's parse of the text if that is more
+    (:data:`OBJ_BYTES_PER_FILE_BYTE`, :data:`OBJ_BYTES_PER_LINE`)."""
     need = triangles * BYTES_PER_TRIANGLE
+    if file_type == "obj":
+        need = max(need, len(data) * OBJ_BYTES_PER_FILE_BYTE + (data.count(b"\n") + 1) * OBJ_BYTES_PER_LINE)
+    return need
+
+
+def check_memory(p: Path, triangles: int, need: int | None = None) -> None:
+    """Refuse a model whose triangles need more memory than :func:`memory_limit` allows: one line
+    with the count, the memory it needs (``need``, else :func:`needed_bytes` of the count), the
+    limit and how to raise it."""
+    need = needed_bytes(triangles) if need is None else need
     limit = memory_limit()
     if need > limit:
         raise SandboxError(f"model file {p}: {triangles:,} triangles need about {_size(need)} of memory to load "

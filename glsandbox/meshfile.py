@@ -43,8 +43,10 @@ needs more memory than ``GLSANDBOX_MODEL_MEMORY`` allows
 (:mod:`glsandbox.meshcheck`). Time and memory are linear in the triangles:
 normals and vertices are made by :mod:`glsandbox.meshnormals` (integer ids,
 no per-position square work), a glTF's nodes placed once each, the per-face
-steps done in blocks (about 155-190 bytes per triangle of numpy's arrays at the peak for a binary
-file; an OBJ's text costs trimesh's reader about 600 more). Loads are cached by (resolved path, modification
+steps done in blocks (about 155-190 bytes per triangle of numpy's arrays at the peak, from the parsed
+file to the first frame). An OBJ's text is trimesh's largest cost: its parse peaks at about 8 bytes
+per byte of the file (572 per triangle for the bunny with normals), so the text is handed to trimesh
+and no copy of it is kept here. Loads are cached by (resolved path, modification
 time, size, options): loading a file again returns the same :class:`Model`
 (and the same Mesh object, whose GPU buffers the executor keeps), until the
 file changes. trimesh's log messages and warnings are kept off stderr.
@@ -72,8 +74,8 @@ from numpy.typing import NDArray
 from glsandbox.errors import SandboxError
 from glsandbox.files import open_user_file
 from glsandbox.geometry import Mesh
-from glsandbox.meshcheck import MEMORY_ENV, check_memory, checked_data, claimed_triangles
-from glsandbox.meshlooks import Look, file_warnings, is_closed, look_of
+from glsandbox.meshcheck import MEMORY_ENV, check_memory, checked_data, claimed_triangles, needed_bytes
+from glsandbox.meshlooks import Look, file_warnings, is_closed, look_of, warning_data
 from glsandbox.meshnormals import face_geometry, normal_groups, row_ids, split_vertices
 from glsandbox.scene import Material, Node, Texture
 
@@ -249,17 +251,19 @@ def load_model(path: str | os.PathLike[str], *, fit: bool = False, normals: str 
     data = checked_data(p, data, file_type)
     claimed = claimed_triangles(data, file_type)
     if claimed is not None:
-        check_memory(p, claimed)  # before the reader makes a single array
-    scene = _trimesh_scene(p, data, file_type)
-    if file_type not in ("gltf", "glb", "obj"):
-        data = b""  # only a glTF's JSON and an OBJ's lines are read again (for what is not drawn)
+        check_memory(p, claimed, needed_bytes(claimed, file_type, data))  # before the reader makes an array
+    said = warning_data(data, file_type)  # only a glTF's JSON and an OBJ's mtllib lines are read again
+    source = _Source(data, file_type)
+    del data  # the reader holds the file's only copy: an OBJ's text is dropped as trimesh copies it
+    scene = _trimesh_scene(p, source, file_type)
+    del source
     parts = _parts(p, scene)
     del scene
     gc.collect()  # trimesh's objects hold reference cycles: its copies of the data go now, not later
     triangles = sum(part.faces.shape[0] for part in parts)
     check_memory(p, triangles)  # the count itself, for a glTF whose count no header gives
     try:
-        model = _model(p, file_type, parts, bool(fit), normals, float(crease_angle), data)
+        model = _model(p, file_type, parts, bool(fit), normals, float(crease_angle), said)
     except MemoryError:
         raise SandboxError(f"model file {p}: out of memory making {triangles:,} triangles drawable (set "
                            f"{MEMORY_ENV} below the memory this machine has, so a model too big is refused "
@@ -278,6 +282,12 @@ def fit_mesh(mesh: Mesh) -> Mesh:
         return mesh
     centre, scale = _fit_transform(positions, mesh.name)
     return replace(mesh, positions=(positions - centre) * scale)
+
+
+def _box(positions: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``[low, high]``, the bounding box of ``(N, 3)`` points: column by column (a reduction over
+    the rows of an ``(N, 3)`` array is several times slower; minima and maxima are exact either way)."""
+    return np.array([[column.min() for column in positions.T], [column.max() for column in positions.T]])
 
 
 def _fit_transform(positions: NDArray[np.float64], name: str = "model") -> tuple[NDArray[np.float64], float]:
@@ -331,8 +341,26 @@ def _reason(exc: BaseException) -> str:
     return text if len(text) <= 160 else text[:157] + "..."
 
 
-def _trimesh_scene(p: Path, data: bytes, file_type: str) -> Any:
-    """The file as a ``trimesh.Scene`` (every format becomes one), read from ``data``."""
+class _Source:
+    """The file's bytes as trimesh reads them: a binary file from memory; an OBJ as its text,
+    decoded here (:func:`glsandbox.meshcheck.checked_data` made it UTF-8, as trimesh would decode
+    it) and handed over at trimesh's one ``read()``: trimesh copies the text as it cleans it up,
+    and no copy of it is kept here (an OBJ's text is the reader's largest array)."""
+
+    def __init__(self, data: bytes, file_type: str) -> None:
+        self.text: str | None = data.decode("utf-8") if file_type == "obj" else None
+        self.stream = None if self.text is not None else io.BytesIO(data)
+
+    def reader(self) -> Any:
+        return self if self.text is not None else self.stream
+
+    def read(self, size: int = -1) -> str:  # trimesh's OBJ reader reads the whole text once
+        text, self.text = self.text or "", None
+        return text
+
+
+def _trimesh_scene(p: Path, source: _Source, file_type: str) -> Any:
+    """The file as a ``trimesh.Scene`` (every format becomes one), read from ``source``."""
     with _quiet():
         import trimesh  # only a model load pays for the import
         from trimesh.resolvers import FilePathResolver
@@ -352,8 +380,8 @@ def _trimesh_scene(p: Path, data: bytes, file_type: str) -> Any:
             resolver.file_path = _printable(resolver.file_path)
             loader = getattr(trimesh, "load_scene", None)
             if loader is not None:
-                return loader(io.BytesIO(data), file_type=file_type, resolver=resolver, process=False)
-            return trimesh.load(io.BytesIO(data), file_type=file_type, resolver=resolver, process=False,
+                return loader(source.reader(), file_type=file_type, resolver=resolver, process=False)
+            return trimesh.load(source.reader(), file_type=file_type, resolver=resolver, process=False,
                                 force="scene")
         except SandboxError:
             raise
@@ -495,12 +523,12 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
     # One vertex and face list for all parts, to check them as the file numbers them.
     offsets = np.cumsum([0] + [part.positions.shape[0] for part in parts])
     positions, faces = _all_parts(parts, offsets)
-    bad = np.flatnonzero(~np.isfinite(positions).all(axis=1))
-    if bad.size:
+    if not np.isfinite(positions.reshape(-1)).all():  # (flat: a row-wise test is ten times slower)
+        bad = np.flatnonzero(~np.isfinite(positions).all(axis=1))
         raise SandboxError(f"model file {p}: {_count(bad.size, 'vertex', 'vertices')} with NaN or infinite "
                            f"coordinates (the first is vertex {int(bad[0])})")
-    outside = (faces < 0) | (faces >= positions.shape[0])
-    if outside.any():
+    if faces.size and (faces.min() < 0 or faces.max() >= positions.shape[0]):
+        outside = (faces < 0) | (faces >= positions.shape[0])
         f = int(np.flatnonzero(outside.any(axis=1))[0])
         index = int(faces[f][outside[f]][0])
         raise SandboxError(f"model file {p}: face {f} refers to vertex {index}, but the file has "
@@ -533,7 +561,7 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
                            "(zero area or a repeated vertex)")
     transform = None
     if fit:  # the box of all parts' boxes
-        corners = np.concatenate([[mesh.positions.min(axis=0), mesh.positions.max(axis=0)] for _, mesh, _, _ in built])
+        corners = np.concatenate([_box(mesh.positions) for _, mesh, _, _ in built])
         transform = _fit_transform(corners)
     model_parts = []
     for i, (look, mesh, kept, how) in enumerate(built):

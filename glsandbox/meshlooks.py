@@ -42,7 +42,7 @@ from numpy.typing import NDArray
 
 from .meshnormals import BLOCK_FACES
 
-__all__ = ["Look", "file_warnings", "is_closed", "look_of"]
+__all__ = ["Look", "file_warnings", "is_closed", "look_of", "warning_data"]
 
 Rgba = tuple[float, float, float, float]
 
@@ -196,9 +196,28 @@ def _mix(x: NDArray[np.uint64]) -> NDArray[np.uint64]:
 # --- what is not drawn ------------------------------------------------------
 
 
+def warning_data(data: bytes, file_type: str) -> bytes:
+    """The part of a file's bytes that :func:`file_warnings` reads: a glTF's JSON, a GLB's
+    header and JSON chunk (not its binary buffers), an OBJ's ``mtllib`` lines (not its
+    vertices and faces), nothing of the other formats. Taken before the reader parses the
+    file, so the file's bytes need not be kept beside what it makes of them (the peak)."""
+    if file_type == "gltf":
+        return data
+    if file_type == "glb":
+        try:
+            length, kind = struct.unpack_from("<I4s", data, 12)
+        except struct.error:
+            return b""
+        return data[:20 + length] if kind == b"JSON" else b""
+    if file_type == "obj":  # the lines _obj_warnings matches, one a line (pos/endpos: no copy of the text)
+        return b"\n".join(match.group(0) for match in _MTLLIB.finditer(data, 0, _MTL_LIMIT))
+    return b""
+
+
 def file_warnings(path: Path, data: bytes, file_type: str, looks: list[Look]) -> dict[str, list[str]]:
     """What the file asks for that is not drawn: ``{part name: [what, ...]}``, the
-    file-wide things (animations, cameras) under ``""``. Never raises: a file this
+    file-wide things (animations, cameras) under ``""``. ``data``: the file's bytes, or
+    their part that :func:`warning_data` keeps. Never raises: a file this
     cannot read was refused by trimesh already or has nothing to say."""
     try:
         if file_type in ("gltf", "glb"):

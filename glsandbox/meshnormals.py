@@ -51,9 +51,12 @@ integers, so no corner-sized float matrix is ever hashed.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import NDArray
+
+if TYPE_CHECKING:  # annotations only: numpy.typing is not imported at run time (a cold start, issue 24)
+    from numpy.typing import NDArray
 
 __all__ = ["BLOCK_FACES", "MODES", "PAIR_LIMIT", "corner_normals", "face_geometry", "face_normals", "normal_groups", "row_ids", "split_vertices",
            "unique_vertices"]
@@ -67,7 +70,7 @@ PAIR_LIMIT = 64
 
 #: Faces worked on at once where a step needs several temporary arrays per face (bounds the
 #: memory a big model needs: a few megabytes per array, not one per triangle of the model).
-BLOCK_FACES = 1 << 16
+BLOCK_FACES = 1 << 13
 
 #: Pairs tested at once by the pairwise tier (bounds its temporary arrays).
 _PAIR_BLOCK = 1 << 21
@@ -131,8 +134,9 @@ def face_geometry(positions: NDArray[np.float64], tris: NDArray[np.intp], with_a
         area_sq = np.einsum("ij,ij->i", cross, cross)
         size = np.sqrt(area_sq)
         unit = faces[lo:lo + BLOCK_FACES]
-        unit[:] = 0.0  # a zero row stays zero
-        np.divide(cross, size[:, None], out=unit, where=size[:, None] > 0.0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            np.divide(cross, size[:, None], out=unit)
+        unit[size == 0.0] = 0.0  # a zero row stays zero (0/0 above)
         if flat is not None:
             longest = np.einsum("ij,ij->i", e01, e01)
             for e in (e12, e02):
@@ -187,7 +191,12 @@ def row_ids(rows: NDArray[np.float64], ordered: bool = True) -> tuple[NDArray[np
         first[inverse] = np.arange(n)  # any row of each id: they are all the same, or a collision shows
     inverse = inverse.reshape(-1)
     del h
-    if not np.array_equal(bits[first[inverse]], bits):  # a collision: sort the rows themselves
+    # Every row against its id's representative: only the rows that are not their own (a row
+    # given once is its own), gathered with take (faster than fancy indexing).
+    others = first.take(inverse)
+    moved = np.flatnonzero(others != np.arange(n))
+    others = others.take(moved)
+    if not np.array_equal(bits.take(others, axis=0), bits.take(moved, axis=0)):  # a collision: sort the rows themselves
         _, first, inverse = np.unique(bits, axis=0, return_index=True, return_inverse=True)
         inverse = inverse.reshape(-1)
     return _by_first_appearance(first, inverse) if ordered else (inverse, first)
@@ -278,7 +287,7 @@ def normal_groups(positions: NDArray[np.float64], tris: NDArray[np.intp], mode: 
         ids, firsts = row_ids(faces, ordered=False)  # coplanar faces' corners at one position: one vertex
         return np.repeat(ids, 3), faces[firsts]
     pid = row_ids(positions, ordered=False)[0] if position_ids is None else position_ids
-    corner_pid = pid[tris.reshape(-1)]  # the welded position of each corner
+    corner_pid = pid.take(tris.reshape(-1))  # the welded position of each corner
     del pid
     npos = int(corner_pid.max()) + 1
     if mode == "smooth":

@@ -11,6 +11,7 @@ No GL here.
 from __future__ import annotations
 
 import math
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -108,7 +109,11 @@ class PlanarShadow:
     def height(self) -> float:
         """``P·L``: the point light's height above the plane, or the cosine of
         a directional light with the normal; <= 0 means the receiver is unlit."""
-        return float(np.dot(self.plane, self.light))
+        height = self.__dict__.get("_height")
+        if height is None:  # the shadow is immutable: once per shadow, not per frame
+            height = float(np.dot(self.plane, self.light))
+            object.__setattr__(self, "_height", height)
+        return height
 
     def matrix(self) -> np.ndarray:
         """The lifted shadow matrix ``T(lift·n) @ S`` (see :func:`glsandbox.transforms.shadow_matrix`);
@@ -155,7 +160,7 @@ def shadow_casters(shadow: PlanarShadow, models: dict[str, tuple[np.ndarray, np.
         if name not in models:
             raise SandboxError(f"shadow caster {name!r} is not a node of the scene")
         model, positions = models[name]
-        if shadow.light[3] == 1.0:
+        if shadow.light[3] == 1.0 and not _below_by_box(shadow.plane, height, model, positions):
             world = transforms.transform_points(model, positions)
             top = float(np.max(world @ plane[:3] + plane[3]))
             if top >= height - transforms.SHADOW_EPSILON:
@@ -163,3 +168,57 @@ def shadow_casters(shadow: PlanarShadow, models: dict[str, tuple[np.ndarray, np.
                 continue
         kept.append(name)
     return ShadowCasting(tuple(kept), tuple(culled))
+
+
+#: Each caster mesh's bounding box, by its positions array: (the array, weakly; its centre; its
+#: half sizes), made once per mesh (a mesh's arrays are read-only), so that a caster moving every
+#: frame is checked from its box (:func:`_below_by_box`), not by transforming every vertex.
+_BOXES: dict[int, tuple[weakref.ref, tuple[float, ...], tuple[float, ...]]] = {}
+
+
+def _box(positions: np.ndarray) -> tuple[tuple[float, ...], tuple[float, ...]] | None:
+    """The centre and half sizes of the bounding box of ``positions`` (kept while the array lives),
+    or None for an array that may change (writable) or holds no point."""
+    kept = _BOXES.get(id(positions))
+    if kept is not None and kept[0]() is positions:
+        return kept[1], kept[2]
+    if not isinstance(positions, np.ndarray) or positions.flags.writeable or positions.size == 0:
+        return None
+    points = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
+    low, high = points.min(axis=0), points.max(axis=0)
+    centre, half = tuple((low + high) / 2.0), tuple((high - low) / 2.0)
+    if len(_BOXES) >= 256:  # meshes made anew each frame: start again
+        _BOXES.clear()
+    _BOXES[id(positions)] = (weakref.ref(positions), centre, half)
+    return centre, half
+
+
+def _below_by_box(plane: tuple[float, ...], height: float, model: np.ndarray, positions: np.ndarray) -> bool:
+    """True when every vertex of a caster lies below the point light's height, known from its
+    mesh's box alone; False where the box cannot tell, and the vertices decide.
+
+    For an affine model ``M = [A t; 0 1]`` a vertex v's height over the plane (n, d) is
+    ``n·(A v + t) + d = a·v + n·t + d`` with ``a = Aᵀ n``. Over the box (centre c, half sizes h)
+    the largest ``a·v`` is ``a·c + Σ |a_i| h_i``, and every vertex lies in the box, so no vertex is
+    higher than that. Only a bound clearly below ``height - SHADOW_EPSILON`` (by a margin far above
+    rounding) keeps the caster here: the decision is always the vertices' own, and the culling
+    reason, which names the top vertex's height, always comes from them."""
+    box = _box(positions)
+    if box is None:
+        return False
+    m = np.asarray(model, dtype=np.float64)
+    if m.shape != (4, 4):
+        return False
+    row_x, row_y, row_z, row_w = m.tolist()
+    if row_w != [0.0, 0.0, 0.0, 1.0]:  # a projective model divides by w: only the vertices tell
+        return False
+    nx, ny, nz, d = plane
+    (cx, cy, cz), (hx, hy, hz) = box
+    ax = nx * row_x[0] + ny * row_y[0] + nz * row_z[0]
+    ay = nx * row_x[1] + ny * row_y[1] + nz * row_z[1]
+    az = nx * row_x[2] + ny * row_y[2] + nz * row_z[2]
+    offset = nx * row_x[3] + ny * row_y[3] + nz * row_z[3] + d
+    spread = abs(ax) * hx + abs(ay) * hy + abs(az) * hz
+    top = ax * cx + ay * cy + az * cz + spread + offset
+    size = abs(ax * cx) + abs(ay * cy) + abs(az * cz) + spread + abs(offset) + abs(height)
+    return top < height - transforms.SHADOW_EPSILON - 1e-9 * (1.0 + size)

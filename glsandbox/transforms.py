@@ -31,10 +31,12 @@ column-vector matrix ``R @ T @ S``.
 
 pyrr
 ----
-This is the only module that imports pyrr. pyrr stores matrices for row
-vectors (translation in the last row) and its ``Matrix44 * Matrix44`` applies
-the *right* operand first; we use its plain functions and transpose their
-results into column-vector form in :func:`_from_pyrr`.
+pyrr stores matrices for row vectors (translation in the last row) and its
+``Matrix44 * Matrix44`` applies the *right* operand first (a trap the
+transform-order lesson's tests show). :func:`look_at` and :func:`perspective`
+build pyrr's ``create_look_at`` and ``create_perspective_projection`` here
+with the same operations, transposed into column-vector form, bit for bit (a
+test compares them): importing pyrr cost every start-up about 6 ms (issue 24).
 """
 
 from __future__ import annotations
@@ -42,18 +44,9 @@ from __future__ import annotations
 import functools
 import itertools
 import math
-import warnings
 from collections.abc import Sequence
 
 import numpy as np
-
-# pyrr 0.10.3's docstrings hold invalid escape sequences ("\\s"): compiling them, the
-# first import after install, prints a SyntaxWarning on Python 3.12+ (a
-# DeprecationWarning before) on the student's terminal. Not our code and harmless.
-with warnings.catch_warnings():
-    warnings.filterwarnings("ignore", message="invalid escape sequence", category=SyntaxWarning)
-    warnings.filterwarnings("ignore", message="invalid escape sequence", category=DeprecationWarning)
-    import pyrr
 
 from glsandbox.errors import SandboxError, plain
 
@@ -160,7 +153,10 @@ def normal_matrix(model: Matrix) -> np.ndarray:
     normals lean off the surface (the ``phong`` lesson's ``normals=naive``).
     """
     block = np.asarray(model, dtype=np.float64)[:3, :3]
-    if abs(np.linalg.det(block)) < 1e-300:
+    # The determinant by cofactors on nine Python floats (numpy's det costs more than the
+    # inverse on a 3x3, and a moving lit node asks every frame); it only tells singular apart.
+    (a, b, c), (d, e, f), (g, h, i) = block.tolist()
+    if abs(a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)) < 1e-300:
         raise SandboxError("model matrix is singular: its normal matrix does not exist")
     return np.linalg.inv(block).T
 
@@ -200,9 +196,9 @@ def transform_points(m: Matrix, points: np.ndarray) -> np.ndarray:
 # --- camera and projection --------------------------------------------------
 
 
-def _from_pyrr(m: np.ndarray) -> Matrix:
-    """pyrr builds matrices for row vectors; transpose into column-vector form."""
-    return np.asarray(m, dtype=np.float64).T.copy()
+def _unit(v: np.ndarray) -> np.ndarray:
+    """``v / |v|``, the length summed as pyrr's ``vector.normalize`` sums it (same bits)."""
+    return v / np.sqrt(np.sum(v**2))
 
 
 def look_at(eye: Sequence[float], target: Sequence[float], up: Sequence[float]) -> Matrix:
@@ -241,7 +237,16 @@ def _look_at(eye: Sequence[float], target: Sequence[float], up: Sequence[float])
             f"camera up {plain(tuple(u))} is parallel to the view direction {plain(tuple(forward / f_len))}: "
             "no camera orientation exists; choose an up vector not along the view"
         )
-    return _from_pyrr(pyrr.matrix44.create_look_at(e, t, u, dtype=np.float64))
+    # gluLookAt: the camera's axes as the rows of the rotation, f = forward, s = f x up
+    # (right), u = s x f (true up); the camera looks down -z. The last column moves the
+    # eye to the origin: -R @ eye, one dot product per axis.
+    f = _unit(t - e)
+    s = _unit(np.cross(f, u))
+    u = _unit(np.cross(s, f))
+    return np.array(((s[0], s[1], s[2], -np.dot(s, e)),
+                     (u[0], u[1], u[2], -np.dot(u, e)),
+                     (-f[0], -f[1], -f[2], np.dot(f, e)),
+                     (0.0, 0.0, 0.0, 1.0)), dtype=np.float64)
 
 
 def perspective(fovy_degrees: float, aspect: float, near: float, far: float) -> Matrix:
@@ -266,9 +271,15 @@ def _perspective(fovy_degrees: float, aspect: float, near: float, far: float) ->
         raise SandboxError(f"need 0 < near < far, got near={near}, far={far}")
     if aspect <= 0.0:
         raise SandboxError(f"aspect ratio must be positive, got {aspect}")
-    return _from_pyrr(
-        pyrr.matrix44.create_perspective_projection(fovy_degrees, aspect, near, far, dtype=np.float64)
-    )
+    # gluPerspective: the near plane spans [-x, x] by [-y, y] with y = near * tan(fovy / 2);
+    # x and y map to -1..1 at the near plane (2 near / width), and depth -near..-far maps to
+    # -1..1 through clip w = -z. The frustum is symmetric, so the off-centre terms are 0.
+    ymax = near * np.tan(fovy_degrees * np.pi / 360.0)
+    xmax = ymax * aspect
+    return np.array(((2.0 * near / (xmax + xmax), 0.0, 0.0, 0.0),
+                     (0.0, 2.0 * near / (ymax + ymax), 0.0, 0.0),
+                     (0.0, 0.0, -(far + near) / (far - near), -2.0 * far * near / (far - near)),
+                     (0.0, 0.0, -1.0, 0.0)), dtype=np.float64)
 
 
 # --- the one DirectX -> OpenGL conversion -----------------------------------

@@ -99,7 +99,11 @@ vec4 tri_rec(int k, int r) { return u_tri[k * TRI_RECORDS + r]; }
 #else
 uniform sampler2D u_tris;
 uniform sampler2D u_nodes;
-vec4 record(sampler2D s, int i) { return texelFetch(s, ivec2(i % TEX_WIDTH, i / TEX_WIDTH), 0); }
+// Record i's texel (i >= 0: unsigned row and column, a mask and a shift; see bvh_at).
+vec4 record(sampler2D s, int i) {
+    uint u = uint(i);
+    return texelFetch(s, ivec2(int(u % uint(TEX_WIDTH)), int(u / uint(TEX_WIDTH))), 0);
+}
 vec4 node_rec(int k, int r) { return record(u_nodes, k * NODE_RECORDS + r); }
 vec4 tri_rec(int k, int r) { return record(u_tris, k * TRI_RECORDS + r); }
 #endif

@@ -86,6 +86,14 @@ class TextureCache:
         if max(width, height) > self.max_size:
             raise SandboxError(f"texture {name} is {width}x{height}, larger than this context allows "
                                f"({self.max_size}x{self.max_size})")
+        # Textures are made on first use, within a frame whose earlier draws are still queued.
+        # On Mesa's llvmpipe (22.3) a texture uploaded and mipmapped (glGenerateMipmap renders
+        # each level) while a frame is in flight is left so that every later bind of it between
+        # two draws flushes the frame and waits for the rasterizer: 4-15 ms of wall time and
+        # +30-50 us of main-thread CPU per frame, for as long as the texture lives (issue 24: the
+        # texture lesson's cube). Finishing the queued work first (once per upload) leaves it an
+        # ordinary texture; the sampler objects were not the cause, and the pixels are the same.
+        self.ctx.finish()
         texture = self.ctx.texture((width, height), 4, np.ascontiguousarray(levels[0]).tobytes())
         # glGenerateMipmap allocates and fills every level (box-filtered halves);
         # hand-drawn levels then overwrite the generated ones.

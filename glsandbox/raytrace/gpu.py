@@ -97,7 +97,12 @@ node). A ray that reaches the bound writes alpha 0, and the render raises
 :class:`RayTraceError` instead of returning the picture. A scene with such a
 mesh node builds its BVHs when it is uploaded and then keeps of its World only
 the nodes, lights and textures (the textures hold what the shader reads of
-the triangles): a 1M-triangle model's frame keeps about 200 MiB, not 820. Scenes whose mesh
+the triangles): a 1M-triangle model's frame keeps about 170 MiB over the model
+(resident, measured), not 820. The upload builds the BVHs first, then packs the
+triangle records a chunk at a time straight into their texture (never whole on
+the host), and hands the freed heap back: its peak is what the build meets of
+the World (the corners and float32 normals, about 105 MiB for 1M triangles)
+plus the BVH build's own working arrays. Scenes whose mesh
 nodes all have at most :data:`BVH_TRIANGLES` triangles (the cubes, quads and
 floors of most lessons) keep the scan, which tests its triangles with the
 same watertight test (``shaders/common/watertight.glsl``; the triangle
@@ -124,8 +129,10 @@ except on a few pixels where a ray grazes an edge or a shadow boundary
 
 from __future__ import annotations
 
+import ctypes
 import hashlib
 import sys
+from collections.abc import Iterable, Iterator
 
 import moderngl
 import numpy as np
@@ -292,27 +299,49 @@ def world_anchor(world: World) -> NDArray[np.float64]:
     return 0.5 * (lo + hi)
 
 
-def pack_triangles(world: World, anchor: NDArray[np.float64] | None = None) -> NDArray[np.float32]:
+def pack_triangles(world: World, anchor: NDArray[np.float64] | None = None,
+                   rows: slice = slice(None), ok: NDArray[np.bool_] | None = None) -> NDArray[np.float32]:
     """``TRI_RECORDS`` vec4 per triangle (layout in ``shaders/raytrace.glsl``), positions
-    relative to ``anchor`` (see :func:`world_anchor`)."""
+    relative to ``anchor`` (see :func:`world_anchor`); ``rows``: only those triangles
+    (:func:`triangle_chunks` packs a large World a slice at a time); ``ok``: every
+    triangle's :func:`~glsandbox.raytrace.watertight.nondegenerate`, where it was taken
+    before the corners were moved (else it is taken here)."""
     anchor = np.zeros(3) if anchor is None else anchor
-    m = world.triangle_count
+    v0w, v1w, v2w = world.v0[rows], world.v1[rows], world.v2[rows]
+    m = v0w.shape[0]
     # Filled in float32 directly (each value rounded once, as a float64 array cast
     # afterwards would): a 1M-triangle model's records are 144 MB, not 288 + 144.
     rec = np.zeros((m, TRI_RECORDS, 4), dtype=np.float32)
     # The corners themselves, not v0 and two edges: the watertight test needs a
     # corner shared by two triangles to be the same three floats in both.
-    ok = nondegenerate(world.v0, world.v1, world.v2)  # the BVH's rule: a triangle without area is never hit
-    v0 = world.v0 - anchor
+    # The BVH's rule: a triangle without area is never hit.
+    ok = nondegenerate(v0w, v1w, v2w) if ok is None else ok[rows]
+    v0 = v0w - anchor
     rec[:, TRI["v0"], :3] = v0
-    rec[:, TRI["v1"], :3] = np.where(ok[:, None], world.v1 - anchor, v0)  # degenerate: one point, det = 0
-    rec[:, TRI["v2"], :3] = np.where(ok[:, None], world.v2 - anchor, v0)
+    rec[:, TRI["v1"], :3] = np.where(ok[:, None], v1w - anchor, v0)  # degenerate: one point, det = 0
+    rec[:, TRI["v2"], :3] = np.where(ok[:, None], v2w - anchor, v0)
+    normals, colors = world.normals[rows], world.colors[rows]
     for k in range(3):
-        rec[:, TRI["normal"] + k, :3] = world.normals[:, k]
-        rec[:, TRI["color"] + k, :3] = world.colors[:, k]
-    flat_uv = world.uvs.reshape(m, 6)  # uv0.x, uv0.y, uv1.x, uv1.y, uv2.x, uv2.y
+        rec[:, TRI["normal"] + k, :3] = normals[:, k]
+        rec[:, TRI["color"] + k, :3] = colors[:, k]
+    flat_uv = world.uvs[rows].reshape(m, 6)  # uv0.x, uv0.y, uv1.x, uv1.y, uv2.x, uv2.y
     rec[:, TRI["normal"]:TRI["color"] + 3, 3] = flat_uv
     return rec.reshape(-1, 4)
+
+
+#: Triangles packed at a time by :func:`triangle_chunks` (9 MB of records; 65,536 triangles
+#: are 576 full rows of a :data:`TEX_WIDTH` texture).
+PACK_CHUNK = 1 << 16
+
+
+def triangle_chunks(world: World, anchor: NDArray[np.float64] | None = None,
+                    ok: NDArray[np.bool_] | None = None) -> Iterator[NDArray[np.float32]]:
+    """:func:`pack_triangles` of ``world`` in slices of :data:`PACK_CHUNK` triangles, in order:
+    a large model is uploaded and digested without its whole records in memory at once
+    (a 1M-triangle model's are 144 MB, and the texture holds a copy of them)."""
+    m = world.triangle_count
+    for start in range(0, m, PACK_CHUNK):
+        yield pack_triangles(world, anchor, slice(start, min(m, start + PACK_CHUNK)), ok)
 
 
 def node_order(world: World) -> list[int]:
@@ -368,13 +397,32 @@ def _same_key(a: tuple[object, ...] | None, b: tuple[object, ...]) -> bool:
         return False
 
 
-def _records_digest(tris: NDArray[np.float32], nodes: NDArray[np.float32]) -> bytes:
-    """A blake2b digest of the packed records (equal records, equal digests)."""
-    h = hashlib.blake2b(digest_size=20)
-    for rows in (tris, nodes):
-        h.update(np.int64(rows.shape[0]).tobytes())
-        h.update(np.ascontiguousarray(rows).data)
-    return h.digest()
+class _RecordsDigest:
+    """A blake2b digest of the packed records (equal records, equal digests), fed the
+    triangle records chunk by chunk (:func:`triangle_chunks`) and then the node records."""
+
+    def __init__(self, tri_rows: int) -> None:
+        self._hash = hashlib.blake2b(digest_size=20)
+        self._hash.update(np.int64(tri_rows).tobytes())
+
+    def passing(self, chunks: Iterable[NDArray[np.float32]]) -> Iterator[NDArray[np.float32]]:
+        """``chunks`` unchanged, each hashed as it goes by."""
+        for chunk in chunks:
+            self._hash.update(np.ascontiguousarray(chunk).data)
+            yield chunk
+
+    def finish(self, nodes: NDArray[np.float32]) -> bytes:
+        self._hash.update(np.int64(nodes.shape[0]).tobytes())
+        self._hash.update(np.ascontiguousarray(nodes).data)
+        return self._hash.digest()
+
+
+def _records_digest(world: World, anchor: NDArray[np.float64], nodes: NDArray[np.float32]) -> bytes:
+    """The digest of ``world``'s records (:class:`_RecordsDigest`), packed a chunk at a time."""
+    digest = _RecordsDigest(world.triangle_count * TRI_RECORDS)
+    for _ in digest.passing(triangle_chunks(world, anchor)):
+        pass
+    return digest.finish(nodes)
 
 
 def _drop_triangle_arrays(world: World, corners: bool) -> None:
@@ -384,6 +432,27 @@ def _drop_triangle_arrays(world: World, corners: bool) -> None:
     if corners:
         world.v0 = world.v1 = world.v2 = np.zeros((0, 3))
         world.tri_node = np.zeros(0, dtype=np.intp)
+
+
+def _emptying(parts: list[NDArray[np.float32]]) -> Iterator[NDArray[np.float32]]:
+    """The arrays of ``parts`` in order, each let go by the list as it is handed on."""
+    while parts:
+        yield parts.pop(0)
+
+
+def _return_freed_memory() -> None:
+    """Hand the heap's free pages back to the system after a large upload (glibc's
+    ``malloc_trim``; nothing elsewhere). numpy's arrays of a few MB come from the heap,
+    whose freed space glibc keeps: after a 1M-triangle upload 200 to 400 MiB of it stayed
+    resident, free, beside what the textures hold (measured: 170 MiB kept over the model
+    with the trim, 370 to 580 without)."""
+    if not sys.platform.startswith("linux"):
+        return
+    try:
+        libc = ctypes.CDLL("libc.so.6")
+        libc.malloc_trim(0)
+    except (OSError, AttributeError):  # another C library (musl): nothing to hand back this way
+        pass
 
 
 class _Uploaded:
@@ -403,11 +472,10 @@ class _Uploaded:
         #: Every uploaded position is relative to this point (:func:`world_anchor`; the
         #: origin for ``relative=False``, world-space float32, what the tradeoffs knob shows).
         self.anchor = world_anchor(world) if relative else np.zeros(3)
-        tris = pack_triangles(world, self.anchor)
         nodes = pack_nodes(world, self.anchor)
-        #: What the records pack to (:meth:`same_data`), not the records themselves: a
-        #: 1M-triangle model's are 144 MB, and the texture holds them already.
-        self.digest = _records_digest(tris, nodes)
+        tri_rows = world.triangle_count * TRI_RECORDS
+        #: Triangles of the World uploaded (its corner arrays are dropped after a BVH upload).
+        self.triangle_count = world.triangle_count
         self.mesh_count = sum(1 for node in world.nodes if node.kind.triangles)
         #: Analytic nodes (spheres, cylinders): the records after the mesh nodes'.
         self.shape_count = len(world.nodes) - self.mesh_count
@@ -418,45 +486,82 @@ class _Uploaded:
         self.large_mesh = max((node.count for node in world.nodes if node.kind.triangles),
                               default=0) > BVH_TRIANGLES
         self.unrolled = (not self.large_mesh and len(world.nodes) <= UNROLL_NODES and loops <= UNROLL_LOOPS
-                         and max(1, tris.shape[0]) + max(1, nodes.shape[0]) <= block_records)
+                         and max(1, tri_rows) + max(1, nodes.shape[0]) <= block_records)
         self.block: moderngl.Buffer | None = None
         #: The BVH program's stack depth once its textures are uploaded (0: not yet).
         self.bvh_stack = 0
         #: Samplers by uniform name, in texture unit order.
         self.textures: dict[str, moderngl.Texture] = {}
+        #: What the records pack to (:meth:`same_data`), not the records themselves: a
+        #: 1M-triangle model's are 144 MB, and the texture holds them already.
+        digest = _RecordsDigest(tri_rows)
+        anchor, ok = self.anchor, None
+        if self.large_mesh:
+            # Every render of this scene traces its meshes through BVHs: build them first,
+            # and keep of the World (this upload's own) only what the renders read (its
+            # nodes, lights, textures): its per-triangle float64 arrays are 200 bytes a
+            # triangle, and the textures hold what the shader needs of them. The build
+            # moves the corners to the anchor in place (no copy of them beside the build's
+            # own arrays), so the triangle records are packed afterwards from the moved
+            # corners (anchor 0: x - 0 is x) with the degenerate rule taken before the
+            # move. In this order the BVH build's working arrays meet the World's shading
+            # arrays, not the triangle texture (which is larger).
+            world.tri_node = np.zeros(0, dtype=np.intp)
+            # The shading arrays as the float32 their records hold (the same one rounding the
+            # packing does), so that the build meets half their bytes; a view (no vertex
+            # colours) stays one. Without a texture no uv is ever read (sample_texture):
+            # their records hold zeros.
+            world.normals = world.normals.astype(np.float32)
+            world.uvs = world.uvs.astype(np.float32) if world.textures else \
+                np.broadcast_to(np.zeros((1, 3, 2), dtype=np.float32), world.uvs.shape)
+            if world.colors.strides[0] != 0:
+                world.colors = world.colors.astype(np.float32)
+            slices = [slice(start, start + PACK_CHUNK) for start in range(0, world.triangle_count, PACK_CHUNK)]
+            ok = np.concatenate([np.zeros(0, dtype=bool),
+                                 *(nondegenerate(world.v0[at], world.v1[at], world.v2[at]) for at in slices)])
+            self.bvh_textures(ctx, own_corners=True)
+            _return_freed_memory()  # the build's freed arrays, before the triangle texture is allocated
+            anchor = np.zeros(3)
         if self.unrolled:
+            tris = np.concatenate([np.zeros((0, 4), dtype=np.float32),
+                                   *digest.passing(triangle_chunks(world, anchor))])
             self.block = ctx.buffer(np.concatenate([_at_least_one(nodes), _at_least_one(tris)]).tobytes())
+            del tris
         else:
-            from glsandbox.raytrace.gpu_bvh import _texture
+            from glsandbox.raytrace.gpu_bvh import texture_from_chunks
 
-            for name, rows in (("u_tris", tris), ("u_nodes", nodes)):
-                self.textures[name] = _texture(ctx, _at_least_one(rows), TEX_WIDTH)
+            # Packed and written a chunk at a time (:func:`triangle_chunks`): the records
+            # never exist whole on the host, only in the texture.
+            chunks = digest.passing(triangle_chunks(world, anchor, ok))
+            self.textures["u_tris"] = texture_from_chunks(ctx, chunks if tri_rows else (np.zeros((1, 4), np.float32),),
+                                                          max(1, tri_rows), TEX_WIDTH)
+            self.textures["u_nodes"] = texture_from_chunks(ctx, (_at_least_one(nodes),), max(1, nodes.shape[0]),
+                                                           TEX_WIDTH)
+        self.digest = digest.finish(nodes)
         for slot, (image, _wrap) in enumerate(world.textures):
             pixels = np.floor(image * 255.0 + 0.5).astype(np.uint8)
             h, w = pixels.shape[:2]
             texture = ctx.texture((w, h), 4, np.ascontiguousarray(pixels).tobytes())
             texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
             self.textures[f"u_tex{slot}"] = texture
-        del tris, nodes
+        del nodes
         if self.large_mesh:
-            # Every render of this scene traces its meshes through BVHs: build them now,
-            # and keep of the World (this upload's own) only what the renders read (its
-            # nodes, lights, textures): its per-triangle float64 arrays are 336 bytes a
-            # triangle, and the textures hold what the shader needs of them. The shading
-            # arrays go before the BVH is built, the corners after.
-            _drop_triangle_arrays(world, corners=False)
-            self.bvh_textures(ctx)
+            del ok
             _drop_triangle_arrays(world, corners=True)
+            _return_freed_memory()
 
-    def bvh_textures(self, ctx: moderngl.Context) -> int:
+    def bvh_textures(self, ctx: moderngl.Context, own_corners: bool = False) -> int:
         """Upload (once) one BVH per mesh node, concatenated into one node/triangle
         texture pair (``shaders/common/bvh.glsl``'s layout, indices offset per node;
         stored triangle indices are the World's), and ``u_bvh_roots`` (texel k: mesh
-        slot k's root). Returns the stack depth the shader needs."""
+        slot k's root). Returns the stack depth the shader needs. ``own_corners``: the
+        World's corners are not read afterwards, so they are moved to the anchor in place
+        (the same float64 differences, without a copy of them beside the build's)."""
         if self.bvh_stack:
             return self.bvh_stack
         from glsandbox.raytrace.bvh import build_bvh
         from glsandbox.raytrace.gpu_bvh import RECORD_TEXELS, TEX_WIDTH as BVH_TEX_WIDTH, _texture, pack_bvh
+        from glsandbox.raytrace.gpu_bvh import texture_from_chunks
 
         world = self.world
         node_parts: list[NDArray[np.float32]] = []
@@ -470,9 +575,15 @@ class _Uploaded:
             rows = slice(node.start, stop)
             # Built, not taken from bvh.py's cache: these are anchor-relative triangles
             # no other engine asks for, and the upload keeps what the shader needs.
-            bvh = build_bvh(world.v0[rows] - self.anchor, world.v1[rows] - self.anchor,
-                            world.v2[rows] - self.anchor, leaf_size=BVH_LEAF_SIZE)
+            if own_corners:
+                corners = tuple(np.subtract(v[rows], self.anchor, out=v[rows]) for v in (world.v0, world.v1, world.v2))
+            else:
+                corners = tuple(v[rows] - self.anchor for v in (world.v0, world.v1, world.v2))
+            bvh = build_bvh(*corners, leaf_size=BVH_LEAF_SIZE)
+            del corners
             nodes, tris = pack_bvh(bvh)
+            depth = max(depth, bvh.depth)
+            del bvh  # its float64 arrays: the records hold what the shader reads
             children = nodes.reshape(-1, 2, 4)  # (box min, ref), (box max, count) per child: a view
             tris = tris.reshape(-1, 3, 4)
             leaf = children[:, 1, 3] > 0
@@ -481,13 +592,15 @@ class _Uploaded:
             roots.append(record_offset)
             record_offset += nodes.shape[0] // RECORD_TEXELS
             tri_offset += tris.shape[0]
-            depth = max(depth, bvh.depth)
             node_parts.append(nodes)
             tri_parts.append(tris.reshape(-1, 4))
+            del nodes, tris
         if RECORD_TEXELS * record_offset > (1 << 24) or 3 * tri_offset > (1 << 24):
             raise RayTraceError(f"the gpu BVH holds at most {(1 << 24) // 3:,} triangles, this scene has {tri_offset:,}")
-        self.textures["u_bvh_nodes"] = _texture(ctx, np.concatenate(node_parts), BVH_TEX_WIDTH)
-        self.textures["u_bvh_tris"] = _texture(ctx, np.concatenate(tri_parts), BVH_TEX_WIDTH)
+        # The parts written one after the other (no concatenated copy), each freed once written.
+        for name, parts in (("u_bvh_nodes", node_parts), ("u_bvh_tris", tri_parts)):
+            count = sum(part.shape[0] for part in parts)
+            self.textures[name] = texture_from_chunks(ctx, _emptying(parts), count, BVH_TEX_WIDTH)
         root_rows = np.zeros((max(1, len(roots)), 4), dtype=np.float32)
         root_rows[: len(roots), 0] = roots
         self.textures["u_bvh_roots"] = _texture(ctx, root_rows, root_rows.shape[0])
@@ -566,13 +679,15 @@ class _Uploaded:
     def same_data(self, world: World) -> bool:
         """Whether ``world`` packs to exactly what is uploaded (then the upload can be kept)."""
         old = self.world
+        if world.triangle_count != self.triangle_count or len(world.nodes) != len(old.nodes):
+            return False  # not worth packing a model to find out
         if not (np.array_equal(world.background, old.background) and np.array_equal(world.light_positions, old.light_positions)
                 and np.array_equal(world.light_colors, old.light_colors)):
             return False
         return (len(world.textures) == len(self.world.textures)
                 and all(a is b or np.array_equal(a, b) for (a, _), (b, _) in zip(world.textures, self.world.textures))
                 and [w for _, w in world.textures] == [w for _, w in self.world.textures]
-                and _records_digest(pack_triangles(world, self.anchor_of(world)),
+                and _records_digest(world, self.anchor_of(world),
                                     pack_nodes(world, self.anchor_of(world))) == self.digest)
 
     def anchor_of(self, world: World) -> NDArray[np.float64]:

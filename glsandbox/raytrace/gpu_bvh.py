@@ -36,6 +36,7 @@ saying how many rays were cut off, rather than return hits that may be wrong.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import moderngl
@@ -53,7 +54,9 @@ from glsandbox.scene import Camera
 
 __all__ = ["EXACT_INTEGERS", "LOOP_LIMIT", "MAX_STEPS", "RECORD_TEXELS", "TEX_WIDTH", "GpuBVH", "GpuHits", "pack_bvh"]
 
-#: Texels per row of the node and triangle textures (``BVH_TEX_WIDTH`` in the shader).
+#: Texels per row of the node and triangle textures (``BVH_TEX_WIDTH`` in the shader): a power of
+#: two (the shader takes a texel's row and column with a shift and a mask, and a node record's
+#: 4 texels stay in one row).
 TEX_WIDTH: int = 4096
 #: Node visits plus triangle tests one ray may use (``BVH_MAX_STEPS``).
 MAX_STEPS: int = 8192
@@ -150,18 +153,36 @@ def _check_overflow(overflow: NDArray[np.bool_], max_steps: int) -> None:
 
 def _texture(ctx: moderngl.Context, rows: NDArray[np.float32], width: int) -> moderngl.Texture:
     """``(n, 4)`` float32 records as a ``width``-wide RGBA32F texture, texel i at
-    ``(i % width, i // width)``: the full rows and the last, partial one written
-    straight from ``rows`` (no padded copy: a 1M-triangle model's records are 144 MB;
-    the texels past the last record are never read)."""
-    rows = np.ascontiguousarray(rows, dtype=np.float32)
-    count = rows.shape[0]
+    ``(i % width, i // width)`` (:func:`texture_from_chunks` with one chunk)."""
+    return texture_from_chunks(ctx, (rows,), rows.shape[0], width)
+
+
+def texture_from_chunks(ctx: moderngl.Context, chunks: Iterable[NDArray[np.float32]], count: int,
+                        width: int) -> moderngl.Texture:
+    """``count`` float32 records (texels) arriving as ``(k, 4)`` chunks, in order, as a
+    ``width``-wide RGBA32F texture, texel i at ``(i % width, i // width)``. Each chunk's full
+    rows are written straight from it (no padded copy of the whole: a 1M-triangle model's
+    records are 144 MB, and the texture holds a copy), a partial row carried to the next
+    chunk; the texels past the last record are never read."""
     height = max(1, math.ceil(count / width))
     texture = ctx.texture((width, height), 4, dtype="f4")
-    full = count // width
-    if full:
-        texture.write(rows[: full * width], viewport=(0, 0, width, full))
-    if count > full * width:
-        texture.write(rows[full * width:], viewport=(0, full, count - full * width, 1))
+    row, written = 0, 0
+    carry = np.zeros((0, 4), dtype=np.float32)
+    for chunk in chunks:
+        chunk = np.ascontiguousarray(chunk, dtype=np.float32)
+        written += chunk.shape[0]
+        if carry.shape[0]:
+            chunk = np.concatenate([carry, chunk])
+        full = chunk.shape[0] // width
+        if full:
+            texture.write(chunk[: full * width], viewport=(0, row, width, full))
+            row += full
+        carry = chunk[full * width:]
+    if carry.shape[0]:
+        texture.write(carry, viewport=(0, row, carry.shape[0], 1))
+    if written != count:
+        texture.release()
+        raise ValueError(f"texture_from_chunks: {written} records given, {count} announced")
     texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
     return texture
 
@@ -181,8 +202,12 @@ class GpuBVH:
         #: The shader's stack: the ordered traversal pushes at most one entry per level.
         self.stack = max(2, bvh.depth + 1)
         self._programs: dict[tuple[bool, bool], tuple[moderngl.Program, moderngl.VertexArray]] = {}
-        #: The two float result targets and their framebuffer, kept for the last grid size.
-        self._target: tuple[tuple[int, int], list[moderngl.Texture], moderngl.Framebuffer] | None = None
+        #: The two float result targets, their framebuffer and the host arrays they are read
+        #: back into, kept for the last grid size (a 800x600 grid's are 15 MB).
+        self._target: tuple[tuple[int, int], list[moderngl.Texture], moderngl.Framebuffer,
+                            list[NDArray[np.float32]]] | None = None
+        #: The ray origin and direction textures of :meth:`trace` and :meth:`any_hit`, kept for the last grid size.
+        self._rays: tuple[moderngl.Texture, ...] | None = None
         # A far point the padding rays of a grid start from, pointing away: they miss the root at once.
         root_hi = np.where(np.isfinite(bvh.node_max[0]), bvh.node_max[0], 0.0)
         self._away = root_hi + 1.0 + np.abs(root_hi)
@@ -203,12 +228,14 @@ class GpuBVH:
     def _draw(self, program: moderngl.Program, vao: moderngl.VertexArray, width: int, height: int,
               rays: dict[str, moderngl.Texture]) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
         """One fragment per ray over a ``width x height`` grid: the two result targets, row 0 first
-        (the targets are kept for the next call of the same size)."""
+        (the targets and the arrays they are read into are kept for the next call of the same
+        size: what is returned is overwritten by the next call)."""
         if self._target is None or self._target[0] != (width, height):
             self._release_target()
             outputs = [self.ctx.texture((width, height), 4, dtype="f4") for _ in range(2)]
-            self._target = ((width, height), outputs, self.ctx.framebuffer(color_attachments=outputs))
-        fbo = self._target[2]
+            self._target = ((width, height), outputs, self.ctx.framebuffer(color_attachments=outputs),
+                            [np.empty((width * height, 4), dtype=np.float32) for _ in range(2)])
+        fbo, results = self._target[2], self._target[3]
         textures = {"u_bvh_nodes": self._nodes, "u_bvh_tris": self._tris, **rays}
         self.ctx.clear_samplers(0, len(textures))  # their own NEAREST state, not a sampler left bound
         for unit, (name, texture) in enumerate(textures.items()):
@@ -219,9 +246,9 @@ class GpuBVH:
         fbo.viewport = (0, 0, width, height)
         self.ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
         vao.render(moderngl.TRIANGLE_STRIP, vertices=4)
-        hit = np.frombuffer(fbo.read(components=4, attachment=0, dtype="f4"), dtype=np.float32)
-        info = np.frombuffer(fbo.read(components=4, attachment=1, dtype="f4"), dtype=np.float32)
-        return hit.reshape(-1, 4), info.reshape(-1, 4)
+        for attachment, result in enumerate(results):  # into the kept arrays: no new 7.7 MB bytes each
+            fbo.read_into(result, components=4, attachment=attachment, dtype="f4")
+        return results[0], results[1]
 
     def _release_target(self) -> None:
         if self._target is not None:
@@ -245,16 +272,21 @@ class GpuBVH:
         rays_o[n:, :3], rays_o[n:, 3] = self._away, 0.0
         rays_d[n:, 0] = 1.0
         program, vao = self._program(any_hit)
-        ray_o = self.ctx.texture((width, height), 4, rays_o.tobytes(), dtype="f4")
-        ray_d = self.ctx.texture((width, height), 4, rays_d.tobytes(), dtype="f4")
-        try:
-            for texture in (ray_o, ray_d):
+        if self._rays is None or self._rays[0].size != (width, height):  # kept for the next grid of this size
+            self._release_rays()
+            self._rays = tuple(self.ctx.texture((width, height), 4, dtype="f4") for _ in range(2))
+            for texture in self._rays:
                 texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
-            hit, info = self._draw(program, vao, width, height, {"u_ray_origins": ray_o, "u_ray_dirs": ray_d})
-        finally:
-            ray_o.release()
-            ray_d.release()
+        ray_o, ray_d = self._rays
+        ray_o.write(rays_o)
+        ray_d.write(rays_d)
+        hit, info = self._draw(program, vao, width, height, {"u_ray_origins": ray_o, "u_ray_dirs": ray_d})
         return hit[:n], info[:n], n
+
+    def _release_rays(self) -> None:
+        for texture in self._rays or ():
+            texture.release()
+        self._rays = None
 
     @staticmethod
     def _hits(hit: NDArray[np.float32], info: NDArray[np.float32]) -> GpuHits:
@@ -314,5 +346,6 @@ class GpuBVH:
             program.release()
         self._programs.clear()
         self._release_target()
+        self._release_rays()
         self._nodes.release()
         self._tris.release()

@@ -392,7 +392,10 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
             face = _unit_rows(np.cross(b - a, c - a))
             n = np.repeat(face[:, None, :], 3, axis=1)
         uv = np.asarray(mesh.uvs, dtype=np.float64)[tri] if mesh.uvs is not None else np.zeros((len(tri), 3, 2))
-        col = np.asarray(mesh.colors, dtype=np.float64)[tri] if mesh.colors is not None else np.ones((len(tri), 3, 3))
+        # No vertex colours: white at every corner, as a read-only view of one row (a 1M-triangle
+        # model's would be 72 MB of ones); stacked with other nodes' it becomes a real array.
+        col = np.asarray(mesh.colors, dtype=np.float64)[tri] if mesh.colors is not None else \
+            np.broadcast_to(np.ones((1, 3, 3)), (len(tri), 3, 3))
         v0s.append(a), v1s.append(b), v2s.append(c), ns.append(n), uvs.append(uv), cols.append(col)
         owners.append(np.full(len(tri), len(nodes), dtype=np.intp))
         nodes.append(NodeInfo(kind=NodeKind.MESH, start=start, count=len(tri), box_min=world.min(axis=0),
@@ -409,12 +412,16 @@ def build_world(scene: Scene, viewport: int = 0, *, analytic_spheres: bool = Tru
                 info.lamp_of |= 1 << i
 
     def stack(parts: list[NDArray[np.float64]], shape: tuple[int, ...]) -> NDArray[np.float64]:
+        # One node's arrays are the World's as they are: np.concatenate would copy them
+        # (a 1M-triangle model's World is 260 MiB, and the copy doubled its peak).
+        if len(parts) == 1:
+            return parts[0]
         return np.concatenate(parts) if parts else np.zeros((0, *shape))
 
     return World(
         nodes=nodes, v0=stack(v0s, (3,)), v1=stack(v1s, (3,)), v2=stack(v2s, (3,)), normals=stack(ns, (3, 3)),
         uvs=stack(uvs, (3, 2)), colors=stack(cols, (3, 3)),
-        tri_node=np.concatenate(owners) if owners else np.zeros(0, dtype=np.intp),
+        tri_node=(owners[0] if len(owners) == 1 else np.concatenate(owners)) if owners else np.zeros(0, dtype=np.intp),
         light_positions=np.array([l.position for l in lights], dtype=np.float64).reshape(-1, 3),
         light_colors=np.array([l.color for l in lights], dtype=np.float64).reshape(-1, 3),
         background=np.asarray(clear[:3], dtype=np.float64), textures=textures,

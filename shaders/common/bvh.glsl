@@ -70,8 +70,16 @@ struct BvhHit {
     int steps;      // loop iterations used
 };
 
+// Texel i's place. Indices are never negative, so the row and column are taken
+// unsigned: by a power-of-two width a mask and a shift, where int's % and / need
+// sign fix-ups (measured: 3-5% of a model frame's CPU time on llvmpipe).
+ivec2 bvh_at(int i) {
+    uint u = uint(i);
+    return ivec2(int(u % uint(BVH_TEX_WIDTH)), int(u / uint(BVH_TEX_WIDTH)));
+}
+
 vec4 bvh_texel(sampler2D s, int i) {
-    return texelFetch(s, ivec2(i % BVH_TEX_WIDTH, i / BVH_TEX_WIDTH), 0);
+    return texelFetch(s, bvh_at(i), 0);
 }
 
 // A ray as the traversal needs it: the watertight test's per-ray setup and
@@ -92,8 +100,9 @@ BvhRay bvh_ray(vec3 o, vec3 d) {
 // the ray is in the box between the largest entry and the smallest exit. `near`
 // is the entry; `entry` what the traversal holds for the child (bvh_entry).
 bool bvh_child(BvhRay r, int rec, int side, float limit, out float near, out int entry) {
-    vec4 lo = bvh_texel(u_bvh_nodes, 4 * rec + 2 * side);
-    vec4 hi = bvh_texel(u_bvh_nodes, 4 * rec + 2 * side + 1);
+    ivec2 at = bvh_at(4 * rec + 2 * side);  // even, and the width is: the max texel is the next one in its row
+    vec4 lo = texelFetch(u_bvh_nodes, at, 0);
+    vec4 hi = texelFetch(u_bvh_nodes, at + ivec2(1, 0), 0);
     vec3 ta = (lo.xyz - r.pad - r.w.o) * r.w.inv_d;
     vec3 tb = (hi.xyz + r.pad - r.w.o) * r.w.inv_d;
     vec3 tn = min(ta, tb);
@@ -109,9 +118,9 @@ bool bvh_child(BvhRay r, int rec, int side, float limit, out float near, out int
 
 // A leaf entry's triangle range.
 void bvh_leaf(int entry, out int first, out int stop) {
-    int code = -2 - entry;
-    first = code / 64;
-    stop = first + code % 64 + 1;
+    uint code = uint(-2 - entry);  // >= 0
+    first = int(code / 64u);
+    stop = first + int(code % 64u) + 1;
 }
 
 // The watertight test against stored triangle k: t (or -1.0 for a miss),

@@ -223,9 +223,13 @@ def test_tour_lessons_dir_renders_each_file_and_goes_on_past_a_broken_one(tmp_pa
 # What a plain `glsandbox render` leaves out of its cold start (issue 24: start-up <= 1.2x a raw
 # ModernGL script): each is imported where it is used, and an eager import anywhere on the render
 # path (glsandbox/__init__, scene, overlay, cli, lesson, ...) brings it back into sys.modules here.
+# pyrr: transforms builds its two matrices itself; hashlib (OpenSSL): the mesh digests use BLAKE2's
+# own module; Pillow's other format plugins: a PNG is written by name (files.png_bytes).
 LAZY_AT_RENDER = ("glsandbox.meshfile", "glsandbox.meshgen", "glsandbox.meshlooks", "glsandbox.course_page",
                   "glsandbox.measure.rubric", "glsandbox.measure.golden", "glsandbox.window", "glsandbox.raytrace",
-                  "trimesh", "tqdm", "imgui", "PIL.ImageDraw", "PIL.ImageFont", "tomllib", "difflib", "json", "html")
+                  "glsandbox.camera", "glsandbox.planar", "trimesh", "tqdm", "imgui", "PIL.ImageDraw",
+                  "PIL.ImageFont", "tomllib", "difflib", "json", "html", "pyrr", "hashlib", "PIL.BmpImagePlugin",
+                  "PIL.GifImagePlugin", "PIL.JpegImagePlugin", "PIL.PpmImagePlugin")
 
 
 @pytest.mark.slow  # a subprocess: a cold start is the point

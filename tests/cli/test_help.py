@@ -30,6 +30,22 @@ def test_every_subcommand_has_a_summary_and_examples() -> None:
 
 
 @pytest.mark.parametrize("name", SUBCOMMANDS)
+def test_a_command_lines_parser_is_the_whole_parsers_subcommand(name: str) -> None:
+    # main() builds only the subcommand a command line names (issue 24: a cold start): the same
+    # options, help and parse of its examples as the whole parser's.
+    def subcommand(parser):
+        (sub,) = [a for a in parser._actions if a.dest == "command"]
+        return sub.choices
+
+    whole, one = cli.build_parser(), cli.build_parser(name)
+    assert list(subcommand(one)) == [name]
+    assert subcommand(one)[name].format_help() == subcommand(whole)[name].format_help()
+    for example in cli.COMMANDS[name][1]:
+        words = shlex.split(example)[1:]
+        assert vars(one.parse_args(words)) == vars(whole.parse_args(words))
+
+
+@pytest.mark.parametrize("name", SUBCOMMANDS)
 def test_subcommand_help_says_what_it_does_and_shows_examples(capsys, name: str) -> None:
     text = help_text(capsys, name)
     summary, examples = cli.COMMANDS[name]

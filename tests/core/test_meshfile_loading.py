@@ -17,7 +17,8 @@ import trimesh
 
 from glsandbox import meshgen
 from glsandbox.errors import SandboxError
-from glsandbox.meshcheck import BYTES_PER_TRIANGLE, MEMORY_ENV
+from glsandbox.meshcheck import (BYTES_PER_TRIANGLE, MEMORY_ENV, OBJ_BYTES_PER_FILE_BYTE, OBJ_BYTES_PER_LINE,
+                                 needed_bytes)
 from glsandbox.meshfile import load_model
 from glsandbox.meshnormals import corner_normals, face_normals
 from support import assert_user_error, run_cli
@@ -173,6 +174,71 @@ def test_a_model_bigger_than_the_memory_limit_is_refused_before_loading(tmp_path
     assert f"{MEMORY_ENV}=" in text and str(path) in text
     monkeypatch.setenv(MEMORY_ENV, "1G")  # raised: it loads
     assert load_model(path).triangles == 10_000
+
+
+def test_an_obj_is_refused_by_what_its_text_needs(tmp_path: Path, monkeypatch) -> None:
+    # 10,000 triangles need 2.56 MB by their count; trimesh's parse of the 360 kB text of one triangle
+    # repeated (vertices too), 40,000 short lines, needs more: that is the figure checked and given.
+    path = write_repeated(tmp_path / "repeated.obj", 10_000)
+    data = path.read_bytes()
+    need = needed_bytes(10_000, "obj", data)
+    assert need == len(data) * OBJ_BYTES_PER_FILE_BYTE + (data.count(b"\n") + 1) * OBJ_BYTES_PER_LINE
+    assert need > 10_000 * BYTES_PER_TRIANGLE
+    monkeypatch.setenv(MEMORY_ENV, str((need + 10_000 * BYTES_PER_TRIANGLE) // 2))
+    with pytest.raises(SandboxError) as caught:
+        load_model(path)
+    text = str(caught.value)
+    assert "\n" not in text and "10,000 triangles" in text and f"{need / 1e6:.1f} MB" in text
+    monkeypatch.setenv(MEMORY_ENV, str(need))  # just enough: it loads
+    assert load_model(path).triangles == 10_000
+
+
+@pytest.mark.parametrize("kind", ["repeated", "normals"])
+def test_the_obj_memory_estimate_covers_what_trimesh_parses(tmp_path: Path, kind: str) -> None:
+    # The estimate of an OBJ's need (by its bytes and lines) against the traced peak of loading it:
+    # the text's parse is trimesh's, so a reader that grew would show here.
+    if kind == "repeated":
+        path, triangles = write_repeated(tmp_path / "repeated.obj", 20_000), 20_000
+    else:
+        path, triangles = write_sphere_obj(tmp_path / "sphere.obj"), 20_480
+    load_model(path, crease_angle=31.0)  # the reader's imports, once
+    peak = traced_peak(lambda: load_model(path))
+    need = needed_bytes(triangles, "obj", path.read_bytes())
+    assert peak <= need, f"{peak / triangles:.0f} bytes per triangle at the peak, {need / triangles:.0f} estimated"
+
+
+def test_an_obj_load_peaks_at_what_trimesh_alone_needs_to_parse_it(tmp_path: Path) -> None:
+    # The text is trimesh's to parse: no copy of the file is kept beside it, and glsandbox's own
+    # arrays after it (normals, vertices) peak lower than the parse. A copy kept (69 bytes per
+    # triangle here, 12% of the parse) would show.
+    path = write_sphere_obj(tmp_path / "sphere.obj")
+    load_model(path, crease_angle=31.0)
+    ours = traced_peak(lambda: load_model(path))
+    alone = traced_peak(lambda: trimesh.load_scene(str(path), process=False))
+    assert ours <= 1.04 * alone, f"{ours / 20_480:.0f} bytes per triangle, trimesh alone {alone / 20_480:.0f}"
+
+
+def write_sphere_obj(path: Path) -> Path:
+    """A 20,480-triangle sphere as an OBJ with normals, ``f a//a b//b c//c`` (as the bunny is written)."""
+    sphere = trimesh.creation.icosphere(5)
+    normals = sphere.vertices / np.linalg.norm(sphere.vertices, axis=1, keepdims=True)
+    lines = [f"v {x:.6f} {y:.6f} {z:.6f}" for x, y, z in sphere.vertices]
+    lines += [f"vn {x:.6f} {y:.6f} {z:.6f}" for x, y, z in normals]
+    lines += [f"f {a}//{a} {b}//{b} {c}//{c}" for a, b, c in sphere.faces + 1]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def traced_peak(load: Callable[[], object]) -> int:
+    """The peak of Python's and numpy's allocations while ``load`` runs (tracemalloc)."""
+    import tracemalloc
+
+    tracemalloc.start()
+    try:
+        load()
+        return tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
 
 
 def test_the_memory_refusal_is_one_error_line_and_exit_2(tmp_path: Path) -> None:

@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import re
+import sys
 import time
 
-from glsandbox.measure.bench import Case, Result, Side, format_table, measure
+import pytest
+
+from glsandbox.measure.bench import Case, Result, Side, format_table, measure, run_process
 
 
 def spin(seconds: float) -> None:
@@ -41,3 +45,16 @@ def test_a_case_without_a_baseline_has_no_cpu_difference() -> None:
     (result,) = measure([case], rounds=1)
     assert result.extra_cpu_us is None
     assert result.to_dict()["extra_cpu_us"] is None
+
+
+@pytest.mark.slow  # starts processes
+def test_a_process_sides_cpu_is_the_processs_own() -> None:
+    # The cold-start row's column: the child's CPU (all of it), not the parent's waiting.
+    idle = [sys.executable, "-c", "import time; time.sleep(0.1)"]
+    busy = [sys.executable, "-c", "import time\nend = time.process_time() + 0.2\nwhile time.process_time() < end: pass"]
+    case = Case("startup", "idle vs busy", Side("idle", run_process(idle)), Side("busy", run_process(busy)),
+                repeat=1, unit="s")
+    (result,) = measure([case], rounds=2)
+    assert min(result.subject_cpu_s) >= 0.2 > max(result.baseline_cpu_s)
+    assert result.extra_cpu_us is not None and result.extra_cpu_us >= 150_000
+    assert re.search(r"  \+0\.[12]\d\d s  ", format_table([result]))  # the column, in seconds

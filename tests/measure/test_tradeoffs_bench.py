@@ -410,12 +410,47 @@ def test_model_cases_cover_every_size_mode_and_engine(monkeypatch) -> None:
     module = _models_module()
     monkeypatch.setattr(module, "embree_available", lambda: True)
     monkeypatch.setattr(module, "bunny_path", lambda: None)
+    monkeypatch.setattr(module, "mitsuba_missing", lambda: "mitsuba not installed")
     found = module.cases(BenchEnv())  # nothing is built until a case runs
     assert found[0].name == "BVH build, 1,000,000 tris"
     assert [c.name for c in found[1:5]] == ["1,000 tris, primary, numpy", "1,000 tris, primary, gpu",
                                            "1,000 tris, shadow+bounce, numpy", "1,000 tris, shadow+bounce, gpu"]
     assert len(found) == 1 + 4 * len(module.SIZES)
     assert {c.goal for c in found[1:]} == {2.0, 50.0}
+
+
+def test_model_cases_without_mitsuba_leave_its_rows_out_and_say_why(monkeypatch) -> None:
+    from glsandbox.measure.bench import BenchEnv
+
+    module = _models_module()
+    monkeypatch.setattr(module, "embree_available", lambda: True)
+    monkeypatch.setattr(module, "bunny_path", lambda: None)
+    monkeypatch.setitem(sys.modules, "mitsuba", None)  # `import mitsuba` fails, installed or not
+    why = module.mitsuba_missing.__wrapped__()  # not the cached answer for this machine
+    assert why == "mitsuba not installed (uv run --group bench --group mitsuba glsandbox bench)"
+    monkeypatch.setattr(module, "mitsuba_missing", lambda: why)
+    env = BenchEnv(quick=True)
+    found = module.cases(env)
+    assert not [c for c in found if "mitsuba" in c.name]
+    assert f"{module.GROUP}: the Mitsuba rows skipped: {why}" in env.notes
+
+
+def test_model_cases_with_mitsuba_add_a_row_beside_each_gpu_row(monkeypatch) -> None:
+    from glsandbox.measure.bench import BenchEnv
+
+    module = _models_module()
+    monkeypatch.setattr(module, "embree_available", lambda: True)
+    monkeypatch.setattr(module, "bunny_path", lambda: None)
+    monkeypatch.setattr(module, "mitsuba_missing", lambda: None)
+    found = module.cases(BenchEnv())  # nothing is built (nor mitsuba imported) until a case runs
+    assert [c.name for c in found[1:7]] == [
+        "1,000 tris, primary, numpy", "1,000 tris, primary, gpu", "1,000 tris, primary, mitsuba",
+        "1,000 tris, shadow+bounce, numpy", "1,000 tris, shadow+bounce, gpu", "1,000 tris, shadow+bounce, mitsuba"]
+    mitsuba = [c for c in found if c.name.endswith("mitsuba")]
+    assert len(mitsuba) == 2 * len(module.SIZES)
+    assert {c.baseline.label for c in mitsuba} == {"Embree (embreex)"}
+    assert {c.subject.label for c in mitsuba} == {"Mitsuba 3 (llvm_ad_rgb)"}
+    assert {c.goal for c in mitsuba} == {None} and "compiled at the warm-up, not timed" in mitsuba[0].note
 
 
 def test_model_summary_gives_the_time_exponent_and_the_mode_ratio() -> None:
@@ -440,6 +475,18 @@ def test_model_summary_gives_the_time_exponent_and_the_mode_ratio() -> None:
     assert "Embree's in the same rows: 0.00" in lines[0]
     assert lines[1] == f"{module.GROUP}: gpu engine, shadow+bounce ratio / primary ratio: 10,000 tris 3.00x (goal: within 2x)"
     assert len(lines) == 2  # numpy rows were not measured: no lines for them
+
+
+def test_model_summary_puts_the_gpu_engine_beside_mitsuba() -> None:
+    """gpu / Mitsuba is the ratio of their two ratios to Embree, each measured beside Embree."""
+    from glsandbox.measure.bench import Case, Result, Side
+
+    module = _models_module()
+    side = Side("x", lambda k: None)
+    results = [Result(Case(module.GROUP, f"bunny, primary, {kind}", side, side), [1.0, 1.0, 1.0], [t, t, t])
+               for kind, t in (("gpu", 2.4), ("mitsuba", 0.2))]
+    assert module.summarize(results) == [
+        f"{module.GROUP}: gpu engine time / Mitsuba time (each ratio to Embree in its own rows): bunny primary 12.0x"]
 
 
 def test_near_edge_tells_grazing_rays_from_clear_ones() -> None:
@@ -471,3 +518,104 @@ def test_hit_miss_against_embree_counts_the_differing_pixels() -> None:
     holed = image.copy()
     holed[row, col, :3] = np.round(np.asarray(module.BACKGROUND[:3]) * 255)
     assert reference.compare(holed) == f"hit/miss: 1 of {40 * 30:,} px differ from Embree, 0 at an edge"
+
+
+# --- Mitsuba 3 beside the model rows (benchmarks/_mitsuba.py; the optional mitsuba group) ------------
+
+
+def _mitsuba_or_skip():
+    """The models module, when Mitsuba's LLVM variant runs here and embreex is installed."""
+    pytest.importorskip("embreex")  # the bench group
+    pytest.importorskip("mitsuba")  # the mitsuba group: never in the dev group
+    module = _models_module()
+    why = module.mitsuba_missing()
+    if why is not None:
+        pytest.skip(why)
+    return module
+
+
+def test_mitsuba_casts_embrees_rays_and_compiles_once() -> None:
+    module = _mitsuba_or_skip()
+    import drjit as dr
+    from _mitsuba import MitsubaCaster
+    from raytrace import EmbreeCaster
+
+    size = (40, 30)
+    reference = module.HitMiss("1000", size)
+    for mode, options in module.MODES.items():
+        scene = module.model_scene("1000")
+        caster = MitsubaCaster(scene, size, options["shadows"], options["max_depth"])
+        caster.cast()  # traces and compiles the kernel
+        with dr.scoped_set_flag(dr.JitFlag.KernelHistory):
+            caster.cast()
+            history = dr.kernel_history([dr.KernelType.JIT])
+        assert history and all(run["cache_hit"] for run in history), mode  # the timed casts compile nothing
+        assert caster.ray_count() == EmbreeCaster(scene, size, options["shadows"], options["max_depth"]).cast()
+        assert reference.compare(caster.image(module.BACKGROUND)).startswith("hit/miss: identical to Embree")
+
+
+def test_mitsuba_row_times_a_positive_ratio_to_embree() -> None:
+    module = _mitsuba_or_skip()
+    from _mitsuba import mitsuba_side
+    from raytrace import embree_side
+
+    from glsandbox.measure.bench import Case, measure
+
+    size = (40, 30)
+    case = Case(module.GROUP, "1,000 tris, shadow+bounce, mitsuba",
+                embree_side(lambda: module.model_scene("1000"), size, "shadow+bounce"),
+                mitsuba_side(lambda: module.model_scene("1000"), size, "shadow+bounce", module.BACKGROUND),
+                repeat=1, unit="s", compare=lambda _rays, image: module.HitMiss("1000", size).compare(image))
+    (result,) = measure([case], rounds=2)
+    assert min(result.subject_s) > 0 and result.ratio is not None and result.ratio > 0
+    assert result.same.startswith("hit/miss: identical to Embree")
+
+
+@pytest.mark.slow
+def test_mitsuba_without_libllvm_says_what_it_needs() -> None:
+    _mitsuba_or_skip()
+    code = "import sys; sys.path.insert(0, 'benchmarks'); from _mitsuba import mitsuba_missing; print(mitsuba_missing())"
+    env = {**os.environ, "DRJIT_LIBLLVM_PATH": "/nonexistent/libLLVM.so"}
+    proc = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=120, env=env)
+    assert proc.returncode == 0, proc.stderr
+    line = proc.stdout.strip()
+    assert line.startswith("mitsuba's llvm_ad_rgb cannot run: ") and "libLLVM" in line
+
+
+# --- loading model files (benchmarks/model_load.py) ---------------------------------------------
+
+
+def test_model_load_memory_line_puts_trimeshs_parse_beside_glsandboxs_part(monkeypatch) -> None:
+    """The memory line under the table: the peak against the goal, trimesh's own load of the file alone,
+    and, traced, trimesh's parse and glsandbox's own part after it, each judged against the goal."""
+    from glsandbox.measure.bench import Case, Result, Side
+
+    module = _benchmark_module("model_load.py")
+    figures = {"triangles": 56_172, "peak": 626.4, "trimesh": 610.0, "trimesh_traced": 572.2, "parse": 572.4,
+               "own": 157.3, "held": 36.0, "arrays": 36.0}
+    monkeypatch.setattr(module, "peak_bytes_per_triangle", lambda path: figures)
+    side = Side("x", lambda k: None)
+    results = [Result(Case(module.GROUP, "load + first frame, bunny", side, side), [0.3], [0.4])]
+    assert module.summarize(results) == [
+        f"{module.GROUP}: peak memory of load + first frame, bunny (56,172 triangles): 626 bytes per triangle "
+        "(goal: at most 250: NOT met); trimesh's own load_scene of the file alone: 610 (572 traced); numpy and "
+        "Python allocations: trimesh's parse 572 at its peak, glsandbox's own part after it 157 at its peak (met), "
+        "36 held after; the loaded model's arrays: 36"]
+
+
+@pytest.mark.slow
+def test_model_load_memory_is_measured_in_fresh_processes(gl, tmp_path: Path) -> None:
+    """A small OBJ measured as the bench does: trimesh alone and glsandbox in their own processes; the
+    OBJ's text parse is trimesh's (glsandbox's parse peak is trimesh's own, within a few percent)."""
+    import trimesh
+
+    module = _benchmark_module("model_load.py")
+    path = tmp_path / "sphere.obj"
+    trimesh.creation.icosphere(4).export(path, include_normals=False)
+    m = module.peak_bytes_per_triangle(path)
+    assert m["triangles"] == 5_120
+    # Resident growth can be zero for a model this small (memory the warm-up freed is reused); the
+    # traced figures cannot.
+    assert m["peak"] >= 0 and m["trimesh"] >= 0 and m["arrays"] > 0 and m["held"] >= m["arrays"]
+    assert m["trimesh_traced"] <= m["parse"] <= 1.05 * m["trimesh_traced"]
+    assert m["own"] > m["held"]

@@ -126,3 +126,76 @@ def test_the_unrolled_scan_draws_what_the_node_loops_draw(gl, monkeypatch) -> No
     shadowed = (unrolled[..., :3].astype(int).sum(axis=-1) < 120) & (unrolled[..., :3] != 25).any(axis=-1)
     assert shadowed.sum() > 50  # the cubes cast shadows on the floor
     assert np.array_equal(unrolled, looped)
+
+
+def test_a_model_packed_in_chunks_draws_what_one_pack_draws_and_is_recognised_again(gl, monkeypatch) -> None:
+    """A model's triangle records are packed and written to their texture a chunk at a time
+    (never whole on the host). Chunks of 1,000 triangles (9,000 texels: rows of 1,024 split
+    across chunks) draw exactly what one chunk draws, and a rebuilt Scene with the same data
+    is recognised by its chunked digest (no second upload), one with other data is not."""
+    scene = rock_scene()
+    size = (160, 120)
+    options = dict(shadows=True, max_depth=1)
+    tracer = gpu_engine.GpuTracer(gl.host.ctx)
+    try:
+        whole = tracer.render_viewport(scene, size, **options).copy()
+        tracer.forget_scenes()
+        monkeypatch.setattr(gpu_engine, "PACK_CHUNK", 1000)
+        chunked = tracer.render_viewport(scene, size, **options).copy()
+        assert np.array_equal(whole, chunked)
+        assert tracer.uploads == 2
+        rebuilt = Scene("rock", nodes=(Node("rock", scene.nodes[0].mesh, np.eye(4), scene.nodes[0].material),),
+                        camera=scene.camera, lights=scene.lights, clear_color=scene.clear_color)
+        assert np.array_equal(tracer.render_viewport(rebuilt, size, **options), whole)
+        assert (tracer.uploads, tracer.reuses) == (2, 1)
+        tracer.render_viewport(rock_scene(4), size, **options)  # another rock: uploaded
+        assert tracer.uploads == 3
+    finally:
+        tracer.release()
+
+
+def test_a_model_upload_holds_no_second_copy_of_its_records(gl, monkeypatch) -> None:
+    """Host memory (numpy's arrays, tracemalloc) of building a one-node model's World and
+    uploading it to the BVH program, in bytes a triangle of a ~60k-triangle terrain: the
+    World's arrays are the node's own (no concatenated copy; absent vertex colours a view,
+    not 72 bytes of ones): 200 held, 248 at its peak (272 and 592 before). When the BVH
+    build starts the upload holds the World's corners (moved to the anchor in place, not
+    copied) and float32 normals (no uv without a texture): 110 (152 before, corners copied);
+    outside the build (bvh.py's own working arrays) it never holds the triangle records
+    whole (packed a chunk at a time): 418 at most."""
+    import tracemalloc
+
+    from glsandbox.raytrace import bvh as bvh_module
+
+    mesh = meshgen.terrain(meshgen.terrain_cells_for(60_000))
+    scene = Scene("terrain", nodes=(Node("terrain", mesh, np.eye(4), Material(color=(0.7, 0.7, 0.7, 1.0))),),
+                  camera=Camera(eye=(0.0, 1.2, 2.2)), lights=(Light((1.0, 3.0, 1.5)),))
+    mesh.triangle_indices()
+    seen: dict[str, int] = {}
+    build = bvh_module.build_bvh
+
+    def measured_build(*args, **kwargs):
+        held, peak = tracemalloc.get_traced_memory()
+        seen["held at the build"], seen["peak before the build"] = held - seen["start"], peak - seen["start"]
+        result = build(*args, **kwargs)
+        tracemalloc.reset_peak()  # the build's own peak is bvh.py's
+        return result
+
+    monkeypatch.setattr(bvh_module, "build_bvh", measured_build)
+    tracer = gpu_engine.GpuTracer(gl.host.ctx)
+    tracemalloc.start()
+    try:
+        world = build_world(scene, 0)
+        count = world.triangle_count
+        held, world_peak = tracemalloc.get_traced_memory()
+        del world
+        seen["start"] = tracemalloc.get_traced_memory()[0]
+        tracer.render_viewport(scene, (40, 30), shadows=False, max_depth=0)
+        peak_after = tracemalloc.get_traced_memory()[1] - seen["start"]
+    finally:
+        tracemalloc.stop()
+        tracer.release()
+    assert held <= 205 * count  # corners, normals, uvs (float64) and the node of each triangle
+    assert world_peak <= 300 * count, world_peak / count
+    assert seen["held at the build"] <= 120 * count, seen["held at the build"] / count
+    assert max(seen["peak before the build"], peak_after) <= 450 * count, (seen, peak_after / count)

@@ -16,7 +16,7 @@ from glsandbox.plan import ProgramVariant
 from glsandbox.raytrace.bvh import build_bvh, mesh_world_triangles
 from glsandbox.raytrace.bvh_traverse import any_hit, closest_hit
 from glsandbox.raytrace.errors import RayTraceError
-from glsandbox.raytrace.gpu_bvh import GpuBVH, pack_bvh
+from glsandbox.raytrace.gpu_bvh import GpuBVH, pack_bvh, texture_from_chunks
 from glsandbox.raytrace.world import camera_rays
 from glsandbox.scene import Camera
 
@@ -246,3 +246,19 @@ def test_camera_rays_made_in_the_shader_match_the_numpy_camera_rays(ctx) -> None
     assert np.all(excused[differ]) and differ.mean() < 0.01
     same = ~differ & want.hit
     np.testing.assert_allclose(got.t[same], want.t[same], rtol=2e-5)
+
+
+def test_records_written_in_uneven_chunks_fill_the_texture_in_order(ctx) -> None:
+    """texture_from_chunks: chunks that end mid-row (a row is carried to the next chunk),
+    an empty chunk and a last partial row put texel i at (i % width, i // width)."""
+    records = np.arange(4 * 23, dtype=np.float32).reshape(23, 4)
+    chunks = (records[:3], records[3:3], records[3:12], records[12:21], records[21:])
+    texture = texture_from_chunks(ctx, chunks, 23, 5)
+    try:
+        assert texture.size == (5, 5)
+        texels = np.frombuffer(texture.read(), dtype=np.float32).reshape(-1, 4)
+    finally:
+        texture.release()
+    assert np.array_equal(texels[:23], records)
+    with pytest.raises(ValueError):
+        texture_from_chunks(ctx, (records,), 24, 5)
