@@ -328,7 +328,7 @@ def _build(a: NDArray[np.float64], b: NDArray[np.float64], c: NDArray[np.float64
         lambda: np.minimum.reduceat(np.take(lo, order, axis=0), starts, axis=0),
         lambda: np.maximum.reduceat(np.take(hi, order, axis=0), starts, axis=0)])
     node_min, node_max = _exact_boxes(leaf_min, leaf_max, count, first, leaves, tree.levels)
-    return BVH(node_min, node_max, first, count, a, b, c, keep[order].astype(np.int64), tree.depth, total)
+    return BVH(node_min, node_max, first, count, a, b, c, np.take(keep, order), tree.depth, total)
 
 
 class _Tree:
