@@ -844,11 +844,12 @@ def _exact_cut(exact: NDArray[np.int64], counts: NDArray[np.int64], axis: NDArra
     return result
 
 
-def _box_half_area(box: NDArray[np.float32]) -> NDArray[np.float32]:
+def _box_half_area(box: NDArray[np.float32], empty: bool = True) -> NDArray[np.float32]:
     """Half the surface area of boxes stored as ``(6, ...)``: ``min x, y, z, −max x, y, z``
-    (an empty box, all ``inf``, has 0)."""
+    (an empty box, all ``inf``, has 0; ``empty=False``: there is none, min − max is never above 0)."""
     e = box[0:3] + box[3:6]  # min − max: minus the extent
-    np.minimum(e, np.float32(0.0), out=e)
+    if empty:
+        np.minimum(e, np.float32(0.0), out=e)
     result: NDArray[np.float32] = e[0] * e[1]
     result += e[1] * e[2]
     result += e[2] * e[0]
@@ -910,8 +911,9 @@ def _split_small(tree: _Tree, small: tuple[NDArray[np.int64], NDArray[np.int64],
         child = np.repeat(np.arange(child_count.size), child_count)
         rank = np.arange(tris.size) - np.repeat(np.cumsum(child_count) - child_count, child_count)
         tri_leaf = is_leaf[child]
-        tree.leaf_of[caller[tris[tri_leaf]]] = child_ids[child[tri_leaf]]
-        tree.leaf_rank[caller[tris[tri_leaf]]] = rank[tri_leaf]
+        leaf_tris = caller[tris[tri_leaf]]
+        tree.leaf_of[leaf_tris] = child_ids[child[tri_leaf]]
+        tree.leaf_rank[leaf_tris] = rank[tri_leaf]
         tris = tris[~tri_leaf]
         ids = child_ids[~is_leaf]
         counts = child_count[~is_leaf]
@@ -934,7 +936,8 @@ def _small_cuts(table: NDArray[np.float32], order_bits: NDArray[np.int32], tris:
     shift = int(w - 1).bit_length()
     flat_tri = tri.reshape(-1)
     cuts = np.arange(1, w, dtype=np.float32)[:, None]  # cut i: sorted triangles [0, i) go left
-    no_cut = cuts >= counts  # (w − 1, r)
+    no_cut = np.where(cuts >= counts, np.float32(np.inf), np.float32(0.0))  # (w − 1, r): added to the costs
+    rest = counts.astype(np.float32) - cuts  # the right side's triangles
     columns = np.arange(r)
     orders = []
     costs = np.empty((3, r), dtype=np.float32)
@@ -961,13 +964,13 @@ def _small_cuts(table: NDArray[np.float32], order_bits: NDArray[np.int32], tris:
         for i in range(1, w):  # boxes of the first i + 1
             np.minimum(sweep[:, i - 1], sweep[:, i], out=sweep[:, i])
         if parent is None:
-            parent = size * _box_half_area(sweep[:, w - 1])
-        sah = _box_half_area(sweep[:, :-1])
+            parent = size * _box_half_area(sweep[:, w - 1], empty=False)
+        sah = _box_half_area(sweep[:, :-1], empty=False)  # the first i + 1 slots: slot 0 is never padding
         sah *= cuts
         right = _box_half_area(back[:, 1:])
-        right *= size - cuts
+        right *= rest
         sah += right
-        sah[no_cut] = np.inf
+        sah += no_cut  # inf where the cut leaves the right side nothing
         pick = np.argmin(sah, axis=0)
         best[axis] = pick + 1
         costs[axis] = sah[pick, columns]
