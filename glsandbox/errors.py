@@ -83,9 +83,12 @@ def check_numbers(value: object, what: str, counts: tuple[int, ...] = (3,), low:
     """A tuple of ``counts`` numbers (floats), each checked as :func:`check_number` does."""
     # The common case, checked every frame: a tuple of floats in range (a NaN fails
     # the comparison, so it takes the slow path below and gets its message).
-    if type(value) is tuple and len(value) in counts \
-            and all(type(v) is float and low <= v <= high for v in value):
-        return value
+    if type(value) is tuple and len(value) in counts:
+        for v in value:  # (a loop, not all() over a generator: this runs for every moved light every frame)
+            if type(v) is not float or not low <= v <= high:
+                break
+        else:
+            return value
     try:
         items = list(value)  # type: ignore[call-overload]
     except TypeError:

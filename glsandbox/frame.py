@@ -77,9 +77,12 @@ def trace_viewports(scene: Scene, size: tuple[int, int], ctx: object | None = No
     and enlarges the image (nearest pixel): the interactive window's coarse
     frames while the camera moves.
     """
-    ray = {i for i, vp in enumerate(scene.viewports) if vp.renderer != "raster"}
-    if not ray:
+    for vp in scene.viewports:
+        if vp.renderer != "raster":
+            break
+    else:  # only raster viewports (a loop, not a set: this runs every frame)
         return scene
+    ray = {i for i, vp in enumerate(scene.viewports) if vp.renderer != "raster"}
     from glsandbox.raytrace.render import render  # only frames that trace pay for the import
 
     width, height = size
@@ -155,14 +158,19 @@ class FrameRenderer:
         self._targets: dict[tuple[tuple[int, int], Buffers], OffscreenTarget] = {}
         self._plans: dict[int, tuple[Scene, tuple, Plan]] = {}  # by id of the scene frames were moved from
         self._noted: set[str] = set()  # user-shader notes already printed: once per run, not per frame
+        self._last_target: tuple[tuple[int, int], Buffers, OffscreenTarget] | None = None  # what target() gave last
 
     def target(self, size: tuple[int, int], buffers: Buffers) -> OffscreenTarget:
+        last = self._last_target
+        if last is not None and last[0] == size and last[1] is buffers:  # a kept plan's frames: no hashing
+            return last[2]
         key = (size, buffers)
         target = self._targets.get(key)
         if target is None:
             if len(self._targets) >= self.KEEP_TARGETS:  # drop the oldest
                 self._targets.pop(next(iter(self._targets))).release()
             target = self._targets[key] = OffscreenTarget(self.host, size, buffers)
+        self._last_target = (size, buffers, target)
         return target
 
     def draw(self, scene: Scene, size: tuple[int, int],
@@ -219,6 +227,7 @@ class FrameRenderer:
         for target in self._targets.values():
             target.release()
         self._targets.clear()
+        self._last_target = None
         self.executor.release()
 
 

@@ -291,7 +291,7 @@ class Lesson:
 
     def _still_key(self) -> tuple | None:
         """Every value but ``time``, with its type (1, 1.0 and True stay apart), or None when one cannot be hashed."""
-        key = tuple((name, type(value), value) for name, value in sorted(self.values.items()) if name != "time")
+        key = tuple([(name, type(value), value) for name, value in sorted(self.values.items()) if name != "time"])
         try:
             hash(key)
         except TypeError:

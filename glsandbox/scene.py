@@ -391,6 +391,11 @@ def check_node_model(name: str, model: object) -> np.ndarray:
     matrix = np.asarray(model)
     if matrix.shape != (4, 4) or matrix.dtype.kind not in "biuf":
         raise SandboxError(f"node {name!r}: model matrix must be 4x4 numbers, got {plain(model)}")
+    if matrix.dtype.kind == "f":  # the common case, checked every frame a node moves: sixteen Python floats
+        entries = matrix.ravel().tolist()
+        total = sum(entries)  # NaN or infinite where an entry is: then the general test below speaks
+        if total - total == 0.0 and -NUMBER_LIMIT <= min(entries) and max(entries) <= NUMBER_LIMIT:
+            return matrix
     in_bounds = bool(np.abs(matrix).max() <= NUMBER_LIMIT)  # False for NaN (max propagates it) and inf too
     if not in_bounds and not np.all(np.isfinite(matrix)):
         raise SandboxError(f"node {name!r}: model matrix has a non-finite entry: {plain(matrix)}")
@@ -617,8 +622,7 @@ def _copy_with(obj: Any, **changes: Any) -> Any:
     """A frozen dataclass ``obj`` with ``changes``, without running its ``__post_init__`` again:
     the caller has checked the changed fields (the others were checked when ``obj`` was made)."""
     new = object.__new__(type(obj))
-    new.__dict__.update(obj.__dict__)
-    new.__dict__.update(changes)
+    new.__dict__.update({**obj.__dict__, **changes})
     return new
 
 
@@ -653,10 +657,17 @@ def moved_scene(scene: Scene, motion: Motion) -> Scene:
     bounded numbers); every other part is the same object as in ``scene``. The result
     remembers ``scene`` (:func:`scene_origin`): the renderers keep what they derived from
     it (the plan, per-draw uniform bytes) while only positions change."""
-    origin = scene_origin(scene) or scene
+    origin = scene.__dict__.get("_moved_from") or scene  # (scene_origin, inline: this runs every frame)
     nodes, lights, overlays = scene.nodes, scene.lights, scene.overlays
-    if motion.models or motion.positions:
-        models, positions = dict(motion.models), dict(motion.positions)
+    models, positions = motion.models, motion.positions
+    if models or positions:
+        names = origin.__dict__.get("_node_names")  # the same in every scene moved from ``origin``
+        if names is None:
+            names = origin.__dict__["_node_names"] = frozenset(node.name for node in origin.nodes)
+        if not names.issuperset(models) or (positions and not names.issuperset(positions)):
+            unknown = (set(models) | set(positions)) - names
+            raise SandboxError(f"scene {scene.name!r}: the motion moves {', '.join(map(repr, sorted(unknown)))}, "
+                               f"which is not a node of the scene")
         moved = []
         for node in nodes:
             model, points = models.get(node.name), positions.get(node.name)
@@ -672,10 +683,6 @@ def moved_scene(scene: Scene, motion: Motion) -> Scene:
             if points is not None:
                 changes["mesh"] = moved_mesh(node.mesh, points)
             moved.append(_copy_with(node, **changes))
-        unknown = (set(models) | set(positions)) - {node.name for node in nodes}
-        if unknown:
-            raise SandboxError(f"scene {scene.name!r}: the motion moves {', '.join(map(repr, sorted(unknown)))}, "
-                               f"which is not a node of the scene")
         nodes = tuple(moved)
     if motion.overlays:
         images = dict(motion.overlays)

@@ -26,7 +26,7 @@ import numpy as np
 from glsandbox import transforms
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh
-from glsandbox.scene import Light, Node, Scene
+from glsandbox.scene import Light, Node, Scene, scene_origin
 
 
 def casting_light(scene: Scene) -> int | None:
@@ -69,12 +69,49 @@ def _corners(mesh: Mesh) -> np.ndarray:
     return corners
 
 
+#: Each node's world corners by (its model's bytes, id of its mesh), with the mesh kept to
+#: check: a node that does not move is transformed once, not every frame.
+_WORLD_CORNERS: dict[tuple[bytes, int], tuple[Mesh, np.ndarray]] = {}
+#: Entries kept; past this many (a moving node adds one per frame) it starts again.
+_WORLD_CORNERS_KEPT = 256
+
+
+def _node_corners(node: Node) -> np.ndarray:
+    """The corners of ``node``'s mesh bounds in world space (8 rows, read-only)."""
+    model = np.asarray(node.model, dtype=np.float64)
+    key = (model.tobytes(), id(node.mesh))
+    kept = _WORLD_CORNERS.get(key)
+    if kept is None or kept[0] is not node.mesh:
+        if len(_WORLD_CORNERS) >= _WORLD_CORNERS_KEPT:
+            _WORLD_CORNERS.clear()
+        corners = transforms.transform_points(model, _corners(node.mesh))
+        corners.flags.writeable = False
+        kept = _WORLD_CORNERS[key] = (node.mesh, corners)
+    return kept[1]
+
+
 def _world_corners(nodes: list[Node]) -> np.ndarray:
     """The corners of each node's mesh bounds in world space (8 per node)."""
     if not nodes:
         return np.zeros((0, 3))
-    return np.concatenate([transforms.transform_points(np.asarray(node.model, dtype=np.float64), _corners(node.mesh))
-                           for node in nodes])
+    return np.concatenate([_node_corners(node) for node in nodes])
+
+
+def _casters_and_receivers(scene: Scene) -> tuple[list[Node], list[Node]]:
+    """:func:`casters` and :func:`receivers` of ``scene``. Which nodes they are depends on nothing
+    a lesson's motion changes (:func:`glsandbox.scene.moved_scene` keeps every node's flags and
+    material, and the viewports): for a moved scene they are found once, by index, on the scene
+    it was moved from."""
+    origin = scene_origin(scene)
+    if origin is None:
+        return casters(scene), receivers(scene)
+    kept = origin.__dict__.get("_shadow_map_nodes")
+    if kept is None:
+        index = {id(node): i for i, node in enumerate(origin.nodes)}
+        kept = origin.__dict__["_shadow_map_nodes"] = (tuple(index[id(node)] for node in casters(origin)),
+                                                         tuple(index[id(node)] for node in receivers(origin)))
+    nodes = scene.nodes
+    return [nodes[i] for i in kept[0]], [nodes[i] for i in kept[1]]
 
 
 def light_camera(scene: Scene, light: Light) -> tuple[np.ndarray, np.ndarray]:
@@ -86,7 +123,8 @@ def light_camera(scene: Scene, light: Light) -> tuple[np.ndarray, np.ndarray]:
     """
     assert light.shadow is not None
     eye = np.asarray(light.position, dtype=np.float64)
-    cast = _world_corners(casters(scene))
+    casting, receiving = _casters_and_receivers(scene)
+    cast = _world_corners(casting)
     target = cast.mean(axis=0) if len(cast) else eye - np.array([0.0, 1.0, 0.0])
     forward = target - eye
     if np.linalg.norm(forward) < 1e-9:
@@ -96,7 +134,7 @@ def light_camera(scene: Scene, light: Light) -> tuple[np.ndarray, np.ndarray]:
     # Any up not along the view works (the map's rotation about its axis does not matter).
     up = (0.0, 0.0, 1.0) if abs(forward[1]) > 0.9 else (0.0, 1.0, 0.0)
     view = transforms.look_at(tuple(eye), tuple(target), up)
-    points = np.concatenate([cast, _world_corners(receivers(scene))])
+    points = np.concatenate([cast, _world_corners(receiving)])
     depths = -(transforms.transform_points(view, points)[:, 2]) if len(points) else np.array([1.0])
     far = max(float(depths.max()), 1e-3) * 1.01
     near = max(float(depths.min()) * 0.99, far * 1e-3)

@@ -28,7 +28,7 @@ from glsandbox.gl.target import clear_opaque
 from glsandbox.gl.textures import TextureCache
 from glsandbox.gl.passes import FrameState, PassRunner
 from glsandbox.plan import SHADOW_MAP_UNIT, Draw, Pass, Plan, ProgramVariant, plan as make_plan
-from glsandbox.scene import Light, Material, Node, Scene, mesh_origin
+from glsandbox.scene import Camera, Light, Material, Node, Scene, mesh_origin
 
 try:  # hashlib.blake2b is this very type; importing hashlib loads OpenSSL too (~4 ms of every start, issue 24)
     from _blake2 import blake2b
@@ -142,17 +142,29 @@ def _eye_bytes(view: bytes) -> bytes:
     return eye_position(np.frombuffer(view).reshape(4, 4)).astype("f4").tobytes()
 
 
-@functools.lru_cache(maxsize=1024)
-def _model_matrix_bytes(model: bytes) -> bytes:
-    """``m_model``'s uniform bytes (float32, column-major) for a float64 model matrix given as bytes."""
-    return transforms.gl_bytes(np.frombuffer(model).reshape(4, 4))
+#: ``m_model``'s and ``m_normal``'s uniform bytes by the float64 model matrix's bytes (see
+#: :meth:`Executor.draw_node`): a node that does not move converts its matrix, and inverts it,
+#: once; an array changed in place between frames has other bytes, so it is converted again.
+_MODEL_BYTES: dict[bytes, bytes] = {}
+_NORMAL_BYTES: dict[bytes, bytes] = {}
+#: Entries each of those keeps; past it, it starts again (a moving node adds one per frame).
+_MATRICES_KEPT = 1024
 
 
-@functools.lru_cache(maxsize=1024)
-def _normal_matrix_bytes(model: bytes) -> bytes:
-    """The normal matrix's uniform bytes for a float64 model matrix given as
-    bytes: models that do not move (walls, floors) skip the inverse each frame."""
-    return transforms.gl_bytes(transforms.normal_matrix(np.frombuffer(model).reshape(4, 4)))
+def _model_matrix_bytes(content: bytes, matrix: np.ndarray) -> bytes:
+    """``m_model``'s uniform bytes (float32, column-major) of ``matrix`` (float64, whose bytes are ``content``)."""
+    if len(_MODEL_BYTES) >= _MATRICES_KEPT:
+        _MODEL_BYTES.clear()
+    data = _MODEL_BYTES[content] = transforms.gl_bytes(matrix)
+    return data
+
+
+def _normal_matrix_bytes(content: bytes, matrix: np.ndarray) -> bytes:
+    """The normal matrix's uniform bytes of ``matrix`` (float64, whose bytes are ``content``)."""
+    if len(_NORMAL_BYTES) >= _MATRICES_KEPT:
+        _NORMAL_BYTES.clear()
+    data = _NORMAL_BYTES[content] = transforms.gl_bytes(transforms.normal_matrix(matrix))
+    return data
 
 
 @dataclass(frozen=True)
@@ -233,10 +245,69 @@ class _DrawSetup:
     normal: bool  # the program reads m_normal
     # The program's uniforms by name, and the bytes last written into each (the program's
     # entry of Executor._written): draw_node's loop writes only what changed.
-    uniforms: dict[str, moderngl.Uniform] = field(default_factory=dict)
+    uniforms: dict[str, moderngl.Uniform] = field(default_factory=dict)  # a _Uniforms
     written: dict[str, bytes] = field(default_factory=dict)
-    # Per material drawn with it (by id, the object kept to check): its constant uniform bytes.
-    constants: dict[int, tuple[Material, tuple[tuple[str, bytes], ...]]] = field(default_factory=dict)
+
+
+#: A key of a program's ``written`` dict that names no uniform: the constants tuple of the
+#: prepared draw that wrote its material's uniforms last (see :meth:`Executor.draw_node`).
+_CONSTANTS = "#constants"
+#: The PassCamera whose view and projection a program holds (its ``written`` dict's key, like
+#: :data:`_CONSTANTS`): draws through the same camera skip comparing them.
+_CAMERA = "#camera"
+#: The PassCamera whose eye position a program holds (lit draws only write it).
+_EYE = "#eye"
+#: A model matrix of this dtype is converted and compared as it is.
+_FLOAT64 = np.dtype(np.float64)
+
+
+def _constants_change(written: dict[str, bytes], last: tuple | None,
+                      constants: tuple[tuple[str, bytes], ...]) -> tuple[tuple[str, bytes], ...]:
+    """What a draw writes of its material's ``constants`` into a program that holds ``last``'s (the
+    constants a draw wrote last; None: not known, so the program's ``written`` bytes are compared):
+    the entries whose bytes differ (walls of one program that differ only in colour: ``u_color``)."""
+    held = written if last is None else dict(last)
+    return tuple((name, data) for name, data in constants if held.get(name) != data)
+
+
+class _NoUniform:
+    """What :class:`_Uniforms` gives for a name the program lacks (a term the compiler removed)."""
+
+    @staticmethod
+    def write(data: bytes) -> None:
+        pass
+
+
+class _Uniforms(dict):
+    """A program's uniforms by name; a name it lacks gives :class:`_NoUniform` (nothing written)."""
+
+    def __missing__(self, name: str) -> type[_NoUniform]:
+        return _NoUniform
+
+
+class _DrawStep:
+    """One draw of a kept plan prepared once (issue 24's flat draw list): what
+    :meth:`Executor.draw_node` found for ``draw`` drawn with ``material`` and ``front_face``
+    (its set-up, culling, whether lit, its material's constant uniform bytes). A frame whose
+    only change is time finds it by the Draw (plans are kept while only time moves) and
+    writes only the model matrix and what moved; any other draw prepares a step anew."""
+
+    __slots__ = ("draw", "material", "front_face", "mesh", "origin", "setup", "user", "culling", "lit",
+                 "constants", "change", "lights")
+
+    def __init__(self, draw: Draw, material: Material, front_face: str, mesh: Mesh, origin: Mesh | None,
+                 setup: _DrawSetup, user: UserProgram | None, lit: bool,
+                 constants: tuple[tuple[str, bytes], ...]) -> None:
+        self.draw, self.material, self.front_face = draw, material, front_face
+        self.mesh = mesh  # the node's mesh drawn last
+        self.origin = origin  # a moved mesh's origin: another moved copy of it keeps the step
+        self.setup, self.user, self.lit, self.constants = setup, user, lit, constants
+        self.culling = (draw.cull_back_faces, front_face)
+        # The constants a program held before this draw last time, and the entries it wrote then (a
+        # kept plan draws in the same order every frame: the same ones again).
+        self.change: tuple[tuple | None, tuple[tuple[str, bytes], ...]] = (None, ())
+        # The lights this draw was lit by last, and their uniform bytes.
+        self.lights: tuple[tuple[Light, ...] | None, bytes, bytes] = (None, b"", b"")
 
 
 class Executor:
@@ -269,17 +340,24 @@ class Executor:
         # What a draw of one mesh with one program needs, found once (see _draw_setup), by
         # (program key, id of the mesh); emptied whenever a VAO or a program is released.
         self._setups: dict[tuple[str, int], _DrawSetup] = {}
-        # Pass cameras by the camera, the viewport's pixels and the depth mode (see _frame_camera).
+        # The prepared draws of the plans drawn lately (see _DrawStep), by (id of the Draw, front
+        # face); emptied with the set-ups whenever a VAO or a program is released.
+        self._steps: dict[tuple[int, str], _DrawStep] = {}
+        # Pass cameras by the camera, the viewport's pixels and the depth mode (see _viewport_camera).
         self._cameras: dict[tuple[int, tuple[int, int, int, int], str], tuple[object, PassCamera]] = {}
+        # What the frames of each plan drawn lately share (see _prepare_frame), by id of the plan.
+        self._prepared_frames: dict[int, _PreparedFrame] = {}
         self._overlays: OverlayDrawer | None = None  # made on the first overlay pass
         self._textures = TextureCache(host)
         self._lights: tuple[Light, ...] = ()  # the lights of the frame being drawn (draw_node's default)
-        self._lights_cache: tuple[tuple[Light, ...], bytes, bytes] | None = None
+        # u_light_pos and u_light_color bytes by id of the lights tuple (the tuple kept to check): see _light_bytes.
+        self._lights_cache: dict[int, tuple[tuple[Light, ...], bytes, bytes]] = {}
         # The uniform bytes last written into each program (by program key): see _uniform_writer.
         self._written: dict[str, dict[str, bytes]] = {}
         self._culling: tuple[bool, str] | None = None  # what _set_culling set last (None: not known)
         self._bound_texture: object | None = None  # the material texture on unit 0 in this frame
         self._clear_depth = 1.0  # 0 with reverse-Z (glsandbox.gl.depth)
+        self._pass_rect: tuple[int, int, int, int] | None = None  # the pass's viewport in pixels (see render)
         self.shadow_maps = gl_shadowmap.ShadowMaps(self.ctx)  # the lights' depth textures
 
     # --- resources ----------------------------------------------------------
@@ -324,7 +402,9 @@ class Executor:
             vao.release()
         self._vaos.clear()
         self._setups.clear()
+        self._steps.clear()
         self._programs = fresh
+        self._prepared_frames.clear()
         self._user = users
         self._member_names.clear()
         self._written.clear()  # new programs hold no values yet
@@ -423,6 +503,7 @@ class Executor:
             for vao_key in [k for k in self._vaos if k[0] == key]:
                 self._vaos.pop(vao_key).release()
             self._setups.clear()
+            self._steps.clear()
             for buffer in gpu.buffers.values():
                 buffer.release()
             if gpu.index is not None:
@@ -448,91 +529,131 @@ class Executor:
     def render(self, scene: Scene, framebuffer: moderngl.Framebuffer, size: tuple[int, int],
                frame_plan: Plan | None = None) -> Plan:
         """Draw one frame of ``scene`` into ``framebuffer`` (``size`` pixels)."""
-        if any(vp.renderer != "raster" for vp in scene.viewports):
-            raise ValueError("the executor draws raster viewports only: trace the others first "
-                             "(glsandbox.frame.trace_viewports)")
         frame_plan = frame_plan or make_plan(scene)
+        prepared = self._prepared_frames.get(id(frame_plan))
+        if (prepared is None or prepared.plan is not frame_plan or prepared.viewports is not scene.viewports
+                or prepared.size != size or prepared.overrides is not scene.uniform_overrides
+                or prepared.depth_mode != scene.depth_mode or prepared.programs is not self._programs):
+            prepared = self._prepare_frame(scene, frame_plan, size)
         self._frame += 1
-        for variant in frame_plan.programs:
-            self.program(variant)
         self._overrides = scene.uniform_overrides
-        users = [self._user[v.key] for v in frame_plan.programs if v.user]
-        for name in scene.uniform_overrides if users else ():
-            if not any(name in user.declared for user in users):
-                raise SandboxError(f"--set u.{name}: no shader of the scene declares uniform {name} "
-                                   f"({', '.join(sorted(str(user.path) for user in users))})")
         frame = FrameState(scene, {node.name: node for node in scene.nodes}, framebuffer, size)
         self._lights = scene.lights
-        self._clear_depth = gl_depth.clear_depth_value(scene)
+        self._clear_depth = prepared.clear_depth
         framebuffer.use()
         self._culling = None  # not known: the first draw sets it
-        gl_depth.begin_depth_mode(self.ctx, self.raw, scene)
+        ctx, raw = self.ctx, self.raw
+        if prepared.reverse_z:
+            gl_depth.begin_depth_mode(ctx, raw, scene)
+        # The state groups of gl.passes.restore_state that a pass left changed. Every pass starts
+        # from that state but for the groups it sets wholly itself before drawing (a stencil pass
+        # its stencil, a blended pass its blending): only the others are put back before it runs,
+        # and after the last pass whatever is left. Culling is the executor's own (_set_culling,
+        # per draw); a pass of a kind not listed in _PASS_STATE changes anything: all is put back.
+        changed: frozenset[str] = frozenset()
         try:
-            for step in frame_plan.passes:
-                runner = PASS_RUNNERS.get(step.kind)
-                if runner is None:
-                    raise SandboxError(f"pass kind {step.kind!r} has no runner (gl.executor.PASS_RUNNERS)")
-                # Every pass starts from the same state (gl.passes.restore_state), whatever the last
-                # one set or raised. A clear pass sets nothing, and a draw pass only culling (blended
-                # draws put blending and depth writes back themselves): those put back only that.
-                restored = False
-                try:
-                    runner(self, frame, step, self._frame_camera(frame, step))
-                    restored = step.kind in _STATE_KEEPING
-                    changed = _PASS_CHANGES.get(step.kind)
-                    if changed is not None:  # a planar pass: only what it changes is put back
-                        gl_passes.restore_state(self.ctx, self.raw, changed)
-                        restored = True
-                finally:
-                    if restored:
-                        self._set_culling(False, "ccw")
-                    else:
-                        gl_passes.restore_state(self.ctx, self.raw)
-                        self._culling = (False, "ccw")  # what restore_state leaves
+            for runner, step, viewport, rect, sets, changes in prepared.passes:
+                if changed:
+                    pending = changed - sets
+                    if pending:
+                        gl_passes.restore_state(ctx, raw, pending)
+                        changed = changed & sets
+                camera, self._pass_rect = None, rect
+                if viewport is not None:  # a frame pass through a viewport: its rectangle, depth test and camera
+                    framebuffer.viewport = rect
+                    self._set_depth(step.depth_test)
+                    camera = self._viewport_camera(viewport.camera or scene.camera, rect, scene)
+                if changes is None:  # a runner of unknown habits: it starts and ends in the default state
+                    self._set_culling(False, "ccw")  # (every other group is put back above)
+                    runner(self, frame, step, camera)
+                    gl_passes.restore_state(ctx, raw)
+                    self._culling = _NO_CULLING
+                    continue
+                runner(self, frame, step, camera)
+                if changes:
+                    changed = changed | changes
+                if step.kind == "overlay" and self._culling is not None:  # OverlayDrawer switches culling off
+                    self._culling = (False, self._culling[1])
+        except BaseException:
+            # Whatever the pass that raised left set is put back, as after any pass.
+            gl_passes.restore_state(ctx, raw)
+            self._culling = _NO_CULLING
+            raise
         finally:
             # Also when a pass raised (a texture file that cannot be read, say): a sampler
             # object left on unit 0 overrides the state of every texture later bound there,
             # and a mipmapped filter makes the gpu ray engine's data textures incomplete
             # (texelFetch then reads zeros) on a context the next user shares.
-            gl_depth.end_depth_mode(self.ctx, self.raw, scene)
-            self._unbind_texture()
-            self._set_depth(False)  # the depth test a pass switched on, also when it raised
+            if prepared.reverse_z:
+                gl_depth.end_depth_mode(ctx, raw, scene)
+            if self._bound_texture is not None:
+                self._unbind_texture()
+            ctx.disable(moderngl.DEPTH_TEST)  # the depth test a pass switched on, also when it raised
+        if changed:
+            gl_passes.restore_state(ctx, raw, changed)
+        if self._culling != _NO_CULLING:
+            self._set_culling(False, "ccw")
         framebuffer.viewport = (0, 0, *size)
-        self.ctx.disable(moderngl.CULL_FACE)
-        self._release_stale_meshes()
+        if len(self._meshes) > self.MESH_LIMIT:
+            self._release_stale_meshes()
         return frame_plan
+
+    def _prepare_frame(self, scene: Scene, frame_plan: Plan, size: tuple[int, int]) -> _PreparedFrame:
+        """What every frame of ``frame_plan`` at ``size`` shares, found once (issue 24): each pass's
+        runner, viewport rectangle and state habits, the programs compiled, the scene's checks
+        (raster viewports only, ``--set u.NAME`` values some shader declares). Kept while the
+        plan, the scene's viewports and overrides, the size and the programs stay the same objects."""
+        if any(vp.renderer != "raster" for vp in scene.viewports):
+            raise ValueError("the executor draws raster viewports only: trace the others first "
+                             "(glsandbox.frame.trace_viewports)")
+        for variant in frame_plan.programs:
+            self.program(variant)
+        users = [self._user[v.key] for v in frame_plan.programs if v.user]
+        for name in scene.uniform_overrides if users else ():
+            if not any(name in user.declared for user in users):
+                raise SandboxError(f"--set u.{name}: no shader of the scene declares uniform {name} "
+                                   f"({', '.join(sorted(str(user.path) for user in users))})")
+        passes = []
+        for step in frame_plan.passes:
+            runner = PASS_RUNNERS.get(step.kind)
+            if runner is None:
+                raise SandboxError(f"pass kind {step.kind!r} has no runner (gl.executor.PASS_RUNNERS)")
+            viewport = None
+            rect = scene.viewports[step.viewport].pixels(*size) if 0 <= step.viewport < len(scene.viewports) else None
+            if step.target == "frame" and step.camera == "viewport":
+                viewport = scene.viewports[step.viewport]
+            habits = _PASS_STATE.get(step.kind)
+            sets, changes = habits(step) if habits is not None else (frozenset(), None)
+            passes.append((runner, step, viewport, rect, sets, changes))
+        prepared = _PreparedFrame(frame_plan, scene.viewports, size, scene.uniform_overrides, self._programs,
+                                  scene.depth_mode, gl_depth.clear_depth_value(scene), scene.depth_mode == "reverse_z",
+                                  tuple(passes))
+        if len(self._prepared_frames) >= 16:  # a live compare draws a few plans by turns; more: start again
+            self._prepared_frames.clear()
+        self._prepared_frames[id(frame_plan)] = prepared
+        return prepared
 
     @staticmethod
     def pass_camera(view: np.ndarray, proj: np.ndarray) -> PassCamera:
         """A pass's camera from its matrices (for runners that look through their own, a light's)."""
         return PassCamera(view, proj)
 
-    def _frame_camera(self, frame: FrameState, step: Pass) -> PassCamera | None:
-        """A frame pass with ``camera="viewport"``: its viewport set, its depth test
-        switched, and its camera (the viewport's or the scene's). Other passes set
-        their own target up (:data:`PASS_RUNNERS`)."""
-        if step.target != "frame" or step.camera != "viewport":
-            return None
-        scene = frame.scene
-        viewport = scene.viewports[step.viewport]
-        rect = viewport.pixels(*frame.size)
-        camera = viewport.camera or scene.camera
-        aspect = rect[2] / rect[3] if rect[3] else 1.0
-        frame.framebuffer.viewport = rect
-        self._set_depth(step.depth_test)
-        # A camera that does not change (a Camera is immutable) keeps its matrices and their bytes.
+    def _viewport_camera(self, camera: Camera, rect: tuple[int, int, int, int], scene: Scene) -> PassCamera:
+        """The pass camera of ``camera`` seen in ``rect``. A camera that does not change (a Camera
+        is immutable) keeps its matrices and their bytes."""
         key = (id(camera), rect, scene.depth_mode)
         kept = self._cameras.get(key)
         if kept is None or kept[0] is not camera:
             if len(self._cameras) >= 64:
                 self._cameras.clear()
+            aspect = rect[2] / rect[3] if rect[3] else 1.0
             kept = self._cameras[key] = (camera, PassCamera(camera.view(), gl_depth.projection_for(
                 scene, camera.projection(aspect))))
         return kept[1]
 
     def _clear(self, frame: FrameState, step: Pass, camera: PassCamera | None) -> None:
         framebuffer = frame.framebuffer
-        rect = frame.scene.viewports[step.viewport].pixels(*frame.size)
+        rect = self._pass_rect or frame.scene.viewports[step.viewport].pixels(*frame.size)
         r, g, b, _ = step.clear_color or (0.0, 0.0, 0.0, 0.0)
         # Frames are opaque whatever the clear colour's alpha (glsandbox.gl.target).
         clear_opaque(framebuffer, (r, g, b), self._clear_depth, rect)
@@ -541,17 +662,21 @@ class Executor:
 
     def _set_culling(self, cull: bool, front_face: str) -> None:
         """Back-face culling on or off, with the winding rule of front faces, set only where it
-        differs from what the executor set last in this pass (GL keeps it; draws of one
-        pass mostly share it). Only the executor changes culling within a pass."""
+        differs from what the executor set last in this frame (GL keeps it; draws mostly share it),
+        each part (on or off, the front face) only where it differs. Only the executor changes
+        culling within a frame (the overlay pass switches it off; :meth:`render` notes that)."""
         state = (cull, front_face)
-        if state == self._culling:
+        known = self._culling
+        if state == known:
             return
-        if cull:
-            self.ctx.enable(moderngl.CULL_FACE)
-            self.ctx.cull_face = "back"
-        else:
-            self.ctx.disable(moderngl.CULL_FACE)
-        self.ctx.front_face = front_face
+        if known is None or known[0] != cull:
+            if cull:
+                self.ctx.enable(moderngl.CULL_FACE)
+                self.ctx.cull_face = "back"
+            else:
+                self.ctx.disable(moderngl.CULL_FACE)
+        if known is None or known[1] != front_face:
+            self.ctx.front_face = front_face
         self._culling = state
 
     def _set_depth(self, on: bool) -> None:
@@ -569,11 +694,11 @@ class Executor:
             names = self._member_names[program_key] = frozenset(self._programs[program_key][1])
         return names
 
-    def _uniforms(self, program_key: str) -> dict[str, moderngl.Uniform]:
+    def _uniforms(self, program_key: str) -> _Uniforms:
         """A program's uniforms by name (its other members are attributes)."""
         program = self._programs[program_key][1]
-        return {name: member for name in self._members(program_key)
-                if isinstance(member := program[name], moderngl.Uniform)}
+        return _Uniforms({name: member for name in self._members(program_key)
+                          if isinstance(member := program[name], moderngl.Uniform)})
 
     def draw_node(self, node: Node, draw: Draw, camera: PassCamera, *, model: np.ndarray | None = None,
                   front_face: str = "ccw", lights: tuple[Light, ...] | None = None,
@@ -588,48 +713,87 @@ class Executor:
         ``"cw"``, the reflected lights; a planar shadow: the flattening
         matrix and one flat colour).
         """
-        user = self._user.get(draw.program)
+        if material is None:
+            material = node.material
+        key = (id(draw), front_face)
+        step = self._steps.get(key)
+        if step is None or step.draw is not draw or step.material is not material:
+            step = self._draw_step(key, node, draw, material, front_face)
+        elif step.mesh is not node.mesh:
+            mesh = node.mesh
+            if step.origin is not None and mesh_origin(mesh) is step.origin:
+                self._moved_gpu_mesh(mesh, step.origin)  # this frame's positions into its buffer
+                step.mesh = mesh
+            else:
+                step = self._draw_step(key, node, draw, material, front_face)
+        setup = step.setup
         own: dict[str, object] = {}
-        if user is not None:  # a node's own shader: checked before anything is made or drawn with it
-            own = self._check_user_draw(user, self._programs[draw.program][1], self._members(draw.program), node)
+        if step.user is not None:  # a node's own shader: checked before anything is drawn with it
+            own = self._check_user_draw(step.user, setup.program, setup.members, node)
             self._user_nodes.setdefault(draw.program, {})[node.name] = node
-        setup = self._draw_setup(draw.program, node.mesh)
         self._mesh_last_frame[setup.mesh_key] = self._frame
-        model = node.model if model is None else model
-        material = node.material if material is None else material
-        if (draw.cull_back_faces, front_face) != self._culling:
+        if step.culling != self._culling:
             self._set_culling(draw.cull_back_faces, front_face)
-        model_bytes, normal_bytes = self._model_bytes(model, setup.normal)
-        # What this draw writes: the matrices, then (lit) the eye and the lights, then the
-        # material's constants (made once per material and program, _material_constants).
-        values = [("m_model", model_bytes), ("m_view", camera.view_bytes), ("m_proj", camera.proj_bytes)]
-        if normal_bytes is not None:
-            values.append(("m_normal", normal_bytes))
-        lit = material.lit or user is not None  # a node's own shader may light itself whatever the shading
-        if lit:
-            values.append(("u_eye", camera.eye_bytes))
+        # What this draw writes, each only where its bytes differ from the program's last
+        # (a program keeps its uniform values between draws and frames): the matrices, then
+        # (lit) the eye and the lights, then the material's constants. A uniform the compiler
+        # removed (a term switched off) is remembered as written and writes nothing (_Uniforms).
+        written, uniforms = setup.written, setup.uniforms
+        matrix = node.model if model is None else model
+        if type(matrix) is not np.ndarray or matrix.dtype != _FLOAT64:
+            matrix = np.asarray(matrix, dtype=np.float64)
+        content = matrix.tobytes()
+        data = _MODEL_BYTES.get(content) or _model_matrix_bytes(content, matrix)
+        if written.get("m_model") != data:
+            written["m_model"] = data
+            uniforms["m_model"].write(data)
+        if written.get(_CAMERA) is not camera:  # (a pass's draws share its camera)
+            if camera.view_bytes != written.get("m_view"):
+                written["m_view"] = camera.view_bytes
+                uniforms["m_view"].write(camera.view_bytes)
+            if camera.proj_bytes != written.get("m_proj"):
+                written["m_proj"] = camera.proj_bytes
+                uniforms["m_proj"].write(camera.proj_bytes)
+            written[_CAMERA] = camera
+        if setup.normal:
+            data = _NORMAL_BYTES.get(content) or _normal_matrix_bytes(content, matrix)
+            if written.get("m_normal") != data:
+                written["m_normal"] = data
+                uniforms["m_normal"].write(data)
+        if step.lit:
+            if written.get(_EYE) is not camera:
+                data = camera.eye_bytes
+                if written.get("u_eye") != data:
+                    written["u_eye"] = data
+                    uniforms["u_eye"].write(data)
+                written[_EYE] = camera
             frame_lights = self._lights if lights is None else lights
             if frame_lights:  # with none, the shader's arrays do not exist (NUM_LIGHTS 0)
-                light_pos, light_color = self._light_bytes(frame_lights)
-                values += (("u_light_pos", light_pos), ("u_light_color", light_color))
-        constants = setup.constants.get(id(material))
-        if constants is None or constants[0] is not material:
-            if len(setup.constants) >= 64:  # materials made anew each frame (a planar shadow's): start again
-                setup.constants.clear()
-            constants = setup.constants[id(material)] = (material, self._material_constants(material, lit))
-        written, uniforms = setup.written, setup.uniforms
-        for name, data in (*values, *constants[1]):
-            # A program keeps its uniform values between draws and frames: bytes equal to the
-            # last written (the view while the camera stands, lights, materials) are not sent.
-            if written.get(name) != data:
+                if step.lights[0] is not frame_lights:  # (lights that do not move: the same tuple every frame)
+                    step.lights = (frame_lights, *self._light_bytes(frame_lights))
+                _, light_pos, light_color = step.lights
+                if written.get("u_light_pos") != light_pos:
+                    written["u_light_pos"] = light_pos
+                    uniforms["u_light_pos"].write(light_pos)
+                if written.get("u_light_color") != light_color:
+                    written["u_light_color"] = light_color
+                    uniforms["u_light_color"].write(light_color)
+        constants = step.constants
+        last = written.get(_CONSTANTS)
+        if last is not constants:  # another material's were written since: only the bytes that differ
+            change = step.change
+            if change[0] is not last or last is None:
+                change = (last, _constants_change(written, last, constants))
+                step.change = change
+            for name, data in change[1]:
                 written[name] = data
-                uniform = uniforms.get(name)
-                if uniform is not None:  # a term the compiler removed has no uniform
-                    uniform.write(data)
+                uniforms[name].write(data)
+            written[_CONSTANTS] = constants
         if own:
             program = setup.program
             for name, value in own.items():
                 program[name].value = value
+            written.pop(_CONSTANTS, None)  # a node's own values may have replaced a constant
         texture = material.texture
         if texture is not None and self._bound_texture is not texture:  # unit 0; consecutive draws bind once
             self._textures.bind(texture, 0)
@@ -647,6 +811,23 @@ class Executor:
             self.raw.glDepthMask(1)
             self.ctx.disable(moderngl.BLEND)
             self.ctx.blend_func = moderngl.DEFAULT_BLENDING
+
+    def _draw_step(self, key: tuple[int, str], node: Node, draw: Draw, material: Material,
+                   front_face: str) -> _DrawStep:
+        """Prepare ``draw`` of ``node`` with ``material`` and ``front_face`` (see :class:`_DrawStep`)
+        and keep it under ``key`` until the set-ups are dropped (a program reloaded, a mesh released)."""
+        user = self._user.get(draw.program)
+        if user is not None:  # a node's own shader: checked before anything is made or drawn with it
+            self._check_user_draw(user, self._programs[draw.program][1], self._members(draw.program), node)
+        mesh = node.mesh
+        setup = self._draw_setup(draw.program, mesh)
+        lit = material.lit or user is not None  # a node's own shader may light itself whatever the shading
+        origin = setup.source if setup.source is not mesh else None  # a moved mesh's set-up is its origin's
+        if len(self._steps) >= self.SETUPS_KEPT:  # new draws every frame (plans not kept): start again
+            self._steps.clear()
+        step = self._steps[key] = _DrawStep(draw, material, front_face, mesh, origin, setup, user, lit,
+                                            self._material_constants(material, lit))
+        return step
 
     def _draw_setup(self, program_key: str, mesh: Mesh) -> _DrawSetup:
         """What every draw of ``mesh`` with the program ``program_key`` needs, found once: the
@@ -699,8 +880,10 @@ class Executor:
         :func:`~glsandbox.transforms.normal_matrix`), looked up by the matrix's content: a node
         that does not move converts its matrix once, not every frame, and an array changed in
         place between frames is converted again (no stale matrix)."""
-        content = np.asarray(model, dtype=np.float64).tobytes()
-        return _model_matrix_bytes(content), _normal_matrix_bytes(content) if normal else None
+        matrix = np.asarray(model, dtype=np.float64)
+        content = matrix.tobytes()
+        return (_MODEL_BYTES.get(content) or _model_matrix_bytes(content, matrix),
+                (_NORMAL_BYTES.get(content) or _normal_matrix_bytes(content, matrix)) if normal else None)
 
     def _uniform_writer(self, program_key: str, program: moderngl.Program,
                         members: Collection[str]) -> Callable[[str, bytes], None]:
@@ -722,12 +905,16 @@ class Executor:
         return write
 
     def _light_bytes(self, lights: tuple[Light, ...]) -> tuple[bytes, bytes]:
-        """``u_light_pos`` and ``u_light_color`` bytes of ``lights``, made once per frame (and once
-        per pass that reflects them): every lit draw of the frame writes the same ones."""
-        cached = self._lights_cache
+        """``u_light_pos`` and ``u_light_color`` bytes of ``lights``, made once per lights tuple: every
+        lit draw of a frame writes the same ones, and lights that do not move (the scene's, and
+        the mirror's reflected ones) keep them from frame to frame."""
+        cached = self._lights_cache.get(id(lights))
         if cached is None or cached[0] is not lights:
-            cached = self._lights_cache = (lights, np.array([l.position for l in lights], dtype="f4").tobytes(),
-                                           np.array([l.color for l in lights], dtype="f4").tobytes())
+            if len(self._lights_cache) >= 8:  # lights that move make a tuple a frame
+                self._lights_cache.clear()
+            cached = self._lights_cache[id(lights)] = (
+                lights, np.array([l.position for l in lights], dtype="f4").tobytes(),
+                np.array([l.color for l in lights], dtype="f4").tobytes())
         return cached[1], cached[2]
 
     def _unbind_texture(self) -> None:
@@ -773,7 +960,9 @@ class Executor:
         self.shadow_maps.release()
         self._vaos.clear()
         self._setups.clear()
+        self._steps.clear()
         self._cameras.clear()
+        self._prepared_frames.clear()
         self._meshes.clear()
         self._mesh_last_frame.clear()
         self._programs.clear()
@@ -793,18 +982,55 @@ def eye_position(view: np.ndarray) -> np.ndarray:
     return np.linalg.inv(np.asarray(view, dtype=np.float64))[:3, 3]
 
 
-#: Pass kinds whose runners leave GL state as :func:`glsandbox.gl.passes.restore_state` sets it,
-#: but for culling (:meth:`Executor._set_culling`): a clear, a draw pass (its blended draws
-#: put blending and depth writes back) and an overlay pass (:meth:`OverlayDrawer.draw` puts
-#: blending and the scissor back, and switches off only the depth test, which every pass
-#: sets for itself, and culling, which restore_state leaves off).
-_STATE_KEEPING = frozenset({"clear", "draw", "overlay"})
-#: The planar passes (:mod:`glsandbox.gl.planar`) and the groups of
-#: :func:`~glsandbox.gl.passes.restore_state` each changes (culling besides, through
-#: :meth:`Executor._set_culling`): after one, only those are put back.
-_PASS_CHANGES = {"mark_mirror": frozenset({"stencil", "masks"}), "reflection": frozenset({"stencil"}),
-                 "mirror_surface": frozenset({"blend"}),
-                 "planar_shadow": frozenset({"stencil", "masks", "blend", "offset"})}
+_NO_SETS: frozenset[str] = frozenset()
+
+
+def _stencil_set(step: Pass) -> frozenset[str]:
+    """A planar pass with a stencil state sets all of the stencil group (gl.planar.set_stencil)."""
+    return frozenset({"stencil"}) if step.stencil is not None else _NO_SETS
+
+
+#: How each pass kind treats the state groups of :func:`glsandbox.gl.passes.restore_state`
+#: (culling aside: the executor sets it per draw, :meth:`Executor._set_culling`), from its pass:
+#: (the groups it sets wholly itself before it draws, so what the pass before left there need
+#: not be put back first; the groups it leaves changed). A clear sets nothing; a draw pass
+#: changes nothing (its blended draws put blending and depth writes back); an overlay pass puts
+#: blending and the scissor back itself; a shadow-map pass binds the frame's framebuffer again,
+#: which sets its write masks. The planar passes (:mod:`glsandbox.gl.planar`): marking the mirror
+#: sets the stencil and both write masks, the reflection the stencil (with one), the glass its
+#: blending, the shadow the stencil (with one) and its blending, and leaves depth writes off
+#: and the polygon offset set. A kind not listed here is put back wholly before and after it.
+_PASS_STATE: dict[str, Callable[[Pass], tuple[frozenset[str], frozenset[str]]]] = {
+    "clear": lambda step: (_NO_SETS, _NO_SETS),
+    "draw": lambda step: (_NO_SETS, _NO_SETS),
+    "overlay": lambda step: (_NO_SETS, _NO_SETS),
+    "shadow_map": lambda step: (_NO_SETS, _NO_SETS),
+    "mark_mirror": lambda step: (_stencil_set(step) | {"masks"}, frozenset({"stencil", "masks"})),
+    "reflection": lambda step: (_stencil_set(step), _stencil_set(step)),
+    "mirror_surface": lambda step: (frozenset({"blend"}), frozenset({"blend"})),
+    "planar_shadow": lambda step: (_stencil_set(step) | {"blend"}, frozenset({"stencil", "masks", "blend", "offset"})),
+}
+#: What restore_state leaves of culling (off, counter-clockwise fronts).
+_NO_CULLING = (False, "ccw")
+
+
+@dataclass(frozen=True)
+class _PreparedFrame:
+    """What the frames of one plan share (:meth:`Executor._prepare_frame`): per pass, its runner,
+    the pass, its viewport and rectangle (a frame pass through a viewport; else None), and the
+    state groups it sets and changes (:data:`_PASS_STATE`)."""
+
+    plan: Plan
+    viewports: tuple
+    size: tuple[int, int]
+    overrides: Mapping[str, object]
+    programs: dict
+    depth_mode: str
+    clear_depth: float
+    reverse_z: bool  # the frame's depth mode is begun and ended (glsandbox.gl.depth)
+    passes: tuple[tuple[PassRunner, Pass, object, tuple[int, int, int, int] | None, frozenset[str],
+                        frozenset[str] | None], ...]
+
 
 #: One runner per pass kind (:data:`glsandbox.plan.PASS_KINDS`); a new kind adds
 #: its entry here and its describer in :data:`glsandbox.plan.PASS_DESCRIBERS`.

@@ -93,10 +93,26 @@ def reflected_lights(lights: tuple[Light, ...], reflection: np.ndarray) -> tuple
                  for l in lights)
 
 
-@functools.lru_cache(maxsize=16)
+#: The last lights reflected: (lights, mirror, their reflections), see :func:`_mirrored_lights`.
+_LAST_MIRRORED: list[tuple[tuple[Light, ...], Mirror, tuple[Light, ...]]] = []
+
+
 def _mirrored_lights(lights: tuple[Light, ...], mirror: Mirror) -> tuple[Light, ...]:
-    """:func:`reflected_lights` through ``mirror``, once per set of lights (Lights and Mirrors are
-    immutable and compare by value): lights that do not move are reflected once, not every frame."""
+    """:func:`reflected_lights` through ``mirror``, once per set of lights: lights that do not move
+    are reflected once, not every frame. The same objects as last time (a scene moved only by time
+    keeps its lights tuple and mirror) are found without hashing them; others by value (Lights and
+    Mirrors are immutable and compare by value)."""
+    if _LAST_MIRRORED:
+        last_lights, last_mirror, reflected = _LAST_MIRRORED[0]
+        if last_lights is lights and last_mirror is mirror:
+            return reflected
+    reflected = _mirrored_by_value(lights, mirror)
+    _LAST_MIRRORED[:] = [(lights, mirror, reflected)]
+    return reflected
+
+
+@functools.lru_cache(maxsize=16)
+def _mirrored_by_value(lights: tuple[Light, ...], mirror: Mirror) -> tuple[Light, ...]:
     return reflected_lights(lights, mirror.matrix())
 
 
@@ -130,6 +146,13 @@ def mirror_surface(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: An
         drawer.draw_node(frame.nodes[draw.node], draw, camera)
 
 
+@functools.lru_cache(maxsize=16)
+def _flat_material(color: tuple[float, ...]) -> Material:
+    """The planar shadow's material, one object per colour: the executor keeps what it prepared
+    for a draw while its material is the same object (Materials are immutable)."""
+    return Material(color=color)
+
+
 def planar_shadow(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any) -> None:
     """The casters flattened by the lifted shadow matrix, dark and blended.
 
@@ -154,7 +177,7 @@ def planar_shadow(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any
         sign = 1.0 if scene.depth_mode == "reverse_z" else -1.0
         ctx.polygon_offset = (sign, sign)
     flatten = shadow.matrix()
-    flat = Material(color=shadow.color)  # one colour, unlit, untextured
+    flat = _flat_material(shadow.color)  # one colour, unlit, untextured
     for draw in step.draws:  # drawn without culling, as the plan says
         node = nodes[draw.node]
         material = flat

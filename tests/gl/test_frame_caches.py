@@ -15,6 +15,7 @@ import pytest
 
 from glsandbox.frame import FrameRenderer
 from glsandbox.lesson import find_lesson
+from glsandbox.plan import plan
 
 SIZE = (80, 60)
 #: Lessons with lights (reflected ones too: the mirror), textures, overlays and split viewports.
@@ -101,3 +102,47 @@ def test_a_texture_drawn_with_another_filter_is_sampled_with_it(gl) -> None:
     assert not np.array_equal(frames[nearest], frames[smooth])
     both = scene(nearest, smooth)
     assert np.array_equal(gl.render_scene(both, SIZE).image, fresh_frame(gl, both))
+
+
+def test_a_kept_plan_drawn_with_other_parts_draws_those_parts(gl) -> None:
+    """The executor prepares each plan's passes and draws once (issue 24) and keeps them while
+    the plan object is the same. One plan drawn in turn with scenes that differ in a material's
+    colour, a texture's image, a mesh, the lights and the frame's size draws each as a fresh renderer
+    draws it: what was prepared is found again only for the same material, mesh and size."""
+    from dataclasses import replace
+
+    from glsandbox import geometry
+    from glsandbox.scene import Camera, Light, Material, Node, Scene, Texture
+
+    ball = Node("ball", geometry.sphere(), np.diag([1.2, 1.2, 1.2, 1.0]),
+                Material((1.0, 0.3, 0.2, 1.0), shading="phong"))
+    stripes = np.zeros((8, 8, 4), np.uint8)
+    stripes[:, ::2] = (255, 255, 255, 255)
+    stripes[:, 1::2] = (40, 200, 60, 255)
+    box = Node("box", geometry.cube24(), np.array([[0.8, 0, 0, 1.8], [0, 0.8, 0, 0], [0, 0, 0.8, 0], [0, 0, 0, 1.0]]),
+               Material(shading="phong", texture=Texture("stripes", image=stripes)))
+    base = Scene("parts", nodes=(ball, box), lights=(Light((2.0, 3.0, 4.0)),), camera=Camera(eye=(0.0, 1.0, 6.0)))
+    recolored = replace(base, nodes=(replace(ball, material=replace(ball.material, color=(0.2, 0.4, 1.0, 1.0))), box))
+    # Another image under the same name: the plan names the texture only, the GL texture differs.
+    retextured = replace(base, nodes=(ball, replace(box, material=replace(
+        box.material, texture=Texture("stripes", image=np.ascontiguousarray(stripes.transpose(1, 0, 2)))))))
+    reshaped = replace(base, nodes=(ball, replace(box, mesh=geometry.sphere())))
+    relit = replace(base, lights=(Light((-3.0, 1.0, 2.0), (1.0, 0.9, 0.2)),))
+    kept = plan(base)
+    for scene in (recolored, retextured, reshaped, relit):
+        assert plan(scene) == kept  # the same passes and programs: the one plan object draws them all
+    pictures = {}
+    for size in (SIZE, (64, 48), SIZE):
+        target = gl.target(size, kept.buffers)
+        for name, scene in (("base", base), ("recolored", recolored), ("retextured", retextured),
+                            ("reshaped", reshaped), ("relit", relit), ("base", base)):
+            gl.executor.render(scene, target.framebuffer, size, kept)
+            image = target.read().copy()
+            renderer = FrameRenderer(gl.host)
+            try:
+                assert np.array_equal(image, renderer.render_scene(scene, size).image), (name, size)
+            finally:
+                renderer.close()
+            pictures.setdefault((name, size), image)
+    for name in ("recolored", "retextured", "reshaped", "relit"):  # each change shows
+        assert not np.array_equal(pictures[(name, SIZE)], pictures[("base", SIZE)]), name

@@ -3,10 +3,11 @@ an unregistered kind is refused by name, and every pass leaves GL as it found it
 
 from __future__ import annotations
 
+import moderngl
 import pytest
 
 from glsandbox.errors import SandboxError
-from glsandbox.gl import executor as gl_executor
+from glsandbox.gl import executor as gl_executor, rawgl
 from glsandbox.plan import PASS_DESCRIBERS, PASS_KINDS, Pass, plan
 from lessons.mirror import MirrorLesson
 from lessons.shadow_map import ShadowMapLesson
@@ -36,27 +37,77 @@ def test_an_unregistered_kind_is_refused_by_name(gl):
         gl.executor.render(scene, target.framebuffer, SIZE, bad)
 
 
+#: The snapshot's entries (glsandbox.gl.rawgl.RawGL.state_snapshot) of each group of
+#: glsandbox.gl.passes.restore_state, and of culling.
+GROUP_ENTRIES = {"stencil": ("stencil_test", "stencil_func", "stencil_value_mask", "stencil_fail",
+                             "stencil_pass_depth_fail", "stencil_pass_depth_pass", "stencil_ref", "stencil_writemask"),
+                 "masks": ("depth_writemask", "color_writemask"), "blend": ("blend", "blend_src_rgb", "blend_dst_rgb"),
+                 "offset": ("polygon_offset_fill", "polygon_offset_factor", "polygon_offset_units")}
+CULLING = ("cull_face", "front_face", "cull_face_mode")
+
+
 def test_gl_state_is_the_same_when_every_pass_starts(gl, monkeypatch):
     """The registry's runners, each wrapped to read the GL state as it starts: every pass
-    of a frame after the first finds what the first found (less the depth test, which the
-    executor sets for each pass from the plan, and the depth clear value, which
-    only a clear reads and every clear sets)."""
+    of a frame after the first finds what the first found, less the depth test (which the
+    executor sets for each pass from the plan), the depth clear value (read only by clears,
+    which set it), culling (which the executor sets for each draw) and the state groups the
+    pass sets wholly itself before it draws (gl.executor._PASS_STATE: a stencil pass after
+    a stencil pass finds the last one's stencil, not the default)."""
     seen: list[tuple[str, str, dict]] = []
     for kind, runner in list(gl_executor.PASS_RUNNERS.items()):
         def spy(executor, frame, step, camera, runner=runner):
             state = executor.raw.state_snapshot()
-            state.pop("depth_test", None)
-            state.pop("depth_clear_value", None)  # read only by clears, which set it
+            sets = gl_executor._PASS_STATE[step.kind](step)[0]
+            for name in ("depth_test", "depth_clear_value", *CULLING,
+                         *(entry for group in sets for entry in GROUP_ENTRIES[group])):
+                del state[name]
             seen.append((frame.scene.name, step.kind, state))
             return runner(executor, frame, step, camera)
         monkeypatch.setitem(gl_executor.PASS_RUNNERS, kind, spy)
-    for lesson in (ShadowMapLesson(), MirrorLesson()):
-        gl.render(lesson, SIZE)
+    for _ in range(2):  # the first frame of each plan and a frame of a kept plan
+        for lesson in (ShadowMapLesson(), MirrorLesson()):
+            gl.render(lesson, SIZE)
     kinds = {kind for _, kind, _ in seen}
     assert {"shadow_map", "planar_shadow", "mark_mirror", "reflection", "mirror_surface", "draw", "clear"} <= kinds
     for name in ("shadow_map", "mirror"):  # a frame's depth mode (reverse-Z in the mirror) holds for all its passes
         states = [(kind, state) for scene, kind, state in seen if scene == name]
-        assert [kind for kind, state in states if state != states[0][1]] == [], name
+        first = states[0][1]
+        assert [kind for kind, state in states if state != {k: first[k] for k in state}] == [], name
+
+
+def test_a_pass_of_unknown_habits_starts_and_ends_in_the_default_state(gl, monkeypatch):
+    """A runner the executor knows nothing of (a kind added to PASS_RUNNERS without an entry in
+    _PASS_STATE) finds every group put back, culling too, and whatever it sets is put back
+    after it: the next pass finds the state the first pass found."""
+    seen: dict[str, dict] = {}
+
+    def odd(executor, frame, step, camera):  # a pass that leaves blending, culling and the stencil on
+        seen["odd"] = executor.raw.state_snapshot()
+        executor.ctx.enable(moderngl.BLEND | moderngl.CULL_FACE)
+        executor.raw.glEnable(rawgl.GL_STENCIL_TEST)
+
+    def spy_clear(executor, frame, step, camera, runner=gl_executor.PASS_RUNNERS["clear"]):
+        seen.setdefault("clear", executor.raw.state_snapshot())
+        return runner(executor, frame, step, camera)
+
+    def spy_draw(executor, frame, step, camera, runner=gl_executor.PASS_RUNNERS["draw"]):
+        seen["draw"] = executor.raw.state_snapshot()
+        return runner(executor, frame, step, camera)
+
+    monkeypatch.setitem(gl_executor.PASS_RUNNERS, "odd", odd)
+    monkeypatch.setitem(gl_executor.PASS_RUNNERS, "clear", spy_clear)
+    monkeypatch.setitem(gl_executor.PASS_RUNNERS, "draw", spy_draw)
+    scene = MirrorLesson().scene()
+    frame_plan = plan(scene)
+    draw_at = next(i for i, p in enumerate(frame_plan.passes) if p.kind == "draw")
+    passes = (*frame_plan.passes[:draw_at + 1], Pass("odd", 0), *frame_plan.passes[draw_at + 1:],
+              Pass("odd", 0), frame_plan.passes[draw_at])
+    odd_plan = type(frame_plan)(**{**frame_plan.__dict__, "passes": passes})
+    target = gl.target(SIZE, frame_plan.buffers)
+    gl.executor.render(scene, target.framebuffer, SIZE, odd_plan)
+    first = {k: v for k, v in seen["clear"].items() if k not in ("depth_test", "depth_clear_value")}
+    for name in ("odd", "draw"):
+        assert {k: seen[name][k] for k in first} == first, name
 
 
 def test_a_frame_leaves_no_sampler_object_or_depth_test_even_when_a_pass_raises(gl, tmp_path):

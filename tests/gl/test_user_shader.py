@@ -24,7 +24,7 @@ from glsandbox.geometry import builtin_mesh
 from glsandbox.file_watch import FileWatch
 from glsandbox.lesson import find_lesson
 from glsandbox.plan import plan
-from glsandbox.scene import SHADER_INPUTS, Node, Scene
+from glsandbox.scene import SHADER_INPUTS, Motion, Node, Scene, moved_scene
 from glsandbox.scene_file import load_scene
 
 TOON = REPO / "examples" / "toon" / "toon.toml"
@@ -404,6 +404,32 @@ def test_a_save_reloads_the_users_shader_and_a_broken_one_keeps_the_last_good(fo
     with pytest.raises(SandboxError, match="uniform tint is a float, but node 'box' gives it 0, 1, 0"):
         gl.executor.reload_shaders()
     assert tuple(gl.render_scene(scene, (32, 32)).image[16, 16]) == (255, 0, 0, 255)
+
+
+def test_frames_of_a_kept_plan_see_a_reload_and_changed_uniform_values(folder: Path, fresh) -> None:
+    """The executor keeps each plan's prepared passes and draws while the plan is the same object
+    (a scene moved only by time); a reloaded program, a node's other uniform values and other
+    ``--set u.NAME`` values still reach its frames."""
+    gl = fresh
+    scene = load_scene(folder / "scene.toml")
+    size = (32, 32)
+    kept = gl.plan(moved_scene(scene, Motion(camera=scene.camera)))  # moved: the renderer keeps its plan
+    target = gl.target(size, kept.buffers)
+
+    def pixel(drawn: Scene) -> tuple[int, ...]:
+        gl.executor.render(drawn, target.framebuffer, size, kept)
+        return tuple(target.read()[16, 16])
+
+    assert pixel(scene) == (0, 255, 0, 255)
+    assert gl.plan(moved_scene(scene, Motion(camera=scene.camera))) is kept
+    box = scene.nodes[0]
+    assert pixel(replace(scene, nodes=(replace(box, uniforms={"tint": (1, 0, 0)}),))) == (255, 0, 0, 255)
+    assert pixel(replace(scene, uniform_overrides={"tint": (0, 0, 1)})) == (0, 0, 255, 255)
+    assert pixel(scene) == (0, 255, 0, 255)
+    shader = folder / "tint.glsl"
+    shader.write_text(TINT.replace("vec4(tint, 1.0)", "vec4(tint.gbr, 1.0)"))
+    gl.executor.reload_shaders()
+    assert pixel(scene) == (255, 0, 0, 255)
 
 
 @pytest.mark.slow
