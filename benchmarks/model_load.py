@@ -18,9 +18,11 @@ Rows per model (``--quick``: the bunny only):
   uploading its vertices and faces and drawing them once (``finish``: the
   limit) against ``glsandbox.load_model`` (normals, vertex merging, checks)
   and glsandbox's first frame of the mesh on the same context (goal: 3x);
-- **BVH build**: Embree (``embreex``) building its tree for the same triangles
-  against :func:`glsandbox.raytrace.bvh.build_bvh` (goal: 2x), the SAH cost of
-  glsandbox's tree in the note.
+- **BVH build**: Embree (``embreex``, in its own TBB threads) building its tree
+  for the same triangles against :func:`glsandbox.raytrace.bvh.build_bvh` (goal:
+  2x; threads on the CPUs that are idle when it starts, see
+  :func:`~glsandbox.raytrace.bvh.build_threads`), the SAH cost of glsandbox's
+  tree in the note.
 
 Under the table: peak memory per triangle of a load and first frame, measured
 in a fresh process that has loaded and drawn the model once already (the
@@ -189,7 +191,8 @@ def build_case(label: str, case: Any, side: Any) -> Any:
     def ours(_: int) -> float:
         return build_bvh(*_triangles(label)).build_seconds
 
-    return case(GROUP, f"BVH build, {label}", side("Embree (embreex)", embree), side("build_bvh (binned SAH)", ours),
+    return case(GROUP, f"BVH build, {label}", side("Embree (embreex, its own threads)", embree),
+                side("build_bvh (binned SAH, threads on idle CPUs)", ours),
                 repeat=1, unit="s", goal=BUILD_GOAL,
                 note="both from the same float64 triangles, made once; sah_cost() of glsandbox's tree is printed "
                      "under the table")
@@ -198,17 +201,14 @@ def build_case(label: str, case: Any, side: Any) -> Any:
 _MEASURE_PRELUDE = """
 import gc, json, sys, tracemalloc
 from pathlib import Path
-def status(key):
-    with open('/proc/self/status') as f:
-        return next(int(line.split()[1]) * 1024 for line in f if line.startswith(key))
+sys.path.insert(0, sys.argv[2])
+from _memory import peak_growth, peak_start
 def grown(load):
     # Linux: the peak resident size (VmHWM) starts again from the current one; then its growth.
     gc.collect()  # what an earlier load left in reference cycles (trimesh's scenes) goes first
-    with open('/proc/self/clear_refs', 'w') as f:
-        f.write('5')
-    before = status('VmRSS:')
+    start = peak_start()
     load()
-    return status('VmHWM:') - before
+    return peak_growth(start)
 path = Path(sys.argv[1])
 """
 
@@ -216,7 +216,6 @@ path = Path(sys.argv[1])
 #: parse (``meshfile._trimesh_scene``, wrapped) and of all that follows it (glsandbox's own part), what is
 #: held after, and the loaded model's arrays.
 _GLSANDBOX_MEMORY = _MEASURE_PRELUDE + """
-sys.path.insert(0, sys.argv[2])
 import trimesh, glsandbox, glsandbox.meshfile as meshfile
 from glsandbox.measure.bench import BenchEnv
 import model_load

@@ -108,12 +108,17 @@ class EmbreeCaster:
         from embreex.mesh_construction import TriangleMesh
 
         world = build_world(scene, analytic_spheres=False)
-        triangles = np.stack([world.v0, world.v1, world.v2], axis=1).astype(np.float32)
+        triangles = np.empty((world.v0.shape[0], 3, 3), dtype=np.float32)  # no float64 copy on the way
+        for corner, v in enumerate((world.v0, world.v1, world.v2)):
+            triangles[:, corner] = v
         self.scene = rtcore_scene.EmbreeScene()
         TriangleMesh(self.scene, triangles)
         self.shadow_scenes = []  # one per light, without that light's lamp
         for index in range(len(world.light_positions) if shadows else 0):
             keep = np.array([not world.nodes[k].lamp_of >> index & 1 for k in world.tri_node], dtype=bool)
+            if keep.all():  # no lamp: the shadow rays query the same scene
+                self.shadow_scenes.append(self.scene)
+                continue
             occluders = rtcore_scene.EmbreeScene()
             if keep.any():
                 TriangleMesh(occluders, np.ascontiguousarray(triangles[keep]))
@@ -123,9 +128,38 @@ class EmbreeCaster:
         self.lit = np.array([n.lit for n in world.nodes], dtype=bool)
         self.reflectivity = np.array([n.reflectivity for n in world.nodes])
         self.max_depth = max_depth
+        self._rays(scene, size)
+
+    def _rays(self, scene: object, size: tuple[int, int]) -> None:
         eye, dirs = camera_rays(scene.viewports[0].camera or scene.camera, *size)
         self.origins = np.ascontiguousarray(np.broadcast_to(eye, dirs.shape), dtype=np.float32)
         self.directions = np.ascontiguousarray(dirs, dtype=np.float32)
+
+    @classmethod
+    def of_model(cls, scene: object, size: tuple[int, int], shadows: bool, max_depth: int) -> EmbreeCaster:
+        """The same rays for a scene of one lit mesh node and no lamp (``models.py``'s scenes), Embree
+        given the mesh's own vertices and indices as a renderer built on it would take them: no
+        World (glsandbox's float64 arrays a triangle), and the shadow rays query the same scene."""
+        from embreex import rtcore_scene
+        from embreex.mesh_construction import TriangleMesh
+
+        from glsandbox.transforms import transform_points
+
+        (node,) = scene.nodes
+        assert node.mesh.mode == "triangles" and node.material.lit, "one lit triangle mesh"
+        self = cls.__new__(cls)
+        self.scene = rtcore_scene.EmbreeScene()
+        vertices = transform_points(np.asarray(node.model, dtype=np.float64), np.asarray(node.mesh.positions))
+        indices = np.asarray(node.mesh.indices).reshape(-1, 3)
+        TriangleMesh(self.scene, vertices.astype(np.float32), indices)
+        self.shadow_scenes = [self.scene] * (len(scene.lights) if shadows else 0)
+        self.lights = np.array([light.position for light in scene.lights], dtype=np.float32).reshape(-1, 3)
+        self.tri_node = np.broadcast_to(np.intp(0), (indices.shape[0],))  # every triangle is node 0's
+        self.lit = np.array([True])
+        self.reflectivity = np.array([node.material.reflectivity])
+        self.max_depth = max_depth
+        self._rays(scene, size)
+        return self
 
     def cast(self) -> int:
         """Cast every ray once; returns how many were cast."""

@@ -42,12 +42,14 @@ BYTES_PER_TRIANGLE = 256
 
 #: An OBJ's text costs trimesh's reader, at its peak, this many bytes per byte of the file plus
 #: :data:`OBJ_BYTES_PER_LINE` per line (its copies of the text, and a Python string per line).
-#: Measured (traced peak of a load): 348 bytes per triangle for a triangle repeated, 36 bytes and 4
-#: lines each (this gives 384); 572 for the bunny's ``f a//a``, 69 bytes and 2 lines (600); 745 with
-#: uvs and normals, 95 bytes and 2.5 lines (820). Before glsandbox's own arrays exist, so an OBJ
-#: needs the larger of this and :data:`BYTES_PER_TRIANGLE` per triangle.
-OBJ_BYTES_PER_FILE_BYTE = 8
-OBJ_BYTES_PER_LINE = 24
+#: Measured (traced peak of a load, numpy 2.4): 348 bytes per triangle for a triangle repeated, 36
+#: bytes and 4 lines each; 572 for the bunny's ``f a//a``, 69 bytes and 2 lines; 745 with uvs and
+#: normals, 95 bytes and 2.5 lines. numpy 2.5's ``unique`` takes about 14% more on the repeated
+#: triangle (396 a triangle), so the rule keeps a margin: 468, 693 and 945 for those three. Before
+#: glsandbox's own arrays exist, so an OBJ needs the larger of this and :data:`BYTES_PER_TRIANGLE`
+#: per triangle.
+OBJ_BYTES_PER_FILE_BYTE = 9
+OBJ_BYTES_PER_LINE = 36
 
 #: The environment variable that sets the memory a model may use (bytes, or ``512M``, ``8G``).
 MEMORY_ENV = "GLSANDBOX_MODEL_MEMORY"

@@ -68,13 +68,20 @@ class Side:
     run: Callable[[int], Any]
 
 
+#: Units of cases whose sides return what is measured (:class:`Case`) instead of being timed.
+QUANTITY_UNITS = ("MiB",)
+
+
 @dataclass(frozen=True)
 class Case:
     """Two sides measured side by side; the ratio is subject / baseline.
 
     ``repeat`` is how many repetitions make one timed sample (many cheap
     frames, one process start); ``unit`` is how the per-repetition time is
-    printed ("ms" or "s"); ``goal`` is the ratio aimed for (printed, never
+    printed ("ms" or "s"), or a quantity's unit (:data:`QUANTITY_UNITS`, e.g.
+    "MiB"): then each side's ``run`` returns the figure itself (e.g. a fresh
+    process's peak memory), which is the sample in place of the time, and
+    there is no warm-up call; ``goal`` is the ratio aimed for (printed, never
     asserted); ``cpu_goal_us`` the most extra main-thread CPU per repetition
     aimed for, in microseconds (printed likewise); ``compare`` decides whether the two sides show the same
     picture from their first results (None: nothing to compare).
@@ -125,7 +132,8 @@ class BenchEnv:
 
 @dataclass
 class Result:
-    """The timings of one case: per-repetition seconds of each sample, both sides."""
+    """The timings of one case: per-repetition seconds of each sample, both sides (a quantity
+    case's figures instead: :data:`QUANTITY_UNITS`)."""
 
     case: Case
     baseline_s: list[float]
@@ -185,12 +193,13 @@ def cpu_seconds() -> float:
     return cpu
 
 
-def _sample(side: Side, repeat: int, start: int) -> tuple[float, float]:
-    """Wall and CPU seconds (:func:`cpu_seconds`) per repetition."""
+def _sample(side: Side, repeat: int, start: int) -> tuple[float, float, Any]:
+    """Wall and CPU seconds (:func:`cpu_seconds`) per repetition, and what the last one returned."""
     cpu0, t0 = cpu_seconds(), time.perf_counter()
+    value = None
     for k in range(repeat):
-        side.run(start + k)
-    return (time.perf_counter() - t0) / repeat, (cpu_seconds() - cpu0) / repeat
+        value = side.run(start + k)
+    return (time.perf_counter() - t0) / repeat, (cpu_seconds() - cpu0) / repeat, value
 
 
 def measure(cases: Sequence[Case], rounds: int, log: Callable[[str], None] = lambda s: None,
@@ -202,6 +211,10 @@ def measure(cases: Sequence[Case], rounds: int, log: Callable[[str], None] = lam
     """
     results = []
     for case in cases:
+        if case.unit in QUANTITY_UNITS:  # each call measures anew: nothing to warm up
+            results.append(Result(case, [], []))
+            advance(1)
+            continue
         first_base = case.baseline.run(0) if case.baseline else None
         first_subject = case.subject.run(0)
         same = case.compare(first_base, first_subject) if case.compare and case.baseline else ""
@@ -217,8 +230,8 @@ def measure(cases: Sequence[Case], rounds: int, log: Callable[[str], None] = lam
                 sides.reverse()
             for side, samples, cpu_samples in sides:
                 if side is not None:
-                    wall, cpu = _sample(side, case.repeat, r * case.repeat)
-                    samples.append(wall)
+                    wall, cpu, value = _sample(side, case.repeat, r * case.repeat)
+                    samples.append(float(value) if case.unit in QUANTITY_UNITS else wall)
                     cpu_samples.append(cpu)
             advance(1)
     return results

@@ -425,19 +425,18 @@ def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.fl
     normal = np.zeros((n, 3))
     base = np.zeros((n, 3))
     alpha = np.ones(n)
-    uv = np.zeros((n, 2))
     for k, node in enumerate(world.nodes):
         sel = np.nonzero(hits.node == k)[0]
         if sel.size == 0:
             continue
-        normal[sel], uv[sel], colors = _SURFACE[node.kind](world, node, hits, sel, o, d, point, spawn)
+        normal[sel], uv, colors = _SURFACE[node.kind](world, node, hits, sel, o, d, point, spawn)
         color = np.broadcast_to(node.color, (sel.size, 3)).copy()
         if colors is not None:  # vertex colours, times the material colour (basic.glsl, phong.glsl)
             color *= colors
         alpha[sel] = node.alpha
         if node.texture >= 0:
             image, wrap = world.textures[node.texture]
-            texel = _sample(image, wrap, uv[sel])
+            texel = _sample(image, wrap, uv)
             color *= texel[:, :3]
             alpha[sel] *= texel[:, 3]
         base[sel] = color
@@ -486,9 +485,10 @@ def _surface_cylinder(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[np
 
 def _surface_triangles(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[np.intp], o: NDArray[np.float64],
                        d: NDArray[np.float64], point: NDArray[np.float64], spawn: _Spawn | None
-                       ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64] | None]:
-    """A mesh node's (normal, uv, vertex colour) at its hits, barycentric; its spawn
-    points are the barycentric points with their error bound and the face normal."""
+                       ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None]:
+    """A mesh node's (normal, uv, vertex colour) at its hits, barycentric (uv None without a
+    texture: nothing reads it); its spawn points are the barycentric points with their error
+    bound and the face normal."""
     tri = hits.tri[sel]
     v0, v1, v2 = world.v0[tri], world.v1[tri], world.v2[tri]  # each gathered once
     e1 = v1 - v0
@@ -511,7 +511,8 @@ def _surface_triangles(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[n
         spawn.error[sel] = gamma(TRIANGLE_POINT_GAMMA, UNIT_F64) * reach
         spawn.normal[sel] = face
     colors = _interpolate(world.colors[tri], w) if node.mode == 1 or node.vertex_colors else None  # when shown
-    return normal, _interpolate(world.uvs[tri], w), colors
+    uv = _interpolate(world.uvs[tri], w) if node.texture >= 0 else None  # read by a texture only
+    return normal, uv, colors
 
 
 #: The node table's per-kind code (:class:`~glsandbox.raytrace.world.NodeKind`): a hit
@@ -563,15 +564,18 @@ def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.floa
     lit = table.lit[hits.node]
     if lit.any():
         idx = np.nonzero(lit)[0]
-        nodes = hits.node[idx]
+        every = idx.size == lit.size  # every hit lit (a lit model): the arrays as they are, read only
+        pick = slice(None) if every else idx
+        nodes = hits.node[pick]
         ka = table.ka[nodes][:, None]
         kd = table.kd[nodes][:, None]
         ks = table.ks[nodes][:, None]
         shin = table.shininess[nodes]
         blinn = table.blinn[nodes]
-        p, nrm, mesh = point[idx], normal[idx], base[idx]
-        lit_spawn = spawn.subset(idx) if spawn is not None else None
-        to_eye = -d[idx] / length(d[idx])[:, None]
+        p, nrm, mesh = point[pick], normal[pick], base[pick]
+        lit_spawn = spawn if every or spawn is None else spawn.subset(idx)
+        dl = d[pick]
+        to_eye = -dl / length(dl)[:, None]
         total = np.zeros_like(mesh)
         for index, (light, light_color) in enumerate(zip(world.light_positions, world.light_colors)):
             to_light = light - p
@@ -596,7 +600,7 @@ def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.floa
                 blocked = _occluded(world, start, light - start, index, cull, aabb, stats, bvh)
                 lighting *= np.where(blocked, 0.0, 1.0)[:, None]  # in shadow only the ambient term stays
             total += np.minimum(ka * mesh + lighting, 1.0)
-        color[idx] = total
+        color[pick] = total
     return color, normal, alpha, spawn
 
 
@@ -651,9 +655,13 @@ def _trace(world: World, o: NDArray[np.float64], d: NDArray[np.float64], max_dep
 
 def to_rgba8(rgb: NDArray[np.float64]) -> NDArray[np.uint8]:
     """Clamp to 0..1 and round to 8 bits as GL's unorm conversion does; alpha 255."""
-    c = np.floor(np.clip(rgb, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
-    alpha = np.full((*c.shape[:-1], 1), 255, dtype=np.uint8)
-    return np.concatenate([c, alpha], axis=-1)
+    c = np.clip(rgb, 0.0, 1.0) * 255.0  # the same steps in place: floor(x·255 + 0.5)
+    c += 0.5
+    np.floor(c, out=c)
+    out = np.empty((*c.shape[:-1], 4), dtype=np.uint8)
+    out[..., :3] = c  # astype's conversion, written into place
+    out[..., 3] = 255
+    return out
 
 
 #: The World (and its BVHs) of each Scene object rendered, while the Scene lives: a
@@ -672,6 +680,25 @@ def _world_of(scene: Scene, viewport: int, analytic_spheres: bool, bvh: bool) ->
     return kept[key]
 
 
+#: The primary rays of each Scene object rendered, per viewport and size, while the Scene
+#: lives (its camera cannot change): a frame of the same Scene again casts them without
+#: making them (about 10 ms at 800x600), as Embree's bench caster keeps its rays. Read-only.
+_RAYS: weakref.WeakKeyDictionary[Scene, dict[tuple[int, int, int], tuple[NDArray[np.float64], NDArray[np.float64]]]] \
+    = weakref.WeakKeyDictionary()
+
+
+def _rays_of(scene: Scene, viewport: int, width: int, height: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    kept = _RAYS.setdefault(scene, {})
+    key = (viewport, width, height)
+    if key not in kept:
+        vp = scene.viewports[viewport]
+        eye, dirs = camera_rays(vp.camera or scene.camera, width, height)
+        eye.setflags(write=False)
+        dirs.setflags(write=False)
+        kept[key] = (eye, dirs)
+    return kept[key]
+
+
 def render_viewport(scene: Scene, size: tuple[int, int], viewport: int = 0, *, max_depth: int = 2,
                     shadows: bool = True, cull_backfaces: bool | None = None, aabb: bool = True,
                     bvh: bool = True, analytic_spheres: bool = True,
@@ -681,9 +708,8 @@ def render_viewport(scene: Scene, size: tuple[int, int], viewport: int = 0, *, m
     The options are :func:`glsandbox.raytrace.render`'s; ``stats`` counts the rays cast.
     """
     width, height = size
-    vp = scene.viewports[viewport]
     world, accel = _world_of(scene, viewport, analytic_spheres, bvh)
-    eye, dirs = camera_rays(vp.camera or scene.camera, width, height)
+    eye, dirs = _rays_of(scene, viewport, width, height)
     stats = stats if stats is not None else RenderStats()
     stats.primary += dirs.shape[0]
     rgb = np.empty((dirs.shape[0], 3))

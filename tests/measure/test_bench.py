@@ -58,3 +58,22 @@ def test_a_process_sides_cpu_is_the_processs_own() -> None:
     assert min(result.subject_cpu_s) >= 0.2 > max(result.baseline_cpu_s)
     assert result.extra_cpu_us is not None and result.extra_cpu_us >= 150_000
     assert re.search(r"  \+0\.[12]\d\d s  ", format_table([result]))  # the column, in seconds
+
+
+def test_a_quantity_case_records_what_its_sides_return() -> None:
+    # A memory row: each call returns its figure (MiB), which is the sample in place of the time.
+    calls: list[str] = []
+
+    def side(label: str, figures: list[float]) -> Side:
+        return Side(label, lambda k: calls.append(label) or figures[k])
+
+    case = Case("memory", "frame", side("small", [100.0, 120.0, 110.0]), side("big", [300.0, 330.0, 360.0]),
+                repeat=1, unit="MiB", goal=3.0)
+    (result,) = measure([case], rounds=3)
+    assert calls.count("small") == calls.count("big") == 3  # no warm-up call: each one measures anew
+    assert result.baseline_s == [100.0, 120.0, 110.0] and sorted(result.subject_s) == [300.0, 330.0, 360.0]
+    assert result.ratio == pytest.approx(330.0 / 110.0)
+    row = format_table([result]).splitlines()[2]
+    assert "110.000 MiB (100.000-120.000)" in row and "330.000 MiB (300.000-360.000)" in row
+    assert "3.00x" in row and "<=3.00x met" in row
+    assert result.to_dict()["subject_time"] == {"median": 330.0, "min": 300.0, "max": 360.0}

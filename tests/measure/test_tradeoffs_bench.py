@@ -416,7 +416,7 @@ def test_model_cases_cover_every_size_mode_and_engine(monkeypatch) -> None:
     assert [c.name for c in found[1:5]] == ["1,000 tris, primary, numpy", "1,000 tris, primary, gpu",
                                            "1,000 tris, shadow+bounce, numpy", "1,000 tris, shadow+bounce, gpu"]
     assert len(found) == 1 + 4 * len(module.SIZES)
-    assert {c.goal for c in found[1:]} == {2.0, 50.0}
+    assert {c.goal for c in found[1:]} == {1.0, 5.0}  # issue 24's goals
 
 
 def test_model_cases_without_mitsuba_leave_its_rows_out_and_say_why(monkeypatch) -> None:
@@ -580,6 +580,57 @@ def test_mitsuba_without_libllvm_says_what_it_needs() -> None:
     assert proc.returncode == 0, proc.stderr
     line = proc.stdout.strip()
     assert line.startswith("mitsuba's llvm_ad_rgb cannot run: ") and "libLLVM" in line
+
+
+# --- a 1M-triangle frame's memory (benchmarks/frame_memory.py, benchmarks/_memory.py) ---------------
+
+
+def test_frame_memory_row_compares_the_gpu_engine_with_embree_in_mib(monkeypatch) -> None:
+    from glsandbox.measure.bench import BenchEnv
+
+    module = _benchmark_module("frame_memory.py")
+    monkeypatch.setattr(module, "embree_available", lambda: True)
+    (case,) = module.cases(BenchEnv())  # nothing runs until measured
+    assert case.name == "1,000,000 tris, shadow+bounce, gpu" and case.unit == "MiB" and case.goal == 3.0
+    assert case.baseline.label.startswith("Embree") and case.subject.label.startswith("gpu engine")
+    assert "models vs Embree" in case.group  # --only "models vs Embree" selects it with the model rows
+    quick = BenchEnv(quick=True)
+    assert module.cases(quick) == [] and "skipped under --quick" in quick.notes[0]
+    monkeypatch.setattr(module, "embree_available", lambda: False)
+    missing = BenchEnv()
+    assert module.cases(missing) == [] and "skipped: embreex not installed" in missing.notes[0]
+
+
+def test_frame_memory_reads_the_childs_last_line() -> None:
+    module = _benchmark_module("frame_memory.py")
+    out = "a warning from the driver\n" + module.child_line("gpu", 3 * 2 ** 20 + 2 ** 19) + "\n"
+    assert module.parse_child(out, "gpu") == 3.5
+    with pytest.raises(ValueError, match="asked for embree"):
+        module.parse_child(out, "embree")
+    with pytest.raises(ValueError, match="printed nothing"):
+        module.parse_child("\n", "gpu")
+
+
+@pytest.mark.slow  # a fresh process: its peak before the step is small on every platform
+def test_peak_growth_sees_an_allocation_in_a_fresh_process() -> None:
+    code = ("import sys; sys.path.insert(0, 'benchmarks'); import numpy as np; from _memory import peak_growth, "
+            "peak_start\nstart = peak_start(); a = np.ones(96 * 2 ** 20 // 8); del a\nprint(peak_growth(start))")
+    done = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert 90 * 2 ** 20 <= int(done.stdout) <= 200 * 2 ** 20  # 96 MiB touched, then freed: still the peak
+
+
+def test_embree_of_model_casts_the_time_rows_rays() -> None:
+    pytest.importorskip("embreex")  # the bench group
+    models, module = _models_module(), _raytrace_module()
+    size = (40, 30)
+    scene = models.model_scene("1000")
+    for mode, options in module.MODES.items():
+        full = module.EmbreeCaster(scene, size, options["shadows"], options["max_depth"])
+        lean = module.EmbreeCaster.of_model(scene, size, options["shadows"], options["max_depth"])
+        assert lean.cast() == full.cast() > size[0] * size[1] * (mode != "primary"), mode
+        ours, theirs = (c.scene.run(c.origins, c.directions, output=1)["primID"] for c in (lean, full))
+        assert np.array_equal(ours, theirs), mode  # the same triangles, numbered alike
 
 
 # --- loading model files (benchmarks/model_load.py) ---------------------------------------------

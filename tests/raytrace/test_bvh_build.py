@@ -7,9 +7,11 @@ import math
 import time
 
 import numpy as np
+import pytest
 
 from glsandbox import meshgen
-from glsandbox.raytrace.bvh import LEAF_SIZE, SMALL, build_bvh, mesh_world_triangles, sah_cost
+from glsandbox.raytrace import bvh as bvh_module
+from glsandbox.raytrace.bvh import LEAF_SIZE, SMALL, build_bvh, build_threads, mesh_world_triangles, sah_cost
 
 
 def fan(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -109,3 +111,34 @@ def test_a_small_node_is_cut_where_the_sah_is_least() -> None:
 def test_sah_cost_of_a_single_leaf_is_its_triangle_count() -> None:
     a, b, c = fan(3)
     assert sah_cost(build_bvh(a, b, c)) == 3.0
+
+
+def leaf_sets(bvh) -> list[tuple[int, ...]]:
+    """The tree's leaves as sorted tuples of the caller's triangle indices, sorted: the tree without its numbering."""
+    leaves = np.flatnonzero(bvh.node_count)
+    return sorted(tuple(sorted(bvh.tri_index[bvh.node_first[i]:bvh.node_first[i] + bvh.node_count[i]].tolist()))
+                  for i in leaves)
+
+
+def test_a_build_in_parts_and_threads_is_the_tree_of_one_pass(monkeypatch) -> None:
+    # A big build is cut into parts (the subtrees of the first level with PARTS open nodes, and the
+    # small nodes made above it), built in threads and numbered in a fixed order: the same leaves and
+    # boxes as one pass, and the same arrays for any thread count. Degenerate triangles are left out.
+    a, b, c = mesh_world_triangles(meshgen.terrain(meshgen.terrain_cells_for(20_000)))
+    c = c.copy()
+    c[::9] = a[::9]  # degenerate: no area
+    one_pass = build_bvh(a, b, c)
+    monkeypatch.setattr(bvh_module, "PART_MIN", 1_000)
+    built = [build_bvh(a, b, c, threads=n) for n in (1, 2, 3)]
+    assert leaf_sets(built[0]) == leaf_sets(one_pass)
+    assert built[0].node_total == one_pass.node_total and built[0].depth == one_pass.depth
+    assert not np.array_equal(built[0].node_first, one_pass.node_first)  # numbered part after part
+    assert sah_cost(built[0]) == pytest.approx(sah_cost(one_pass), rel=1e-12)
+    for field in ("node_min", "node_max", "node_first", "node_count", "v0", "v1", "v2", "tri_index"):
+        assert all(np.array_equal(getattr(built[0], field), getattr(other, field)) for other in built[1:]), field
+    assert leaves_hold_every_triangle_once(built[1]) and built[1].triangle_count == one_pass.triangle_count
+
+
+def test_build_threads_are_the_idle_usable_cpus_at_most_threads() -> None:
+    assert build_threads(3) == 3 and build_threads(0) == 1
+    assert 1 <= build_threads() <= bvh_module.THREADS
