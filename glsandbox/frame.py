@@ -30,12 +30,12 @@ import numpy as np
 
 from glsandbox.errors import SandboxError
 from glsandbox.gl.context import GLHost, open_context
-from glsandbox.gl.executor import Executor
+from glsandbox.gl.executor import MOVED_PASSES, Executor
 from glsandbox.gl.target import OffscreenTarget
 from glsandbox.lesson import Lesson
 from glsandbox.overlay import Overlay
 from glsandbox.plan import TRACE_OPTIONS, Buffers, Plan, motion_decisions, plan, traced_image_name, traced_scene
-from glsandbox.scene import Scene
+from glsandbox.scene import Motion, Scene, motion_parts, moved_scene
 
 __all__ = ["DEFAULT_SIZE", "Frame", "FrameRenderer", "HeadlessRenderer", "InteractiveResolution",
            "LazyRenderer", "trace_viewports", "with_samples"]
@@ -157,6 +157,9 @@ class FrameRenderer:
         self.executor = Executor(host)
         self._targets: dict[tuple[tuple[int, int], Buffers], OffscreenTarget] = {}
         self._plans: dict[int, tuple[Scene, tuple, Plan]] = {}  # by id of the scene frames were moved from
+        # Whether a plan's frames may be drawn from a motion handed over (render_motion), by id of the plan.
+        self._moves: dict[int, tuple[Plan, bool]] = {}
+        self._unmoved: dict[int, Scene] = {}  # scenes whose frames render_motion leaves to the caller
         self._noted: set[str] = set()  # user-shader notes already printed: once per run, not per frame
         self._last_target: tuple[tuple[int, int], Buffers, OffscreenTarget] | None = None  # what target() gave last
 
@@ -192,11 +195,15 @@ class FrameRenderer:
         # The whole frame's plan: the same raster passes after the trace passes, with the
         # notes and warnings of the scene as given (a traced viewport's nodes are an image now).
         frame_plan = raster_plan if traced is scene else plan(scene)
-        for note in (*frame_plan.notes, *frame_plan.warnings):  # once per run, after a frame that worked
+        self._note(frame_plan)
+        return frame_plan, target
+
+    def _note(self, frame_plan: Plan) -> None:
+        """The plan's notes and warnings, one ``warning:`` line each, once per run (after a frame that worked)."""
+        for note in (*frame_plan.notes, *frame_plan.warnings):
             if note not in self._noted:
                 self._noted.add(note)
                 print(f"warning: {note}", file=sys.stderr, flush=True)
-        return frame_plan, target
 
     def plan(self, scene: Scene) -> Plan:
         """:func:`~glsandbox.plan.plan` of ``scene``, kept while only time moves it.
@@ -218,6 +225,50 @@ class FrameRenderer:
             self._plans.pop(next(iter(self._plans)))
         self._plans[id(origin)] = (origin, decisions, fresh)
         return fresh
+
+    def render_motion(self, scene: Scene, motion: Motion, size: tuple[int, int]) -> Frame | None:
+        """The frame of ``moved_scene(scene, motion)``, read back, drawn without making that scene
+        (issue 24: a frame whose only change is time pays for what moves): the motion's model
+        matrices and lights are checked as :func:`~glsandbox.scene.moved_scene` checks them
+        (:func:`~glsandbox.scene.motion_parts`), the plan is the one kept for frames moved from
+        ``scene`` while its :func:`~glsandbox.plan.motion_decisions` agree, and the executor
+        writes the moved uniforms into its prepared steps. None, with nothing drawn, where this
+        does not apply: a motion that moves meshes, overlays or the camera, a ray-traced
+        viewport, a plan with a pass that reads the scene's nodes where they are (a shadow map
+        fits its light to them: known from the scene's first frame on); the caller then draws
+        the moved scene."""
+        if motion.positions or motion.overlays or motion.camera is not None:
+            return None
+        for vp in scene.viewports:
+            if vp.renderer != "raster":
+                return None
+        if self._unmoved.get(id(scene)) is scene:  # its plan has such a pass: known since its first frame
+            return None
+        start = time.perf_counter()
+        models, lights = motion_parts(scene, motion)
+        decisions = motion_decisions(scene, models)
+        kept = self._plans.get(id(scene))
+        if kept is not None and kept[0] is scene and kept[1] == decisions:
+            frame_plan = kept[2]
+        else:  # a new plan: made from the moved scene, and kept as that scene's frames keep it
+            frame_plan = self.plan(moved_scene(scene, motion))
+        moves = self._moves.get(id(frame_plan))
+        if moves is None or moves[0] is not frame_plan:
+            if len(self._moves) >= self.KEEP_PLANS:
+                self._moves.clear()
+            moves = self._moves[id(frame_plan)] = (frame_plan, all(step.kind in MOVED_PASSES
+                                                                   for step in frame_plan.passes))
+        if not moves[1]:
+            if len(self._unmoved) >= self.KEEP_PLANS:
+                self._unmoved.clear()
+            self._unmoved[id(scene)] = scene
+            return None
+        self.host.make_current()
+        target = self.target(size, frame_plan.buffers)
+        self.executor.render(scene, target.framebuffer, size, frame_plan, (models, lights))
+        self._note(frame_plan)
+        image = target.read()
+        return Frame(image, frame_plan, time.perf_counter() - start)
 
     def render_scene(self, scene: Scene, size: tuple[int, int]) -> Frame:
         """Draw one frame and read it back (headless, and the window's live compare tiles)."""
@@ -242,7 +293,18 @@ class HeadlessRenderer(FrameRenderer):
         super().__init__(open_context(backend))
 
     def render(self, lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: int = 0) -> Frame:
-        scene = lesson.scene()
+        """One frame of ``lesson``. A lesson moved only by time (:meth:`~glsandbox.lesson.Lesson.motion`)
+        hands its motion to :meth:`render_motion` where it applies: the same pixels and plan as
+        its moved scene's, without that scene being made."""
+        parts = lesson.moving() if type(lesson).scene is Lesson.scene else None  # (a lesson's own scene(): asked)
+        if parts is not None:
+            if samples == parts[0].samples:
+                frame = self.render_motion(*parts, size)
+                if frame is not None:
+                    return frame
+            scene = moved_scene(*parts)
+        else:
+            scene = lesson.scene()
         if samples != scene.samples:  # (equal: the scene's own, checked when it was made)
             scene = with_samples(scene, samples)
         return self.render_scene(scene, size)

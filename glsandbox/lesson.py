@@ -270,12 +270,23 @@ class Lesson:
         set of its other values (at most :data:`SCENES_KEPT` kept per lesson class) and per
         frame only moves that (:func:`glsandbox.scene.moved_scene`): no dataclass is
         made or checked again but the moved ones, and the renderers keep their plan."""
+        parts = self.moving()
+        if parts is None:
+            return self._scene_as_built()
+        return moved_scene(*parts)
+
+    def moving(self) -> tuple[Scene, Motion] | None:
+        """The scene :meth:`scene` moves and the motion it moves it by (None: a lesson without
+        :meth:`motion`, built every frame): :meth:`scene` is ``moved_scene(*lesson.moving())``.
+        The scene is the kept one (built once per set of the other values) unless a value
+        cannot be a key; a headless frame hands the motion to the renderer without making the
+        moved scene (:meth:`glsandbox.frame.FrameRenderer.render_motion`)."""
         motion = self.motion()
         if motion is None:
-            return self._scene_as_built()
+            return None
         key = self._still_key()
         if key is None:  # a value that cannot be a key (an array given from Python): built every frame
-            return moved_scene(self._scene_as_built(), motion)
+            return self._scene_as_built(), motion
         cls = type(self)
         kept = cls.__dict__.get("_scenes_kept")  # the class's own (not a parent's): it goes with the class
         if kept is None:
@@ -287,7 +298,7 @@ class Lesson:
             if len(kept) >= SCENES_KEPT:
                 del kept[next(iter(kept))]  # the least recently used
         kept[key] = scene  # the most recent last
-        return moved_scene(scene, motion)
+        return scene, motion
 
     def _still_key(self) -> tuple | None:
         """Every value but ``time``, with its type (1, 1.0 and True stay apart), or None when one cannot be hashed.

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field, replace
 import functools
 import math
 import weakref
+from collections.abc import Mapping
 from typing import Any, Callable
 
 import numpy as np
@@ -20,7 +21,7 @@ import numpy as np
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh
 from glsandbox.overlay import Overlay
-from glsandbox.scene import Camera, Color, Material, Node, Scene
+from glsandbox.scene import Camera, Color, Material, Node, Scene, _copy_with
 from glsandbox.shadowmap import casters, casting_light, receivers
 
 
@@ -417,7 +418,7 @@ def _mirrored_eye(mirror: Any, camera: Camera) -> np.ndarray:
     return (mirror.matrix() @ np.append(np.asarray(camera.eye, dtype=np.float64), 1.0))[:3]
 
 
-def motion_decisions(scene: Scene) -> tuple:
+def motion_decisions(scene: Scene, models: Mapping[str, Any] | None = None) -> tuple:
     """What of :func:`plan`'s answer depends on where nodes, lights and cameras are: the order
     of each viewport's blended draws (:func:`_distance`) and which casters the planar shadow
     keeps or culls, and why (:func:`glsandbox.planar.shadow_casters`). Everything else of a
@@ -426,8 +427,14 @@ def motion_decisions(scene: Scene) -> tuple:
     equal decisions have equal plans: the frame renderer keeps the plan between such frames.
 
     Which nodes take part (blended ones per viewport, the casters) depends on none of what
-    moves, so a moved scene finds them once per scene it was moved from (every frame asks)."""
+    moves, so a moved scene finds them once per scene it was moved from (every frame asks).
+
+    ``models`` (model matrices by node name, :func:`glsandbox.scene.motion_parts`): the
+    decisions of ``scene`` with those nodes moved there, the same as those of the moved scene,
+    which a headless frame does not make."""
     origin = scene.__dict__.get("_moved_from")  # (glsandbox.scene.scene_origin, inline)
+    if origin is None and models is not None:
+        origin = scene  # (the parts depend on nothing that moves: kept on the scene itself)
     parts = None if origin is None else origin.__dict__.get("_decision_parts")
     if parts is None:
         parts = _decision_parts(scene)
@@ -435,6 +442,8 @@ def motion_decisions(scene: Scene) -> tuple:
             origin.__dict__["_decision_parts"] = parts
     blended, reflected, casters = parts
     nodes, viewports = scene.nodes, scene.viewports
+    if models and (blended or reflected):  # the nodes sorted by where they are: as moved_scene moves them
+        nodes = tuple(_copy_with(node, model=models[node.name]) if node.name in models else node for node in nodes)
     decisions: list[object] = []
     for index, shown in blended:
         pairs = [(nodes[i], None) for i in shown]
@@ -445,13 +454,13 @@ def motion_decisions(scene: Scene) -> tuple:
         decisions.append(("mirror", tuple(node.name for node, _ in _farthest_first(pairs, eye))))
     shadow = scene.planar_shadow
     if shadow is not None:
-        models = {}
+        placed = {}
         for name, i in casters:
             node = nodes[i]
-            models[name] = (node.model, node.mesh.positions)
+            placed[name] = (node.model if not models or name not in models else models[name], node.mesh.positions)
         from glsandbox.planar import shadow_casters  # loaded already: the scene holds a PlanarShadow
 
-        decisions.append(shadow_casters(shadow, models))
+        decisions.append(shadow_casters(shadow, placed))
     return tuple(decisions)
 
 

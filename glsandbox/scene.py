@@ -678,28 +678,8 @@ def moved_scene(scene: Scene, motion: Motion) -> Scene:
     nodes, lights, overlays = scene.nodes, scene.lights, scene.overlays
     models, positions = motion.models, motion.positions
     if models or positions:
-        # Where each name's nodes are (the same in every scene moved from ``origin``: a moved
-        # scene's nodes are its origin's, some replaced by moved copies, in the same order).
-        where = origin.__dict__.get("_node_indices")
-        if where is None:
-            where = {}
-            for i, node in enumerate(origin.nodes):
-                where[node.name] = (*where.get(node.name, ()), i)
-            origin.__dict__["_node_indices"] = where
-        if not where.keys() >= models.keys() or (positions and not where.keys() >= positions.keys()):
-            unknown = (set(models) | set(positions)) - where.keys()
-            raise SandboxError(f"scene {scene.name!r}: the motion moves {', '.join(map(repr, sorted(unknown)))}, "
-                               f"which is not a node of the scene")
-        # Only the moved nodes are visited (in scene order: the first bad one is named), not every node.
-        touched: list[int] = []
-        for name in models:
-            touched += where[name]
-        for name in positions:
-            if name not in models:
-                touched += where[name]
-        touched.sort()
         moved = list(nodes)
-        for i in touched:
+        for i in _touched_nodes(scene, origin, models, positions):
             node = nodes[i]
             model, points = models.get(node.name), positions.get(node.name)
             if points is None:  # (the common case: a node turning)
@@ -724,19 +704,72 @@ def moved_scene(scene: Scene, motion: Motion) -> Scene:
         overlays = tuple(Overlay(o.name, images[o.name], o.viewport, o.position) if o.name in images else o
                          for o in overlays)
     if motion.lights:
-        lights = list(lights)
-        for index, position in motion.lights.items():
-            if not (isinstance(index, int) and 0 <= index < len(lights)):
-                raise SandboxError(f"scene {scene.name!r}: the motion moves light {plain(index)}, and the scene "
-                                   f"has {len(lights)}")
-            lights[index] = _copy_with(lights[index], position=check_numbers(position, "light position"))
-        lights = tuple(lights)
+        lights = _moved_lights(scene, motion.lights)
     camera = scene.camera
     if motion.camera is not None:
         if not isinstance(motion.camera, Camera):
             raise SandboxError(f"scene {scene.name!r}: the motion's camera must be a Camera, got {plain(motion.camera)}")
         camera = motion.camera
     return _copy_with(scene, nodes=nodes, lights=lights, camera=camera, overlays=overlays, _moved_from=origin)
+
+
+def _touched_nodes(scene: Scene, origin: Scene, models: Mapping[str, Any],
+                   positions: Mapping[str, Any]) -> list[int]:
+    """The indices into ``scene.nodes`` of the nodes ``models`` and ``positions`` name, in scene
+    order (the first bad one is then named), or the error naming what is not a node. Only the
+    moved nodes are visited, not every node."""
+    # Where each name's nodes are (the same in every scene moved from ``origin``: a moved
+    # scene's nodes are its origin's, some replaced by moved copies, in the same order).
+    where = origin.__dict__.get("_node_indices")
+    if where is None:
+        where = {}
+        for i, node in enumerate(origin.nodes):
+            where[node.name] = (*where.get(node.name, ()), i)
+        origin.__dict__["_node_indices"] = where
+    if not where.keys() >= models.keys() or (positions and not where.keys() >= positions.keys()):
+        unknown = (set(models) | set(positions)) - where.keys()
+        raise SandboxError(f"scene {scene.name!r}: the motion moves {', '.join(map(repr, sorted(unknown)))}, "
+                           f"which is not a node of the scene")
+    touched: list[int] = []
+    for name in models:
+        touched += where[name]
+    for name in positions:
+        if name not in models:
+            touched += where[name]
+    touched.sort()
+    return touched
+
+
+def _moved_lights(scene: Scene, moves: Mapping[int, Any]) -> tuple[Light, ...]:
+    """``scene``'s lights with ``moves`` (new positions by index) applied, each checked."""
+    lights = list(scene.lights)
+    for index, position in moves.items():
+        if not (isinstance(index, int) and 0 <= index < len(lights)):
+            raise SandboxError(f"scene {scene.name!r}: the motion moves light {plain(index)}, and the scene "
+                               f"has {len(lights)}")
+        lights[index] = _copy_with(lights[index], position=check_numbers(position, "light position"))
+    return tuple(lights)
+
+
+def motion_parts(scene: Scene, motion: Motion) -> tuple[dict[str, Any], tuple[Light, ...]]:
+    """What a motion of model matrices and light positions alone (no ``positions``,
+    ``overlays`` or ``camera``) moves in ``scene``, checked exactly as :func:`moved_scene`
+    checks it (the same errors, in the same order), without making the moved scene: the
+    moved models by node name (a name given None left out) and the lights. The headless
+    frames hand these to the executor (:meth:`glsandbox.frame.FrameRenderer.render_motion`);
+    ``moved_scene(scene, motion)`` has exactly these models and lights."""
+    origin = scene.__dict__.get("_moved_from") or scene
+    nodes, models = scene.nodes, motion.models
+    moved: dict[str, Any] = {}
+    if models:
+        for i in _touched_nodes(scene, origin, models, {}):
+            node = nodes[i]
+            model = models[node.name]
+            if model is not None:  # (a name given None: nothing moves)
+                check_moved_model(node.name, model, node.material.lit)
+                moved[node.name] = model
+    lights = _moved_lights(scene, motion.lights) if motion.lights else scene.lights
+    return moved, lights
 
 
 def scene_origin(scene: Scene) -> Scene | None:

@@ -13,6 +13,7 @@ import weakref
 from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import MappingProxyType
 
 import moderngl
 import numpy as np
@@ -545,18 +546,33 @@ class Executor:
     # --- frames -------------------------------------------------------------
 
     def render(self, scene: Scene, framebuffer: moderngl.Framebuffer, size: tuple[int, int],
-               frame_plan: Plan | None = None) -> Plan:
-        """Draw one frame of ``scene`` into ``framebuffer`` (``size`` pixels)."""
+               frame_plan: Plan | None = None,
+               moved: tuple[Mapping[str, np.ndarray], tuple[Light, ...]] | None = None) -> Plan:
+        """Draw one frame of ``scene`` into ``framebuffer`` (``size`` pixels).
+
+        ``moved``: (model matrices by node name, lights), checked (:func:`glsandbox.scene.motion_parts`):
+        the frame of ``scene`` moved there, drawn without the moved scene being made (a headless
+        frame moved only by time, :meth:`glsandbox.frame.FrameRenderer.render_motion`; ``frame_plan``
+        is then the moved scene's). Only a plan whose passes all draw at :class:`FrameState`'s
+        models and lights takes it (:data:`MOVED_PASSES`)."""
         frame_plan = frame_plan or make_plan(scene)
         prepared = self._prepared_frames.get(id(frame_plan))
         if (prepared is None or prepared.plan is not frame_plan or prepared.viewports is not scene.viewports
                 or prepared.size != size or prepared.overrides is not scene.uniform_overrides
-                or prepared.depth_mode != scene.depth_mode or prepared.programs is not self._programs):
+                or prepared.depth_mode != scene.depth_mode or prepared.programs is not self._programs
+                or (moved is not None and prepared.scene is not scene)):
             prepared = self._prepare_frame(scene, frame_plan, size)
         self._frame += 1
         self._overrides = scene.uniform_overrides
-        frame = FrameState(scene, {node.name: node for node in scene.nodes}, framebuffer, size)
-        self._lights = scene.lights
+        if moved is None:
+            frame = FrameState(scene, {node.name: node for node in scene.nodes}, framebuffer, size, _NO_MODELS,
+                               scene.lights)
+        else:
+            if not prepared.moves:
+                raise ValueError(f"a moved frame of scene {scene.name!r} has a pass that reads where the scene's "
+                                 "nodes are: draw the moved scene (glsandbox.scene.moved_scene)")
+            frame = FrameState(scene, prepared.nodes, framebuffer, size, *moved)
+        self._lights = frame.lights
         self._clear_depth = prepared.clear_depth
         framebuffer.use()
         self._culling = None  # not known: the first draw sets it
@@ -645,7 +661,8 @@ class Executor:
             passes.append((runner, step, viewport, rect, sets, changes))
         prepared = _PreparedFrame(frame_plan, scene.viewports, size, scene.uniform_overrides, self._programs,
                                   scene.depth_mode, gl_depth.clear_depth_value(scene), scene.depth_mode == "reverse_z",
-                                  tuple(passes))
+                                  tuple(passes), scene, {node.name: node for node in scene.nodes},
+                                  all(step.kind in MOVED_PASSES for step in frame_plan.passes))
         if len(self._prepared_frames) >= 16:  # a live compare draws a few plans by turns; more: start again
             self._prepared_frames.clear()
         self._prepared_frames[id(frame_plan)] = prepared
@@ -949,8 +966,9 @@ class Executor:
     def _draw(self, frame: FrameState, step: Pass, camera: PassCamera | None) -> None:
         """A ``draw`` pass: each node with its program, through the viewport's camera."""
         assert camera is not None
+        nodes, models = frame.nodes, frame.models
         for draw in step.draws:
-            self.draw_node(frame.nodes[draw.node], draw, camera)
+            self.draw_node(nodes[draw.node], draw, camera, model=models.get(draw.node))
 
     def _draw_overlays(self, frame: FrameState, step: Pass, camera: PassCamera | None) -> None:
         """An ``overlay`` pass: labels and figures, blended over the frame (:mod:`glsandbox.gl.overlay`)."""
@@ -1027,6 +1045,12 @@ _PASS_STATE: dict[str, Callable[[Pass], tuple[frozenset[str], frozenset[str]]]] 
     "mirror_surface": lambda step: (frozenset({"blend"}), frozenset({"blend"})),
     "planar_shadow": lambda step: (_stencil_set(step) | {"blend"}, frozenset({"stencil", "masks", "blend", "offset"})),
 }
+#: The pass kinds whose runners draw each node at :class:`FrameState`'s ``models`` and light with
+#: its ``lights`` (a shadow-map pass fits its light's frustum to the scene's nodes: not one).
+MOVED_PASSES = frozenset({"clear", "draw", "overlay", "mark_mirror", "reflection", "mirror_surface",
+                          "planar_shadow"})
+#: A frame's models where nothing is moved by a motion handed over (see :class:`FrameState`).
+_NO_MODELS: Mapping[str, np.ndarray] = MappingProxyType({})
 #: What restore_state leaves of culling (off, counter-clockwise fronts).
 _NO_CULLING = (False, "ccw")
 
@@ -1047,6 +1071,11 @@ class _PreparedFrame:
     reverse_z: bool  # the frame's depth mode is begun and ended (glsandbox.gl.depth)
     passes: tuple[tuple[PassRunner, Pass, object, tuple[int, int, int, int] | None, frozenset[str],
                         frozenset[str] | None], ...]
+    # The scene it was prepared for and its nodes by name: a moved frame's (see render's ``moved``),
+    # whose scene is the one every frame of the plan is moved from.
+    scene: Scene
+    nodes: dict
+    moves: bool  # every pass is of MOVED_PASSES: frames of the plan may be drawn ``moved``
 
 
 #: One runner per pass kind (:data:`glsandbox.plan.PASS_KINDS`); a new kind adds

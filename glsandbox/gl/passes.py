@@ -11,6 +11,7 @@ needs and never has to undo it.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -19,17 +20,25 @@ import moderngl
 from glsandbox.gl import rawgl
 from glsandbox.gl.target import FRAME_COLOR_MASK
 from glsandbox.plan import Pass
-from glsandbox.scene import Node, Scene
+from glsandbox.scene import Light, Node, Scene
 
 
 @dataclass(frozen=True)
 class FrameState:
-    """The frame being drawn: its scene, its nodes by name, and its target."""
+    """The frame being drawn: its scene, its nodes by name, and its target.
+
+    ``models`` and ``lights`` are where the nodes and lights are in this frame: a headless frame
+    moved only by time hands its motion's model matrices (by node name) and lights to the
+    executor without making the moved scene (:meth:`glsandbox.frame.FrameRenderer.render_motion`);
+    a runner draws a node at ``models.get(name, node.model)`` and lights with ``lights``, not
+    with ``scene.lights``. Any other frame: no models, the scene's lights."""
 
     scene: Scene
     nodes: dict[str, Node]
     framebuffer: moderngl.Framebuffer
     size: tuple[int, int]
+    models: Mapping[str, Any]
+    lights: tuple[Light, ...]
 
 
 class PassRunner(Protocol):

@@ -99,12 +99,12 @@ def mark_mirror(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any) 
     are off: this pass changes nothing but the stencil.
     """
     assert step.stencil is not None
-    raw, nodes = drawer.raw, frame.nodes
+    raw, nodes, models = drawer.raw, frame.nodes, frame.models
     set_stencil(raw, step.stencil)
     raw.glColorMask(0, 0, 0, 0)
     raw.glDepthMask(0)
     for draw in step.draws:
-        drawer.draw_node(nodes[draw.node], draw, camera)
+        drawer.draw_node(nodes[draw.node], draw, camera, model=models.get(draw.node))
 
 
 def reflected_lights(lights: tuple[Light, ...], reflection: np.ndarray) -> tuple[Light, ...]:
@@ -147,15 +147,16 @@ def reflection(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any) -
     Without the stencil (``mirror=no_stencil``) nothing stops the reflection
     outside the glass.
     """
-    scene, nodes = frame.scene, frame.nodes
+    scene, nodes, models = frame.scene, frame.nodes, frame.models
     assert scene.mirror is not None
     if step.stencil is not None:  # read only: write mask 0
         set_stencil(drawer.raw, step.stencil)
     reflection = scene.mirror.matrix()
-    lights = _mirrored_lights(scene.lights, scene.mirror)
+    lights = _mirrored_lights(frame.lights, scene.mirror)
     for draw in step.draws:
         node = nodes[draw.node]
-        drawer.draw_node(node, draw, camera, model=_times(reflection, node.model), front_face="cw", lights=lights)
+        drawer.draw_node(node, draw, camera, model=_times(reflection, models.get(draw.node, node.model)),
+                         front_face="cw", lights=lights)
 
 
 def mirror_surface(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any) -> None:
@@ -165,7 +166,7 @@ def mirror_surface(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: An
     ctx.enable(moderngl.BLEND)
     ctx.blend_func = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA)
     for draw in step.draws:
-        drawer.draw_node(frame.nodes[draw.node], draw, camera)
+        drawer.draw_node(frame.nodes[draw.node], draw, camera, model=frame.models.get(draw.node))
 
 
 @functools.lru_cache(maxsize=16)
@@ -186,7 +187,7 @@ def planar_shadow(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any
     and the bit is then set (``GL_INVERT`` under write mask 2), so the
     flattened cube's overlapping front and back faces darken it once.
     """
-    scene, nodes = frame.scene, frame.nodes
+    scene, nodes, models = frame.scene, frame.nodes, frame.models
     shadow = scene.planar_shadow
     assert shadow is not None
     raw, ctx = drawer.raw, drawer.ctx
@@ -205,4 +206,5 @@ def planar_shadow(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any
         material = flat
         if draw.program == CUTOUT_SHADOW_PROGRAM.key:  # a cut-out: its texture's alpha, the part's cutoff
             material = cutout_caster_material(node.material, shadow.color)
-        drawer.draw_node(node, draw, camera, model=_times(flatten, node.model), material=material)
+        drawer.draw_node(node, draw, camera, model=_times(flatten, models.get(draw.node, node.model)),
+                         material=material)

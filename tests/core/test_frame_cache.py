@@ -20,7 +20,7 @@ from glsandbox.errors import SandboxError
 from glsandbox.lesson import all_lessons, find_lesson
 from glsandbox.planar import Mirror, PlanarShadow
 from glsandbox.plan import motion_decisions, plan
-from glsandbox.scene import Camera, Light, Material, Motion, Node, Scene, moved_scene, scene_origin
+from glsandbox.scene import Camera, Light, Material, Motion, Node, Scene, motion_parts, moved_scene, scene_origin
 
 #: Moments the frames are checked at (seconds): the first, and three that turn things well apart.
 TIMES = (0.0, 0.37, 1.9, 7.3)
@@ -120,8 +120,12 @@ def test_moved_scene_changes_only_what_moves():
     (Motion(overlays={"label": np.zeros((2, 2, 4), np.uint8)}), "overlay 'label', which is not an overlay"),
 ])
 def test_moved_scene_checks_what_moves(motion, message):
-    with pytest.raises(SandboxError, match=message.replace("(", r"\(").replace(")", r"\)").replace("[0]", r"\[0\]")):
+    with pytest.raises(SandboxError, match=message.replace("(", r"\(").replace(")", r"\)").replace("[0]", r"\[0\]")) as error:
         moved_scene(_lit_scene(), motion)
+    if not motion.positions and not motion.overlays:  # what a headless frame checks without the moved scene
+        with pytest.raises(SandboxError) as handed_over:
+            motion_parts(_lit_scene(), motion)
+        assert str(handed_over.value) == str(error.value)
 
 
 def test_moved_scene_moves_every_node_of_a_moved_name_in_scene_order():
@@ -138,6 +142,14 @@ def test_moved_scene_moves_every_node_of_a_moved_name_in_scene_order():
     assert again.nodes[0] is moved.nodes[0] and again.nodes[1].model is not twice.nodes[1].model
     with pytest.raises(SandboxError, match="node 'a'"):
         moved_scene(twice, Motion(models={"c": np.full((4, 4), np.nan), "a": np.full((4, 4), np.nan)}))
+    with pytest.raises(SandboxError, match="node 'a'"):
+        motion_parts(twice, Motion(models={"c": np.full((4, 4), np.nan), "a": np.full((4, 4), np.nan)}))
+    lit = Scene("s", nodes=(Node("a", geometry.cube()), Node("b", geometry.sphere(), material=Material(shading="phong")),
+                            Node("a", geometry.sphere(), material=Material(shading="phong"))))
+    flat = np.diag([1.0, 0.0, 1.0, 1.0])  # fine for the unlit first 'a', singular for the lit second one
+    for check in (moved_scene, motion_parts):
+        with pytest.raises(SandboxError, match="node 'a': model matrix is singular"):
+            check(lit, Motion(models={"a": flat}))
 
 
 def test_a_moved_scenes_decisions_are_a_fresh_scenes():
@@ -158,8 +170,27 @@ def test_a_moved_scenes_decisions_are_a_fresh_scenes():
         moved = moved_scene(scene, Motion(models={"a": ahead, "caster": lifted}))
         decisions = motion_decisions(moved)
         assert decisions == motion_decisions(replace(moved, name=moved.name))  # made anew: no origin
+        assert decisions == motion_decisions(scene, {"a": ahead, "caster": lifted})  # the motion handed over
         seen.add(decisions)
     assert len(seen) == 4  # the order of a and b, and the caster culled above the light, both move
+
+
+@pytest.mark.parametrize(("name", "settings"), moving_lessons(), ids=lambda v: str(v) if v else "")
+def test_a_motion_handed_over_is_the_moved_scenes(name, settings):
+    """What a headless frame hands the executor instead of the moved scene (motion_parts: models
+    by name and lights; the decisions from them) is exactly what the moved scene holds."""
+    lesson = find_lesson(name)(**settings)
+    for t in TIMES:
+        scene, motion = lesson.at(t).moving()
+        if motion.positions or motion.overlays or motion.camera is not None:
+            continue  # (drawn from the moved scene: FrameRenderer.render_motion)
+        moved = moved_scene(scene, motion)
+        models, lights = motion_parts(scene, motion)
+        assert set(models) <= {node.name for node in scene.nodes}
+        for before, after in zip(scene.nodes, moved.nodes):
+            assert np.array_equal(np.asarray(models.get(before.name, before.model)), np.asarray(after.model))
+        assert lights == moved.lights
+        assert motion_decisions(scene, models) == motion_decisions(moved)
 
 
 def test_the_camera_keys_move_the_scene():
@@ -275,3 +306,85 @@ def test_a_moved_overlay_shows_its_new_image(gl):
     moved = moved_scene(scene, Motion(overlays={"label": text_image(["90 deg"])}))
     fresh = Scene("panel", overlays=(Overlay("label", text_image(["90 deg"])),))
     assert np.array_equal(gl.render_scene(moved, SIZE).image, gl.render_scene(fresh, SIZE).image)
+
+
+# --- headless frames moved only by time: the motion handed over (issue 24) -----------------------
+
+
+def _counting_moved_scenes(monkeypatch) -> list:
+    """Every moved scene the frame renderer makes from now on (glsandbox.frame.moved_scene)."""
+    import glsandbox.frame
+
+    made = []
+
+    def counted(scene, motion):
+        made.append(scene)
+        return moved_scene(scene, motion)
+
+    monkeypatch.setattr(glsandbox.frame, "moved_scene", counted)
+    return made
+
+
+@pytest.mark.parametrize(("name", "settings", "handed_over"), [
+    ("indexed_cube", {}, True), ("phong", {}, True), ("texture", {}, True), ("mirror", {}, True),
+    ("mirror", {"light": "directional", "shadow": "double_blend"}, True),
+    ("shadow_map", {"show": "map"}, False),  # its light's frustum is fitted to the nodes where they are
+    ("transform_order", {}, False),  # its trail's points and its panel move: meshes and overlays
+])
+def test_a_headless_frame_moved_by_time_makes_no_moved_scene(gl, monkeypatch, name, settings, handed_over):
+    lesson = find_lesson(name)(**settings)
+    gl.render(lesson, SIZE)  # the first frame builds, plans (from a moved scene) and uploads
+    made = _counting_moved_scenes(monkeypatch)
+    for t in TIMES:
+        moment = lesson.at(t)
+        kept = gl.render(moment, SIZE)
+        fresh = gl.render_scene(moment._scene_as_built(), SIZE)
+        assert kept.plan == fresh.plan
+        assert np.array_equal(kept.image, fresh.image), f"{name} {settings} at t={t}"
+    assert len(made) == (0 if handed_over else len(TIMES))
+
+
+class _BadCube(find_lesson("indexed_cube")):
+    """The indexed cube whose motion gives a bad matrix from time 1 on (not registered)."""
+
+    def motion(self) -> Motion:
+        model = self.cube_model()
+        if self.time >= 1.0:
+            model = model.copy()
+            model[0, 3] = float("nan") if self.time < 2.0 else 2e9
+        return Motion(models={"cube": model})
+
+
+def test_a_bad_motion_fails_a_headless_frame_as_it_fails_the_moved_scene(gl):
+    lesson = _BadCube()
+    good = gl.render(lesson.at(0.5), SIZE).image.copy()
+    for t in (1.5, 2.5):
+        with pytest.raises(SandboxError) as error:
+            gl.render(lesson.at(t), SIZE)
+        with pytest.raises(SandboxError) as expected:
+            lesson.at(t).scene()
+        assert str(error.value) == str(expected.value) and "node 'cube': model matrix" in str(error.value)
+    assert np.array_equal(gl.render(lesson.at(0.5), SIZE).image, good)  # and the next good frame draws
+
+
+def test_a_frame_after_a_changed_value_is_drawn_from_its_new_scene(gl):
+    """A value changed between frames (a key) builds the scene again; the motion then moves that."""
+    lesson = find_lesson("phong")()
+    before_scene, _ = lesson.at(1.0).moving()
+    gl.render(lesson.at(1.0), SIZE)
+    lesson.on_key("4")  # the next shading
+    after_scene, _ = lesson.at(1.0).moving()
+    assert after_scene is not before_scene
+    after = gl.render(lesson.at(1.0), SIZE)
+    fresh = gl.render_scene(lesson.at(1.0)._scene_as_built(), SIZE)
+    assert after.plan == fresh.plan and np.array_equal(after.image, fresh.image)
+
+
+def test_a_moved_frame_refuses_a_plan_that_reads_the_nodes_where_they_are(gl):
+    lesson = find_lesson("shadow_map")(show="map")
+    scene, motion = lesson.at(0.5).moving()
+    assert gl.render_motion(scene, motion, SIZE) is None  # the caller draws the moved scene
+    frame_plan = gl.plan(moved_scene(scene, motion))
+    target = gl.target(SIZE, frame_plan.buffers)
+    with pytest.raises(ValueError, match="draw the moved scene"):
+        gl.executor.render(scene, target.framebuffer, SIZE, frame_plan, motion_parts(scene, motion))
