@@ -161,6 +161,7 @@ class FrameRenderer:
         self._moves: dict[int, tuple[Plan, bool]] = {}
         self._unmoved: dict[int, Scene] = {}  # scenes whose frames render_motion leaves to the caller
         self._noted: set[str] = set()  # user-shader notes already printed: once per run, not per frame
+        self._noted_plan: Plan | None = None  # the plan render_motion printed the notes of last
         self._last_target: tuple[tuple[int, int], Buffers, OffscreenTarget] | None = None  # what target() gave last
 
     def target(self, size: tuple[int, int], buffers: Buffers) -> OffscreenTarget:
@@ -246,7 +247,11 @@ class FrameRenderer:
             return None
         start = time.perf_counter()
         models, lights = motion_parts(scene, motion)
-        decisions = motion_decisions(scene, models)
+        parts = scene.__dict__.get("_decision_parts")  # (motion_decisions keeps them on the scene)
+        if parts is not None and not any(parts) and scene.planar_shadow is None:
+            decisions: tuple = ()  # nothing blended, reflected blended or casting a planar shadow: no decision moves
+        else:
+            decisions = motion_decisions(scene, models)
         kept = self._plans.get(id(scene))
         if kept is not None and kept[0] is scene and kept[1] == decisions:
             frame_plan = kept[2]
@@ -266,7 +271,9 @@ class FrameRenderer:
         self.host.make_current()
         target = self.target(size, frame_plan.buffers)
         self.executor.render(scene, target.framebuffer, size, frame_plan, (models, lights))
-        self._note(frame_plan)
+        if frame_plan is not self._noted_plan:  # (a plan's notes are printed by its first frame)
+            self._note(frame_plan)
+            self._noted_plan = frame_plan
         image = target.read()
         return Frame(image, frame_plan, time.perf_counter() - start)
 
