@@ -388,3 +388,19 @@ def test_a_moved_frame_refuses_a_plan_that_reads_the_nodes_where_they_are(gl):
     target = gl.target(SIZE, frame_plan.buffers)
     with pytest.raises(ValueError, match="draw the moved scene"):
         gl.executor.render(scene, target.framebuffer, SIZE, frame_plan, motion_parts(scene, motion))
+
+
+def test_the_last_frames_scene_is_found_again_only_for_the_same_values():
+    """Lesson.moving finds the last frame's scene by comparing the values (no key hashed): the
+    same values in another type, or a value holding an array, are not the same values."""
+    cls = find_lesson("indexed_cube")
+    first, _ = cls().at(0.3).moving()
+    assert cls().at(1.7).moving()[0] is first
+    other = cls(speed=2)  # an int, not the float default: another key, built again
+    assert other.moving()[0] is not first and cls().moving()[0] is first
+    held = cls()
+    held.values["cull"] = (1.0,)  # a tuple: a key like any (build() reads it as true)
+    kept, _ = held.moving()
+    odd = cls()
+    odd.values["cull"] = (np.array([1.0, 2.0]),)  # from Python: a tuple of the same type that cannot be a key
+    assert odd.moving()[0] is not kept and held.moving()[0] is kept and cls().moving()[0] is first
