@@ -1,6 +1,6 @@
 """The ``glsandbox`` command, and ``python -m lessons.<module>``.
 
-``list``, ``run LESSON``, ``render LESSON --out FILE.png``, ``tour [--out DIR]
+``list``, ``run LESSON``, ``render LESSON --out FILE.png``, ``explain LESSON --pixel X,Y``, ``tour [--out DIR]
 [--lessons DIR]``, ``plan LESSON``, ``compare``, ``new NAME``, ``check LESSON
 --golden REF.png``, ``tradeoffs`` and ``bench``, where LESSON is a lesson
 name, a lesson ``.py`` file or a scene ``.toml`` file. :func:`lesson_main` is the entry point
@@ -440,6 +440,17 @@ def cmd_tradeoffs(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_explain(args: argparse.Namespace) -> int:
+    """``glsandbox explain LESSON --pixel X,Y``: one pixel's story, or its raw record (``--json``)."""
+    from glsandbox.story import Story, parse_pixel
+    from glsandbox.story.ray import explain_ray_pixel
+
+    lesson = _lesson(args)
+    story = Story(explain_ray_pixel(lesson.scene(), _size(args), parse_pixel(args.pixel), lesson.name))
+    print(story.to_json() if args.json else story.text)
+    return 0
+
+
 def cmd_bench(args: argparse.Namespace) -> int:
     """``glsandbox bench``: every benchmark in benchmarks/, one table of side-by-side ratios."""
     from glsandbox.measure.bench import run_all
@@ -459,6 +470,11 @@ COMMANDS: dict[str, tuple[str, tuple[str, ...]]] = {
                 "glsandbox render phong --set time=1.5 --size 800x600 --out phong.png")),
     "plan": ("print the passes, buffers and shader variants a lesson's frame needs",
              ("glsandbox plan mirror", "glsandbox plan scene.toml")),
+    "explain": ("tell one pixel's story: the ray, each shape's test and t, the nearest hit, the shadow rays, "
+                "Phong's terms, the reflections and the 8-bit colour",
+                ("glsandbox explain ray_spheres --pixel 320,240",
+                 "glsandbox explain ray_phong --set scene=exam2013 --pixel 300,200 --size 640x480",
+                 "glsandbox explain mirror --set renderer=ray_numpy --pixel 100,100 --json")),
     "tour": ("render every lesson headless into a folder, with a gallery page (index.html) and tour.json",
              ("glsandbox tour", "glsandbox tour --out gallery --size 320x240",
               "glsandbox tour --lessons submissions/ --out checked")),
@@ -519,6 +535,16 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         if name == "render":
             p.add_argument("--out", type=Path, required=True, help="the PNG file to write")
         p.set_defaults(func=func)
+
+    if wanted("explain"):
+        p = add_command(sub, "explain")
+        p.add_argument("lesson", metavar="LESSON", help="a lesson name, a lesson .py file or a scene .toml file")
+        p.add_argument("--pixel", required=True, metavar="X,Y", help="the pixel, x from the left, y from the top")
+        p.add_argument("--size", default=None, help=f"frame size WxH (default {DEFAULT_SIZE[0]}x{DEFAULT_SIZE[1]})")
+        p.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
+                       help="a lesson parameter (repeatable); every lesson has time=SECONDS")
+        p.add_argument("--json", action="store_true", help="print the raw record as JSON instead of the story")
+        p.set_defaults(func=cmd_explain)
 
     if wanted("tour"):
         p = add_command(sub, "tour")

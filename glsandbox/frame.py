@@ -38,7 +38,7 @@ from glsandbox.plan import TRACE_OPTIONS, Buffers, Plan, motion_decisions, plan,
 from glsandbox.scene import Motion, Scene, motion_parts, moved_scene
 
 __all__ = ["DEFAULT_SIZE", "Frame", "FrameRenderer", "HeadlessRenderer", "InteractiveResolution",
-           "LazyRenderer", "trace_viewports", "with_samples"]
+           "LazyRenderer", "single_viewport", "trace_viewports", "with_samples"]
 
 #: The frame size when none is given (``--size``).
 DEFAULT_SIZE = (640, 480)
@@ -61,6 +61,14 @@ def with_samples(scene: Scene, samples: int) -> Scene:
 
 
 # --- the raster-versus-ray hook ----------------------------------------------
+
+
+def single_viewport(scene: Scene, index: int) -> Scene:
+    """Viewport ``index`` of ``scene`` as a scene of its own, filling the frame: its nodes
+    (those shown in it), no overlays. What a ray-traced viewport is traced as."""
+    vp = scene.viewports[index]
+    return replace(scene, viewports=(replace(vp, rect=(0.0, 0.0, 1.0, 1.0)),),
+                   nodes=tuple(replace(n, viewports=None) for n in scene.nodes if n.shown_in(index)), overlays=())
 
 
 def trace_viewports(scene: Scene, size: tuple[int, int], ctx: object | None = None,
@@ -92,9 +100,7 @@ def trace_viewports(scene: Scene, size: tuple[int, int], ctx: object | None = No
         w, h = vp.pixels(width, height)[2:]
         if w <= 0 or h <= 0:
             continue
-        single = replace(scene, viewports=(replace(vp, rect=(0.0, 0.0, 1.0, 1.0)),),
-                         nodes=tuple(replace(n, viewports=None) for n in scene.nodes if n.shown_in(i)),
-                         overlays=())
+        single = single_viewport(scene, i)
         engine = "gpu" if vp.renderer == "ray" and ctx is not None else "numpy"
         if resolution < 1.0:
             small = (max(1, math.ceil(w * resolution)), max(1, math.ceil(h * resolution)))
