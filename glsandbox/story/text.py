@@ -76,18 +76,25 @@ def _light_lines(light: LightStep, base: Sequence[float]) -> list[str]:
         verdict = (f"blocked by {light.blocker} at s = {num(light.blocker_s, 4)} "
                    f"(t = {num((light.blocker_s or 0.0) * (light.distance or 0.0))} < {num(light.distance)}): "
                    "in shadow, only the ambient term stays") if light.blocked else \
-            "nothing at 0 < s < 1 (s = 1 is the light): lit"
+            "nothing at 0 < s < 1 (s = 1 is the light): lit" + (" (no matter here: N·L ≤ 0)" if light.n_dot_l <= 0 else "")
         if light.blocked and light.blocker is None:
             verdict = "blocked: in shadow, only the ambient term stays"
         lines.append(f"   shadow ray (Gölge testi) from P moved {num(light.offset, 3)} off the surface to "
                      f"{vec(light.origin)}, distance {num(light.distance)} to the light: {verdict}")
     spec = "N·H" if light.blinn else "R·E"
-    lines.append(f"   ambient  ka·colour = {num(light.ka, 3)}·{vec(base, 4)} = {vec(light.ambient, 4)}")
-    lines.append(f"   diffuse  kd·max(N·L, 0)·colour⊙light = {num(light.kd, 3)}·{vec(light.diffuse, 4)}")
-    lines.append(f"   specular ks·max({spec}, 0)^{num(light.shininess)}·light = {num(light.ks, 3)}·"
-                 f"{vec(light.specular, 4)}  ({spec} = {num(light.cosine, 4)})")
-    lines.append(f"   = min(ka·ambient + kd·diffuse + ks·specular, 1) = {vec(light.term, 4)}"
-                 + ("  (in shadow: ambient only)" if light.blocked else ""))
+    kd_diffuse = [light.kd * c for c in light.diffuse]
+    ks_specular = [light.ks * c for c in light.specular]
+    lines.append(f"   ka·ambient = ka·colour = {num(light.ka, 3)}·{vec(base, 4)} = {vec(light.ambient, 4)}")
+    if light.n_dot_l <= 0.0:
+        lines.append("   N·L ≤ 0: the light is behind the surface, no diffuse and no specular")
+    else:
+        lines.append(f"   kd·diffuse = kd·max(N·L, 0)·colour⊙light = {num(light.kd, 3)}·{num(light.n_dot_l, 4)}·"
+                     f"{vec(base, 4)}⊙{vec(light.color, 3)} = {vec(kd_diffuse, 4)}")
+        lines.append(f"   ks·specular = ks·max({spec}, 0)^{num(light.shininess)}·light = {num(light.ks, 3)}·"
+                     f"{num(max(light.cosine, 0.0), 4)}^{num(light.shininess)}·{vec(light.color, 3)} = "
+                     f"{vec(ks_specular, 4)}")
+    shadowed = "  (in shadow: the ambient term alone)" if light.blocked else ""
+    lines.append(f"   ka·ambient + kd·diffuse + ks·specular, each channel at most 1: {vec(light.term, 4)}{shadowed}")
     return lines
 
 
