@@ -1,0 +1,29 @@
+"""``glsandbox explain``: the story on stdout, the record with --json, bad input one line and exit 2."""
+
+from __future__ import annotations
+
+import json
+
+from support import assert_user_error, run_cli
+
+
+def test_explain_prints_the_story() -> None:
+    run = run_cli("explain", "ray_spheres", "--set", "camera=0,0,0,0,0.6,-0.8", "--size", "101x101", "--pixel", "50,50")
+    assert run.returncode == 0, run.stderr
+    assert "s = l·Rd = 80, m² = l·l − s² = 3600, q = √(r² − m²) = 45" in run.stdout
+    assert "t = s − q = 35 → hit" in run.stdout and "P = R0 + t·Rd = (0, 21, -28)" in run.stdout
+
+
+def test_explain_json_is_the_record() -> None:
+    run = run_cli("explain", "ray_phong", "--set", "scene=exam2013", "--pixel", "10,10", "--size", "64x48", "--json")
+    assert run.returncode == 0, run.stderr
+    record = json.loads(run.stdout)
+    assert record["pixel"] == [10, 10] and len(record["rgba8"]) == 4 and record["bounces"]
+
+
+def test_explain_bad_input() -> None:
+    assert_user_error(run_cli("explain", "ray_spheres", "--pixel", "1"), "--pixel", "X,Y")
+    assert_user_error(run_cli("explain", "ray_spheres", "--pixel", "700,10"), "outside the 640x480 frame")
+    assert_user_error(run_cli("explain", "phong", "--pixel", "1,1"), "rasterised", "renderer=ray_numpy")
+    assert_user_error(run_cli("explain", "no_such_lesson", "--pixel", "1,1"))
+    assert_user_error(run_cli("explain", "ray_spheres", "--pixel", "1,1", "--size", "0x5"), "--size")
