@@ -116,8 +116,10 @@ def _bounce_lines(bounce: Bounce, step: list[int], trace: PixelTrace) -> list[st
             f"times its weight: {vec(bounce.contribution, 4)}")
         return lines
     tri = f", triangle {bounce.triangle}" if bounce.triangle is not None else ""
-    add(f"Nearest hit (min_indis): {bounce.hit}{tri} at t = {num(bounce.t)}, P = R0 + t·Rd = {vec(bounce.point)}, "
-        f"normal N = {vec(bounce.normal, 4)}")
+    found = [f"{test.node} {num(test.t)}" for test in bounce.tests if test.verdict == "hit"]
+    among = f" (the smallest t of {', '.join(found)})" if len(found) > 1 else ""
+    add(f"Nearest hit (min_indis): {bounce.hit}{tri} at t = {num(bounce.t)}{among}, P = R0 + t·Rd = "
+        f"{vec(bounce.point)}, normal N = {vec(bounce.normal, 4)}")
     base = bounce.base or [0.0, 0.0, 0.0]
     if not bounce.lit:
         add(f"Colour: {vec(base, 4)} (unlit: its own colour)")
