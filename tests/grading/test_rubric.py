@@ -11,7 +11,7 @@ import pytest
 from support import glsandbox
 
 from glsandbox.errors import SandboxError
-from glsandbox.measure.rubric import load_rubric
+from glsandbox.grading.rubric import load_rubric
 
 
 def run(*args: str, cwd: Path):

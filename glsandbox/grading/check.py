@@ -7,13 +7,13 @@ bad share exceeds ``max_bad_share``). On a failure the actual and expected
 images and a diff picture are written (:func:`~glsandbox.measure.golden.write_artifacts`).
 
 A folder of submissions (:func:`glsandbox.lesson.lesson_files`) is graded
-with each submission in a process of its own (:mod:`glsandbox.measure.isolate`),
+with each submission in a process of its own (:mod:`glsandbox.grading.isolate`),
 under a time and memory limit, reading only its own files
-(:mod:`glsandbox.measure.sandbox`), sending back only pixels. This process
+(:mod:`glsandbox.grading.sandbox`), sending back only pixels. This process
 reads the references, compares and writes every verdict and report: nothing
 a submission does reaches another's verdict, the references, the reports or
 the exit code. Each submission gets one picture per :class:`Check` (one, or
-a rubric's several, :mod:`glsandbox.measure.rubric`) and an outcome per
+a rubric's several, :mod:`glsandbox.grading.rubric`) and an outcome per
 picture: PASS, FAIL, BROKEN (its error line), TIMEOUT, CRASHED or OUT OF MEMORY.
 """
 
@@ -37,8 +37,8 @@ from glsandbox.errors import SandboxError
 from glsandbox.frame import DEFAULT_SIZE, Frame, HeadlessRenderer
 from glsandbox.lesson import Lesson, lesson_files, user_code_error
 from glsandbox.measure.golden import DEFAULT_THRESHOLD, ImageMatch, compare_images, write_artifacts
-from glsandbox.measure.isolate import BROKEN, CRASHED, OOM, TIMEOUT, Job, JobResult, Picture, Render, run_jobs
-from glsandbox.measure.rubric import Check
+from glsandbox.grading.isolate import BROKEN, CRASHED, OOM, TIMEOUT, Job, JobResult, Picture, Render, run_jobs
+from glsandbox.grading.rubric import Check
 
 PASS, FAIL = "PASS", "FAIL"
 #: Every outcome, in the order the summary counts them.
