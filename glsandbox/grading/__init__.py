@@ -2,6 +2,7 @@
 
 - :mod:`~glsandbox.grading.check`: lessons, scene files and folders of submissions against references;
 - :mod:`~glsandbox.grading.rubric`: grading files (checks, points, tolerances, hidden checks);
+- :mod:`~glsandbox.grading.kinds`: the kinds of check, one registry (a new kind is one entry);
 - :mod:`~glsandbox.grading.isolate`: a process per submission, the grader's side and the messages;
 - :mod:`~glsandbox.grading.worker`: the zygote, supervisor and renderer;
 - :mod:`~glsandbox.grading.warm`: the warm template renderers fork from;

@@ -38,6 +38,7 @@ from glsandbox.frame import DEFAULT_SIZE, Frame, HeadlessRenderer
 from glsandbox.lesson import Lesson, lesson_files, user_code_error
 from glsandbox.measure.golden import DEFAULT_THRESHOLD, ImageMatch, compare_images, write_artifacts
 from glsandbox.grading.isolate import BROKEN, CRASHED, OOM, TIMEOUT, Job, JobResult, Picture, Render, run_jobs
+from glsandbox.grading.kinds import kind_of
 from glsandbox.grading.rubric import Check
 
 PASS, FAIL = "PASS", "FAIL"
@@ -186,12 +187,16 @@ def judge(actual: np.ndarray, expected: np.ndarray, tolerances: dict[str, float]
     match = compare_images(actual, expected, **tolerances)
     if match.passed:
         return match, {}
+    return match, _artifacts(actual, expected, tolerances, artifacts_dir, artifact_name)
+
+
+def _artifacts(actual: np.ndarray, expected: np.ndarray, tolerances: dict[str, float], artifacts_dir: Path,
+               artifact_name: str) -> dict[str, Path]:
     try:
-        paths = write_artifacts(actual, expected, artifacts_dir, artifact_name,
-                                threshold=int(tolerances.get("threshold", DEFAULT_THRESHOLD)))
+        return write_artifacts(actual, expected, artifacts_dir, artifact_name,
+                               threshold=int(tolerances.get("threshold", DEFAULT_THRESHOLD)))
     except OSError as exc:
         raise SandboxError(f"{artifacts_dir}: cannot write the diff images ({exc.strerror or exc})") from None
-    return match, paths
 
 
 def results_dir(check: Check) -> Path:
@@ -245,12 +250,16 @@ def _outcomes(result: JobResult, checks: Sequence[Check], references: dict[Path,
 
 
 def _outcome(check: Check, picture: Picture, expected: np.ndarray, name: str) -> Outcome:
+    """What came back for ``check``, judged by its kind (:mod:`glsandbox.grading.kinds`); a failed
+    comparison's pictures go into :func:`results_dir`."""
     if picture.image is None:
         return Outcome(check, picture.status or CRASHED, error=shown(picture.error), seconds=picture.seconds)
-    stem = file_stem(name)
-    match, paths = judge(picture.image, expected, check.tolerances, results_dir(check), stem)
-    return Outcome(check, PASS if match.passed else FAIL, match, seconds=picture.seconds, artifacts=paths,
-                   thumb=_thumbnail(picture.image))
+    verdict = kind_of(check.kind).judge(check, picture.image, expected)
+    paths: dict[str, Path] = {}
+    if not verdict.passed and verdict.match is not None:
+        paths = _artifacts(picture.image, expected, check.tolerances, results_dir(check), file_stem(name))
+    return Outcome(check, PASS if verdict.passed else FAIL, verdict.match, error=verdict.detail,
+                   seconds=picture.seconds, artifacts=paths, thumb=_thumbnail(picture.image))
 
 
 def read_references(checks: Sequence[Check]) -> dict[Path, np.ndarray]:
