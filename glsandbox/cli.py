@@ -144,8 +144,22 @@ def cmd_plan(args: argparse.Namespace) -> int:
 def cmd_render(args: argparse.Namespace) -> int:
     lesson = _lesson(args)
     size = _size(args)
-    frame = render_to_file(lesson, args.out, size, args.samples, args.backend)
-    print(f"wrote {args.out} ({size[0]}x{size[1]}, {frame.seconds * 1000:.1f} ms)")
+    if args.out is None and args.xray is None:
+        raise SandboxError("render: give --out FILE.png, --xray DIR or both")
+    if args.out is not None:
+        frame = render_to_file(lesson, args.out, size, args.samples, args.backend)
+        print(f"wrote {args.out} ({size[0]}x{size[1]}, {frame.seconds * 1000:.1f} ms)")
+    if args.xray is not None:
+        from glsandbox.story.xray import write_xray, xray
+
+        if args.xray.exists() and not args.xray.is_dir():
+            raise SandboxError(f"--xray {args.xray}: is a file, expected a folder")
+        with HeadlessRenderer(args.backend) as renderer:
+            x = xray(renderer, with_samples(lesson.scene(), args.samples), size)
+        written = write_xray(x, args.xray)
+        for note in x.notes:
+            print(f"note: {note}")
+        print(f"wrote {len(written)} pictures of {len(x.passes)} passes to {args.xray} (contact_sheet.png: all of them)")
     return 0
 
 
@@ -445,9 +459,22 @@ def cmd_explain(args: argparse.Namespace) -> int:
     from glsandbox.story import Story, parse_pixel
     from glsandbox.story.ray import explain_ray_pixel
 
+    from glsandbox.story.ray import locate_pixel
+
     lesson = _lesson(args)
-    story = Story(explain_ray_pixel(lesson.scene(), _size(args), parse_pixel(args.pixel), lesson.name))
-    print(story.to_json() if args.json else story.text)
+    scene, size, pixel = lesson.scene(), _size(args), parse_pixel(args.pixel)
+    index, _, _ = locate_pixel(scene, size, pixel)
+    if scene.viewports[index].renderer != "raster":
+        story = Story(explain_ray_pixel(scene, size, pixel, lesson.name))
+        print(story.to_json() if args.json else story.text)
+        return 0
+    import json
+
+    from glsandbox.story.raster import explain_raster_pixel, render_raster_story
+
+    with HeadlessRenderer(args.backend) as renderer:
+        trace = explain_raster_pixel(renderer, scene, size, pixel, lesson.name)
+    print(json.dumps(trace.to_dict(), indent=1) if args.json else render_raster_story(trace))
     return 0
 
 
@@ -466,7 +493,7 @@ COMMANDS: dict[str, tuple[str, tuple[str, ...]]] = {
             ("glsandbox run phong", "glsandbox run phong --set shading=gouraud --samples 4",
              "glsandbox run my_lesson.py")),
     "render": ("render a lesson headless to a PNG file",
-               ("glsandbox render indexed_cube --out cube.png",
+               ("glsandbox render indexed_cube --out cube.png", "glsandbox render mirror --xray mirror_passes",
                 "glsandbox render phong --set time=1.5 --size 800x600 --out phong.png")),
     "plan": ("print the passes, buffers and shader variants a lesson's frame needs",
              ("glsandbox plan mirror", "glsandbox plan scene.toml")),
@@ -533,7 +560,9 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         p.add_argument("lesson", metavar="LESSON", help="a lesson name, a lesson .py file or a scene .toml file")
         add_render_options(p)
         if name == "render":
-            p.add_argument("--out", type=Path, required=True, help="the PNG file to write")
+            p.add_argument("--out", type=Path, default=None, help="the PNG file to write")
+            p.add_argument("--xray", type=Path, default=None, metavar="DIR",
+                           help="also (or instead) write each pass's colour, depth and stencil, and a contact sheet")
         p.set_defaults(func=func)
 
     if wanted("explain"):
@@ -544,6 +573,8 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         p.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
                        help="a lesson parameter (repeatable); every lesson has time=SECONDS")
         p.add_argument("--json", action="store_true", help="print the raw record as JSON instead of the story")
+        p.add_argument("--backend", default=None, help=f"a rasterised pixel: one of {', '.join(BACKENDS)} "
+                       "(default: GLSANDBOX_BACKEND or auto)")
         p.set_defaults(func=cmd_explain)
 
     if wanted("tour"):

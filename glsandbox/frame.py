@@ -24,6 +24,7 @@ from __future__ import annotations
 import math
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -34,7 +35,7 @@ from glsandbox.gl.executor import MOVED_PASSES, Executor
 from glsandbox.gl.target import OffscreenTarget
 from glsandbox.lesson import Lesson
 from glsandbox.overlay import Overlay
-from glsandbox.plan import TRACE_OPTIONS, Buffers, Plan, motion_decisions, plan, traced_image_name, traced_scene
+from glsandbox.plan import TRACE_OPTIONS, Buffers, Pass, Plan, motion_decisions, plan, traced_image_name, traced_scene
 from glsandbox.scene import Motion, Scene, motion_parts, moved_scene
 
 __all__ = ["DEFAULT_SIZE", "Frame", "FrameRenderer", "HeadlessRenderer", "InteractiveResolution",
@@ -183,11 +184,12 @@ class FrameRenderer:
         self._last_target = (size, buffers, target)
         return target
 
-    def draw(self, scene: Scene, size: tuple[int, int],
-             ray_resolution: float = 1.0) -> tuple[Plan, OffscreenTarget]:
+    def draw(self, scene: Scene, size: tuple[int, int], ray_resolution: float = 1.0,
+             after_pass: Callable[[int, Pass], None] | None = None) -> tuple[Plan, OffscreenTarget]:
         """Draw one frame; returns its plan (with a ``trace`` pass per ray-traced viewport)
         and the target holding it. ``ray_resolution`` < 1 traces ray-traced viewports
-        coarser (the window while moving). What a ray-traced viewport ignores of the
+        coarser (the window while moving); ``after_pass`` is handed to the executor (called
+        after each raster pass: the X-ray). What a ray-traced viewport ignores of the
         scene, and what a model file holds that is not drawn, is one ``warning:`` line
         each on stderr, once per run."""
         self.host.make_current()
@@ -198,7 +200,7 @@ class FrameRenderer:
                 break
         raster_plan = self.plan(traced)
         target = self.target(size, raster_plan.buffers)
-        self.executor.render(traced, target.framebuffer, size, raster_plan)
+        self.executor.render(traced, target.framebuffer, size, raster_plan, after_pass=after_pass)
         # The whole frame's plan: the same raster passes after the trace passes, with the
         # notes and warnings of the scene as given (a traced viewport's nodes are an image now).
         frame_plan = raster_plan if traced is scene else plan(scene)

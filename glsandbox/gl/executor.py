@@ -547,8 +547,12 @@ class Executor:
 
     def render(self, scene: Scene, framebuffer: moderngl.Framebuffer, size: tuple[int, int],
                frame_plan: Plan | None = None,
-               moved: tuple[Mapping[str, np.ndarray], tuple[Light, ...]] | None = None) -> Plan:
+               moved: tuple[Mapping[str, np.ndarray], tuple[Light, ...]] | None = None,
+               after_pass: Callable[[int, Pass], None] | None = None) -> Plan:
         """Draw one frame of ``scene`` into ``framebuffer`` (``size`` pixels).
+
+        ``after_pass(index, step)`` is called after each pass has drawn (the X-ray of
+        :mod:`glsandbox.story.xray` reads the target back there); it must leave GL as it found it.
 
         ``moved``: (model matrices by node name, lights), checked (:func:`glsandbox.scene.motion_parts`):
         the frame of ``scene`` moved there, drawn without the moved scene being made (a headless
@@ -586,7 +590,7 @@ class Executor:
         # per draw); a pass of a kind not listed in _PASS_STATE changes anything: all is put back.
         changed: frozenset[str] = frozenset()
         try:
-            for runner, step, viewport, rect, sets, changes in prepared.passes:
+            for index, (runner, step, viewport, rect, sets, changes) in enumerate(prepared.passes):
                 if changed:
                     pending = changed - sets
                     if pending:
@@ -602,12 +606,16 @@ class Executor:
                     runner(self, frame, step, camera)
                     gl_passes.restore_state(ctx, raw)
                     self._culling = _NO_CULLING
+                    if after_pass is not None:
+                        after_pass(index, step)
                     continue
                 runner(self, frame, step, camera)
                 if changes:
                     changed = changed | changes
                 if step.kind == "overlay" and self._culling is not None:  # OverlayDrawer switches culling off
                     self._culling = (False, self._culling[1])
+                if after_pass is not None:
+                    after_pass(index, step)
         except BaseException:
             # Whatever the pass that raised left set is put back, as after any pass.
             gl_passes.restore_state(ctx, raw)

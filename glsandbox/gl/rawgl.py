@@ -45,6 +45,7 @@ GL_KEEP = 0x1E00
 GL_REPLACE = 0x1E01
 GL_INVERT = 0x150A
 GL_STENCIL_BUFFER_BIT = 0x0400
+GL_PACK_ALIGNMENT = 0x0D05
 GL_SCISSOR_TEST = 0x0C11
 GL_LOWER_LEFT = 0x8CA1
 GL_NEGATIVE_ONE_TO_ONE = 0x935E
@@ -97,6 +98,7 @@ _SIGNATURES: dict[str, tuple] = {
     "glScissor": (_VOID, _INT, _INT, _INT, _INT),
     "glGetFloatv": (_VOID, _UINT, ctypes.POINTER(ctypes.c_float)),
     "glReadPixels": (_VOID, _INT, _INT, _INT, _INT, _UINT, _UINT, ctypes.c_void_p),
+    "glPixelStorei": (_VOID, _UINT, _INT),
     "glBlitFramebuffer": (_VOID, _INT, _INT, _INT, _INT, _INT, _INT, _INT, _INT, _UINT, _UINT),
 }
 
@@ -225,7 +227,32 @@ class RawGL:
         old = self.get_integer(GL_FRAMEBUFFER_BINDING)
         self.glBindFramebuffer(GL_FRAMEBUFFER, fbo)
         data = ctypes.create_string_buffer(size[0] * size[1])
+        alignment = self.get_integer(GL_PACK_ALIGNMENT)
+        self.glPixelStorei(GL_PACK_ALIGNMENT, 1)  # rows of one byte a pixel, packed tight
         self.glReadPixels(0, 0, size[0], size[1], 0x1901, 0x1401, data)  # GL_STENCIL_INDEX, GL_UNSIGNED_BYTE
+        self.glPixelStorei(GL_PACK_ALIGNMENT, alignment)
+        self.glBindFramebuffer(GL_FRAMEBUFFER, old)
+        return data.raw
+
+    def read_color(self, fbo: int, size: tuple[int, int]) -> bytes:
+        """The RGBA8 colour of a single-sample framebuffer's first attachment, bottom row first."""
+        old = self.get_integer(GL_FRAMEBUFFER_BINDING)
+        self.glBindFramebuffer(GL_FRAMEBUFFER, fbo)
+        data = ctypes.create_string_buffer(size[0] * size[1] * 4)
+        self.glReadPixels(0, 0, size[0], size[1], 0x1908, 0x1401, data)  # GL_RGBA, GL_UNSIGNED_BYTE
+        self.glBindFramebuffer(GL_FRAMEBUFFER, old)
+        return data.raw
+
+    def bound_framebuffer(self) -> int:
+        """The framebuffer object bound for drawing now."""
+        return self.get_integer(GL_FRAMEBUFFER_BINDING)
+
+    def read_depth(self, fbo: int, size: tuple[int, int]) -> bytes:
+        """The depth values (0..1, float32) of a single-sample framebuffer, bottom row first."""
+        old = self.get_integer(GL_FRAMEBUFFER_BINDING)
+        self.glBindFramebuffer(GL_FRAMEBUFFER, fbo)
+        data = ctypes.create_string_buffer(size[0] * size[1] * 4)
+        self.glReadPixels(0, 0, size[0], size[1], 0x1902, 0x1406, data)  # GL_DEPTH_COMPONENT, GL_FLOAT
         self.glBindFramebuffer(GL_FRAMEBUFFER, old)
         return data.raw
 

@@ -243,7 +243,7 @@ def explain_ray_pixel(scene: Scene, size: tuple[int, int], pixel: tuple[int, int
     vp = scene.viewports[index]
     if vp.renderer == "raster":
         raise SandboxError(f"--pixel {pixel[0]},{pixel[1]}: viewport {index} is rasterised; "
-                           "trace it with --set renderer=ray_numpy")
+                           "its story is the X-ray's (glsandbox.story.raster), or trace it with --set renderer=ray_numpy")
     single = single_viewport(scene, index)
     world, accel = numpy_engine._world_of(single, 0, True, True)
     eye, dirs = numpy_engine._rays_of(single, 0, w, h)

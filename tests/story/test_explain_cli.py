@@ -24,7 +24,6 @@ def test_explain_json_is_the_record() -> None:
 def test_explain_bad_input() -> None:
     assert_user_error(run_cli("explain", "ray_spheres", "--pixel", "1"), "--pixel", "X,Y")
     assert_user_error(run_cli("explain", "ray_spheres", "--pixel", "700,10"), "outside the 640x480 frame")
-    assert_user_error(run_cli("explain", "phong", "--pixel", "1,1"), "rasterised", "renderer=ray_numpy")
     assert_user_error(run_cli("explain", "no_such_lesson", "--pixel", "1,1"))
     assert_user_error(run_cli("explain", "ray_spheres", "--pixel", "1,1", "--size", "0x5"), "--size")
 

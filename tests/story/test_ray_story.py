@@ -136,7 +136,7 @@ def test_bad_pixels_are_one_line_errors() -> None:
     scene = find_lesson("ray_spheres")().scene()
     with pytest.raises(SandboxError, match="outside the 96x72 frame"):
         explain_ray_pixel(scene, SIZE, (96, 0))
-    with pytest.raises(SandboxError, match="rasterised"):
+    with pytest.raises(SandboxError, match="rasterised"):  # the command tells a raster pixel's story instead
         explain_ray_pixel(find_lesson("phong")().scene(), SIZE, (1, 1))
     with pytest.raises(SandboxError, match="X,Y"):
         parse_pixel("1;2")
