@@ -7,6 +7,10 @@ rays are made again every time, as a new ``glsandbox explain`` process makes the
 (the lesson's own build and the interpreter's start are not in it: a lesson such as
 ``ray_acceleration`` spends its time building its figures, which ``render`` pays too).
 No baseline: the goal is absolute, printed under the table.
+
+The X-ray rows (``glsandbox render LESSON --xray``'s work, the pictures' files left
+out) draw a raster lesson's frame reading the target back after every pass, against
+the same frame drawn and read back once: goal at most 3x.
 """
 
 from __future__ import annotations
@@ -21,6 +25,10 @@ GROUP = "explain"
 GOAL_S = 1.0
 #: ``--quick``: these lessons only.
 QUICK = ("ray_spheres", "ray_phong")
+#: The X-ray's goal: at most this ratio of the plain frame's time.
+XRAY_GOAL = 3.0
+#: The lessons whose frame is X-rayed (``--quick``: the first).
+XRAY_LESSONS = ("mirror", "phong", "shadow_map")
 
 
 def cases(env) -> list:
@@ -42,13 +50,34 @@ def cases(env) -> list:
 
         out.append(Case(GROUP, f"one pixel, {cls.name}", None, Side("explain", run), repeat=1, unit="ms",
                         note=f"goal < {GOAL_S:g} s"))
+    out.extend(xray_cases(env))
+    return out
+
+
+def xray_cases(env) -> list:
+    from glsandbox.lesson import find_lesson
+    from glsandbox.measure.bench import Case, Side
+    from glsandbox.story.xray import xray
+
+    out = []
+    for name in XRAY_LESSONS[:1] if env.quick else XRAY_LESSONS:
+        scene = find_lesson(name)().scene()
+
+        def frame(k: int, scene=scene):
+            return env.renderer.render_scene(scene, env.size).image.copy()
+
+        def rayed(k: int, scene=scene):
+            return xray(env.renderer, scene, env.size).frame
+
+        out.append(Case(GROUP, f"X-ray, {name}", Side("frame", frame), Side("frame + X-ray", rayed), repeat=3,
+                        goal=XRAY_GOAL, compare=lambda a, b: "yes" if (a == b).all() else "NO"))
     return out
 
 
 def summarize(results: Sequence[Any]) -> list[str]:
     """The slowest lesson's explain against the goal."""
     times = {r.case.name.split(", ", 1)[1]: statistics.median(r.subject_s) for r in results
-             if r.case.group == GROUP and r.subject_s}
+             if r.case.group == GROUP and r.subject_s and r.case.name.startswith("one pixel")}
     if not times:
         return []
     slowest = max(times, key=times.__getitem__)
