@@ -456,25 +456,16 @@ def cmd_tradeoffs(args: argparse.Namespace) -> int:
 
 def cmd_explain(args: argparse.Namespace) -> int:
     """``glsandbox explain LESSON --pixel X,Y``: one pixel's story, or its raw record (``--json``)."""
-    from glsandbox.story import Story, parse_pixel
-    from glsandbox.story.ray import explain_ray_pixel
-
-    from glsandbox.story.ray import locate_pixel
+    from glsandbox.frame import LazyRenderer
+    from glsandbox.story import parse_pixel, pixel_story
 
     lesson = _lesson(args)
-    scene, size, pixel = lesson.scene(), _size(args), parse_pixel(args.pixel)
-    index, _, _ = locate_pixel(scene, size, pixel)
-    if scene.viewports[index].renderer != "raster":
-        story = Story(explain_ray_pixel(scene, size, pixel, lesson.name))
-        print(story.to_json() if args.json else story.text)
-        return 0
-    import json
-
-    from glsandbox.story.raster import explain_raster_pixel, render_raster_story
-
-    with HeadlessRenderer(args.backend) as renderer:
-        trace = explain_raster_pixel(renderer, scene, size, pixel, lesson.name)
-    print(json.dumps(trace.to_dict(), indent=1) if args.json else render_raster_story(trace))
+    lazy = LazyRenderer(args.backend)  # opened only for a rasterised pixel
+    try:
+        story = pixel_story(lesson.scene(), _size(args), parse_pixel(args.pixel), lesson.name, lambda: lazy.renderer)
+    finally:
+        lazy.close()
+    print(story.to_json() if args.json else story.text)
     return 0
 
 

@@ -33,7 +33,7 @@ import numpy as np
 from glsandbox.controls import Control, lesson_controls, to_text
 from glsandbox.errors import SandboxError
 from glsandbox.files import png_bytes
-from glsandbox.frame import DEFAULT_SIZE, LazyRenderer, with_samples
+from glsandbox.frame import DEFAULT_SIZE, FrameRenderer, LazyRenderer, with_samples
 from glsandbox.lesson import Lesson, find_lesson
 from glsandbox.scene import Scene
 
@@ -41,6 +41,11 @@ from glsandbox.scene import Scene
 _RENDERER = LazyRenderer()
 NOTEBOOK_MISSING = ("glsandbox.{helper} needs {module}: install the notebook extra "
                     "(pip install 'glsandbox[notebook]', or uv sync --extra notebook)")
+
+
+def shared_renderer() -> FrameRenderer:
+    """The headless renderer every notebook helper shares (opened on first use)."""
+    return _RENDERER.renderer
 
 
 class Picture:

@@ -1,35 +1,39 @@
 """Why does this pixel look like that: a pixel's story, step by step.
 
-:func:`explain` (also ``glsandbox.explain`` and ``glsandbox explain LESSON --pixel X,Y``)
-traces one pixel of a ray-traced viewport through the numpy engine and returns a
-:class:`Story`: its text (numbered steps in the course's names, :mod:`.text`), its
-raw record (:class:`~glsandbox.story.ray.PixelTrace`, ``--json``), and in a
-notebook an HTML view. The modules: ``ray`` (the record and its recorder, on the
-numpy engine's probe seam), ``text`` (the story's rendering).
+:func:`explain` (also ``glsandbox.explain``, ``glsandbox explain LESSON --pixel X,Y`` and
+F2 in the window) tells one pixel's story and returns a :class:`Story`: its text, its raw
+record (``--json``), and in a notebook an HTML view. A ray-traced pixel is traced through
+the numpy engine (numbered steps in the course's names); a rasterised one is told pass
+by pass from the frame's X-ray. The modules: ``ray`` (the ray record and its recorder,
+on the numpy engine's probe seam), ``text`` (the ray story's rendering), ``xray`` (each
+pass's colour, depth and stencil), ``raster`` (a rasterised pixel's story).
 """
 
 from __future__ import annotations
 
 import html
 import json
+from collections.abc import Callable
 from typing import Any
 
 from glsandbox.errors import SandboxError
-from glsandbox.story.ray import PixelTrace, explain_ray_pixel
-from glsandbox.story.text import render_story
+from glsandbox.frame import FrameRenderer
 from glsandbox.scene import Scene
+from glsandbox.story.ray import explain_ray_pixel, locate_pixel
+from glsandbox.story.text import render_story
 
-__all__ = ["Story", "explain", "parse_pixel"]
+__all__ = ["Story", "explain", "parse_pixel", "pixel_story"]
 
 
 class Story:
     """One pixel's story: :attr:`text` (what the terminal prints), :attr:`record` (the raw
-    :class:`~glsandbox.story.ray.PixelTrace`), :meth:`to_json`. Jupyter shows it as a
-    block of text (``_repr_html_``)."""
+    record: a ray-traced pixel's :class:`~glsandbox.story.ray.PixelTrace` or a rasterised
+    one's :class:`~glsandbox.story.raster.RasterTrace`), :meth:`to_json`. Jupyter shows it
+    as a block of text with a swatch of the colour (``_repr_html_``)."""
 
-    def __init__(self, record: PixelTrace) -> None:
+    def __init__(self, record: Any, text: str) -> None:
         self.record = record
-        self.text = render_story(record)
+        self.text = text
 
     @property
     def rgba8(self) -> list[int]:
@@ -56,6 +60,23 @@ class Story:
                 f'pixel {r.pixel[0]},{r.pixel[1]}<pre style="white-space:pre-wrap">{html.escape(self.text)}</pre></div>')
 
 
+def pixel_story(scene: Scene, size: tuple[int, int], pixel: tuple[int, int], title: str = "",
+                renderer: Callable[[], FrameRenderer] | None = None) -> Story:
+    """The story of frame pixel ``pixel`` (row 0 at the top) of ``scene`` at ``size``: traced
+    when its viewport is ray-traced, else pass by pass on the renderer ``renderer()`` gives
+    (asked for only then: a ray-traced pixel needs no GL)."""
+    index, _, _ = locate_pixel(scene, size, pixel)
+    if scene.viewports[index].renderer != "raster":
+        record = explain_ray_pixel(scene, size, pixel, title)
+        return Story(record, render_story(record))
+    if renderer is None:
+        raise SandboxError(f"--pixel {pixel[0]},{pixel[1]}: a rasterised pixel needs a GL context")
+    from glsandbox.story.raster import explain_raster_pixel, render_raster_story
+
+    raster = explain_raster_pixel(renderer(), scene, size, pixel, title)
+    return Story(raster, render_raster_story(raster))
+
+
 def parse_pixel(text: str) -> tuple[int, int]:
     """``X,Y`` (row 0 at the top) -> ``(X, Y)``, refusing anything else with the value named."""
     parts = str(text).replace(" ", "").split(",")
@@ -70,7 +91,8 @@ def explain(lesson_or_scene: Any, pixel: tuple[int, int] | str, size: tuple[int,
             **params: Any) -> Story:
     """The story of one pixel of a lesson (a name, class or instance, with ``params`` as
     ``glsandbox.show`` takes them) or a :class:`Scene`, framed at ``size`` (default
-    640x480): ``glsandbox.explain("ray_spheres", (320, 240))``."""
+    640x480): ``glsandbox.explain("ray_spheres", (320, 240))``. A rasterised pixel is drawn
+    on the notebook helpers' shared headless renderer."""
     from glsandbox.frame import DEFAULT_SIZE
 
     if isinstance(pixel, str):
@@ -85,4 +107,6 @@ def explain(lesson_or_scene: Any, pixel: tuple[int, int] | str, size: tuple[int,
         lesson = make_lesson(lesson_or_scene, **params)
         scene, title = lesson.scene(), lesson.name
     frame = tuple(size) if size is not None else DEFAULT_SIZE
-    return Story(explain_ray_pixel(scene, (int(frame[0]), int(frame[1])), (int(pixel[0]), int(pixel[1])), title))
+    from glsandbox.notebook import shared_renderer
+
+    return pixel_story(scene, (int(frame[0]), int(frame[1])), (int(pixel[0]), int(pixel[1])), title, shared_renderer)

@@ -74,3 +74,11 @@ def test_render_needs_out_or_xray(tmp_path: Path) -> None:
     afile = tmp_path / "f.png"
     afile.write_bytes(b"")
     assert_user_error(run_cli("render", "mirror", "--xray", str(afile)), "is a file")
+
+
+def test_notebook_explain_of_a_rasterised_pixel(gl) -> None:
+    import glsandbox
+
+    story = glsandbox.explain("mirror", (40, 30), (80, 60))
+    assert "mark mirror viewport 0" in repr(story) and "<pre" in story._repr_html_()
+    assert story.rgba8 == gl.render(find_lesson("mirror")(), (80, 60)).image[30, 40].tolist()
