@@ -28,15 +28,15 @@ def test_explain_bad_input() -> None:
     assert_user_error(run_cli("explain", "ray_spheres", "--pixel", "1,1", "--size", "0x5"), "--size")
 
 
-def test_the_docs_walk_through_show_todays_stories() -> None:
-    """docs/explain.md quotes two stories: each is what the command prints now."""
+def test_the_docs_walk_through_show_todays_stories(gl) -> None:
+    """docs/explain.md quotes three stories (two traced, one rasterised): each is what the command prints now."""
     import re
 
     from support import REPO_ROOT
 
     text = (REPO_ROOT / "docs" / "explain.md").read_text(encoding="utf-8")
     walks = re.findall(r"```sh\n(glsandbox explain [^\n]*)\n```\n\n```\n(.*?)\n```", text, re.S)
-    assert len(walks) == 2
+    assert len(walks) == 3
     for command, story in walks:
         run = run_cli(*command.split()[1:])
         assert run.returncode == 0, run.stderr
