@@ -1,18 +1,21 @@
-"""What a draw needs, found once: a mesh's set-up with one program, and a prepared draw of a
-kept plan (found again by its Draw while only time moves)."""
+"""What a draw and a frame need, found once: a mesh's set-up with one program, a prepared
+draw of a kept plan (found again by its Draw while only time moves), and what the frames of
+one plan share."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
 import moderngl
 
 from glsandbox.geometry import Mesh
 from glsandbox.gl.gpu_meshes import _GpuMesh
+from glsandbox.gl.passes import RunPass
 from glsandbox.gl.user_shaders import UserProgram
-from glsandbox.passes.base import Draw
-from glsandbox.scene import Light, Material
+from glsandbox.passes.base import Draw, Pass
+from glsandbox.plan import Plan
+from glsandbox.scene import Light, Material, Scene
 
 @dataclass
 class _DrawSetup:
@@ -62,3 +65,26 @@ class _DrawStep:
         self.change: tuple[tuple | None, tuple[tuple[str, bytes], ...]] = (None, ())
         # The lights this draw was lit by last, and their uniform bytes.
         self.lights: tuple[tuple[Light, ...] | None, bytes, bytes] = (None, b"", b"")
+
+
+@dataclass(frozen=True)
+class _PreparedFrame:
+    """What the frames of one plan share (:meth:`Executor._prepare_frame`): per pass, its runner,
+    the pass, its viewport and rectangle (a frame pass through a viewport; else None), and the
+    state groups it sets and changes (:attr:`glsandbox.gl.passes.Runner.state`)."""
+
+    plan: Plan
+    viewports: tuple
+    size: tuple[int, int]
+    overrides: Mapping[str, object]
+    programs: dict
+    depth_mode: str
+    clear_depth: float
+    reverse_z: bool  # the frame's depth mode is begun and ended (glsandbox.gl.depth)
+    passes: tuple[tuple[RunPass, Pass, object, tuple[int, int, int, int] | None, frozenset[str],
+                        frozenset[str] | None], ...]
+    # The scene it was prepared for and its nodes by name: a moved frame's (see render's ``moved``),
+    # whose scene is the one every frame of the plan is moved from.
+    scene: Scene
+    nodes: dict
+    moves: bool  # every pass's runner is moved: frames of the plan may be drawn ``moved``

@@ -8,7 +8,6 @@ says and nothing more; choosing passes is :func:`glsandbox.plan.plan`'s job.
 from __future__ import annotations
 
 from collections.abc import Callable, Collection, Mapping
-from dataclasses import dataclass
 from pathlib import Path
 from types import MappingProxyType
 
@@ -22,26 +21,21 @@ from glsandbox.gl.context import GLHost
 from glsandbox.gl.overlay import OverlayDrawer
 from glsandbox.gl.shaders import compile_with_sources, declared_uniforms, source_files
 from glsandbox.gl.textures import TextureCache
-from glsandbox.gl.passes import FrameState, RunPass
-from glsandbox.gl.gpu_meshes import _ATTRIBUTES, _MESH_KEYS, _MODES, _GpuMesh, _gpu_arrays, _mesh_key, _moved_key
+from glsandbox.gl.passes import FrameState
+from glsandbox.gl.gpu_meshes import GpuMeshes, _mesh_key, _moved_key
 from glsandbox.gl.uniform_bytes import (_CAMERA, _CONSTANTS, _EYE, _FLOAT64, _MODEL_BYTES, _NORMAL_BYTES,
                                         PassCamera, _constants_change, material_constants,
                                         _Uniforms, _Written)
-from glsandbox.gl.draw_steps import _DrawSetup, _DrawStep, _Steps
+from glsandbox.gl.draw_steps import _DrawSetup, _DrawStep, _PreparedFrame, _Steps
 from glsandbox.gl.user_shaders import UserProgram, check_user_draw
 from glsandbox.passes.base import SHADOW_MAP_UNIT, Draw, Pass, ProgramVariant
 from glsandbox.plan import Plan, plan as make_plan
 from glsandbox.scene import Camera, Light, Material, Node, Scene, mesh_origin
 
 
-class Executor:
+class Executor(GpuMeshes):
     """Runs plans on one context, keeping programs and meshes between frames."""
 
-    #: Uploaded meshes kept between frames. A lesson that makes a new mesh
-    #: every frame (transform_order's trail) would otherwise fill GPU memory
-    #: in a long-running window: past this many, the least recently drawn
-    #: are released (never one the current frame draws).
-    MESH_LIMIT = 256
     #: Draw set-ups kept (:meth:`_draw_setup`), all dropped at once past this many (a lesson
     #: making a new mesh every frame).
     SETUPS_KEPT = 1024
@@ -136,79 +130,6 @@ class Executor:
     def shader_files(self) -> frozenset[Path]:
         """The files the nodes' own shader programs were built from (with their includes)."""
         return frozenset(path for user in self._user.values() for path in user.files)
-
-    def _gpu_mesh(self, mesh: Mesh) -> tuple[tuple[str, str], _GpuMesh]:
-        origin = mesh_origin(mesh)
-        if origin is not None:
-            return self._moved_gpu_mesh(mesh, origin)
-        arrays = None if mesh in _MESH_KEYS else _gpu_arrays(mesh)  # made once for the digest and the upload
-        key = _mesh_key(mesh, arrays)
-        gpu = self._meshes.get(key)
-        if gpu is None:
-            gpu = self._meshes[key] = self._upload(mesh, arrays or _gpu_arrays(mesh))
-        self._mesh_last_frame[key] = self._frame
-        return key, gpu
-
-    def _upload(self, mesh: Mesh, arrays: dict[str, np.ndarray], moving: bool = False) -> _GpuMesh:
-        """GPU buffers of ``arrays`` (:func:`_gpu_arrays` of ``mesh``); ``moving``: the positions
-        are rewritten each frame (a dynamic buffer, and the mesh's positions remembered)."""
-        index_array = arrays.pop("indices", None)
-        buffers = {attr: self.ctx.buffer(array, dynamic=moving and attr == "in_position")
-                   for attr, array in arrays.items()}
-        index = None if index_array is None else self.ctx.buffer(index_array)
-        return _GpuMesh(buffers, index, _MODES[mesh.mode], mesh.element_count, mesh.positions if moving else None)
-
-    def _moved_gpu_mesh(self, mesh: Mesh, origin: Mesh) -> tuple[tuple[str, str], _GpuMesh]:
-        """A moved mesh (:func:`glsandbox.scene.moved_mesh`): the buffers of the mesh it was moved
-        from, its own, with ``mesh``'s positions written into the position buffer where they
-        are not the ones it holds (once per frame however many passes draw it)."""
-        key = _moved_key(origin)
-        gpu = self._meshes.get(key)
-        if gpu is None:
-            gpu = self._meshes[key] = self._upload(mesh, _gpu_arrays(mesh), moving=True)
-        elif gpu.positions is not mesh.positions:
-            gpu.buffers["in_position"].write(np.ascontiguousarray(mesh.positions, dtype="f4"))
-            gpu.positions = mesh.positions
-        self._mesh_last_frame[key] = self._frame
-        return key, gpu
-
-    @property
-    def mesh_count(self) -> int:
-        """How many meshes are uploaded now."""
-        return len(self._meshes)
-
-    def _release_stale_meshes(self) -> None:
-        """Keep at most :attr:`MESH_LIMIT` meshes, dropping the least recently drawn."""
-        excess = len(self._meshes) - self.MESH_LIMIT
-        if excess <= 0:
-            return
-        stale = sorted((frame, key) for key, frame in self._mesh_last_frame.items() if frame < self._frame)
-        for _, key in stale[:excess]:
-            gpu = self._meshes.pop(key)
-            del self._mesh_last_frame[key]
-            for vao_key in [k for k in self._vaos if k[0] == key]:
-                self._vaos.pop(vao_key).release()
-            self._setups.clear()
-            self._steps.clear()
-            for buffer in gpu.buffers.values():
-                buffer.release()
-            if gpu.index is not None:
-                gpu.index.release()
-
-    def _vao(self, mesh: Mesh, program_key: str) -> tuple[moderngl.VertexArray, _GpuMesh]:
-        key, gpu = self._gpu_mesh(mesh)
-        vao = self._vaos.get((key, program_key))
-        if vao is None:
-            program = self._programs[program_key][1]
-            content = []
-            for _, attr, width in _ATTRIBUTES:
-                if attr in program:
-                    if attr not in gpu.buffers:
-                        raise SandboxError(f"mesh {mesh.name!r} has no {attr[3:]} data, which {program_key} needs")
-                    content.append((gpu.buffers[attr], f"{width}f", attr))
-            vao = self.ctx.vertex_array(program, content, index_buffer=gpu.index)
-            self._vaos[(key, program_key)] = vao
-        return vao, gpu
 
     # --- frames -------------------------------------------------------------
 
@@ -665,26 +586,3 @@ class Executor:
 _NO_MODELS: Mapping[str, np.ndarray] = MappingProxyType({})
 #: What restore_state leaves of culling (off, counter-clockwise fronts).
 _NO_CULLING = (False, "ccw")
-
-
-@dataclass(frozen=True)
-class _PreparedFrame:
-    """What the frames of one plan share (:meth:`Executor._prepare_frame`): per pass, its runner,
-    the pass, its viewport and rectangle (a frame pass through a viewport; else None), and the
-    state groups it sets and changes (:attr:`glsandbox.gl.passes.Runner.state`)."""
-
-    plan: Plan
-    viewports: tuple
-    size: tuple[int, int]
-    overrides: Mapping[str, object]
-    programs: dict
-    depth_mode: str
-    clear_depth: float
-    reverse_z: bool  # the frame's depth mode is begun and ended (glsandbox.gl.depth)
-    passes: tuple[tuple[RunPass, Pass, object, tuple[int, int, int, int] | None, frozenset[str],
-                        frozenset[str] | None], ...]
-    # The scene it was prepared for and its nodes by name: a moved frame's (see render's ``moved``),
-    # whose scene is the one every frame of the plan is moved from.
-    scene: Scene
-    nodes: dict
-    moves: bool  # every pass's runner is moved: frames of the plan may be drawn ``moved``
