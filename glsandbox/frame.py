@@ -160,9 +160,11 @@ class FrameRenderer:
     #: Plans kept for frames moved from one scene (:meth:`plan`): a live compare's variants.
     KEEP_PLANS = 16
 
-    def __init__(self, host: GLHost) -> None:
+    def __init__(self, host: GLHost, primitive_ids: bool = False) -> None:
         self.host = host
-        self.executor = Executor(host)
+        #: Targets and programs with the X-ray's primitive ids (:mod:`glsandbox.story.xray`).
+        self.primitive_ids = primitive_ids
+        self.executor = Executor(host, primitive_ids)
         self._targets: dict[tuple[tuple[int, int], Buffers], OffscreenTarget] = {}
         self._plans: dict[int, tuple[Scene, tuple, Plan]] = {}  # by id of the scene frames were moved from
         # Whether a plan's frames may be drawn from a motion handed over (render_motion), by id of the plan.
@@ -181,7 +183,7 @@ class FrameRenderer:
         if target is None:
             if len(self._targets) >= self.KEEP_TARGETS:  # drop the oldest
                 self._targets.pop(next(iter(self._targets))).release()
-            target = self._targets[key] = OffscreenTarget(self.host, size, buffers)
+            target = self._targets[key] = OffscreenTarget(self.host, size, buffers, self.primitive_ids)
         self._last_target = (size, buffers, target)
         return target
 

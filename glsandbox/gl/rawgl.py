@@ -99,6 +99,8 @@ _SIGNATURES: dict[str, tuple] = {
     "glGetFloatv": (_VOID, _UINT, ctypes.POINTER(ctypes.c_float)),
     "glReadPixels": (_VOID, _INT, _INT, _INT, _INT, _UINT, _UINT, ctypes.c_void_p),
     "glPixelStorei": (_VOID, _UINT, _INT),
+    "glClearBufferuiv": (_VOID, _UINT, _INT, ctypes.c_void_p),
+    "glReadBuffer": (_VOID, _UINT),
     "glBlitFramebuffer": (_VOID, _INT, _INT, _INT, _INT, _INT, _INT, _INT, _INT, _UINT, _UINT),
 }
 
@@ -163,6 +165,23 @@ class RawGL:
             raise SandboxError(f"offscreen framebuffer {size[0]}x{size[1]} (samples {samples}) "
                                f"is incomplete: status 0x{status:04X}")
         return fbo.value, rb.value
+
+    def attach_color(self, fbo: int, index: int, renderbuffer: int) -> None:
+        """Attach ``renderbuffer`` as colour attachment ``index`` of ``fbo`` (the X-ray's primitive
+        ids: attachment 1); moderngl's ``detect_framebuffer`` then draws into every attachment."""
+        old = self.get_integer(GL_FRAMEBUFFER_BINDING)
+        self.glBindFramebuffer(GL_FRAMEBUFFER, fbo)
+        self.glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + index, GL_RENDERBUFFER, renderbuffer)
+        self.glBindFramebuffer(GL_FRAMEBUFFER, old)
+
+    def clear_ids(self, rect: tuple[int, int, int, int]) -> None:
+        """Clear colour attachment 1 (the primitive ids, unsigned integers) of the bound framebuffer
+        to 0 inside ``rect``: a float clear colour leaves an integer attachment undefined."""
+        self.glEnable(GL_SCISSOR_TEST)
+        self.glScissor(*rect)
+        zeros = (_UINT * 4)(0, 0, 0, 0)
+        self.glClearBufferuiv(0x1800, 1, zeros)  # GL_COLOR, draw buffer 1
+        self.glDisable(GL_SCISSOR_TEST)
 
     def attachment_bits(self, fbo: int) -> tuple[int, int]:
         """(depth bits, stencil bits) of a framebuffer's depth attachment."""
@@ -239,6 +258,7 @@ class RawGL:
         old = self.get_integer(GL_FRAMEBUFFER_BINDING)
         self.glBindFramebuffer(GL_FRAMEBUFFER, fbo)
         data = ctypes.create_string_buffer(size[0] * size[1] * 4)
+        self.glReadBuffer(GL_COLOR_ATTACHMENT0)  # (moderngl's read of attachment 1 leaves that one set)
         self.glReadPixels(0, 0, size[0], size[1], 0x1908, 0x1401, data)  # GL_RGBA, GL_UNSIGNED_BYTE
         self.glBindFramebuffer(GL_FRAMEBUFFER, old)
         return data.raw

@@ -90,14 +90,16 @@ def render_raster_story(trace: RasterTrace) -> str:
         if not wrote:
             why = "nothing it drew covers this pixel, or what did failed the depth or stencil test"
             if row["stencil_passes"]:
-                why = f"the stencil test passes here ({row['stencil_before']}), but " + why.replace(", or what did",                     "; or what did")
+                why = (f"the stencil test passes here ({row['stencil_before']}), but nothing it drew covers this "
+                       "pixel, or what did failed the depth test")
             lines.append(f"{head}: left the pixel as it was: {why}")
             continue
         parts = []
         if "colour" in wrote:
             verb = "blended over" if row["blended"] else "replaced"
+            who = f"; {row['node']}, triangle {row['triangle']}" if row.get("node") else ""
             parts.append(f"colour {_rgb(row['color_before'])} → {_rgb(row['color'])}"
-                         + (f" ({verb} the colour before)" if row["kind"] != "clear" else ""))
+                         + (f" ({verb} the colour before{who})" if row["kind"] != "clear" else ""))
         if "depth" in wrote:
             parts.append(f"depth {num(row['depth_before'])} → {num(row['depth'])}")
         if "stencil" in wrote:

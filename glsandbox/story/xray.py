@@ -13,6 +13,7 @@ an MSAA scene's X-ray is of its frame with ``samples = 0``.
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -38,7 +39,9 @@ def pass_name(step: Pass) -> str:
 @dataclass
 class PassPicture:
     """The target after one pass: ``color`` (H, W, 4) uint8, ``depth`` (H, W) float32 in 0..1
-    (None without a depth buffer), ``stencil`` (H, W) uint8 (None without one); top row first."""
+    (None without a depth buffer), ``stencil`` (H, W) uint8 (None without one), ``ids`` (H, W, 2)
+    uint32: the node (its place in the scene's nodes + 1, 0 for none) and the triangle of the
+    last fragment written there; top row first."""
 
     number: int
     name: str
@@ -47,6 +50,7 @@ class PassPicture:
     color: NDArray[np.uint8]
     depth: NDArray[np.float32] | None
     stencil: NDArray[np.uint8] | None
+    ids: NDArray[np.uint32] | None = None
 
 
 @dataclass
@@ -56,6 +60,8 @@ class XRay:
     passes: list[PassPicture]
     frame: NDArray[np.uint8]
     notes: list[str] = field(default_factory=list)
+    #: The nodes the ids number: ``node_names[k - 1]`` is node ``k``.
+    node_names: list[str] = field(default_factory=list)
 
     def rebuilt(self) -> NDArray[np.uint8]:
         """The frame put together again from the passes: each pass's pixels where it
@@ -69,14 +75,31 @@ class XRay:
         return out
 
 
+#: The X-ray renderers (primitive ids on), one per renderer X-rayed with, on its context.
+_ID_RENDERERS: weakref.WeakKeyDictionary[FrameRenderer, FrameRenderer] = weakref.WeakKeyDictionary()
+
+
+def id_renderer(renderer: FrameRenderer) -> FrameRenderer:
+    """A renderer on ``renderer``'s context drawing with the primitive-id target (its own
+    programs and targets, made once and kept while ``renderer`` lives)."""
+    if renderer.primitive_ids:
+        return renderer
+    kept = _ID_RENDERERS.get(renderer)
+    if kept is None:
+        kept = _ID_RENDERERS[renderer] = FrameRenderer(renderer.host, primitive_ids=True)
+    return kept
+
+
 def xray(renderer: FrameRenderer, scene: Scene, size: tuple[int, int]) -> XRay:
-    """Draw one frame of ``scene`` at ``size`` and keep the target after every pass."""
+    """Draw one frame of ``scene`` at ``size`` on ``renderer``'s context and keep the target after
+    every pass, with the primitive ids (:func:`id_renderer`)."""
     notes = []
     if scene.samples:
         notes.append(f"drawn without MSAA (the scene asks for {scene.samples}x): a multisampled "
                      "target cannot be read pixel by pixel")
         scene = with_samples(scene, 0)
-    raw = renderer.host.raw
+    drawer = id_renderer(renderer)
+    raw = drawer.host.raw
     width, height = size
     pictures: list[PassPicture] = []
 
@@ -85,18 +108,30 @@ def xray(renderer: FrameRenderer, scene: Scene, size: tuple[int, int]) -> XRay:
             notes.append(f"{pass_name(step)} draws into {step.target}, not the frame: not pictured")
             return
         fbo = raw.bound_framebuffer()
+        if step.kind == "clear" and drawer.executor.pass_rect is not None:
+            raw.clear_ids(drawer.executor.pass_rect)  # integer ids: a float clear leaves them undefined
         depth_bits, stencil_bits = raw.attachment_bits(fbo)
         color = np.frombuffer(raw.read_color(fbo, size), dtype=np.uint8).reshape(height, width, 4)[::-1].copy()
         depth = np.frombuffer(raw.read_depth(fbo, size), dtype=np.float32).reshape(height, width)[::-1].copy() \
             if depth_bits else None
         stencil = np.frombuffer(raw.read_stencil(fbo, size), dtype=np.uint8).reshape(height, width)[::-1].copy() \
             if stencil_bits else None
-        pictures.append(PassPicture(len(pictures) + 1, pass_name(step), step.describe(), step, color, depth, stencil))
+        target = drawer.target(size, frame_buffers[0]) if frame_buffers else None
+        ids = None if target is None else np.array(target.read_ids())
+        pictures.append(PassPicture(len(pictures) + 1, pass_name(step), step.describe(), step, color, depth, stencil,
+                                    ids))
 
-    renderer.host.make_current()
-    _, target = renderer.draw(scene, size, after_pass=after_pass)
+    drawer.host.make_current()
+    frame_buffers: list[Any] = []
+    traced = scene
+    if any(vp.renderer != "raster" for vp in scene.viewports):
+        from glsandbox.frame import trace_viewports
+
+        traced = trace_viewports(scene, size, drawer.host.ctx)
+    frame_buffers.append(drawer.plan(traced).buffers)
+    _, target = drawer.draw(traced, size, after_pass=after_pass)
     frame = np.array(target.read())
-    return XRay(pictures, frame, notes)
+    return XRay(pictures, frame, notes, [node.name for node in traced.nodes])
 
 
 # --- pictures ------------------------------------------------------------------
@@ -204,7 +239,8 @@ def write_xray(x: XRay, folder: Path) -> list[Path]:
 
 def pixel_passes(x: XRay, pixel: tuple[int, int]) -> list[dict[str, Any]]:
     """Pixel ``(x, y)`` (row 0 at the top) pass by pass: for each pass its colour, depth and
-    stencil before and after, and whether it wrote any of them."""
+    stencil before and after, which of them it wrote, and the node and triangle of the last
+    fragment that wrote the colour there so far (the primitive ids)."""
     px, py = pixel
     out = []
     before_color, before_depth, before_stencil = [0, 0, 0, 0], None, None
@@ -214,8 +250,14 @@ def pixel_passes(x: XRay, pixel: tuple[int, int]) -> list[dict[str, Any]]:
         stencil = None if picture.stencil is None else int(picture.stencil[py, px])
         wrote = [name for name, a, b in (("colour", before_color, color), ("depth", before_depth, depth),
                                          ("stencil", before_stencil, stencil)) if a != b]
+        node = triangle = None
+        if picture.ids is not None:
+            number, prim = (int(v) for v in picture.ids[py, px])
+            if 0 < number <= len(x.node_names):
+                node, triangle = x.node_names[number - 1], prim
         out.append({"pass": picture.number, "name": picture.name, "description": picture.description,
                     "color_before": before_color, "color": color, "depth_before": before_depth, "depth": depth,
-                    "stencil_before": before_stencil, "stencil": stencil, "wrote": wrote})
+                    "stencil_before": before_stencil, "stencil": stencil, "wrote": wrote,
+                    "node": node, "triangle": triangle})
         before_color, before_depth, before_stencil = color, depth, stencil
     return out
