@@ -1,7 +1,8 @@
 """Benchmark: ``glsandbox explain`` of one pixel, every lesson, against the goal of under 1 s.
 
 Each lesson's scene (the ray lessons as they are, the others with
-``renderer=ray_numpy``) is built once; each repetition explains its centre pixel at
+``renderer=ray_numpy``, and the others as they are: their pixel told pass by pass,
+the frame drawn again with its X-ray) is built once; each repetition explains its centre pixel at
 800x600 on a fresh copy of that Scene, so the World (and its BVHs) and the primary
 rays are made again every time, as a new ``glsandbox explain`` process makes them
 (the lesson's own build and the interpreter's start are not in it: a lesson such as
@@ -24,7 +25,7 @@ GROUP = "explain"
 #: The goal: one pixel's story in under this many seconds, every lesson.
 GOAL_S = 1.0
 #: ``--quick``: these lessons only.
-QUICK = ("ray_spheres", "ray_phong")
+QUICK = ("ray_spheres", "ray_phong", "mirror")
 #: The X-ray's goal: at most this ratio of the plain frame's time.
 XRAY_GOAL = 3.0
 #: The lessons whose frame is X-rayed (``--quick``: the first).
@@ -34,6 +35,7 @@ XRAY_LESSONS = ("mirror", "phong", "shadow_map")
 def cases(env) -> list:
     from glsandbox.lesson import all_lessons
     from glsandbox.measure.bench import Case, Side
+    from glsandbox.story.raster import explain_raster_pixel
     from glsandbox.story.ray import explain_ray_pixel
 
     out = []
@@ -50,6 +52,14 @@ def cases(env) -> list:
 
         out.append(Case(GROUP, f"one pixel, {cls.name}", None, Side("explain", run), repeat=1, unit="ms",
                         note=f"goal < {GOAL_S:g} s"))
+        if settings:  # a raster lesson: its pixel pass by pass too (the X-ray of its frame)
+            raster = cls().scene()
+
+            def run_raster(k: int, scene=raster, pixel=pixel) -> list[int]:
+                return explain_raster_pixel(env.renderer, replace(scene), size, pixel).rgba8
+
+            out.append(Case(GROUP, f"one pixel, {cls.name} (rasterised)", None, Side("explain", run_raster), repeat=1,
+                            unit="ms", note=f"goal < {GOAL_S:g} s"))
     out.extend(xray_cases(env))
     return out
 

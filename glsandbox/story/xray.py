@@ -111,13 +111,18 @@ def xray(renderer: FrameRenderer, scene: Scene, size: tuple[int, int]) -> XRay:
         if step.kind == "clear" and drawer.executor.pass_rect is not None:
             raw.clear_ids(drawer.executor.pass_rect)  # integer ids: a float clear leaves them undefined
         depth_bits, stencil_bits = raw.attachment_bits(fbo)
-        color = np.frombuffer(raw.read_color(fbo, size), dtype=np.uint8).reshape(height, width, 4)[::-1].copy()
-        depth = np.frombuffer(raw.read_depth(fbo, size), dtype=np.float32).reshape(height, width)[::-1].copy() \
+        color = np.frombuffer(raw.read_color(fbo, size), dtype=np.uint8).reshape(height, width, 4)[::-1]
+        depth = np.frombuffer(raw.read_depth(fbo, size), dtype=np.float32).reshape(height, width)[::-1] \
             if depth_bits else None
-        stencil = np.frombuffer(raw.read_stencil(fbo, size), dtype=np.uint8).reshape(height, width)[::-1].copy() \
-            if stencil_bits else None
+        previous = pictures[-1] if pictures else None
+        if not stencil_bits:
+            stencil = None
+        elif step.stencil is None and step.kind != "clear" and previous is not None:
+            stencil = previous.stencil  # no stencil test, no stencil writes: what the pass before left
+        else:
+            stencil = np.frombuffer(raw.read_stencil(fbo, size), dtype=np.uint8).reshape(height, width)[::-1]
         target = drawer.target(size, frame_buffers[0]) if frame_buffers else None
-        ids = None if target is None else np.array(target.read_ids())
+        ids = None if target is None else target.read_ids()
         pictures.append(PassPicture(len(pictures) + 1, pass_name(step), step.describe(), step, color, depth, stencil,
                                     ids))
 
