@@ -97,16 +97,9 @@ def explain(lesson_or_scene: Any, pixel: tuple[int, int] | str, size: tuple[int,
 
     if isinstance(pixel, str):
         pixel = parse_pixel(pixel)
-    if isinstance(lesson_or_scene, Scene):
-        if params:
-            raise SandboxError(f"explain: a Scene takes no parameters (got {', '.join(params)})")
-        scene, title = lesson_or_scene, lesson_or_scene.name
-    else:
-        from glsandbox.notebook import make_lesson
+    from glsandbox.notebook import scene_of, shared_renderer
 
-        lesson = make_lesson(lesson_or_scene, **params)
-        scene, title = lesson.scene(), lesson.name
+    scene, title = scene_of(lesson_or_scene, "explain", **params)
     frame = tuple(size) if size is not None else DEFAULT_SIZE
-    from glsandbox.notebook import shared_renderer
 
     return pixel_story(scene, (int(frame[0]), int(frame[1])), (int(pixel[0]), int(pixel[1])), title, shared_renderer)
