@@ -156,6 +156,8 @@ class PixelTrace:
     bounces: list[Bounce]
     color: list[float]
     rgba8: list[int]
+    #: What else the frame shows at the pixel (an overlay drawn over it).
+    notes: list[str] = field(default_factory=list)
 
     def replay(self) -> list[int]:
         """The pixel again from the recorded terms alone, in the engine's order: each
@@ -257,7 +259,23 @@ def explain_ray_pixel(scene: Scene, size: tuple[int, int], pixel: tuple[int, int
     return PixelTrace(title=title or scene.name, pixel=(int(pixel[0]), int(pixel[1])), size=(int(size[0]), int(size[1])),
                       viewport=index, local_pixel=(lx, ly), viewport_size=(w, h), renderer=vp.renderer,
                       max_depth=max_depth, background=_vec(world.background), bounces=bounces, color=_vec(rgb),
-                      rgba8=[int(v) for v in to_rgba8(rgb)[0]])
+                      rgba8=[int(v) for v in to_rgba8(rgb)[0]], notes=overlays_over(scene, size, pixel))
+
+
+def overlays_over(scene: Scene, size: tuple[int, int], pixel: tuple[int, int]) -> list[str]:
+    """A line for each overlay (a lesson's text panel) drawn over frame pixel ``(x, y)``: the frame
+    shows it there, over the traced colour."""
+    width, height = size
+    x, gl_y = pixel[0], height - 1 - pixel[1]  # overlays are placed in GL's rows (y up)
+    lines = []
+    for overlay in scene.overlays:
+        region = scene.viewports[overlay.viewport].pixels(width, height) if overlay.viewport is not None \
+            else (0, 0, width, height)
+        ox, oy, ow, oh = overlay.placement(region)
+        if ox <= x < ox + ow and oy <= gl_y < oy + oh and overlay.image[oy + oh - 1 - gl_y, x - ox, 3] > 0:
+            lines.append(f"the overlay {overlay.name!r} is drawn over this pixel: the frame shows it here, "
+                         "over the traced colour below")
+    return lines
 
 
 def _bounces(world: World, events: list[tuple[str, dict[str, Any]]], shadows: bool) -> list[Bounce]:

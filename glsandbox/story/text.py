@@ -153,6 +153,7 @@ def render_story(trace: PixelTrace) -> str:
     lines = [f"{trace.title}: pixel {trace.pixel[0]},{trace.pixel[1]} of {trace.size[0]}x{trace.size[1]}{where}",
              f"({who}; reflections to depth {trace.max_depth}; scene coordinates, OpenGL's: the course's z is "
              "mirrored)"]
+    lines.extend(f"note: {note}" for note in trace.notes)
     step = [0]
     for bounce in trace.bounces:
         lines.extend(_bounce_lines(bounce, step, trace))

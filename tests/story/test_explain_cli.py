@@ -8,7 +8,7 @@ from support import assert_user_error, run_cli
 
 
 def test_explain_prints_the_story() -> None:
-    run = run_cli("explain", "ray_spheres", "--set", "camera=0,0,0,0,0.6,-0.8", "--size", "101x101", "--pixel", "50,50")
+    run = run_cli("explain", "ray_spheres", "--set", "camera=0,0,0,0,0.6,-0.8", "--size", "401x301", "--pixel", "200,150")
     assert run.returncode == 0, run.stderr
     assert "s = l·Rd = 80, m² = l·l − s² = 3600, q = √(r² − m²) = 45" in run.stdout
     assert "t = s − q = 35 → hit" in run.stdout and "P = R0 + t·Rd = (0, 21, -28)" in run.stdout

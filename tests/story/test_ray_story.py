@@ -65,7 +65,7 @@ def test_replayed_trace_is_the_rendered_pixel(name: str, settings: tuple[str, ..
 def course_ray(lesson: str, direction: str, *settings: str) -> Story:
     """The centre pixel of an odd-sized frame whose camera sits at the origin looking along
     ``direction``: that pixel's ray is the notes' ray from (0, 0, 0)."""
-    return explain(lesson, (50, 50), (101, 101), camera=f"0,0,0,{direction}", **dict(s.split("=") for s in settings))
+    return explain(lesson, (200, 150), (401, 301), camera=f"0,0,0,{direction}", **dict(s.split("=") for s in settings))
 
 
 def test_worked_example_4_sphere_t_35() -> None:
@@ -155,3 +155,20 @@ def test_split_viewports_find_their_pixel() -> None:
     assert (index, local, size) == (1, (12, 10), (48, 72))
     frame = traced_frame(two, SIZE)
     assert explain_ray_pixel(two, SIZE, (60, 10)).replay() == frame[10, 60].tolist()
+
+
+def test_the_frame_shows_the_story_where_no_overlay_covers_it(gl) -> None:
+    """The whole frame (GL, overlays and all) of ray_spheres traced by the numpy engine: each grid
+    pixel is the story's colour, or the story says an overlay covers it."""
+    lesson = find_lesson("ray_spheres").from_settings(["renderer=ray_numpy"])
+    frame = gl.render(lesson, SIZE).image
+    covered = 0
+    for y in range(1, SIZE[1], 7):
+        for x in range(1, SIZE[0], 7):
+            trace = explain_ray_pixel(lesson.scene(), SIZE, (x, y))
+            if trace.notes:
+                covered += 1
+                assert "overlay 'figures'" in trace.notes[0]
+            else:
+                assert trace.rgba8 == frame[y, x].tolist(), (x, y)
+    assert covered > 0
