@@ -145,7 +145,8 @@ def cmd_render(args: argparse.Namespace) -> int:
     lesson = _lesson(args)
     size = _size(args)
     if args.out is None and args.xray is None:
-        raise SandboxError("render: give --out FILE.png, --xray DIR or both")
+        raise SandboxError("glsandbox render: the following arguments are required: --out FILE.png, or --xray DIR "
+                           "(see glsandbox render --help)")
     if args.out is not None:
         frame = render_to_file(lesson, args.out, size, args.samples, args.backend)
         print(f"wrote {args.out} ({size[0]}x{size[1]}, {frame.seconds * 1000:.1f} ms)")
