@@ -1,5 +1,5 @@
 // The unit sphere |p| = 1 in its own space (glsandbox/raytrace/shapes/sphere.py).
-// Needs INF and PI (shaders/raytrace.glsl).
+// Needs INF, PI (shaders/raytrace.glsl) and SPHERE_C_ERROR (raytrace/constants.py).
 
 // Işın-Küre kesim testi, the numerically stable form (Ray Tracing Gems ch. 7):
 // discriminant from the vector h = l − (b/a)d, roots q/a and c/q without cancellation.
@@ -15,6 +15,11 @@ float sphere_t(vec3 o, vec3 d, bool cull) {
     if (q == 0.0) return INF;
     float l_len = length(l);
     float c = (l_len - 1.0) * (l_len + 1.0);
+    // The sphere's error bound (derived in glsandbox/raytrace/sphere.py's intersect_many,
+    // here r = 1 and the centre the origin): |c| <= γ·(|l| + 1 + |o|)·(|l| + 1), |o| = |l|,
+    // means the origin is on the surface to within the arithmetic: the root c/q is 0,
+    // the surface the ray leaves, and the other root (the far side, or behind) answers.
+    if (abs(c) <= SPHERE_C_ERROR * (2.0 * l_len + 1.0) * (l_len + 1.0)) c = 0.0;
     float t1 = q / a;
     float t0 = c / q;
     float near = min(t0, t1);
