@@ -111,29 +111,25 @@ def xray(renderer: FrameRenderer, scene: Scene, size: tuple[int, int]) -> XRay:
         if step.kind == "clear" and drawer.executor.pass_rect is not None:
             raw.clear_ids(drawer.executor.pass_rect)  # integer ids: a float clear leaves them undefined
         depth_bits, stencil_bits = raw.attachment_bits(fbo)
-        color = np.frombuffer(raw.read_color(fbo, size), dtype=np.uint8).reshape(height, width, 4)[::-1]
-        depth = np.frombuffer(raw.read_depth(fbo, size), dtype=np.float32).reshape(height, width)[::-1] \
-            if depth_bits else None
+        color = raw.read_pixels(fbo, size, "color")
+        depth = raw.read_pixels(fbo, size, "depth") if depth_bits else None
         previous = pictures[-1] if pictures else None
         if not stencil_bits:
             stencil = None
         elif step.stencil is None and step.kind != "clear" and previous is not None:
             stencil = previous.stencil  # no stencil test, no stencil writes: what the pass before left
         else:
-            stencil = np.frombuffer(raw.read_stencil(fbo, size), dtype=np.uint8).reshape(height, width)[::-1]
-        target = drawer.target(size, frame_buffers[0]) if frame_buffers else None
-        ids = None if target is None else target.read_ids()
+            stencil = raw.read_pixels(fbo, size, "stencil")
+        ids = raw.read_pixels(fbo, size, "ids") if drawer.primitive_ids else None
         pictures.append(PassPicture(len(pictures) + 1, pass_name(step), step.describe(), step, color, depth, stencil,
                                     ids))
 
     drawer.host.make_current()
-    frame_buffers: list[Any] = []
     traced = scene
     if any(vp.renderer != "raster" for vp in scene.viewports):
         from glsandbox.frame import trace_viewports
 
         traced = trace_viewports(scene, size, drawer.host.ctx)
-    frame_buffers.append(drawer.plan(traced).buffers)
     _, target = drawer.draw(traced, size, after_pass=after_pass)
     frame = np.array(target.read())
     return XRay(pictures, frame, notes, [node.name for node in traced.nodes])
