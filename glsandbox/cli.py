@@ -383,10 +383,14 @@ def cmd_check(args: argparse.Namespace) -> int:
         if args.update:
             raise SandboxError(f"--update writes references from the model answer: give one lesson, not the folder {target}")
 
+        from glsandbox.grading.layers import describe
+
+        layers_line = describe()  # which layers confine a submission on this machine
         bars = []  # the progress bar, made when the first submission reports (the total known then)
 
         def report(done: int, total: int, result) -> None:
-            if not bars:
+            if not bars:  # the first line of the output (none when the run stops with an error)
+                say(layers_line, file=sys.stdout)
                 bars.append(progress(total, "check", "submission"))
             # Lines on stdout above the bar on stderr (only a terminal gets the bar).
             say(f"[{done}/{total}] {result.line()}", file=sys.stdout)

@@ -174,8 +174,14 @@ class _Zygote:
 
         self.channel, theirs = socket.socketpair()
         code = "import sys; from glsandbox.grading.worker import zygote_main; zygote_main(int(sys.argv[1]))"
+        # a fresh program with only what rendering reads: every fork's /proc/self/environ is this one
+        from glsandbox.grading.layers import minimal_environment
+
+        package_parent = str(Path(__file__).resolve().parents[2])
+        code = f"import sys; sys.path.insert(0, {package_parent!r}); " + code
         self.process = subprocess.Popen([sys.executable, "-c", code, str(theirs.fileno())], pass_fds=[theirs.fileno()],
-                                        stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL)  # never the grader's stdout
+                                        stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,  # never the grader's stdout
+                                        env=minimal_environment())
         theirs.close()
 
     def start(self, job: Job) -> int:

@@ -8,6 +8,7 @@ module runs only in those processes; the grader starts the zygote with
 from __future__ import annotations
 
 import ctypes
+import functools
 import json
 import os
 import select
@@ -21,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from glsandbox.grading import layers
 from glsandbox.grading.isolate import (BROKEN, CRASHED, OOM, TAIL_LINES, TAIL_WIDTH, TIMEOUT, Job, Picture, Reader,
                                        job_from, send)
 from glsandbox.grading.processes import kill_tree, killpg, set_subreaper, wait_briefly
@@ -34,9 +36,6 @@ PRELOAD = ["glsandbox.grading.worker", "glsandbox.frame", "glsandbox.lesson", "g
            "glsandbox.grading.sandbox", "glsandbox.gl.context", "glsandbox.gl.shaders", "numpy", "moderngl",
            "glcontext", "glcontext.egl", "PIL.Image", "lessons"]
 
-#: The environment a renderer keeps (by prefix): the drivers', the locale's and glsandbox's own.
-_ENV_KEPT = ("PATH", "HOME", "LANG", "LC_", "TZ", "DISPLAY", "WAYLAND_", "XDG_", "MESA_", "LIBGL_", "GALLIUM_",
-             "LP_", "EGL_", "__EGL_", "__GLX_", "GLCONTEXT_", "PYOPENGL_", "GLSANDBOX_", "PYTHONHASHSEED", "CI")
 
 
 # --- the renderer (grandchild) ---------------------------------------------------------------
@@ -57,12 +56,14 @@ def _limit(job: Job) -> None:
             pass
 
 
-def _renderer(job: Job, root: str, target: str, work: str, out: int) -> None:
-    """The renderer's whole life; it never returns (``os._exit``)."""
+def _renderer(job: Job, root: str, target: str, work: str, out: int, ids: tuple[int, int] | None) -> None:
+    """The renderer's whole life; it never returns (``os._exit``). ``ids``: the user it becomes
+    before the submission's code runs (the grader is root)."""
     from glsandbox.errors import SandboxError
     from glsandbox.frame import HeadlessRenderer
+    from glsandbox.grading import layers
+    from glsandbox.grading.sandbox import confine, landlock_abi
     from glsandbox.lesson import find_lesson, submission_lesson, user_code_error
-    from glsandbox.grading.sandbox import confine
 
     os.setsid()
     null = os.open(os.devnull, os.O_RDONLY)
@@ -77,9 +78,7 @@ def _renderer(job: Job, root: str, target: str, work: str, out: int) -> None:
     os.closerange(4, os.sysconf("SC_OPEN_MAX"))
     sys.stdin = open(os.devnull)  # noqa: SIM115 - the submission's, for its life
     sys.argv = ["submission"]
-    for key in list(os.environ):  # only what rendering reads: no path of the teacher's (PWD, OLDPWD, ...)
-        if not key.startswith(_ENV_KEPT):
-            del os.environ[key]
+    layers.close_network()  # before a context starts threads: a user namespace needs a single thread
     cwd = os.path.join(work, "cwd")
     os.chdir(root if job.copy else cwd)
     _limit(job)
@@ -90,7 +89,13 @@ def _renderer(job: Job, root: str, target: str, work: str, out: int) -> None:
         except SandboxError as exc:
             send(out, {"kind": "nogl", "error": str(exc)})
             return
-        confine(root, [root if job.copy else cwd, cwd], cache_writable=job.writes_cache)
+        kept_reading = False
+        if ids is not None:  # Python only root may read: reading kept, bounded by Landlock below
+            kept_reading = not _python_readable() and landlock_abi() >= 1
+            layers.drop_privileges(ids, keep_reading=kept_reading)
+        if not confine(root, [root if job.copy else cwd, cwd], cache_writable=job.writes_cache) and kept_reading:
+            layers.drop_reading()
+        layers.install_seccomp()
         try:
             cls = find_lesson(target) if job.source is None else submission_lesson(Path(root) / target)
         except MemoryError as exc:
@@ -139,6 +144,24 @@ def _copy_submission(source: Path, into: Path) -> Path:
         into.mkdir()
         shutil.copy2(source, into / source.name, follow_symlinks=False)
     return into
+
+
+def _hand_over(work: str, folders: list[str], ids: tuple[int, int]) -> None:
+    """Make ``folders`` (and all in them) ``ids``'s; ``work`` above them only passable by others."""
+    uid, gid = ids
+    os.chmod(work, 0o711)
+    for folder in folders:
+        os.lchown(folder, uid, gid)
+        for base, dirs, names in os.walk(folder):
+            for name in dirs + names:
+                os.lchown(os.path.join(base, name), uid, gid)
+
+
+@functools.cache
+def _python_readable() -> bool:
+    from glsandbox.grading.layers import python_readable_by_others
+
+    return python_readable_by_others()
 
 
 def _exit_reason(status: int, job: Job) -> tuple[str, str]:
@@ -244,11 +267,14 @@ def _supervise(job: Job, out: int) -> None:
             result["root"] = root
         else:
             root, target = str(Path(job.source).parent), job.target
+        ids = layers.submission_ids(os.getpid()) if job.copy else None
+        if ids is not None:  # its own copy and working folder, owned by the user it runs as
+            _hand_over(work, [root, os.path.join(work, "cwd")], ids)
         read_end, write_end = os.pipe()
         pid = os.fork()
         if pid == 0:  # the renderer: no GL context here, or the warm template's, checked safe to fork
             os.close(read_end)
-            _renderer(job, root, target, work, write_end)
+            _renderer(job, root, target, work, write_end, ids)
         os.close(write_end)
         try:
             pictures = _collect(job, pid, read_end)
@@ -317,6 +343,7 @@ def zygote_main(channel_fd: int) -> None:
     from glsandbox.grading.sandbox import read_roots
 
     read_roots()  # worked out once, for every renderer
+    _python_readable()
     zygote(channel_fd)
 
 
