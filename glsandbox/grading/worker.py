@@ -97,7 +97,7 @@ def _renderer(job: Job, root: str, target: str, work: str, out: int, ids: tuple[
             layers.drop_reading()
         layers.install_seccomp()
         try:
-            cls = find_lesson(target) if job.source is None else submission_lesson(Path(root) / target)
+            cls = find_lesson(target) if job.source is None else submission_lesson(Path(root) / target, job.entry)
         except MemoryError as exc:
             send(out, {"kind": "oom", "index": 0, "error": str(user_code_error(exc)), "all": True})
             return
@@ -107,13 +107,23 @@ def _renderer(job: Job, root: str, target: str, work: str, out: int, ids: tuple[
         except BaseException as exc:  # noqa: BLE001 - anything the submission raised while loading
             send(out, {"kind": "broken", "index": 0, "error": str(user_code_error(exc)), "all": True})
             return
+        if job.describe:  # the tour's card: read from the class now, sent as text
+            try:
+                from glsandbox.lesson import lesson_description
+
+                send(out, {"kind": "meta", "title": str(cls.title)[:500], "course_section": str(cls.course_section)[:500],
+                           "description": str(lesson_description(cls))[:2000]})
+            except BaseException:  # noqa: BLE001 - a class whose attributes raise: its card says less
+                pass
         for index, render in enumerate(job.renders):
             started = time.perf_counter()
             try:
-                image = renderer.render(cls.from_settings(render.settings), render.size, render.samples).image
-                image = np.ascontiguousarray(image, dtype=np.uint8)
+                frame = renderer.render(cls.from_settings(render.settings), render.size, render.samples)
+                image = np.ascontiguousarray(frame.image, dtype=np.uint8)
                 header = {"kind": "image", "index": index, "shape": list(image.shape),
                           "seconds": time.perf_counter() - started}
+                if job.describe:
+                    header["info"] = {"plan": frame.plan.to_dict(), "plan_text": frame.plan.describe()}
                 send(out, header, image.tobytes())
             except MemoryError as exc:
                 send(out, {"kind": "oom", "index": index, "error": str(user_code_error(exc))})
@@ -168,13 +178,13 @@ def _exit_reason(status: int, job: Job) -> tuple[str, str]:
     if os.WIFSIGNALED(status):
         number = os.WTERMSIG(status)
         if number == signal.SIGXCPU:
-            return TIMEOUT, f"CPU time limit ({int(job.timeout * len(job.renders)) + 10} s) reached"
+            return TIMEOUT, f"timed out: the CPU time limit ({int(job.timeout * len(job.renders)) + 10} s) reached"
         name = signal.Signals(number).name if number in signal.Signals._value2member_map_ else str(number)
         return CRASHED, f"killed by signal {name}"
     return CRASHED, f"exited with code {os.WEXITSTATUS(status)} before its picture was sent"
 
 
-def _collect(job: Job, pid: int, fd: int) -> list[Picture]:
+def _collect(job: Job, pid: int, fd: int, meta: dict | None = None) -> list[Picture]:
     """Each picture as it arrives, against the clock: ``job.timeout`` seconds for each."""
     pictures: list[Picture] = [Picture() for _ in job.renders]
     limit = max(w * h * 4 for w, h in (r.size for r in job.renders))
@@ -191,7 +201,8 @@ def _collect(job: Job, pid: int, fd: int) -> list[Picture]:
     while current < len(pictures):
         remaining = started + job.timeout - time.monotonic()
         if remaining <= 0:
-            return finish(TIMEOUT, f"after {job.timeout:g} s")
+            pictures[current].seconds = time.monotonic() - started  # the limit it ran into, not 0
+            return finish(TIMEOUT, f"timed out after {job.timeout:g} s")
         if status is None:
             done, status_now = os.waitpid(pid, os.WNOHANG)
             status = status_now if done else None
@@ -204,6 +215,9 @@ def _collect(job: Job, pid: int, fd: int) -> list[Picture]:
                 kind = header.get("kind")
                 if kind == "nogl":
                     raise _NoGL(str(header.get("error", "")))
+                if kind == "meta" and meta is not None and not meta:
+                    meta.update({k: str(header.get(k, ""))[:2000] for k in ("title", "course_section", "description")})
+                    continue
                 index = int(header.get("index", -1))
                 if index != current:
                     raise ValueError("a message out of order on the result pipe")
@@ -215,6 +229,8 @@ def _collect(job: Job, pid: int, fd: int) -> list[Picture]:
                         raise ValueError(f"a picture of shape {shape} for a {w}x{h} render")
                     picture.image = np.frombuffer(payload, dtype=np.uint8).reshape(h, w, 4)
                     picture.seconds = float(header.get("seconds", 0.0))
+                    if job.describe and isinstance(header.get("info"), dict):
+                        picture.info = header["info"]
                 else:
                     picture.status = OOM if kind == "oom" else BROKEN
                     picture.error = str(header.get("error", ""))[:500]
@@ -248,7 +264,7 @@ def _supervise(job: Job, out: int) -> None:
     set_subreaper()
     send(out, {"kind": "pid", "pid": os.getpid()})
     work = tempfile.mkdtemp(prefix="glsandbox-grade-")
-    result: dict = {"kind": "result", "pictures": None, "output": [], "no_gl": "", "root": ""}
+    result: dict = {"kind": "result", "pictures": None, "output": [], "no_gl": "", "root": "", "meta": {}}
     pictures: list[Picture] | None = None
     cleaned = False
     try:
@@ -277,7 +293,7 @@ def _supervise(job: Job, out: int) -> None:
             _renderer(job, root, target, work, write_end, ids)
         os.close(write_end)
         try:
-            pictures = _collect(job, pid, read_end)
+            pictures = _collect(job, pid, read_end, result["meta"])
         except _NoGL as exc:
             result["no_gl"] = str(exc)
         wait_briefly(pid)  # after its last picture it ends by itself: then one look finds nothing left
@@ -296,7 +312,7 @@ def _supervise(job: Job, out: int) -> None:
             for picture in pictures:
                 image = picture.image
                 result["pictures"].append({"status": picture.status, "error": picture.error,
-                                           "seconds": picture.seconds,
+                                           "seconds": picture.seconds, "info": picture.info,
                                            "shape": None if image is None else list(image.shape)})
                 payload += b"" if image is None else image.tobytes()
         send(out, result, payload)
