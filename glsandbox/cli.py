@@ -518,6 +518,7 @@ COMMANDS: dict[str, tuple[str, tuple[str, ...]]] = {
               ("glsandbox check my_lesson.py --golden expected.png",
                "glsandbox check submissions/ --golden expected.png --csv marks.csv",
                "glsandbox check submissions/ --rubric shading.grading.toml --html marks.html",
+               "glsandbox check --one submission/ --rubric shading.grading.toml --student-report mine.html",
                "glsandbox check phong --golden phong.png --update")),
     "tradeoffs": ("time each accuracy knob and compare it with a reference (FLIP, RMSE): report.md, CSV and plot",
                   ("glsandbox tradeoffs --quick", "glsandbox tradeoffs --knob antialiasing --out out/aa")),
