@@ -1,0 +1,40 @@
+"""The exercises, one module each, in the course's order.
+
+A module defines ``EXERCISE``, an :class:`~glsandbox.exercises.base.Exercise`.
+To add one: write the module (``ray_sphere.py`` is the template: the
+reference wrapped from the engine, the notes' worked examples as visible
+cases, a generator of hard cases, the probe, at least three named mistakes),
+add its name to :data:`MODULES`, and its tests follow from
+``tests/exercises/`` (every exercise is checked by the same tests).
+"""
+
+from __future__ import annotations
+
+import importlib
+
+from glsandbox.errors import SandboxError
+from glsandbox.exercises.base import Exercise
+
+__all__ = ["MODULES", "all_exercises", "get"]
+
+#: Every exercise's module, in the order of the course's sections.
+MODULES: tuple[str, ...] = (
+    "ray_sphere",
+)
+
+_LOADED: dict[str, Exercise] = {}
+
+
+def all_exercises() -> list[Exercise]:
+    """Every exercise, in the course's order."""
+    return [get(name) for name in MODULES]
+
+
+def get(name: str) -> Exercise:
+    """The exercise ``name``; a :class:`SandboxError` naming the known ones when there is none."""
+    if name not in MODULES:
+        known = ", ".join(MODULES)
+        raise SandboxError(f"no exercise {name!r}; the exercises are: {known} (glsandbox exercise list)")
+    if name not in _LOADED:
+        _LOADED[name] = importlib.import_module(f"glsandbox.exercises.catalogue.{name}").EXERCISE
+    return _LOADED[name]
