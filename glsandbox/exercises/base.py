@@ -77,13 +77,16 @@ class Probe:
     all of them at once (vectorized: the picture must not cost seconds);
     ``shade(value)`` maps an answer to a brightness in ``[0, 1]`` for the
     pixels where both agree (``None`` and ``False`` are the dark background).
-    ``what`` says in words what the field is.
+    ``what`` says in words what the field is. ``resolution``, when given, is
+    the field's side for a function too slow to ask 65,536 times (each of
+    its inputs then covers a square of pixels of the picture).
     """
 
     what: str
     inputs: Callable[[int], list[tuple[Any, ...]]]
     reference_many: Callable[[list[tuple[Any, ...]]], list[Any]] | None = None
     shade: Callable[[Any], float] | None = None
+    resolution: int | None = None
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import ast
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -178,23 +178,36 @@ def _same(a: Any, b: Any, returns: str) -> bool:
     return matches(x, y, 1e-6, 1e-9)
 
 
-def match_mistakes(exercise: Exercise, evidence: list[tuple[tuple[Any, ...], Any]]) -> list[Mistake]:
-    """The named mistakes whose answers are the student's where the student is wrong.
+@dataclass(frozen=True)
+class Evidence:
+    """One input the student answered: the arguments, the answer, whether it is wrong, and how
+    to tell a right answer there (the case's judgement, or the probe reference's value)."""
 
-    ``evidence`` lists (arguments, the student's wrong answer). The mistake
-    giving the same wrong answer on the largest share of them is named when
-    that share is at least :data:`HINT_SHARE`, or at least half of them (a
-    student who made two mistakes); then the same again on what it leaves
-    unexplained, so two mistakes made together are both named."""
+    args: tuple[Any, ...]
+    answer: Any
+    wrong: bool
+    right: Callable[[Any], bool]
+
+
+def match_mistakes(exercise: Exercise, evidence: list[Evidence]) -> list[Mistake]:
+    """The named mistakes that answer as the student does where either of them is wrong.
+
+    For each mistake, over the inputs where the student or the mistake is wrong, the share
+    where the student gives the mistake's own answer (a mistake that is wrong where the
+    student is right loses). The best is named when that share is at least half, then the
+    same again on the student's wrong answers it leaves unexplained, so two mistakes made
+    together are both named; a second one needs :data:`HINT_SHARE`."""
     named: list[Mistake] = []
     left = list(evidence)
-    while left and len(named) < 2:
+    while any(e.wrong for e in left) and len(named) < 2:
         best, best_same, best_share = None, [], 0.0
         for mistake in exercise.mistakes:
             if mistake in named:
                 continue
-            same = [_same(_mistake_answer(mistake, args), got, exercise.returns) for args, got in left]
-            share = sum(same) / len(left)
+            answers = [_mistake_answer(mistake, e.args) for e in left]
+            same = [e.wrong and _same(a, e.answer, exercise.returns) for a, e in zip(answers, left, strict=True)]
+            union = sum(e.wrong or not e.right(a) for a, e in zip(answers, left, strict=True))
+            share = sum(same) / union if union else 0.0
             if share > best_share:
                 best, best_same, best_share = mistake, same, share
         if best is None or best_share < (HINT_SHARE if named else 0.5):
@@ -210,20 +223,22 @@ def check(exercise: Exercise, caller: Isolated | InProcess, *, hidden: bool = Fa
     judge them; draw the probe picture (``probe``) and, where the exercise has one and
     ``lesson`` is asked, the lesson rendered with the student's function."""
     results: list[CaseResult] = []
-    evidence: list[tuple[tuple[Any, ...], Any]] = []
+    evidence: list[Evidence] = []
     for case in exercise.cases(hidden):
         answer = caller.call(case.args)
         status, note = _outcome(case, answer, exercise)
         got = describe(answer.value) if answer.status == VALUE else _GOT[answer.status]
         results.append(CaseResult(case.name, case.group, _call_text(exercise, case.args), describe(case.expected),
                                   got, status, note))
-        if status == FAIL and not note:
-            evidence.append((case.args, answer.value))
+        if status in (PASS, FAIL) and not note:
+            evidence.append(Evidence(case.args, answer.value, status == FAIL,
+                                     lambda value, case=case: judge(case, value, exercise.returns)[0]))
     result = CheckResult(exercise.name, exercise.function, exercise.signature, results,
                          load_error=caller.load_error)
     if probe and not caller.load_error:
         result.probe = probe_picture(exercise, caller, probe_size)
-        evidence += result.probe.wrong_sample(HINT_STRIDE)
+        evidence += [Evidence(args, answer, wrong, lambda value, ref=ref: _same(value, ref, exercise.returns))
+                     for args, answer, ref, wrong in result.probe.sample(HINT_STRIDE)]
     for mistake in match_mistakes(exercise, evidence):
         result.mistakes.append(mistake.name)
         result.hints.append(mistake.hint)

@@ -342,7 +342,7 @@ class Isolated:
     def batch(self, inputs: Sequence[Sequence[Any]]) -> tuple[list[Any], dict[int, str]] | Answer:
         """Many calls at once (a probe picture's field): the values, and the errors by index;
         an :class:`Answer` when the whole batch failed (timed out, crashed)."""
-        message = self._request({"batch": [list(a) for a in inputs]}, self.limits.batch_seconds)
+        message = self._request(_batch_request(inputs), self.limits.batch_seconds)
         if isinstance(message, Answer):
             return message
         values = message.get("values")
@@ -355,6 +355,15 @@ class Isolated:
             return Answer(CRASHED, error="the function's process sent a batch of the wrong length")
         errors = {int(k): str(v) for k, v in (message.get("errors") or {}).items()}
         return values, errors
+
+
+def _batch_request(inputs: Sequence[Sequence[Any]]) -> dict:
+    """A batch as sent: the arguments every input shares (the same object in each: a probe's
+    scene) once, under ``shared``, and only the others per input."""
+    first = inputs[0] if inputs else ()
+    shared = {k for k in range(len(first)) if all(len(a) == len(first) and a[k] is first[k] for a in inputs)}
+    return {"batch": [[a[k] for k in range(len(a)) if k not in shared] for a in inputs],
+            "shared": {str(k): first[k] for k in sorted(shared)}, "arity": len(first)}
 
 
 class InProcess:

@@ -9,9 +9,9 @@ colour                    meaning
 ========================  ==========================================================
 dark                      both say "nothing" (``None``, ``False``)
 grey (shaded)             both give the same answer (the shade shows the value)
+amber (shaded)            both answer, with different values (shaded by the student's)
 red                       the student's function answers, the reference says nothing
 blue                      the reference answers, the student's function says nothing
-amber                     both answer, with different values
 magenta                   the student's function raised, or gave NaN or the wrong type
 ========================  ==========================================================
 
@@ -21,7 +21,7 @@ own pattern of colours (the tests check that no two are alike).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -30,7 +30,7 @@ from glsandbox.exercises import runner
 from glsandbox.exercises.base import Exercise
 from glsandbox.exercises.compare import WrongType, matches, normalize
 
-__all__ = ["CLASSES", "COLOURS", "ProbeResult", "classify", "probe_picture", "reference_values"]
+__all__ = ["CLASSES", "COLOURS", "ProbeResult", "classify", "picture", "probe_picture", "reference_values"]
 
 #: The classes of a probe pixel, in the order of :data:`COLOURS`.
 CLASSES = ("both none", "agree", "student only", "reference only", "value differs", "broken")
@@ -49,6 +49,7 @@ class ProbeResult:
     classes: np.ndarray | None
     inputs: list[tuple[Any, ...]]
     student: list[Any]
+    reference: list[Any] = field(default_factory=list)
     error: str = ""
 
     def counts(self) -> dict[str, int]:
@@ -76,16 +77,19 @@ class ProbeResult:
         text = ", ".join(f"{100.0 * n / total:.1f}% {name}" for name, n in shown)
         return f"{total:,} inputs ({self.what}): {text}"
 
-    def wrong_sample(self, stride: int) -> list[tuple[tuple[Any, ...], Any]]:
-        """(inputs, answer) of a sample of the wrong pixels: evidence for matching a mistake."""
+    def sample(self, stride: int) -> list[tuple[tuple[Any, ...], Any, Any, bool]]:
+        """(inputs, the student's answer, the reference's, whether the student's is wrong) of
+        every ``stride``-th input each way, but none the student's function raised on: the
+        evidence for matching a named mistake."""
         if self.classes is None:
             return []
         n = self.classes.shape[0]
         out = []
         for y in range(0, n, stride):
             for x in range(0, n, stride):
-                if self.classes[y, x] in (2, 3, 4):
-                    out.append((self.inputs[y * n + x], self.student[y * n + x]))
+                i = y * n + x
+                if self.classes[y, x] != 5:
+                    out.append((self.inputs[i], self.student[i], self.reference[i], self.classes[y, x] >= 2))
         return out
 
 
@@ -122,28 +126,49 @@ def classify(exercise: Exercise, reference: list[Any], student: list[Any], error
     return out
 
 
-def _draw(exercise: Exercise, classes: np.ndarray, reference: list[Any], n: int) -> np.ndarray:
-    colours = COLOURS[classes].reshape(n, n, 3).copy()
-    shade = exercise.probe.shade or (lambda value: 0.75)
-    agree = np.flatnonzero(classes == 1)
-    grey = np.array([80 + 160 * min(1.0, max(0.0, float(shade(normalize(reference[i], exercise.returns)))))
-                     for i in agree], dtype=np.float64)
-    flat = colours.reshape(-1, 3)
-    flat[agree] = np.round(grey)[:, None].astype(np.uint8)
-    rgba = np.empty((n, n, 4), dtype=np.uint8)
-    rgba[..., :3] = colours
-    rgba[..., 3] = 255
-    return rgba
+def _brightness(exercise: Exercise, value: Any) -> float:
+    shade = exercise.probe.shade
+    if shade is None:
+        return 0.75
+    try:
+        level = float(shade(normalize(value, exercise.returns)))
+    except (WrongType, TypeError, ValueError, ZeroDivisionError):
+        return 0.75
+    return min(1.0, max(0.0, level)) if level == level else 0.75
+
+
+def _draw(exercise: Exercise, classes: np.ndarray, reference: list[Any], student: list[Any], n: int) -> np.ndarray:
+    """The picture: each class's colour; where both agree, grey shaded by the value; where the
+    values differ, amber shaded by the student's value (so two wrong versions that differ
+    everywhere still draw different pictures)."""
+    flat = COLOURS[classes].astype(np.float64)
+    for i in np.flatnonzero(classes == 1):
+        flat[i] = 80.0 + 160.0 * _brightness(exercise, reference[i])
+    for i in np.flatnonzero(classes == 4):
+        flat[i] = COLOURS[4] * (0.45 + 0.55 * _brightness(exercise, student[i]))
+    rgba = np.full((n * n, 4), 255, dtype=np.uint8)
+    rgba[:, :3] = np.round(flat).astype(np.uint8)
+    return rgba.reshape(n, n, 4)
 
 
 def probe_picture(exercise: Exercise, caller: Any, n: int = 256) -> ProbeResult:
-    """The probe of ``caller``'s function (``Isolated`` or ``InProcess``) against the reference."""
-    inputs = exercise.probe.inputs(n)
+    """The probe of ``caller``'s function (``Isolated`` or ``InProcess``) against the reference,
+    drawn ``n x n`` (from a coarser field where the exercise's probe has a ``resolution``)."""
+    m = min(n, exercise.probe.resolution or n)
+    inputs = exercise.probe.inputs(m)
     batch = caller.batch(inputs)
     if not isinstance(batch, tuple):
-        return ProbeResult(exercise.probe.what, None, None, inputs, [], batch.error)
+        return ProbeResult(exercise.probe.what, None, None, inputs, [], error=batch.error)
     student, errors = batch
     reference = reference_values(exercise, inputs)
+    classes, image = picture(exercise, reference, student, errors, m)
+    if m < n:
+        image = np.repeat(np.repeat(image, -(-n // m), axis=0), -(-n // m), axis=1)[:n, :n]
+    return ProbeResult(exercise.probe.what, image, classes, inputs, student, reference)
+
+
+def picture(exercise: Exercise, reference: list[Any], student: list[Any], errors: dict[int, str],
+            n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The classes (``n x n``) and the RGBA picture of ``student``'s answers against ``reference``'s."""
     classes = classify(exercise, reference, student, errors)
-    return ProbeResult(exercise.probe.what, _draw(exercise, classes, reference, n), classes.reshape(n, n), inputs,
-                       student)
+    return classes.reshape(n, n), _draw(exercise, classes, reference, student, n)

@@ -11,7 +11,8 @@ glsandbox's files. This script adds a Python audit hook with the same file
 rules (for systems without Landlock), then loads the submission.
 
 Protocol, JSON lines: requests on file descriptor ``requests`` (``{"id": i,
-"args": [...]}`` or ``{"id": i, "batch": [[...], ...]}``), answers on
+"args": [...]}`` or ``{"id": i, "batch": [[...], ...], "shared": {position: value},
+"arity": n}``, a batch's arguments common to every call sent once), answers on
 descriptor ``answers`` (``{"id": i, "value": v}``, ``{"id": i, "error": "..."}``,
 ``{"id": i, "values": [...], "errors": {...}}``). The answers never hold
 anything but what the student's function returned.
@@ -187,7 +188,14 @@ def main():
         request = json.loads(line)
         if "batch" in request:
             values, errors, stopped = [], {}, None
-            for i, args in enumerate(request["batch"]):
+            shared = {int(k): v for k, v in request.get("shared", {}).items()}
+            arity = int(request.get("arity", 0))
+            for i, varying in enumerate(request["batch"]):
+                if shared:  # the arguments every input shares, put back in their places
+                    rest = iter(varying)
+                    args = [shared[k] if k in shared else next(rest) for k in range(arity)]
+                else:
+                    args = varying
                 result = _call(function, args, limit)
                 values.append(result.get("value"))
                 if "error" in result:

@@ -19,7 +19,17 @@ __all__ = ["MODULES", "all_exercises", "get"]
 
 #: Every exercise's module, in the order of the course's sections.
 MODULES: tuple[str, ...] = (
+    "image_plane",
+    "triangle_normal",
+    "ray_plane",
+    "ray_triangle",
     "ray_sphere",
+    "reflect",
+    "phong",
+    "shadow",
+    "backface",
+    "aabb",
+    "camera_turn",
 )
 
 _LOADED: dict[str, Exercise] = {}
