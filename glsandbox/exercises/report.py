@@ -54,8 +54,10 @@ def text(result: CheckResult, *, hidden_shown: bool = True) -> str:
         lines.append(f"  hint: {hint}")
     if result.probe is not None:
         lines.append(f"  probe: {result.probe.summary()}")
+    if result.lesson is not None:
+        lines.append(f"  lesson: {result.lesson.summary()}")
     for name, path in result.pictures.items():
-        lines.append(f"  {name}: {path}")
+        lines.append(f"  {name} picture: {path}")
     verdict = "every visible case passes" if result.visible_passed else "not every visible case passes yet"
     lines.append(f"  {verdict}")
     return "\n".join(lines)
