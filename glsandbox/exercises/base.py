@@ -80,6 +80,14 @@ class Probe:
     ``what`` says in words what the field is. ``resolution``, when given, is
     the field's side for a function too slow to ask 65,536 times (each of
     its inputs then covers a square of pixels of the picture).
+
+    ``draw``, when given, makes a picture of another kind: ``inputs(n)`` are
+    then a few argument tuples, and ``draw(reference, student, errors, n)``
+    returns each of the ``n x n`` pixels' class (an index into
+    :data:`glsandbox.exercises.probe.CLASSES`) and a shade in ``[0, 1]``,
+    drawn from all the answers at once (a matrix's picture is the unit cube's
+    image under it, not one pixel per input). Each input is then one piece
+    of evidence for naming a mistake.
     """
 
     what: str
@@ -87,6 +95,7 @@ class Probe:
     reference_many: Callable[[list[tuple[Any, ...]]], list[Any]] | None = None
     shade: Callable[[Any], float] | None = None
     resolution: int | None = None
+    draw: Callable[[list[Any], list[Any], dict[int, str], int], tuple[Any, Any]] | None = None
 
 
 @dataclass(frozen=True)

@@ -51,6 +51,8 @@ class ProbeResult:
     student: list[Any]
     reference: list[Any] = field(default_factory=list)
     error: str = ""
+    #: For a drawn probe (``Probe.draw``): each input's own class, the evidence of :meth:`sample`.
+    input_classes: np.ndarray | None = None
 
     def counts(self) -> dict[str, int]:
         if self.classes is None:
@@ -83,6 +85,9 @@ class ProbeResult:
         evidence for matching a named mistake."""
         if self.classes is None:
             return []
+        if self.input_classes is not None:
+            return [(args, s, r, bool(c >= 2)) for args, s, r, c in
+                    zip(self.inputs, self.student, self.reference, self.input_classes, strict=True) if c != 5]
         n = self.classes.shape[0]
         out = []
         for y in range(0, n, stride):
@@ -151,10 +156,22 @@ def _draw(exercise: Exercise, classes: np.ndarray, reference: list[Any], student
     return rgba.reshape(n, n, 4)
 
 
+def _shaded(classes: np.ndarray, shade: np.ndarray) -> np.ndarray:
+    """A drawn probe's picture: each class's colour, agreeing pixels grey and differing ones
+    amber, both shaded by ``shade``."""
+    flat = COLOURS[classes].astype(np.float64)
+    level = np.clip(np.nan_to_num(shade, nan=0.75), 0.0, 1.0)[..., None]
+    flat = np.where((classes == 1)[..., None], 80.0 + 160.0 * level, flat)
+    flat = np.where((classes == 4)[..., None], COLOURS[4] * (0.45 + 0.55 * level), flat)
+    rgba = np.full((*classes.shape, 4), 255, dtype=np.uint8)
+    rgba[..., :3] = np.round(flat).astype(np.uint8)
+    return rgba
+
+
 def probe_picture(exercise: Exercise, caller: Any, n: int = 256) -> ProbeResult:
     """The probe of ``caller``'s function (``Isolated`` or ``InProcess``) against the reference,
     drawn ``n x n`` (from a coarser field where the exercise's probe has a ``resolution``)."""
-    m = min(n, exercise.probe.resolution or n)
+    m = n if exercise.probe.draw is not None else min(n, exercise.probe.resolution or n)
     inputs = exercise.probe.inputs(m)
     batch = caller.batch(inputs)
     if not isinstance(batch, tuple):
@@ -164,11 +181,15 @@ def probe_picture(exercise: Exercise, caller: Any, n: int = 256) -> ProbeResult:
     classes, image = picture(exercise, reference, student, errors, m)
     if m < n:
         image = np.repeat(np.repeat(image, -(-n // m), axis=0), -(-n // m), axis=1)[:n, :n]
-    return ProbeResult(exercise.probe.what, image, classes, inputs, student, reference)
+    own = classify(exercise, reference, student, errors) if exercise.probe.draw is not None else None
+    return ProbeResult(exercise.probe.what, image, classes, inputs, student, reference, input_classes=own)
 
 
 def picture(exercise: Exercise, reference: list[Any], student: list[Any], errors: dict[int, str],
             n: int) -> tuple[np.ndarray, np.ndarray]:
     """The classes (``n x n``) and the RGBA picture of ``student``'s answers against ``reference``'s."""
+    if exercise.probe.draw is not None:
+        drawn, shade = exercise.probe.draw(reference, student, errors, n)
+        return drawn, _shaded(np.asarray(drawn, dtype=np.uint8), np.asarray(shade, dtype=np.float64))
     classes = classify(exercise, reference, student, errors)
     return classes.reshape(n, n), _draw(exercise, classes, reference, student, n)

@@ -30,6 +30,7 @@ MODULES: tuple[str, ...] = (
     "backface",
     "aabb",
     "camera_turn",
+    "world_matrix",
 )
 
 _LOADED: dict[str, Exercise] = {}
