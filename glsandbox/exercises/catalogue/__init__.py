@@ -31,6 +31,7 @@ MODULES: tuple[str, ...] = (
     "aabb",
     "camera_turn",
     "world_matrix",
+    "look_at",
 )
 
 _LOADED: dict[str, Exercise] = {}
