@@ -32,6 +32,7 @@ MODULES: tuple[str, ...] = (
     "camera_turn",
     "world_matrix",
     "look_at",
+    "perspective",
 )
 
 _LOADED: dict[str, Exercise] = {}
