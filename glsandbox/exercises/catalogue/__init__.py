@@ -33,6 +33,7 @@ MODULES: tuple[str, ...] = (
     "world_matrix",
     "look_at",
     "perspective",
+    "reflect_matrix",
 )
 
 _LOADED: dict[str, Exercise] = {}
