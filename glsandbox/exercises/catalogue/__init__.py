@@ -34,6 +34,7 @@ MODULES: tuple[str, ...] = (
     "look_at",
     "perspective",
     "reflect_matrix",
+    "shadow_matrix",
 )
 
 _LOADED: dict[str, Exercise] = {}
