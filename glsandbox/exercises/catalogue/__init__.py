@@ -33,6 +33,7 @@ MODULES: tuple[str, ...] = (
     "world_matrix",
     "look_at",
     "perspective",
+    "normal_matrix",
     "reflect_matrix",
     "shadow_matrix",
 )
