@@ -22,8 +22,9 @@ __all__ = ["RESULT_KINDS", "Case", "Exercise", "LessonView", "Mistake", "Probe"]
 
 #: What an exercise's function may return:
 #: ``t`` a distance ``t > 0`` or ``None``; ``number`` a float; ``bool``; ``vec3`` three numbers;
-#: ``vec3_or_none`` three numbers or ``None``; ``matrix4`` a 4x4 matrix.
-RESULT_KINDS = ("t", "number", "bool", "vec3", "vec3_or_none", "matrix4")
+#: ``vec3_or_none`` three numbers or ``None``; ``matrix4`` a 4x4 matrix; ``indices`` an index
+#: buffer (whole numbers >= 0, three per triangle).
+RESULT_KINDS = ("t", "number", "bool", "vec3", "vec3_or_none", "matrix4", "indices")
 
 
 @dataclass(frozen=True)
@@ -37,7 +38,9 @@ class Case:
     of a decision (a ray exactly on an edge, a tangent ray), either side is
     right, and ``margin`` says why. ``group`` is ``"visible"`` (the notes'
     worked examples, shown) or a hidden group's name (graded only when the
-    teacher runs the hidden cases).
+    teacher runs the hidden cases). An ``expected`` with an ``accepts(value)``
+    method judges the answer itself (an index buffer is right in more than
+    one triangulation).
     """
 
     name: str
@@ -87,7 +90,8 @@ class Probe:
     :data:`glsandbox.exercises.probe.CLASSES`) and a shade in ``[0, 1]``,
     drawn from all the answers at once (a matrix's picture is the unit cube's
     image under it, not one pixel per input). Each input is then one piece
-    of evidence for naming a mistake.
+    of evidence for naming a mistake: ``draw`` returns, third, each input's
+    class (1 agree, 4 differ, 5 broken).
     """
 
     what: str
@@ -95,7 +99,7 @@ class Probe:
     reference_many: Callable[[list[tuple[Any, ...]]], list[Any]] | None = None
     shade: Callable[[Any], float] | None = None
     resolution: int | None = None
-    draw: Callable[[list[Any], list[Any], dict[int, str], int], tuple[Any, Any]] | None = None
+    draw: Callable[[list[Any], list[Any], dict[int, str], int], tuple[Any, Any, Any]] | None = None
 
 
 @dataclass(frozen=True)

@@ -69,7 +69,26 @@ def normalize(value: Any, returns: str) -> Any:
         if not isinstance(value, list) or len(value) != 4:
             raise WrongType(f"returned {_what(value)}, expected a 4x4 matrix (four rows of four)")
         return tuple(_vector(row, 4, "a 4x4 matrix (four rows of four)") for row in value)
+    if returns == "indices":
+        return _indices(value)
     raise ValueError(f"unknown result kind {returns!r}")
+
+
+def _indices(value: Any) -> tuple[tuple[int, int, int], ...]:
+    """An index buffer as its triangles, each turned to start at its smallest index (the same
+    triangle, the same winding) and sorted: two buffers listing the same triangles agree."""
+    kind = "a list of whole numbers >= 0, three per triangle"
+    if not isinstance(value, list) or len(value) % 3:
+        raise WrongType(f"returned {_what(value)}, expected {kind}")
+    for v in value:
+        if isinstance(v, bool) or not isinstance(v, int) or v < 0:
+            raise WrongType(f"returned an index {_what(v)}, expected {kind}")
+    triangles = []
+    for i in range(0, len(value), 3):
+        a, b, c = value[i:i + 3]
+        first = min(range(3), key=lambda k: (a, b, c)[k])
+        triangles.append(((a, b, c) * 2)[first:first + 3])
+    return tuple(sorted(triangles))
 
 
 def _flat(value: Any) -> list[float]:
@@ -79,7 +98,10 @@ def _flat(value: Any) -> list[float]:
 
 
 def matches(got: Any, expected: Any, rel: float, abs_: float) -> bool:
-    """Whether two normalized values agree within ``abs_ + rel·|expected|``."""
+    """Whether two normalized values agree within ``abs_ + rel·|expected|`` (or, for an expected
+    value that judges answers itself, whether it ``accepts`` ``got``)."""
+    if hasattr(expected, "accepts"):
+        return bool(expected.accepts(got))
     if expected is None or got is None or isinstance(expected, bool) or isinstance(got, bool):
         return got == expected and type(got) is type(expected)
     g, e = _flat(got), _flat(expected)

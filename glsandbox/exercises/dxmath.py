@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from glsandbox.exercises.compare import WrongType, normalize
+from glsandbox.exercises.compare import WrongType, matches, normalize
 
 __all__ = ["look_at_lh", "perspective_fov_lh", "row", "CUBE_POINTS", "CUBE_EDGES", "camera", "edge_probe",
            "cube_segments"]
@@ -108,10 +108,13 @@ def edge_probe(segments: Callable[[np.ndarray, int], np.ndarray]) -> Callable[..
     student's: an edge of both is grey, the student's only red, the reference's only blue; a
     tile whose answer is no 4x4 matrix (or raised) is magenta."""
 
+    from glsandbox.exercises.probe import PROBE_ABS, PROBE_REL
+
     def draw(reference: list[Any], student: list[Any], errors: dict[int, str], n: int):  # noqa: ANN202
         k = max(1, math.ceil(math.sqrt(len(reference))))
         size = n // k
         classes = np.zeros((n, n), dtype=np.uint8)
+        own = np.full(len(reference), 5, dtype=np.uint8)
         for i, (r, s) in enumerate(zip(reference, student, strict=True)):
             y0, x0 = (i // k) * size, (i % k) * size
             tile = classes[y0:y0 + size, x0:x0 + size]
@@ -119,12 +122,13 @@ def edge_probe(segments: Callable[[np.ndarray, int], np.ndarray]) -> Callable[..
             if i in errors or got is None or ref is None:
                 tile[:] = 5
                 continue
+            own[i] = 1 if matches(tuple(map(tuple, got)), tuple(map(tuple, ref)), PROBE_REL, PROBE_ABS) else 4
             a = _mask(segments(ref, i), size)
             with np.errstate(all="ignore"):
                 b = _mask(segments(got, i), size)
             tile[a & b] = 1
             tile[b & ~a] = 2
             tile[a & ~b] = 3
-        return classes, np.full((n, n), 0.8)
+        return classes, np.full((n, n), 0.8), own
 
     return draw

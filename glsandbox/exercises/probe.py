@@ -171,25 +171,30 @@ def _shaded(classes: np.ndarray, shade: np.ndarray) -> np.ndarray:
 def probe_picture(exercise: Exercise, caller: Any, n: int = 256) -> ProbeResult:
     """The probe of ``caller``'s function (``Isolated`` or ``InProcess``) against the reference,
     drawn ``n x n`` (from a coarser field where the exercise's probe has a ``resolution``)."""
-    m = n if exercise.probe.draw is not None else min(n, exercise.probe.resolution or n)
+    draw = exercise.probe.draw
+    m = n if draw is not None else min(n, exercise.probe.resolution or n)
     inputs = exercise.probe.inputs(m)
     batch = caller.batch(inputs)
     if not isinstance(batch, tuple):
         return ProbeResult(exercise.probe.what, None, None, inputs, [], error=batch.error)
     student, errors = batch
     reference = reference_values(exercise, inputs)
+    if draw is not None:
+        classes, shade, own = draw(reference, student, errors, n)
+        classes = np.asarray(classes, dtype=np.uint8)
+        return ProbeResult(exercise.probe.what, _shaded(classes, np.asarray(shade, dtype=np.float64)), classes,
+                           inputs, student, reference, input_classes=np.asarray(own, dtype=np.uint8))
     classes, image = picture(exercise, reference, student, errors, m)
     if m < n:
         image = np.repeat(np.repeat(image, -(-n // m), axis=0), -(-n // m), axis=1)[:n, :n]
-    own = classify(exercise, reference, student, errors) if exercise.probe.draw is not None else None
-    return ProbeResult(exercise.probe.what, image, classes, inputs, student, reference, input_classes=own)
+    return ProbeResult(exercise.probe.what, image, classes, inputs, student, reference)
 
 
 def picture(exercise: Exercise, reference: list[Any], student: list[Any], errors: dict[int, str],
             n: int) -> tuple[np.ndarray, np.ndarray]:
     """The classes (``n x n``) and the RGBA picture of ``student``'s answers against ``reference``'s."""
     if exercise.probe.draw is not None:
-        drawn, shade = exercise.probe.draw(reference, student, errors, n)
+        drawn, shade, _ = exercise.probe.draw(reference, student, errors, n)
         return drawn, _shaded(np.asarray(drawn, dtype=np.uint8), np.asarray(shade, dtype=np.float64))
     classes = classify(exercise, reference, student, errors)
     return classes.reshape(n, n), _draw(exercise, classes, reference, student, n)

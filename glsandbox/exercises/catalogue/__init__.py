@@ -30,6 +30,7 @@ MODULES: tuple[str, ...] = (
     "backface",
     "aabb",
     "camera_turn",
+    "cube_indices",
     "world_matrix",
     "look_at",
     "perspective",
