@@ -77,6 +77,8 @@ class ProbeResult:
         shown = [("agree", counts["both none"] + counts["agree"])]
         shown += [(name, counts[name]) for name in CLASSES[2:] if counts[name]]
         text = ", ".join(f"{100.0 * n / total:.1f}% {name}" for name, n in shown)
+        if self.input_classes is not None:
+            return f"{len(self.inputs)} inputs drawn over {total:,} pixels ({self.what}): {text}"
         return f"{total:,} inputs ({self.what}): {text}"
 
     def sample(self, stride: int) -> list[tuple[tuple[Any, ...], Any, Any, bool]]:
