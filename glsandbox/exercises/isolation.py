@@ -176,6 +176,11 @@ def _restrict(reads: list[str], writes: list[str], limits: Limits) -> Callable[[
     return setup
 
 
+def _broken(message: dict) -> bool:
+    """Whether an answers-pipe reading is the pipe's end or garbage rather than an answer."""
+    return bool(message.get("closed") or message.get("garbled"))
+
+
 class Isolated:
     """The function ``function`` of the file ``path``, called in its own confined process.
 
@@ -238,6 +243,7 @@ class Isolated:
         self.buffer = b""
         message = self._read(self.limits.start_seconds)
         if message is None or "ready" not in message:
+            message = None if message is None or _broken(message) else message
             reason = (message or {}).get("load_error") or self._ending()
             self._stop()
             self.load_error = str(reason) or "the submission did not start"
@@ -287,7 +293,7 @@ class Isolated:
                 return None
             chunk = os.read(self.answers, 1 << 20)
             if not chunk:
-                return None
+                return {"closed": True}
             self.buffer += chunk
             if len(self.buffer) > 256 << 20:
                 return None
@@ -314,18 +320,17 @@ class Isolated:
         except OSError:
             pass
         message = self._read(seconds)
-        while message is not None and message.get("id") != self.next_id and not message.get("garbled"):
+        while message is not None and message.get("id") != self.next_id and not _broken(message):
             message = self._read(seconds)  # something the function wrote itself on the answers pipe
-        if message is not None and not message.get("garbled"):
+        if message is not None and not _broken(message):
             return message
-        alive = self.process is not None and self.process.poll() is None
-        reason = "" if alive else self._ending()
+        reason = self._ending() if message is not None and message.get("closed") else ""
         self._stop()
         self.endings += 1
-        if message is not None:
-            return Answer(CRASHED, error="the function's process sent something that is not an answer")
-        if alive:
+        if message is None:
             return Answer(TIMEOUT, error=f"no answer within {seconds:g} s (an endless loop, or a sleep?)")
+        if message.get("garbled"):
+            return Answer(CRASHED, error="the function's process sent something that is not an answer")
         return Answer(CRASHED, error=reason)
 
     # --- calls -------------------------------------------------------------------------
@@ -360,10 +365,15 @@ class Isolated:
 def _batch_request(inputs: Sequence[Sequence[Any]]) -> dict:
     """A batch as sent: the arguments every input shares (the same object in each: a probe's
     scene) once, under ``shared``, and only the others per input."""
-    first = inputs[0] if inputs else ()
-    shared = {k for k in range(len(first)) if all(len(a) == len(first) and a[k] is first[k] for a in inputs)}
-    return {"batch": [[a[k] for k in range(len(a)) if k not in shared] for a in inputs],
-            "shared": {str(k): first[k] for k in sorted(shared)}, "arity": len(first)}
+    if not inputs:
+        return {"batch": [], "shared": {}, "arity": 0}
+    columns = list(zip(*inputs, strict=True))
+    # list.count compares by identity first: a column of one shared object counts in C
+    shared = [k for k, column in enumerate(columns) if column.count(column[0]) == len(column)
+              and all(column[i] is column[0] for i in (0, len(column) // 2, -1))]
+    varying = [column for k, column in enumerate(columns) if k not in shared]
+    return {"batch": list(zip(*varying, strict=True)) if varying else [[] for _ in inputs],
+            "shared": {str(k): columns[k][0] for k in shared}, "arity": len(columns)}
 
 
 class InProcess:

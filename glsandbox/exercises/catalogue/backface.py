@@ -119,6 +119,6 @@ EXERCISE = Exercise(
     doc=DOC, example="is_backface((30, -40, 60), (60, -120, 0), (0, -120, 0), (0, 0, 1)) is False",
     returns="bool", reference=reference, visible=VISIBLE, hidden=hidden,
     probe=Probe("the notes' triangle turned about y by -180°..180° (across), seen along (v, 0, 1) (down)",
-                _probe_inputs, resolution=128),
+                _probe_inputs, resolution=64),
     mistakes=MISTAKES, order=90,
 )

@@ -125,6 +125,6 @@ EXERCISE = Exercise(
     doc=DOC, example="list(phong((0, 0, 1), (0, 0.6, 0.8), (0, 0, 1), (255, 0, 0), 0, 1, 0, 32)) == [204, 0, 0]",
     returns="vec3", reference=reference, visible=VISIBLE, hidden=hidden,
     probe=Probe("a hemisphere of normals (seen from above) lit from the upper left, the eye to the right",
-                _probe_inputs, shade=lambda c: (c[0] + c[1] + c[2]) / 765.0, resolution=128),
+                _probe_inputs, shade=lambda c: (c[0] + c[1] + c[2]) / 765.0, resolution=64),
     mistakes=MISTAKES, order=70,
 )

@@ -45,19 +45,14 @@ def reference(origin, direction, center, radius):  # noqa: ANN001, ANN201 - the 
 
 
 def _reference_many(inputs: list[tuple]) -> list[float | None]:
+    """The engine's batch test (:meth:`Sphere.intersect_many`) over a field of one sphere."""
     from glsandbox.raytrace.sphere import Sphere
 
-    groups: dict[tuple, list[int]] = {}
-    for i, (_, _, center, radius) in enumerate(inputs):
-        groups.setdefault((tuple(center), float(radius)), []).append(i)
-    out: list[float | None] = [None] * len(inputs)
-    for (center, radius), rows in groups.items():
-        o = np.array([inputs[i][0] for i in rows], dtype=np.float64)
-        d = np.array([inputs[i][1] for i in rows], dtype=np.float64)
-        t = Sphere(center, radius).intersect_many(o, d)
-        for i, value in zip(rows, t.tolist(), strict=True):
-            out[i] = value if math.isfinite(value) else None
-    return out
+    origins, directions, centers, radii = zip(*inputs, strict=True)
+    if centers.count(centers[0]) != len(centers) or radii.count(radii[0]) != len(radii):
+        return [reference(*args) for args in inputs]
+    t = Sphere(centers[0], radii[0]).intersect_many(np.array(origins), np.array(directions))
+    return [value if math.isfinite(value) else None for value in t.tolist()]
 
 
 # --- the named mistakes: the course's test with one step wrong -----------------------------

@@ -162,7 +162,7 @@ def hidden() -> list[Case]:
 
 
 #: The probe's triangle: tilted (its plane is z = x/2), seen from its back along +z.
-PROBE_TRIANGLE = ((-1.5, -1.2, -0.75), (1.5, -1.2, 0.75), (0.0, 1.5, 0.0))
+PROBE_TRIANGLE = ((-1.5, -1.23, -0.75), (1.5, -1.23, 0.75), (0.13, 1.47, 0.065))
 
 
 def _probe_inputs(n: int) -> list[tuple]:

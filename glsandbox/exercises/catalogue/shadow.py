@@ -37,6 +37,22 @@ def reference(point, light, triangles):  # noqa: ANN001, ANN201 - the student's 
     return in_shadow(point, light, [Triangle(*t) for t in triangles])
 
 
+def _reference_many(inputs: list[tuple]) -> list[bool]:
+    """:func:`reference` over a field whose inputs share one list of triangles: its
+    :class:`Triangle` objects made once."""
+    from glsandbox.raytrace.trace import in_shadow
+    from glsandbox.raytrace.triangle import Triangle
+
+    made: dict[int, list] = {}
+    out = []
+    for point, light, triangles in inputs:
+        shapes = made.get(id(triangles))
+        if shapes is None:
+            shapes = made[id(triangles)] = [Triangle(*t) for t in triangles]
+        out.append(in_shadow(point, light, shapes))
+    return out
+
+
 def _sub(a, b):  # noqa: ANN001, ANN202
     return [x - y for x, y in zip(a, b, strict=True)]
 
@@ -164,6 +180,6 @@ EXERCISE = Exercise(
     doc=DOC, example="in_shadow((72, 21, 0), (100, 117, 0), [((85, 87, -10), (101, 99, -10), (93, 93, 20))]) is True",
     returns="bool", reference=reference, visible=VISIBLE, hidden=hidden,
     probe=Probe("points of a floor (seen from above) under a light at height 3: a triangle between (its "
-                "shadow), one above the light, one under the floor", _probe_inputs, resolution=64),
+                "shadow), one above the light, one under the floor", _probe_inputs, _reference_many, resolution=64),
     mistakes=MISTAKES, order=80,
 )
