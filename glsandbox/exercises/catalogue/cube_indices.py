@@ -94,9 +94,15 @@ class Covers:
             if len(triangles) != 2 or not all(front for _, front, _ in triangles):
                 return False
             a, b = triangles[0][2], triangles[1][2]
-            if a == b or len(a | b) != 4:
+            if a == b or len(a | b) != 4 or not self._diagonal(a & b):
                 return False
         return True
+
+    def _diagonal(self, pair: frozenset) -> bool:
+        """Whether two corners of a face are opposite (differ in both of the face's coordinates):
+        two triangles meeting there cover the face once; meeting along an edge, they overlap."""
+        p, q = (np.asarray(self.vertices[k]) for k in pair)
+        return int(np.sum(p != q)) == 2
 
     def __repr__(self) -> str:
         return "36 indices, each face twice, clockwise"
