@@ -102,7 +102,7 @@ def hidden() -> list[Case]:
 
 
 _PROBE_INPUTS = [(math.pi / 4, 1.0, 0.01, 100.0), (math.pi / 2, 2.0, 0.5, 50.0),
-                 (math.pi / 6, 0.5, 1.0, 20.0), (math.pi / 4, 1.0, 8.0, 12.0)]
+                 (math.pi / 6, 0.5, 1.0, 20.0), (math.pi / 4, 1.0, 9.2, 12.0)]
 _WORLD_VIEW = look_at_lh((2.0, 3.0, -9.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0))
 
 
@@ -119,7 +119,7 @@ EXERCISE = Exercise(
                      " == [1.81066, 0.0, 0.0, 0.0]",
     returns="matrix4", reference=reference, visible=VISIBLE, hidden=hidden,
     probe=Probe("the course's cube through a fixed View and Projection (π/4 square; π/2 wide; π/6 tall; "
-                "near 8 cutting the cube, depth clipped to 0..1)", lambda n: list(_PROBE_INPUTS),
+                "near 9.2 cutting the cube, depth clipped to 0..1)", lambda n: list(_PROBE_INPUTS),
                 draw=edge_probe(_segments)),
     mistakes=MISTAKES, convention=CONVENTION, order=140,
 )
