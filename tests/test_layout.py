@@ -24,13 +24,17 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
               "glsandbox.version")),
     ("scene data", ("glsandbox.scene", "glsandbox.planar", "glsandbox.images",
                     "glsandbox.overlay", "glsandbox.meshfile", "glsandbox.meshcheck")),
-    ("scene logic", ("glsandbox.scene_file", "glsandbox.shadowmap", "glsandbox.plan", "glsandbox.camera",
-                     "glsandbox.lesson")),
+    ("scene logic", ("glsandbox.scene_file", "glsandbox.shadowmap", "glsandbox.passes", "glsandbox.plan_variants",
+                     "glsandbox.plan_notes", "glsandbox.plan", "glsandbox.camera", "glsandbox.lesson")),
     ("renderers", ("glsandbox.gl", "glsandbox.raytrace")),
     ("one frame", ("glsandbox.frame",)),
     ("window and measuring", ("glsandbox.window", "glsandbox.panel", "glsandbox.controls", "glsandbox.notebook",
                               "glsandbox.notebook_view", "glsandbox.course_page", "glsandbox.measure",
-                              "glsandbox.exercises")),
+                              # an exercise's data, its catalogue and its pictures (the course page lists them)
+                              "glsandbox.exercises.base", "glsandbox.exercises.fields", "glsandbox.exercises.compare",
+                              "glsandbox.exercises.catalogue", "glsandbox.exercises.probe",
+                              "glsandbox.exercises.lesson_view", "glsandbox.exercises.runner")),
+    ("grading", ("glsandbox.grading", "glsandbox.exercises")),
     ("command line", ("glsandbox.cli", "glsandbox.pytest_plugin", "glsandbox.__main__")),
 ]
 

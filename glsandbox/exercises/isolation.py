@@ -12,7 +12,7 @@ that:
   glsandbox is not on its path;
 - cannot read glsandbox's files: on Linux the kernel enforces it (Landlock,
   set in the child before the interpreter starts, with the rule set of
-  :func:`glsandbox.measure.sandbox` which reads only the allowed folders and
+  :func:`glsandbox.grading.sandbox` which reads only the allowed folders and
   none of glsandbox's), and a Python audit hook refuses it too (where
   Landlock is missing), with writes outside the private folder, starting
   programs and signalling others.
@@ -45,7 +45,7 @@ from pathlib import Path
 from typing import Any
 
 from glsandbox.exercises import runner
-from glsandbox.measure.processes import kill_tree, killpg
+from glsandbox.grading.processes import kill_tree, killpg
 
 __all__ = ["Answer", "InProcess", "Isolated", "Limits", "VALUE", "ERROR", "TIMEOUT", "CRASHED"]
 
@@ -160,7 +160,7 @@ def _restrict(reads: list[str], writes: list[str], limits: Limits) -> Callable[[
     """What the child does after fork and before the interpreter starts."""
     import resource
 
-    from glsandbox.measure.sandbox import _landlock  # the grader's kernel rules, shared (one place)
+    from glsandbox.grading.sandbox import _landlock  # the grader's kernel rules, shared (one place)
 
     def setup() -> None:
         os.setsid()

@@ -101,7 +101,7 @@ def test_values_come_back_as_plain_data(hostile) -> None:
 
 
 def test_the_kernel_refuses_reading_the_reference_even_past_python(hostile) -> None:
-    from glsandbox.measure.sandbox import landlock_abi
+    from glsandbox.grading.sandbox import landlock_abi
 
     if landlock_abi() < 1:
         pytest.skip("no Landlock in this kernel: the audit hook alone refuses the read")

@@ -15,7 +15,7 @@ import importlib
 from glsandbox.errors import SandboxError
 from glsandbox.exercises.base import Exercise
 
-__all__ = ["MODULES", "all_exercises", "get"]
+__all__ = ["MODULES", "all_exercises", "get", "markdown_table"]
 
 #: Every exercise's module, in the order of the course's sections.
 MODULES: tuple[str, ...] = (
@@ -55,3 +55,14 @@ def get(name: str) -> Exercise:
     if name not in _LOADED:
         _LOADED[name] = importlib.import_module(f"glsandbox.exercises.catalogue.{name}").EXERCISE
     return _LOADED[name]
+
+
+def markdown_table() -> str:
+    """The catalogue as a Markdown table (the docs' and the README's, kept true by a test)."""
+    rows = ["| exercise | function | course section | cases (visible + hidden) | named mistakes |",
+            "|---|---|---|---|---|"]
+    for e in all_exercises():
+        mistakes = ", ".join(f"`{m.name}`" for m in e.mistakes)
+        rows.append(f"| `{e.name}` | `{e.signature}` | {e.section} | {len(e.visible)} + {len(e.hidden())} | "
+                    f"{mistakes} |")
+    return "\n".join(rows)

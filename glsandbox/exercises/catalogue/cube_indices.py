@@ -267,5 +267,5 @@ EXERCISE = Exercise(
     returns="indices", reference=reference, visible=VISIBLE, hidden=hidden,
     probe=Probe("the notes' cube (and its corners in another order) from four sides, each pixel its nearest "
                 "triangle's face and winding", lambda n: list(_PROBE_INPUTS), draw=_draw),
-    mistakes=MISTAKES, order=125, extra={"variants": {"the other diagonal": _variant_other_diagonal}},
+    mistakes=MISTAKES, order=115, extra={"variants": {"the other diagonal": _variant_other_diagonal}},
 )
