@@ -33,7 +33,8 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
                               # an exercise's data, its catalogue and its pictures (the course page lists them)
                               "glsandbox.exercises.base", "glsandbox.exercises.fields", "glsandbox.exercises.compare",
                               "glsandbox.exercises.catalogue", "glsandbox.exercises.probe",
-                              "glsandbox.exercises.lesson_view", "glsandbox.exercises.runner")),
+                              "glsandbox.exercises.lesson_view", "glsandbox.exercises.runner",
+                              "glsandbox.exercises.dxmath")),
     ("grading", ("glsandbox.grading", "glsandbox.exercises")),
     ("command line", ("glsandbox.cli", "glsandbox.pytest_plugin", "glsandbox.__main__")),
 ]
