@@ -32,6 +32,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
                               "glsandbox.notebook_view", "glsandbox.course_page", "glsandbox.measure",
                               # an exercise's data, its catalogue and its pictures (the course page lists them)
                               "glsandbox.exercises.base", "glsandbox.exercises.fields", "glsandbox.exercises.compare",
+                              "glsandbox.exercises.plain",
                               "glsandbox.exercises.catalogue", "glsandbox.exercises.probe",
                               "glsandbox.exercises.lesson_view", "glsandbox.exercises.runner",
                               "glsandbox.exercises.dxmath")),

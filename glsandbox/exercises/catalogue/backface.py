@@ -6,6 +6,7 @@ import math
 
 from glsandbox.exercises.base import Case, Exercise, Mistake, Probe
 from glsandbox.exercises.fields import grid
+from glsandbox.exercises.plain import dot
 
 DOC = """Arka yüz (back-face culling), course section "Hızlandırma: backface culling, AABB".
 
@@ -43,12 +44,10 @@ def _normal(v0, v1, v2):  # noqa: ANN001, ANN202
     return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 
 
-def _dot(a, b):  # noqa: ANN001, ANN202
-    return sum(x * y for x, y in zip(a, b, strict=True))
 
 
 def sign_flipped(v0, v1, v2, direction):  # noqa: ANN001, ANN201
-    return _dot(_normal(v0, v1, v2), direction) < 0
+    return dot(_normal(v0, v1, v2), direction) < 0
 
 
 def view_axis(v0, v1, v2, direction):  # noqa: ANN001, ANN201
@@ -56,7 +55,7 @@ def view_axis(v0, v1, v2, direction):  # noqa: ANN001, ANN201
 
 
 def from_the_origin(v0, v1, v2, direction):  # noqa: ANN001, ANN201
-    return _dot(_normal(v0, v1, v2), v0) > 0
+    return dot(_normal(v0, v1, v2), v0) > 0
 
 
 MISTAKES = (

@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-import math
-
 from glsandbox.exercises.base import Case, Exercise, Mistake, Probe
 from glsandbox.exercises.fields import hemisphere
+from glsandbox.exercises.plain import unit
 
 DOC = """Phong boyama modeli (Phong shading), course section "Phong boyama modeli".
 
@@ -32,16 +31,13 @@ def reference(normal, to_light, to_eye, color, ka, kd, ks, shininess):  # noqa: 
     return phong(normal, to_light, to_eye, color, (1.0, 1.0, 1.0), ka, kd, ks, shininess)
 
 
-def _unit(v):  # noqa: ANN001, ANN202
-    size = math.sqrt(sum(x * x for x in v))
-    return [x / size for x in v]
 
 
 def _phong(normal, to_light, to_eye, color, ka, kd, ks, shininess, *, clamp_diffuse=True,  # noqa: ANN001, ANN202
-           gate=True, clamp_specular=True, sign=1.0, unit=True):
-    n = _unit(normal)
-    light = _unit(to_light) if unit else list(to_light)
-    eye = _unit(to_eye)
+           gate=True, clamp_specular=True, sign=1.0, unit_light=True):
+    n = unit(normal)
+    light = unit(to_light) if unit_light else list(to_light)
+    eye = unit(to_eye)
     nl = sum(a * b for a, b in zip(n, light, strict=True))
     r = [sign * (2 * nl * a - b) for a, b in zip(n, light, strict=True)]
     re = sum(a * b for a, b in zip(r, eye, strict=True))
@@ -64,7 +60,7 @@ def reflected_wrong_way(*args):  # noqa: ANN002, ANN201
 
 
 def light_not_normalized(*args):  # noqa: ANN002, ANN201
-    return _phong(*args, unit=False)
+    return _phong(*args, unit_light=False)
 
 
 MISTAKES = (

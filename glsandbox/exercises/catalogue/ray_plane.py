@@ -8,6 +8,7 @@ import numpy as np
 
 from glsandbox.exercises.base import Case, Exercise, Mistake, Probe
 from glsandbox.exercises.fields import grid
+from glsandbox.exercises.plain import dot
 
 DOC = """Işın-Düzlem kesimi (ray-plane intersection), course section "Işın-Üçgen kesim testi" (its first step).
 
@@ -44,15 +45,13 @@ def _reference_many(inputs: list[tuple]) -> list:
     return [v if math.isfinite(v) else None for v in t]
 
 
-def _dot(a, b):  # noqa: ANN001, ANN202
-    return sum(x * y for x, y in zip(a, b, strict=True))
 
 
 def _t(origin, direction, normal, d, sign_d=1.0, sign_t=1.0, positive=True):  # noqa: ANN001, ANN202
-    den = _dot(normal, direction)
+    den = dot(normal, direction)
     if den == 0:
         return None
-    t = sign_t * -(_dot(normal, origin) + sign_d * d) / den
+    t = sign_t * -(dot(normal, origin) + sign_d * d) / den
     return t if (t > 0 or not positive) else None
 
 

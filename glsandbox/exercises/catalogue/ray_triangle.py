@@ -8,6 +8,7 @@ import numpy as np
 
 from glsandbox.exercises.base import Case, Exercise, LessonView, Mistake, Probe
 from glsandbox.exercises.fields import grid
+from glsandbox.exercises.plain import cross, dot, sub
 
 DOC = """Işın-Üçgen kesimi (ray-triangle intersection), course section "Işın-Üçgen kesim testi".
 
@@ -59,30 +60,24 @@ def _reference_many(inputs: list[tuple]) -> list:
 # --- the named mistakes: the plane, then a same-side test with one thing wrong ------------------
 
 
-def _sub(a, b):  # noqa: ANN001, ANN202
-    return [x - y for x, y in zip(a, b, strict=True)]
 
 
-def _cross(a, b):  # noqa: ANN001, ANN202
-    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 
 
-def _dot(a, b):  # noqa: ANN001, ANN202
-    return sum(x * y for x, y in zip(a, b, strict=True))
 
 
 def _plane_then(origin, direction, v0, v1, v2, *, inside=True, behind=False, cull=False,  # noqa: ANN001, ANN202
                 edges=((0, 1), (1, 2), (2, 0))):
-    n = _cross(_sub(v1, v0), _sub(v2, v0))
-    den = _dot(n, direction)
+    n = cross(sub(v1, v0), sub(v2, v0))
+    den = dot(n, direction)
     if den == 0 or (cull and den > 0):
         return None
-    t = _dot(n, _sub(v0, origin)) / den
+    t = dot(n, sub(v0, origin)) / den
     if t <= 0 and not behind:
         return None
     p = [o + t * d for o, d in zip(origin, direction, strict=True)]
     vs = (v0, v1, v2)
-    if inside and any(_dot(_cross(_sub(vs[j], vs[i]), _sub(p, vs[i])), n) < 0 for i, j in edges):
+    if inside and any(dot(cross(sub(vs[j], vs[i]), sub(p, vs[i])), n) < 0 for i, j in edges):
         return None
     return t if t != 0 else None
 

@@ -6,6 +6,7 @@ import math
 
 from glsandbox.exercises.base import Case, Exercise, Mistake, Probe
 from glsandbox.exercises.fields import grid
+from glsandbox.exercises.plain import cross, dot, sub
 
 DOC = """Gölge testi (the shadow test), course section "Gölge testi".
 
@@ -53,35 +54,29 @@ def _reference_many(inputs: list[tuple]) -> list[bool]:
     return out
 
 
-def _sub(a, b):  # noqa: ANN001, ANN202
-    return [x - y for x, y in zip(a, b, strict=True)]
 
 
-def _cross(a, b):  # noqa: ANN001, ANN202
-    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 
 
-def _dot(a, b):  # noqa: ANN001, ANN202
-    return sum(x * y for x, y in zip(a, b, strict=True))
 
 
 def _hit(origin, direction, v0, v1, v2):  # noqa: ANN001, ANN202
     """Plane then the edge test; t (any sign) or None."""
-    n = _cross(_sub(v1, v0), _sub(v2, v0))
-    den = _dot(n, direction)
+    n = cross(sub(v1, v0), sub(v2, v0))
+    den = dot(n, direction)
     if den == 0:
         return None
-    t = _dot(n, _sub(v0, origin)) / den
+    t = dot(n, sub(v0, origin)) / den
     p = [o + t * d for o, d in zip(origin, direction, strict=True)]
     vs = (v0, v1, v2)
-    if any(_dot(_cross(_sub(vs[(i + 1) % 3], vs[i]), _sub(p, vs[i])), n) < 0 for i in range(3)):
+    if any(dot(cross(sub(vs[(i + 1) % 3], vs[i]), sub(p, vs[i])), n) < 0 for i in range(3)):
         return None
     return t
 
 
 def _shadow(point, light, triangles, *, beyond=False, offset=1e-6, reverse=False):  # noqa: ANN001, ANN202
-    to_light = _sub(light, point)
-    distance = math.sqrt(_dot(to_light, to_light))
+    to_light = sub(light, point)
+    distance = math.sqrt(dot(to_light, to_light))
     d = [x / distance for x in to_light]
     if reverse:
         d = [-x for x in d]
@@ -99,8 +94,8 @@ def the_notes_erratum(point, light, triangles):  # noqa: ANN001, ANN201
 
 
 def no_offset(point, light, triangles):  # noqa: ANN001, ANN201
-    to_light = _sub(light, point)
-    distance = math.sqrt(_dot(to_light, to_light))
+    to_light = sub(light, point)
+    distance = math.sqrt(dot(to_light, to_light))
     d = [x / distance for x in to_light]
     return any((t := _hit(point, d, *tri)) is not None and -1e-9 <= t < distance for tri in triangles)
 

@@ -6,6 +6,7 @@ import math
 
 from glsandbox.exercises.base import Case, Exercise, Mistake, Probe
 from glsandbox.exercises.fields import grid
+from glsandbox.exercises.plain import unit
 
 DOC = """Üçgenin normali (a triangle's normal), course section "Vektörel işlemler (normalize, dot, cross)".
 
@@ -32,13 +33,15 @@ def reference(v0, v1, v2):  # noqa: ANN001, ANN201 - the student's plain signatu
     return None if triangle.is_degenerate else triangle.normal
 
 
+def _normalized(n):  # noqa: ANN001, ANN202
+    u = unit(n)
+    return None if u is None else tuple(u)
+
+
 def _edges(v0, v1, v2):  # noqa: ANN001, ANN202
     return [b - a for a, b in zip(v0, v1, strict=True)], [c - a for a, c in zip(v0, v2, strict=True)]
 
 
-def _unit(n):  # noqa: ANN001, ANN202
-    size = math.sqrt(sum(x * x for x in n))
-    return None if size == 0 else tuple(x / size for x in n)
 
 
 def unnormalized(v0, v1, v2):  # noqa: ANN001, ANN201
@@ -49,17 +52,17 @@ def unnormalized(v0, v1, v2):  # noqa: ANN001, ANN201
 
 def reversed_order(v0, v1, v2):  # noqa: ANN001, ANN201
     b, a = _edges(v0, v1, v2)
-    return _unit((a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]))
+    return _normalized((a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]))
 
 
 def cross_y_sign(v0, v1, v2):  # noqa: ANN001, ANN201
     a, b = _edges(v0, v1, v2)
-    return _unit((a[1] * b[2] - a[2] * b[1], a[0] * b[2] - a[2] * b[0], a[0] * b[1] - a[1] * b[0]))
+    return _normalized((a[1] * b[2] - a[2] * b[1], a[0] * b[2] - a[2] * b[0], a[0] * b[1] - a[1] * b[0]))
 
 
 def vertices_not_edges(v0, v1, v2):  # noqa: ANN001, ANN201
     a, b = v1, v2
-    return _unit((a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]))
+    return _normalized((a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]))
 
 
 MISTAKES = (
