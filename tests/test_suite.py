@@ -19,10 +19,15 @@ def test_every_lesson_has_a_test_file_and_at_least_one_golden() -> None:
 
 
 def test_goldens_are_grouped_by_lesson() -> None:
-    """tests/goldens/<lesson>/<variant>.png: no loose files, no folder for a lesson that does not exist."""
+    """tests/goldens/<lesson>/<variant>.png, and the exercises' probe pictures in
+    tests/goldens/exercises/<exercise>_<variant>.png: no loose files, no folder for a lesson or
+    picture for an exercise that does not exist."""
+    from glsandbox.exercises.catalogue import MODULES
+
     entries = sorted(GOLDENS_DIR.iterdir())
     assert [p.name for p in entries if not p.is_dir()] == []
-    assert [p.name for p in entries if p.name not in LESSON_NAMES] == []
+    assert [p.name for p in entries if p.name not in LESSON_NAMES and p.name != "exercises"] == []
+    assert all(any(p.name.startswith(f"{name}_") for name in MODULES) for p in (GOLDENS_DIR / "exercises").iterdir())
     assert all(p.suffix == ".png" and p.is_file() for folder in entries for p in folder.iterdir())
 
 
