@@ -15,7 +15,10 @@ that:
   :func:`glsandbox.grading.sandbox` which reads only the allowed folders and
   none of glsandbox's), and a Python audit hook refuses it too (where
   Landlock is missing), with writes outside the private folder, starting
-  programs and signalling others.
+  programs and signalling others;
+- has no network: the grader's layers (:mod:`glsandbox.grading.layers`) give it
+  a network namespace of its own and a seccomp filter refusing sockets but
+  local Unix ones, where the system has them.
 
 Each call has its own deadline. A call that does not answer in time is
 TIMEOUT and the process is killed (the next call starts a fresh one); one
@@ -160,6 +163,7 @@ def _restrict(reads: list[str], writes: list[str], limits: Limits) -> Callable[[
     """What the child does after fork and before the interpreter starts."""
     import resource
 
+    from glsandbox.grading.layers import close_network, install_seccomp
     from glsandbox.grading.sandbox import _landlock  # the grader's kernel rules, shared (one place)
 
     def setup() -> None:
@@ -171,7 +175,9 @@ def _restrict(reads: list[str], writes: list[str], limits: Limits) -> Callable[[
                 resource.setrlimit(limit, (value, value))
             except (ValueError, OSError):
                 pass
+        close_network()  # a network namespace with nothing up, where the system lets us
         _landlock(reads, writes)
+        install_seccomp()  # no socket but a local Unix one
 
     return setup
 

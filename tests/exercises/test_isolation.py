@@ -57,6 +57,10 @@ def f(mode):
         return subprocess.run(["true"]).returncode
     if mode == "memory":
         return len(bytearray(8 << 30))
+    if mode == "network":
+        import socket
+        socket.create_connection(("127.0.0.1", 9), timeout=0.2)
+        return 1.0
     if mode == "parent":
         return open(f"/proc/{{os.getppid()}}/environ").read()[:20]
 '''
@@ -81,6 +85,7 @@ def hostile(tmp_path_factory):
     ("spawn", ERROR, "may not start processes"),
     ("memory", ERROR, "MemoryError"),
     ("parent", ERROR, "PermissionError: reading /proc/"),
+    ("network", ERROR, "Error"),
     ("exit", CRASHED, "exit code 3"),
     ("loop", TIMEOUT, "no answer within 1 s"),
     ("sleep", TIMEOUT, "no answer within 1 s"),
