@@ -848,7 +848,7 @@ class GpuTracer:
             "u_eye": tuple(eye - uploaded.anchor), "u_half": (half_w, half_h), "u_background": tuple(world.background),
             "u_max_depth": int(max_depth),
             "u_cull": -1 if cull_backfaces is None else int(bool(cull_backfaces)), "u_aabb": bool(aabb),
-            "u_offset": SIMPLE_OFFSET,
+            "u_offset": SIMPLE_OFFSET, "u_offset_origin": tuple(uploaded.anchor),
         }
         for name, value in values.items():
             if name in program:
