@@ -2,7 +2,7 @@
 
 Baseline: every submission loaded and rendered in the grader's own process on
 a fresh context each (how ``glsandbox check DIR`` graded before isolation:
-:func:`glsandbox.measure.check.time_in_process`). Subject: ``glsandbox check
+:func:`glsandbox.grading.check.time_in_process`). Subject: ``glsandbox check
 DIR`` as it is, each submission in a process of its own (a zygote that
 imported glsandbox once forks a supervisor and a renderer per submission),
 with ``--jobs 1`` and ``--jobs 2``. Both sides are whole commands, from
@@ -32,7 +32,7 @@ color = [0.8, 0.4, 0.2]
 # submission {n}
 """
 
-IN_PROCESS = ("import sys; from pathlib import Path; from glsandbox.measure.check import Check, time_in_process; "
+IN_PROCESS = ("import sys; from pathlib import Path; from glsandbox.grading.check import Check, time_in_process; "
               "time_in_process(Path(sys.argv[1]), [Check('ref', Path(sys.argv[2]))], backend='egl')")
 
 

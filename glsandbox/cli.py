@@ -181,7 +181,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
 
 def cmd_tour(args: argparse.Namespace) -> int:
-    from glsandbox.measure.check import render_lesson
+    from glsandbox.grading.check import render_lesson
 
     out: Path = args.out
     if args.lessons is not None and not args.lessons.is_dir():
@@ -296,7 +296,7 @@ def cmd_new(args: argparse.Namespace) -> int:
     from importlib.resources import files as package_files
     from string import Template
 
-    from glsandbox.measure.rubric import STARTER
+    from glsandbox.grading.rubric import STARTER
 
     if (args.name is None) == (args.assignment is None):
         raise SandboxError("new: give a NAME, or --assignment NAME (a model answer and its grading file)")
@@ -338,7 +338,7 @@ def cmd_new(args: argparse.Namespace) -> int:
 
 def _checks(args: argparse.Namespace) -> tuple[list, float | None, int | None]:
     """The checks of ``check``: a rubric's, or one from --golden, --set, --size and --tolerance."""
-    from glsandbox.measure.rubric import Check, load_rubric, parse_tolerances
+    from glsandbox.grading.rubric import Check, load_rubric, parse_tolerances
 
     if (args.golden is None) == (args.rubric is None):
         raise SandboxError("check: give the reference with --golden REF.png or a grading file with --rubric FILE "
@@ -360,8 +360,8 @@ def _checks(args: argparse.Namespace) -> tuple[list, float | None, int | None]:
 
 def cmd_check(args: argparse.Namespace) -> int:
     """``glsandbox check``: render, compare with reference PNGs by the golden rule; 0 all pass, 1 not."""
-    from glsandbox.measure.check import Limits, check_folder, check_one, default_jobs, summary_table
-    from glsandbox.measure.reports import REPORTS, write_reports
+    from glsandbox.grading.check import Limits, check_folder, check_one, default_jobs, summary_table
+    from glsandbox.grading.reports import REPORTS, write_reports
 
     checks, rubric_timeout, rubric_memory = _checks(args)
     timeout = args.timeout if args.timeout is not None else rubric_timeout or 30.0

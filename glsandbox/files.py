@@ -159,7 +159,7 @@ def set_sandbox_root(root: str | os.PathLike[str] | None, also: tuple[str | os.P
     own shader folders); None: any path, the default.
 
     Set only in the child process that renders one graded submission
-    (:mod:`glsandbox.measure.sandbox`); everywhere else files are read wherever they are.
+    (:mod:`glsandbox.grading.sandbox`); everywhere else files are read wherever they are.
     """
     global _sandbox_roots
     _sandbox_roots = () if root is None else tuple(os.path.realpath(r) for r in (root, *also))

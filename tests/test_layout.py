@@ -30,6 +30,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("one frame", ("glsandbox.frame",)),
     ("window and measuring", ("glsandbox.window", "glsandbox.panel", "glsandbox.controls", "glsandbox.notebook",
                               "glsandbox.notebook_view", "glsandbox.course_page", "glsandbox.measure")),
+    ("grading", ("glsandbox.grading",)),
     ("command line", ("glsandbox.cli", "glsandbox.pytest_plugin", "glsandbox.__main__")),
 ]
 

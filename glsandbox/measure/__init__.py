@@ -1,4 +1,5 @@
 """The measuring wing: tools that judge pictures and time frames; nothing here is needed to render one.
+Grading submissions is :mod:`glsandbox.grading`, which uses this wing.
 
 - :mod:`~glsandbox.measure.metrics`: RMSE, PSNR, largest difference, share of differing pixels;
 - :mod:`~glsandbox.measure.golden`: the golden-image rule of the tests, and its diff pictures;

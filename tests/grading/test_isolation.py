@@ -26,8 +26,8 @@ from support import REPO_ROOT
 
 from glsandbox.files import save_png
 from glsandbox.lesson import lesson_files
-from glsandbox.measure.check import shown
-from glsandbox.measure.sandbox import landlock_abi
+from glsandbox.grading.check import shown
+from glsandbox.grading.sandbox import landlock_abi
 
 pytestmark = pytest.mark.slow
 
@@ -80,7 +80,7 @@ def hostile_kinds(ref: Path, results: Path, subs: Path) -> dict[str, tuple[str, 
         "h_proc": ("h_proc.py", lesson(during="open(f'/proc/{os.getppid()}/cmdline', 'rb').read()"),
                    "BROKEN outside the submission"),
         # it decides for others
-        "h_patch": ("h_patch.py", lesson(before="import glsandbox.measure.check as c, glsandbox.measure.golden as g\n"
+        "h_patch": ("h_patch.py", lesson(before="import glsandbox.grading.check as c, glsandbox.measure.golden as g\n"
                                                 "c.compare_images = g.compare_images = lambda *a, **k: None"),
                     "FAIL bad of 3072"),
         "h_cube24": ("h_cube24.py", lesson(before="from glsandbox import geometry\n"

@@ -13,10 +13,10 @@ import numpy as np
 import pytest
 
 from glsandbox.files import save_png
-from glsandbox.measure.check import CheckResult, Outcome, file_stem, shown, summary_table
+from glsandbox.grading.check import CheckResult, Outcome, file_stem, shown, summary_table
 from glsandbox.measure.golden import compare_images
-from glsandbox.measure.reports import REPORTS, write_reports
-from glsandbox.measure.rubric import Check
+from glsandbox.grading.reports import REPORTS, write_reports
+from glsandbox.grading.rubric import Check
 
 NASTY = os.fsdecode(b"<script>alert(1)</script>\xff\n\x1b[31m\"quote\",comma\u202e")
 

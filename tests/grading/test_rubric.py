@@ -11,7 +11,7 @@ import pytest
 from support import glsandbox
 
 from glsandbox.errors import SandboxError
-from glsandbox.measure.rubric import load_rubric
+from glsandbox.grading.rubric import load_rubric
 
 
 def run(*args: str, cwd: Path):
@@ -64,6 +64,7 @@ def test_a_rubric_is_read_with_every_key(tmp_path: Path) -> None:
     ("memory = 'lots'\n[[check]]\ngolden = 'a.png'\n", "memory = 'lots'"),
     ("jobs = 2\n[[check]]\ngolden = 'a.png'\n", "unknown key 'jobs'"),
     ("[[check]\n", "not valid TOML"),
+    ("[[check]]\nkind = 'sound'\ngolden = 'a.png'\n", "check 1: kind = 'sound': expected one of picture"),
 ])
 def test_every_rubric_mistake_is_one_line_naming_the_file(tmp_path: Path, text: str, fragment: str) -> None:
     path = tmp_path / "grading.toml"
@@ -135,3 +136,32 @@ def test_an_assignment_from_new_to_scores_and_every_report(tmp_path: Path, gl) -
     proc = run("check", "subs/ann", "--rubric", "spin.grading.toml", "--gradescope", "one.json", cwd=tmp_path)
     one = json.loads((tmp_path / "one.json").read_text())
     assert proc.returncode == 0 and one["score"] == 4.0 and [t["name"] for t in one["tests"]] == names
+
+
+def test_a_new_kind_of_check_is_one_registry_entry(tmp_path: Path) -> None:
+    """A kind registered once is read from a rubric (its own keys only) and judges what comes back."""
+    import numpy as np
+
+    from glsandbox.grading.check import PASS, _outcome
+    from glsandbox.grading.isolate import Picture
+    from glsandbox.grading.kinds import KINDS, CheckKind, Verdict, register_kind
+
+    seen = []
+
+    def judge(check, image, expected):
+        seen.append((check.kind, image.shape, expected))
+        return Verdict(True)
+
+    register_kind(CheckKind("always", frozenset({"golden"}), judge))
+    try:
+        path = tmp_path / "grading.toml"
+        path.write_text("[[check]]\nkind = 'always'\ngolden = 'a.png'\n")
+        (check,) = load_rubric(path).checks
+        assert check.kind == "always"
+        outcome = _outcome(check, Picture(image=np.zeros((2, 2, 4), "uint8")), "the reference", "ann")
+        assert outcome.status == PASS and seen == [("always", (2, 2, 4), "the reference")]
+        path.write_text("[[check]]\nkind = 'always'\ngolden = 'a.png'\nsize = '4x4'\n")
+        with pytest.raises(SandboxError, match="unknown key 'size'"):
+            load_rubric(path)
+    finally:
+        del KINDS["always"]

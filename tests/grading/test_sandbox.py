@@ -1,4 +1,4 @@
-"""What a confined process may read, write and signal (glsandbox.measure.sandbox), and the file root."""
+"""What a confined process may read, write and signal (glsandbox.grading.sandbox), and the file root."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import pytest
 
 from glsandbox.errors import SandboxError
 from glsandbox.files import read_user_file, set_sandbox_root
-from glsandbox.measure.sandbox import landlock_abi, read_roots
+from glsandbox.grading.sandbox import landlock_abi, read_roots
 
 
 def test_user_files_outside_the_root_are_refused_only_while_grading(tmp_path: Path) -> None:
@@ -34,7 +34,7 @@ def test_user_files_outside_the_root_are_refused_only_while_grading(tmp_path: Pa
 
 CONFINED = """
 import ctypes, os, sys
-from glsandbox.measure.sandbox import confine
+from glsandbox.grading.sandbox import confine
 root, private, outside = sys.argv[1:4]
 kernel = confine(root, [private])
 libc = ctypes.CDLL(None, use_errno=True)

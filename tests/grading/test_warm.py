@@ -1,4 +1,4 @@
-"""The warm template (glsandbox.measure.warm): renderers forked from a context already drawn with."""
+"""The warm template (glsandbox.grading.warm): renderers forked from a context already drawn with."""
 
 from __future__ import annotations
 
@@ -28,7 +28,7 @@ color = {color}
 TEMPLATE = textwrap.dedent("""
     import json, os, sys
     from glsandbox.lesson import find_lesson
-    from glsandbox.measure.warm import open_template, quiet
+    from glsandbox.grading.warm import open_template, quiet
     renderer = open_template(None, [(64, 48)])
     out = {"template": renderer is not None, "pictures": [], "threads": os.listdir("/proc/self/task")}
     for path in sys.argv[1:] if renderer is not None else []:

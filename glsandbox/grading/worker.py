@@ -1,6 +1,6 @@
 """The processes below the grader: the zygote, a supervisor per submission and its renderer.
 
-See :mod:`glsandbox.measure.isolate` for the tree and what each may do. This
+See :mod:`glsandbox.grading.isolate` for the tree and what each may do. This
 module runs only in those processes; the grader starts the zygote with
 :func:`zygote_main` and never imports the rest.
 """
@@ -21,17 +21,17 @@ from pathlib import Path
 
 import numpy as np
 
-from glsandbox.measure.isolate import (BROKEN, CRASHED, OOM, TAIL_LINES, TAIL_WIDTH, TIMEOUT, Job, Picture, Reader,
+from glsandbox.grading.isolate import (BROKEN, CRASHED, OOM, TAIL_LINES, TAIL_WIDTH, TIMEOUT, Job, Picture, Reader,
                                        job_from, send)
-from glsandbox.measure.processes import kill_tree, killpg, set_subreaper, wait_briefly
-from glsandbox.measure.warm import quiet
+from glsandbox.grading.processes import kill_tree, killpg, set_subreaper, wait_briefly
+from glsandbox.grading.warm import quiet
 
 __all__ = ["PRELOAD", "zygote_main"]
 
 #: What the zygote imports once, so each submission starts warm (and no module
 #: opens a GL context at import).
-PRELOAD = ["glsandbox.measure.worker", "glsandbox.frame", "glsandbox.lesson", "glsandbox.scene_file",
-           "glsandbox.measure.sandbox", "glsandbox.gl.context", "glsandbox.gl.shaders", "numpy", "moderngl",
+PRELOAD = ["glsandbox.grading.worker", "glsandbox.frame", "glsandbox.lesson", "glsandbox.scene_file",
+           "glsandbox.grading.sandbox", "glsandbox.gl.context", "glsandbox.gl.shaders", "numpy", "moderngl",
            "glcontext", "glcontext.egl", "PIL.Image", "lessons"]
 
 #: The environment a renderer keeps (by prefix): the drivers', the locale's and glsandbox's own.
@@ -62,7 +62,7 @@ def _renderer(job: Job, root: str, target: str, work: str, out: int) -> None:
     from glsandbox.errors import SandboxError
     from glsandbox.frame import HeadlessRenderer
     from glsandbox.lesson import find_lesson, submission_lesson, user_code_error
-    from glsandbox.measure.sandbox import confine
+    from glsandbox.grading.sandbox import confine
 
     os.setsid()
     null = os.open(os.devnull, os.O_RDONLY)
@@ -85,7 +85,7 @@ def _renderer(job: Job, root: str, target: str, work: str, out: int) -> None:
     _limit(job)
     code = 0
     try:
-        try:  # forked from a warm template: its context, copied (see glsandbox.measure.warm)
+        try:  # forked from a warm template: its context, copied (see glsandbox.grading.warm)
             renderer = _template if _template is not None else HeadlessRenderer(job.backend)
         except SandboxError as exc:
             send(out, {"kind": "nogl", "error": str(exc)})
@@ -314,7 +314,7 @@ def zygote_main(channel_fd: int) -> None:
         except ImportError:  # e.g. no lessons package beside an installed glsandbox
             pass
     preload_gl_libraries()
-    from glsandbox.measure.sandbox import read_roots
+    from glsandbox.grading.sandbox import read_roots
 
     read_roots()  # worked out once, for every renderer
     zygote(channel_fd)
@@ -377,7 +377,7 @@ def zygote(channel_fd: int) -> None:
 def _template_for(job: Job, templates: dict, channel, fds: list[int]) -> object | None:
     """The zygote's end of the warm template for ``job.backend``, started on first use (a forked
     child that opens and warms a context, says whether it is safe to fork, then serves as a
-    zygote); None where it is not (:func:`glsandbox.measure.warm.open_template`)."""
+    zygote); None where it is not (:func:`glsandbox.grading.warm.open_template`)."""
     import socket
 
     if job.backend in templates:
@@ -393,7 +393,7 @@ def _template_for(job: Job, templates: dict, channel, fds: list[int]) -> object 
         for other in templates.values():
             if other is not None:
                 other.close()
-        from glsandbox.measure.warm import open_template
+        from glsandbox.grading.warm import open_template
 
         _template = open_template(job.backend, {r.size for r in job.renders})
         try:

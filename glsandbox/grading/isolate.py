@@ -4,13 +4,13 @@ The process tree of one grading run::
 
     grader (never opens a GL context; reads the reference, compares, writes every report)
      └─ zygote (imported glsandbox, numpy and moderngl once; forks on the grader's word)
-         ├─ warm template, one per backend where safe (:mod:`glsandbox.measure.warm`):
+         ├─ warm template, one per backend where safe (:mod:`glsandbox.grading.warm`):
          │   a single-threaded software context drawn with once; forks the supervisors
          └─ supervisor, one per submission (own session; a "child subreaper": every process
             │  the submission leaves behind is re-parented to it, and it kills them all)
             └─ renderer (own session; stdin /dev/null, stdout and stderr into a file;
                address-space, CPU-time and file-size limits; working folder a private
-               copy of the submission; confined by :mod:`glsandbox.measure.sandbox`)
+               copy of the submission; confined by :mod:`glsandbox.grading.sandbox`)
 
 The renderer opens its GL context, or uses its copy of the warm template's
 (a fork of a process with llvmpipe's rasterizer threads would deadlock on
@@ -28,8 +28,8 @@ replacing ``sys.stdout`` or glsandbox's functions) reaches the grader: the
 worst it can do is lose its own pictures.
 
 This module is the grader's side and what both sides share (the jobs, the
-framed messages); :mod:`glsandbox.measure.worker` is the zygote, supervisor
-and renderer; :mod:`glsandbox.measure.processes` finds and kills a tree.
+framed messages); :mod:`glsandbox.grading.worker` is the zygote, supervisor
+and renderer; :mod:`glsandbox.grading.processes` finds and kills a tree.
 """
 
 from __future__ import annotations
@@ -47,7 +47,7 @@ from pathlib import Path
 
 import numpy as np
 
-from glsandbox.measure.processes import descendants, kill_tree, killpg, set_subreaper
+from glsandbox.grading.processes import descendants, kill_tree, killpg, set_subreaper
 
 __all__ = ["Render", "Job", "Picture", "JobResult", "run_jobs"]
 
@@ -173,7 +173,7 @@ class _Zygote:
         import subprocess
 
         self.channel, theirs = socket.socketpair()
-        code = "import sys; from glsandbox.measure.worker import zygote_main; zygote_main(int(sys.argv[1]))"
+        code = "import sys; from glsandbox.grading.worker import zygote_main; zygote_main(int(sys.argv[1]))"
         self.process = subprocess.Popen([sys.executable, "-c", code, str(theirs.fileno())], pass_fds=[theirs.fileno()],
                                         stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL)  # never the grader's stdout
         theirs.close()

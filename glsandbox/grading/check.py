@@ -7,13 +7,13 @@ bad share exceeds ``max_bad_share``). On a failure the actual and expected
 images and a diff picture are written (:func:`~glsandbox.measure.golden.write_artifacts`).
 
 A folder of submissions (:func:`glsandbox.lesson.lesson_files`) is graded
-with each submission in a process of its own (:mod:`glsandbox.measure.isolate`),
+with each submission in a process of its own (:mod:`glsandbox.grading.isolate`),
 under a time and memory limit, reading only its own files
-(:mod:`glsandbox.measure.sandbox`), sending back only pixels. This process
+(:mod:`glsandbox.grading.sandbox`), sending back only pixels. This process
 reads the references, compares and writes every verdict and report: nothing
 a submission does reaches another's verdict, the references, the reports or
 the exit code. Each submission gets one picture per :class:`Check` (one, or
-a rubric's several, :mod:`glsandbox.measure.rubric`) and an outcome per
+a rubric's several, :mod:`glsandbox.grading.rubric`) and an outcome per
 picture: PASS, FAIL, BROKEN (its error line), TIMEOUT, CRASHED or OUT OF MEMORY.
 """
 
@@ -37,8 +37,9 @@ from glsandbox.errors import SandboxError
 from glsandbox.frame import DEFAULT_SIZE, Frame, HeadlessRenderer
 from glsandbox.lesson import Lesson, lesson_files, user_code_error
 from glsandbox.measure.golden import DEFAULT_THRESHOLD, ImageMatch, compare_images, write_artifacts
-from glsandbox.measure.isolate import BROKEN, CRASHED, OOM, TIMEOUT, Job, JobResult, Picture, Render, run_jobs
-from glsandbox.measure.rubric import Check
+from glsandbox.grading.isolate import BROKEN, CRASHED, OOM, TIMEOUT, Job, JobResult, Picture, Render, run_jobs
+from glsandbox.grading.kinds import kind_of
+from glsandbox.grading.rubric import Check
 
 PASS, FAIL = "PASS", "FAIL"
 #: Every outcome, in the order the summary counts them.
@@ -186,12 +187,16 @@ def judge(actual: np.ndarray, expected: np.ndarray, tolerances: dict[str, float]
     match = compare_images(actual, expected, **tolerances)
     if match.passed:
         return match, {}
+    return match, _artifacts(actual, expected, tolerances, artifacts_dir, artifact_name)
+
+
+def _artifacts(actual: np.ndarray, expected: np.ndarray, tolerances: dict[str, float], artifacts_dir: Path,
+               artifact_name: str) -> dict[str, Path]:
     try:
-        paths = write_artifacts(actual, expected, artifacts_dir, artifact_name,
-                                threshold=int(tolerances.get("threshold", DEFAULT_THRESHOLD)))
+        return write_artifacts(actual, expected, artifacts_dir, artifact_name,
+                               threshold=int(tolerances.get("threshold", DEFAULT_THRESHOLD)))
     except OSError as exc:
         raise SandboxError(f"{artifacts_dir}: cannot write the diff images ({exc.strerror or exc})") from None
-    return match, paths
 
 
 def results_dir(check: Check) -> Path:
@@ -245,12 +250,16 @@ def _outcomes(result: JobResult, checks: Sequence[Check], references: dict[Path,
 
 
 def _outcome(check: Check, picture: Picture, expected: np.ndarray, name: str) -> Outcome:
+    """What came back for ``check``, judged by its kind (:mod:`glsandbox.grading.kinds`); a failed
+    comparison's pictures go into :func:`results_dir`."""
     if picture.image is None:
         return Outcome(check, picture.status or CRASHED, error=shown(picture.error), seconds=picture.seconds)
-    stem = file_stem(name)
-    match, paths = judge(picture.image, expected, check.tolerances, results_dir(check), stem)
-    return Outcome(check, PASS if match.passed else FAIL, match, seconds=picture.seconds, artifacts=paths,
-                   thumb=_thumbnail(picture.image))
+    verdict = kind_of(check.kind).judge(check, picture.image, expected)
+    paths: dict[str, Path] = {}
+    if not verdict.passed and verdict.match is not None:
+        paths = _artifacts(picture.image, expected, check.tolerances, results_dir(check), file_stem(name))
+    return Outcome(check, PASS if verdict.passed else FAIL, verdict.match, error=verdict.detail,
+                   seconds=picture.seconds, artifacts=paths, thumb=_thumbnail(picture.image))
 
 
 def read_references(checks: Sequence[Check]) -> dict[Path, np.ndarray]:

@@ -71,7 +71,7 @@ def _descriptors() -> set[str]:
 def _shared_writable() -> set[str]:
     """The file mappings this process could write and another process sees (``rw-s``), but
     Mesa's shader cache's (its index, which every process that opens a context maps alike)."""
-    from glsandbox.measure.sandbox import shader_cache_dirs
+    from glsandbox.grading.sandbox import shader_cache_dirs
 
     caches = shader_cache_dirs()
     found = set()

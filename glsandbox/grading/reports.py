@@ -1,7 +1,7 @@
 """The reports of a graded folder: CSV, JSON, an HTML page, JUnit XML and Gradescope's ``results.json``.
 
 Each is written atomically by the grader alone, from the results in folder
-order. Names are written as :func:`glsandbox.measure.check.shown` gives them
+order. Names are written as :func:`glsandbox.grading.check.shown` gives them
 (any bytes escaped), so no name breaks a writer or forges a line; the HTML
 page and the XML escape them again for their own syntax.
 """
@@ -21,7 +21,7 @@ from xml.sax.saxutils import escape as xml_escape
 
 from glsandbox import files
 from glsandbox.errors import SandboxError
-from glsandbox.measure.check import OUTCOMES, PASS, CheckResult, Outcome, counts, points, read_reference, shown
+from glsandbox.grading.check import OUTCOMES, PASS, CheckResult, Outcome, counts, points, read_reference, shown
 
 __all__ = ["REPORTS", "write_reports"]
 
@@ -141,7 +141,7 @@ def _img(image, alt: str) -> str:
 def html_text(results: Sequence[CheckResult], title: str) -> str:
     """One self-contained page: a row per student, reference | submission | difference per check,
     the score, the outcome's colour and the error line; click a heading to sort."""
-    from glsandbox.measure.check import _thumbnail
+    from glsandbox.grading.check import _thumbnail
     from glsandbox.measure.golden import _diff_image
 
     checks = [o.check for o in results[0].outcomes] if results else []

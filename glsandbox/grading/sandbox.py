@@ -17,7 +17,7 @@ of the submission's code runs:
    the same file rules, and from kernel 6.12 (Landlock ABI 6) the signal
    rule, against code that bypasses Python (``ctypes`` calling the C
    library). Where Landlock is missing, layers 1 and 2 remain; the time,
-   memory and process limits (:mod:`glsandbox.measure.isolate`) hold always.
+   memory and process limits (:mod:`glsandbox.grading.isolate`) hold always.
 
 The folders a submission may read: its own copy, its private working folder,
 the Python installation and its packages, glsandbox's own files, and the

@@ -8,6 +8,7 @@ per check and gives each student a score out of the total. The file::
     memory = 2048           # MB of address space for each submission
 
     [[check]]
+    kind = "picture"        # the default; the kinds are glsandbox.grading.kinds.KINDS
     name = "still"          # default: the golden's stem
     golden = "goldens/still.png"   # relative to this file; may be a hidden one only the teacher has
     points = 2              # default 1
@@ -30,6 +31,7 @@ from typing import Any
 
 from glsandbox.errors import SandboxError, parse_size_text
 from glsandbox.files import read_user_file
+from glsandbox.grading.kinds import COMMON_KEYS, kind_of, known
 from glsandbox.measure.golden import DEFAULT_MAX_BAD_SHARE, DEFAULT_THRESHOLD
 
 __all__ = ["Check", "Rubric", "load_rubric", "parse_tolerances", "TOLERANCES", "parse_size_text", "STARTER"]
@@ -50,6 +52,8 @@ class Check:
     tolerances: dict[str, float] = field(default_factory=dict)
     points: float = 1.0
     hidden: bool = False
+    #: The kind of check (:mod:`glsandbox.grading.kinds`): how what comes back is judged.
+    kind: str = "picture"
 
 
 @dataclass(frozen=True)
@@ -93,7 +97,6 @@ def parse_tolerances(items: list[str] | tuple[str, ...]) -> dict[str, float]:
 
 
 _TOP_KEYS = {"timeout", "memory", "check"}
-_CHECK_KEYS = {"name", "golden", "points", "set", "size", "samples", "renderer", "tolerance", "hidden"}
 
 
 def load_rubric(path: Path) -> Rubric:
@@ -130,9 +133,17 @@ def load_rubric(path: Path) -> Rubric:
 
 def _check(entry: dict[str, Any], number: int, path: Path) -> Check:
     where = f"{path}: check {number}"
-    unknown = sorted(set(entry) - _CHECK_KEYS)
+    kind_name = entry.get("kind", "picture")
+    try:
+        kind = kind_of(kind_name) if isinstance(kind_name, str) else None
+    except KeyError:
+        kind = None
+    if kind is None:
+        raise SandboxError(f"{where}: kind = {kind_name!r}: expected one of {', '.join(known())}")
+    allowed = COMMON_KEYS | kind.keys
+    unknown = sorted(set(entry) - allowed)
     if unknown:
-        raise SandboxError(f"{where}: unknown key {unknown[0]!r} (expected {', '.join(sorted(_CHECK_KEYS))})")
+        raise SandboxError(f"{where}: unknown key {unknown[0]!r} (expected {', '.join(sorted(allowed))})")
     golden = entry.get("golden")
     if not isinstance(golden, str) or not golden.lower().endswith(".png"):
         raise SandboxError(f"{where}: golden = {golden!r}: expected the path of a .png file")
@@ -165,7 +176,8 @@ def _check(entry: dict[str, Any], number: int, path: Path) -> Check:
     hidden = entry.get("hidden", False)
     if not isinstance(hidden, bool):
         raise SandboxError(f"{where}: hidden = {hidden!r}: expected true or false")
-    return Check(name.strip(), golden_path, tuple(settings), size_value, samples, tolerances, float(points), hidden)
+    return Check(name.strip(), golden_path, tuple(settings), size_value, samples, tolerances, float(points), hidden,
+                 kind.name)
 
 
 #: The starting rubric ``glsandbox new --assignment NAME`` writes beside the model answer.
