@@ -191,3 +191,64 @@ def shadow_state(renderer: Any, offset: float, scale: float = 1.0, size: tuple[i
     rays = shadow_mask(*traced)
     found = state_mismatch(raster, rays)
     return ShadowState(found.differ, found.off_edge, found.reference_shadowed)
+
+
+def ray_id_shift(offset: float, scale: float = 1.0, size: tuple[int, int] = (256, 192), engine: str = "numpy",
+                 ctx: Any = None) -> IdShift:
+    """:func:`id_shift` through a ray engine (its triangle-id picture against its own at the origin)."""
+    from glsandbox.raytrace import render
+
+    def ids(scene: Scene) -> np.ndarray:
+        return decode_ids(render(triangle_ids(scene), size, engine, ctx=ctx, max_depth=0, shadows=False))
+
+    origin_scene = oracle_scene(0.0, scale)
+    return compare_ids(ids(oracle_scene(offset, scale)), ids(origin_scene), node_triangles(origin_scene)["decal"])
+
+
+def contact_kept(offset: float, choice: str, engine: str = "numpy", ctx: Any = None,
+                 size: tuple[int, int] = (96, 72)) -> float:
+    """Share of the cube-on-a-floor contact shadow (:mod:`glsandbox.measure.knobs._far`) that
+    shadow rays leaving by ``offset=choice`` keep at ``offset``, against the float64 engine's
+    at the origin."""
+    from glsandbox.measure.knobs._far import contact_shadow
+    from glsandbox.raytrace import render
+
+    def trace(scene: Scene, shape: tuple[int, int], **options: Any) -> np.ndarray:
+        return render(scene, shape, engine, ctx=ctx, **options)
+
+    _, want = contact_shadow(lambda s, shape, **o: render(s, shape, **o), 0.0, size)
+    _, got = contact_shadow(trace, offset, size, offset=choice)
+    return float(np.count_nonzero(want & got) / max(1, np.count_nonzero(want)))
+
+
+def table(renderer: Any) -> list[str]:
+    """The rows of docs/numerics.md's table, measured with ``renderer`` (a HeadlessRenderer)
+    and both ray engines (the gpu one on the renderer's context)."""
+    ctx = renderer.host.ctx
+    places = [(o, 1.0, f"{o:g}") for o in OFFSETS] + [(SMALL[1], SMALL[0], "1e-4 at 1e3")]
+    rows = ["| place | raster ids moved (off edges), decal kept | shadow map wrong px (off edges) | "
+            "numpy ids moved | gpu ids moved | simple offset kept numpy / gpu | bound offset kept numpy / gpu |",
+            "|---|---|---|---|---|---|---|"]
+    for offset, scale, name in places:
+        raster = id_shift(renderer, offset, scale)
+        shadow = shadow_state(renderer, offset, scale)
+        numpy_ids = ray_id_shift(offset, scale)
+        gpu_ids = ray_id_shift(offset, scale, engine="gpu", ctx=ctx)
+        kept = {(c, e): contact_kept(offset * (scale == 1.0), c, e, ctx) for c in ("simple", "bound")
+                for e in ("numpy", "gpu")} if scale == 1.0 else None
+        offsets = ("-", "-") if kept is None else tuple(
+            f"{kept[c, 'numpy']:.0%} / {kept[c, 'gpu']:.0%}" for c in ("simple", "bound"))
+        rows.append(f"| {name} | {raster.moved} ({raster.off_edge}), {raster.decal - raster.decal_lost}/"
+                    f"{raster.decal} | {shadow.differ} ({shadow.off_edge}) | {numpy_ids.moved} | {gpu_ids.moved} | "
+                    f"{offsets[0]} | {offsets[1]} |")
+    return rows
+
+
+if __name__ == "__main__":  # python -m glsandbox.measure.far_raster: the table of docs/numerics.md
+    from glsandbox.frame import HeadlessRenderer
+
+    with_renderer = HeadlessRenderer()
+    try:
+        print("\n".join(table(with_renderer)))
+    finally:
+        with_renderer.close()
