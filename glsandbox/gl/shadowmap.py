@@ -34,8 +34,9 @@ class ShadowMaps:
     def __init__(self, ctx: moderngl.Context) -> None:
         self.ctx = ctx
         self._maps: dict[tuple[int, int], tuple[moderngl.Texture, moderngl.Framebuffer]] = {}
-        #: light -> (its map's texture, light projection @ view as uniform bytes, its ShadowMap)
-        self._current: dict[int, tuple[moderngl.Texture, bytes, ShadowMap]] = {}
+        #: light -> (its map's texture, light projection @ view (float64), its ShadowMap, and the
+        #: matrix's uniform bytes by the receiving pass's origin)
+        self._current: dict[int, tuple[moderngl.Texture, np.ndarray, ShadowMap, dict[bytes, bytes]]] = {}
 
     def target(self, light: int, size: int) -> tuple[moderngl.Texture, moderngl.Framebuffer]:
         key = (light, size)
@@ -48,18 +49,30 @@ class ShadowMaps:
         return self._maps[key]
 
     def drawn(self, light: int, texture: moderngl.Texture, matrix: np.ndarray, settings: ShadowMap) -> None:
-        self._current[light] = (texture, transforms.gl_bytes(matrix), settings)
+        self._current[light] = (texture, np.asarray(matrix, dtype=np.float64), settings, {})
 
-    def use(self, light: int, unit: int) -> tuple[tuple[str, bytes], ...]:
+    def use(self, light: int, unit: int, origin: np.ndarray | None = None) -> tuple[tuple[str, bytes], ...]:
         """Light ``light``'s map on texture unit ``unit``; returns the receiver's uniforms as
-        ``(name, bytes)`` (the executor writes those a program has and that changed)."""
-        texture, matrix, settings = self._current[light]
+        ``(name, bytes)`` (the executor writes those a program has and that changed).
+        ``origin``: the receiving pass's (its positions are relative to it, see
+        :class:`~glsandbox.gl.executor.PassCamera`): the light's matrix is taken times
+        ``T(origin)`` in float64, so a receiver far from the world's origin looks its map up
+        as precisely as one near it."""
+        texture, matrix, settings, relative = self._current[light]
         texture.use(unit)
-        return (*_settings_bytes(unit, settings), ("u_shadow_matrix", matrix))
+        key = b"" if origin is None else np.asarray(origin, dtype=np.float64).tobytes()
+        data = relative.get(key)
+        if data is None:
+            moved = matrix.copy()
+            if origin is not None:
+                moved[:, 3] += matrix[:, :3] @ np.asarray(origin, dtype=np.float64)  # M @ T(o)
+            data = relative[key] = transforms.gl_bytes(moved)
+        return (*_settings_bytes(unit, settings), ("u_shadow_matrix", data))
 
-    def bind(self, light: int, unit: int, program: moderngl.Program, members: Collection[str]) -> None:
+    def bind(self, light: int, unit: int, program: moderngl.Program, members: Collection[str],
+             origin: np.ndarray | None = None) -> None:
         """Light ``light``'s map on texture unit ``unit``, and the receiver's uniforms."""
-        for name, data in self.use(light, unit):
+        for name, data in self.use(light, unit, origin):
             if name in members:
                 program[name].write(data)
 
@@ -100,7 +113,7 @@ def run_shadow_map_pass(executor: Any, frame: FrameState, step: Pass, camera: An
         framebuffer.viewport = (0, 0, light.shadow.size, light.shadow.size)
         framebuffer.clear(depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST)
-        pass_camera = executor.pass_camera(view, proj)
+        pass_camera = executor.pass_camera(view, proj, np.asarray(light.position, dtype=np.float64))
         for draw in step.draws:
             node = frame.nodes[draw.node]
             if draw.program == CUTOUT_SHADOW_PROGRAM.key:  # a cut-out: depth only where its texels are drawn
