@@ -320,18 +320,21 @@ class Material:
 #: program is compiled with ``NUM_LIGHTS`` (the scene's light count) and, for
 #: a textured material, ``TEXTURED`` defined. An attribute the mesh lacks is
 #: an error (normals excepted: a mesh without them gets face normals).
+#: "World" is camera-relative: the world translated so that the eye is at 0
+#: (formed in float64, so a scene far from the origin keeps its precision;
+#: docs/numerics.md). Directions and distances are the world's.
 SHADER_INPUTS: tuple[tuple[str, str, str, str], ...] = (
     ("in_position", "in vec3", "model", "vertex position"),
     ("in_normal", "in vec3", "model", "vertex normal (face normals if the mesh has none)"),
     ("in_uv", "in vec2", "texture", "texture coordinates (the mesh must have them)"),
     ("in_color", "in vec3", "-", "vertex colour (the mesh must have them)"),
-    ("m_model", "uniform mat4", "model -> world", "the node's model matrix"),
-    ("m_view", "uniform mat4", "world -> view", "the camera's view matrix"),
+    ("m_model", "uniform mat4", "model -> world", "the node's model matrix (world relative to the eye)"),
+    ("m_view", "uniform mat4", "world -> view", "the camera's view matrix (a rotation: the eye is at 0)"),
     ("m_proj", "uniform mat4", "view -> clip", "the projection"),
     ("m_normal", "uniform mat3", "model -> world", "normal matrix, inverse transpose of m_model's 3x3"),
     ("u_color", "uniform vec4", "-", "material colour (rgba, 0..1)"),
-    ("u_eye", "uniform vec3", "world", "camera position"),
-    ("u_light_pos", "uniform vec3[NUM_LIGHTS]", "world", "light positions (only if NUM_LIGHTS > 0)"),
+    ("u_eye", "uniform vec3", "world", "camera position (0: world is relative to the eye)"),
+    ("u_light_pos", "uniform vec3[NUM_LIGHTS]", "world", "light positions, relative to the eye (if NUM_LIGHTS > 0)"),
     ("u_light_color", "uniform vec3[NUM_LIGHTS]", "-", "light colours"),
     ("u_ambient", "uniform float", "-", "material coefficient (0.1)"),
     ("u_diffuse", "uniform float", "-", "material coefficient (0.4)"),
