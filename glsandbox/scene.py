@@ -139,21 +139,24 @@ class ShadowMap:
     nearest caster seen from the light, ``size`` x ``size`` texels, which a
     lit receiver compares its own distance with.
 
-    ``bias`` (world units) and ``slope_bias`` (world units per unit of
-    ``tan`` of the angle between the surface normal and the light) move the
-    receiver's point towards the light before the comparison: too little and a
-    surface shadows itself in stripes (acne), too much and shadows come loose
-    from their casters (peter-panning). ``pcf`` is the width in texels of the
+    ``bias`` and ``slope_bias`` (per unit of ``tan`` of the angle between the
+    surface normal and the light) move the receiver's point towards the light
+    before the comparison, in *texels*: the map's texel width where the point
+    is (``2·tan(fov/2)·d / size`` at distance ``d`` from the light, the
+    frustum's own fov, :func:`glsandbox.shadowmap.light_frame`), so the same
+    settings hold for a scene of any size anywhere: too little and a surface
+    shadows itself in stripes (acne), too much and shadows come loose from
+    their casters (peter-panning). ``pcf`` is the width in texels of the
     percentage-closer filter (1: one comparison, hard aliased edges; 3: a 3x3
     grid of comparisons averaged). ``fov`` is the light frustum's field of view
-    in degrees: a point light gets one perspective frustum looking from it at
-    the centre of the shadow casters, not a cube map (what lies outside the
-    frustum is lit).
+    in degrees at most: a point light gets one perspective frustum looking from
+    it at the centre of the shadow casters, fitted to them and the receivers,
+    not a cube map (what lies outside the frustum is lit).
     """
 
     size: int = 1024
-    bias: float = 0.02
-    slope_bias: float = 0.02
+    bias: float = 2.5
+    slope_bias: float = 2.5
     pcf: int = 3
     fov: float = 90.0
 

@@ -24,7 +24,7 @@ from glsandbox.gl import depth as gl_depth
 from glsandbox.gl.passes import FrameState
 from glsandbox.plan import CUTOUT_SHADOW_PROGRAM, Pass, cutout_caster_material
 from glsandbox.scene import ShadowMap
-from glsandbox.shadowmap import light_camera
+from glsandbox.shadowmap import light_frame
 
 
 class ShadowMaps:
@@ -34,9 +34,9 @@ class ShadowMaps:
     def __init__(self, ctx: moderngl.Context) -> None:
         self.ctx = ctx
         self._maps: dict[tuple[int, int], tuple[moderngl.Texture, moderngl.Framebuffer]] = {}
-        #: light -> (its map's texture, light projection @ view (float64), its ShadowMap, and the
-        #: matrix's uniform bytes by the receiving pass's origin)
-        self._current: dict[int, tuple[moderngl.Texture, np.ndarray, ShadowMap, dict[bytes, bytes]]] = {}
+        #: light -> (its map's texture, light projection @ view (float64), its ShadowMap, the
+        #: matrix's uniform bytes by the receiving pass's origin, a texel's width at unit distance)
+        self._current: dict[int, tuple[moderngl.Texture, np.ndarray, ShadowMap, dict[bytes, bytes], float]] = {}
 
     def target(self, light: int, size: int) -> tuple[moderngl.Texture, moderngl.Framebuffer]:
         key = (light, size)
@@ -48,8 +48,11 @@ class ShadowMaps:
             self._maps[key] = (texture, self.ctx.framebuffer(depth_attachment=texture))
         return self._maps[key]
 
-    def drawn(self, light: int, texture: moderngl.Texture, matrix: np.ndarray, settings: ShadowMap) -> None:
-        self._current[light] = (texture, np.asarray(matrix, dtype=np.float64), settings, {})
+    def drawn(self, light: int, texture: moderngl.Texture, matrix: np.ndarray, settings: ShadowMap,
+              footprint: float) -> None:
+        """Light ``light``'s map was drawn with ``matrix`` (projection @ view, float64); ``footprint``:
+        a texel's width at unit distance from the light (:meth:`~glsandbox.shadowmap.LightFrame.footprint`)."""
+        self._current[light] = (texture, np.asarray(matrix, dtype=np.float64), settings, {}, footprint)
 
     def use(self, light: int, unit: int, origin: np.ndarray | None = None) -> tuple[tuple[str, bytes], ...]:
         """Light ``light``'s map on texture unit ``unit``; returns the receiver's uniforms as
@@ -58,7 +61,7 @@ class ShadowMaps:
         :class:`~glsandbox.gl.executor.PassCamera`): the light's matrix is taken times
         ``T(origin)`` in float64, so a receiver far from the world's origin looks its map up
         as precisely as one near it."""
-        texture, matrix, settings, relative = self._current[light]
+        texture, matrix, settings, relative, footprint = self._current[light]
         texture.use(unit)
         key = b"" if origin is None else np.asarray(origin, dtype=np.float64).tobytes()
         data = relative.get(key)
@@ -67,7 +70,8 @@ class ShadowMaps:
             if origin is not None:
                 moved[:, 3] += matrix[:, :3] @ np.asarray(origin, dtype=np.float64)  # M @ T(o)
             data = relative[key] = transforms.gl_bytes(moved)
-        return (*_settings_bytes(unit, settings), ("u_shadow_matrix", data))
+        return (*_settings_bytes(unit, settings), ("u_shadow_footprint", struct.pack("f", footprint)),
+                ("u_shadow_matrix", data))
 
     def bind(self, light: int, unit: int, program: moderngl.Program, members: Collection[str],
              origin: np.ndarray | None = None) -> None:
@@ -106,7 +110,8 @@ def run_shadow_map_pass(executor: Any, frame: FrameState, step: Pass, camera: An
     light = scene.lights[light_index]
     assert light.shadow is not None
     texture, framebuffer = executor.shadow_maps.target(light_index, light.shadow.size)
-    view, proj = light_camera(scene, light)
+    fitted = light_frame(scene, light)
+    view, proj = fitted.view, fitted.proj
     gl_depth.end_depth_mode(ctx, executor.raw, scene)
     try:
         framebuffer.use()
@@ -124,4 +129,4 @@ def run_shadow_map_pass(executor: Any, frame: FrameState, step: Pass, camera: An
     finally:
         gl_depth.begin_depth_mode(ctx, executor.raw, scene)
         frame.framebuffer.use()
-    executor.shadow_maps.drawn(light_index, texture, proj @ view, light.shadow)
+    executor.shadow_maps.drawn(light_index, texture, proj @ view, light.shadow, fitted.footprint(light.shadow.size))

@@ -12,16 +12,8 @@ import pytest
 from glsandbox.measure import far_raster
 from glsandbox.measure.far_raster import OFFSETS, SMALL
 
-#: Where the rasterizer does not hold yet (strict: a case that starts to pass fails until it is taken off).
-NOT_YET = {"ids": (), "shadows": ("1e-4at1e3",)}
-
-
-def places(check: str) -> list:
-    """(offset, scale) of each oracle scene, named as the docs' table."""
-    cases = [(o, 1.0, f"at{o:g}") for o in OFFSETS] + [(SMALL[1], SMALL[0], "1e-4at1e3")]
-    return [pytest.param(o, s, id=name, marks=[pytest.mark.xfail(strict=True, reason="a bias in world units")]
-                         if name in NOT_YET[check] else []) for o, s, name in cases]
-
+#: (offset, scale) of each oracle scene, named as the docs' table.
+PLACES = [pytest.param(o, 1.0, id=f"at{o:g}") for o in OFFSETS] + [pytest.param(SMALL[1], SMALL[0], id="1e-4at1e3")]
 #: Id pixels that may change along the edges (a vertex rounded to a neighbouring pixel centre).
 EDGE_PIXELS = 20
 
@@ -49,16 +41,23 @@ def test_compare_ids_counts_a_moved_edge_and_a_lost_decal() -> None:
     assert (found.moved, found.off_edge, found.decal, found.decal_lost) == (13, 1, 144, 1)
 
 
-@pytest.mark.parametrize("offset, scale", places("ids"))
+@pytest.mark.parametrize("offset, scale", PLACES)
 def test_raster_triangle_ids_stay_put_far_from_the_origin(gl, offset, scale) -> None:
     found = far_raster.id_shift(gl, offset, scale)
+    # Measured: 0 pixels move at every place (transforms formed in float64 relative to the eye);
+    # in float32 world transforms 453 at 1e5, 3,202 at 9e5, 7,576 for the small scene, and the
+    # decal lost 85 of its 1,038 pixels at 9e5 and 163 in the small scene.
     assert found.decal > 500
     assert found.moved <= EDGE_PIXELS and found.off_edge == 0, f"at {offset:g} x{scale:g}: {found}"
     assert found.decal_lost == 0, f"at {offset:g} x{scale:g}: {found}"
 
 
-@pytest.mark.parametrize("offset, scale", places("shadows"))
+@pytest.mark.parametrize("offset, scale", PLACES)
 def test_shadow_map_states_match_the_shadow_rays_far_from_the_origin(gl, offset, scale) -> None:
     found = far_raster.shadow_state(gl, offset, scale)
     assert found.shadowed > 800  # the box's and the sphere's shadows on the floor
-    assert found.off_edge == 0, f"at {offset:g} x{scale:g}: {found}"
+    # Measured: 58 pixels differ at every place, all within 2 pixels of an edge (PCF's soft
+    # steps, the tessellated sphere's outline against the exact one). In float32 world
+    # transforms with a world-unit bias: 75 off the edges at 1e5, 23,591 at 9e5 (acne), and
+    # at 1e-4 scale no shadow at all (465 off the edges).
+    assert found.differ <= 100 and found.off_edge == 0, f"at {offset:g} x{scale:g}: {found}"
