@@ -77,7 +77,7 @@ class Executor(GpuMeshes):
         self._bound_texture: object | None = None  # the material texture on unit 0 in this frame
         self.clear_depth = 1.0  # 0 with reverse-Z (glsandbox.gl.depth)
         self.pass_rect: tuple[int, int, int, int] | None = None  # the pass's viewport in pixels (see render)
-        self.shadow_maps = gl_shadowmap.ShadowMaps(self.ctx)  # the lights' depth textures
+        self.shadow_maps = gl_shadowmap.ShadowMaps(self.ctx, self.raw)  # the lights' depth textures
 
     # --- resources ----------------------------------------------------------
 

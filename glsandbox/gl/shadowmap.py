@@ -1,8 +1,9 @@
 """Shadow maps on the GPU: the depth textures, the pass that fills one, and
 what a receiver's draw binds (the maths: :mod:`glsandbox.shadowmap`).
 
-A map is a ``DEPTH_COMPONENT24`` texture attached alone to a framebuffer (no
-colour: the pass writes depth only). It is sampled with a comparison sampler
+A map is a depth texture attached alone to a framebuffer (no colour: the
+pass writes depth only), ``DEPTH_COMPONENT32F`` where the context gives it
+(else moderngl's ``DEPTH_COMPONENT24``). It is sampled with a comparison sampler
 (``compare_func='<='``: GLSL's ``sampler2DShadow``), which returns 1 where
 the receiver's depth is at most the stored depth (lit) and 0 where a caster
 is nearer (shadowed); nearest filtering, so that each comparison is one
@@ -31,8 +32,11 @@ class ShadowMaps:
     """The depth textures of the lights' shadow maps, kept between frames by
     (light, size), with the light matrix and settings of the frame's last pass."""
 
-    def __init__(self, ctx: moderngl.Context) -> None:
+    def __init__(self, ctx: moderngl.Context, raw: Any = None) -> None:
         self.ctx = ctx
+        self.raw = raw  # glsandbox.gl.rawgl.RawGL: the 32-bit float depth format moderngl does not offer
+        #: Whether each map's depth is 32-bit float (else moderngl's 24-bit fixed point), by (light, size).
+        self.float_depth: dict[tuple[int, int], bool] = {}
         self._maps: dict[tuple[int, int], tuple[moderngl.Texture, moderngl.Framebuffer]] = {}
         #: light -> (its map's texture, light projection @ view (float64), its ShadowMap, the
         #: matrix's uniform bytes by the receiving pass's origin, a texel's width at unit distance)
@@ -42,6 +46,11 @@ class ShadowMaps:
         key = (light, size)
         if key not in self._maps:
             texture = self.ctx.depth_texture((size, size))
+            # 32-bit float depth where the context gives it (core since OpenGL 3.0): the map's
+            # depths are compared with depths the same matrix makes, so 24-bit fixed point is
+            # not the limit at any scale, but a float keeps 24 bits of mantissa at every depth
+            # and fixed point only 2^-24 steps of the whole range.
+            self.float_depth[key] = bool(self.raw is not None and self.raw.float_depth_texture(texture.glo, (size, size)))
             texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
             texture.repeat_x = texture.repeat_y = False
             texture.compare_func = "<="
@@ -86,6 +95,7 @@ class ShadowMaps:
             texture.release()
         self._maps.clear()
         self._current.clear()
+        self.float_depth.clear()
 
 
 @functools.lru_cache(maxsize=64)

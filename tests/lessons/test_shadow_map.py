@@ -160,3 +160,11 @@ def test_gl_state_is_restored_after_a_shadow_map_frame(gl):
                                       ("show=map", "bias=50")])
 def test_shadow_map_goldens(gl, golden, settings):
     check_lesson_golden(gl, golden, "shadow_map", *settings)
+
+
+def test_the_map_stores_32_bit_float_depth_where_the_context_gives_it(gl):
+    gl.render(ShadowMapLesson(show="map"), SIZE)
+    maps = gl.executor.shadow_maps
+    assert maps.float_depth[0, 1024] is True  # OpenGL 3.3 core has DEPTH_COMPONENT32F
+    texture, _ = maps.target(0, 1024)
+    assert gl.host.raw.texture_depth_bits(texture.glo) == (32, True)
