@@ -475,6 +475,16 @@ def cmd_check(args: argparse.Namespace) -> int:
     return 1 if failed else 0
 
 
+def cmd_gradescope(args: argparse.Namespace) -> int:
+    """``glsandbox gradescope``: the Gradescope autograder zip of a grading file (:mod:`glsandbox.grading.gradescope`)."""
+    from glsandbox.grading.gradescope import build_bundle
+
+    names = build_bundle(args.assignment, args.out, args.wheel)
+    print(f"wrote {args.out}: {', '.join(names)}")
+    print("next: upload it as the assignment's autograder (Gradescope: Configure Autograder, zip file)")
+    return 0
+
+
 def cmd_tradeoffs(args: argparse.Namespace) -> int:
     """``glsandbox tradeoffs``: accuracy knobs, timed and compared with a reference (:mod:`glsandbox.measure.tradeoffs`)."""
     from glsandbox.measure.tradeoffs import run
@@ -520,6 +530,10 @@ COMMANDS: dict[str, tuple[str, tuple[str, ...]]] = {
                "glsandbox check submissions/ --rubric shading.grading.toml --html marks.html",
                "glsandbox check --one submission/ --rubric shading.grading.toml --student-report mine.html",
                "glsandbox check phong --golden phong.png --update")),
+    "gradescope": ("build a Gradescope autograder zip from a grading file: setup.sh, run_autograder, the "
+                   "checks, their goldens (hidden ones too) and this glsandbox as a wheel",
+                   ("glsandbox gradescope shading.grading.toml --out autograder.zip",
+                    "glsandbox gradescope shading.grading.toml --out autograder.zip --wheel dist/glsandbox-0.1.0-py3-none-any.whl")),
     "tradeoffs": ("time each accuracy knob and compare it with a reference (FLIP, RMSE): report.md, CSV and plot",
                   ("glsandbox tradeoffs --quick", "glsandbox tradeoffs --knob antialiasing --out out/aa")),
     "bench": ("run every benchmark in benchmarks/ and print one table of side-by-side ratios",
@@ -625,6 +639,15 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
                            help=f"folder mode: {text}")
         add_render_options(p, size_default="the reference's size")
         p.set_defaults(func=cmd_check)
+
+    if wanted("gradescope"):
+        p = add_command(sub, "gradescope")
+        p.add_argument("assignment", type=Path, metavar="ASSIGNMENT",
+                       help="a grading file NAME.grading.toml (glsandbox new --assignment NAME writes one)")
+        p.add_argument("--out", type=Path, default=Path("autograder.zip"), help="the zip to write (default autograder.zip)")
+        p.add_argument("--wheel", type=Path, default=None, metavar="FILE",
+                       help="this glsandbox's wheel (default: built from the checkout, or packed from the installed one)")
+        p.set_defaults(func=cmd_gradescope)
 
     if wanted("tradeoffs"):
         p = add_command(sub, "tradeoffs")

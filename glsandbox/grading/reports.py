@@ -119,7 +119,9 @@ def gradescope_text(results: Sequence[CheckResult], title: str) -> str:
         for o in r.outcomes:
             name = o.check.name if len(results) == 1 else f"{r.shown}: {o.check.name}"
             output = f"{o.status}: {o.detail()}".rstrip(": ")
-            if r.output and o.status != PASS:
+            if o.check.hidden:  # shown after publishing: its outcome and points, never its figures or output
+                output = o.status
+            elif r.output and o.status != PASS:
                 output += "\nlast lines printed:\n" + "\n".join(_output(r))
             tests.append({"name": name, "score": o.points, "max_score": o.check.points, "output": output,
                           "status": "passed" if o.status == PASS else "failed",
@@ -132,7 +134,9 @@ def gradescope_text(results: Sequence[CheckResult], title: str) -> str:
                    "the others after the grades are published")
     else:
         summary = f"glsandbox check: {points(score)}/{points(sum(r.total for r in results))} points"
-    return json.dumps({"score": score, "output": summary, "tests": tests}, indent=2) + "\n"
+    # stdout (check's own lines, hidden checks' figures among them) is the teacher's alone
+    return json.dumps({"score": score, "output": summary, "stdout_visibility": "hidden", "tests": tests},
+                      indent=2) + "\n"
 
 
 _COLOURS = {"PASS": "#d7f5d7", "FAIL": "#ffe0b3", "BROKEN": "#ffd0d0", "TIMEOUT": "#e4d7ff",
