@@ -62,6 +62,8 @@ def _output(r: CheckResult) -> list[str]:
 
 def csv_text(results: Sequence[CheckResult], title: str) -> str:
     table = rows(results)
+    if not table:  # an empty shard of a class
+        return ""
     out = io.StringIO()
     writer = csv.DictWriter(out, fieldnames=list(table[0]), lineterminator="\n")
     writer.writeheader()
@@ -77,9 +79,10 @@ def json_text(results: Sequence[CheckResult], title: str) -> str:
                                     "digest": r.digest, "same_as": [shown(n) for n in r.same_as]}
         if len(r.outcomes) == 1:
             entry.update({k: v for k, v in _figures(r.outcomes[0]).items() if k != "status"})
+            entry["detail"] = r.outcomes[0].detail()
         else:
-            entry["checks"] = [{"check": o.check.name, "points": o.points, "of": o.check.points, **_figures(o)}
-                               for o in r.outcomes]
+            entry["checks"] = [{"check": o.check.name, "points": o.points, "of": o.check.points, **_figures(o),
+                                "detail": o.detail()} for o in r.outcomes]
         submissions.append(entry)
     c = {k.lower().replace(" ", "_"): v for k, v in counts(results).items()}
     return json.dumps({"reference": title, **c, "submissions": submissions}, indent=2) + "\n"
