@@ -476,9 +476,11 @@ def cmd_check(args: argparse.Namespace) -> int:
         if args.update:
             raise SandboxError(f"--update writes references from the model answer: give one lesson, not the folder {target}")
 
+        from glsandbox.grading import portable
         from glsandbox.grading.layers import describe
 
-        layers_line = describe()  # which layers confine a submission on this machine
+        # which layers confine a submission on this machine
+        layers_line = portable.describe() if portable.wanted() else describe()
         bars = []  # the progress bar, made when the first submission reports (the total known then)
 
         def report(done: int, total: int, result) -> None:
