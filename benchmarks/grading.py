@@ -16,7 +16,9 @@ and ``/proc``), one in 4 of the rest wrong, ``--jobs 2 --timeout 2``; its
 notes give the submissions per second, the peak resident memory of the
 grader's whole process tree (RSS summed over it, sampled every 50 ms: pages
 shared by forks count once per process, so an upper bound), and the
-processes and temporary files the run left (none is the goal). ``glsandbox
+processes (found by a mark in their environment) and the supervisors'
+private folders (``glsandbox-grade-*`` in the temp folder) the run left
+(none is the goal). ``glsandbox
 bench`` grades 40 (``--quick``: 20); ``python benchmarks/grading.py --class
 1000`` grades a class of 1,000 once and prints the same figures.
 """
@@ -168,7 +170,8 @@ def grade_class(folder: Path, ref: Path, jobs: int = 2) -> dict[str, object]:
         raise RuntimeError(f"check ended with {proc.returncode}: {errors.decode(errors='replace')[-400:]}")
     time.sleep(0.5)  # a process being reaped is not one left behind
     left = _marked(mark)
-    new_tmp = sorted(name for name in {p.name for p in tmp.iterdir()} - before if "glsandbox" in name)
+    # the supervisors' private folders (on a shared machine, another's grading run at the same time shows too)
+    new_tmp = sorted(name for name in {p.name for p in tmp.iterdir()} - before if name.startswith("glsandbox-grade-"))
     count = sum(1 for _ in folder.iterdir())
     return {"seconds": seconds, "per_second": count / seconds, "peak_mib": peak[0] / 2**20,
             "processes_left": left, "temp_left": new_tmp, "count": count}
