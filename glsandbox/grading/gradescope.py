@@ -164,7 +164,7 @@ def _installed_editable(dist: importlib.metadata.Distribution) -> bool:
 
 def _build_from_checkout(root: Path, folder: Path) -> Path:
     """``uv build --wheel`` (or ``pip wheel``) of the checkout into ``folder``."""
-    uv = shutil.which("uv")
+    uv = shutil.which("uv") or (os.environ.get("UV") if os.path.isfile(os.environ.get("UV", "")) else None)
     commands = ([[uv, "build", "--wheel", "--out-dir", str(folder), str(root)]] if uv else []) + \
         [[sys.executable, "-m", "pip", "wheel", "--no-deps", "--wheel-dir", str(folder), str(root)]]
     reasons = []
@@ -192,10 +192,8 @@ def _wheel_from_installed(dist: importlib.metadata.Distribution, folder: Path) -
     with zipfile.ZipFile(target, "w", zipfile.ZIP_DEFLATED) as wheel:
         for entry in dist.files or []:
             name = entry.as_posix()
-            if name.startswith("..") or "__pycache__" in name or name.endswith((".pyc", "/RECORD", "INSTALLER",
+            if name.startswith(("..", "/")) or "__pycache__" in name or name.endswith((".pyc", "/RECORD", "INSTALLER",
                                                                                  "direct_url.json")):
-                continue
-            if not (name.startswith("glsandbox/") or name.startswith(info + "/")):
                 continue
             data = Path(dist.locate_file(entry)).read_bytes()
             wheel.writestr(name, data)

@@ -203,3 +203,26 @@ def test_bad_input_is_one_line_and_no_zip(tmp_path: Path) -> None:
     rubric.write_text("[[check]\n")
     assert_user_error(run_cli("gradescope", str(rubric), "--out", str(out / "a.zip"), unchanged=out), "not valid TOML")
     assert list(out.iterdir()) == []
+
+
+def test_an_installed_glsandbox_is_packed_back_into_the_same_wheel(tmp_path: Path) -> None:
+    import importlib.metadata
+
+    from glsandbox.grading.gradescope import _build_from_checkout, _project_root, _wheel_from_installed
+
+    root = _project_root()
+    assert root is not None  # the tests run from the checkout
+    built = _build_from_checkout(root, tmp_path / "built")
+    installed = tmp_path / "site"
+    with zipfile.ZipFile(built) as z:
+        z.extractall(installed)
+        original = {n: z.read(n) for n in z.namelist() if not n.endswith("/RECORD")}
+    dist = importlib.metadata.PathDistribution(next(installed.glob("glsandbox-*.dist-info")))
+    (tmp_path / "packed").mkdir()
+    packed = _wheel_from_installed(dist, tmp_path / "packed")
+    assert packed.name == built.name
+    with zipfile.ZipFile(packed) as z:
+        again = {n: z.read(n) for n in z.namelist() if not n.endswith("/RECORD")}
+        record = z.read(next(n for n in z.namelist() if n.endswith("/RECORD"))).decode()
+    assert again == original  # every file of the package, its lessons and shaders, byte for byte
+    assert all(f"{name},sha256=" in record for name in again)
