@@ -135,6 +135,8 @@ def grade_class(folder: Path, ref: Path, jobs: int = 2) -> dict[str, object]:
     tree (MiB), and the processes and temporary files left after it ended."""
     import psutil
 
+    from glsandbox.grading.portable import tree_rss
+
     mark = uuid.uuid4().hex
     tmp = Path(tempfile.gettempdir())
     before = {p.name for p in tmp.iterdir()}
@@ -148,16 +150,7 @@ def grade_class(folder: Path, ref: Path, jobs: int = 2) -> dict[str, object]:
 
     def sample() -> None:
         while not done.is_set():
-            total = 0
-            try:
-                for p in [proc, *proc.children(recursive=True)]:
-                    try:
-                        total += p.memory_info().rss
-                    except psutil.Error:
-                        pass
-            except psutil.Error:
-                pass
-            peak[0] = max(peak[0], total)
+            peak[0] = max(peak[0], tree_rss(proc.pid))
             done.wait(0.05)
 
     sampler = threading.Thread(target=sample, daemon=True)

@@ -38,7 +38,7 @@ import numpy as np
 from glsandbox.grading.isolate import (BROKEN, CRASHED, OOM, TIMEOUT, Job, JobResult, Picture, Reader, _job_data,
                                        job_from, send)
 
-__all__ = ["wanted", "describe", "run_jobs_portable", "child_main"]
+__all__ = ["wanted", "describe", "run_jobs_portable", "child_main", "tree_rss"]
 
 #: Seconds a new interpreter may take to import glsandbox and open its context before its clock starts.
 STARTUP_SECONDS = 60.0
@@ -103,7 +103,7 @@ def _child() -> None:
     from glsandbox.errors import SandboxError
     from glsandbox.frame import HeadlessRenderer
     from glsandbox.grading.sandbox import confine
-    from glsandbox.lesson import find_lesson, submission_lesson, user_code_error
+    from glsandbox.grading.worker import render_job
 
     _limit_memory(job)
     try:
@@ -113,33 +113,27 @@ def _child() -> None:
         return
     confine(root, [root, cwd], cache_writable=job.writes_cache)
     send(out, {"kind": "ready"})
-    try:
-        cls = find_lesson(job.target) if job.source is None else submission_lesson(Path(root) / job.target, job.entry)
-    except MemoryError as exc:
-        send(out, {"kind": "oom", "index": 0, "error": str(user_code_error(exc)), "all": True})
-        return
-    except SandboxError as exc:
-        send(out, {"kind": "broken", "index": 0, "error": str(exc), "all": True})
-        return
-    except BaseException as exc:  # noqa: BLE001 - anything the submission raised while loading
-        send(out, {"kind": "broken", "index": 0, "error": str(user_code_error(exc)), "all": True})
-        return
-    for index, render in enumerate(job.renders):
-        started = time.perf_counter()
-        try:
-            frame = renderer.render(cls.from_settings(render.settings), render.size, render.samples)
-            image = np.ascontiguousarray(frame.image, dtype=np.uint8)
-            send(out, {"kind": "image", "index": index, "shape": list(image.shape),
-                       "seconds": time.perf_counter() - started}, image.tobytes())
-        except MemoryError as exc:
-            send(out, {"kind": "oom", "index": index, "error": str(user_code_error(exc))})
-        except SandboxError as exc:
-            send(out, {"kind": "broken", "index": index, "error": str(exc)})
-        except BaseException as exc:  # noqa: BLE001 - KeyboardInterrupt, SystemExit, its own kinds
-            send(out, {"kind": "broken", "index": index, "error": str(user_code_error(exc))})
+    render_job(job, renderer, root, job.target, out)
 
 
 # --- the grader's side ------------------------------------------------------------------------
+
+
+def tree_rss(pid: int) -> int:
+    """Bytes resident in the process ``pid`` and every descendant psutil finds (shared pages once per process)."""
+    import psutil
+
+    total = 0
+    try:
+        top = psutil.Process(pid)
+        for proc in [top, *top.children(recursive=True)]:
+            try:
+                total += proc.memory_info().rss
+            except psutil.Error:
+                pass
+    except psutil.Error:
+        pass
+    return total
 
 
 def _kill_tree(pid: int) -> None:
@@ -200,6 +194,7 @@ class _Submission:
         self.current, self.started, self.ready = 0, time.monotonic(), False
         self.no_gl = ""
         self.output: list[str] = []
+        self.meta: dict[str, str] = {}
 
     def _read(self) -> None:
         while True:
@@ -217,20 +212,6 @@ class _Submission:
         self.current = len(self.pictures)
         return True
 
-    def _tree_bytes(self) -> int:
-        import psutil
-
-        total = 0
-        try:
-            top = psutil.Process(self.process.pid)
-            for proc in [top, *top.children(recursive=True)]:
-                try:
-                    total += proc.memory_info().rss
-                except psutil.Error:
-                    pass
-        except psutil.Error:
-            pass
-        return total
 
     def poll(self) -> bool:
         """Read what arrived, watch the clock and memory; True once this submission is done."""
@@ -248,6 +229,9 @@ class _Submission:
             if kind == "ready":
                 self.ready, self.started = True, time.monotonic()
                 continue
+            if kind == "meta":  # the tour's card (tour --lessons)
+                self.meta = {k: str(header.get(k, ""))[:2000] for k in ("title", "course_section", "description")}
+                continue
             index = int(header.get("index", -1))
             if index != self.current:
                 return self._finish(CRASHED, "sent a message out of order")
@@ -258,6 +242,8 @@ class _Submission:
                     return self._finish(CRASHED, f"sent a picture of shape {header.get('shape')} for a {w}x{h} render")
                 picture.image = np.frombuffer(payload, dtype=np.uint8).reshape(h, w, 4)
                 picture.seconds = float(header.get("seconds", 0.0))
+                if self.job.describe and isinstance(header.get("info"), dict):
+                    picture.info = header["info"]
             else:
                 picture.status = OOM if kind == "oom" else BROKEN
                 picture.error = str(header.get("error", ""))[:500]
@@ -272,7 +258,7 @@ class _Submission:
         if self.ready and elapsed > self.job.timeout:
             self.pictures[self.current].seconds = elapsed
             return self._finish(TIMEOUT, f"timed out after {self.job.timeout:g} s")
-        if self._tree_bytes() > self.job.memory_mb * 1024 * 1024:
+        if tree_rss(self.process.pid) > self.job.memory_mb * 1024 * 1024:
             return self._finish(OOM, f"out of memory: its processes held more than {self.job.memory_mb} MB")
         code = self.process.poll()
         if code is not None and eof:
@@ -292,7 +278,8 @@ class _Submission:
             for picture in self.pictures:
                 picture.error = picture.error.replace(self.root, self.original)
             output = [line.replace(self.root, self.original) for line in output]
-        return JobResult(self.job, self.pictures, output)
+        meta = {k: v.replace(self.root, self.original) if self.original else v for k, v in self.meta.items()}
+        return JobResult(self.job, self.pictures, output, meta=meta)
 
     def close(self) -> None:
         """Kill its tree, keep its last printed lines (:attr:`output`), remove its private folder."""

@@ -54,3 +54,18 @@ def test_the_portable_path_holds_the_core_hostile_kinds(tmp_path: Path, gl) -> N
     assert outcomes["spy"][0] == "BROKEN" and report["spy"]["output"]  # it printed its environment: not the grader's
     assert SECRET not in proc.stdout + (tmp_path / "r.json").read_text()
     assert {p.pid for p in psutil.Process().children(recursive=True)} <= before  # every tree killed
+
+
+@pytest.mark.slow
+def test_tour_lessons_takes_the_portable_path_too(tmp_path: Path, gl) -> None:
+    lessons = tmp_path / "lessons"
+    lessons.mkdir()
+    (lessons / "room.toml").write_text(RIGHT)
+    (lessons / "endless.py").write_text(LESSON.format(body="while True:\n            pass"))
+    out = tmp_path / "tour"
+    proc = run_cli("tour", "--lessons", str(lessons), "--out", str(out), "--size", "64x48", "--timeout", "2",
+                   env={"GLSANDBOX_ISOLATION": "portable"})
+    assert proc.returncode == 1, proc.stderr
+    cards = {entry["lesson"]: entry for entry in json.loads((out / "tour.json").read_text())["lessons"]}
+    assert cards["endless"]["ok"] is False and cards["endless"]["error"] == "TIMEOUT: timed out after 2 s"
+    assert cards["room"]["ok"] and cards["room"]["title"]  # its card, sent back as on the full path
