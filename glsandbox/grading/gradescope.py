@@ -56,6 +56,7 @@ SETUP_SH = f"""#!/usr/bin/env bash
 # nothing else: glsandbox itself is the wheel beside this script.
 set -euo pipefail
 here="$(cd "$(dirname "${{BASH_SOURCE[0]}}")" && pwd)"
+prefix="${{GLSANDBOX_PREFIX:-{PREFIX}}}"   # where Python and glsandbox go
 export DEBIAN_FRONTEND=noninteractive
 apt-get update
 # OpenGL without a display: EGL and Mesa's software drivers (llvmpipe), OSMesa as the fallback
@@ -65,20 +66,25 @@ apt-get install -y --no-install-recommends ca-certificates python3 python3-pip \
 # --break-system-packages, which 22.04's pip does not know)
 python3 -m pip install --upgrade uv --break-system-packages 2>/dev/null || python3 -m pip install --upgrade uv
 uv="$(python3 -c 'import shutil, sysconfig, os; print(shutil.which("uv") or os.path.join(sysconfig.get_path("scripts"), "uv"))')"
-# glsandbox needs Python 3.11 or newer: uv installs its own, readable by every user
-export UV_PYTHON_INSTALL_DIR={PREFIX}/python
-"$uv" python install 3.12
-"$uv" venv --python 3.12 {PREFIX}/venv
-"$uv" pip install --python {PREFIX}/venv/bin/python "$here"/glsandbox-*.whl
-chmod -R a+rX {PREFIX}
-{PREFIX}/venv/bin/glsandbox --version
+# glsandbox needs Python 3.11 or newer: the image's where it has one (24.04: 3.12), else
+# uv installs 3.12 (22.04 ships 3.10), where every user can read it
+export UV_PYTHON_INSTALL_DIR="$prefix/python"
+python="$("$uv" python find --system '>=3.11' 2>/dev/null || true)"
+if [ -z "$python" ]; then
+    "$uv" python install 3.12
+    python=3.12
+fi
+"$uv" venv --python "$python" "$prefix/venv"
+"$uv" pip install --python "$prefix/venv/bin/python" "$here"/glsandbox-*.whl
+chmod -R a+rX "$prefix"
+"$prefix/venv/bin/glsandbox" --version
 """
 
 RUN_AUTOGRADER = f"""#!/usr/bin/env bash
 # Gradescope runs this for each submission. The score is in results.json; the exit
 # status is 0 even for a failing student (a non-zero one reads as the autograder failing).
 root="${{GLSANDBOX_AUTOGRADER_ROOT:-/autograder}}"
-export PATH="{PREFIX}/venv/bin:$PATH"   # setup.sh's glsandbox, else the one on PATH
+export PATH="${{GLSANDBOX_PREFIX:-{PREFIX}}}/venv/bin:$PATH"   # setup.sh's glsandbox, else the one on PATH
 mkdir -p "$root/results"
 results="$root/results/results.json"
 rm -f "$results"

@@ -141,6 +141,7 @@ def test_the_bundle_grades_a_right_a_wrong_and_a_hostile_submission(tmp_path: Pa
     assert any(n.startswith("glsandbox-") and n.endswith(".whl") for n in names)
     assert modes["setup.sh"] & stat.S_IXUSR and modes["run_autograder"] & stat.S_IXUSR
     assert "uv\" python install 3.12" in setup and "libegl1" in setup and "apt-get update" in setup
+    assert setup.index("apt-get update") < setup.index("apt-get install") < setup.index("pip install --upgrade uv")
     secret_golden = (tmp_path / "teacher" / "goldens" / "secret.png").read_bytes()
 
     outcomes = {}
