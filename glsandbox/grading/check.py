@@ -38,7 +38,8 @@ from glsandbox.errors import SandboxError
 from glsandbox.frame import DEFAULT_SIZE, Frame, HeadlessRenderer
 from glsandbox.lesson import Lesson, entry_point, lesson_files, user_code_error
 from glsandbox.measure.golden import DEFAULT_THRESHOLD, ImageMatch, compare_images, write_artifacts
-from glsandbox.grading.isolate import BROKEN, CRASHED, OOM, TIMEOUT, Job, JobResult, Picture, Render, run_jobs
+from glsandbox.grading.isolate import BROKEN, CRASHED, OOM, TIMEOUT, Job, JobResult, Picture, Render
+from glsandbox.grading.runner import run_jobs
 from glsandbox.grading.kinds import kind_of
 from glsandbox.grading.rubric import Check
 

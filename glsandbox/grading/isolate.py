@@ -227,13 +227,9 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
 
     The grader becomes a subreaper for the run, so a process a submission
     leaves behind whose supervisor was killed still comes back here, and is
-    killed at the end with everything else the run started. Where there is no ``fork``, or
-    ``GLSANDBOX_ISOLATION=portable`` asks, :mod:`glsandbox.grading.portable` runs them instead.
+    killed at the end with everything else the run started. (:func:`glsandbox.grading.runner.run_jobs`
+    chooses between this and :mod:`glsandbox.grading.portable`.)
     """
-    from glsandbox.grading import portable
-
-    if portable.wanted():
-        return portable.run_jobs_portable(jobs, workers, done)
     if not hasattr(os, "fork"):
         from glsandbox.errors import SandboxError
 
