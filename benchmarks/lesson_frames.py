@@ -264,7 +264,7 @@ class RawTransformOrder:
         from glsandbox import geometry
         from lessons import transform_order as lesson
 
-        defaults = {p.name: p.default for p in lesson.TransformOrder.params}
+        defaults = {p.name: p.default for p in lesson.TransformOrder.all_params()}
         assert defaults["order"] == "STR" and defaults["view"] == "single" and defaults["overlay"]
         self.speed, self.spin, self.span = defaults["speed"], defaults["spin"], defaults["trail"]
         self.ctx, self.size, self.fbo = ctx, size, framebuffer(ctx, size)

@@ -661,7 +661,7 @@ def plan(scene: Scene) -> Plan:
     """
     ray = [i for i, vp in enumerate(scene.viewports) if vp.renderer != "raster"]
     if ray:
-        images = {i: Overlay(traced_image_name(i), _PLACEHOLDER, viewport=i, position=(0, 0)) for i in ray}
+        images = {i: Overlay(traced_image_name(i), _PLACEHOLDER, viewport=i, position=(0, 0), scalable=False) for i in ray}
         drawn = plan(traced_scene(scene, images))
         return replace(drawn, passes=(*(_trace_pass(scene, i) for i in ray), *drawn.passes),
                        meshes=tuple(f"{node.name}: {', '.join(node.mesh.notes)}" for node in scene.nodes
