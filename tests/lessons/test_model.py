@@ -247,7 +247,7 @@ def test_model_lesson_plan_is_pinned() -> None:
     from lessons.model import ModelLesson
 
     draw = "floor with phong[NUM_LIGHTS=2]; model with phong[NUM_LIGHTS=2]"
-    assert plan(ModelLesson().scene()).describe() == "\n".join([
+    assert plan(ModelLesson(mesh="rock").scene()).describe() == "\n".join([
         "plan for model",
         "buffers: colour RGBA8, depth 24, no MSAA",
         "programs:",
