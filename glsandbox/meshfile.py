@@ -414,7 +414,7 @@ def _parts(p: Path, scene: Any) -> list[_Part]:
     looks: dict[int, Look] = {}  # by material object: many meshes may share one (and its big image)
     with _quiet():
         try:
-            for transform, name in _placements(scene.graph):
+            for transform, name in _placements(scene.graph, p):
                 geometry = scene.geometry.get(name)
                 if isinstance(geometry, trimesh.Trimesh):
                     parts.append(_part(geometry, transform, len(parts), looks))
@@ -425,8 +425,12 @@ def _parts(p: Path, scene: Any) -> list[_Part]:
     return parts
 
 
-def _placements(graph: Any) -> list[tuple[NDArray[np.float64], Any]]:
+def _placements(graph: Any, path: Path) -> list[tuple[NDArray[np.float64], Any]]:
     """``(world transform, geometry name)`` of every node with geometry, in trimesh's node order.
+
+    A node that is its own ancestor (glTF nodes whose ``children`` form a cycle,
+    which the glTF spec forbids) is refused naming ``path`` and the node: the
+    walk up its parents would never reach the root.
 
     Asking trimesh's graph (``graph[node]``) walks the path from the root for
     every node and checks a hash of the whole graph on each call: a chain of
@@ -441,7 +445,12 @@ def _placements(graph: Any) -> list[tuple[NDArray[np.float64], Any]]:
 
     def transform_of(node: Any) -> NDArray[np.float64]:
         chain = []  # the node and its ancestors whose transforms are not known yet, deepest first
+        seen = set()
         while node not in world:
+            if node in seen:
+                raise SandboxError(f"model file {path}: node {node!r} is its own ancestor "
+                                   "(its nodes' children form a cycle)")
+            seen.add(node)
             parent = forest.parents.get(node)
             if parent is None:  # not under the root: trimesh would not place it either
                 world[node] = np.eye(4)
