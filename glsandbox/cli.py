@@ -591,10 +591,18 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    from glsandbox import supervise
+
     words = sys.argv[1:] if argv is None else argv
+    if argv is None and supervise.CHILD_ENV not in os.environ:
+        source = supervise.user_code_in(words)
+        if source is not None:  # a lesson file of the user's: run in a child that cannot end us quietly
+            return supervise.supervised(words, source)
     named = words[0] if words and words[0] in COMMANDS else None  # else: the whole parser (--help, a mistake)
     args = build_parser(named).parse_args(argv)
-    return run_guarded(lambda: args.func(args))
+    status = run_guarded(lambda: args.func(args))
+    supervise.finished()
+    return status
 
 
 def lesson_main(lesson_cls: type[Lesson], argv: list[str] | None = None) -> int:

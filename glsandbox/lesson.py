@@ -433,6 +433,12 @@ def built_scene(lesson: Lesson) -> Scene:
     is shown, see README "The rule for a lesson file".)"""
     try:
         scene = lesson.build()
+    except SystemExit as exc:  # sys.exit() in build(): no picture, and never a quiet exit 0
+        source = lesson_source(type(lesson))
+        line = _user_line(exc, str(source)) if source is not None else 0
+        where = f"{source}:{line}: " if source is not None else ""
+        raise SandboxError(f"{where}{type(lesson).__name__}.build() exited (SystemExit {exc.code}) "
+                           "before its picture") from None
     except SandboxError as exc:
         source = lesson_source(type(lesson))
         line = _user_line(exc, str(source)) if source is not None else 0
