@@ -161,7 +161,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
     from glsandbox.measure.compare import build_variants, compare_variants, default_out
 
     lesson_cls = find_lesson(args.lesson)
-    out: Path = args.out or default_out(lesson_cls.name)
+    out: Path = args.out or default_out(lesson_cls.name, args.lesson)
     size = _size(args)
     check_writable(out)
     # Everything is parsed and every scene built before a context opens.
@@ -534,7 +534,8 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         p.add_argument("--vary", action="append", default=[], metavar="KEY=V1,V2,...",
                        help="a parameter and its values, one tile each (twice: a grid)")
         add_render_options(p)
-        p.add_argument("--out", type=Path, default=None, help="the PNG to write (default compare_LESSON.png)")
+        p.add_argument("--out", type=Path, default=None, help="the PNG to write (default compare_LESSON.png; "
+                       "for a lesson file, compare_NAME_py.png or compare_NAME_toml.png)")
         p.set_defaults(func=cmd_compare)
 
     if wanted("new"):

@@ -225,7 +225,14 @@ def load_model(path: str | os.PathLike[str], *, fit: bool = False, normals: str 
     :data:`NORMALS`; ``crease_angle``: in degrees, 0..180, for crease normals.
     Every problem is one :class:`SandboxError` line naming the file (module
     docstring). Cached by path, modification time, size and options.
+    numpy's floating-point warnings (a vertex at 1e300 overflows a cross
+    product) are not printed: the checks on the results say what is wrong.
     """
+    with np.errstate(all="ignore"):
+        return _load_model(path, fit=fit, normals=normals, crease_angle=crease_angle)
+
+
+def _load_model(path: str | os.PathLike[str], *, fit: bool, normals: str, crease_angle: float) -> Model:
     if normals not in NORMALS:
         raise SandboxError(f"unknown normals {normals!r} for a model file; use one of {', '.join(NORMALS)}")
     if isinstance(crease_angle, bool) or not isinstance(crease_angle, (int, float)) \

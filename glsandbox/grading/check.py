@@ -26,11 +26,13 @@ import os
 import re
 import time
 import unicodedata
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from PIL import Image
 
 from glsandbox import files
 from glsandbox.errors import SandboxError
@@ -79,7 +81,13 @@ def read_reference(path: Path) -> np.ndarray:
     """The reference PNG as RGBA, or a one-line error naming it."""
     data = files.read_user_file(path, "reference", "a .png file")
     try:
-        return files.load_png(io.BytesIO(data))
+        with warnings.catch_warnings():
+            # A decompression bomb (a small file that decodes to gigabytes): refused, past
+            # Pillow's warning size too, before its pixels are decoded.
+            warnings.simplefilter("error", Image.DecompressionBombWarning)
+            return files.load_png(io.BytesIO(data))
+    except (Image.DecompressionBombError, Image.DecompressionBombWarning) as exc:
+        raise SandboxError(f"reference {path}: too large to decode safely ({' '.join(str(exc).split())})") from None
     except OSError as exc:
         raise SandboxError(f"reference {path}: not a PNG image ({exc})") from None
 

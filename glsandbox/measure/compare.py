@@ -340,5 +340,10 @@ def difference_image(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.dstack([grey, grey, grey, np.full_like(grey, 255)])
 
 
-def default_out(lesson_name: str) -> Path:
+def default_out(lesson_name: str, given: str | None = None) -> Path:
+    """``compare_LESSON.png``; for a lesson file, its whole name with the dot made ``_``
+    (``compare_my_lesson_py.png``, ``compare_my_lesson_toml.png``), so comparing
+    ``my_lesson.py`` and ``my_lesson.toml`` never writes one file over the other."""
+    if given is not None and Path(given).suffix.lower() in (".py", ".toml"):
+        return Path(f"compare_{Path(given).name.replace('.', '_')}.png")
     return Path(f"compare_{lesson_name}.png")
