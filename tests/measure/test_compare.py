@@ -101,7 +101,8 @@ def test_cli_refuses_bad_values_with_exit_2_and_writes_nothing(tmp_path: Path, c
     assert not out.exists()
 
 
-@pytest.mark.parametrize(("lesson", "vary"), [("mirror", "mirror=stencil,off,no_stencil"), ("phong", "lights=0,2")])
+@pytest.mark.parametrize(("lesson", "vary"), [("mirror", "mirror=stencil,off,no_stencil"), ("mirror", "shadow=on,off"),
+                                             ("phong", "lights=0,2")])
 def test_variants_that_cannot_share_a_frame_are_stitched_tile_by_tile(gl, lesson: str, vary: str) -> None:
     # A mirror owns the frame's stencil; lights belong to a whole scene: such
     # variants are rendered alone at the tile size and placed in the frame.
