@@ -378,10 +378,6 @@ class _SceneReader:
                 raise self.fail("nodes", i, "texture", f"expected an image name or file path, got {plain(source)}")
             if source not in BUILTIN_TEXTURES and not Path(source).is_absolute():
                 source = str(self.path.parent / source)  # relative to the scene file, not the shell
-            if source not in BUILTIN_TEXTURES and not Path(source).exists():
-                # Found now, with the line that names it (the image is read when first drawn).
-                raise self.fail("nodes", i, "texture", f"texture file {data['texture']} not found next to "
-                                f"{self.path.name} (built-in images: {', '.join(BUILTIN_TEXTURES)})")
             filter_name = self.text(data, "filter", "nodes", i, default="mip_linear")
             wrap = self.text(data, "wrap", "nodes", i, default="repeat")
             try:

@@ -16,7 +16,6 @@ on every ray and, with ``timing=on``, the cost of one test in microseconds
 from __future__ import annotations
 
 import functools
-import math
 import sys
 import time
 
@@ -41,30 +40,6 @@ from glsandbox.raytrace import INSIDE_TESTS, Plane, Ray, Triangle
 V0, V1, V2 = (30.0, -40.0, 60.0), (60.0, -120.0, 0.0), (0.0, -120.0, 0.0)
 GRID = (80, 60)
 PANEL_SCALE = 1
-
-
-#: The frame size whose rays :func:`vectorised_costs` times (the tradeoffs report's quick size).
-TIMING_SIZE = (64, 48)
-
-
-def vectorised_costs(rounds: int = 3) -> tuple[dict[str, float], int, int]:
-    """Nanoseconds per ray-triangle test of Möller–Trumbore (float64) and the watertight
-    test, measured as ``glsandbox tradeoffs`` measures them (its ``triangle_test`` knob):
-    the vectorised scans over every triangle of its icosphere, on its rays (aimed at the
-    vertices and edges), best of ``rounds``. Returns the costs, rays and triangles."""
-    from glsandbox.measure.knobs.triangle_test import aimed_rays, nearest_t
-
-    tris, origins, directions = aimed_rays(TIMING_SIZE, 0.0)
-    pairs = directions.shape[0] * tris[0].shape[0]
-    costs = {}
-    for test, name in (("mt64", "moller_trumbore"), ("watertight", "watertight")):
-        best = math.inf
-        for _ in range(rounds):
-            start = time.perf_counter()
-            nearest_t(test, tris, origins, directions)
-            best = min(best, time.perf_counter() - start)
-        costs[name] = best / pairs * 1e9
-    return costs, directions.shape[0], tris[0].shape[0]
 
 
 @functools.lru_cache(maxsize=2)
@@ -101,12 +76,7 @@ def panels(timing: bool) -> tuple[np.ndarray, list[str]]:
             f"{'hit' if tri.intersect(Ray((0, 0, 0), (0, 0, 1))) else 'miss'}",
             f"all six agree on {w * h} rays: {'yes' if agree else 'NO'}; {int(reference.sum())} hit the triangle"]
     if timing:
-        # The scalar tests, one Python call per ray (the six side by side), and the two the
-        # engines use, vectorised as the tradeoffs report times them: the numbers to compare.
-        rows.append("us per scalar test: " + ", ".join(f"{k} {v:.1f}" for k, v in costs.items()))
-        fast, n_rays, n_tris = vectorised_costs()
-        rows.append(f"vectorised ({n_rays} rays x {n_tris} triangles, as tradeoffs): ns per test: "
-                    + ", ".join(f"{k} {v:.1f}" for k, v in fast.items()))
+        rows.append("us per test: " + ", ".join(f"{k} {v:.1f}" for k, v in costs.items()))
     return np.concatenate([top, bottom], axis=0), rows
 
 

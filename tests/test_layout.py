@@ -31,7 +31,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("window and measuring", ("glsandbox.window", "glsandbox.panel", "glsandbox.controls", "glsandbox.notebook",
                               "glsandbox.notebook_view", "glsandbox.course_page", "glsandbox.measure")),
     ("grading", ("glsandbox.grading",)),
-    ("command line", ("glsandbox.cli", "glsandbox.pytest_plugin", "glsandbox.__main__")),
+    ("command line", ("glsandbox.cli", "glsandbox.supervise", "glsandbox.pytest_plugin", "glsandbox.__main__")),
 ]
 
 #: The two doors up, each opened only when called: lesson discovery

@@ -20,12 +20,6 @@ def _scene(folder: Path, node: str) -> Path:
     return path
 
 
-def test_a_missing_texture_names_the_scene_file_and_line(tmp_path: Path) -> None:
-    _scene(tmp_path, 'texture = "box"')
-    proc = run_cli("render", "scene.toml", "--out", str(tmp_path / "o.png"), cwd=tmp_path, unchanged=tmp_path)
-    assert_user_error(proc, "scene.toml:4: nodes[0].texture: texture file box not found")
-
-
 def test_a_shader_error_is_relative_to_the_users_folder_and_a_nul_byte_is_refused(tmp_path: Path, gl) -> None:
     (tmp_path / "bad.glsl").write_text(SHADER.format(tail=""))
     _scene(tmp_path, 'shader = "bad.glsl"')
