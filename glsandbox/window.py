@@ -41,7 +41,8 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
                max_frames: int | None = None, instead: str | None = None) -> None:
     """Open a window and run the lesson until ESC or the window closes.
 
-    Keys: ESC quits; F1 hides or shows the panel; F12 writes ``screenshots/<lesson>-<n>.png``
+    Keys: ESC quits; F1 hides or shows the panel; F2 prints the story of the pixel under
+    the mouse cursor (``glsandbox explain``); F12 writes ``screenshots/<lesson>-<n>.png``
     (the next free ``n``; the frame without the panel); R reloads the
     shaders from disk (a broken shader keeps the last good program and shows
     its error in the title and on stderr), as saving a node's own shader file
@@ -68,7 +69,7 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
     renderer = FrameRenderer(host)
     executor = renderer.executor
     motion = InteractiveResolution()  # ray-traced viewports: coarser while the camera moves
-    state = {"lesson": lesson, "error": "", "lesson_error": "", "shoot": False}
+    state = {"lesson": lesson, "error": "", "lesson_error": "", "shoot": False, "explain": False}
     session = Session(lesson, Clock(lesson.time, glfw.get_time()), samples, CameraInput())
     pending: list[int] = []
 
@@ -161,6 +162,8 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
             panel.toggle()  # without imgui-bundle: one line saying how to install the panel
         elif key == glfw.KEY_F12:
             state["shoot"] = True  # taken from the next frame's target, before the panel is drawn
+        elif key == glfw.KEY_F2:
+            state["explain"] = True  # the pixel under the cursor, in the next frame's scene
         elif key == glfw.KEY_R:
             reload_shaders()
             if source is not None:
@@ -193,6 +196,10 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
                 if state["shoot"]:
                     state["shoot"] = False
                     screenshot(target.read(), next_numbered(screenshot_dir, lesson.name))
+                if state["explain"]:
+                    state["explain"] = False
+                    explain_cursor(host.window, scene, (width, height), renderer, current.name)
+                    target.framebuffer.use()
                 session.record((width, height), frame_plan)
                 host.raw.blit_color(target.resolved().glo, host.ctx.screen.glo, (width, height))
                 host.ctx.screen.use()
@@ -213,6 +220,28 @@ def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: in
         panel.close()
         renderer.close()
         host.release()
+
+
+def explain_cursor(window: Any, scene: Scene, size: tuple[int, int], renderer: FrameRenderer, title: str) -> None:
+    """F2: print the story of the pixel under the mouse cursor (:func:`glsandbox.story.pixel_story`;
+    a rasterised pixel's frame is drawn again with its X-ray on the window's own renderer)."""
+    import glfw
+
+    from glsandbox.story import pixel_story
+
+    cx, cy = glfw.get_cursor_pos(window)
+    ww, wh = glfw.get_window_size(window)
+    # Window coordinates to framebuffer pixels (a HiDPI framebuffer has more of them), row 0 at the top.
+    x, y = int(cx * size[0] / max(ww, 1)), int(cy * size[1] / max(wh, 1))
+    if not (0 <= x < size[0] and 0 <= y < size[1]):
+        print("explain: the cursor is outside the window", file=sys.stderr, flush=True)
+        return
+    try:
+        story = pixel_story(scene, size, (x, y), title, lambda: renderer)
+    except SandboxError as exc:
+        print(f"error: {exc}", file=sys.stderr, flush=True)
+        return
+    print(story.text, flush=True)
 
 
 def screenshot(image: np.ndarray, path: Path) -> Path:
