@@ -176,7 +176,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
     from glsandbox.measure.compare import build_variants, compare_variants, default_out
 
     lesson_cls = find_lesson(args.lesson)
-    out: Path = args.out or default_out(lesson_cls.name)
+    out: Path = args.out or default_out(lesson_cls.name, args.lesson)
     size = _size(args)
     check_writable(out)
     # Everything is parsed and every scene built before a context opens.
@@ -709,7 +709,8 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         p.add_argument("--vary", action="append", default=[], metavar="KEY=V1,V2,...",
                        help="a parameter and its values, one tile each (twice: a grid)")
         add_render_options(p)
-        p.add_argument("--out", type=Path, default=None, help="the PNG to write (default compare_LESSON.png)")
+        p.add_argument("--out", type=Path, default=None, help="the PNG to write (default compare_LESSON.png; "
+                       "for a lesson file, compare_NAME_py.png or compare_NAME_toml.png)")
         p.set_defaults(func=cmd_compare)
 
     if wanted("new"):
@@ -794,12 +795,20 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    from glsandbox import supervise
+
     words = sys.argv[1:] if argv is None else argv
     if words[:2] == ["check", "merge"]:  # a verb of its own: the shards' reports, not a lesson named merge
         return cmd_check_merge(words[2:])
+    if argv is None and supervise.CHILD_ENV not in os.environ:
+        source = supervise.user_code_in(words)
+        if source is not None:  # a lesson file of the user's: run in a child that cannot end us quietly
+            return supervise.supervised(words, source)
     named = words[0] if words and words[0] in COMMANDS else None  # else: the whole parser (--help, a mistake)
     args = build_parser(named).parse_args(argv)
-    return run_guarded(lambda: args.func(args))
+    status = run_guarded(lambda: args.func(args))
+    supervise.finished()
+    return status
 
 
 def lesson_main(lesson_cls: type[Lesson], argv: list[str] | None = None) -> int:

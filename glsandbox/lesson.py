@@ -187,6 +187,11 @@ def camera_from_numbers(base: Camera, numbers: tuple[float, ...]) -> Camera:
 CAMERA = Param("camera", "", "replace the lesson's camera: eye x,y,z, target x,y,z[, fov, near, far] "
                "(empty: the lesson's own)", convert=parse_camera)
 
+#: Every lesson has ``overlay``: off drops the text, figures and helper lines drawn on
+#: the picture (a lesson's own, such as a trail, too), leaving the 3D picture alone.
+OVERLAY = Param("overlay", True, "the text, figures and helper lines drawn on the picture "
+                "(off: the 3D picture alone, to compare pixel for pixel)")
+
 
 class Lesson:
     """Base class. Subclasses set the class attributes and implement :meth:`build`."""
@@ -284,6 +289,8 @@ class Lesson:
         motion = self.motion()
         if motion is None:
             return None
+        if motion.overlays and not self.values.get("overlay", True):
+            motion = replace(motion, overlays={})  # overlay=off: the scene has none to change
         cls = type(self)
         last = cls.__dict__.get("_scene_last")  # (values, their types, scene) of the class's last frame
         if last is not None:  # the same values as the last frame's (the common case): no key hashed
@@ -348,6 +355,8 @@ class Lesson:
         camera = self.values.get("camera")
         if camera:  # --set camera=...: the lens stays the lesson's where not given
             scene = replace(scene, camera=camera_from_numbers(scene.camera, camera))
+        if scene.overlays and not self.values.get("overlay", True):
+            scene = replace(scene, overlays=())
         plan_mode = self.values.get("effects", "needed")  # effects=all: the bench's everything-on plan
         scene = scene if scene.plan_mode == plan_mode else replace(scene, plan_mode=plan_mode)
         uniforms = {k[len(UNIFORM_PREFIX):]: v for k, v in self.values.items() if k.startswith(UNIFORM_PREFIX)}
@@ -369,7 +378,7 @@ class Lesson:
 SCENES_KEPT = 16
 
 #: The parameters every lesson has; a lesson's own may not reuse their names.
-SHARED_PARAMS = (TIME, RENDERER, EFFECTS_PARAM, CAMERA)
+SHARED_PARAMS = (TIME, RENDERER, EFFECTS_PARAM, CAMERA, OVERLAY)
 
 
 def check_lesson_class(cls: type[Lesson]) -> None:
@@ -424,6 +433,12 @@ def built_scene(lesson: Lesson) -> Scene:
     is shown, see README "The rule for a lesson file".)"""
     try:
         scene = lesson.build()
+    except SystemExit as exc:  # sys.exit() in build(): no picture, and never a quiet exit 0
+        source = lesson_source(type(lesson))
+        line = _user_line(exc, str(source)) if source is not None else 0
+        where = f"{source}:{line}: " if source is not None else ""
+        raise SandboxError(f"{where}{type(lesson).__name__}.build() exited (SystemExit {exc.code}) "
+                           "before its picture") from None
     except SandboxError as exc:
         source = lesson_source(type(lesson))
         line = _user_line(exc, str(source)) if source is not None else 0

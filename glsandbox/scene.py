@@ -707,7 +707,7 @@ def moved_scene(scene: Scene, motion: Motion) -> Scene:
         if unknown:
             raise SandboxError(f"scene {scene.name!r}: the motion changes overlay "
                                f"{', '.join(map(repr, sorted(unknown)))}, which is not an overlay of the scene")
-        overlays = tuple(Overlay(o.name, images[o.name], o.viewport, o.position) if o.name in images else o
+        overlays = tuple(Overlay(o.name, images[o.name], o.viewport, o.position, o.scalable) if o.name in images else o
                          for o in overlays)
     if motion.lights:
         lights = _moved_lights(scene, motion.lights)

@@ -27,11 +27,13 @@ import re
 import sys
 import time
 import unicodedata
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
+from PIL import Image
 
 from glsandbox import files
 from glsandbox.errors import SandboxError
@@ -84,7 +86,13 @@ def read_reference(path: Path) -> np.ndarray:
         raise SandboxError(f"reference {path}: an empty file, not a PNG image; write it from the model answer "
                            "with --update")
     try:
-        return files.load_png(io.BytesIO(data))
+        with warnings.catch_warnings():
+            # A decompression bomb (a small file that decodes to gigabytes): refused, past
+            # Pillow's warning size too, before its pixels are decoded.
+            warnings.simplefilter("error", Image.DecompressionBombWarning)
+            return files.load_png(io.BytesIO(data))
+    except (Image.DecompressionBombError, Image.DecompressionBombWarning) as exc:
+        raise SandboxError(f"reference {path}: too large to decode safely ({' '.join(str(exc).split())})") from None
     except (OSError, ValueError, SyntaxError):  # Pillow's reason names its buffer object, no use to a reader
         raise SandboxError(f"reference {path}: not a PNG image ({len(data)} bytes that PNG cannot read)") from None
 
