@@ -24,7 +24,10 @@ The same harness drives ``python benchmarks/cube_frame.py`` on its own.
 from __future__ import annotations
 
 import importlib.util
+import datetime
 import json
+import os
+import platform
 import statistics
 import subprocess
 import sys
@@ -376,12 +379,20 @@ def run_all(json_path: Path | None = None, quick: bool = False, only: Sequence[s
     for text in env.notes:
         print(text)
     if json_path is not None:
-        data = {"title": title, "renderer": renderer, "rounds": rounds, "quick": quick,
+        data = {"title": title, "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+                "machine": machine(), "renderer": renderer, "rounds": rounds, "quick": quick,
                 "seconds": round(time.perf_counter() - started, 2), "cases": [r.to_dict() for r in results],
                 "notes": list(env.notes)}
         write_text(json_path, json.dumps(data, indent=2) + "\n")
         print(f"wrote {json_path}")
     return 0
+
+
+def machine() -> str:
+    """The machine a run measured on, in one line: system, processor and cores, Python."""
+    cpu = platform.processor() or platform.machine()
+    return (f"{platform.system()} {platform.release()}, {cpu}, {os.cpu_count()} cores, "
+            f"Python {platform.python_version()}")
 
 
 def _quick(case: Case) -> Case:
