@@ -14,7 +14,7 @@ panel is text whose numbers change), the raw side does that work too, with its
 own code; what never changes (a constant text panel) is made once, like a mesh.
 The table's last column says whether both draw the same picture; the tests
 (``tests/measure/test_tradeoffs_bench.py``) check each pixel for pixel at 160x120.
-Goals (issue 24): glsandbox <= 1.05x raw, and at most 50 us of extra main-thread
+Goals: glsandbox <= 1.05x raw, and at most 50 us of extra main-thread
 CPU per frame (the bench's "extra CPU" column).
 """
 

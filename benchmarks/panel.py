@@ -1,4 +1,4 @@
-"""Benchmark: a lesson window frame with and without the live controls (issue 14).
+"""Benchmark: a lesson window frame with and without the live controls.
 
 One glfw window on the window backend (under Xvfb where there is no screen:
 ``xvfb-run glsandbox bench --only panel``), 800x600, the phong lesson: each

@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, BinaryIO
 import numpy as np
 from PIL import Image
 
-if TYPE_CHECKING:  # annotations only: numpy.typing is not imported at run time (a cold start, issue 24)
+if TYPE_CHECKING:  # annotations only: numpy.typing is not imported at run time (a cold start)
     import numpy.typing as npt
 
 from glsandbox.errors import SandboxError
@@ -230,7 +230,7 @@ def _png_image(image: npt.ArrayLike) -> Image.Image:
 class _PngBuffer(io.BytesIO):
     """An in-memory file named ``*.png``: Pillow then takes the format from the name and
     imports only its PNG plugin, where ``format="PNG"`` imports five (BMP, GIF, JPEG, PPM
-    and PNG: about 2 ms of every cold start, issue 24). The bytes are the same."""
+    and PNG: about 2 ms of every cold start). The bytes are the same."""
 
     name = "image.png"
 

@@ -229,7 +229,7 @@ class FrameRenderer:
 
     def render_motion(self, scene: Scene, motion: Motion, size: tuple[int, int]) -> Frame | None:
         """The frame of ``moved_scene(scene, motion)``, read back, drawn without making that scene
-        (issue 24: a frame whose only change is time pays for what moves): the motion's model
+        (a frame whose only change is time pays for what moves): the motion's model
         matrices and lights are checked as :func:`~glsandbox.scene.moved_scene` checks them
         (:func:`~glsandbox.scene.motion_parts`), the plan is the one kept for frames moved from
         ``scene`` while its :func:`~glsandbox.plan.motion_decisions` agree, and the executor

@@ -335,7 +335,7 @@ class Lesson:
         :class:`~glsandbox.scene.Motion` promises that :meth:`build` depends on its
         :attr:`values` alone, and that its scene at any time is the one built at another
         time with this motion applied (a static lesson returns an empty ``Motion()``);
-        its frames then pay only for what moves (issue 24). ``tests/core/test_frame_cache.py``
+        its frames then pay only for what moves. ``tests/core/test_frame_cache.py``
         checks every built-in lesson's promise, pixel for pixel, at several times."""
         return None
 

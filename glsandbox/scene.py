@@ -24,7 +24,7 @@ from glsandbox.errors import NUMBER_LIMIT, SandboxError, check_number, check_num
 from glsandbox.geometry import Mesh
 from glsandbox.overlay import Overlay
 
-if TYPE_CHECKING:  # imported where a scene has a planar effect: a plain render skips it (a cold start, issue 24)
+if TYPE_CHECKING:  # imported where a scene has a planar effect: a plain render skips it (a cold start)
     from glsandbox.planar import Mirror, PlanarShadow
 
 Color = tuple[float, float, float, float]
@@ -611,7 +611,7 @@ class Scene:
             raise SandboxError(f"scene {self.name!r}: samples must be a whole number >= 0, got {plain(self.samples)}")
 
 
-# --- frames that pay only for what moves (issue 24) ------------------------------
+# --- frames that pay only for what moves ------------------------------
 
 
 @dataclass(frozen=True)

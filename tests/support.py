@@ -431,3 +431,10 @@ def two_textures_glb(path: Path) -> Path:
         parts.append(square)
     trimesh.Scene(parts).export(path)
     return path
+
+
+def chromium_command(binary: str, profile: Path, size: tuple[int, int]) -> list[str]:
+    """Headless Chromium, offline and quiet, with a fresh profile."""
+    return [binary, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+            "--disable-background-networking", "--disable-component-update", "--disable-sync",
+            "--hide-scrollbars", f"--user-data-dir={profile}", f"--window-size={size[0]},{size[1]}"]

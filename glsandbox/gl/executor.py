@@ -31,7 +31,7 @@ from glsandbox.gl.passes import FrameState, PassRunner
 from glsandbox.plan import SHADOW_MAP_UNIT, Draw, Pass, Plan, ProgramVariant, plan as make_plan
 from glsandbox.scene import Camera, Light, Material, Node, Scene, mesh_origin
 
-try:  # hashlib.blake2b is this very type; importing hashlib loads OpenSSL too (~4 ms of every start, issue 24)
+try:  # hashlib.blake2b is this very type; importing hashlib loads OpenSSL too (~4 ms of every start)
     from _blake2 import blake2b
 except ImportError:  # a Python built without its own BLAKE2
     from hashlib import blake2b
@@ -305,7 +305,7 @@ class _Steps(dict):
 
 
 class _DrawStep:
-    """One draw of a kept plan prepared once (issue 24's flat draw list): what
+    """One draw of a kept plan prepared once (the flat draw list): what
     :meth:`Executor.draw_node` found for ``draw`` drawn with ``material`` and ``front_face``
     (its set-up, culling, whether lit, its material's constant uniform bytes). A frame whose
     only change is time finds it by the Draw (plans are kept while only time moves) and
@@ -633,7 +633,7 @@ class Executor:
         return frame_plan
 
     def _prepare_frame(self, scene: Scene, frame_plan: Plan, size: tuple[int, int]) -> _PreparedFrame:
-        """What every frame of ``frame_plan`` at ``size`` shares, found once (issue 24): each pass's
+        """What every frame of ``frame_plan`` at ``size`` shares, found once: each pass's
         runner, viewport rectangle and state habits, the programs compiled, the scene's checks
         (raster viewports only, ``--set u.NAME`` values some shader declares). Kept while the
         plan, the scene's viewports and overrides, the size and the programs stay the same objects."""

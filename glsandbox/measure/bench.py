@@ -53,7 +53,7 @@ from glsandbox.gl.context import headless_order
 
 #: The frame size of the frame benchmarks (the course's 800x600 window).
 FRAME_SIZE = (800, 600)
-#: Goals of a lesson frame against its raw-ModernGL baseline (issue 24): at most this ratio
+#: Goals of a lesson frame against its raw-ModernGL baseline: at most this ratio
 #: of the raw frame's wall time, and at most this much extra main-thread CPU (µs) per frame.
 LESSON_FRAME_GOAL = 1.05
 LESSON_FRAME_CPU_GOAL_US = 50.0
