@@ -1,4 +1,4 @@
-"""The ``glsandbox`` command, and ``python -m lessons.<module>``.
+"""The ``glsandbox`` command, and ``python -m glsandbox.lessons.<module>``.
 
 ``list``, ``run LESSON``, ``render LESSON --out FILE.png``, ``tour [--out DIR]
 [--lessons DIR]``, ``plan LESSON``, ``compare``, ``new NAME``, ``check LESSON
@@ -638,7 +638,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def lesson_main(lesson_cls: type[Lesson], argv: list[str] | None = None) -> int:
     """Entry point of a lesson module: a window, or ``--headless --out FILE.png``."""
-    prog = f"python -m lessons.{lesson_cls.name}"
+    prog = f"python -m glsandbox.lessons.{lesson_cls.name}"
     parser = ArgumentParser(prog=prog, description=f"{lesson_cls.title} ({lesson_cls.course_section}): "
                             "opens it in a window, or renders it headless to a PNG.",
                             epilog=f"examples:\n  {prog}\n  {prog} --headless --out {lesson_cls.name}.png",
@@ -659,7 +659,7 @@ def lesson_main(lesson_cls: type[Lesson], argv: list[str] | None = None) -> int:
             from glsandbox.window import run_window
 
             run_window(lesson, size, args.samples, args.backend,
-                       instead=f"or render it headless: python -m lessons.{lesson_cls.name} --headless --out FILE.png")
+                       instead=f"or render it headless: {prog} --headless --out FILE.png")
         return 0
 
     return run_guarded(body)

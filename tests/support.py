@@ -438,3 +438,36 @@ def chromium_command(binary: str, profile: Path, size: tuple[int, int]) -> list[
     return [binary, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
             "--disable-background-networking", "--disable-component-update", "--disable-sync",
             "--hide-scrollbars", f"--user-data-dir={profile}", f"--window-size={size[0]},{size[1]}"]
+
+
+# --- a user's own lessons/ package beside the course's ---------------------------------------
+
+#: Run in a folder made by :func:`student_lessons_folder` with ``theirs first`` or ``course first``:
+#: prints the user's ``lessons`` package's file, the course's package's file and the module a
+#: course lesson found by name comes from.
+STUDENT_LESSONS_CHECK = """
+import sys
+def theirs():
+    import lessons, lessons.indexed_cube
+    assert lessons.indexed_cube.MINE == "the user's own", lessons.indexed_cube
+    return lessons.__file__
+def course():
+    import glsandbox, glsandbox.lesson as L
+    cls = L.find_lesson("indexed_cube")
+    L.all_lessons()
+    glsandbox.lesson.builtin_lessons()
+    return sys.modules["glsandbox.lessons"].__file__, cls.__module__
+if sys.argv[1] == "theirs first":
+    mine = theirs(); (package, module) = course()
+else:
+    (package, module) = course(); mine = theirs()
+print(mine, package, module)
+"""
+
+
+def student_lessons_folder(tmp_path: Path) -> Path:
+    """A working directory with a user's own ``lessons`` package, which has an ``indexed_cube`` of its own."""
+    (tmp_path / "lessons").mkdir()
+    (tmp_path / "lessons" / "__init__.py").write_text('"""A student\'s own lessons."""\n')
+    (tmp_path / "lessons" / "indexed_cube.py").write_text('MINE = "the user\'s own"\n')
+    return tmp_path

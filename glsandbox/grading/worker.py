@@ -32,7 +32,7 @@ __all__ = ["PRELOAD", "zygote_main"]
 #: opens a GL context at import).
 PRELOAD = ["glsandbox.grading.worker", "glsandbox.frame", "glsandbox.lesson", "glsandbox.scene_file",
            "glsandbox.grading.sandbox", "glsandbox.gl.context", "glsandbox.gl.shaders", "numpy", "moderngl",
-           "glcontext", "glcontext.egl", "PIL.Image", "lessons"]
+           "glcontext", "glcontext.egl", "PIL.Image", "glsandbox.lessons"]
 
 #: The environment a renderer keeps (by prefix): the drivers', the locale's and glsandbox's own.
 _ENV_KEPT = ("PATH", "HOME", "LANG", "LC_", "TZ", "DISPLAY", "WAYLAND_", "XDG_", "MESA_", "LIBGL_", "GALLIUM_",
