@@ -73,10 +73,11 @@ def knob_renders(knob: Knob, quick: bool, runs: int) -> int:
 
 def measure_knob(knob: Knob, context: RenderContext, out: Path, quick: bool, runs: int = RUNS,
                  log: Callable[[str], None] = lambda s: None,
-                 advance: Callable[[int], object] = lambda n: None) -> KnobResult:
+                 advance: Callable[[int], object] = lambda n: None, flip: bool = True) -> KnobResult:
     """Render every setting and the reference, time them in interleaved runs, compare with the reference.
 
     ``advance(1)`` is called after each of the :func:`knob_renders` renders (a progress bar's ``update``).
+    ``flip=False`` (flip-evaluator missing) leaves FLIP and the error maps out.
     """
     settings = [*knob.chosen(quick), knob.reference]
     pictures = []
@@ -109,17 +110,20 @@ def measure_knob(knob: Knob, context: RenderContext, out: Path, quick: bool, run
     rows = []
     for setting, picture, taken in zip(settings, pictures, times):
         is_ref = setting is knob.reference
-        flip_mean, error_map = flip_error(reference, picture)
         stem = f"{knob.name}-{_slug(setting.label)}"
         image_path, map_path = Path("images") / f"{stem}.png", Path("error_maps") / f"{stem}.png"
         save_png(np.ascontiguousarray(picture), out / image_path)
-        save_png(np.ascontiguousarray(error_map), out / map_path)
+        flip_mean: float | None = None
+        if flip:
+            flip_mean, error_map = flip_error(reference, picture)
+            save_png(np.ascontiguousarray(error_map), out / map_path)
         count = None
         if setting.count is not None:
             log(f"  count {knob.count_label} of {setting.label}")
             count = setting.count(context)
         rows.append(Row(knob.name, setting.label, is_ref, taken, metrics.rmse(reference, picture),
-                        metrics.psnr(reference, picture), flip_mean, str(image_path), str(map_path), count))
+                        metrics.psnr(reference, picture), flip_mean, str(image_path),
+                        str(map_path) if flip else "", count))
     return KnobResult(knob, rows)
 
 
@@ -136,6 +140,9 @@ def run(out: Path, quick: bool = False, backend: str | None = None, runs: int = 
             raise SandboxError(f"unknown knob {unknown[0]!r}; knobs: {', '.join(k.name for k in knobs)}")
         knobs = [k for k in knobs if k.name in only]
     extra.require_all()  # before anything is rendered or written
+    flip = extra.has_flip()
+    if not flip:
+        say(extra.FLIP_MISSING)
     try:
         for folder in (out, out / "images", out / "error_maps"):
             folder.mkdir(parents=True, exist_ok=True)
@@ -158,7 +165,8 @@ def run(out: Path, quick: bool = False, backend: str | None = None, runs: int = 
                 continue
             say(f"[{number}/{len(knobs)}] {knob.name}: {len(knob.chosen(quick))} settings + reference")
             try:
-                results.append(measure_knob(knob, context, out, quick, runs, lambda text: say(text), bar.update))
+                results.append(measure_knob(knob, context, out, quick, runs, lambda text: say(text), bar.update,
+                                            flip=flip))
             except OSError as exc:  # its images could not be written
                 raise SandboxError(f"--out {out}: cannot write ({exc.strerror or exc})") from None
         host = context.renderer.host
