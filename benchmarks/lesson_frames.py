@@ -210,7 +210,7 @@ class RawTexture:
     def __init__(self, ctx: moderngl.Context, size: tuple[int, int]) -> None:
         from glsandbox import geometry
         from glsandbox.images import builtin_levels
-        from lessons.texture import ground
+        from glsandbox.lessons.texture import ground
 
         self.ctx, self.size, self.fbo = ctx, size, framebuffer(ctx, size)
         self.program = ctx.program(vertex_shader=TEXTURED_VS, fragment_shader=TEXTURED_FS)
@@ -262,7 +262,7 @@ class RawTransformOrder:
         from PIL import Image, ImageDraw, ImageFont
 
         from glsandbox import geometry
-        from lessons import transform_order as lesson
+        from glsandbox.lessons import transform_order as lesson
 
         defaults = {p.name: p.default for p in lesson.TransformOrder.params}
         assert defaults["order"] == "STR" and defaults["view"] == "single" and defaults["overlay"]
@@ -389,7 +389,7 @@ class RawMirror:
 
     def __init__(self, ctx: moderngl.Context, size: tuple[int, int]) -> None:
         from glsandbox import geometry
-        from lessons import mirror as lesson
+        from glsandbox.lessons import mirror as lesson
 
         v = {p.name: p.default for p in lesson.MirrorLesson.params}
         assert (v["mirror"], v["shadow"], v["light"], v["depth"], v["offset"]) == \
@@ -571,7 +571,7 @@ class RawShadowMap:
 
     def __init__(self, ctx: moderngl.Context, size: tuple[int, int]) -> None:
         from glsandbox import geometry
-        from lessons import shadow_map as lesson
+        from glsandbox.lessons import shadow_map as lesson
 
         self.ctx, self.size, self.fbo, self.lesson = ctx, size, framebuffer(ctx, size), lesson
         self.depth = ctx.program(vertex_shader=SOLID_VS, fragment_shader=SOLID_FS)

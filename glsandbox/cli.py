@@ -26,7 +26,7 @@ from glsandbox.errors import SandboxError, parse_size_text
 from glsandbox.files import save_png, write_text
 from glsandbox.frame import DEFAULT_SIZE, Frame, HeadlessRenderer, with_samples
 from glsandbox.gl.context import BACKENDS
-from glsandbox.lesson import Lesson, all_lessons, find_lesson, lesson_description, lesson_files, submission_lesson
+from glsandbox.lesson import Lesson, all_lessons, find_lesson, lesson_description, lesson_files
 from glsandbox.plan import plan
 from glsandbox.progress import progress, say
 from glsandbox.scene import Scene
@@ -181,8 +181,6 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
 
 def cmd_tour(args: argparse.Namespace) -> int:
-    from glsandbox.grading.check import render_lesson
-
     out: Path = args.out
     if args.lessons is not None and not args.lessons.is_dir():
         raise SandboxError(f"--lessons {args.lessons}: not a folder")
@@ -194,45 +192,11 @@ def cmd_tour(args: argparse.Namespace) -> int:
         raise SandboxError(f"--out {out}: cannot create folder ({exc.strerror})") from None
     if not os.access(out, os.W_OK | os.X_OK):
         raise SandboxError(f"--out {out}: folder is not writable")
-    # (name, how to load it): the course's lessons, or with --lessons DIR the files in DIR instead
-    if args.lessons is not None:
-        found = lesson_files(args.lessons)
-        if not found:
-            raise SandboxError(f"--lessons {args.lessons}: no .py or .toml lesson files (nor subfolders holding one)")
-        lessons = [(name, lambda path=path: submission_lesson(path)) for name, path in found]
-        commands = {name: f"glsandbox run {shlex.quote(str(path))}" for name, path in found}
-    else:
-        lessons = [(cls.name, lambda cls=cls: cls) for cls in all_lessons()]
-        commands = {cls.name: f"glsandbox run {cls.name}" for cls in all_lessons()}
-    results = []
     started = time.perf_counter()
-    with HeadlessRenderer(args.backend) as renderer, progress(len(lessons), "tour", "lesson") as bar:
-        say(f"tour: {len(lessons)} lessons at {size[0]}x{size[1]} on {renderer.host.backend} "
-            f"({renderer.host.ctx.info['GL_RENDERER']}) -> {out}/")
-        for number, (name, load) in enumerate(lessons, start=1):
-            entry = {"lesson": name, "title": "", "course_section": "", "command": commands[name], "contrasts": []}
-            prefix = f"[{number}/{len(lessons)}] {name}"
-            try:
-                cls = load()
-                entry.update(title=cls.title, course_section=cls.course_section, description=lesson_description(cls))
-                if args.lessons is None:
-                    frame = renderer.render(cls(), size, args.samples)
-                else:  # a user's file: its own exceptions are one line, and a fresh context each
-                    frame = render_lesson(cls(), size, args.samples, args.backend)
-                image_path = out / f"{name}.png"
-                write_png(frame.image, image_path)
-                entry.update(ok=True, image=image_path.name, render_ms=round(frame.seconds * 1000, 2),
-                             plan=frame.plan.to_dict(), plan_text=frame.plan.describe())
-                say(f"{prefix}: ok, {frame.seconds * 1000:.1f} ms")
-                if args.lessons is None:  # a user's lesson file runs only where its errors are caught
-                    entry["contrasts"] = _tour_contrasts(cls, out, size, args.samples, renderer, prefix)
-            except SandboxError as exc:  # one broken lesson must not stop the tour
-                entry.update(ok=False, error=str(exc))
-                say(f"{prefix}: FAILED: {exc}")
-            results.append(entry)
-            bar.update(1)
-        renderer_name = renderer.host.renderer
-        backend = renderer.host.backend
+    if args.lessons is not None:  # students' code: isolated and limited as check grades it
+        results, renderer_name, backend = _tour_isolated(args, size, out)
+    else:
+        results, renderer_name, backend = _tour_course(args, size, out)
     summary = {"size": list(size), "samples": args.samples, "backend": backend, "renderer": renderer_name,
                "folder": None if args.lessons is None else str(args.lessons),
                "seconds": round(time.perf_counter() - started, 3), "lessons": results}
@@ -252,6 +216,78 @@ def cmd_tour(args: argparse.Namespace) -> int:
         print(f"tour: failed: {', '.join(failed)}", file=sys.stderr)
         return 1
     return 0
+
+
+def _tour_course(args: argparse.Namespace, size: tuple[int, int], out: Path) -> tuple[list[dict], str, str]:
+    """The course's own lessons, rendered in this process on one context, with their contrasts."""
+    lessons = all_lessons()
+    results = []
+    with HeadlessRenderer(args.backend) as renderer, progress(len(lessons), "tour", "lesson") as bar:
+        say(f"tour: {len(lessons)} lessons at {size[0]}x{size[1]} on {renderer.host.backend} "
+            f"({renderer.host.ctx.info['GL_RENDERER']}) -> {out}/")
+        for number, cls in enumerate(lessons, start=1):
+            entry = {"lesson": cls.name, "title": cls.title, "course_section": cls.course_section,
+                     "command": f"glsandbox run {cls.name}", "contrasts": [], "description": lesson_description(cls)}
+            prefix = f"[{number}/{len(lessons)}] {cls.name}"
+            try:
+                frame = renderer.render(cls(), size, args.samples)
+                image_path = out / f"{cls.name}.png"
+                write_png(frame.image, image_path)
+                entry.update(ok=True, image=image_path.name, render_ms=round(frame.seconds * 1000, 2),
+                             plan=frame.plan.to_dict(), plan_text=frame.plan.describe())
+                say(f"{prefix}: ok, {frame.seconds * 1000:.1f} ms")
+                entry["contrasts"] = _tour_contrasts(cls, out, size, args.samples, renderer, prefix)
+            except SandboxError as exc:  # one broken lesson must not stop the tour
+                entry.update(ok=False, error=str(exc))
+                say(f"{prefix}: FAILED: {exc}")
+            results.append(entry)
+            bar.update(1)
+        return results, renderer.host.renderer, renderer.host.backend
+
+
+def _tour_isolated(args: argparse.Namespace, size: tuple[int, int], out: Path) -> tuple[list[dict], str, str]:
+    """``tour --lessons DIR``: each lesson in a process of its own, under ``check``'s limits and
+    confinement (:func:`glsandbox.grading.check.render_submissions`); a lesson that does not finish is
+    TIMEOUT on its card, and the page is still written."""
+    from glsandbox.grading.check import DEFAULT_MEMORY, Limits, default_jobs, render_submissions, shown
+
+    found = lesson_files(args.lessons)
+    if not found:
+        raise SandboxError(f"--lessons {args.lessons}: no .py or .toml lesson files (nor subfolders holding one)")
+    timeout = args.timeout
+    if not 0 < timeout <= 3600:
+        raise SandboxError(f"--timeout {timeout:g}: expected seconds, more than 0 and at most 3600")
+    limits = Limits(float(timeout), DEFAULT_MEMORY, default_jobs())
+    say(f"tour: {len(found)} lessons of {args.lessons} at {size[0]}x{size[1]}, each isolated "
+        f"({timeout:g} s each) -> {out}/")
+    position = {name: number for number, (name, _) in enumerate(found, start=1)}  # lines numbered in folder order
+    with progress(len(found), "tour", "lesson") as bar:
+        def heard(name: str, path: Path, result) -> None:
+            picture = result.pictures[0] if result.pictures else None
+            state = "ok" if picture is not None and picture.image is not None else \
+                f"FAILED: {picture.status if picture else 'CRASHED'}: {shown(picture.error) if picture else ''}"
+            say(f"[{position.get(name, 0)}/{len(found)}] {shown(name)}: {state}")
+            bar.update(1)
+
+        rendered = render_submissions(args.lessons, size, args.samples, args.backend, limits, heard)
+    results = []
+    for name, path, result in rendered:
+        entry = {"lesson": name, "title": result.meta.get("title", ""), "contrasts": [],
+                 "course_section": result.meta.get("course_section", ""),
+                 "description": result.meta.get("description", ""),
+                 "command": f"glsandbox run {shlex.quote(str(path))}"}
+        picture = result.pictures[0] if result.pictures else None
+        if picture is not None and picture.image is not None:
+            image_path = out / f"{name}.png"
+            write_png(picture.image, image_path)
+            entry.update(ok=True, image=image_path.name, render_ms=round(picture.seconds * 1000, 2),
+                         plan=picture.info.get("plan", {}), plan_text=str(picture.info.get("plan_text", "")))
+        else:
+            status = picture.status if picture is not None else "CRASHED"
+            error = shown(picture.error) if picture is not None else "its grading process ended without a result"
+            entry.update(ok=False, error=f"{status}: {error}")
+        results.append(entry)
+    return results, "each lesson in a process of its own", args.backend or "auto"
 
 
 #: A contrast grid's columns on the course page: three tiles side by side still read on a card.
@@ -348,6 +384,7 @@ def _checks(args: argparse.Namespace) -> tuple[list, float | None, int | None]:
             raise SandboxError(f"--rubric {args.rubric}: each check's settings, size and tolerance are in the "
                                "grading file; drop --set, --size, --samples and --tolerance")
         rubric = load_rubric(args.rubric)
+        args.entry = rubric.entry
         return list(rubric.checks), rubric.timeout, rubric.memory
     reference: Path = args.golden
     if reference.suffix.lower() != ".png":
@@ -379,14 +416,20 @@ def cmd_check(args: argparse.Namespace) -> int:
         if path is not None and path.is_dir():
             raise SandboxError(f"--{kind} {path}: is a folder, expected a file name")
     target = Path(args.lesson)
+    if args.one and not target.is_dir():
+        raise SandboxError(f"--one {target}: expected a student's folder (a lesson and its helper files)")
     if target.is_dir():
         if args.update:
             raise SandboxError(f"--update writes references from the model answer: give one lesson, not the folder {target}")
 
+        from glsandbox.grading.layers import describe
+
+        layers_line = describe()  # which layers confine a submission on this machine
         bars = []  # the progress bar, made when the first submission reports (the total known then)
 
         def report(done: int, total: int, result) -> None:
-            if not bars:
+            if not bars:  # the first line of the output (none when the run stops with an error)
+                say(layers_line, file=sys.stdout)
                 bars.append(progress(total, "check", "submission"))
             # Lines on stdout above the bar on stderr (only a terminal gets the bar).
             say(f"[{done}/{total}] {result.line()}", file=sys.stdout)
@@ -396,7 +439,8 @@ def cmd_check(args: argparse.Namespace) -> int:
             bars[0].update(1)
 
         try:
-            results = check_folder(target, checks, args.backend, limits, report)
+            results = check_folder(target, checks, args.backend, limits, report, getattr(args, "entry", None),
+                                   one=args.one)
         finally:
             for bar in bars:
                 bar.close()
@@ -407,7 +451,7 @@ def cmd_check(args: argparse.Namespace) -> int:
             print(f"wrote {path}")
         return 0 if all(r.status == "PASS" for r in results) else 1
     if any(path is not None for path in reports.values()):
-        raise SandboxError(f"--{', --'.join(REPORTS)} report a folder of submissions; give a folder")
+        raise SandboxError(f"--{', --'.join(k.replace('_', '-') for k in REPORTS)} report a folder of submissions; give a folder")
     failed = False
     for one in check_one(args.lesson, checks, args.update, args.backend, limits):
         reference = one.check.golden
@@ -504,6 +548,7 @@ COMMANDS: dict[str, tuple[str, tuple[str, ...]]] = {
               ("glsandbox check my_lesson.py --golden expected.png",
                "glsandbox check submissions/ --golden expected.png --csv marks.csv",
                "glsandbox check submissions/ --rubric shading.grading.toml --html marks.html",
+               "glsandbox check --one submission/ --rubric shading.grading.toml --student-report mine.html",
                "glsandbox check phong --golden phong.png --update")),
     "tradeoffs": ("time each accuracy knob and compare it with a reference (FLIP, RMSE): report.md, CSV and plot",
                   ("glsandbox tradeoffs --quick", "glsandbox tradeoffs --knob antialiasing --out out/aa")),
@@ -556,7 +601,10 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         p = add_command(sub, "tour")
         add_render_options(p, settings=False)  # --set is per lesson: tour refuses it
         p.add_argument("--lessons", type=Path, default=None, metavar="DIR",
-                       help="the lesson files (.py, .toml) in DIR instead of the course's lessons")
+                       help="the lesson files (.py, .toml) in DIR instead of the course's lessons, each rendered "
+                            "isolated as check grades it")
+        p.add_argument("--timeout", type=float, default=30.0, metavar="SECONDS",
+                       help="with --lessons: the time each lesson may take (default 30)")
         p.add_argument("--out", type=Path, default=Path("out"), help="output folder (default out/)")
         p.set_defaults(func=cmd_tour, settings=[])
 
@@ -589,8 +637,12 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
                        help="write the references when missing or different (a passing one is kept)")
         p.add_argument("--tolerance", action="append", default=[], metavar="KEY=VALUE",
                        help="threshold=LEVELS (default 2) or max_bad_share=FRACTION (default 0.0005); repeatable")
+        p.add_argument("--one", action="store_true",
+                       help="LESSON_OR_DIR is one student's folder (its lesson and helper files; Gradescope's "
+                            "/autograder/submission), not a folder of students")
         p.add_argument("--jobs", type=int, default=None, metavar="N",
-                       help="submissions graded at once (default: the number of cores)")
+                       help="submissions graded at once (default: the CPUs this process may use, by its "
+                            "cgroup's quota and affinity)")
         p.add_argument("--timeout", type=float, default=None, metavar="SECONDS",
                        help="time for each picture of a submission (default 30)")
         p.add_argument("--memory", type=int, default=None, metavar="MB",
@@ -598,8 +650,11 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         for kind, text in (("csv", "the figures as CSV"), ("json", "the figures as JSON"),
                            ("html", "a page: a row per student with reference | submission | difference"),
                            ("junit", "JUnit XML (what CI systems read)"),
-                           ("gradescope", "Gradescope's results.json")):
-            p.add_argument(f"--{kind}", type=Path, default=None, metavar="FILE", help=f"folder mode: {text}")
+                           ("gradescope", "Gradescope's results.json"),
+                           ("student_report", "the student's page: no hidden check's reference, difference or "
+                                              "figures")):
+            p.add_argument(f"--{kind.replace('_', '-')}", dest=kind, type=Path, default=None, metavar="FILE",
+                           help=f"folder mode: {text}")
         add_render_options(p, size_default="the reference's size")
         p.set_defaults(func=cmd_check)
 

@@ -30,7 +30,8 @@ import numpy as np
 
 from glsandbox.errors import SandboxError
 from glsandbox.gl.context import GLHost, open_context
-from glsandbox.gl.executor import MOVED_PASSES, Executor
+from glsandbox.gl.executor import Executor
+from glsandbox.gl.passes import all_moved
 from glsandbox.gl.target import OffscreenTarget
 from glsandbox.lesson import Lesson
 from glsandbox.overlay import Overlay
@@ -261,8 +262,7 @@ class FrameRenderer:
         if moves is None or moves[0] is not frame_plan:
             if len(self._moves) >= self.KEEP_PLANS:
                 self._moves.clear()
-            moves = self._moves[id(frame_plan)] = (frame_plan, all(step.kind in MOVED_PASSES
-                                                                   for step in frame_plan.passes))
+            moves = self._moves[id(frame_plan)] = (frame_plan, all_moved(frame_plan.passes))
         if not moves[1]:
             if len(self._unmoved) >= self.KEEP_PLANS:
                 self._unmoved.clear()

@@ -130,7 +130,7 @@ RENDERER = Param("renderer", "raster", "who draws the 3D content: the rasterizer
                  "(the same Scene)", choices=RENDERERS)
 
 
-#: ``--set u.NAME=value``: a uniform of the scene's own shaders (README "Your own shader").
+#: ``--set u.NAME=value``: a uniform of the scene's own shaders (docs/your-own.md, "Your own shader").
 UNIFORM_PREFIX = "u."
 
 
@@ -421,7 +421,7 @@ def built_scene(lesson: Lesson) -> Scene:
     """``lesson.build()``, checked to be a Scene. A :class:`SandboxError` raised in a lesson
     file's ``build()`` (a Scene, Node or Mesh refusing a value) gets the file and line
     it came from in front. (Any other exception is the lesson's own code: its traceback
-    is shown, see README "The rule for a lesson file".)"""
+    is shown, see docs/your-own.md, "The rule for a lesson file".)"""
     try:
         scene = lesson.build()
     except SandboxError as exc:
@@ -663,51 +663,111 @@ def _the_lesson_in(module: types.ModuleType, path: Path) -> type[Lesson]:
     return chosen
 
 
-def lesson_files(folder: Path) -> list[tuple[str, Path]]:
+def lesson_files(folder: Path, entry: str | None = None) -> list[tuple[str, Path]]:
     """The lesson files in ``folder``, as (name, path), sorted by name: the rule
     of ``glsandbox tour --lessons DIR`` and ``glsandbox check DIR``.
 
     Each ``.py`` and ``.toml`` file directly in the folder is one lesson,
     named by its stem (by its file name when a ``.py`` and a ``.toml`` share
-    a stem). Each subfolder is one lesson too, named by the subfolder: its one
-    ``.py`` file, else its one ``.toml`` file (a student's folder, with its
-    textures or helper modules beside). A subfolder with none, or with
-    several of the kind that counts, is listed with the folder itself as its
-    path, and loading it (:func:`find_lesson`) reports why. Hidden and
-    ``_``-prefixed names are skipped.
+    a stem). Each subfolder is one lesson too, named by the subfolder, its
+    lesson file chosen by :func:`entry_point` (a student's folder, with its
+    helper modules, textures, models and shaders beside). A subfolder whose
+    lesson cannot be told is listed with the folder itself as its path, and
+    loading it (:func:`submission_lesson`) reports why. A file or subfolder
+    that is a symbolic link is listed as the link, which loading refuses.
+    Hidden and ``_``-prefixed names are skipped.
     """
     if not folder.is_dir():
         raise SandboxError(f"{folder}: not a folder")
-    files, subfolders = [], []
-    for entry in sorted(folder.iterdir()):
-        if entry.name.startswith((".", "_")):
+    files, subfolders, links = [], [], []
+    for entry_path in sorted(folder.iterdir()):
+        if entry_path.name.startswith((".", "_")):
             continue
-        if entry.is_dir():
-            subfolders.append(entry)
-        elif entry.suffix in LESSON_SUFFIXES and entry.is_file():
-            files.append(entry)
-    stems = [f.stem for f in files]
+        if entry_path.is_symlink():
+            if entry_path.is_dir() or entry_path.suffix in LESSON_SUFFIXES:
+                links.append(entry_path)
+        elif entry_path.is_dir():
+            subfolders.append(entry_path)
+        elif entry_path.suffix in LESSON_SUFFIXES and entry_path.is_file():
+            files.append(entry_path)
+    stems = [f.stem for f in [*files, *(p for p in links if not p.is_dir())]]
     found = [(f.stem if stems.count(f.stem) == 1 else f.name, f) for f in files]
-    for sub in subfolders:
-        for suffix in LESSON_SUFFIXES:
-            inside = sorted(p for p in sub.iterdir() if p.suffix == suffix and p.is_file()
-                            and not p.name.startswith((".", "_")))
-            if inside:
-                found.append((sub.name, inside[0] if len(inside) == 1 else sub))
-                break
-        else:
-            found.append((sub.name, sub))
+    found += [(p.name if p.is_dir() or stems.count(p.stem) > 1 else p.stem, p) for p in links]
+    found += [(sub.name, entry_point(sub, entry)) for sub in subfolders]
     return sorted(found)
 
 
-def submission_lesson(path: Path) -> type[Lesson]:
+def _imported_names(path: Path) -> set[str]:
+    """The top-level module names ``path`` imports (read, never run); none when it does not parse."""
+    import ast
+
+    try:
+        if path.stat().st_size > 1 << 20:
+            return set()
+        tree = ast.parse(path.read_bytes())
+    except (OSError, SyntaxError, ValueError, RecursionError, MemoryError):
+        return set()
+    names = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            names.update(alias.name.split(".")[0] for alias in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            if node.module and node.level <= 1:
+                names.add(node.module.split(".")[0])
+            elif node.level == 1:  # from . import helpers
+                names.update(alias.name for alias in node.names)
+    return names
+
+
+def _defines_a_class_with_bases(path: Path) -> bool:
+    import ast
+
+    try:
+        tree = ast.parse(path.read_bytes()) if path.stat().st_size <= 1 << 20 else None
+    except (OSError, SyntaxError, ValueError, RecursionError, MemoryError):
+        return False
+    return tree is not None and any(isinstance(n, ast.ClassDef) and n.bases for n in tree.body)
+
+
+def entry_point(folder: Path, entry: str | None = None) -> Path:
+    """A student's folder's lesson file: ``entry`` (the rubric's, e.g. ``spin.py``) when given; else
+    its one ``.py`` file, or of several the one no other imports (the rest are its helper modules),
+    or of those the one defining a class; else its one ``.toml``. ``folder`` itself when none can
+    be told (:func:`submission_lesson` says why)."""
+    if entry is not None:
+        chosen = folder / entry
+        return chosen if chosen.is_file() and not chosen.is_symlink() else folder
+    for suffix in LESSON_SUFFIXES:
+        inside = sorted(p for p in folder.iterdir() if p.suffix == suffix and p.is_file() and not p.is_symlink()
+                        and not p.name.startswith((".", "_")))
+        if len(inside) == 1:
+            return inside[0]
+        if len(inside) > 1 and suffix == ".py":
+            imported = set().union(*(_imported_names(p) for p in inside))
+            candidates = [p for p in inside if p.stem not in imported]
+            if len(candidates) > 1:
+                candidates = [p for p in candidates if _defines_a_class_with_bases(p)]
+            return candidates[0] if len(candidates) == 1 else folder
+        if inside:
+            return folder
+    return folder
+
+
+def submission_lesson(path: Path, entry: str | None = None) -> type[Lesson]:
     """:func:`find_lesson` for an entry of :func:`lesson_files`, a subfolder's problem named."""
+    if path.is_symlink():
+        raise SandboxError(f"{path}: is a link (a submission is its own files, not a link to others')")
     if path.is_dir():
         kinds = " or ".join(LESSON_SUFFIXES)
+        if entry is not None:
+            raise SandboxError(f"{path}: no {entry} in this folder (the rubric's entry point)")
         count = {s: sum(1 for p in path.iterdir() if p.suffix == s) for s in LESSON_SUFFIXES}
         if not any(count.values()):
             raise SandboxError(f"{path}: no {kinds} lesson file in this folder")
         several = next(s for s in LESSON_SUFFIXES if count[s] > 1)
+        if several == ".py":
+            raise SandboxError(f"{path}: {count[several]} .py files in this folder and none stands out as the "
+                               "lesson (the one no other imports); name it with entry = \"FILE.py\" in the rubric")
         raise SandboxError(f"{path}: {count[several]} {several} files in this folder; expected one")
     return find_lesson(str(path))
 

@@ -310,7 +310,7 @@ class Material:
         return self.shading in LIT_SHADINGS
 
 
-# --- a node's own shader (README "Your own shader") -----------------------------
+# --- a node's own shader (docs/your-own.md, "Your own shader") -----------------------------
 
 #: What the rasterizer gives a node's own shader (``Node.shader``), as
 #: ``(name, GLSL type, space, what)``: the vertex attributes, then the
@@ -355,7 +355,7 @@ def check_uniform_name(name: object, what: str) -> str:
     if not isinstance(name, str) or not _GLSL_NAME.fullmatch(name) or name.startswith("gl_"):
         raise SandboxError(f"{what}: not a GLSL uniform name (letters, digits and _, not gl_...)")
     if name in STANDARD_SHADER_NAMES:
-        raise SandboxError(f"{what}: set by the renderer (the README's table of shader inputs), not by a scene")
+        raise SandboxError(f"{what}: set by the renderer (the manual's table of shader inputs, docs/your-own.md), not by a scene")
     return name
 
 

@@ -1,6 +1,6 @@
 """Scene files: a :class:`~glsandbox.scene.Scene` read from TOML, with line-numbered errors.
 
-The format is the README's "Scene files" section: top-level ``name``,
+The format is docs/commands.md's "Scene files" section: top-level ``name``,
 ``clear_color``, ``depth_test`` and ``depth_mode``, a ``[camera]`` table,
 ``[[nodes]]``, ``[[lights]]`` and ``[[viewports]]`` arrays, and the optional
 ``[mirror]`` and ``[shadow]`` tables that tie the planar effects to nodes by

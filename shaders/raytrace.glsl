@@ -20,7 +20,8 @@
 // rays read its texels), REFLECT (reflection bounces and passes through
 // see-through surfaces: some node reflects, is a cut-out or is blended, and
 // max_depth > 0), HAS_MESHES, HAS_SHAPES (some analytic node) and
-// HAS_<KIND> per analytic kind (HAS_SPHERE, HAS_CYLINDER), TWO_SIDED (a node is lit
+// HAS_<KIND> per analytic kind (HAS_SPHERE, HAS_CYLINDER; their cases in
+// shape_t and shape_surface), TWO_SIDED (a node is lit
 // on both sides), SEE_THROUGH (a node is a cut-out or blended), SIMPLE_OFFSET
 // (the teaching variant of the secondary rays' offset), VERTEX_COLORS (a node uses
 // them); SCENE_NODES (the scene's node list, see nearest()) with
@@ -167,90 +168,30 @@ float triangle_hit(int k, WtRay r, bool cull, out vec3 vwd) {
     return wt_hit(r, tri_rec(k, TRI_V0).xyz, tri_rec(k, TRI_V1).xyz, tri_rec(k, TRI_V2).xyz, cull, INF, vwd);
 }
 
-// Işın-Küre kesim testi in the unit sphere's own space, the numerically
-// stable form (Ray Tracing Gems ch. 7): discriminant from the vector
-// h = l − (b/a)d, roots q/a and c/q without cancellation.
-float sphere_t(vec3 o, vec3 d, bool cull) {
-    if (cull && dot(o, o) < 1.0) return INF;  // from inside, every front face faces away
-    vec3 l = -o;
-    float a = dot(d, d);
-    float b = dot(l, d);
-    vec3 h = l - (b / a) * d;
-    float disc = a * (1.0 - dot(h, h));
-    if (disc < 0.0) return INF;
-    float q = b + (b >= 0.0 ? sqrt(disc) : -sqrt(disc));
-    if (q == 0.0) return INF;
-    float l_len = length(l);
-    float c = (l_len - 1.0) * (l_len + 1.0);
-    float t1 = q / a;
-    float t0 = c / q;
-    float near = min(t0, t1);
-    float far = max(t0, t1);
-    return near > 0.0 ? near : (far > 0.0 ? far : INF);
-}
-
-// The capped unit cylinder x² + z² <= 1, |y| <= 1 in its own space
-// (numpy_engine.unit_cylinder_t): the side is the sphere's stable quadratic
-// in the xz-plane, its roots kept where |y| <= 1; each cap the plane y = ±1,
-// kept where x² + z² <= 1.
-float cylinder_t(vec3 o, vec3 d, bool cull) {
-    if (cull && dot(o.xz, o.xz) < 1.0 && abs(o.y) < 1.0) return INF;  // from inside
-    float best = INF;
-    float a = dot(d.xz, d.xz);
-    vec2 l = -o.xz;
-    float b = dot(l, d.xz);
-    vec2 h = l - (b / a) * d.xz;
-    float disc = a * (1.0 - dot(h, h));
-    if (a > 0.0 && disc >= 0.0) {
-        float q = b + (b >= 0.0 ? sqrt(disc) : -sqrt(disc));
-        if (q != 0.0) {
-            float l_len = length(l);
-            float c = (l_len - 1.0) * (l_len + 1.0);
-            float t0 = c / q, t1 = q / a;
-            if (t0 > 0.0 && t0 < best && abs(o.y + t0 * d.y) <= 1.0) best = t0;
-            if (t1 > 0.0 && t1 < best && abs(o.y + t1 * d.y) <= 1.0) best = t1;
-        }
-    }
-    if (d.y != 0.0) {
-        float tb = (-1.0 - o.y) / d.y, tt = (1.0 - o.y) / d.y;
-        vec2 pb = o.xz + tb * d.xz, pt = o.xz + tt * d.xz;
-        if (tb > 0.0 && tb < best && dot(pb, pb) <= 1.0) best = tb;
-        if (tt > 0.0 && tt < best && dot(pt, pt) <= 1.0) best = tt;
-    }
-    return best;
-}
-
-// --- the analytic kinds (glsandbox.raytrace.world.NodeKind, KIND_* defines):
-// a hit test and a surface (own-space normal, uv) per kind. A kind the scene
-// has not is compiled out (HAS_<KIND>); a new kind is one line in each.
-float shape_t(int kind, vec3 o, vec3 d, bool cull) {
-#if HAS_CYLINDER
-    if (kind == KIND_CYLINDER) return cylinder_t(o, d, cull);
-#endif
-    return sphere_t(o, d, cull);
-}
-
 const float PI = 3.14159265358979;
+
+// --- the analytic kinds (glsandbox/raytrace/shapes/, one GLSL file each): a hit
+// test <kind>_t and a surface <kind>_surface (own-space normal, uv) per kind.
+// SHAPE_T_CASES and SHAPE_SURFACE_CASES (shapes.glsl_dispatch) hold one case per
+// kind the scene has; there is no default case: a kind code with none flags the
+// pixel (g_bad_kind, alpha 0.25) and the host raises.
+#include "shapes/sphere.glsl"
+#include "shapes/cylinder.glsl"
+
+bool g_bad_kind = false;
+
+float shape_t(int kind, vec3 o, vec3 d, bool cull) {
+    SHAPE_T_CASES
+    g_bad_kind = true;
+    return INF;
+}
 
 // q: the hit in the kind's own space; n: its own-space normal.
 void shape_surface(int kind, vec3 q, out vec3 n, out vec2 uv) {
-#if HAS_CYLINDER
-    if (kind == KIND_CYLINDER) {  // as geometry.cylinder() lays them out
-        float r = length(q.xz);
-        float phi = atan(q.x, q.z);
-        if (abs(abs(q.y) - 1.0) < abs(r - 1.0)) {  // a cap
-            n = vec3(0.0, sign(q.y), 0.0);
-            uv = 0.5 + 0.5 * q.xz;
-        } else {
-            n = vec3(q.x, 0.0, q.z) / r;
-            uv = vec2((phi < 0.0 ? phi + 2.0 * PI : phi) / (2.0 * PI), 0.5 * (1.0 - q.y));
-        }
-        return;
-    }
-#endif
-    n = normalize(q);  // the hit on the unit sphere
-    float phi = atan(n.x, n.z);
-    uv = vec2((phi < 0.0 ? phi + 2.0 * PI : phi) / (2.0 * PI), acos(clamp(n.y, -1.0, 1.0)) / PI);
+    SHAPE_SURFACE_CASES
+    g_bad_kind = true;
+    n = vec3(0.0);
+    uv = vec2(0.0);
 }
 // --- end of the analytic kinds
 
@@ -773,9 +714,9 @@ void main() {
     }
 #endif
 #if BVH
-    frag_color = vec4(clamp(color, 0.0, 1.0), g_overflow ? 0.0 : 1.0);
+    frag_color = vec4(clamp(color, 0.0, 1.0), g_overflow ? 0.0 : (g_bad_kind ? 0.25 : 1.0));
 #else
-    frag_color = vec4(clamp(color, 0.0, 1.0), 1.0);
+    frag_color = vec4(clamp(color, 0.0, 1.0), g_bad_kind ? 0.25 : 1.0);
 #endif
 }
 #endif

@@ -8,6 +8,7 @@
 - :mod:`~glsandbox.grading.warm`: the warm template renderers fork from;
 - :mod:`~glsandbox.grading.processes`: a process tree found and killed;
 - :mod:`~glsandbox.grading.sandbox`: what a graded submission may read, write and signal;
+- :mod:`~glsandbox.grading.layers`: its environment, user and network, and the line naming them;
 - :mod:`~glsandbox.grading.reports`: CSV, JSON, HTML, JUnit XML and Gradescope reports.
 
 The wing judges pictures with :mod:`glsandbox.measure.golden`; the rest of

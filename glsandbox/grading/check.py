@@ -24,10 +24,11 @@ import io
 import math
 import os
 import re
+import sys
 import time
 import unicodedata
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -35,7 +36,7 @@ import numpy as np
 from glsandbox import files
 from glsandbox.errors import SandboxError
 from glsandbox.frame import DEFAULT_SIZE, Frame, HeadlessRenderer
-from glsandbox.lesson import Lesson, lesson_files, user_code_error
+from glsandbox.lesson import Lesson, entry_point, lesson_files, user_code_error
 from glsandbox.measure.golden import DEFAULT_THRESHOLD, ImageMatch, compare_images, write_artifacts
 from glsandbox.grading.isolate import BROKEN, CRASHED, OOM, TIMEOUT, Job, JobResult, Picture, Render, run_jobs
 from glsandbox.grading.kinds import kind_of
@@ -78,10 +79,13 @@ def file_stem(name: str) -> str:
 def read_reference(path: Path) -> np.ndarray:
     """The reference PNG as RGBA, or a one-line error naming it."""
     data = files.read_user_file(path, "reference", "a .png file")
+    if not data:
+        raise SandboxError(f"reference {path}: an empty file, not a PNG image; write it from the model answer "
+                           "with --update")
     try:
         return files.load_png(io.BytesIO(data))
-    except OSError as exc:
-        raise SandboxError(f"reference {path}: not a PNG image ({exc})") from None
+    except (OSError, ValueError, SyntaxError):  # Pillow's reason names its buffer object, no use to a reader
+        raise SandboxError(f"reference {path}: not a PNG image ({len(data)} bytes that PNG cannot read)") from None
 
 
 def render_lesson(lesson: Lesson, size: tuple[int, int], samples: int = 0, backend: str | None = None,
@@ -133,6 +137,9 @@ class CheckResult:
     path: Path
     outcomes: list[Outcome]
     output: list[str] = field(default_factory=list)
+    #: A hash of the submission's files (:func:`submission_digest`), and the others with the same.
+    digest: str = ""
+    same_as: list[str] = field(default_factory=list)
 
     @property
     def shown(self) -> str:
@@ -213,8 +220,50 @@ class Limits:
     jobs: int = 1
 
 
+def cgroup_cpus(root: Path = Path("/sys/fs/cgroup"), membership: Path = Path("/proc/self/cgroup")) -> float | None:
+    """The CPUs this process's cgroup quota allows (``cpu.max``, the smallest along its cgroup's path;
+    cgroup v1's ``cpu.cfs_quota_us`` where there is no v2); None when there is no quota."""
+    try:
+        lines = membership.read_text().splitlines()
+    except OSError:
+        return None
+    quotas = []
+    for line in lines:
+        number, _, rest = line.partition(":")
+        controllers, _, path = rest.partition(":")
+        if number == "0" and controllers == "":  # v2: every cgroup from this one up to the root
+            folder = root / path.lstrip("/")
+            while True:
+                try:
+                    quota, period = (folder / "cpu.max").read_text().split()[:2]
+                    if quota != "max":
+                        quotas.append(int(quota) / int(period))
+                except (OSError, ValueError):
+                    pass
+                if folder == root or root not in folder.parents:
+                    break
+                folder = folder.parent
+        elif "cpu" in controllers.split(","):
+            for base in (root / "cpu,cpuacct", root / "cpu"):
+                try:
+                    quota_us = int((base / path.lstrip("/") / "cpu.cfs_quota_us").read_text())
+                    period_us = int((base / path.lstrip("/") / "cpu.cfs_period_us").read_text())
+                except (OSError, ValueError):
+                    continue
+                if quota_us > 0 and period_us > 0:
+                    quotas.append(quota_us / period_us)
+                break
+    return min(quotas) if quotas else None
+
+
 def default_jobs() -> int:
-    return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
+    """``--jobs`` when not given: the CPUs this process may run on (its affinity) and, in a
+    container, its cgroup's quota allows (a 2-CPU quota on a 64-core machine is 2)."""
+    cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+    quota = cgroup_cpus() if sys.platform == "linux" else None
+    if quota is not None:
+        cpus = min(cpus, math.ceil(quota))
+    return max(1, cpus)
 
 
 def _renders(checks: Sequence[Check], references: dict[Path, np.ndarray]) -> tuple[Render, ...]:
@@ -226,19 +275,67 @@ def _renders(checks: Sequence[Check], references: dict[Path, np.ndarray]) -> tup
     return tuple(out)
 
 
-def submission_jobs(folder: Path, renders: tuple[Render, ...], backend: str | None,
-                    limits: Limits) -> list[tuple[str, Path, Job]]:
-    """(name, path, job) for each submission in ``folder``: a file alone, or the whole of its folder."""
+def submission_jobs(entries: Sequence[tuple[str, Path, Path]], renders: tuple[Render, ...], backend: str | None,
+                    limits: Limits, entry: str | None = None) -> list[tuple[str, Path, Job]]:
+    """(name, path, job) for each submission (name, its file or folder, its lesson file or the
+    folder when none can be told): a file alone, or the whole of its folder."""
     out = []
-    for index, (name, path) in enumerate(lesson_files(folder)):
-        if path.parent != folder:  # a student's folder: the folder is the submission, its lesson inside
-            job = Job(index, str(path.parent), path.name, renders, backend, limits.timeout, limits.memory)
-        elif path.is_dir():  # a folder without one lesson file: loading it says why
-            job = Job(index, str(path), "", renders, backend, limits.timeout, limits.memory)
-        else:
-            job = Job(index, str(path), path.name, renders, backend, limits.timeout, limits.memory)
-        out.append((name, path, job))
+    for index, (name, source, lesson) in enumerate(entries):
+        target = "" if lesson.is_dir() else lesson.relative_to(source).as_posix() if source.is_dir() else source.name
+        job = Job(index, str(source), target, renders, backend, limits.timeout, limits.memory, entry=entry)
+        out.append((name, lesson, job))
     return out
+
+
+def submissions(folder: Path, entry: str | None = None, one: bool = False) -> list[tuple[str, Path, Path]]:
+    """(name, submission, lesson file) for each student's submission in ``folder``; ``one``: the
+    folder is one student's (a flat folder of a lesson and its helpers, as Gradescope gives it)."""
+    if one:
+        if folder.is_symlink():
+            return [(folder.name or "submission", folder, folder)]
+        return [(folder.resolve().name or "submission", folder, entry_point(folder, entry))]
+    out = []
+    for name, path in lesson_files(folder, entry):
+        source = path if path.parent == folder else path.parent
+        out.append((name, source, path))
+    return out
+
+
+def submission_digest(source: Path) -> str:
+    """A hash of a submission's files (their paths inside it and their bytes; a link by its text):
+    two submissions with the same digest are the same files."""
+    digest = hashlib.sha256()
+    if source.is_symlink():
+        return ""
+    paths = sorted(source.rglob("*")) if source.is_dir() else [source]
+    for path in paths:
+        relative = path.relative_to(source).as_posix() if source.is_dir() else ""
+        if path.is_symlink():
+            digest.update(b"L" + os.fsencode(relative) + b"\0" + os.fsencode(os.readlink(path)) + b"\0")
+        elif path.is_file():
+            digest.update(b"F" + os.fsencode(relative) + b"\0")
+            try:
+                with path.open("rb") as handle:
+                    for chunk in iter(lambda: handle.read(1 << 20), b""):
+                        digest.update(chunk)
+            except OSError:
+                digest.update(b"?")
+            digest.update(b"\0")
+    return digest.hexdigest()
+
+
+def mark_duplicates(results: Sequence[CheckResult]) -> None:
+    """Give each result the names of the others whose files are the same (:attr:`CheckResult.same_as`)."""
+    by_digest: dict[str, list[CheckResult]] = {}
+    for result in results:
+        if result.digest:
+            by_digest.setdefault(result.digest, []).append(result)
+    for group in by_digest.values():
+        for result in group:
+            result.same_as = [other.name for other in group if other is not result]
+
+
+LINK_ERROR = "is a link (a submission is its own files, not a link to others')"
 
 
 def _outcomes(result: JobResult, checks: Sequence[Check], references: dict[Path, np.ndarray],
@@ -276,32 +373,82 @@ def read_references(checks: Sequence[Check]) -> dict[Path, np.ndarray]:
 
 def check_folder(folder: Path, checks: Sequence[Check], backend: str | None = None, limits: Limits = Limits(),
                  progress: Callable[[int, int, CheckResult], None] = lambda done, total, result: None,
-                 ) -> list[CheckResult]:
+                 entry: str | None = None, one: bool = False) -> list[CheckResult]:
     """Grade every submission in ``folder`` against ``checks``; never stops at a broken one.
 
     ``progress`` hears each submission as it finishes (in the order they
     finish); the results come back in folder order. Failures leave their
-    images in ``<golden stem>-results/`` beside each golden.
+    images in ``<golden stem>-results/`` beside each golden. ``entry``: the
+    lesson file's name in a student's folder (the rubric's); ``one``: the
+    folder is one student's. A submission that is a symbolic link is BROKEN
+    without running; submissions that are the same files are marked
+    (:func:`mark_duplicates`).
     """
-    if not lesson_files(folder):
+    found = submissions(folder, entry, one)
+    if not found or (one and not folder.is_dir()):
         raise SandboxError(f"{folder}: no .py or .toml lesson files (nor subfolders holding one)")
     references = read_references(checks)
     renders = _renders(checks, references)
-    entries = submission_jobs(folder, renders, backend, limits)
+    links = [(name, source) for name, source, _ in found if source.is_symlink()]
+    entries = submission_jobs([e for e in found if not e[1].is_symlink()], renders, backend, limits, entry)
+    digests = {name: submission_digest(source) for name, source, _ in found}
+    total = len(found)
+    finished: dict[str, CheckResult] = {}
+
+    def record(result: CheckResult) -> None:
+        result.digest = digests.get(result.name, "")
+        finished[result.name] = result
+        progress(len(finished), total, result)
+
+    for name, source in links:
+        record(CheckResult(name, source, [Outcome(c, BROKEN, error=f"{shown(str(source))}: {LINK_ERROR}")
+                                          for c in checks]))
     by_index = {job.index: (name, path) for name, path, job in entries}
-    finished: dict[int, CheckResult] = {}
 
     def done(result: JobResult) -> None:
         name, path = by_index[result.job.index]
-        finished[result.job.index] = CheckResult(name, path, _outcomes(result, checks, references, name),
-                                                 [shown(line) for line in result.output])
-        progress(len(finished), len(entries), finished[result.job.index])
+        record(CheckResult(name, path, _outcomes(result, checks, references, name),
+                           [shown(line) for line in result.output]))
 
-    results = run_jobs([job for _, _, job in entries], limits.jobs, done)
+    results = run_jobs([job for _, _, job in entries], limits.jobs, done) if entries else []
     no_gl = next((r.no_gl for r in results if r.no_gl), "")
     if no_gl:  # the machine's problem, not every submission's
         raise SandboxError(no_gl)
-    return [finished[job.index] for _, _, job in entries]
+    ordered = [finished[name] for name, _, _ in found]
+    mark_duplicates(ordered)
+    return ordered
+
+
+def render_submissions(folder: Path, size: tuple[int, int], samples: int, backend: str | None, limits: Limits,
+                       progress: Callable[[str, Path, JobResult], None] = lambda name, path, result: None,
+                       ) -> list[tuple[str, Path, JobResult]]:
+    """Each lesson of ``folder`` (:func:`submissions`: students' files and folders) rendered once,
+    isolated and limited as ``check`` grades them, with what the tour's page shows
+    (:attr:`~glsandbox.grading.isolate.Job.describe`); a link is BROKEN without running."""
+    found = submissions(folder)
+    render = (Render((), size, samples),)
+    live = [e for e in found if not e[1].is_symlink()]
+    entries = submission_jobs(live, render, backend, limits)
+    jobs = [replace(job, describe=True) for _, _, job in entries]
+    by_index = {job.index: (name, path) for name, path, job in entries}
+    finished: dict[str, tuple[str, Path, JobResult]] = {}
+
+    def done(result: JobResult) -> None:
+        name, path = by_index[result.job.index]
+        finished[name] = (name, path, result)
+        progress(name, path, result)
+
+    for name, source, _ in found:
+        if source.is_symlink():
+            broken = JobResult(Job(-1, str(source), "", render), [Picture(status=BROKEN,
+                                                                          error=f"{shown(str(source))}: {LINK_ERROR}")])
+            finished[name] = (name, source, broken)
+            progress(name, source, broken)
+    results = run_jobs(jobs, limits.jobs, done) if jobs else []
+    no_gl = next((r.no_gl for r in results if r.no_gl), "")
+    if no_gl:
+        raise SandboxError(no_gl)
+    return [finished[name] for name, _, _ in found]
 
 
 def render_isolated(spec: str, checks: Sequence[Check], sizes: Sequence[tuple[int, int]],
@@ -415,7 +562,19 @@ def summary_table(results: Sequence[CheckResult]) -> str:
             figures = f"{'-':>8} {'-':>8} {'-':>8}"
         lines.append(f"{r.shown[:24]:<24} {r.status:<13} {figures} {r.seconds:>7.2f}")
     lines.append(counts_line(results))
+    lines += [f"same files: {' = '.join(group)}" for group in duplicate_groups(results)]
     return "\n".join(lines)
+
+
+def duplicate_groups(results: Sequence[CheckResult]) -> list[list[str]]:
+    """The names (shown) of each group of submissions that are the same files, in folder order."""
+    groups, seen = [], set()
+    for r in results:
+        if r.same_as and r.name not in seen:
+            group = [r.name, *r.same_as]
+            seen.update(group)
+            groups.append([shown(n) for n in group])
+    return groups
 
 
 def time_in_process(folder: Path, checks: Sequence[Check], backend: str | None = None) -> float:

@@ -90,6 +90,10 @@ class Job:
     copy: bool = True
     #: The model answer (``--update``): its compiled shaders may go into Mesa's cache for the submissions.
     writes_cache: bool = False
+    #: The rubric's name for the lesson file in a student's folder (for the error when it is missing).
+    entry: str | None = None
+    #: Send back what the tour's page shows too: the lesson's title, section and description, each frame's plan.
+    describe: bool = False
 
 
 @dataclass
@@ -100,6 +104,8 @@ class Picture:
     status: str = ""
     error: str = ""
     seconds: float = 0.0
+    #: With :attr:`Job.describe`: the frame's plan (``plan``, its dict, and ``plan_text``).
+    info: dict = field(default_factory=dict)
 
 
 @dataclass
@@ -110,6 +116,8 @@ class JobResult:
     pictures: list[Picture]
     output: list[str] = field(default_factory=list)
     no_gl: str = ""
+    #: With :attr:`Job.describe`: the lesson's ``title``, ``course_section`` and ``description``.
+    meta: dict = field(default_factory=dict)
 
 
 # --- the framed messages of a pipe: a JSON header and raw bytes ---------------------------------
@@ -153,6 +161,7 @@ class Reader:
 def _job_data(job: Job) -> dict:
     return {"index": job.index, "source": job.source, "target": job.target, "backend": job.backend,
             "timeout": job.timeout, "memory_mb": job.memory_mb, "copy": job.copy, "writes_cache": job.writes_cache,
+            "entry": job.entry, "describe": job.describe,
             "renders": [{"settings": list(r.settings), "size": list(r.size), "samples": r.samples}
                         for r in job.renders]}
 
@@ -174,8 +183,14 @@ class _Zygote:
 
         self.channel, theirs = socket.socketpair()
         code = "import sys; from glsandbox.grading.worker import zygote_main; zygote_main(int(sys.argv[1]))"
+        # a fresh program with only what rendering reads: every fork's /proc/self/environ is this one
+        from glsandbox.grading.layers import minimal_environment
+
+        package_parent = str(Path(__file__).resolve().parents[2])
+        code = f"import sys; sys.path.insert(0, {package_parent!r}); " + code
         self.process = subprocess.Popen([sys.executable, "-c", code, str(theirs.fileno())], pass_fds=[theirs.fileno()],
-                                        stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL)  # never the grader's stdout
+                                        stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,  # never the grader's stdout
+                                        env=minimal_environment())
         theirs.close()
 
     def start(self, job: Job) -> int:
@@ -294,13 +309,19 @@ def _result(job: Job, message: tuple[dict, bytes] | None) -> JobResult:
             h, w, c = entry["shape"]
             image = np.frombuffer(payload, dtype=np.uint8, count=h * w * c, offset=offset).reshape(h, w, c)
             offset += h * w * c
+        info = entry.get("info") if isinstance(entry.get("info"), dict) else {}
         pictures.append(Picture(image, str(entry.get("status", "")), str(entry.get("error", "")),
-                                float(entry.get("seconds", 0.0))))
+                                float(entry.get("seconds", 0.0)), info))
     output = [str(line) for line in header.get("output", [])]
     root = str(header.get("root") or "")
+    original = ""
     if root and job.source:  # the private copy's path, said as the submission's own
         original = job.source if Path(job.source).is_dir() else str(Path(job.source).parent)
         for picture in pictures:
             picture.error = picture.error.replace(root, original)
         output = [line.replace(root, original) for line in output]
-    return JobResult(job, pictures, output)
+    raw = header.get("meta") if isinstance(header.get("meta"), dict) else {}
+    meta = {k: str(raw.get(k, ""))[:2000] for k in ("title", "course_section", "description")}
+    if root and job.source:
+        meta = {k: v.replace(root, original) for k, v in meta.items()}
+    return JobResult(job, pictures, output, meta=meta)

@@ -1,4 +1,5 @@
-"""The reports of a graded folder: CSV, JSON, an HTML page, JUnit XML and Gradescope's ``results.json``.
+"""The reports of a graded folder: CSV, JSON, an HTML page, JUnit XML and Gradescope's ``results.json``
+(the teacher's), and the student's page, which shows nothing of a hidden check.
 
 Each is written atomically by the grader alone, from the results in folder
 order. Names are written as :func:`glsandbox.grading.check.shown` gives them
@@ -43,7 +44,7 @@ def rows(results: Sequence[CheckResult]) -> list[dict[str, object]]:
     out = []
     for r in results:
         for o in r.outcomes:
-            row: dict[str, object] = {"name": r.shown, "path": _path(r)}
+            row: dict[str, object] = {"name": r.shown, "path": _path(r), "same_as": " ".join(map(shown, r.same_as))}
             if len(r.outcomes) > 1:
                 row.update(check=o.check.name, points=o.points, of=o.check.points)
             out.append({**row, **_figures(o)})
@@ -72,7 +73,8 @@ def json_text(results: Sequence[CheckResult], title: str) -> str:
     submissions = []
     for r in results:
         entry: dict[str, object] = {"name": r.shown, "path": _path(r), "status": r.status,
-                                    "score": r.score, "total": r.total, "output": _output(r)}
+                                    "score": r.score, "total": r.total, "output": _output(r),
+                                    "digest": r.digest, "same_as": [shown(n) for n in r.same_as]}
         if len(r.outcomes) == 1:
             entry.update({k: v for k, v in _figures(r.outcomes[0]).items() if k != "status"})
         else:
@@ -123,8 +125,14 @@ def gradescope_text(results: Sequence[CheckResult], title: str) -> str:
                           "status": "passed" if o.status == PASS else "failed",
                           "visibility": "after_published" if o.check.hidden else "visible"})
     score = sum(r.score for r in results)
-    return json.dumps({"score": score, "output": f"glsandbox check: {points(score)}/"
-                       f"{points(sum(r.total for r in results))} points", "tests": tests}, indent=2) + "\n"
+    shown_now = [o for r in results for o in r.outcomes if not o.check.hidden]
+    if len(shown_now) < sum(len(r.outcomes) for r in results):  # the hidden checks' points say nothing yet
+        summary = (f"glsandbox check: {points(sum(o.points for o in shown_now))}/"
+                   f"{points(sum(o.check.points for o in shown_now))} points on the checks shown now; "
+                   "the others after the grades are published")
+    else:
+        summary = f"glsandbox check: {points(score)}/{points(sum(r.total for r in results))} points"
+    return json.dumps({"score": score, "output": summary, "tests": tests}, indent=2) + "\n"
 
 
 _COLOURS = {"PASS": "#d7f5d7", "FAIL": "#ffe0b3", "BROKEN": "#ffd0d0", "TIMEOUT": "#e4d7ff",
@@ -167,7 +175,9 @@ def html_text(results: Sequence[CheckResult], title: str) -> str:
                          f'<div class="detail">{text}</div></td>')
         output = (f'<details><summary>output</summary><pre>{html.escape(chr(10).join(_output(r)))}</pre></details>'
                   if r.output else "")
-        body.append(f'<tr><td class="name">{html.escape(r.shown)}{output}</td>'
+        same = (f'<div class="same">same files as {html.escape(", ".join(map(shown, r.same_as)))}</div>'
+                if r.same_as else "")
+        body.append(f'<tr><td class="name">{html.escape(r.shown)}{same}{output}</td>'
                     f'<td style="background:{_COLOURS.get(r.status, "#fff")}">{html.escape(r.status)}</td>'
                     f'<td data-sort="{r.score}">{points(r.score)}/{points(r.total)}</td>{"".join(cells)}</tr>')
     c = counts(results)
@@ -179,6 +189,7 @@ body {{ font-family: sans-serif; margin: 1.5em; }}
 table {{ border-collapse: collapse; }} th, td {{ border: 1px solid #bbb; padding: 4px; vertical-align: top; }}
 th {{ cursor: pointer; background: #eee; }} img {{ image-rendering: pixelated; margin-right: 2px; }}
 .detail {{ font-size: 80%; max-width: 40em; word-break: break-all; }} .name {{ font-family: monospace; }}
+.same {{ color: #b00; font-weight: bold; }}
 </style></head><body>
 <h1>glsandbox check: {html.escape(title)}</h1>
 <p>{len(results)} submissions: {html.escape(summary)}</p>
@@ -200,9 +211,58 @@ document.querySelectorAll("#grades th").forEach((th, column) => th.addEventListe
 """
 
 
+def student_text(results: Sequence[CheckResult], title: str) -> str:
+    """The student's page (``--student-report``): for each check shown now, the reference, the
+    submission, the difference and the figures; a hidden check only by its name and points, never
+    its reference, difference, figures or outcome before the grades are published."""
+    from glsandbox.grading.check import _thumbnail
+    from glsandbox.measure.golden import _diff_image
+
+    sections = []
+    for r in results:
+        rows_html = []
+        for o in r.outcomes:
+            if o.check.hidden:
+                rows_html.append(f"<tr><td>{html.escape(o.check.name)}</td><td>- / {points(o.check.points)}</td>"
+                                 '<td colspan="2">shown after the grades are published</td></tr>')
+                continue
+            try:
+                ref = _thumbnail(read_reference(o.check.golden))
+            except SandboxError:
+                ref = None
+            diff = None
+            if o.thumb is not None and ref is not None and o.thumb.shape == ref.shape:
+                diff = _diff_image(o.thumb, ref, int(o.match.threshold if o.match else 2))
+            rows_html.append(
+                f'<tr><td>{html.escape(o.check.name)}</td><td>{points(o.points)} / {points(o.check.points)}</td>'
+                f'<td style="background:{_COLOURS.get(o.status, "#fff")}">{html.escape(o.status)}: '
+                f'{html.escape(o.detail())}</td>'
+                f"<td>{_img(ref, 'reference')}{_img(o.thumb, 'yours')}{_img(diff, 'difference')}</td></tr>")
+        visible = [o for o in r.outcomes if not o.check.hidden]
+        score = f"{points(sum(o.points for o in visible))} / {points(sum(o.check.points for o in visible))}"
+        later = " (the hidden checks' points after publishing)" if len(visible) < len(r.outcomes) else ""
+        output = (f"<details><summary>what your lesson printed</summary><pre>{html.escape(chr(10).join(_output(r)))}"
+                  "</pre></details>" if r.output and not any(o.check.hidden for o in r.outcomes) else "")
+        sections.append(f"<h2>{html.escape(r.shown)}: {score} points{later}</h2>\n<table><thead><tr><th>check</th>"
+                        "<th>points</th><th>outcome</th><th>reference | yours | difference</th></tr></thead>"
+                        f"<tbody>{''.join(rows_html)}</tbody></table>{output}")
+    return f"""<!doctype html>
+<html lang="en"><head><meta charset="utf-8"><title>glsandbox check</title>
+<style>
+body {{ font-family: sans-serif; margin: 1.5em; }}
+table {{ border-collapse: collapse; }} th, td {{ border: 1px solid #bbb; padding: 4px; vertical-align: top; }}
+img {{ image-rendering: pixelated; margin-right: 2px; }}
+</style></head><body>
+<h1>glsandbox check</h1>
+{chr(10).join(sections)}
+</body></html>
+"""
+
+
 #: The report kinds: the command-line flag and its writer.
 REPORTS: dict[str, Callable[[Sequence[CheckResult], str], str]] = {
-    "csv": csv_text, "json": json_text, "html": html_text, "junit": junit_text, "gradescope": gradescope_text}
+    "csv": csv_text, "json": json_text, "html": html_text, "junit": junit_text, "gradescope": gradescope_text,
+    "student_report": student_text}
 
 
 def write_reports(results: Sequence[CheckResult], targets: dict[str, Path | None], title: str) -> list[Path]:
@@ -214,6 +274,6 @@ def write_reports(results: Sequence[CheckResult], targets: dict[str, Path | None
         try:
             files.write_text(path, REPORTS[kind](results, title))
         except OSError as exc:
-            raise SandboxError(f"--{kind} {path}: cannot write ({exc.strerror or exc})") from None
+            raise SandboxError(f"--{kind.replace('_', '-')} {path}: cannot write ({exc.strerror or exc})") from None
         written.append(path)
     return written

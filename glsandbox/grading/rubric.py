@@ -6,6 +6,7 @@ per check and gives each student a score out of the total. The file::
     # every key below [[check]] is optional except golden
     timeout = 30            # seconds for each picture (the command line's --timeout wins)
     memory = 2048           # MB of address space for each submission
+    entry = "spin.py"       # the lesson file in a student's folder (default: the one no other file imports)
 
     [[check]]
     kind = "picture"        # the default; the kinds are glsandbox.grading.kinds.KINDS
@@ -63,6 +64,8 @@ class Rubric:
     checks: tuple[Check, ...]
     timeout: float | None = None
     memory: int | None = None
+    #: The lesson file's name in a student's folder (None: the one no other file imports).
+    entry: str | None = None
 
     @property
     def total(self) -> float:
@@ -96,7 +99,7 @@ def parse_tolerances(items: list[str] | tuple[str, ...]) -> dict[str, float]:
     return tolerances
 
 
-_TOP_KEYS = {"timeout", "memory", "check"}
+_TOP_KEYS = {"timeout", "memory", "entry", "check"}
 
 
 def load_rubric(path: Path) -> Rubric:
@@ -128,7 +131,11 @@ def load_rubric(path: Path) -> Rubric:
     memory = data.get("memory")
     if memory is not None and (isinstance(memory, bool) or not isinstance(memory, int) or not 64 <= memory <= 1 << 20):
         raise SandboxError(f"{path}: memory = {memory!r}: expected a whole number of MB, at least 64")
-    return Rubric(tuple(checks), None if timeout is None else float(timeout), memory)
+    entry = data.get("entry")
+    if entry is not None and (not isinstance(entry, str) or not entry.endswith((".py", ".toml")) or "/" in entry
+                              or "\\" in entry or entry.startswith(".")):
+        raise SandboxError(f"{path}: entry = {entry!r}: expected a lesson file's name, e.g. \"spin.py\"")
+    return Rubric(tuple(checks), None if timeout is None else float(timeout), memory, entry)
 
 
 def _check(entry: dict[str, Any], number: int, path: Path) -> Check:
@@ -185,7 +192,7 @@ def _check(entry: dict[str, Any], number: int, path: Path) -> Check:
 
 #: The starting rubric ``glsandbox new --assignment NAME`` writes beside the model answer.
 STARTER = """\
-# Grading file for the assignment "$name" (see the README, "Grading a class").
+# Grading file for the assignment "$name" (see the manual, docs/grading-a-class.md).
 #   1. write the goldens from the model answer:
 #        glsandbox check $name.py --rubric $name.grading.toml --update
 #   2. grade a folder of submissions (one .py/.toml file or one folder per student):

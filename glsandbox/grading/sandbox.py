@@ -16,12 +16,17 @@ of the submission's code runs:
 3. Landlock (Linux 5.13 and later, where enabled) makes the kernel enforce
    the same file rules, and from kernel 6.12 (Landlock ABI 6) the signal
    rule, against code that bypasses Python (``ctypes`` calling the C
-   library). Where Landlock is missing, layers 1 and 2 remain; the time,
+   library), and from ABI 4 refuses every TCP bind and connect. Of ``/proc``
+   it may read only its own entries (and the machine's ``cpuinfo``,
+   ``meminfo``, ...), so no other process's environment or command line.
+   Where Landlock is missing, layers 1 and 2 remain; the time,
    memory and process limits (:mod:`glsandbox.grading.isolate`) hold always.
+
+The user, environment and network around the process are :mod:`glsandbox.grading.layers`'.
 
 The folders a submission may read: its own copy, its private working folder,
 the Python installation and its packages, glsandbox's own files, and the
-system's (``/usr``, ``/lib``, ``/etc``, ``/dev``, ``/proc``, ``/sys``).
+system's (``/usr``, ``/lib``, ``/etc``, ``/dev``, ``/sys``, and of ``/proc`` its own entries).
 """
 
 from __future__ import annotations
@@ -170,6 +175,9 @@ _FS_V1 = (1 << 13) - 1
 _FS_BY_ABI = {1: _FS_V1, 2: _FS_V1 | 1 << 13, 3: _FS_V1 | 1 << 13 | 1 << 14, 4: _FS_V1 | 1 << 13 | 1 << 14}
 _READ = 1 | 4 | 8  # EXECUTE, READ_FILE, READ_DIR
 _SCOPE_SIGNAL, _SCOPE_UNIX = 2, 1
+_NET_BIND_TCP, _NET_CONNECT_TCP = 1, 2
+#: What of /proc a confined process may read besides its own /proc/<pid>: no other process's entries.
+PROC_READ = ("/proc/cpuinfo", "/proc/meminfo", "/proc/stat", "/proc/version", "/proc/sys/kernel")
 
 
 class _RulesetAttr(ctypes.Structure):
@@ -204,7 +212,9 @@ def _landlock(reads: Sequence[str], writes: Sequence[str]) -> bool:
     if abi < 1 or libc is None:
         return False
     fs = _FS_BY_ABI.get(abi, _FS_BY_ABI[4] | 1 << 15)
-    attr = _RulesetAttr(fs, 0, _SCOPE_SIGNAL | _SCOPE_UNIX if abi >= 6 else 0)
+    # ABI 4: TCP bind and connect are handled, and no rule allows any port: both refused.
+    attr = _RulesetAttr(fs, _NET_BIND_TCP | _NET_CONNECT_TCP if abi >= 4 else 0,
+                        _SCOPE_SIGNAL | _SCOPE_UNIX if abi >= 6 else 0)
     size = 24 if abi >= 6 else 16 if abi >= 4 else 8
     ruleset = libc.syscall(_SYS_CREATE, ctypes.byref(attr), ctypes.c_size_t(size), ctypes.c_uint32(0))
     if ruleset < 0:
@@ -241,7 +251,9 @@ def confine(submission: str | os.PathLike[str], private: Sequence[str | os.PathL
     root = os.path.realpath(submission)
     cache = shader_cache_dirs()
     writes = [os.path.realpath(p) for p in private] + (cache if cache_writable else [])
-    reads = read_roots([root, *cache])
+    # /proc: its own entries only (/proc/self resolves to them), never another process's
+    own_proc = [f"/proc/{os.getpid()}", *(p for p in PROC_READ if os.path.exists(p))]
+    reads = [r for r in read_roots([root, *cache]) if r != "/proc"] + own_proc
     from glsandbox.gl.shaders import shader_roots
 
     files.set_sandbox_root(root, also=(*writes, *shader_roots()))

@@ -8,6 +8,7 @@ module runs only in those processes; the grader starts the zygote with
 from __future__ import annotations
 
 import ctypes
+import functools
 import json
 import os
 import select
@@ -21,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from glsandbox.grading import layers
 from glsandbox.grading.isolate import (BROKEN, CRASHED, OOM, TAIL_LINES, TAIL_WIDTH, TIMEOUT, Job, Picture, Reader,
                                        job_from, send)
 from glsandbox.grading.processes import kill_tree, killpg, set_subreaper, wait_briefly
@@ -34,9 +36,6 @@ PRELOAD = ["glsandbox.grading.worker", "glsandbox.frame", "glsandbox.lesson", "g
            "glsandbox.grading.sandbox", "glsandbox.gl.context", "glsandbox.gl.shaders", "numpy", "moderngl",
            "glcontext", "glcontext.egl", "PIL.Image", "glsandbox.lessons"]
 
-#: The environment a renderer keeps (by prefix): the drivers', the locale's and glsandbox's own.
-_ENV_KEPT = ("PATH", "HOME", "LANG", "LC_", "TZ", "DISPLAY", "WAYLAND_", "XDG_", "MESA_", "LIBGL_", "GALLIUM_",
-             "LP_", "EGL_", "__EGL_", "__GLX_", "GLCONTEXT_", "PYOPENGL_", "GLSANDBOX_", "PYTHONHASHSEED", "CI")
 
 
 # --- the renderer (grandchild) ---------------------------------------------------------------
@@ -57,12 +56,14 @@ def _limit(job: Job) -> None:
             pass
 
 
-def _renderer(job: Job, root: str, target: str, work: str, out: int) -> None:
-    """The renderer's whole life; it never returns (``os._exit``)."""
+def _renderer(job: Job, root: str, target: str, work: str, out: int, ids: tuple[int, int] | None) -> None:
+    """The renderer's whole life; it never returns (``os._exit``). ``ids``: the user it becomes
+    before the submission's code runs (the grader is root)."""
     from glsandbox.errors import SandboxError
     from glsandbox.frame import HeadlessRenderer
+    from glsandbox.grading import layers
+    from glsandbox.grading.sandbox import confine, landlock_abi
     from glsandbox.lesson import find_lesson, submission_lesson, user_code_error
-    from glsandbox.grading.sandbox import confine
 
     os.setsid()
     null = os.open(os.devnull, os.O_RDONLY)
@@ -77,9 +78,7 @@ def _renderer(job: Job, root: str, target: str, work: str, out: int) -> None:
     os.closerange(4, os.sysconf("SC_OPEN_MAX"))
     sys.stdin = open(os.devnull)  # noqa: SIM115 - the submission's, for its life
     sys.argv = ["submission"]
-    for key in list(os.environ):  # only what rendering reads: no path of the teacher's (PWD, OLDPWD, ...)
-        if not key.startswith(_ENV_KEPT):
-            del os.environ[key]
+    layers.close_network()  # before a context starts threads: a user namespace needs a single thread
     cwd = os.path.join(work, "cwd")
     os.chdir(root if job.copy else cwd)
     _limit(job)
@@ -90,9 +89,15 @@ def _renderer(job: Job, root: str, target: str, work: str, out: int) -> None:
         except SandboxError as exc:
             send(out, {"kind": "nogl", "error": str(exc)})
             return
-        confine(root, [root if job.copy else cwd, cwd], cache_writable=job.writes_cache)
+        kept_reading = False
+        if ids is not None:  # Python only root may read: reading kept, bounded by Landlock below
+            kept_reading = not _python_readable() and landlock_abi() >= 1
+            layers.drop_privileges(ids, keep_reading=kept_reading)
+        if not confine(root, [root if job.copy else cwd, cwd], cache_writable=job.writes_cache) and kept_reading:
+            layers.drop_reading()
+        layers.install_seccomp()
         try:
-            cls = find_lesson(target) if job.source is None else submission_lesson(Path(root) / target)
+            cls = find_lesson(target) if job.source is None else submission_lesson(Path(root) / target, job.entry)
         except MemoryError as exc:
             send(out, {"kind": "oom", "index": 0, "error": str(user_code_error(exc)), "all": True})
             return
@@ -102,13 +107,23 @@ def _renderer(job: Job, root: str, target: str, work: str, out: int) -> None:
         except BaseException as exc:  # noqa: BLE001 - anything the submission raised while loading
             send(out, {"kind": "broken", "index": 0, "error": str(user_code_error(exc)), "all": True})
             return
+        if job.describe:  # the tour's card: read from the class now, sent as text
+            try:
+                from glsandbox.lesson import lesson_description
+
+                send(out, {"kind": "meta", "title": str(cls.title)[:500], "course_section": str(cls.course_section)[:500],
+                           "description": str(lesson_description(cls))[:2000]})
+            except BaseException:  # noqa: BLE001 - a class whose attributes raise: its card says less
+                pass
         for index, render in enumerate(job.renders):
             started = time.perf_counter()
             try:
-                image = renderer.render(cls.from_settings(render.settings), render.size, render.samples).image
-                image = np.ascontiguousarray(image, dtype=np.uint8)
+                frame = renderer.render(cls.from_settings(render.settings), render.size, render.samples)
+                image = np.ascontiguousarray(frame.image, dtype=np.uint8)
                 header = {"kind": "image", "index": index, "shape": list(image.shape),
                           "seconds": time.perf_counter() - started}
+                if job.describe:
+                    header["info"] = {"plan": frame.plan.to_dict(), "plan_text": frame.plan.describe()}
                 send(out, header, image.tobytes())
             except MemoryError as exc:
                 send(out, {"kind": "oom", "index": index, "error": str(user_code_error(exc))})
@@ -141,17 +156,35 @@ def _copy_submission(source: Path, into: Path) -> Path:
     return into
 
 
+def _hand_over(work: str, folders: list[str], ids: tuple[int, int]) -> None:
+    """Make ``folders`` (and all in them) ``ids``'s; ``work`` above them only passable by others."""
+    uid, gid = ids
+    os.chmod(work, 0o711)
+    for folder in folders:
+        os.lchown(folder, uid, gid)
+        for base, dirs, names in os.walk(folder):
+            for name in dirs + names:
+                os.lchown(os.path.join(base, name), uid, gid)
+
+
+@functools.cache
+def _python_readable() -> bool:
+    from glsandbox.grading.layers import python_readable_by_others
+
+    return python_readable_by_others()
+
+
 def _exit_reason(status: int, job: Job) -> tuple[str, str]:
     if os.WIFSIGNALED(status):
         number = os.WTERMSIG(status)
         if number == signal.SIGXCPU:
-            return TIMEOUT, f"CPU time limit ({int(job.timeout * len(job.renders)) + 10} s) reached"
+            return TIMEOUT, f"timed out: the CPU time limit ({int(job.timeout * len(job.renders)) + 10} s) reached"
         name = signal.Signals(number).name if number in signal.Signals._value2member_map_ else str(number)
         return CRASHED, f"killed by signal {name}"
     return CRASHED, f"exited with code {os.WEXITSTATUS(status)} before its picture was sent"
 
 
-def _collect(job: Job, pid: int, fd: int) -> list[Picture]:
+def _collect(job: Job, pid: int, fd: int, meta: dict | None = None) -> list[Picture]:
     """Each picture as it arrives, against the clock: ``job.timeout`` seconds for each."""
     pictures: list[Picture] = [Picture() for _ in job.renders]
     limit = max(w * h * 4 for w, h in (r.size for r in job.renders))
@@ -168,7 +201,8 @@ def _collect(job: Job, pid: int, fd: int) -> list[Picture]:
     while current < len(pictures):
         remaining = started + job.timeout - time.monotonic()
         if remaining <= 0:
-            return finish(TIMEOUT, f"after {job.timeout:g} s")
+            pictures[current].seconds = time.monotonic() - started  # the limit it ran into, not 0
+            return finish(TIMEOUT, f"timed out after {job.timeout:g} s")
         if status is None:
             done, status_now = os.waitpid(pid, os.WNOHANG)
             status = status_now if done else None
@@ -181,6 +215,9 @@ def _collect(job: Job, pid: int, fd: int) -> list[Picture]:
                 kind = header.get("kind")
                 if kind == "nogl":
                     raise _NoGL(str(header.get("error", "")))
+                if kind == "meta" and meta is not None and not meta:
+                    meta.update({k: str(header.get(k, ""))[:2000] for k in ("title", "course_section", "description")})
+                    continue
                 index = int(header.get("index", -1))
                 if index != current:
                     raise ValueError("a message out of order on the result pipe")
@@ -192,6 +229,8 @@ def _collect(job: Job, pid: int, fd: int) -> list[Picture]:
                         raise ValueError(f"a picture of shape {shape} for a {w}x{h} render")
                     picture.image = np.frombuffer(payload, dtype=np.uint8).reshape(h, w, 4)
                     picture.seconds = float(header.get("seconds", 0.0))
+                    if job.describe and isinstance(header.get("info"), dict):
+                        picture.info = header["info"]
                 else:
                     picture.status = OOM if kind == "oom" else BROKEN
                     picture.error = str(header.get("error", ""))[:500]
@@ -225,7 +264,7 @@ def _supervise(job: Job, out: int) -> None:
     set_subreaper()
     send(out, {"kind": "pid", "pid": os.getpid()})
     work = tempfile.mkdtemp(prefix="glsandbox-grade-")
-    result: dict = {"kind": "result", "pictures": None, "output": [], "no_gl": "", "root": ""}
+    result: dict = {"kind": "result", "pictures": None, "output": [], "no_gl": "", "root": "", "meta": {}}
     pictures: list[Picture] | None = None
     cleaned = False
     try:
@@ -244,14 +283,17 @@ def _supervise(job: Job, out: int) -> None:
             result["root"] = root
         else:
             root, target = str(Path(job.source).parent), job.target
+        ids = layers.submission_ids(os.getpid()) if job.copy else None
+        if ids is not None:  # its own copy and working folder, owned by the user it runs as
+            _hand_over(work, [root, os.path.join(work, "cwd")], ids)
         read_end, write_end = os.pipe()
         pid = os.fork()
         if pid == 0:  # the renderer: no GL context here, or the warm template's, checked safe to fork
             os.close(read_end)
-            _renderer(job, root, target, work, write_end)
+            _renderer(job, root, target, work, write_end, ids)
         os.close(write_end)
         try:
-            pictures = _collect(job, pid, read_end)
+            pictures = _collect(job, pid, read_end, result["meta"])
         except _NoGL as exc:
             result["no_gl"] = str(exc)
         wait_briefly(pid)  # after its last picture it ends by itself: then one look finds nothing left
@@ -270,7 +312,7 @@ def _supervise(job: Job, out: int) -> None:
             for picture in pictures:
                 image = picture.image
                 result["pictures"].append({"status": picture.status, "error": picture.error,
-                                           "seconds": picture.seconds,
+                                           "seconds": picture.seconds, "info": picture.info,
                                            "shape": None if image is None else list(image.shape)})
                 payload += b"" if image is None else image.tobytes()
         send(out, result, payload)
@@ -317,6 +359,7 @@ def zygote_main(channel_fd: int) -> None:
     from glsandbox.grading.sandbox import read_roots
 
     read_roots()  # worked out once, for every renderer
+    _python_readable()
     zygote(channel_fd)
 
 

@@ -16,7 +16,7 @@ the subject's extra CPU per repetition is a column of its own, steadier than
 wall time on a shared machine (GL drivers' worker threads in this process are
 not in it). Speed goals are printed, never
 asserted: no test depends on a timing, which a busy machine would fail
-(README, "Benchmarks").
+(docs/benchmarks.md).
 
 The same harness drives ``python benchmarks/cube_frame.py`` on its own.
 """

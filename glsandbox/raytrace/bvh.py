@@ -506,6 +506,40 @@ class _Open(NamedTuple):
 _Small = tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.float32]]
 
 
+class _Buffers:
+    """Flat buffers a level's per-column arrays are viewed from, made once per
+    :func:`_split_levels` (fresh pages each level cost more than the work on them)."""
+
+    def __init__(self, cols: NDArray[np.float32]) -> None:
+        k = cols.shape[1]
+        # The columns move between two flat buffers level after level: a fresh 24 bytes per
+        # triangle each level would be fresh pages for the kernel to zero and map each time.
+        self.spare = np.empty(cols.size, dtype=np.float32)
+        # Viewed as contiguous (3, width) arrays each level: np.take copies a strided array whole first.
+        self.centre = np.empty(3 * k, dtype=np.float32)
+        # int32 keys (a level's n·B bins are fewer than its columns): np.minimum.at reads them faster than int64.
+        self.bin_keys = np.empty(3 * k, dtype=np.int32)
+        self.bin_rows = np.empty(3 * k, dtype=np.uint8)  # each column's bin on each axis (the key less i·B)
+
+
+class _Found:
+    """The nodes of at most :data:`SMALL` triangles the levels made, for :func:`_split_small`."""
+
+    def __init__(self) -> None:
+        self.tris: list[NDArray[np.int64]] = []
+        self.ids: list[NDArray[np.int64]] = []
+        self.counts: list[NDArray[np.int64]] = []
+        self.depth: list[NDArray[np.int64]] = []
+        self.boxes: list[NDArray[np.float32]] = []
+
+    def arrays(self, cols: NDArray[np.float32]) -> _Small:
+        if not self.ids:
+            none = np.zeros(0, dtype=np.int64)
+            return none, none, none, none, cols[:, :0]
+        return (np.concatenate(self.tris), np.concatenate(self.ids), np.concatenate(self.counts),
+                np.concatenate(self.depth), np.concatenate(self.boxes, axis=1))
+
+
 def _split_levels(start: _Open, tree: _Tree, leaf_size: int, max_bins: int, stop: int = 0
                   ) -> tuple[_Small, _Open | None]:
     """The breadth-first binned-SAH splitting of the nodes of more than :data:`SMALL` triangles
@@ -524,294 +558,348 @@ def _split_levels(start: _Open, tree: _Tree, leaf_size: int, max_bins: int, stop
     children's in one pass (a counting sort: no ``argsort`` per level).
     Every choice is per node (the bins per node are ``max_bins`` at every
     level: open nodes hold more than SMALL ≥ 64 triangles), so the nodes of a
-    level may be split in separate calls with the same result.
+    level may be split in separate calls with the same result. One level is
+    four steps: bin (:func:`_bin_level`), score the cuts (:func:`_score_cuts`),
+    put each column on its side (:func:`_sides`), partition (:func:`_partition`).
     """
     small = max(SMALL, leaf_size)
-    small_tris, small_ids, small_counts, small_depth, small_boxes = [], [], [], [], []
-    tris, cols, counts, box_lo, box_hi, open_ids, level = start
-    k = tris.size
-    # Two flat buffers the columns are moved between, level after level: a fresh 24 bytes per
-    # triangle each level would be fresh pages for the kernel to zero and map each time.
-    spare = np.empty(cols.size, dtype=np.float32)
-    # Flat buffers, made once (fresh pages each level cost more than the casts), viewed as
-    # contiguous (3, width) arrays each level: np.take copies a strided array whole first.
-    centre = np.empty(3 * k, dtype=np.float32)
-    # int32 keys (a level's n·B bins are fewer than its columns): np.minimum.at reads them faster than int64.
-    bin_keys = np.empty(3 * k, dtype=np.int32)
-    bin_rows = np.empty(3 * k, dtype=np.uint8)  # each column's bin on each axis (the key less its node's i·B)
-    rest = None
-    while counts.size:
-        if stop and counts.size >= stop:
-            rest = _Open(tris, cols, counts, box_lo, box_hi, open_ids, level)
-            break
-        n = counts.size
-        width = tris.size
-        cen = centre[:3 * width].reshape(3, width)
-        np.add(cols[0:3], cols[3:6], out=cen)  # twice the centroids (halving them would be one more pass)
-        # Bins per node: max_bins, fewer once nodes are small (about one per
-        # triangle), so the per-bin work never exceeds the per-triangle work.
-        bins = int(min(max_bins, max(4, 1 << int(np.log2(max(1, width // n))))))
-        # Binning range per node and axis: the node's box (from its parent's
-        # sweep), cut into `bins` equal slabs; a flat axis puts all in bin 0.
-        # Where the triangles' centroids span less than CENTROID_RANGE of it on
-        # an axis, the centroids' own range instead (Wald 2007): slivers meeting
-        # at one point (a fan) have their centroids bunched in one slab of their
-        # box, and only the stragglers could be cut off, one level each (a fan
-        # of 1M triangles was 5,470 levels deep).
-        starts = np.cumsum(counts) - counts
-        centre_lo = 0.5 * np.minimum.reduceat(cen, starts, axis=1).T.astype(np.float64)
-        centre_hi = 0.5 * np.maximum.reduceat(cen, starts, axis=1).T.astype(np.float64)
-        bunched = (centre_hi - centre_lo) < CENTROID_RANGE * (box_hi - box_lo)
-        box_lo = np.where(bunched, centre_lo, box_lo)
-        box_hi = np.where(bunched, centre_hi, box_hi)
-        extent = box_hi - box_lo
-        scale = np.where(extent > 0.0, bins * (1.0 - 1e-6) / np.where(extent > 0.0, extent, 1.0), 0.0)
-        # A node of SAMPLED_ONLY triangles or more is binned from every stride-th
-        # of its triangles (about SAMPLE of them): its bins' counts (scaled by
-        # stride) and boxes are the heuristic's estimate of the children's sizes
-        # and areas, which picks the axis; the exact counts on that axis then
-        # pick the cut (below). Smaller nodes bin all their triangles (exact
-        # counts) and, over 2·SAMPLE of them, take the bins' boxes from every
-        # stride-th (the boxes are only the estimate of the children's areas).
-        stride = np.maximum(1, counts // SAMPLE)
-        sampled = bool(counts.max() >= SAMPLED_ONLY)
-        if sampled:
-            bin_stride = np.where(counts >= SAMPLED_ONLY, stride, 1)
-            taken = -(-counts // bin_stride)
-            sample = _every(starts, taken, bin_stride)
-            box_rows = np.take(cols, sample, axis=1)
-            bin_cen = np.take(cen, sample, axis=1)
-            del sample
+    found = _Found()
+    buffers = _Buffers(start.cols)
+    level: _Open | None = start
+    while level is not None and level.counts.size:
+        if stop and level.counts.size >= stop:
+            return found.arrays(level.cols), level
+        binned = _bin_level(level, buffers, max_bins)
+        cuts = _score_cuts(binned, level.counts)
+        right, node_of = _sides(binned, cuts, level.counts)
+        cols = level.cols
+        level = _partition(level, binned, cuts, right, node_of, tree, leaf_size, small, found, buffers)
+    return found.arrays(cols if level is None else level.cols), None
+
+
+class _Binned(NamedTuple):
+    """One level's nodes binned (:func:`_bin_level`)."""
+
+    n: int  # open nodes
+    width: int  # their columns
+    bins: int  # bins per node and axis
+    starts: NDArray[np.int64]  # each node's first column
+    cen: NDArray[np.float32]  # (3, width): twice the columns' centroids
+    box_lo: NDArray[np.float64]  # (n, 3): the binning ranges
+    box_hi: NDArray[np.float64]
+    scale: NDArray[np.float64]  # (n, 3): bins per unit length
+    sampled: bool  # some node binned from a sample of its columns only
+    taken: NDArray[np.int64]  # binned columns per node
+    bin_key: NDArray[np.int32]  # (3, binned): node i's bins are i·B .. i·B + B − 1
+    bin_row: NDArray[np.uint8]  # (3, binned): the bin within the node
+    box_rows: NDArray[np.float32]  # (6, boxed): the boxes the bins' boxes are made of
+    box_keys: NDArray[np.int32]  # (3, boxed): their bins
+
+
+def _bin_level(level: _Open, buffers: _Buffers, max_bins: int) -> _Binned:
+    """Every open node's binning range and each of its (sampled) columns' bin on each axis."""
+    tris, cols, counts, box_lo, box_hi = level.tris, level.cols, level.counts, level.box_lo, level.box_hi
+    n = counts.size
+    width = tris.size
+    cen = buffers.centre[:3 * width].reshape(3, width)
+    np.add(cols[0:3], cols[3:6], out=cen)  # twice the centroids (halving them would be one more pass)
+    # Bins per node: max_bins, fewer once nodes are small (about one per
+    # triangle), so the per-bin work never exceeds the per-triangle work.
+    bins = int(min(max_bins, max(4, 1 << int(np.log2(max(1, width // n))))))
+    # Binning range per node and axis: the node's box (from its parent's
+    # sweep), cut into `bins` equal slabs; a flat axis puts all in bin 0.
+    # Where the triangles' centroids span less than CENTROID_RANGE of it on
+    # an axis, the centroids' own range instead (Wald 2007): slivers meeting
+    # at one point (a fan) have their centroids bunched in one slab of their
+    # box, and only the stragglers could be cut off, one level each (a fan
+    # of 1M triangles was 5,470 levels deep).
+    starts = np.cumsum(counts) - counts
+    centre_lo = 0.5 * np.minimum.reduceat(cen, starts, axis=1).T.astype(np.float64)
+    centre_hi = 0.5 * np.maximum.reduceat(cen, starts, axis=1).T.astype(np.float64)
+    bunched = (centre_hi - centre_lo) < CENTROID_RANGE * (box_hi - box_lo)
+    box_lo = np.where(bunched, centre_lo, box_lo)
+    box_hi = np.where(bunched, centre_hi, box_hi)
+    extent = box_hi - box_lo
+    scale = np.where(extent > 0.0, bins * (1.0 - 1e-6) / np.where(extent > 0.0, extent, 1.0), 0.0)
+    # A node of SAMPLED_ONLY triangles or more is binned from every stride-th
+    # of its triangles (about SAMPLE of them): its bins' counts (scaled by
+    # stride) and boxes are the heuristic's estimate of the children's sizes
+    # and areas, which picks the axis; the exact counts on that axis then
+    # pick the cut (:func:`_sides`). Smaller nodes bin all their triangles (exact
+    # counts) and, over 2·SAMPLE of them, take the bins' boxes from every
+    # stride-th (the boxes are only the estimate of the children's areas).
+    stride = np.maximum(1, counts // SAMPLE)
+    sampled = bool(counts.max() >= SAMPLED_ONLY)
+    if sampled:
+        bin_stride = np.where(counts >= SAMPLED_ONLY, stride, 1)
+        taken = -(-counts // bin_stride)
+        sample = _every(starts, taken, bin_stride)
+        box_rows = np.take(cols, sample, axis=1)
+        bin_cen = np.take(cen, sample, axis=1)
+        del sample
+    else:
+        taken = counts
+        box_rows, bin_cen = cols, cen
+    bin_key, bin_row = _bin_keys(bin_cen, taken, box_lo, scale, bins, buffers)
+    box_stride = np.where(counts >= SAMPLED_ONLY, 1, stride)
+    box_keys = bin_key
+    if box_stride.max() > 1:
+        box_sample = _every(np.cumsum(taken) - taken, -(-taken // box_stride), box_stride)
+        box_rows = np.take(box_rows, box_sample, axis=1)
+        box_keys = np.take(bin_key, box_sample, axis=1)
+    return _Binned(n, width, bins, starts, cen, box_lo, box_hi, scale, sampled, taken, bin_key, bin_row,
+                   box_rows, box_keys)
+
+
+def _bin_keys(bin_cen: NDArray[np.float32], taken: NDArray[np.int64], box_lo: NDArray[np.float64],
+              scale: NDArray[np.float64], bins: int, buffers: _Buffers
+              ) -> tuple[NDArray[np.int32], NDArray[np.uint8]]:
+    """Each binned column's bin on each axis, ``⌊(c − lo)·scale⌋`` clipped to the node's bins, and
+    as a key node-major over the level (node i's bins are i·B .. i·B + B − 1)."""
+    binned = bin_cen.shape[1]
+    node_key = np.repeat(np.arange(taken.size, dtype=np.int32) * np.int32(bins), taken)
+    bin_key = buffers.bin_keys[:3 * binned].reshape(3, binned)
+    bin_row = buffers.bin_rows[:3 * binned].reshape(3, binned)
+    rel = np.empty(binned, dtype=np.float32)
+    for axis in range(3):  # one row at a time: np.repeat of a 1-D array is a plain copy loop
+        # (2c − 2·lo)·(scale / 2): the same float32 value as (c − lo)·scale (halving and
+        # doubling are exact), from the doubled centroids.
+        np.subtract(bin_cen[axis], np.repeat((2.0 * box_lo[:, axis]).astype(np.float32), taken), out=rel)
+        rel *= np.repeat((0.5 * scale[:, axis]).astype(np.float32), taken)
+        np.clip(rel, 0, bins - 1, out=rel)
+        bin_row[axis] = rel
+        np.add(bin_row[axis], node_key, out=bin_key[axis])
+    return bin_key, bin_row
+
+
+class _Cuts:
+    """Each node's cheapest cut so far (axis, first bin on the right, the children's boxes) and its
+    most even cut by count (where no SAH cut gains), over the axes scored (:func:`_score_cuts`)."""
+
+    def __init__(self, n: int) -> None:
+        self.cost = np.full(n, np.inf)
+        self.axis = np.zeros(n, dtype=np.int64)
+        self.cut = np.ones(n, dtype=np.int64)
+        self.lo = np.empty((n, 2, 3))
+        self.hi = np.empty((n, 2, 3))
+        self.even_gap = np.full(n, np.inf)
+        self.even_axis = np.zeros(n, dtype=np.int64)
+        self.even_cut = np.ones(n, dtype=np.int64)
+        self.even_lo = np.empty((n, 2, 3))
+        self.even_hi = np.empty((n, 2, 3))
+        self.no_gain = np.zeros(0, dtype=np.int64)
+        #: Per axis (sampled levels): the running boxes and the cuts' half areas (left, right).
+        self.sweeps: list[tuple[NDArray[np.float32], ...]] = []
+        self.areas: list[tuple[NDArray[np.float32], NDArray[np.float32]]] = []
+
+    def keep(self, which: NDArray[np.int64], axis: int, cut: NDArray[np.int64],
+             sweep: tuple[NDArray[np.float32], ...], even: bool = False) -> None:
+        """Nodes ``which`` take the cut before bin ``cut + 1`` on ``axis``: its axis, cut and the
+        children's boxes from the running boxes ``sweep`` (left lo, hi, right lo, hi)."""
+        llo, lhi, rlo, rhi = sweep
+        lo, hi = (self.even_lo, self.even_hi) if even else (self.lo, self.hi)
+        (self.even_axis if even else self.axis)[which] = axis
+        (self.even_cut if even else self.cut)[which] = cut + 1  # bins below the cut go left
+        lo[which, 0] = llo[:, cut, which].T
+        hi[which, 0] = lhi[:, cut, which].T
+        lo[which, 1] = rlo[:, cut + 1, which].T
+        hi[which, 1] = rhi[:, cut + 1, which].T
+
+
+def _score_cuts(binned: _Binned, counts: NDArray[np.int64]) -> _Cuts:
+    """The SAH cost ``N_left·A_left + N_right·A_right`` of every cut between bins on every axis,
+    each node's cheapest kept; where it gains nothing, the most even cut by count instead."""
+    n, bins = binned.n, binned.bins
+    cuts = _Cuts(n)
+    nodes = np.arange(n)
+    to_counts = (counts / binned.taken)[:, None] if binned.sampled else None  # a sampled bin's count: stride × its own
+    node_lo = node_hi = None
+    for axis in range(3):
+        cnt, sweep = _axis_bins(binned, axis)
+        llo, lhi, rlo, rhi = sweep
+        if node_lo is None:  # all the bins: the node's (sampled) box
+            node_lo, node_hi = llo[:, -1], lhi[:, -1]
+        n_left = np.cumsum(cnt.T[:-1], axis=0)
+        # Both sides something, from the binned columns' own (integer) counts: scaled ones
+        # round, and a side of none could look like a sliver of one.
+        both = (n_left > 0) & (n_left < binned.taken)
+        if to_counts is not None:
+            n_left = n_left * to_counts.T
+        n_right = counts - n_left
+        area_left, area_right = _half_area(llo[:, :-1], lhi[:, :-1]), _half_area(rlo[:, 1:], rhi[:, 1:])
+        if binned.sampled:
+            cuts.sweeps.append(sweep)
+            cuts.areas.append((area_left, area_right))
+        sah = n_left * area_left + n_right * area_right
+        sah = np.where(both, sah, np.inf)  # a cut must leave both sides something
+        cut = np.argmin(sah, axis=0)  # the best cut on this axis, minus one
+        cost = sah[cut, nodes]
+        gap = np.where(both, np.abs(2 * n_left - counts), np.inf)
+        even = np.argmin(gap, axis=0)
+        evener = np.flatnonzero(gap[even, nodes] < cuts.even_gap)
+        if evener.size:
+            cuts.even_gap[evener] = gap[even[evener], evener]
+            cuts.keep(evener, axis, even[evener], sweep, even=True)
+        better = np.flatnonzero(cost < cuts.cost)
+        if better.size:
+            cuts.cost[better] = cost[better]
+            cuts.keep(better, axis, cut[better], sweep)
+    # No gain: when the best cut costs about what the node itself does (N·A: every child box
+    # as big as the parent's), the SAH would peel a few triangles off per level and the tree
+    # grow as deep as the node is large. The most even cut by count keeps the depth logarithmic.
+    parent_cost = counts * _half_area(node_lo, node_hi).astype(np.float64)
+    cuts.no_gain = np.flatnonzero(np.isfinite(cuts.cost) & (cuts.cost >= NO_GAIN * parent_cost)
+                                  & np.isfinite(cuts.even_gap))
+    if cuts.no_gain.size:
+        g = cuts.no_gain
+        cuts.axis[g], cuts.cut[g], cuts.lo[g], cuts.hi[g] = cuts.even_axis[g], cuts.even_cut[g], cuts.even_lo[g], \
+            cuts.even_hi[g]
+    return cuts
+
+
+def _axis_bins(binned: _Binned, axis: int) -> tuple[NDArray[np.int64], tuple[NDArray[np.float32], ...]]:
+    """On one axis: every node's bin counts ``(n, B)`` and the sweep, the boxes of bins ``[0, s]``
+    and ``[s, B)`` for every ``s`` (left lo, hi, right lo, hi; ``(3, B, n)`` each)."""
+    n, bins = binned.n, binned.bins
+    cnt = np.bincount(binned.bin_key[axis], minlength=n * bins).reshape(n, bins)
+    blo = np.full((3, n * bins), np.inf, dtype=np.float32)
+    bhi = np.full((3, n * bins), -np.inf, dtype=np.float32)
+    key = binned.box_keys[axis]
+    for j in range(3):
+        np.minimum.at(blo[j], key, binned.box_rows[j])
+        np.maximum.at(bhi[j], key, binned.box_rows[3 + j])
+    # Bin-major copies, (3, B, n): the sweep then runs over contiguous rows.
+    blo3 = np.ascontiguousarray(blo.reshape(3, n, bins).transpose(0, 2, 1))
+    bhi3 = np.ascontiguousarray(bhi.reshape(3, n, bins).transpose(0, 2, 1))
+    llo, lhi = _sweep(blo3, bhi3, forward=True)
+    rlo, rhi = _sweep(blo3, bhi3, forward=False)
+    return cnt, (llo, lhi, rlo, rhi)
+
+
+def _sides(binned: _Binned, cuts: _Cuts, counts: NDArray[np.int64]) -> tuple[NDArray[np.bool_], NDArray[np.int64]]:
+    """Each column's side (True: the right child) on its node's chosen axis, and its node.
+
+    On a sampled level the sample chose the axis; the exact counts of every column's bin on
+    it then pick the cut there (:func:`_exact_cut`), and the children's boxes follow it. A
+    child that got no box (none of the sampled columns were its own) is binned over its
+    parent's range; a node no cut separates (every centroid in one bin on every axis) is
+    split in half by count, in column order."""
+    n, bins, cen = binned.n, binned.bins, binned.cen
+    nodes = np.arange(n)
+    # (Byte rows: the column's bin on each axis, its node's axis and cut repeated per column.)
+    axis_of = np.repeat(cuts.axis.astype(np.uint8), counts)
+    cut_of = np.repeat(cuts.cut.astype(np.uint8), counts)
+    node_of = np.repeat(nodes, counts)  # each column's node
+    if binned.sampled:
+        # Only the chosen axis's bin of every column, by the same float32 steps as _bin_keys.
+        if (cuts.axis == cuts.axis[0]).all():  # one axis for all (the top levels: one or two nodes)
+            rel = cen[cuts.axis[0]].copy()
         else:
-            taken = counts
-            box_rows, bin_cen = cols, cen
-        binned = bin_cen.shape[1]
-        # Each binned column's bin on each axis, as a key node-major over the level: node i's
-        # bins are i·B .. i·B + B − 1.
-        node_key = np.repeat(np.arange(n, dtype=np.int32) * np.int32(bins), taken)
-        bin_key = bin_keys[:3 * binned].reshape(3, binned)
-        bin_row = bin_rows[:3 * binned].reshape(3, binned)
-        rel = np.empty(binned, dtype=np.float32)
-        for axis in range(3):  # one row at a time: np.repeat of a 1-D array is a plain copy loop
-            # (2c − 2·lo)·(scale / 2): the same float32 value as (c − lo)·scale (halving and
-            # doubling are exact), from the doubled centroids.
-            np.subtract(bin_cen[axis], np.repeat((2.0 * box_lo[:, axis]).astype(np.float32), taken), out=rel)
-            rel *= np.repeat((0.5 * scale[:, axis]).astype(np.float32), taken)
-            np.clip(rel, 0, bins - 1, out=rel)
-            bin_row[axis] = rel
-            np.add(bin_row[axis], node_key, out=bin_key[axis])
-        del rel, node_key
-        best_cost = np.full(n, np.inf)
-        best_axis = np.zeros(n, dtype=np.int64)
-        best_cut = np.ones(n, dtype=np.int64)
-        child_lo = np.empty((n, 2, 3))
-        child_hi = np.empty((n, 2, 3))
-        nodes = np.arange(n)
-        # The most even cut by count over all axes: used where no SAH cut gains (below).
-        even_gap = np.full(n, np.inf)
-        even_axis = np.zeros(n, dtype=np.int64)
-        even_cut = np.ones(n, dtype=np.int64)
-        even_lo = np.empty((n, 2, 3))
-        even_hi = np.empty((n, 2, 3))
-        box_stride = np.where(counts >= SAMPLED_ONLY, 1, stride)
-        box_keys = bin_key
-        if box_stride.max() > 1:
-            box_sample = _every(np.cumsum(taken) - taken, -(-taken // box_stride), box_stride)
-            box_rows = np.take(box_rows, box_sample, axis=1)
-            box_keys = np.take(bin_key, box_sample, axis=1)
-            del box_sample
-        to_counts = (counts / taken)[:, None] if sampled else None  # a sampled bin's count: stride × its own
-        node_lo = node_hi = None
-        sweeps, areas = [], []  # per axis: the running boxes and the cuts' half areas (left, right)
-        for axis in range(3):
-            cnt = np.bincount(bin_key[axis], minlength=n * bins).reshape(n, bins)
-            blo = np.full((3, n * bins), np.inf, dtype=np.float32)
-            bhi = np.full((3, n * bins), -np.inf, dtype=np.float32)
-            key = box_keys[axis]
-            for j in range(3):
-                np.minimum.at(blo[j], key, box_rows[j])
-                np.maximum.at(bhi[j], key, box_rows[3 + j])
-            # Bin-major copies, (3, B, n): the sweep below then runs over contiguous rows.
-            blo3 = np.ascontiguousarray(blo.reshape(3, n, bins).transpose(0, 2, 1))
-            bhi3 = np.ascontiguousarray(bhi.reshape(3, n, bins).transpose(0, 2, 1))
-            # The sweep: boxes of bins [0, s) and [s, B) for every cut s, and
-            # the SAH cost N_left·A_left + N_right·A_right of each cut.
-            llo, lhi = _sweep(blo3, bhi3, forward=True)
-            rlo, rhi = _sweep(blo3, bhi3, forward=False)
-            if node_lo is None:  # all the bins: the node's (sampled) box
-                node_lo, node_hi = llo[:, -1], lhi[:, -1]
-            n_left = np.cumsum(cnt.T[:-1], axis=0)
-            # Both sides something, from the binned columns' own (integer) counts: scaled ones
-            # round, and a side of none could look like a sliver of one.
-            both = (n_left > 0) & (n_left < taken)
-            if to_counts is not None:
-                n_left = n_left * to_counts.T
-            n_right = counts - n_left
-            area_left, area_right = _half_area(llo[:, :-1], lhi[:, :-1]), _half_area(rlo[:, 1:], rhi[:, 1:])
-            if sampled:
-                sweeps.append((llo, lhi, rlo, rhi))
-                areas.append((area_left, area_right))
-            sah = n_left * area_left + n_right * area_right
-            sah = np.where(both, sah, np.inf)  # a cut must leave both sides something
-            cut = np.argmin(sah, axis=0)  # the best cut on this axis, minus one
-            cost = sah[cut, nodes]
-            gap = np.where(both, np.abs(2 * n_left - counts), np.inf)
-            even = np.argmin(gap, axis=0)
-            evener = np.flatnonzero(gap[even, nodes] < even_gap)
-            if evener.size:
-                ce = even[evener]
-                even_gap[evener] = gap[ce, evener]
-                even_axis[evener] = axis
-                even_cut[evener] = ce + 1
-                even_lo[evener, 0] = llo[:, ce, evener].T
-                even_hi[evener, 0] = lhi[:, ce, evener].T
-                even_lo[evener, 1] = rlo[:, ce + 1, evener].T
-                even_hi[evener, 1] = rhi[:, ce + 1, evener].T
-            better = np.flatnonzero(cost < best_cost)
-            if better.size:
-                cb = cut[better]
-                best_cost[better] = cost[better]
-                best_axis[better] = axis
-                best_cut[better] = cb + 1  # bins below the cut go left
-                child_lo[better, 0] = llo[:, cb, better].T
-                child_hi[better, 0] = lhi[:, cb, better].T
-                child_lo[better, 1] = rlo[:, cb + 1, better].T
-                child_hi[better, 1] = rhi[:, cb + 1, better].T
-        # No gain: when the best cut costs about what the node itself does (N·A: every child box
-        # as big as the parent's), the SAH would peel a few triangles off per level and the tree
-        # grow as deep as the node is large. The most even cut by count keeps the depth logarithmic.
-        parent_cost = counts * _half_area(node_lo, node_hi).astype(np.float64)
-        no_gain = np.flatnonzero(np.isfinite(best_cost) & (best_cost >= NO_GAIN * parent_cost)
-                                 & np.isfinite(even_gap))
-        if no_gain.size:
-            best_axis[no_gain] = even_axis[no_gain]
-            best_cut[no_gain] = even_cut[no_gain]
-            child_lo[no_gain] = even_lo[no_gain]
-            child_hi[no_gain] = even_hi[no_gain]
-        # Each column's side (True: the right child) on its node's chosen axis.
-        # (Byte rows: the column's bin on each axis, its node's axis and cut repeated per column.)
-        axis_of = np.repeat(best_axis.astype(np.uint8), counts)
-        cut_of = np.repeat(best_cut.astype(np.uint8), counts)
-        node_of = np.repeat(nodes, counts)  # each column's node
-        if sampled:
-            # Only the chosen axis's bin of every column, by the same float32 steps as above; its
-            # exact counts then pick the cut on that axis (the sample chose the axis).
-            if (best_axis == best_axis[0]).all():  # one axis for all (the top levels: one or two nodes)
-                rel = cen[best_axis[0]].copy()
-            else:
-                rel = np.where(axis_of == 0, cen[0], np.where(axis_of == 1, cen[1], cen[2]))
-            rel -= np.repeat((2.0 * box_lo[nodes, best_axis]).astype(np.float32), counts)
-            rel *= np.repeat((0.5 * scale[nodes, best_axis]).astype(np.float32), counts)
-            np.clip(rel, 0, bins - 1, out=rel)
-            chosen_bin = rel.astype(np.uint8)
-            del rel
-            exact = np.bincount(node_of * bins + chosen_bin, minlength=n * bins).reshape(n, bins)
-            best_cut = _exact_cut(exact, counts, best_axis, best_cut, no_gain, areas)
-            cut_of = np.repeat(best_cut.astype(np.uint8), counts)
-            right = np.greater_equal(chosen_bin, cut_of)
-            del chosen_bin
-            moved_cut = np.flatnonzero(np.isfinite(best_cost))
-            if moved_cut.size:
-                ax, cb = best_axis[moved_cut], best_cut[moved_cut] - 1
-                for j, (llo, lhi, rlo, rhi) in enumerate(sweeps):  # the children's boxes at the new cut
-                    on = moved_cut[ax == j]
-                    cj = cb[ax == j]
-                    child_lo[on, 0] = llo[:, cj, on].T
-                    child_hi[on, 0] = lhi[:, cj, on].T
-                    child_lo[on, 1] = rlo[:, cj + 1, on].T
-                    child_hi[on, 1] = rhi[:, cj + 1, on].T
-        else:
-            right = np.greater_equal(bin_row[2], cut_of)
-            np.copyto(right, np.greater_equal(bin_row[1], cut_of), where=axis_of == 1)
-            np.copyto(right, np.greater_equal(bin_row[0], cut_of), where=axis_of == 0)
-        del axis_of, cut_of, sweeps, areas
-        # A child whose sampled triangles were none of its own (at the cut picked from exact counts too) has no box:
-        # bin it over its parent's.
-        empty = np.logical_not(np.logical_and(np.isfinite(child_lo).all(axis=2), np.isfinite(child_hi).all(axis=2)))
-        if empty.any():
-            child_lo = np.where(empty[:, :, None], box_lo[:, None, :], child_lo)
-            child_hi = np.where(empty[:, :, None], box_hi[:, None, :], child_hi)
-        stuck = np.flatnonzero(~np.isfinite(best_cost))
-        if stuck.size:
-            # No cut separates them (every centroid in one bin on every axis):
-            # split in half by count, in column order.
-            where = np.repeat(~np.isfinite(best_cost), counts)
-            rank = np.arange(width) - np.repeat(starts, counts)
-            right[where] = (rank >= np.repeat(counts // 2, counts))[where]
-            child_lo[stuck] = box_lo[stuck][:, None, :]
-            child_hi[stuck] = box_hi[stuck][:, None, :]
-        # Children in pairs: open node i gets the ids of children 2i (left) and 2i + 1.
-        child = node_of
-        child *= 2
-        child += right
-        # Each column's rank within its child (lefts keep their order, rights
-        # too): with the child's start, its place in the partition below.
-        # A right column's rank is the rights before it less the rights before its node's first
-        # column; a left's, the lefts before it less the lefts before its node: one gather per
-        # column of a per-child offset, no per-column repeat of per-node values.
-        rights_before = right.astype(np.int64)
-        np.cumsum(rights_before, out=rights_before)
-        rights_before -= right  # rights in columns [0, i)
-        at_start = rights_before[starts]
-        child_count = np.empty(2 * n, dtype=np.int64)  # a node's rights: those before the next node's less its own
-        child_count[1::2] = np.append(at_start[1:], rights_before[-1] + right[-1]) - at_start
-        np.subtract(counts, child_count[1::2], out=child_count[0::2])
-        child_ids, is_leaf = tree.children(open_ids, child_count, leaf_size)
-        level += 1
-        tree.depth = max(tree.depth, level)
-        offset = np.empty(2 * n, dtype=np.int64)
-        offset[0::2] = starts - at_start  # lefts before each node's first column
-        offset[1::2] = at_start
-        rank = np.arange(width)
-        rank -= rights_before  # lefts in columns [0, i)
-        np.copyto(rank, rights_before, where=right)
-        # One stable counting sort of all the columns by child, the children in three runs: those
-        # that stay open, then the small ones (SMALL triangles at most: on to _split_small, node
-        # after node), then the leaves (whose triangles get their places here).
-        is_small = ~is_leaf & (child_count <= small)
-        group = is_leaf.astype(np.int8) * 2 + is_small  # 0 open, 1 small, 2 leaf
-        runs = np.argsort(group, kind="stable")
-        child_start = np.empty(2 * n, dtype=np.int64)
-        run_counts = child_count[runs]
-        child_start[runs] = np.cumsum(run_counts) - run_counts
-        offset -= child_start
-        rank -= offset[child]  # each column's place in the sorted order: the child's start plus its rank in it
-        source = np.empty(width, dtype=np.int64)
-        source[rank] = np.arange(width)
-        n_open = int(child_count[group == 0].sum())
-        n_small = int(child_count[is_small].sum())
-        leaf_cols = source[n_open + n_small:]
-        leaf_tris = tris[leaf_cols]
-        leaf_child = child[leaf_cols]
-        tree.leaf_of[leaf_tris] = child_ids[leaf_child]
-        # A leaf column's place in its leaf: its place in the sorted order less the leaf's start.
-        tree.leaf_rank[leaf_tris] = np.arange(n_open + n_small, width) - child_start[leaf_child]
-        if n_small:
-            smalls = np.flatnonzero(is_small)
-            small_ids.append(child_ids[smalls])
-            small_counts.append(child_count[smalls])
-            small_depth.append(np.full(smalls.size, level, dtype=np.int64))
-            grouped = source[n_open:n_open + n_small]  # their columns, node after node
-            small_tris.append(tris[grouped])
-            small_boxes.append(np.take(cols, grouped, axis=1))
-        if n_open == 0:
-            break
-        kept_children = np.flatnonzero(group == 0)
-        source = source[:n_open]
-        moved = spare[:6 * n_open].reshape(6, n_open)
-        np.take(cols, source, axis=1, out=moved, mode="clip")  # "clip": unbuffered (all in range)
-        spare = cols.base if cols.base is not None and cols.base.ndim == 1 else cols.reshape(-1)
-        cols = moved
-        tris = np.take(tris, source)
-        counts = child_count[kept_children]
-        open_ids = child_ids[kept_children]
-        box_lo = child_lo.reshape(2 * n, 3)[kept_children]
-        box_hi = child_hi.reshape(2 * n, 3)[kept_children]
-    if not small_ids:
-        none = np.zeros(0, dtype=np.int64)
-        return (none, none, none, none, cols[:, :0]), rest
-    return (np.concatenate(small_tris), np.concatenate(small_ids), np.concatenate(small_counts),
-            np.concatenate(small_depth), np.concatenate(small_boxes, axis=1)), rest
+            rel = np.where(axis_of == 0, cen[0], np.where(axis_of == 1, cen[1], cen[2]))
+        rel -= np.repeat((2.0 * binned.box_lo[nodes, cuts.axis]).astype(np.float32), counts)
+        rel *= np.repeat((0.5 * binned.scale[nodes, cuts.axis]).astype(np.float32), counts)
+        np.clip(rel, 0, bins - 1, out=rel)
+        chosen_bin = rel.astype(np.uint8)
+        del rel
+        exact = np.bincount(node_of * bins + chosen_bin, minlength=n * bins).reshape(n, bins)
+        cuts.cut = _exact_cut(exact, counts, cuts.axis, cuts.cut, cuts.no_gain, cuts.areas)
+        cut_of = np.repeat(cuts.cut.astype(np.uint8), counts)
+        right = np.greater_equal(chosen_bin, cut_of)
+        del chosen_bin
+        moved_cut = np.flatnonzero(np.isfinite(cuts.cost))
+        if moved_cut.size:
+            ax = cuts.axis[moved_cut]
+            for j, sweep in enumerate(cuts.sweeps):  # the children's boxes at the new cut
+                cuts.keep(moved_cut[ax == j], j, cuts.cut[moved_cut][ax == j] - 1, sweep)
+    else:
+        bin_row = binned.bin_row
+        right = np.greater_equal(bin_row[2], cut_of)
+        np.copyto(right, np.greater_equal(bin_row[1], cut_of), where=axis_of == 1)
+        np.copyto(right, np.greater_equal(bin_row[0], cut_of), where=axis_of == 0)
+    del axis_of, cut_of
+    empty = np.logical_not(np.logical_and(np.isfinite(cuts.lo).all(axis=2), np.isfinite(cuts.hi).all(axis=2)))
+    if empty.any():
+        cuts.lo = np.where(empty[:, :, None], binned.box_lo[:, None, :], cuts.lo)
+        cuts.hi = np.where(empty[:, :, None], binned.box_hi[:, None, :], cuts.hi)
+    stuck = np.flatnonzero(~np.isfinite(cuts.cost))
+    if stuck.size:
+        where = np.repeat(~np.isfinite(cuts.cost), counts)
+        rank = np.arange(binned.width) - np.repeat(binned.starts, counts)
+        right[where] = (rank >= np.repeat(counts // 2, counts))[where]
+        cuts.lo[stuck] = binned.box_lo[stuck][:, None, :]
+        cuts.hi[stuck] = binned.box_hi[stuck][:, None, :]
+    return right, node_of
+
+
+def _partition(level: _Open, binned: _Binned, cuts: _Cuts, right: NDArray[np.bool_], node_of: NDArray[np.int64],
+               tree: _Tree, leaf_size: int, small: int, found: _Found, buffers: _Buffers) -> _Open | None:
+    """Number the children (in pairs: open node i's are 2i, left, and 2i + 1), record the leaves'
+    triangles in ``tree`` and the small children in ``found``, and move the columns of the
+    children still open into node order: the next level (None when none is open).
+
+    One stable counting sort of all the columns by child, the children in three runs: those
+    that stay open, then the small ones (SMALL triangles at most: on to _split_small, node
+    after node), then the leaves (whose triangles get their places here)."""
+    tris, cols, n, width, starts = level.tris, level.cols, binned.n, binned.width, binned.starts
+    child = node_of
+    child *= 2
+    child += right
+    # Each column's rank within its child (lefts keep their order, rights
+    # too): with the child's start, its place in the partition below.
+    # A right column's rank is the rights before it less the rights before its node's first
+    # column; a left's, the lefts before it less the lefts before its node: one gather per
+    # column of a per-child offset, no per-column repeat of per-node values.
+    rights_before = right.astype(np.int64)
+    np.cumsum(rights_before, out=rights_before)
+    rights_before -= right  # rights in columns [0, i)
+    at_start = rights_before[starts]
+    child_count = np.empty(2 * n, dtype=np.int64)  # a node's rights: those before the next node's less its own
+    child_count[1::2] = np.append(at_start[1:], rights_before[-1] + right[-1]) - at_start
+    np.subtract(level.counts, child_count[1::2], out=child_count[0::2])
+    child_ids, is_leaf = tree.children(level.ids, child_count, leaf_size)
+    depth = level.level + 1
+    tree.depth = max(tree.depth, depth)
+    offset = np.empty(2 * n, dtype=np.int64)
+    offset[0::2] = starts - at_start  # lefts before each node's first column
+    offset[1::2] = at_start
+    rank = np.arange(width)
+    rank -= rights_before  # lefts in columns [0, i)
+    np.copyto(rank, rights_before, where=right)
+    is_small = ~is_leaf & (child_count <= small)
+    group = is_leaf.astype(np.int8) * 2 + is_small  # 0 open, 1 small, 2 leaf
+    runs = np.argsort(group, kind="stable")
+    child_start = np.empty(2 * n, dtype=np.int64)
+    run_counts = child_count[runs]
+    child_start[runs] = np.cumsum(run_counts) - run_counts
+    offset -= child_start
+    rank -= offset[child]  # each column's place in the sorted order: the child's start plus its rank in it
+    source = np.empty(width, dtype=np.int64)
+    source[rank] = np.arange(width)
+    n_open = int(child_count[group == 0].sum())
+    n_small = int(child_count[is_small].sum())
+    leaf_cols = source[n_open + n_small:]
+    leaf_tris = tris[leaf_cols]
+    leaf_child = child[leaf_cols]
+    tree.leaf_of[leaf_tris] = child_ids[leaf_child]
+    # A leaf column's place in its leaf: its place in the sorted order less the leaf's start.
+    tree.leaf_rank[leaf_tris] = np.arange(n_open + n_small, width) - child_start[leaf_child]
+    if n_small:
+        smalls = np.flatnonzero(is_small)
+        found.ids.append(child_ids[smalls])
+        found.counts.append(child_count[smalls])
+        found.depth.append(np.full(smalls.size, depth, dtype=np.int64))
+        grouped = source[n_open:n_open + n_small]  # their columns, node after node
+        found.tris.append(tris[grouped])
+        found.boxes.append(np.take(cols, grouped, axis=1))
+    if n_open == 0:
+        return None
+    kept = np.flatnonzero(group == 0)
+    source = source[:n_open]
+    moved = buffers.spare[:6 * n_open].reshape(6, n_open)
+    np.take(cols, source, axis=1, out=moved, mode="clip")  # "clip": unbuffered (all in range)
+    buffers.spare = cols.base if cols.base is not None and cols.base.ndim == 1 else cols.reshape(-1)
+    return _Open(np.take(tris, source), moved, child_count[kept], cuts.lo.reshape(2 * n, 3)[kept],
+                 cuts.hi.reshape(2 * n, 3)[kept], child_ids[kept], depth)
 
 
 def _every(starts: NDArray[np.int64], taken: NDArray[np.int64], stride: NDArray[np.int64]) -> NDArray[np.int64]:

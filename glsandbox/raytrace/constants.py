@@ -34,6 +34,8 @@ __all__ = [
     "OFFSETS",
     "SIMPLE_OFFSET",
     "RAY_POINT_GAMMA",
+    "SPHERE_C_GAMMA",
+    "SPHERE_C_GAMMA_GLSL",
     "TRIANGLE_POINT_GAMMA",
     "UNIT_F32",
     "UNIT_F64",
@@ -56,6 +58,15 @@ TRIANGLE_POINT_GAMMA: int = 7
 #: ``|t·D|`` plus the two operations of the sum; 16 covers it with room
 #: (the bound is ``γ(16)·(|O| + |t·D|)`` per component).
 RAY_POINT_GAMMA: int = 16
+#: Roundings behind the stable sphere test's ``c = (|l| − r)(|l| + r)``
+#: (Işın-Küre kesim testi; the derivation is at the line, in
+#: :meth:`glsandbox.raytrace.sphere.Sphere.intersect_many`): ``|l|`` is a sqrt
+#: of a 3-term dot product of squares (γ(3) relative), ``|l| − r`` and
+#: ``|l| + r`` one more each, their product one more: 5 in float64. The GLSL
+#: engine's sqrt and division are only within 2.5 ulps (GLSL 4.00 §4.7.1),
+#: 5 roundings each: :data:`SPHERE_C_GAMMA_GLSL`.
+SPHERE_C_GAMMA: int = 5
+SPHERE_C_GAMMA_GLSL: int = 12
 #: How secondary rays leave a surface, as the engines' ``offset`` option names
 #: it (the value: whether it is the simple relative offset).
 #: ``"bound"``: by the hit point's rounding-error bound (the default, above);
@@ -109,6 +120,7 @@ def glsl_defines() -> tuple[tuple[str, str], ...]:
     return (
         ("TRIANGLE_POINT_ERROR", repr(gamma(TRIANGLE_POINT_GAMMA, UNIT_F32))),
         ("SPHERE_POINT_ERROR", repr(gamma(RAY_POINT_GAMMA, UNIT_F32))),
+        ("SPHERE_C_ERROR", repr(gamma(SPHERE_C_GAMMA_GLSL, UNIT_F32))),
         ("GAMMA2", repr(gamma(2, UNIT_F32))),
         ("GAMMA3", repr(gamma(3, UNIT_F32))),
         ("GAMMA5", repr(gamma(5, UNIT_F32))),

@@ -144,6 +144,7 @@ from glsandbox.raytrace.constants import NODE_BOX_PAD, OFFSETS, SIMPLE_OFFSET, g
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.gpu_records import NODE, TRI, layout_defines
 from glsandbox.raytrace.watertight import nondegenerate
+from glsandbox.raytrace.shapes import glsl_dispatch
 from glsandbox.raytrace.world import MODES, NodeKind, World, build_world, camera_basis, kind_defines
 from glsandbox.scene import Scene
 
@@ -158,6 +159,9 @@ NODE_RECORDS = NODE.records
 MAX_TEXTURES = 4
 #: llvmpipe's loop iterations per shader invocation, all loops together (see the module docstring).
 LOOP_LIMIT = 65_535
+#: The alpha byte of a pixel whose ray met a node kind the shader's dispatch has no case for
+#: (``g_bad_kind``: alpha 0.25, stored as round(0.25·255)).
+BAD_KIND_ALPHA = 64
 
 
 def check_loop_budget(world: World, lights: int, shadows: bool, reflect: bool, max_depth: int) -> int:
@@ -732,7 +736,7 @@ class GpuTracer:
         names = ("NUM_LIGHTS", "NUM_TEXTURES", "SHADOWS", "REFLECT", "HAS_MESHES", "HAS_SHAPES",
                  *(f"HAS_{kind.name}" for kind in shapes))
         defines = (tuple((name, str(value)) for name, value in zip(names, flags)) + glsl_defines() + kind_defines()
-                   + layout_defines() + scene)
+                   + glsl_dispatch({kind.value for kind in shapes if kind in kinds}) + layout_defines() + scene)
         if defines in self._programs:
             self._programs[defines] = self._programs.pop(defines)  # most recently used last
             self._vaos[defines] = self._vaos.pop(defines)
@@ -854,8 +858,12 @@ class GpuTracer:
         self.ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
         vao.render(moderngl.TRIANGLE_STRIP, vertices=4)
         data = target.read(components=4, alignment=1)
-        if use_bvh:
+        if use_bvh or uploaded.shape_count:
             alpha = np.frombuffer(data, dtype=np.uint8)[3::4]
+            unknown = int(np.count_nonzero(alpha == BAD_KIND_ALPHA))
+            if unknown:  # shape_t or shape_surface met a kind code it has no case for
+                raise RayTraceError(f"the gpu engine met a node kind with no GLSL case on {unknown:,} pixels "
+                                    f"(node kinds: {', '.join(k.value for k in uploaded.kinds)})")
             cut = int(np.count_nonzero(alpha < 128))
             if cut:
                 raise RayTraceError(

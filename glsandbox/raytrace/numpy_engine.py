@@ -26,8 +26,8 @@ The BVH
 Both go through :func:`_top_level`, the one loop over the nodes in scene
 order (the top level is the nodes' boxes, course "Hızlandırma: AABB"; the
 tests call it too). Each node is tested by its kind's hit function, in the
-node's own space (the node table :data:`_HIT`, by
-:class:`~glsandbox.raytrace.world.NodeKind`). With ``bvh=True`` (the
+node's own space (:func:`_hit_kind`: the triangles, or the kind's own test in
+``raytrace/shapes/<kind>.py``). With ``bvh=True`` (the
 default) a mesh node's rays that enter its box are traced through the node's
 BVH instead (:class:`~glsandbox.raytrace.bvh_world.WorldBVH`, built once per mesh and
 cached by content; :func:`~glsandbox.raytrace.bvh_traverse.closest_hit`, the
@@ -46,6 +46,7 @@ way.
 from __future__ import annotations
 
 import weakref
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -56,10 +57,9 @@ from glsandbox.raytrace.bvh_traverse import Accept, TraversalCounts, any_hit, cl
 from glsandbox.raytrace.bvh_world import NodeBVH, WorldBVH
 from glsandbox.raytrace.constants import (BVH_BOX_PAD_F64, LENGTH_TINY, OFFSETS, SIMPLE_OFFSET, RAY_POINT_GAMMA,
                                           TRIANGLE_POINT_GAMMA, UNIT_F64, gamma)
-from glsandbox.raytrace.sphere import Sphere
 from glsandbox.raytrace.vec import length, moved_off
 from glsandbox.raytrace.watertight import nearest_watertight
-from glsandbox.raytrace.world import NodeInfo, NodeKind, World, build_world, camera_rays, coverage
+from glsandbox.raytrace.world import NodeInfo, World, build_world, camera_rays, coverage
 from glsandbox.scene import Scene
 
 __all__ = ["RAY_BLOCK", "RenderStats", "render_viewport", "to_rgba8"]
@@ -72,8 +72,6 @@ __all__ = ["RAY_BLOCK", "RenderStats", "render_viewport", "to_rgba8"]
 #: whole-image pass streams every ``(W·H, 3)`` temporary through memory and
 #: pays the page faults of allocating it: about twice as fast at 800x600.
 RAY_BLOCK: int = 1 << 14
-
-_UNIT_SPHERE = Sphere((0.0, 0.0, 0.0), 1.0)
 
 
 @dataclass
@@ -167,7 +165,7 @@ def _top_level(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_m
 
     Each node's box (its slab test, ``1/d`` formed once for all nodes) picks the rays
     that enter it before their best hit so far; only those are tested against the node,
-    by its kind's hit function (:data:`_HIT`, in the node's own space). A strict ``<``
+    by its kind's hit function (:func:`_hit_kind`, in the node's own space). A strict ``<``
     keeps ties with the earlier node. With ``bvh``, a mesh node's rays are traced
     through its BVH instead (its root box widened as the BVH's own boxes are,
     :func:`_box_candidates`) with ``t_max`` their best hit so far (strictly nearer hits
@@ -274,17 +272,17 @@ def _drawn_texels(world: World, k: int, o: NDArray[np.float64], d: NDArray[np.fl
 def _hit_node(world: World, k: int, o: NDArray[np.float64], d: NDArray[np.float64], one_sided: bool
               ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
     """Rays against node ``k`` alone: ``(t, world triangle index)``, ``(inf, −1)`` for a miss
-    and ``−1`` for a sphere's hits.
+    and ``−1`` for an analytic node's hits.
 
-    A sphere node is the unit sphere under its model matrix: the ray is taken
-    into the sphere's own space (Işın-Küre kesim testi there; ``t`` is kept by
-    the affine map). A mesh node's triangles are tested with the watertight test
+    An analytic node is its unit shape under its model matrix: the ray is taken
+    into the shape's own space (the sphere's Işın-Küre kesim testi there; ``t`` is
+    kept by the affine map). A mesh node's triangles are tested with the watertight test
     (:func:`~glsandbox.raytrace.watertight.nearest_watertight`, as the BVH does), the
     lowest index winning a tie. ``one_sided``: backface culling (course "Hızlandırma:
     backface culling").
     """
     node = world.nodes[k]
-    return _HIT[node.kind](world, node, o, d, one_sided)
+    return _hit_kind(node)(world, node, o, d, one_sided)
 
 
 def _own_space(node: NodeInfo, o: NDArray[np.float64], d: NDArray[np.float64]
@@ -295,57 +293,11 @@ def _own_space(node: NodeInfo, o: NDArray[np.float64], d: NDArray[np.float64]
     return o @ inv[:3, :3].T + inv[:3, 3], d @ inv[:3, :3].T
 
 
-def _hit_sphere(world: World, node: NodeInfo, o: NDArray[np.float64], d: NDArray[np.float64], one_sided: bool
-                ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
+def _hit_shape(world: World, node: NodeInfo, o: NDArray[np.float64], d: NDArray[np.float64], one_sided: bool
+               ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
+    """An analytic node's hits: its kind's own-space test (``raytrace/shapes/<kind>.py``)."""
     oo, dd = _own_space(node, o, d)
-    t = _UNIT_SPHERE.intersect_many(oo, dd)
-    if one_sided:  # from inside, the sphere's front faces all face away
-        t = np.where(np.einsum("...j,...j->...", oo, oo) < 1.0, np.inf, t)
-    return t, np.full(d.shape[0], -1, dtype=np.intp)
-
-
-def _hit_cylinder(world: World, node: NodeInfo, o: NDArray[np.float64], d: NDArray[np.float64], one_sided: bool
-                  ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
-    oo, dd = _own_space(node, o, d)
-    t = unit_cylinder_t(np.broadcast_to(oo, dd.shape), dd)
-    if one_sided:  # from inside, every front face faces away
-        inside = (oo[..., 0] ** 2 + oo[..., 2] ** 2 < 1.0) & (np.abs(oo[..., 1]) < 1.0)
-        t = np.where(inside, np.inf, t)
-    return t, np.full(d.shape[0], -1, dtype=np.intp)
-
-
-def unit_cylinder_t(o: NDArray[np.float64], d: NDArray[np.float64]) -> NDArray[np.float64]:
-    """The nearest ``t > 0`` where rays ``o + t·d`` (``(N, 3)`` each) meet the capped unit
-    cylinder ``x² + z² ≤ 1, |y| ≤ 1``; inf for a miss.
-
-    The side is the circle ``x² + z² = 1`` in the xz-plane: the sphere's stable
-    quadratic (Ray Tracing Gems ch. 7) in two dimensions, its roots kept where
-    ``|y| ≤ 1``; each cap is the plane ``y = ±1`` (course "Işın-Düzlem kesim
-    testi"), kept where ``x² + z² ≤ 1``. A ray along the axis (``d_x = d_z =
-    0``) meets only the caps, one parallel to them only the side."""
-    ox, oy, oz = o[:, 0], o[:, 1], o[:, 2]
-    dx, dy, dz = d[:, 0], d[:, 1], d[:, 2]
-    best = np.full(d.shape[0], np.inf)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        a = dx * dx + dz * dz
-        b = -(ox * dx + oz * dz)  # l·d with l = −o, in the xz-plane
-        hx = -ox - (b / a) * dx
-        hz = -oz - (b / a) * dz
-        disc = a * (1.0 - (hx * hx + hz * hz))
-        root = np.sqrt(np.maximum(disc, 0.0))
-        q = b + np.where(b >= 0.0, root, -root)
-        ell = np.hypot(ox, oz)
-        c = (ell - 1.0) * (ell + 1.0)
-        side = (a > 0.0) & (disc >= 0.0) & (q != 0.0)
-        for t in (c / q, q / a):
-            ok = side & (t > 0.0) & (t < best) & (np.abs(oy + t * dy) <= 1.0)
-            best = np.where(ok, t, best)
-        for y in (-1.0, 1.0):
-            t = (y - oy) / dy
-            px, pz = ox + t * dx, oz + t * dz
-            ok = (dy != 0.0) & (t > 0.0) & (t < best) & (px * px + pz * pz <= 1.0)
-            best = np.where(ok, t, best)
-    return best
+    return node.kind.shape.hit(oo, dd, one_sided), np.full(d.shape[0], -1, dtype=np.intp)
 
 
 def _hit_triangles(world: World, node: NodeInfo, o: NDArray[np.float64], d: NDArray[np.float64], one_sided: bool
@@ -419,7 +371,7 @@ def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.fl
     reads); ``spawn`` None unless ``need_spawn`` (no shadow ray or bounce leaves these hits)."""
     n = d.shape[0]
     point = o + hits.t[:, None] * d
-    # Spheres' spawn points are the ray's point; triangles' are replaced below.
+    # Analytic shapes' spawn points are the ray's point; triangles' are replaced below.
     spawn = _Spawn(point.copy(), gamma(RAY_POINT_GAMMA, UNIT_F64) * (np.abs(o) + np.abs(hits.t[:, None] * d)),
                    np.zeros((n, 3))) if need_spawn else None
     normal = np.zeros((n, 3))
@@ -429,7 +381,7 @@ def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.fl
         sel = np.nonzero(hits.node == k)[0]
         if sel.size == 0:
             continue
-        normal[sel], uv, colors = _SURFACE[node.kind](world, node, hits, sel, o, d, point, spawn)
+        normal[sel], uv, colors = _surface_kind(node)(world, node, hits, sel, o, d, point, spawn)
         color = np.broadcast_to(node.color, (sel.size, 3)).copy()
         if colors is not None:  # vertex colours, times the material colour (basic.glsl, phong.glsl)
             color *= colors
@@ -446,40 +398,17 @@ def _surface(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.fl
     return point, normal, base, alpha, spawn
 
 
-def _surface_sphere(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[np.intp], o: NDArray[np.float64],
-                    d: NDArray[np.float64], point: NDArray[np.float64], spawn: _Spawn | None
-                    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64] | None]:
-    """A sphere node's (normal, uv, vertex colour) at its hits; its spawn points stay ``O + t·D``."""
+def _surface_shape(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[np.intp], o: NDArray[np.float64],
+                   d: NDArray[np.float64], point: NDArray[np.float64], spawn: _Spawn | None
+                   ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64] | None]:
+    """An analytic node's (normal, uv, vertex colour) at its hits: its kind's own-space surface at
+    ``M⁻¹P``, the normal taken to the world by the normal matrix ``(M³ˣ³)⁻ᵀ``; its spawn points stay ``O + t·D``."""
     inv = node.inverse
-    q = point[sel] @ inv[:3, :3].T + inv[:3, 3]  # the hit on the unit sphere
-    q /= length(q)[:, None]
-    normal = q @ node.normal_matrix.T
-    if spawn is not None:
-        spawn.normal[sel] = normal
-    # geometry.sphere()'s uv: u = azimuth/2π from +z towards +x, v = polar angle/π from +y.
-    uv = np.stack([np.mod(np.arctan2(q[:, 0], q[:, 2]), 2 * np.pi) / (2 * np.pi),
-                   np.arccos(np.clip(q[:, 1], -1.0, 1.0)) / np.pi], axis=1)
-    return normal, uv, np.ones((sel.size, 3)) if node.mode == 1 else None
-
-
-def _surface_cylinder(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[np.intp], o: NDArray[np.float64],
-                      d: NDArray[np.float64], point: NDArray[np.float64], spawn: _Spawn | None
-                      ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64] | None]:
-    """A cylinder node's (normal, uv, vertex colour) at its hits, as :func:`glsandbox.geometry.cylinder`
-    lays them out: on a cap (the hit nearer ``|y| = 1`` than ``x² + z² = 1``) the cap's
-    normal and ``(½ + x/2, ½ + z/2)``, on the side the radial normal and ``(azimuth/2π, (1 − y)/2)``."""
-    inv = node.inverse
-    q = point[sel] @ inv[:3, :3].T + inv[:3, 3]  # the hit on the unit cylinder
-    r = np.hypot(q[:, 0], q[:, 2])
-    cap = np.abs(np.abs(q[:, 1]) - 1.0) < np.abs(r - 1.0)
-    own = np.where(cap[:, None], np.stack([np.zeros_like(r), np.sign(q[:, 1]), np.zeros_like(r)], axis=1),
-                   q * np.array([1.0, 0.0, 1.0]) / np.maximum(r, LENGTH_TINY)[:, None])
+    q = point[sel] @ inv[:3, :3].T + inv[:3, 3]  # the hit in the kind's own space
+    own, uv = node.kind.shape.surface(q)
     normal = own @ node.normal_matrix.T
     if spawn is not None:
         spawn.normal[sel] = normal
-    uv = np.where(cap[:, None], np.stack([0.5 + 0.5 * q[:, 0], 0.5 + 0.5 * q[:, 2]], axis=1),
-                  np.stack([np.mod(np.arctan2(q[:, 0], q[:, 2]), 2 * np.pi) / (2 * np.pi), 0.5 * (1.0 - q[:, 1])],
-                           axis=1))
     return normal, uv, np.ones((sel.size, 3)) if node.mode == 1 else None
 
 
@@ -515,13 +444,16 @@ def _surface_triangles(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[n
     return normal, uv, colors
 
 
-#: The node table's per-kind code (:class:`~glsandbox.raytrace.world.NodeKind`): a hit
-#: test ``(world, node, o, d, one_sided) -> (t, world triangle or −1)`` in the node's
-#: own space, and a surface ``-> (normal, uv, vertex colour or None unless the node
-#: shows vertex colours)`` that also fills the spawn points (when given). A new kind is one entry in each.
-_HIT = {NodeKind.MESH: _hit_triangles, NodeKind.SPHERE: _hit_sphere, NodeKind.CYLINDER: _hit_cylinder}
-_SURFACE = {NodeKind.MESH: _surface_triangles, NodeKind.SPHERE: _surface_sphere,
-            NodeKind.CYLINDER: _surface_cylinder}
+def _hit_kind(node: NodeInfo) -> Callable[..., tuple[NDArray[np.float64], NDArray[np.intp]]]:
+    """A node's hit test ``(world, node, o, d, one_sided) -> (t, world triangle or −1)``."""
+    return _hit_triangles if node.kind.triangles else _hit_shape
+
+
+def _surface_kind(node: NodeInfo) -> Callable[..., tuple[NDArray[np.float64], NDArray[np.float64] | None,
+                                                         NDArray[np.float64] | None]]:
+    """A node's surface ``-> (normal, uv, vertex colour or None unless the node shows them)``,
+    filling the spawn points when given."""
+    return _surface_triangles if node.kind.triangles else _surface_shape
 
 
 def _interpolate(values: NDArray[np.float64], w: tuple[NDArray[np.float64], ...]) -> NDArray[np.float64]:

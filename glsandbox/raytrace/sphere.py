@@ -43,6 +43,11 @@ quadratic ``a·t² − 2·b·t + c = 0`` with (for any, not necessarily unit, ``
 
 The nearest positive root is returned: the entry point from outside, the exit
 point from inside (a ray starting inside a sphere returns the exit ``t``).
+An origin on the surface (a shadow or reflected ray leaving it) is the root
+``t = 0``: where ``c`` is within its rounding-error bound of 0 the root
+``c/q`` is taken as 0, so such a ray never meets the surface it leaves again
+and a ray into the sphere returns its far side (the bound is derived at the
+line). The geometric test, the course's teaching form, has no such bound.
 """
 
 from __future__ import annotations
@@ -53,6 +58,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from glsandbox.raytrace.base import broadcast_rays, finite_positive_or_none, shared_origin
+from glsandbox.raytrace.constants import SPHERE_C_GAMMA, UNIT_F64, gamma
 from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.ray import Ray
 from glsandbox.raytrace.vec import Vec3, as_vec3, dot, length, normalize
@@ -121,7 +127,8 @@ class Sphere:
         """The stable test for ``N`` rays: a ``(N,)`` array of ``t``, ``inf`` for a miss."""
         o, d = broadcast_rays(origins, directions)
         r = self.radius
-        l = self.center - shared_origin(o)  # noqa: E741 (the course's l; one (3,) vector for a shared origin)
+        origin = shared_origin(o)  # one (3,) vector for a shared origin
+        l = self.center - origin  # noqa: E741 (the course's l)
         a = dot(d, d)
         b = dot(l, d)  # a·s in the course's terms (s = b/a along a non-unit d)
         ok = a > 0.0
@@ -134,6 +141,17 @@ class Sphere:
         q = b + np.copysign(sq, b)  # |q| = |b| + sqrt(disc): no cancellation
         l_len = np.sqrt(dot(l, l))
         c = (l_len - r) * (l_len + r)  # l·l − r², exact subtraction near the surface
+        # The sphere's error bound. fl(l·l) is off by γ(3)·l·l (three squares, two sums of
+        # non-negative terms) and its sqrt by u more: |l| is off by at most γ(3)·|l|, and
+        # |l| − r by that plus u·||l| − r|; each of the two factors and their product round
+        # once more: |c − c_exact| ≤ γ(5)·(|l| + r)². An origin given in floats is itself
+        # known only to u·|O| per component, and the centre to u·|C|: their share of |l| − r
+        # adds γ·(|C| + |O|). So |c| ≤ γ(5)·(|l| + r + |C| + |O|)·(|l| + r) means the origin
+        # lies on the surface to within the arithmetic: the root c/q is 0 (the surface the
+        # ray leaves), not a hit; the other root q/a (the far side, or behind) is the answer.
+        reach = l_len + r + float(np.sqrt(dot(self.center, self.center))) + np.sqrt(dot(origin, origin))
+        on_surface = np.abs(c) <= gamma(SPHERE_C_GAMMA, UNIT_F64) * reach * (l_len + r)
+        c = np.where(on_surface, 0.0, c)
         ok &= q != 0.0  # q == 0 only for a tangent at t = 0: no positive root
         t1 = np.full_like(a, -np.inf)
         t0 = np.full_like(a, -np.inf)

@@ -72,8 +72,10 @@ from glsandbox import transforms
 from glsandbox.geometry import Mesh
 from glsandbox.images import texture_levels
 from glsandbox.plan import traced_reflectivity
-from glsandbox.raytrace.constants import LENGTH_TINY, SQUARES_UNDERFLOW, UNIT_SHAPE_TOLERANCE
+from glsandbox.raytrace import shapes
+from glsandbox.raytrace.constants import LENGTH_TINY, SQUARES_UNDERFLOW
 from glsandbox.raytrace.errors import RayTraceError
+from glsandbox.raytrace.shape_kind import ShapeKind
 from glsandbox.scene import MIN_SCALE, Camera, Node, Scene, Texture
 
 __all__ = [
@@ -95,67 +97,53 @@ ALPHA_CODES = {"opaque": 0, "mask": 1, "blend": 2}
 WRAPS = {"repeat": 0, "mirrored": 1, "clamp": 2}
 
 
-class NodeKind(str, enum.Enum):
+class _Kind(str, enum.Enum):
     """What a traced node is: the one table both engines loop over.
 
-    Each kind is a box (:attr:`own_box`: :func:`build_world` gives every node
-    its world box from it), a hit test in the node's own space and a surface
-    (point, normal, uv):
+    ``MESH``: world-space triangles (``NodeInfo.start``/``count``), hit by the
+    watertight test (a BVH or a scan), surface from barycentrics. Every other
+    member is an analytic kind of :data:`glsandbox.raytrace.shapes.KINDS` (its
+    :attr:`shape`, one module ``raytrace/shapes/<kind>.py`` and one
+    ``shaders/shapes/<kind>.glsl``): the exact unit shape under the node's model
+    matrix. Its rays are taken into its own space by ``NodeInfo.inverse`` (an
+    affine map keeps ``t``), hit there, and its normal goes back through
+    ``NodeInfo.normal_matrix``. A mesh says it tessellates one
+    (``Mesh.analytic``, the kind's value) and :meth:`holds` checks its vertices
+    lie on it.
 
-    - ``MESH``: world-space triangles (``NodeInfo.start``/``count``), hit by
-      the watertight test (a BVH or a scan), surface from barycentrics;
-    - ``SPHERE``: the unit sphere ``|p| = 1`` under the node's model matrix;
-    - ``CYLINDER``: the capped unit cylinder ``x² + z² ≤ 1, |y| ≤ 1`` (axis
-      +y) under the node's model matrix.
-
-    An analytic kind's rays are taken into its own space by
-    ``NodeInfo.inverse`` (an affine map keeps ``t``), hit there, and its normal
-    goes back through ``NodeInfo.normal_matrix``. A mesh says it tessellates
-    one (``Mesh.analytic``, the kind's value, as :func:`glsandbox.geometry.sphere`
-    and :func:`~glsandbox.geometry.cylinder` do) and :meth:`holds` checks its
-    vertices lie on it.
-
-    The value is the kind's name (so ``kind == "sphere"`` still reads true);
+    The value is the kind's name (so ``kind == "sphere"`` reads true);
     :attr:`code` is the number the gpu engine stores in a node record
-    (``shaders/raytrace.glsl`` gets ``KIND_<NAME>`` defines from
-    :func:`kind_defines`). The engines' per-kind code is in
-    :mod:`glsandbox.raytrace.numpy_engine` (``_HIT``/``_SURFACE`` tables) and
-    the shader's ``shape_t``/``shape_surface``; the README's ray tracer section
-    says how to add a kind."""
-
-    MESH = "mesh"
-    SPHERE = "sphere"
-    CYLINDER = "cylinder"
+    (``KIND_<NAME>`` defines from :func:`kind_defines`)."""
 
     @property
     def code(self) -> int:
         """The kind's number in the gpu engine's node records: its place in the table."""
-        return list(NodeKind).index(self)
+        return list(type(self)).index(self)
 
     @property
     def triangles(self) -> bool:
         """Whether the kind's shape is its node's triangles (BVH and scan apply)."""
-        return self is NodeKind.MESH
+        return self.value == "mesh"
+
+    @property
+    def shape(self) -> ShapeKind:
+        """An analytic kind's parts (:class:`glsandbox.raytrace.shapes.ShapeKind`)."""
+        return shapes.by_name(self.value)
 
     @property
     def own_box(self) -> NDArray[np.float64]:
-        """An analytic kind's box in its own space, ``(2, 3)`` min and max: the cube
-        ``[−1, 1]³`` holds the unit sphere and the unit cylinder exactly."""
-        return np.array([[-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]])
+        """An analytic kind's box in its own space, ``(2, 3)`` min and max."""
+        return self.shape.own_box.copy()
 
     def holds(self, positions: NDArray[np.float64]) -> bool:
         """Whether every point lies on this analytic kind's unit shape (to
         :data:`~glsandbox.raytrace.constants.UNIT_SHAPE_TOLERANCE`)."""
-        p = np.asarray(positions, dtype=np.float64)
-        tol = UNIT_SHAPE_TOLERANCE
-        if self is NodeKind.SPHERE:
-            return bool(np.all(np.abs(np.linalg.norm(p, axis=1) - 1.0) < tol))
-        if self is NodeKind.CYLINDER:
-            r = np.hypot(p[:, 0], p[:, 2])
-            side = (np.abs(r - 1.0) < tol) & (np.abs(p[:, 1]) <= 1.0 + tol)
-            cap = (np.abs(np.abs(p[:, 1]) - 1.0) < tol) & (r <= 1.0 + tol)
-            return bool(np.all(side | cap))
-        return False
+        return not self.triangles and self.shape.holds(positions)
+
+
+#: The node kinds: ``MESH`` (code 0), then one per registered shape kind, in the registry's order.
+NodeKind = _Kind("NodeKind", [("MESH", "mesh"), *((kind.name.upper(), kind.name) for kind in shapes.KINDS)],
+                 module=__name__, qualname="NodeKind")
 
 
 def kind_defines() -> tuple[tuple[str, str], ...]:

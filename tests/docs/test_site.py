@@ -63,7 +63,7 @@ def site(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 def test_the_site_has_every_page_and_a_page_per_lesson(site: Path) -> None:
     for page in ("index", "getting-started/index", "your-own/index", "models/index", "raytracer/index",
-                 "grading/index", "accuracy/index", "numerics/index", "benchmarks/index", "how-it-works/index",
+                 "grading/index", "grading-a-class/index", "accuracy/index", "numerics/index", "benchmarks/index", "how-it-works/index",
                  "api/index", "changelog/index", "lessons/index"):
         assert (site / f"{page}.html").is_file(), page
     for cls in all_lessons():

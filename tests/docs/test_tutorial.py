@@ -1,4 +1,4 @@
-"""The README's code runs as written."""
+"""The manual's tutorial code runs as written (docs/your-own.md, docs/how-it-works.md)."""
 
 from __future__ import annotations
 

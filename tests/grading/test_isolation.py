@@ -116,10 +116,10 @@ def hostile_kinds(ref: Path, results: Path, subs: Path) -> dict[str, tuple[str, 
             during=f"{libc}\nr = libc.kill(os.getppid(), 9)\nraise RuntimeError(f'kill gave {{r}}')"),
             "BROKEN kill gave -1"),
         # it stops the run
-        "h_loop": ("h_loop.py", lesson(during="while True:\n    pass"), "TIMEOUT after 6 s"),
-        "h_sleep": ("h_sleep.py", lesson(before="import time\ntime.sleep(1000)"), "TIMEOUT after 6 s"),
+        "h_loop": ("h_loop.py", lesson(during="while True:\n    pass"), "TIMEOUT timed out after 6 s"),
+        "h_sleep": ("h_sleep.py", lesson(before="import time\ntime.sleep(1000)"), "TIMEOUT timed out after 6 s"),
         "h_stop": ("h_stop.py", lesson(during="import signal\nos.kill(os.getpid(), signal.SIGSTOP)"),
-                   "TIMEOUT after 6 s"),
+                   "TIMEOUT timed out after 6 s"),
         "h_thread": ("h_thread.py", lesson(before="import threading, time\n"
                                                    "threading.Thread(target=time.sleep, args=(1000,)).start()"), "FAIL"),
         "h_fork": ("h_fork.py", lesson(before="import time\npid = os.fork()\nif pid == 0:\n    time.sleep(1000)\n"
@@ -142,7 +142,7 @@ def hostile_kinds(ref: Path, results: Path, subs: Path) -> dict[str, tuple[str, 
 
 def kernel_enforced(kinds: dict[str, tuple[str, str, str]]) -> dict[str, tuple[str, str, str]]:
     """The kinds that go around Python (ctypes) are stopped by Landlock: the file ones from ABI 1,
-    signals from ABI 6. Without it they are out of what this machine can guarantee (README)."""
+    signals from ABI 6. Without it they are out of what this machine can guarantee (docs/grading.md)."""
     abi = landlock_abi()
     return {name: kind for name, kind in kinds.items()
             if "ctypes_" not in name or (abi >= 6 if "kill" in name else abi >= 1)}
@@ -277,7 +277,7 @@ def test_one_lesson_is_isolated_too(tmp_path: Path, gl) -> None:
     assert b"CRASHED: exited with code 0 before its picture was sent" in proc.stdout
     (tmp_path / "loops.py").write_text(lesson(during="while True:\n    pass", scene=RIGHT))
     proc = grade("check", str(tmp_path / "loops.py"), "--golden", str(ref), "--timeout", "1", marker=marker)
-    assert proc.returncode == 1 and b"TIMEOUT: after 1 s" in proc.stdout
+    assert proc.returncode == 1 and b"TIMEOUT: timed out after 1 s" in proc.stdout
     (tmp_path / "right.py").write_text(lesson(scene=RIGHT))
     proc = grade("check", str(tmp_path / "right.py"), "--golden", str(ref), marker=marker)
     assert proc.returncode == 0 and b"PASS: identical" in proc.stdout, proc.stdout + proc.stderr

@@ -12,7 +12,8 @@ import pytest
 from glsandbox import geometry, transforms
 from glsandbox.geometry import Mesh
 from glsandbox.raytrace import render
-from glsandbox.raytrace.numpy_engine import _Hits, _nearest, _surface, unit_cylinder_t
+from glsandbox.raytrace.numpy_engine import _Hits, _nearest, _surface
+from glsandbox.raytrace.shapes.cylinder import unit_cylinder_t
 from glsandbox.raytrace.world import NodeKind, build_world
 from glsandbox.scene import Camera, Light, Material, Node, Scene
 
