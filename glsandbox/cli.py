@@ -507,6 +507,8 @@ def cmd_docs(args: argparse.Namespace) -> int:
     if importlib.util.find_spec("mkdocs") is None:
         raise SandboxError("glsandbox docs needs the docs dependency group: uv sync, or uv run --group docs "
                            "glsandbox docs")
+    if not 0 < args.port < 65536:
+        raise SandboxError(f"--port {args.port}: expected a port number 1-65535")
     if args.build is not None and args.build.exists() and not args.build.is_dir():
         raise SandboxError(f"--build {args.build}: not a folder")
     command = [sys.executable, "-m", "mkdocs"]

@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from support import REPO_ROOT
+from support import REPO_ROOT, assert_user_error, run_cli
 
 from glsandbox.cli import build_parser
 from glsandbox.lesson import LESSON_SUFFIXES, all_lessons, find_lesson
@@ -128,3 +128,11 @@ def test_the_headless_commands_in_the_docs_run(tmp_path: Path, gl) -> None:
         assert proc.returncode == 0, f"{page}: glsandbox {shlex.join(words)}\n{proc.stderr}"
     assert len(seen) > 30
     assert (tmp_path / "phong.png").is_file()  # the phong page's render line wrote its picture
+
+
+@pytest.mark.parametrize("args, message", [
+    (["docs", "--port", "0"], "--port 0: expected a port number 1-65535"),
+    (["docs", "--build", "README.md"], "--build README.md: not a folder"),
+])
+def test_glsandbox_docs_mistakes_are_one_line(args: list[str], message: str) -> None:
+    assert_user_error(run_cli(*args, cwd=REPO_ROOT), message)
