@@ -131,7 +131,7 @@ def test_the_headless_commands_in_the_docs_run(tmp_path: Path, gl) -> None:
 
 
 @pytest.mark.parametrize("args, message", [
-    (["docs", "--port", "0"], "--port 0: expected a port number 1-65535"),
+    (["docs", "--port", "0", "--build", "README.md"], "--port 0: expected a port number 1-65535"),
     (["docs", "--build", "README.md"], "--build README.md: not a folder"),
 ])
 def test_glsandbox_docs_mistakes_are_one_line(args: list[str], message: str) -> None:
