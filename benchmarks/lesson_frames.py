@@ -14,7 +14,7 @@ panel is text whose numbers change), the raw side does that work too, with its
 own code; what never changes (a constant text panel) is made once, like a mesh.
 The table's last column says whether both draw the same picture; the tests
 (``tests/measure/test_tradeoffs_bench.py``) check each pixel for pixel at 160x120.
-Goals (issue 24): glsandbox <= 1.05x raw, and at most 50 us of extra main-thread
+Goals: glsandbox <= 1.05x raw, and at most 50 us of extra main-thread
 CPU per frame (the bench's "extra CPU" column).
 """
 
@@ -214,7 +214,7 @@ class RawTexture:
     def __init__(self, ctx: moderngl.Context, size: tuple[int, int]) -> None:
         from glsandbox import geometry
         from glsandbox.images import builtin_levels
-        from lessons.texture import ground
+        from glsandbox.lessons.texture import ground
 
         self.ctx, self.size, self.fbo = ctx, size, framebuffer(ctx, size)
         self.program = ctx.program(vertex_shader=TEXTURED_VS, fragment_shader=TEXTURED_FS)
@@ -267,7 +267,7 @@ class RawTransformOrder:
         from PIL import Image, ImageDraw, ImageFont
 
         from glsandbox import geometry
-        from lessons import transform_order as lesson
+        from glsandbox.lessons import transform_order as lesson
 
         defaults = {p.name: p.default for p in lesson.TransformOrder.all_params()}
         assert defaults["order"] == "STR" and defaults["view"] == "single" and defaults["overlay"]
@@ -404,7 +404,7 @@ class RawMirror:
 
     def __init__(self, ctx: moderngl.Context, size: tuple[int, int]) -> None:
         from glsandbox import geometry
-        from lessons import mirror as lesson
+        from glsandbox.lessons import mirror as lesson
 
         v = {p.name: p.default for p in lesson.MirrorLesson.params}
         assert (v["mirror"], v["shadow"], v["light"], v["depth"], v["offset"]) == \
@@ -586,7 +586,7 @@ class RawShadowMap:
 
     def __init__(self, ctx: moderngl.Context, size: tuple[int, int]) -> None:
         from glsandbox import geometry
-        from lessons import shadow_map as lesson
+        from glsandbox.lessons import shadow_map as lesson
 
         self.ctx, self.size, self.fbo, self.lesson = ctx, size, framebuffer(ctx, size), lesson
         self.depth = ctx.program(vertex_shader=SOLID_VS, fragment_shader=SOLID_FS)

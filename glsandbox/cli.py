@@ -1,4 +1,4 @@
-"""The ``glsandbox`` command, and ``python -m lessons.<module>``.
+"""The ``glsandbox`` command, and ``python -m glsandbox.lessons.<module>``.
 
 ``list``, ``run LESSON``, ``render LESSON --out FILE.png``, ``explain LESSON --pixel X,Y``, ``tour [--out DIR]
 [--lessons DIR]``, ``plan LESSON``, ``compare``, ``new NAME``, ``check LESSON
@@ -590,6 +590,38 @@ def cmd_bench(args: argparse.Namespace) -> int:
     return run_all(json_path=args.json, quick=args.quick, only=args.only)
 
 
+#: The manual's site configuration in a checkout: beside the package, at the repository's top.
+MKDOCS_CONFIG = Path(__file__).resolve().parent.parent / "mkdocs.yml"
+
+
+def cmd_docs(args: argparse.Namespace) -> int:
+    """``glsandbox docs``: serve the manual's site (MkDocs) locally, or with ``--build`` write it strictly."""
+    import importlib.util
+    import os
+    import subprocess
+
+    if not MKDOCS_CONFIG.is_file():
+        raise SandboxError(f"glsandbox docs builds the manual from a checkout: {MKDOCS_CONFIG} not found "
+                           "(an installed glsandbox has no docs/ folder)")
+    if importlib.util.find_spec("mkdocs") is None:
+        raise SandboxError("glsandbox docs needs the docs dependency group: uv sync, or uv run --group docs "
+                           "glsandbox docs")
+    if not 0 < args.port < 65536:
+        raise SandboxError(f"--port {args.port}: expected a port number 1-65535")
+    if args.build is not None and args.build.exists() and not args.build.is_dir():
+        raise SandboxError(f"--build {args.build}: not a folder")
+    command = [sys.executable, "-m", "mkdocs"]
+    if args.build is not None:
+        command += ["build", "--strict", "--config-file", str(MKDOCS_CONFIG), "--site-dir", str(args.build.resolve())]
+    else:
+        command += ["serve", "--config-file", str(MKDOCS_CONFIG), "--dev-addr", f"127.0.0.1:{args.port}"]
+    env = {**os.environ, "NO_MKDOCS_2_WARNING": "1"}  # the theme's notice about its successor, on every build
+    try:
+        return subprocess.run(command, env=env, cwd=MKDOCS_CONFIG.parent).returncode
+    except KeyboardInterrupt:  # Ctrl+C ends serve
+        return 0
+
+
 #: Each command: (what it does, in one line; examples). ``glsandbox COMMAND --help`` shows both.
 COMMANDS: dict[str, tuple[str, tuple[str, ...]]] = {
     "list": ("list the course's lessons in course order, with -v each one's parameters",
@@ -637,6 +669,8 @@ COMMANDS: dict[str, tuple[str, tuple[str, ...]]] = {
                   "glsandbox exercise check ray_sphere my_sphere.py --html report.html")),
     "bench": ("run every benchmark in benchmarks/ and print one table of side-by-side ratios",
               ("glsandbox bench --quick", "glsandbox bench --only clear_and_swap --json bench.json")),
+    "docs": ("serve the manual's site locally (MkDocs), or build it into a folder",
+             ("glsandbox docs", "glsandbox docs --port 8001", "glsandbox docs --build site")),
 }
 
 
@@ -650,8 +684,8 @@ def add_command(sub: argparse._SubParsersAction, name: str) -> argparse.Argument
 
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     """The command line's parser: every subcommand, or with ``command`` only that one (what a
-    command line naming it parses: the other nine cost argparse about 1.5 ms of a cold start,
-    issue 24; the one built is the same)."""
+    command line naming it parses: the others cost argparse about 1.5 ms of a cold start;
+    the one built is the same)."""
     from glsandbox.version import __version__
 
     def wanted(name: str) -> bool:
@@ -791,6 +825,13 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         p.add_argument("--only", action="append", default=[], metavar="NAME",
                        help="only benchmarks whose name contains NAME (repeatable)")
         p.set_defaults(func=cmd_bench)
+
+    if wanted("docs"):
+        p = add_command(sub, "docs")
+        p.add_argument("--build", type=Path, default=None, metavar="DIR",
+                       help="write the site into DIR (strict: a broken link fails) instead of serving it")
+        p.add_argument("--port", type=int, default=8000, help="the local port to serve on (default 8000)")
+        p.set_defaults(func=cmd_docs)
     return parser
 
 
@@ -813,7 +854,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def lesson_main(lesson_cls: type[Lesson], argv: list[str] | None = None) -> int:
     """Entry point of a lesson module: a window, or ``--headless --out FILE.png``."""
-    prog = f"python -m lessons.{lesson_cls.name}"
+    prog = f"python -m glsandbox.lessons.{lesson_cls.name}"
     parser = ArgumentParser(prog=prog, description=f"{lesson_cls.title} ({lesson_cls.course_section}): "
                             "opens it in a window, or renders it headless to a PNG.",
                             epilog=f"examples:\n  {prog}\n  {prog} --headless --out {lesson_cls.name}.png",
@@ -834,7 +875,7 @@ def lesson_main(lesson_cls: type[Lesson], argv: list[str] | None = None) -> int:
             from glsandbox.window import run_window
 
             run_window(lesson, size, args.samples, args.backend,
-                       instead=f"or render it headless: python -m lessons.{lesson_cls.name} --headless --out FILE.png")
+                       instead=f"or render it headless: {prog} --headless --out FILE.png")
         return 0
 
     return run_guarded(body)

@@ -34,7 +34,7 @@ __all__ = ["PRELOAD", "zygote_main"]
 #: opens a GL context at import).
 PRELOAD = ["glsandbox.grading.worker", "glsandbox.frame", "glsandbox.lesson", "glsandbox.scene_file",
            "glsandbox.grading.sandbox", "glsandbox.gl.context", "glsandbox.gl.shaders", "numpy", "moderngl",
-           "glcontext", "glcontext.egl", "PIL.Image", "lessons"]
+           "glcontext", "glcontext.egl", "PIL.Image", "glsandbox.lessons"]
 
 
 

@@ -8,7 +8,7 @@ from support import check_lesson_golden, variant_name
 
 
 def test_acceleration_counts_fewer_tests_with_aabb():
-    from lessons.ray_acceleration import table
+    from glsandbox.lessons.ray_acceleration import table
 
     rows = table("ray_acceleration", False)
     counts = {row[0]: int(row[1].replace(",", "")) for row in rows[2:]}
@@ -19,7 +19,7 @@ def test_acceleration_counts_fewer_tests_with_aabb():
 
 
 def test_acceleration_times_the_bvh_on_a_rock_with_timing_on():
-    from lessons.ray_acceleration import rock_rows
+    from glsandbox.lessons.ray_acceleration import rock_rows
 
     rows = rock_rows(True)
     assert "5,120 triangles" in rows[0] and rows[2].startswith("BVH ") and "x faster" in rows[2]
@@ -30,7 +30,7 @@ def test_acceleration_times_the_bvh_on_a_rock_with_timing_on():
 def test_the_default_rock_line_counts_tests_and_shows_no_time():
     """Times change every run: the default picture holds counts only (tests/gl/test_context.py
     requires every lesson's picture to be the same in two runs and on both backends)."""
-    from lessons.ray_acceleration import RayAcceleration, rock_rows
+    from glsandbox.lessons.ray_acceleration import RayAcceleration, rock_rows
 
     rows = rock_rows(False)
     assert rows[1].startswith("AABB: ") and rows[2].startswith("BVH: ") and rows[2].endswith("x fewer")

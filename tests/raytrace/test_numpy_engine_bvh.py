@@ -69,7 +69,7 @@ def test_render_through_the_bvh_counts_its_tests_and_matches_the_scan() -> None:
 
 
 def test_the_model_lesson_shows_the_bvh_figures() -> None:
-    from lessons.model import bvh_figures, generated
+    from glsandbox.lessons.model import bvh_figures, generated
 
     line = bvh_figures(generated("rock"))
     assert line.startswith("BVH: ") and " nodes, " in line and line.endswith(" leaves") and "not built" not in line

@@ -1,4 +1,4 @@
-"""The README's code runs as written."""
+"""The manual's tutorial code runs as written (docs/your-own.md, docs/how-it-works.md)."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from glsandbox.files import load_png
 
 
 def test_the_readme_lesson_of_your_own_renders(tmp_path: Path, gl) -> None:
-    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    text = (ROOT / "docs" / "how-it-works.md").read_text(encoding="utf-8")
     code = re.search(r"A lesson of your own is a Lesson subclass:\n\n```python\n(.*?)```", text, re.S).group(1)
     script = tmp_path / "spin.py"
     script.write_text(code, encoding="utf-8")
@@ -28,7 +28,7 @@ def test_the_readme_lesson_of_your_own_renders(tmp_path: Path, gl) -> None:
 
 
 def tutorial_section() -> str:
-    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    text = (ROOT / "docs" / "your-own.md").read_text(encoding="utf-8")
     return re.search(r"## Your own lesson, step by step\n(.*?)\n## ", text, re.S).group(1)
 
 
