@@ -55,7 +55,7 @@ __all__ = [
     "COURSE_BLUE", "DEPTH_MODES", "LIT_SHADINGS", "NORMAL_MODES", "TEXTURE_FILTERS", "TEXTURE_WRAPS",
     "Camera", "Lesson", "Light", "Material", "Mesh", "Mirror", "Model", "Motion", "Node", "Overlay", "Param", "PlanarShadow",
     "SandboxError", "Scene", "ShadowMap", "Texture", "Viewport",
-    "__version__", "camera", "check_texture_source", "fit_mesh", "geometry", "load_mesh", "load_model", "meshgen", "register", "run",
+    "__version__", "camera", "check_texture_source", "explain", "fit_mesh", "geometry", "load_mesh", "load_model", "meshgen", "register", "run",
     "show", "text_image", "transforms", "view", "widget",
 ]
 
@@ -109,6 +109,14 @@ def show(lesson_or_scene: object, *args: object, **params: object) -> object:
     from glsandbox.notebook import show as _show
 
     return _show(lesson_or_scene, *args, **params)
+
+
+def explain(lesson_or_scene: object, *args: object, **params: object) -> object:
+    """One pixel's story: ``glsandbox.explain("ray_spheres", (320, 240))`` traces that pixel of the
+    lesson (or a Scene) step by step (:func:`glsandbox.story.explain`); Jupyter shows the story."""
+    from glsandbox.story import explain as _explain
+
+    return _explain(lesson_or_scene, *args, **params)
 
 
 def widget(lesson: object, *args: object, **params: object) -> object:

@@ -1,6 +1,6 @@
 """The ``glsandbox`` command, and ``python -m lessons.<module>``.
 
-``list``, ``run LESSON``, ``render LESSON --out FILE.png``, ``tour [--out DIR]
+``list``, ``run LESSON``, ``render LESSON --out FILE.png``, ``explain LESSON --pixel X,Y``, ``tour [--out DIR]
 [--lessons DIR]``, ``plan LESSON``, ``compare``, ``new NAME``, ``check LESSON
 --golden REF.png``, ``tradeoffs`` and ``bench``, where LESSON is a lesson
 name, a lesson ``.py`` file or a scene ``.toml`` file. :func:`lesson_main` is the entry point
@@ -144,8 +144,23 @@ def cmd_plan(args: argparse.Namespace) -> int:
 def cmd_render(args: argparse.Namespace) -> int:
     lesson = _lesson(args)
     size = _size(args)
-    frame = render_to_file(lesson, args.out, size, args.samples, args.backend)
-    print(f"wrote {args.out} ({size[0]}x{size[1]}, {frame.seconds * 1000:.1f} ms)")
+    if args.out is None and args.xray is None:
+        raise SandboxError("glsandbox render: the following arguments are required: --out FILE.png, or --xray DIR "
+                           "(see glsandbox render --help)")
+    if args.out is not None:
+        frame = render_to_file(lesson, args.out, size, args.samples, args.backend)
+        print(f"wrote {args.out} ({size[0]}x{size[1]}, {frame.seconds * 1000:.1f} ms)")
+    if args.xray is not None:
+        from glsandbox.story.xray import write_xray, xray
+
+        if args.xray.exists() and not args.xray.is_dir():
+            raise SandboxError(f"--xray {args.xray}: is a file, expected a folder")
+        with HeadlessRenderer(args.backend) as renderer:
+            x = xray(renderer, with_samples(lesson.scene(), args.samples), size)
+        written = write_xray(x, args.xray)
+        for note in x.notes:
+            print(f"note: {note}")
+        print(f"wrote {len(written)} pictures of {len(x.passes)} passes to {args.xray} (contact_sheet.png: all of them)")
     return 0
 
 
@@ -484,6 +499,21 @@ def cmd_tradeoffs(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_explain(args: argparse.Namespace) -> int:
+    """``glsandbox explain LESSON --pixel X,Y``: one pixel's story, or its raw record (``--json``)."""
+    from glsandbox.frame import LazyRenderer
+    from glsandbox.story import parse_pixel, pixel_story
+
+    lesson = _lesson(args)
+    lazy = LazyRenderer(args.backend)  # opened only for a rasterised pixel
+    try:
+        story = pixel_story(lesson.scene(), _size(args), parse_pixel(args.pixel), lesson.name, lambda: lazy.renderer)
+    finally:
+        lazy.close()
+    print(story.to_json() if args.json else story.text)
+    return 0
+
+
 def cmd_bench(args: argparse.Namespace) -> int:
     """``glsandbox bench``: every benchmark in benchmarks/, one table of side-by-side ratios."""
     from glsandbox.measure.bench import run_all
@@ -499,10 +529,15 @@ COMMANDS: dict[str, tuple[str, tuple[str, ...]]] = {
             ("glsandbox run phong", "glsandbox run phong --set shading=gouraud --samples 4",
              "glsandbox run my_lesson.py")),
     "render": ("render a lesson headless to a PNG file",
-               ("glsandbox render indexed_cube --out cube.png",
+               ("glsandbox render indexed_cube --out cube.png", "glsandbox render mirror --xray mirror_passes",
                 "glsandbox render phong --set time=1.5 --size 800x600 --out phong.png")),
     "plan": ("print the passes, buffers and shader variants a lesson's frame needs",
              ("glsandbox plan mirror", "glsandbox plan scene.toml")),
+    "explain": ("tell one pixel's story: the ray, each shape's test and t, the nearest hit, the shadow rays, "
+                "Phong's terms, the reflections and the 8-bit colour",
+                ("glsandbox explain ray_spheres --pixel 320,240",
+                 "glsandbox explain ray_phong --set scene=exam2013 --pixel 300,200 --size 640x480",
+                 "glsandbox explain mirror --set renderer=ray_numpy --pixel 100,100 --json")),
     "tour": ("render every lesson headless into a folder, with a gallery page (index.html) and tour.json",
              ("glsandbox tour", "glsandbox tour --out gallery --size 320x240",
               "glsandbox tour --lessons submissions/ --out checked")),
@@ -535,10 +570,43 @@ def add_command(sub: argparse._SubParsersAction, name: str) -> argparse.Argument
                           formatter_class=argparse.RawDescriptionHelpFormatter)
 
 
+def _check_options(p: argparse.ArgumentParser) -> None:
+    """``glsandbox check``'s options: one lesson, a folder of submissions, or one student's folder."""
+    p.add_argument("lesson", metavar="LESSON_OR_DIR",
+                   help="a lesson name, .py or .toml file, or a folder of them (one line each, and a table)")
+    p.add_argument("--golden", type=Path, default=None, metavar="REF.png", help="the reference image")
+    p.add_argument("--rubric", type=Path, default=None, metavar="FILE.toml",
+                   help="a grading file: several checks, each with its golden, settings and points")
+    p.add_argument("--update", action="store_true",
+                   help="write the references when missing or different (a passing one is kept)")
+    p.add_argument("--tolerance", action="append", default=[], metavar="KEY=VALUE",
+                   help="threshold=LEVELS (default 2) or max_bad_share=FRACTION (default 0.0005); repeatable")
+    p.add_argument("--one", action="store_true",
+                   help="LESSON_OR_DIR is one student's folder (its lesson and helper files; Gradescope's "
+                        "/autograder/submission), not a folder of students")
+    p.add_argument("--jobs", type=int, default=None, metavar="N",
+                   help="submissions graded at once (default: the CPUs this process may use, by its "
+                        "cgroup's quota and affinity)")
+    p.add_argument("--timeout", type=float, default=None, metavar="SECONDS",
+                   help="time for each picture of a submission (default 30)")
+    p.add_argument("--memory", type=int, default=None, metavar="MB",
+                   help="memory (address space) of each submission (default 2048)")
+    for kind, text in (("csv", "the figures as CSV"), ("json", "the figures as JSON"),
+                       ("html", "a page: a row per student with reference | submission | difference"),
+                       ("junit", "JUnit XML (what CI systems read)"),
+                       ("gradescope", "Gradescope's results.json"),
+                       ("student_report", "the student's page: no hidden check's reference, difference or "
+                                          "figures")):
+        p.add_argument(f"--{kind.replace('_', '-')}", dest=kind, type=Path, default=None, metavar="FILE",
+                       help=f"folder mode: {text}")
+    add_render_options(p, size_default="the reference's size")
+    p.set_defaults(func=cmd_check)
+
+
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     """The command line's parser: every subcommand, or with ``command`` only that one (what a
-    command line naming it parses: the other nine cost argparse about 1.5 ms of a cold start,
-    issue 24; the one built is the same)."""
+    command line naming it parses: the others cost argparse about 1.5 ms of a cold start; the
+    one built is the same)."""
     from glsandbox.version import __version__
 
     def wanted(name: str) -> bool:
@@ -562,8 +630,22 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         p.add_argument("lesson", metavar="LESSON", help="a lesson name, a lesson .py file or a scene .toml file")
         add_render_options(p)
         if name == "render":
-            p.add_argument("--out", type=Path, required=True, help="the PNG file to write")
+            p.add_argument("--out", type=Path, default=None, help="the PNG file to write")
+            p.add_argument("--xray", type=Path, default=None, metavar="DIR",
+                           help="also (or instead) write each pass's colour, depth and stencil, and a contact sheet")
         p.set_defaults(func=func)
+
+    if wanted("explain"):
+        p = add_command(sub, "explain")
+        p.add_argument("lesson", metavar="LESSON", help="a lesson name, a lesson .py file or a scene .toml file")
+        p.add_argument("--pixel", required=True, metavar="X,Y", help="the pixel, x from the left, y from the top")
+        p.add_argument("--size", default=None, help=f"frame size WxH (default {DEFAULT_SIZE[0]}x{DEFAULT_SIZE[1]})")
+        p.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
+                       help="a lesson parameter (repeatable); every lesson has time=SECONDS")
+        p.add_argument("--json", action="store_true", help="print the raw record as JSON instead of the story")
+        p.add_argument("--backend", default=None, help=f"a rasterised pixel: one of {', '.join(BACKENDS)} "
+                       "(default: GLSANDBOX_BACKEND or auto)")
+        p.set_defaults(func=cmd_explain)
 
     if wanted("tour"):
         p = add_command(sub, "tour")
@@ -595,36 +677,7 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         p.set_defaults(func=cmd_new)
 
     if wanted("check"):
-        p = add_command(sub, "check")
-        p.add_argument("lesson", metavar="LESSON_OR_DIR",
-                       help="a lesson name, .py or .toml file, or a folder of them (one line each, and a table)")
-        p.add_argument("--golden", type=Path, default=None, metavar="REF.png", help="the reference image")
-        p.add_argument("--rubric", type=Path, default=None, metavar="FILE.toml",
-                       help="a grading file: several checks, each with its golden, settings and points")
-        p.add_argument("--update", action="store_true",
-                       help="write the references when missing or different (a passing one is kept)")
-        p.add_argument("--tolerance", action="append", default=[], metavar="KEY=VALUE",
-                       help="threshold=LEVELS (default 2) or max_bad_share=FRACTION (default 0.0005); repeatable")
-        p.add_argument("--one", action="store_true",
-                       help="LESSON_OR_DIR is one student's folder (its lesson and helper files; Gradescope's "
-                            "/autograder/submission), not a folder of students")
-        p.add_argument("--jobs", type=int, default=None, metavar="N",
-                       help="submissions graded at once (default: the CPUs this process may use, by its "
-                            "cgroup's quota and affinity)")
-        p.add_argument("--timeout", type=float, default=None, metavar="SECONDS",
-                       help="time for each picture of a submission (default 30)")
-        p.add_argument("--memory", type=int, default=None, metavar="MB",
-                       help="memory (address space) of each submission (default 2048)")
-        for kind, text in (("csv", "the figures as CSV"), ("json", "the figures as JSON"),
-                           ("html", "a page: a row per student with reference | submission | difference"),
-                           ("junit", "JUnit XML (what CI systems read)"),
-                           ("gradescope", "Gradescope's results.json"),
-                           ("student_report", "the student's page: no hidden check's reference, difference or "
-                                              "figures")):
-            p.add_argument(f"--{kind.replace('_', '-')}", dest=kind, type=Path, default=None, metavar="FILE",
-                           help=f"folder mode: {text}")
-        add_render_options(p, size_default="the reference's size")
-        p.set_defaults(func=cmd_check)
+        _check_options(add_command(sub, "check"))
 
     if wanted("tradeoffs"):
         p = add_command(sub, "tradeoffs")

@@ -24,6 +24,7 @@ from __future__ import annotations
 import math
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -35,11 +36,11 @@ from glsandbox.gl.passes import all_moved
 from glsandbox.gl.target import OffscreenTarget
 from glsandbox.lesson import Lesson
 from glsandbox.overlay import Overlay
-from glsandbox.plan import TRACE_OPTIONS, Buffers, Plan, motion_decisions, plan, traced_image_name, traced_scene
+from glsandbox.plan import TRACE_OPTIONS, Buffers, Pass, Plan, motion_decisions, plan, traced_image_name, traced_scene
 from glsandbox.scene import Motion, Scene, motion_parts, moved_scene
 
 __all__ = ["DEFAULT_SIZE", "Frame", "FrameRenderer", "HeadlessRenderer", "InteractiveResolution",
-           "LazyRenderer", "trace_viewports", "with_samples"]
+           "LazyRenderer", "single_viewport", "trace_viewports", "with_samples"]
 
 #: The frame size when none is given (``--size``).
 DEFAULT_SIZE = (640, 480)
@@ -62,6 +63,14 @@ def with_samples(scene: Scene, samples: int) -> Scene:
 
 
 # --- the raster-versus-ray hook ----------------------------------------------
+
+
+def single_viewport(scene: Scene, index: int) -> Scene:
+    """Viewport ``index`` of ``scene`` as a scene of its own, filling the frame: its nodes
+    (those shown in it), no overlays. What a ray-traced viewport is traced as."""
+    vp = scene.viewports[index]
+    return replace(scene, viewports=(replace(vp, rect=(0.0, 0.0, 1.0, 1.0)),),
+                   nodes=tuple(replace(n, viewports=None) for n in scene.nodes if n.shown_in(index)), overlays=())
 
 
 def trace_viewports(scene: Scene, size: tuple[int, int], ctx: object | None = None,
@@ -93,9 +102,7 @@ def trace_viewports(scene: Scene, size: tuple[int, int], ctx: object | None = No
         w, h = vp.pixels(width, height)[2:]
         if w <= 0 or h <= 0:
             continue
-        single = replace(scene, viewports=(replace(vp, rect=(0.0, 0.0, 1.0, 1.0)),),
-                         nodes=tuple(replace(n, viewports=None) for n in scene.nodes if n.shown_in(i)),
-                         overlays=())
+        single = single_viewport(scene, i)
         engine = "gpu" if vp.renderer == "ray" and ctx is not None else "numpy"
         if resolution < 1.0:
             small = (max(1, math.ceil(w * resolution)), max(1, math.ceil(h * resolution)))
@@ -153,9 +160,11 @@ class FrameRenderer:
     #: Plans kept for frames moved from one scene (:meth:`plan`): a live compare's variants.
     KEEP_PLANS = 16
 
-    def __init__(self, host: GLHost) -> None:
+    def __init__(self, host: GLHost, primitive_ids: bool = False) -> None:
         self.host = host
-        self.executor = Executor(host)
+        #: Targets and programs with the X-ray's primitive ids (:mod:`glsandbox.story.xray`).
+        self.primitive_ids = primitive_ids
+        self.executor = Executor(host, primitive_ids)
         self._targets: dict[tuple[tuple[int, int], Buffers], OffscreenTarget] = {}
         self._plans: dict[int, tuple[Scene, tuple, Plan]] = {}  # by id of the scene frames were moved from
         # Whether a plan's frames may be drawn from a motion handed over (render_motion), by id of the plan.
@@ -174,15 +183,16 @@ class FrameRenderer:
         if target is None:
             if len(self._targets) >= self.KEEP_TARGETS:  # drop the oldest
                 self._targets.pop(next(iter(self._targets))).release()
-            target = self._targets[key] = OffscreenTarget(self.host, size, buffers)
+            target = self._targets[key] = OffscreenTarget(self.host, size, buffers, self.primitive_ids)
         self._last_target = (size, buffers, target)
         return target
 
-    def draw(self, scene: Scene, size: tuple[int, int],
-             ray_resolution: float = 1.0) -> tuple[Plan, OffscreenTarget]:
+    def draw(self, scene: Scene, size: tuple[int, int], ray_resolution: float = 1.0,
+             after_pass: Callable[[int, Pass], None] | None = None) -> tuple[Plan, OffscreenTarget]:
         """Draw one frame; returns its plan (with a ``trace`` pass per ray-traced viewport)
         and the target holding it. ``ray_resolution`` < 1 traces ray-traced viewports
-        coarser (the window while moving). What a ray-traced viewport ignores of the
+        coarser (the window while moving); ``after_pass`` is handed to the executor (called
+        after each raster pass: the X-ray). What a ray-traced viewport ignores of the
         scene, and what a model file holds that is not drawn, is one ``warning:`` line
         each on stderr, once per run."""
         self.host.make_current()
@@ -193,7 +203,7 @@ class FrameRenderer:
                 break
         raster_plan = self.plan(traced)
         target = self.target(size, raster_plan.buffers)
-        self.executor.render(traced, target.framebuffer, size, raster_plan)
+        self.executor.render(traced, target.framebuffer, size, raster_plan, after_pass=after_pass)
         # The whole frame's plan: the same raster passes after the trace passes, with the
         # notes and warnings of the scene as given (a traced viewport's nodes are an image now).
         frame_plan = raster_plan if traced is scene else plan(scene)

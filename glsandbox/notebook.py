@@ -33,7 +33,7 @@ import numpy as np
 from glsandbox.controls import Control, lesson_controls, to_text
 from glsandbox.errors import SandboxError
 from glsandbox.files import png_bytes
-from glsandbox.frame import DEFAULT_SIZE, LazyRenderer, with_samples
+from glsandbox.frame import DEFAULT_SIZE, FrameRenderer, LazyRenderer, with_samples
 from glsandbox.lesson import Lesson, find_lesson
 from glsandbox.scene import Scene
 
@@ -41,6 +41,11 @@ from glsandbox.scene import Scene
 _RENDERER = LazyRenderer()
 NOTEBOOK_MISSING = ("glsandbox.{helper} needs {module}: install the notebook extra "
                     "(pip install 'glsandbox[notebook]', or uv sync --extra notebook)")
+
+
+def shared_renderer() -> FrameRenderer:
+    """The headless renderer every notebook helper shares (opened on first use)."""
+    return _RENDERER.renderer
 
 
 class Picture:
@@ -78,15 +83,20 @@ def make_lesson(lesson: str | type[Lesson] | Lesson, **params: Any) -> Lesson:
     return cls(**values)
 
 
-def render(lesson_or_scene: Any, size: tuple[int, int] = DEFAULT_SIZE, samples: int = 0, **params: Any) -> Picture:
-    """Render a lesson (name, class or instance, with ``params``) or a :class:`Scene` headless."""
+def scene_of(lesson_or_scene: Any, helper: str, **params: Any) -> tuple[Scene, str]:
+    """``(scene, title)`` of a lesson (name, class or instance, with ``params``) or of a :class:`Scene`
+    (which takes none: ``helper`` names the function refusing them)."""
     if isinstance(lesson_or_scene, Scene):
         if params:
-            raise SandboxError(f"show: a Scene takes no parameters (got {', '.join(params)})")
-        scene, title = lesson_or_scene, lesson_or_scene.name
-    else:
-        lesson = make_lesson(lesson_or_scene, **params)
-        scene, title = lesson.scene(), lesson.name
+            raise SandboxError(f"{helper}: a Scene takes no parameters (got {', '.join(params)})")
+        return lesson_or_scene, lesson_or_scene.name
+    lesson = make_lesson(lesson_or_scene, **params)
+    return lesson.scene(), lesson.name
+
+
+def render(lesson_or_scene: Any, size: tuple[int, int] = DEFAULT_SIZE, samples: int = 0, **params: Any) -> Picture:
+    """Render a lesson (name, class or instance, with ``params``) or a :class:`Scene` headless."""
+    scene, title = scene_of(lesson_or_scene, "show", **params)
     frame = _RENDERER.renderer.render_scene(with_samples(scene, samples), tuple(size))
     return Picture(frame.image.copy(), title)
 

@@ -1,9 +1,10 @@
 """The interactive window: the course's render loop on a glfw window.
 
 :class:`Window` clears, draws and swaps each frame, with ESC to quit, F1 for
-the panel, F12 for a screenshot, R to reload shaders (and a lesson file), the
-shared camera keys (:mod:`glsandbox.camera`), the frame rate in the title, and
-resizing. Each frame is drawn exactly as headless draws it
+the panel, F2 for the story of the pixel under the cursor, F12 for a
+screenshot, R to reload shaders (and a lesson file), the shared camera keys
+(:mod:`glsandbox.camera`), the frame rate in the title, and resizing. Each
+frame is drawn exactly as headless draws it
 (:class:`glsandbox.frame.FrameRenderer`, into an offscreen target with the
 plan's buffers) and its colour copied onto the window, so the window shows the
 headless pixels. The live controls (:mod:`glsandbox.panel`, the optional
@@ -34,7 +35,8 @@ from glsandbox.lesson import Lesson, lesson_source, user_code_error
 from glsandbox.lesson import reload_lesson as reload_lesson_file
 from glsandbox.scene import Scene
 
-__all__ = ["FrameRate", "LessonErrors", "Window", "attach_camera_input", "run_window", "screenshot"]
+__all__ = ["FrameRate", "LessonErrors", "Window", "attach_camera_input", "explain_cursor", "run_window",
+           "screenshot"]
 
 
 def run_window(lesson: Lesson, size: tuple[int, int] = DEFAULT_SIZE, samples: int = 0,
@@ -90,10 +92,11 @@ class Window:
     The hooks, each one method: input (:meth:`on_key`, from the key callback
     between frames), the panel (:meth:`draw_panel`, over the copied frame),
     reload (:meth:`reload_shaders` and :meth:`reload_lesson`, on R or a saved
-    file) and the screenshot (:meth:`screenshot`, F12, from the next frame's
-    target).
+    file), the screenshot (:meth:`screenshot`, F12, from the next frame's
+    target) and the pixel's story (:meth:`explain`, F2, from the next frame's scene).
 
-    Keys: ESC quits; F1 hides or shows the panel; F12 writes
+    Keys: ESC quits; F1 hides or shows the panel; F2 prints the story of the pixel under
+    the mouse cursor (``glsandbox explain``); F12 writes
     ``screenshots/<lesson>-<n>.png`` (the next free ``n``; the frame without the
     panel); R reloads the shaders from disk (a broken shader keeps the last good
     program and shows its error in the title and on stderr), as saving a node's
@@ -127,6 +130,7 @@ class Window:
         self.last_scene: Scene | None = None  # the last scene the lesson built
         self.last_drawn: Scene | None = None  # the last scene the renderer drew
         self.shoot = False  # F12: taken from the next frame's target, before the panel is drawn
+        self.explain_next = False  # F2: the pixel under the cursor, in the next frame's scene
         self.pending: list[int] = []
         glfw.set_key_callback(self.host.window, self._on_key_event)
         self.source = lesson_source(type(lesson))  # a lesson .py or scene .toml file: saving it reloads the lesson
@@ -189,6 +193,10 @@ class Window:
         if self.shoot:
             self.shoot = False
             self.screenshot(target)
+        if self.explain_next:
+            self.explain_next = False
+            self.explain(scene, size)
+            target.framebuffer.use()
         session.record(size, frame_plan)
         self.host.raw.blit_color(target.resolved().glo, self.host.ctx.screen.glo, size)
         self.host.ctx.screen.use()
@@ -251,6 +259,8 @@ class Window:
             self.panel.toggle()  # without imgui-bundle: one line saying how to install the panel
         elif key == glfw.KEY_F12:
             self.shoot = True
+        elif key == glfw.KEY_F2:
+            self.explain_next = True
         elif key == glfw.KEY_R:
             self.reload_shaders()
             if self.source is not None:
@@ -290,6 +300,32 @@ class Window:
     def screenshot(self, target: Any) -> Path:
         """The screenshot hook: ``target``'s frame to the next free ``<lesson>-<n>.png``."""
         return screenshot(target.read(), next_numbered(self.screenshot_dir, self.name))
+
+    def explain(self, scene: Scene, size: tuple[int, int]) -> None:
+        """The explain hook: the story of the pixel under the cursor in ``scene`` (see :func:`explain_cursor`)."""
+        explain_cursor(self.host.window, scene, size, self.renderer, self.lesson.name)
+
+
+def explain_cursor(window: Any, scene: Scene, size: tuple[int, int], renderer: FrameRenderer, title: str) -> None:
+    """F2: print the story of the pixel under the mouse cursor (:func:`glsandbox.story.pixel_story`;
+    a rasterised pixel's frame is drawn again with its X-ray on the window's own renderer)."""
+    import glfw
+
+    from glsandbox.story import pixel_story
+
+    cx, cy = glfw.get_cursor_pos(window)
+    ww, wh = glfw.get_window_size(window)
+    # Window coordinates to framebuffer pixels (a HiDPI framebuffer has more of them), row 0 at the top.
+    x, y = int(cx * size[0] / max(ww, 1)), int(cy * size[1] / max(wh, 1))
+    if not (0 <= x < size[0] and 0 <= y < size[1]):
+        print("explain: the cursor is outside the window", file=sys.stderr, flush=True)
+        return
+    try:
+        story = pixel_story(scene, size, (x, y), title, lambda: renderer)
+    except SandboxError as exc:
+        print(f"error: {exc}", file=sys.stderr, flush=True)
+        return
+    print(story.text, flush=True)
 
 
 def screenshot(image: np.ndarray, path: Path) -> Path:

@@ -48,9 +48,11 @@ in vec2 v_uv;
 #ifdef ALPHA_MASK
 uniform float u_alpha_cutoff;
 #endif
-out vec4 frag_color;
+layout(location = 0) out vec4 frag_color;
+#include "common/primitive_id.glsl"
 
 void main() {
+    WRITE_PRIMITIVE_ID();
 #ifdef VERTEX_COLOR
     frag_color = v_color;
 #else

@@ -10,9 +10,11 @@
 #elif defined(FRAGMENT_SHADER)
 uniform sampler2D u_image;
 uniform ivec2 u_origin;  // the frame pixel of the image's bottom-left corner
-out vec4 frag_color;
+layout(location = 0) out vec4 frag_color;
+#include "common/primitive_id.glsl"
 
 void main() {
+    WRITE_PRIMITIVE_ID();
     ivec2 size = textureSize(u_image, 0);
     ivec2 p = ivec2(gl_FragCoord.xy) - u_origin;
     // Texture row 0 is the image's top row (images are stored top first).

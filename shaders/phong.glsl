@@ -98,9 +98,11 @@ in vec3 v_tint;
 #ifdef ALPHA_MASK
 uniform float u_alpha_cutoff;
 #endif
-out vec4 frag_color;
+layout(location = 0) out vec4 frag_color;
+#include "common/primitive_id.glsl"
 
 void main() {
+    WRITE_PRIMITIVE_ID();
     vec4 texel = vec4(1.0);
 #ifdef TEXTURED
     texel = texture(u_texture, v_uv);

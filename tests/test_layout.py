@@ -29,7 +29,8 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("renderers", ("glsandbox.gl", "glsandbox.raytrace")),
     ("one frame", ("glsandbox.frame",)),
     ("window and measuring", ("glsandbox.window", "glsandbox.panel", "glsandbox.controls", "glsandbox.notebook",
-                              "glsandbox.notebook_view", "glsandbox.course_page", "glsandbox.measure")),
+                              "glsandbox.notebook_view", "glsandbox.course_page", "glsandbox.measure",
+                              "glsandbox.story")),
     ("grading", ("glsandbox.grading",)),
     ("command line", ("glsandbox.cli", "glsandbox.pytest_plugin", "glsandbox.__main__")),
 ]

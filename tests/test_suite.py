@@ -101,7 +101,6 @@ NOT_YET_NAMED = {
     "passes/mark_mirror",
     "passes/mirror_surface",
     "passes/overlay",
-    "passes/planar_effects",
     "passes/planar_shadow",
     "passes/reflection",
     "passes/shadow_map",
@@ -113,6 +112,10 @@ NOT_YET_NAMED = {
     "raytrace/watertight",
     "raytrace/world",
     "shadowmap",
+    "story/coverage",
+    "story/raster",
+    "story/ray",
+    "story/text",
 }
 
 

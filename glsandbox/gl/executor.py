@@ -7,6 +7,7 @@ says and nothing more; choosing passes is :func:`glsandbox.plan.plan`'s job.
 
 from __future__ import annotations
 
+import struct
 from collections.abc import Callable, Collection, Mapping
 from pathlib import Path
 from types import MappingProxyType
@@ -40,9 +41,13 @@ class Executor(GpuMeshes):
     #: making a new mesh every frame).
     SETUPS_KEPT = 1024
 
-    def __init__(self, host: GLHost) -> None:
+    def __init__(self, host: GLHost, primitive_ids: bool = False) -> None:
         self.host = host
         self.ctx = host.ctx
+        #: The X-ray's primitive-id target (shaders/common/primitive_id.glsl): the built-in programs
+        #: compiled with PRIMITIVE_ID, each draw telling them its node's number (``node_ids``).
+        self.primitive_ids = primitive_ids
+        self.node_ids: dict[str, int] = {}
         self.raw = host.raw  # the GL calls moderngl lacks (stencil, write masks, clip control)
         self._programs: dict[str, tuple[ProgramVariant, moderngl.Program]] = {}
         # Nodes' own shaders: what each program read and declares, and the nodes drawn with it lately
@@ -91,6 +96,8 @@ class Executor(GpuMeshes):
         return entry[1]
 
     def _compile(self, variant: ProgramVariant) -> tuple[moderngl.Program, UserProgram | None]:
+        if self.primitive_ids and not variant.user:
+            variant = ProgramVariant(variant.shader, (*variant.defines, ("PRIMITIVE_ID", "")))
         program, sources = compile_with_sources(self.ctx, variant)
         if not variant.user:
             return program, None
@@ -135,8 +142,12 @@ class Executor(GpuMeshes):
 
     def render(self, scene: Scene, framebuffer: moderngl.Framebuffer, size: tuple[int, int],
                frame_plan: Plan | None = None,
-               moved: tuple[Mapping[str, np.ndarray], tuple[Light, ...]] | None = None) -> Plan:
+               moved: tuple[Mapping[str, np.ndarray], tuple[Light, ...]] | None = None,
+               after_pass: Callable[[int, Pass], None] | None = None) -> Plan:
         """Draw one frame of ``scene`` into ``framebuffer`` (``size`` pixels).
+
+        ``after_pass(index, step)`` is called after each pass has drawn (the X-ray of
+        :mod:`glsandbox.story.xray` reads the target back there); it must leave GL as it found it.
 
         ``moved``: (model matrices by node name, lights), checked (:func:`glsandbox.scene.motion_parts`):
         the frame of ``scene`` moved there, drawn without the moved scene being made (a headless
@@ -161,6 +172,8 @@ class Executor(GpuMeshes):
                                  "nodes are: draw the moved scene (glsandbox.scene.moved_scene)")
             frame = FrameState(scene, prepared.nodes, framebuffer, size, *moved)
         self._lights = frame.lights
+        if self.primitive_ids:
+            self.node_ids = {node.name: i + 1 for i, node in enumerate(scene.nodes)}
         self.clear_depth = prepared.clear_depth
         framebuffer.use()
         self._culling = None  # not known: the first draw sets it
@@ -174,7 +187,7 @@ class Executor(GpuMeshes):
         # per draw); a pass of unknown habits (gl.passes.unknown_habits) may change any: all is put back.
         changed: frozenset[str] = frozenset()
         try:
-            for runner, step, viewport, rect, sets, changes in prepared.passes:
+            for index, (runner, step, viewport, rect, sets, changes) in enumerate(prepared.passes):
                 if changed:
                     pending = changed - sets
                     if pending:
@@ -190,10 +203,14 @@ class Executor(GpuMeshes):
                     runner(self, frame, step, camera)
                     gl_passes.restore_state(ctx, raw)
                     self._culling = _NO_CULLING
+                    if after_pass is not None:
+                        after_pass(index, step)
                     continue
                 runner(self, frame, step, camera)
                 if changes:
                     changed = changed | changes
+                if after_pass is not None:
+                    after_pass(index, step)
         except BaseException:
             # Whatever the pass that raised left set is put back, as after any pass.
             gl_passes.restore_state(ctx, raw)
@@ -349,6 +366,8 @@ class Executor(GpuMeshes):
             for name, value in own.items():
                 program[name].value = value
             written.pop(_CONSTANTS, None)  # a node's own values may have replaced a constant
+        if self.primitive_ids:  # the X-ray's id target: which node this draw is
+            uniforms["u_node_id"].write(struct.pack("I", self.node_ids.get(node.name, 0)))
         self._bind_and_render(draw, material, setup)
 
     def _prepared_draw(self, node: Node, draw: Draw, material: Material, front_face: str) -> _DrawStep:

@@ -11,6 +11,8 @@ from __future__ import annotations
 import ctypes
 from collections.abc import Callable
 
+import numpy as np
+
 from glsandbox.errors import SandboxError
 
 GL_FRAMEBUFFER = 0x8D40
@@ -45,6 +47,14 @@ GL_KEEP = 0x1E00
 GL_REPLACE = 0x1E01
 GL_INVERT = 0x150A
 GL_STENCIL_BUFFER_BIT = 0x0400
+GL_PACK_ALIGNMENT = 0x0D05
+#: :meth:`RawGL.read_pixels`'s buffers: (GL format, GL type, numpy dtype, components a pixel).
+PIXEL_READS = {
+    "color": (0x1908, 0x1401, np.uint8, 4),  # GL_RGBA, GL_UNSIGNED_BYTE
+    "depth": (0x1902, 0x1406, np.float32, 1),  # GL_DEPTH_COMPONENT, GL_FLOAT
+    "stencil": (0x1901, 0x1401, np.uint8, 1),  # GL_STENCIL_INDEX, GL_UNSIGNED_BYTE
+    "ids": (0x8228, 0x1405, np.uint32, 2),  # GL_RG_INTEGER, GL_UNSIGNED_INT (colour attachment 1)
+}
 GL_SCISSOR_TEST = 0x0C11
 GL_LOWER_LEFT = 0x8CA1
 GL_NEGATIVE_ONE_TO_ONE = 0x935E
@@ -97,6 +107,9 @@ _SIGNATURES: dict[str, tuple] = {
     "glScissor": (_VOID, _INT, _INT, _INT, _INT),
     "glGetFloatv": (_VOID, _UINT, ctypes.POINTER(ctypes.c_float)),
     "glReadPixels": (_VOID, _INT, _INT, _INT, _INT, _UINT, _UINT, ctypes.c_void_p),
+    "glPixelStorei": (_VOID, _UINT, _INT),
+    "glClearBufferuiv": (_VOID, _UINT, _INT, ctypes.c_void_p),
+    "glReadBuffer": (_VOID, _UINT),
     "glBlitFramebuffer": (_VOID, _INT, _INT, _INT, _INT, _INT, _INT, _INT, _INT, _UINT, _UINT),
 }
 
@@ -162,6 +175,23 @@ class RawGL:
                                f"is incomplete: status 0x{status:04X}")
         return fbo.value, rb.value
 
+    def attach_color(self, fbo: int, index: int, renderbuffer: int) -> None:
+        """Attach ``renderbuffer`` as colour attachment ``index`` of ``fbo`` (the X-ray's primitive
+        ids: attachment 1); moderngl's ``detect_framebuffer`` then draws into every attachment."""
+        old = self.get_integer(GL_FRAMEBUFFER_BINDING)
+        self.glBindFramebuffer(GL_FRAMEBUFFER, fbo)
+        self.glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + index, GL_RENDERBUFFER, renderbuffer)
+        self.glBindFramebuffer(GL_FRAMEBUFFER, old)
+
+    def clear_ids(self, rect: tuple[int, int, int, int]) -> None:
+        """Clear colour attachment 1 (the primitive ids, unsigned integers) of the bound framebuffer
+        to 0 inside ``rect``: a float clear colour leaves an integer attachment undefined."""
+        self.glEnable(GL_SCISSOR_TEST)
+        self.glScissor(*rect)
+        zeros = (_UINT * 4)(0, 0, 0, 0)
+        self.glClearBufferuiv(0x1800, 1, zeros)  # GL_COLOR, draw buffer 1
+        self.glDisable(GL_SCISSOR_TEST)
+
     def attachment_bits(self, fbo: int) -> tuple[int, int]:
         """(depth bits, stencil bits) of a framebuffer's depth attachment."""
         old = self.get_integer(GL_FRAMEBUFFER_BINDING)
@@ -225,9 +255,35 @@ class RawGL:
         old = self.get_integer(GL_FRAMEBUFFER_BINDING)
         self.glBindFramebuffer(GL_FRAMEBUFFER, fbo)
         data = ctypes.create_string_buffer(size[0] * size[1])
+        alignment = self.get_integer(GL_PACK_ALIGNMENT)
+        self.glPixelStorei(GL_PACK_ALIGNMENT, 1)  # rows of one byte a pixel, packed tight
         self.glReadPixels(0, 0, size[0], size[1], 0x1901, 0x1401, data)  # GL_STENCIL_INDEX, GL_UNSIGNED_BYTE
+        self.glPixelStorei(GL_PACK_ALIGNMENT, alignment)
         self.glBindFramebuffer(GL_FRAMEBUFFER, old)
         return data.raw
+
+    def read_pixels(self, fbo: int, size: tuple[int, int], what: str) -> np.ndarray:
+        """One buffer of a single-sample framebuffer as an array, top row first: ``what`` is one of
+        :data:`PIXEL_READS` (the X-ray's reads: ``color`` RGBA8, ``depth`` float32 0..1, ``stencil``
+        uint8, ``ids`` two uint32 a pixel from colour attachment 1). GL state is put back."""
+        fmt, kind, dtype, components = PIXEL_READS[what]
+        width, height = size
+        old = self.get_integer(GL_FRAMEBUFFER_BINDING)
+        alignment = self.get_integer(GL_PACK_ALIGNMENT)
+        self.glBindFramebuffer(GL_FRAMEBUFFER, fbo)
+        self.glPixelStorei(GL_PACK_ALIGNMENT, 1)
+        self.glReadBuffer(GL_COLOR_ATTACHMENT0 + (1 if what == "ids" else 0))
+        out = np.empty((height, width, components), dtype=dtype)
+        self.glReadPixels(0, 0, width, height, fmt, kind, out.ctypes.data)
+        self.glReadBuffer(GL_COLOR_ATTACHMENT0)
+        self.glPixelStorei(GL_PACK_ALIGNMENT, alignment)
+        self.glBindFramebuffer(GL_FRAMEBUFFER, old)
+        out = out[::-1]  # GL's bottom row first
+        return out[..., 0] if components == 1 else out
+
+    def bound_framebuffer(self) -> int:
+        """The framebuffer object bound for drawing now."""
+        return self.get_integer(GL_FRAMEBUFFER_BINDING)
 
     def state_snapshot(self) -> dict[str, object]:
         """The pipeline state the effect passes change, read back from GL."""

@@ -45,10 +45,11 @@ def clear_opaque(framebuffer: moderngl.Framebuffer, rgb: tuple[float, float, flo
     frame is drawn; its viewport is set before each pass draws).
     """
     mask = framebuffer.color_mask
-    if mask == ALL_CHANNELS:
+    every = ALL_CHANNELS if not isinstance(mask[0], tuple) else (ALL_CHANNELS,) * len(mask)  # (an X-ray's 2 attachments)
+    if mask == every:
         framebuffer.clear(*rgb, 1.0, depth=depth, viewport=viewport)
         return
-    framebuffer.color_mask = ALL_CHANNELS
+    framebuffer.color_mask = every
     framebuffer.clear(*rgb, 1.0, depth=depth, viewport=viewport)
     framebuffer.color_mask = mask
     framebuffer.use()
@@ -57,7 +58,7 @@ def clear_opaque(framebuffer: moderngl.Framebuffer, rgb: tuple[float, float, flo
 class OffscreenTarget:
     """A framebuffer of ``size`` with the buffers the plan lists."""
 
-    def __init__(self, host: GLHost, size: tuple[int, int], buffers: Buffers) -> None:
+    def __init__(self, host: GLHost, size: tuple[int, int], buffers: Buffers, primitive_ids: bool = False) -> None:
         ctx = host.ctx
         width, height = size
         limit = ctx.info["GL_MAX_RENDERBUFFER_SIZE"]
@@ -73,13 +74,18 @@ class OffscreenTarget:
         self._fbo_name, self._depth_name = host.raw.create_depth_framebuffer(
             self._color.glo, size, samples, stencil=buffers.stencil, depth=buffers.depth,
             float_depth=buffers.float_depth)
+        # The X-ray's primitive ids (shaders/common/primitive_id.glsl): (node, triangle) as two
+        # unsigned integers a pixel, colour attachment 1 (single-sample frames only).
+        self._ids = ctx.renderbuffer(size, 2, dtype="u4") if primitive_ids and not samples else None
+        if self._ids is not None:
+            host.raw.attach_color(self._fbo_name, 1, self._ids.glo)
         self.framebuffer: moderngl.Framebuffer = ctx.detect_framebuffer(self._fbo_name)
         self._resolved: moderngl.Framebuffer | None = None
         if samples:
             self._resolved = ctx.framebuffer(color_attachments=[ctx.renderbuffer(size, 4)])
             self._resolved.clear(0.0, 0.0, 0.0, 1.0)  # the resolve copies alpha 1 here, or keeps this 1
         self.framebuffer.clear(0.0, 0.0, 0.0, 1.0)  # every sample: opaque before the first clear of a frame
-        self.framebuffer.color_mask = FRAME_COLOR_MASK
+        self.framebuffer.color_mask = FRAME_COLOR_MASK if self._ids is None else (FRAME_COLOR_MASK, ALL_CHANNELS)
 
     def bits(self) -> tuple[int, int]:
         """(depth bits, stencil bits) actually allocated."""
@@ -102,10 +108,20 @@ class OffscreenTarget:
         data = self.resolved().read(components=4, alignment=1)
         return np.frombuffer(data, dtype=np.uint8).reshape(self.size[1], self.size[0], 4)[::-1]
 
+    def read_ids(self) -> np.ndarray | None:
+        """The primitive ids, (H, W, 2) uint32 (node number, triangle), top row first; None
+        unless the target was made with them."""
+        if self._ids is None:
+            return None
+        data = self.framebuffer.read(components=2, attachment=1, dtype="u4")
+        return np.frombuffer(data, dtype=np.uint32).reshape(self.size[1], self.size[0], 2)[::-1]
+
     def release(self) -> None:
         # The framebuffer object is ours (rawgl made it); moderngl only wraps it.
         self.host.raw.delete_framebuffer(self._fbo_name, self._depth_name)
         self._color.release()
+        if self._ids is not None:
+            self._ids.release()
         if self._resolved is not None:
             for rb in self._resolved.color_attachments:
                 rb.release()

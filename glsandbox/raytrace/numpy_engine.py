@@ -73,6 +73,14 @@ __all__ = ["RAY_BLOCK", "RenderStats", "render_viewport", "to_rgba8"]
 #: pays the page faults of allocating it: about twice as fast at 800x600.
 RAY_BLOCK: int = 1 << 14
 
+#: A seam for :mod:`glsandbox.story`: ``probe(step, **arrays)`` is called by :func:`_trace`
+#: and :func:`_shade` with the arrays of each step (``"ray"``: a depth's rays and nearest
+#: hits; ``"surface"``: point, normal, base colour, alpha of the hits; ``"light"``: one
+#: light's Phong terms and shadow ray; ``"local"``: the local colour, reflectivity and
+#: coverage; ``"bounce"``: the rays followed next). It only reads: the pixels are the same
+#: with or without one. Renders pass none.
+Probe = Callable[..., None]
+
 
 @dataclass
 class RenderStats:
@@ -487,10 +495,14 @@ def _offset(spawn: _Spawn, normal: NDArray[np.float64], side: NDArray[np.float64
 
 def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.float64], shadows: bool,
            cull: bool | None, aabb: bool, stats: RenderStats, bvh: WorldBVH | None = None, simple: bool = False,
-           bounce: bool = True) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], _Spawn | None]:
+           bounce: bool = True, probe: Probe | None = None
+           ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], _Spawn | None]:
     """Local colour of hit rays (the raster's per-light formula), plus normal, alpha and
-    spawn point for bounces (``bounce``: some may follow; else the spawn is None)."""
+    spawn point for bounces (``bounce``: some may follow; else the spawn is None).
+    ``probe`` is told the surface and each light's terms (see :data:`Probe`)."""
     point, normal, base, alpha, spawn = _surface(world, hits, o, d, need_spawn=shadows or bounce)
+    if probe is not None:
+        probe("surface", point=point, normal=normal, base=base, alpha=alpha, spawn=spawn, lit=world.materials.lit[hits.node])
     color = base.copy()  # unlit surfaces keep their colour
     table = world.materials
     lit = table.lit[hits.node]
@@ -525,6 +537,7 @@ def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.floa
             highlight = np.where(n_dot_l > 0.0, cosine ** shin, 0.0)
             specular = highlight[:, None] * light_color
             lighting = kd * diffuse + ks * specular
+            start = blocked = None
             if shadows:
                 assert lit_spawn is not None
                 start = _offset(lit_spawn, nrm, light - p, simple)
@@ -532,26 +545,33 @@ def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.floa
                 blocked = _occluded(world, start, light - start, index, cull, aabb, stats, bvh)
                 lighting *= np.where(blocked, 0.0, 1.0)[:, None]  # in shadow only the ambient term stays
             total += np.minimum(ka * mesh + lighting, 1.0)
+            if probe is not None:
+                probe("light", index=index, ka=ka, kd=kd, ks=ks, shininess=shin, blinn=blinn, mesh=mesh,
+                      to_light=to_light, to_eye=to_eye, n_dot_l=n_dot_l, cosine=cosine, diffuse=diffuse,
+                      specular=specular, start=start, blocked=blocked)
         color[pick] = total
     return color, normal, alpha, spawn
 
 
 def _trace(world: World, o: NDArray[np.float64], d: NDArray[np.float64], max_depth: int, shadows: bool,
            cull: bool | None, aabb: bool, stats: RenderStats, bvh: WorldBVH | None = None,
-           simple: bool = False) -> NDArray[np.float64]:
+           simple: bool = False, probe: Probe | None = None) -> NDArray[np.float64]:
     """Colour of each ray, reflections followed iteratively: ``(1−r)·local + r·reflected``.
 
     A see-through surface (a cut-out, a blended one) covers a share ``a`` of what lies
     behind it (:func:`~glsandbox.raytrace.world.coverage`): ``a·local + (1−a)·behind``,
     the ray going on straight through it. Such a pass is one of the ``max_depth`` bounces
     (at the last one the surface's own colour stands in), and a see-through surface does
-    not also reflect: one ray per pixel, as in the GLSL engine's loop."""
+    not also reflect: one ray per pixel, as in the GLSL engine's loop. ``probe`` is told
+    every step's values (:data:`Probe`; ``glsandbox explain`` records one ray's)."""
     n = d.shape[0]
     out = np.zeros((n, 3))
     weight = np.ones(n)
     alive = np.arange(n)
     for depth in range(max_depth + 1):
         hits = _nearest(world, o, d, cull, aabb, stats, bvh)
+        if probe is not None:
+            probe("ray", depth=depth, origin=o, direction=d, weight=weight, t=hits.t, node=hits.node, tri=hits.tri)
         miss = hits.node < 0
         out[alive[miss]] += weight[miss, None] * world.background
         hit = ~miss
@@ -560,13 +580,15 @@ def _trace(world: World, o: NDArray[np.float64], d: NDArray[np.float64], max_dep
         sub = _Hits(hits.t[hit], hits.node[hit], hits.tri[hit])
         last = depth >= max_depth
         local, normal, alpha, spawn = _shade(world, sub, _rows(o, hit), d[hit], shadows, cull, aabb, stats, bvh,
-                                             simple, bounce=not last)
+                                             simple, bounce=not last, probe=probe)
         table = world.materials
         r = table.reflectivity[sub.node] if not last else np.zeros(sub.node.size)
         a = np.ones(sub.node.size) if last else coverage(table.alpha_mode[sub.node], alpha,
                                                           table.alpha_cutoff[sub.node])
         through = a < 1.0
         r = np.where(through, 0.0, r)
+        if probe is not None:
+            probe("local", local=local, reflectivity=r, coverage=a, last=last)
         w = weight[hit]
         out[alive[hit]] += (w * a * (1.0 - r))[:, None] * local
         bounce = (r > 0.0) | through
@@ -581,6 +603,8 @@ def _trace(world: World, o: NDArray[np.float64], d: NDArray[np.float64], max_dep
         d = np.where(on, dh, reflected)
         weight = np.where(through, w * (1.0 - a), w * r)[bounce]
         alive = alive[hit][bounce]
+        if probe is not None:
+            probe("bounce", through=through[bounce], reflected=reflected)
         stats.reflection += alive.size
     return out
 
