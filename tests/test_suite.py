@@ -95,7 +95,6 @@ NOT_YET_NAMED = {
     "measure/tradeoffs_report",
     "meshlooks",
     "overlay",
-    "passes/base",
     "passes/clear",
     "passes/draw",
     "passes/mark_mirror",
