@@ -106,7 +106,6 @@ NOT_YET_NAMED = {
     "planar",
     "raytrace/base",
     "raytrace/bvh_traverse",
-    "raytrace/gpu_records",
     "raytrace/watertight",
     "raytrace/world",
     "shadowmap",
