@@ -89,7 +89,6 @@ NOT_YET_NAMED = {
     "measure/knobs/sphere_test",
     "measure/knobs/texture_filter",
     "measure/knobs/triangle_test",
-    "measure/render_context",
     "measure/tradeoffs",
     "measure/tradeoffs_report",
     "meshlooks",
