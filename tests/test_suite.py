@@ -107,7 +107,6 @@ NOT_YET_NAMED = {
     "raytrace/bvh_traverse",
     "raytrace/watertight",
     "raytrace/world",
-    "shadowmap",
     "story/coverage",
     "story/raster",
     "story/ray",
