@@ -103,7 +103,6 @@ NOT_YET_NAMED = {
     "passes/shadow_map",
     "passes/trace",
     "planar",
-    "raytrace/base",
     "raytrace/bvh_traverse",
     "raytrace/watertight",
     "raytrace/world",
