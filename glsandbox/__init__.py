@@ -55,7 +55,7 @@ __all__ = [
     "COURSE_BLUE", "DEPTH_MODES", "LIT_SHADINGS", "NORMAL_MODES", "TEXTURE_FILTERS", "TEXTURE_WRAPS",
     "Camera", "Lesson", "Light", "Material", "Mesh", "Mirror", "Model", "Motion", "Node", "Overlay", "Param", "PlanarShadow",
     "SandboxError", "Scene", "ShadowMap", "Texture", "Viewport",
-    "__version__", "camera", "check_texture_source", "explain", "fit_mesh", "geometry", "load_mesh", "load_model", "meshgen", "register", "run",
+    "__version__", "camera", "check_texture_source", "exercise", "explain", "fit_mesh", "geometry", "load_mesh", "load_model", "meshgen", "register", "run",
     "show", "text_image", "transforms", "view", "widget",
 ]
 
@@ -65,6 +65,7 @@ __all__ = [
 # first use (PEP 562), so a cold start skips them.
 _LAZY = {
     "camera": ("glsandbox.camera", None),
+    "exercise": ("glsandbox.exercises", "exercise"),
     "Mirror": ("glsandbox.planar", "Mirror"),
     "PlanarShadow": ("glsandbox.planar", "PlanarShadow"),
     "meshgen": ("glsandbox.meshgen", None),

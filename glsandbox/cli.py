@@ -2,7 +2,7 @@
 
 ``list``, ``run LESSON``, ``render LESSON --out FILE.png``, ``explain LESSON --pixel X,Y``, ``tour [--out DIR]
 [--lessons DIR]``, ``plan LESSON``, ``compare``, ``new NAME``, ``check LESSON
---golden REF.png``, ``tradeoffs`` and ``bench``, where LESSON is a lesson
+--golden REF.png``, ``exercise list|start|check``, ``tradeoffs`` and ``bench``, where LESSON is a lesson
 name, a lesson ``.py`` file or a scene ``.toml`` file. :func:`lesson_main` is the entry point
 of a lesson module (a window, or ``--headless --out FILE.png``). User errors
 print ``error: <one line>`` and exit with status 2.
@@ -557,6 +557,11 @@ COMMANDS: dict[str, tuple[str, tuple[str, ...]]] = {
                "glsandbox check phong --golden phong.png --update")),
     "tradeoffs": ("time each accuracy knob and compare it with a reference (FLIP, RMSE): report.md, CSV and plot",
                   ("glsandbox tradeoffs --quick", "glsandbox tradeoffs --knob antialiasing --out out/aa")),
+    "exercise": ("write the course's functions yourself: list the exercises, start one, check your file "
+                 "(cases, hints, probe pictures; exit 0 when every visible case passes)",
+                 ("glsandbox exercise list", "glsandbox exercise start ray_sphere --out my_sphere.py",
+                  "glsandbox exercise check ray_sphere my_sphere.py",
+                  "glsandbox exercise check ray_sphere my_sphere.py --html report.html")),
     "bench": ("run every benchmark in benchmarks/ and print one table of side-by-side ratios",
               ("glsandbox bench --quick", "glsandbox bench --only clear_and_swap --json bench.json")),
 }
@@ -687,6 +692,13 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         p.add_argument("--knob", action="append", default=[], metavar="NAME", help="only this knob (repeatable)")
         p.add_argument("--backend", default=None, help="GL backend (default: GLSANDBOX_BACKEND or auto)")
         p.set_defaults(func=cmd_tradeoffs)
+
+    if wanted("exercise"):
+        from glsandbox.exercises.commands import add_arguments, cmd_exercise
+
+        p = add_command(sub, "exercise")
+        add_arguments(p)
+        p.set_defaults(func=cmd_exercise)
 
     if wanted("bench"):
         p = add_command(sub, "bench")

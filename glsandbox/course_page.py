@@ -10,7 +10,9 @@ than the screen: long words, paths and plans wrap.
 
 Everything on the page comes from lessons, and ``tour --lessons DIR`` reads
 users' files, so every text is escaped and every file name percent-encoded
-(a name may hold any bytes the file system allows).
+(a name may hold any bytes the file system allows). The course's page ends
+with the exercises (:mod:`glsandbox.exercises`): what to type to write each
+of the course's functions yourself.
 """
 
 from __future__ import annotations
@@ -193,6 +195,11 @@ figcaption strong { color: var(--ink); }
 .tiles { font-size: .85rem; }
 .error { color: #b00020; font-weight: 600; }
 footer { padding: 0 clamp(.75rem, 3vw, 3rem) 2rem; color: var(--muted); font-size: .9rem; }
+.exercises { margin-top: 2rem; background: #fff; border-radius: 12px; padding: 1rem 1.15rem 1.2rem;
+             box-shadow: 0 1px 2px rgba(16,24,40,.08), 0 4px 14px rgba(16,24,40,.06); overflow-x: auto; }
+.exercises table { border-collapse: collapse; width: 100%; }
+.exercises th, .exercises td { text-align: left; vertical-align: top; padding: .35rem .6rem;
+                               border-top: 1px solid #e6e9f0; overflow-wrap: anywhere; }
 """
 
 
@@ -206,6 +213,23 @@ and <code>glsandbox compare NAME --vary KEY=A,B</code> draws any comparison of y
 def folder_header(folder: str) -> str:
     return (f"<h1>Lessons in {esc(folder)}</h1><p>Each lesson file of the folder as it renders, with what its "
             "docstring says and the command that runs it. Click a picture for full size.</p>")
+
+
+def exercises_section() -> str:
+    """The Exercises section: each exercise's function, course section and what to type."""
+    from glsandbox.exercises.catalogue import all_exercises
+
+    rows = "\n".join(
+        f"<tr><td><code>{esc(e.name)}</code></td><td>{esc(e.section)}</td><td><code>{esc(e.signature)}</code>"
+        f"<br>{esc(e.summary)}</td></tr>" for e in all_exercises())
+    return f"""<section class="exercises"><h2>Exercises</h2>
+<p>Write the course's functions yourself. <code>glsandbox exercise start NAME</code> writes a starter
+(the signature, the notes' formula and worked example); <code>glsandbox exercise check NAME FILE.py</code>
+runs the notes' worked examples on it, names a known mistake when it sees one, and draws where your
+answers differ from the reference's. In a notebook: <code>glsandbox.exercise("ray_sphere", my_function)</code>.</p>
+<table><tr><th>exercise</th><th>course section</th><th>function</th></tr>
+{rows}
+</table></section>"""
 
 
 def course_page(summary: dict) -> str:
@@ -227,7 +251,8 @@ def course_page(summary: dict) -> str:
 </header>
 <main><div class="grid">
 {cards}
-</div></main>
+</div>
+{"" if folder else exercises_section()}</main>
 <footer>{rendered} of {len(lessons)} lessons rendered by {esc(summary['renderer'])} ({esc(summary['backend'])}) at
 {size[0]}x{size[1]} in {float(summary['seconds']):.1f} s; written by <code>glsandbox tour</code>.</footer>
 </body></html>

@@ -30,8 +30,13 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("one frame", ("glsandbox.frame",)),
     ("window and measuring", ("glsandbox.window", "glsandbox.panel", "glsandbox.controls", "glsandbox.notebook",
                               "glsandbox.notebook_view", "glsandbox.course_page", "glsandbox.measure",
-                              "glsandbox.story")),
-    ("grading", ("glsandbox.grading",)),
+                              # an exercise's data, its catalogue and its pictures (the course page lists them)
+                              "glsandbox.exercises.base", "glsandbox.exercises.fields", "glsandbox.exercises.compare",
+                              "glsandbox.exercises.plain",
+                              "glsandbox.exercises.catalogue", "glsandbox.exercises.probe",
+                              "glsandbox.exercises.lesson_view", "glsandbox.exercises.runner",
+                              "glsandbox.exercises.dxmath", "glsandbox.story")),
+    ("grading", ("glsandbox.grading", "glsandbox.exercises")),
     ("command line", ("glsandbox.cli", "glsandbox.pytest_plugin", "glsandbox.__main__")),
 ]
 

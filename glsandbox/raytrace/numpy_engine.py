@@ -46,8 +46,9 @@ way.
 from __future__ import annotations
 
 import weakref
-from collections.abc import Callable
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -62,7 +63,10 @@ from glsandbox.raytrace.watertight import nearest_watertight
 from glsandbox.raytrace.world import NodeInfo, World, build_world, camera_rays, coverage
 from glsandbox.scene import Scene
 
-__all__ = ["RAY_BLOCK", "RenderStats", "render_viewport", "to_rgba8"]
+__all__ = ["RAY_BLOCK", "HitTest", "RenderStats", "render_viewport", "to_rgba8"]
+
+#: A hit test handed to :func:`render_viewport` for one node kind (see :func:`_replaced_hit`).
+HitTest = Callable[..., Any]
 
 #: Primary rays are traced this many at a time, each block through every step
 #: (nearest hit, shading, shadow rays, bounces) before the next. Every ray's
@@ -290,7 +294,36 @@ def _hit_node(world: World, k: int, o: NDArray[np.float64], d: NDArray[np.float6
     backface culling").
     """
     node = world.nodes[k]
+    replaced = world.hit_tests.get(_hit_test_name(node)) if world.hit_tests else None
+    if replaced is not None:
+        return _replaced_hit(replaced, world, node, o, d, one_sided)
     return _hit_kind(node)(world, node, o, d, one_sided)
+
+
+def _hit_test_name(node: NodeInfo) -> str:
+    """The name :func:`render_viewport`'s ``hit_tests`` replaces a node's test by: ``"triangles"``
+    for a mesh, else its kind's (``"sphere"``)."""
+    return "triangles" if node.kind.triangles else str(node.kind.value)
+
+
+def _replaced_hit(test: HitTest, world: World, node: NodeInfo, o: NDArray[np.float64], d: NDArray[np.float64],
+                  one_sided: bool) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
+    """A node's rays through a hit test handed to :func:`render_viewport` (``hit_tests``).
+
+    A sphere node's test gets the rays in the unit sphere's own space, ``(origins,
+    directions)`` (directions not unit: ``t`` is the affine map's, as the engine's own);
+    a mesh node's gets ``(origins, directions, v0, v1, v2, one_sided)`` with the node's
+    triangles and answers ``(t, triangle index within them)``.
+    """
+    o = np.broadcast_to(o, d.shape)
+    if not node.kind.triangles:
+        oo, dd = _own_space(node, o, d)
+        t = np.asarray(test(oo, dd), dtype=np.float64).reshape(d.shape[0])
+        return np.where(t > 0.0, t, np.inf), np.full(d.shape[0], -1, dtype=np.intp)
+    rows = slice(node.start, node.start + node.count)
+    t, j = test(o, d, world.v0[rows], world.v1[rows], world.v2[rows], one_sided)
+    t, j = np.asarray(t, dtype=np.float64), np.asarray(j, dtype=np.intp)
+    return np.where(t > 0.0, t, np.inf), np.where(j >= 0, j + node.start, -1)
 
 
 def _own_space(node: NodeInfo, o: NDArray[np.float64], d: NDArray[np.float64]
@@ -658,13 +691,20 @@ def _rays_of(scene: Scene, viewport: int, width: int, height: int) -> tuple[NDAr
 def render_viewport(scene: Scene, size: tuple[int, int], viewport: int = 0, *, max_depth: int = 2,
                     shadows: bool = True, cull_backfaces: bool | None = None, aabb: bool = True,
                     bvh: bool = True, analytic_spheres: bool = True,
-                    stats: RenderStats | None = None, offset: str = "bound") -> NDArray[np.uint8]:
+                    stats: RenderStats | None = None, offset: str = "bound",
+                    hit_tests: Mapping[str, HitTest] | None = None) -> NDArray[np.uint8]:
     """Trace one viewport at ``size``: ``(H, W, 4)`` uint8, top row first (see :func:`to_rgba8`).
 
     The options are :func:`glsandbox.raytrace.render`'s; ``stats`` counts the rays cast.
+    ``hit_tests`` replaces the engine's own hit test of a node kind, ``"sphere"`` or
+    ``"triangles"``, by a function of whole batches of rays (see :func:`_replaced_hit`):
+    the seam through which an exercise renders a scene with a student's function (mesh
+    nodes are then tested triangle by triangle, without their BVH).
     """
     width, height = size
-    world, accel = _world_of(scene, viewport, analytic_spheres, bvh)
+    world, accel = _world_of(scene, viewport, analytic_spheres, bvh and not hit_tests)
+    if hit_tests:
+        world, accel = replace(world, hit_tests=dict(hit_tests)), None
     eye, dirs = _rays_of(scene, viewport, width, height)
     stats = stats if stats is not None else RenderStats()
     stats.primary += dirs.shape[0]

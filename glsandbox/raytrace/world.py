@@ -63,6 +63,7 @@ from __future__ import annotations
 import enum
 import math
 from dataclasses import dataclass, field
+from typing import Any
 from functools import cached_property
 
 import numpy as np
@@ -243,6 +244,9 @@ class World:
     light_colors: NDArray[np.float64]  # (L, 3)
     background: NDArray[np.float64]  # rgb of the viewport's clear colour
     textures: list[tuple[NDArray[np.float64], int]]  # (image (H, W, 4) in 0..1, wrap code)
+    #: Hit tests that replace the numpy engine's own for a node kind (``"sphere"``,
+    #: ``"triangles"``): see :func:`glsandbox.raytrace.numpy_engine.render_viewport`.
+    hit_tests: dict[str, Any] = field(default_factory=dict)
 
     @property
     def triangle_count(self) -> int:

@@ -114,7 +114,8 @@ def test_the_course_page_fits_a_desktop_and_a_phone_and_every_picture_loads(
     assert desktop["columns"] == 3  # a grid, not one long column
     assert len(desktop["images"]) == len(lessons) + len(contrasts)
     assert desktop["links"] == [i["src"] for i in desktop["images"]]  # each picture links to its full size
-    assert [h.lstrip("0123456789") for h in desktop["headings"]] == [e["title"] for e in lessons]  # course order
+    # course order, then the exercises
+    assert [h.lstrip("0123456789") for h in desktop["headings"]] == [e["title"] for e in lessons] + ["Exercises"]
     phone = measure(chromium, course_tour / "index.html", PHONE, tmp_path)
     assert_fits(phone, PHONE)
     assert phone["columns"] == 1

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import html
 import os
 
 from glsandbox.course_page import clean, course_page, describe, url
@@ -48,3 +49,15 @@ def test_text_is_escaped_and_names_become_their_exact_bytes_in_urls() -> None:
     for raw in ("<script>t", "<x>", "<e>", "<b>lead", "<i>body", "<r>"):
         assert raw not in page
     assert "&lt;script&gt;t&lt;/script&gt;" in page and "failed: &lt;e&gt;" in page
+
+
+def test_the_course_page_ends_with_the_exercises_and_a_folders_page_does_not() -> None:
+    from glsandbox.exercises import all_exercises
+
+    summary = {"size": [64, 48], "renderer": "r", "backend": "egl", "seconds": 1.0, "lessons": []}
+    page = course_page(summary)
+    assert "<h2>Exercises</h2>" in page and "glsandbox exercise check NAME FILE.py" in page
+    for exercise in all_exercises():
+        assert f"<code>{exercise.name}</code>" in page
+        assert f"<code>{html.escape(exercise.signature)}</code>" in page
+    assert "<h2>Exercises</h2>" not in course_page({**summary, "folder": "mine"})

@@ -1,0 +1,201 @@
+"""The student's function in its own process: hostile functions cost their own case, never the
+run, and nothing of glsandbox (the references, the hidden answers) can be reached from there."""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+import pytest
+
+from glsandbox.exercises import get
+from glsandbox.exercises.check import BROKEN, FAIL, PASS, TIMEOUT_STATUS, check_file
+from glsandbox.exercises.isolation import CRASHED, ERROR, TIMEOUT, VALUE, Isolated, Limits, readable_roots
+
+PACKAGE = Path(__file__).resolve().parents[2] / "glsandbox"
+
+HOSTILE = f'''
+import math, os, sys, time
+
+def f(mode):
+    if mode == "ok":
+        return 2.0
+    if mode == "loop":
+        while True:
+            pass
+    if mode == "sleep":
+        time.sleep(60)
+    if mode == "raise":
+        return 1 / 0
+    if mode == "nan":
+        return float("nan")
+    if mode == "type":
+        return "thirty-five"
+    if mode == "print":
+        print("x" * 5_000_000)
+        return 2.0
+    if mode == "exit":
+        os._exit(3)
+    if mode == "sysexit":
+        sys.exit(0)
+    if mode == "read":
+        return open({str(PACKAGE / "raytrace" / "sphere.py")!r}).read()[:20]
+    if mode == "walk":
+        return sorted(os.listdir({str(PACKAGE)!r}))
+    if mode == "import":
+        import glsandbox.raytrace.sphere
+        return 1.0
+    if mode == "ctypes":
+        import ctypes
+        return ctypes.CDLL(None).open({str(PACKAGE / "raytrace" / "sphere.py").encode()!r}, 0)
+    if mode == "numpy":
+        import numpy as np
+        return np.float64(2.0)
+    if mode == "spawn":
+        import subprocess
+        return subprocess.run(["true"]).returncode
+    if mode == "memory":
+        return len(bytearray(8 << 30))
+    if mode == "network":
+        import socket
+        socket.create_connection(("127.0.0.1", 9), timeout=0.2)
+        return 1.0
+    if mode == "parent":
+        return open(f"/proc/{{os.getppid()}}/environ").read()[:20]
+'''
+
+
+@pytest.fixture(scope="module")
+def hostile(tmp_path_factory):
+    path = tmp_path_factory.mktemp("hostile") / "hostile.py"
+    path.write_text(HOSTILE)
+    with Isolated(path, "f", Limits(call_seconds=1.0, memory_mb=1024, restarts=20)) as caller:
+        yield caller
+
+
+@pytest.mark.parametrize(("mode", "status", "fragment"), [
+    ("ok", VALUE, ""),
+    ("raise", ERROR, "ZeroDivisionError: division by zero (line 13)"),
+    ("print", ERROR, "printed more than"),
+    ("sysexit", ERROR, "SystemExit"),
+    ("read", ERROR, "PermissionError: reading"),
+    ("walk", ERROR, "PermissionError: listing"),
+    ("import", ERROR, "No module named 'glsandbox'"),
+    ("spawn", ERROR, "may not start processes"),
+    ("memory", ERROR, "MemoryError"),
+    ("parent", ERROR, "PermissionError: reading /proc/"),
+    ("network", ERROR, "Error"),
+    ("exit", CRASHED, "exit code 3"),
+    ("loop", TIMEOUT, "no answer within 1 s"),
+    ("sleep", TIMEOUT, "no answer within 1 s"),
+])
+def test_each_hostile_call_is_its_own_outcome_and_the_next_call_still_answers(hostile, mode, status,
+                                                                              fragment) -> None:
+    answer = hostile.call([mode])
+    assert answer.status == status, answer
+    assert fragment in answer.error
+    assert hostile.call(["ok"]).value == 2.0
+
+
+def test_values_come_back_as_plain_data(hostile) -> None:
+    assert hostile.call(["numpy"]).value == 2.0
+    nan = hostile.call(["nan"])
+    assert nan.status == VALUE and nan.value != nan.value
+    assert hostile.call(["type"]).value == {"__type__": "str", "repr": ""}  # only its type's name comes back
+
+
+def test_the_kernel_refuses_reading_the_reference_even_past_python(hostile) -> None:
+    from glsandbox.grading.sandbox import landlock_abi
+
+    if landlock_abi() < 1:
+        pytest.skip("no Landlock in this kernel: the audit hook alone refuses the read")
+    answer = hostile.call(["ctypes"])
+    assert answer.status == VALUE and answer.value == -1  # open(2) failed: EACCES
+
+
+def test_no_glsandbox_folder_is_readable_and_site_packages_is_given_by_entries(tmp_path) -> None:
+    site = tmp_path / "site"
+    (site / "glsandbox").mkdir(parents=True)
+    (site / "numpy").mkdir()
+    (site / "other.py").write_text("")
+    roots = readable_roots([str(tmp_path)], [str(site / "glsandbox")])
+    assert sorted(roots) == sorted([str(site / "numpy"), str(site / "other.py")])
+
+
+def test_a_function_that_always_loops_is_given_up_after_the_restarts(tmp_path) -> None:
+    path = tmp_path / "loop.py"
+    path.write_text("def f(x):\n    while True:\n        pass\n")
+    with Isolated(path, "f", Limits(call_seconds=0.3, restarts=2)) as caller:
+        started = time.monotonic()
+        answers = [caller.call([i]) for i in range(6)]
+        assert time.monotonic() - started < 5.0
+    assert [a.status for a in answers] == [TIMEOUT] * 6
+    assert "not run" in answers[-1].error
+
+
+def _submission(tmp_path: Path, body: str) -> Path:
+    path = tmp_path / "mine.py"
+    path.write_text(body)
+    return path
+
+
+@pytest.mark.parametrize(("body", "status"), [
+    ("def intersect_sphere(o, d, c, r):\n    while True:\n        pass\n", TIMEOUT_STATUS),
+    ("def intersect_sphere(o, d, c, r):\n    raise ValueError('no')\n", BROKEN),
+    ("def intersect_sphere(o, d, c, r):\n    return float('nan')\n", FAIL),
+    ("def intersect_sphere(o, d, c, r):\n    return 'hit'\n", FAIL),
+    ("def intersect_sphere(o, d, c, r):\n    print('.' * 3_000_000)\n    return 35.0\n", BROKEN),
+    ("import time\ndef intersect_sphere(o, d, c, r):\n    time.sleep(30)\n", TIMEOUT_STATUS),
+    ("import os\ndef intersect_sphere(o, d, c, r):\n    os._exit(1)\n", BROKEN),
+])
+def test_hostile_submissions_get_the_right_outcome_per_case(tmp_path, body, status) -> None:
+    result = check_file(get("ray_sphere"), _submission(tmp_path, body), probe=False,
+                        limits=Limits(call_seconds=0.5, restarts=2))
+    assert result.cases[0].status == status
+    assert not result.visible_passed
+    json.dumps(result.to_dict())
+
+
+def test_a_submission_that_hunts_for_the_reference_does_not_pass(tmp_path) -> None:
+    body = f'''
+import importlib, os, sys
+def intersect_sphere(origin, direction, center, radius):
+    for name in ("glsandbox.raytrace.sphere", "glsandbox.exercises.catalogue.ray_sphere"):
+        try:
+            module = importlib.import_module(name)
+            return module.Sphere(center, radius).intersect(module.Ray(origin, direction))
+        except Exception:
+            pass
+    sys.path.append({str(PACKAGE.parent)!r})
+    for root, dirs, files in os.walk({str(PACKAGE)!r}):
+        if "sphere.py" in files:
+            return 35.0
+    for module in list(sys.modules.values()):
+        if "glsandbox" in getattr(module, "__name__", ""):
+            return 35.0
+    return None
+'''
+    result = check_file(get("ray_sphere"), _submission(tmp_path, body), probe=False)
+    assert [c.status for c in result.cases] == [FAIL] * len(result.cases)
+
+
+def test_a_correct_submission_passes_in_isolation(tmp_path) -> None:
+    body = '''
+import math
+def intersect_sphere(origin, direction, center, radius):
+    a = sum(d * d for d in direction)
+    l = [o - c for o, c in zip(origin, center)]
+    b = sum(x * d for x, d in zip(l, direction))
+    c = sum(x * x for x in l) - radius * radius
+    disc = b * b - a * c
+    if disc < 0:
+        return None
+    for t in sorted(((-b - math.sqrt(disc)) / a, (-b + math.sqrt(disc)) / a)):
+        if t > 0:
+            return t
+    return None
+'''
+    result = check_file(get("ray_sphere"), _submission(tmp_path, body), hidden=True, probe_size=64)
+    assert all(c.status == PASS for c in result.cases), [c for c in result.cases if c.status != PASS]
+    assert result.probe.agrees
