@@ -18,12 +18,17 @@ def floats(data: bytes) -> list[float]:
     return list(struct.unpack(f"{len(data) // 4}f", data))
 
 
-def test_the_eye_is_the_inverse_views_translation() -> None:
+def test_the_eye_is_the_inverse_views_translation_and_the_pass_is_relative_to_its_origin() -> None:
     view = transforms.look_at((1.0, 3.0, 10.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0))
     np.testing.assert_allclose(eye_position(view), (1.0, 3.0, 10.0), atol=1e-12)
-    camera = PassCamera(view, transforms.perspective(45.0, 4 / 3, 0.1, 100.0))
-    assert floats(camera.eye_bytes) == pytest.approx([1.0, 3.0, 10.0], abs=1e-5)
-    assert camera.view_bytes == transforms.gl_bytes(view)  # float32, column-major
+    proj = transforms.perspective(45.0, 4 / 3, 0.1, 100.0)
+    camera = PassCamera(view, proj)  # relative to the eye: the eye sits at 0, the view only rotates
+    assert floats(camera.eye_bytes) == pytest.approx([0.0, 0.0, 0.0], abs=1e-5)
+    moved = np.asarray(view) @ transforms.translate(1.0, 3.0, 10.0)
+    np.testing.assert_allclose(moved[:3, 3], 0.0, atol=1e-12)
+    np.testing.assert_allclose(floats(camera.view_bytes), floats(transforms.gl_bytes(moved)), atol=1e-6)  # column-major
+    light = PassCamera(view, proj, origin=np.array([0.0, 10.0, 0.0]))  # a shadow map's pass: from the light
+    assert floats(light.eye_bytes) == pytest.approx([1.0, -7.0, 10.0], abs=1e-5)
 
 
 def test_a_materials_constants_are_its_colour_the_formulas_coefficients_the_cutoff_and_texture_unit() -> None:
