@@ -282,7 +282,8 @@ class RawTransformOrder:
         self.trail = ctx.vertex_array(self.solid, [(self.trail_buffer, "3f", "in_position")])
         self.quad = ctx.vertex_array(self.image, [])
         camera = lesson.CAMERA
-        self.view = gl(look_at(camera.eye, camera.target, camera.up))
+        self.eye = camera.eye
+        self.view = gl(eye_relative(look_at(camera.eye, camera.target, camera.up), self.eye))  # camera-relative (RawPhong)
         self.proj = gl(perspective(camera.fov_y, size[0] / size[1], camera.near, camera.far))
         self.ts = translate(*lesson.OFFSET) @ scale(*lesson.SCALE)  # S, then T
         self.corner = (self.ts @ (*lesson.TRAIL_POINT, 1.0))[:3]  # the trail's point after S and T
@@ -361,10 +362,10 @@ class RawTransformOrder:
         colored["m_view"].write(self.view)
         colored["m_proj"].write(self.proj)
         for model in (rotate_y(-self.spin * t), second):
-            colored["m_model"].write(gl(model))
+            colored["m_model"].write(gl(from_eye(model, self.eye)))
             self.cube.render(moderngl.TRIANGLES)
         ctx.disable(moderngl.CULL_FACE)
-        solid["m_model"].write(gl(np.eye(4)))
+        solid["m_model"].write(gl(from_eye(np.eye(4), self.eye)))
         solid["m_view"].write(self.view)
         solid["m_proj"].write(self.proj)
         solid["u_color"].value = self.trail_color

@@ -703,6 +703,9 @@ def _check_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--one", action="store_true",
                    help="LESSON_OR_DIR is one student's folder (its lesson and helper files; Gradescope's "
                         "/autograder/submission), not a folder of students")
+    p.add_argument("--shard", default=None, metavar="K/N",
+                   help="grade only share K of N (by a stable hash of each submission's name; the same on every "
+                        "machine); merge the shards' --json with: glsandbox check merge REPORTS...")
     p.add_argument("--jobs", type=int, default=None, metavar="N",
                    help="submissions graded at once (default: the CPUs this process may use, by its "
                         "cgroup's quota and affinity)")
