@@ -91,3 +91,7 @@ def test_start_then_check_from_the_command_line(gl, tmp_path: Path) -> None:
     run = run_cli("exercise", "check", "mirror_states", "wrong.py", cwd=tmp_path)
     assert run.returncode == 1 and "hint: stencil_always:" in run.stdout
     assert "reflection outside the mirror" in run.stdout
+
+
+def test_check_of_a_missing_file_is_one_error_line(tmp_path: Path) -> None:
+    assert_user_error(run_cli("exercise", "check", "mirror_states", "nowhere.py", cwd=tmp_path), "nowhere.py")

@@ -204,10 +204,11 @@ def parse_tables(source: str, filename: str) -> StateTables:
 
 def load_tables(path: Path) -> StateTables:
     """:func:`parse_tables` of the file at ``path`` (one ``error:`` line when it cannot be read)."""
+    from glsandbox.files import read_user_file
+
+    data = read_user_file(path, "state tables", "a Python file of the tables")
     try:
-        source = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise SandboxError(f"{path}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SandboxError(f"{path}: cannot be read ({exc})") from None
+        source = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise SandboxError(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
     return parse_tables(source, str(path))
