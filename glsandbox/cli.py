@@ -422,8 +422,8 @@ def _shard_filter(text: str | None, one: bool) -> Callable[[str], bool]:
     return lambda name: in_shard(name, shard)
 
 
-def cmd_check_merge(argv: list[str]) -> int:
-    """``glsandbox check merge REPORTS...``: the shards' JSON reports as the whole class's reports."""
+def check_merge_parser() -> ArgumentParser:
+    """The parser of ``glsandbox check merge``, a verb of its own (:func:`main` sends it here before the others)."""
     parser = ArgumentParser(prog="glsandbox check merge",
                             description="Merge the JSON reports of check DIR --shard K/N into the whole class's "
                                         "reports, as one run would have written them.",
@@ -439,7 +439,14 @@ def cmd_check_merge(argv: list[str]) -> int:
     for kind in REPORTS:
         parser.add_argument(f"--{kind.replace('_', '-')}", dest=kind, type=Path, default=None, metavar="FILE",
                             help=f"write the {kind.replace('_', ' ')} report")
-    args = parser.parse_args(argv)
+    return parser
+
+
+def cmd_check_merge(argv: list[str]) -> int:
+    """``glsandbox check merge REPORTS...``: the shards' JSON reports as the whole class's reports."""
+    from glsandbox.grading.reports import REPORTS
+
+    args = check_merge_parser().parse_args(argv)
 
     def body() -> int:
         from glsandbox.grading.check import summary_table
