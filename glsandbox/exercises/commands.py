@@ -1,7 +1,7 @@
 """``glsandbox exercise list | start | check``: the command line's bodies.
 
-Exit codes of ``check``: 0 when every visible case passes, 1 otherwise, 2
-for bad input (no such exercise, a file that is not the exercise's function:
+Exit codes of ``check``: 0 when every visible case passes (a state exercise:
+when its leak map is empty), 1 otherwise, 2 for bad input (no such exercise, a file that is not the exercise's function:
 one ``error:`` line naming the file and line).
 """
 
@@ -37,36 +37,57 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def cmd_exercise(args: argparse.Namespace) -> int:
+    from glsandbox.exercises.states import STATE_EXERCISES
+
     if args.action == "list":
         return _list()
     if args.action == "start":
         return _start(args.name, args.out)
+    if args.name in STATE_EXERCISES:
+        from glsandbox.exercises.states.command import check_states
+
+        return check_states(args)
     return _check(args)
 
 
 def _list() -> int:
-    exercises = all_exercises()
-    name_w = max(len(e.name) for e in exercises)
-    section_w = max(len(e.section) for e in exercises)
-    for e in exercises:
-        print(f"{e.name:<{name_w}}  {e.section:<{section_w}}  {e.signature}")
+    from glsandbox.exercises.states import STATE_EXERCISES
+
+    lines = [(e.name, e.section, e.signature) for e in all_exercises()]
+    lines += [(e.name, e.section, e.holds) for e in STATE_EXERCISES.values()]
+    name_w = max(len(n) for n, _, _ in lines)
+    section_w = max(len(s) for _, s, _ in lines)
+    for name, section, what in lines:
+        print(f"{name:<{name_w}}  {section:<{section_w}}  {what}")
     return 0
 
 
 def _start(name: str, out: Path | None) -> int:
     from glsandbox.exercises.starter import starter
+    from glsandbox.exercises.states import STATE_EXERCISES
 
-    exercise = get(name)
-    path = out or Path(f"{exercise.name}.py")
+    exercise = get(name) if name not in STATE_EXERCISES else None
+    path = out or Path(f"{name}.py")
+    _check_out(path)
+    if exercise is None:
+        from glsandbox.exercises.states.mirror import starter as state_starter
+
+        write_text(path, state_starter())
+        print(f"wrote {path}: fill in its tables, then: glsandbox exercise check {name} {path}")
+        return 0
+    write_text(path, starter(exercise))
+    print(f"wrote {path}: write {exercise.signature} in it, then: glsandbox exercise check {exercise.name} {path}")
+    return 0
+
+
+def _check_out(path: Path) -> None:
+    """A starter's file: a new .py file in a folder that exists."""
     if path.exists():
         raise SandboxError(f"{path}: already exists; not overwritten (remove it, or name another with --out)")
     if path.suffix != ".py":
         raise SandboxError(f"--out {path}: the starter is a Python file, name it .py")
     if not (path.parent if str(path.parent) else Path(".")).is_dir():
         raise SandboxError(f"--out {path}: folder {path.parent} does not exist")
-    write_text(path, starter(exercise))
-    print(f"wrote {path}: write {exercise.signature} in it, then: glsandbox exercise check {exercise.name} {path}")
-    return 0
 
 
 def _check(args: argparse.Namespace) -> int:

@@ -51,8 +51,16 @@ class NodeDrawer(Protocol):
 
 # --- stencil state ---------------------------------------------------------------
 
-_STENCIL_TESTS = {"always": rawgl.GL_ALWAYS, "equal": rawgl.GL_EQUAL}
-_STENCIL_OPS = {"keep": rawgl.GL_KEEP, "replace": rawgl.GL_REPLACE, "invert": rawgl.GL_INVERT}
+_STENCIL_TESTS = {"always": rawgl.GL_ALWAYS, "equal": rawgl.GL_EQUAL, "not_equal": rawgl.GL_NOTEQUAL,
+                  "never": rawgl.GL_NEVER}
+_STENCIL_OPS = {"keep": rawgl.GL_KEEP, "replace": rawgl.GL_REPLACE, "invert": rawgl.GL_INVERT,
+                "incr": rawgl.GL_INCR, "zero": rawgl.GL_ZERO}
+#: A pass's ``blend`` factor names (:attr:`glsandbox.plan.Pass.blend`) as moderngl's.
+BLEND_FACTORS = {"zero": moderngl.ZERO, "one": moderngl.ONE, "src_alpha": moderngl.SRC_ALPHA,
+                 "one_minus_src_alpha": moderngl.ONE_MINUS_SRC_ALPHA, "dst_alpha": moderngl.DST_ALPHA,
+                 "one_minus_dst_alpha": moderngl.ONE_MINUS_DST_ALPHA, "src_color": moderngl.SRC_COLOR,
+                 "one_minus_src_color": moderngl.ONE_MINUS_SRC_COLOR, "dst_color": moderngl.DST_COLOR,
+                 "one_minus_dst_color": moderngl.ONE_MINUS_DST_COLOR}
 
 
 def set_stencil(raw: rawgl.RawGL, stencil: StencilState) -> None:
@@ -102,7 +110,7 @@ def mark_mirror(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any) 
     raw, nodes, models = drawer.raw, frame.nodes, frame.models
     set_stencil(raw, step.stencil)
     raw.glColorMask(0, 0, 0, 0)
-    raw.glDepthMask(0)
+    raw.glDepthMask(1 if step.depth_write else 0)  # (a state table may write it: the reflection is then hidden)
     for draw in step.draws:
         drawer.draw_node(nodes[draw.node], draw, camera, model=models.get(draw.node))
 
@@ -151,12 +159,14 @@ def reflection(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any) -
     assert scene.mirror is not None
     if step.stencil is not None:  # read only: write mask 0
         set_stencil(drawer.raw, step.stencil)
+    if step.depth_write is False:
+        drawer.raw.glDepthMask(0)
     reflection = scene.mirror.matrix()
     lights = _mirrored_lights(frame.lights, scene.mirror)
     for draw in step.draws:
         node = nodes[draw.node]
         drawer.draw_node(node, draw, camera, model=_times(reflection, models.get(draw.node, node.model)),
-                         front_face="cw", lights=lights)
+                         front_face=step.front_face or "cw", lights=lights)
 
 
 def mirror_surface(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any) -> None:
@@ -193,9 +203,10 @@ def planar_shadow(drawer: NodeDrawer, frame: FrameState, step: Pass, camera: Any
     raw, ctx = drawer.raw, drawer.ctx
     if step.stencil is not None:
         set_stencil(raw, step.stencil)
-    raw.glDepthMask(0)
+    raw.glDepthMask(1 if step.depth_write else 0)
     ctx.enable(moderngl.BLEND)
-    ctx.blend_func = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA)
+    source, destination = step.blend or ("src_alpha", "one_minus_src_alpha")
+    ctx.blend_func = (BLEND_FACTORS[source], BLEND_FACTORS[destination])
     if shadow.polygon_offset:
         sign = 1.0 if scene.depth_mode == "reverse_z" else -1.0
         ctx.polygon_offset = (sign, sign)

@@ -57,10 +57,10 @@ class Draw:
 
 
 #: Stencil comparisons a pass may use (``glStencilFunc``).
-STENCIL_TESTS = ("always", "equal")
+STENCIL_TESTS = ("always", "equal", "not_equal", "never")
 #: What a fragment that passes the stencil and depth tests does to the
 #: written bits (``glStencilOp``'s third operation).
-STENCIL_OPS = ("keep", "replace", "invert")
+STENCIL_OPS = ("keep", "replace", "invert", "incr", "zero")
 
 
 @dataclass(frozen=True)
@@ -104,6 +104,8 @@ class StencilState:
             clear_before = (self.test == "equal" and self.write_mask != 0
                             and self.write_mask & self.mask == self.write_mask and self.ref & self.write_mask == 0)
             update = "set it" if clear_before else f"invert bits {self.write_mask}"
+        elif self.on_pass in ("incr", "zero"):
+            update = f"{self.on_pass} bits {self.write_mask}"
         else:
             update = "keep"
         return f"{test}, {update}"
@@ -137,6 +139,14 @@ class Pass:
     detail: str = ""
     target: str = "frame"
     camera: str | None = "viewport"
+    #: The planar passes' rasterizer and blend state where a state table gives them
+    #: (:mod:`glsandbox.exercises.states`); None: the pass kind's own (no depth writes
+    #: for ``mark_mirror`` and ``planar_shadow``, clockwise front faces for ``reflection``,
+    #: source-alpha blending for ``planar_shadow``). ``blend`` is (source, destination)
+    #: factor names of :data:`glsandbox.gl.planar.BLEND_FACTORS`.
+    depth_write: bool | None = None
+    front_face: str | None = None
+    blend: tuple[str, str] | None = None
 
     def describe(self) -> str:
         from glsandbox.passes import describer  # the registry, which finds each kind's module by its name

@@ -8,6 +8,7 @@ import pytest
 from support import assert_user_error, run_cli
 
 from glsandbox.exercises import all_exercises
+from glsandbox.exercises.states import STATE_EXERCISES
 
 SPHERE = '''
 import math
@@ -30,10 +31,12 @@ def test_list_gives_a_line_per_exercise_with_its_section_and_signature() -> None
     run = run_cli("exercise", "list")
     assert run.returncode == 0
     lines = run.stdout.strip().splitlines()
-    assert len(lines) == len(all_exercises())
-    for line, exercise in zip(lines, all_exercises(), strict=True):
+    assert len(lines) == len(all_exercises()) + len(STATE_EXERCISES)
+    for line, exercise in zip(lines, all_exercises(), strict=False):
         assert line.split()[0] == exercise.name
         assert exercise.section in line and line.endswith(exercise.signature)
+    for line, state in zip(lines[len(all_exercises()):], STATE_EXERCISES.values(), strict=True):
+        assert line.split()[0] == state.name and state.section in line and line.endswith(state.holds)
 
 
 def test_start_writes_a_starter_that_fails_and_refuses_to_overwrite_it(tmp_path: Path) -> None:

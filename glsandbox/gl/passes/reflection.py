@@ -1,5 +1,6 @@
 """The ``reflection`` pass's runner (:func:`glsandbox.gl.planar.reflection`): it sets the
-stencil where it has a stencil state, and leaves it so."""
+stencil where it has a stencil state, and leaves it so (and the depth mask, where it turns
+depth writes off)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,9 @@ from glsandbox.passes.base import Pass
 
 
 def habits(step: Pass) -> tuple[frozenset[str], frozenset[str]]:
-    return stencil_set(step), stencil_set(step)
+    # A state table without depth writes in this pass turns them off: the masks are restored after.
+    parts = stencil_set(step) | ({"masks"} if step.depth_write is False else frozenset())
+    return parts, parts
 
 
 RUNNER = Runner("reflection", reflection, habits, moved=True)
