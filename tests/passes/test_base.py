@@ -35,7 +35,7 @@ def test_the_mirror_and_shadow_stencil_states_read_as_the_course_names_them() ->
 
 @pytest.mark.parametrize(("state", "message"), [
     (dict(test="less", ref=0), "unknown stencil test 'less'"),
-    (dict(test="equal", ref=0, on_pass="zero"), "unknown stencil operation 'zero'"),
+    (dict(test="equal", ref=0, on_pass="decr_wrap"), "unknown stencil operation 'decr_wrap'"),
     (dict(test="equal", ref=256), "stencil ref must lie in 0..255"),
     (dict(test="equal", ref=0, write_mask=-1), "stencil write_mask must lie in 0..255"),
 ])
