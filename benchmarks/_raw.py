@@ -73,6 +73,17 @@ def translate(x: float, y: float, z: float) -> np.ndarray:
     return m
 
 
+def eye_relative(view: np.ndarray, eye) -> np.ndarray:
+    """``view @ T(eye)``: the view for positions relative to the eye (glsandbox's camera-relative
+    raster, docs/numerics.md); models go with :func:`from_eye`."""
+    return view @ translate(*eye)
+
+
+def from_eye(model: np.ndarray, eye) -> np.ndarray:
+    """``T(-eye) @ model`` in float64: the model matrix relative to the eye."""
+    return translate(*(-np.asarray(eye, dtype=np.float64))) @ model
+
+
 def scale(x: float, y: float, z: float) -> np.ndarray:
     return np.diag([x, y, z, 1.0])
 

@@ -25,7 +25,7 @@ import math
 import moderngl
 import numpy as np
 
-from _raw import (COLOR_MASK, clear, GL_ALWAYS, GL_EQUAL, GL_INVERT, GL_KEEP, GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE,
+from _raw import (COLOR_MASK, clear, eye_relative, from_eye, GL_ALWAYS, GL_EQUAL, GL_INVERT, GL_KEEP, GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE,
                   GL_REPLACE, GL_STENCIL_BUFFER_BIT, GL_STENCIL_TEST, GL_ZERO_TO_ONE, VERTEX_COLOR_FS, VERTEX_COLOR_VS,
                   depth_stencil_framebuffer, framebuffer, gl, gl_calls, look_at, perspective, read, reverse_z, rotate_x,
                   rotate_y, rotate_z, scale, translate)
@@ -171,14 +171,18 @@ class RawPhong:
         self.sphere = _vao(ctx, self.lit, geometry.sphere(), with_normals=True)
         self.cube = _vao(ctx, self.solid, geometry.cube())
         self.eye = (0.0, 2.5, 8.0)
-        self.view, self.proj = look_at(self.eye, (0, 0, 0)), perspective(45.0, size[0] / size[1], 0.01, 100.0)
+        # Camera-relative, as glsandbox draws: the view without its translation, models and
+        # lights relative to the eye (formed in float64), the eye at 0.
+        self.view = eye_relative(look_at(self.eye, (0, 0, 0)), self.eye)
+        self.proj = perspective(45.0, size[0] / size[1], 0.01, 100.0)
         self.models = [translate(0, -1.2, 0), rotate_y(math.radians(30)) @ scale(1.8, 0.7, 0.9)]
         self.colors = [(0.6, 0.6, 0.6, 1.0), (1.0, 0.25, 0.2, 1.0)]
 
     def frame(self, k: int) -> np.ndarray:
         t = 0.01 * k
         angles = (math.pi / 3 + 0.8 * t, math.pi - math.pi / 3 - 0.8 * t)
-        lights = np.array([(3.0 * math.cos(a), 1.5, 3.0 * math.sin(a)) for a in angles], "f4")
+        lights = np.array([(3.0 * math.cos(a), 1.5, 3.0 * math.sin(a)) for a in angles])
+        relative = (lights - self.eye).astype("f4")
         light_colors = np.array([(1, 1, 1), (1, 1, 0)], "f4")
         ctx, lit, solid = self.ctx, self.lit, self.solid
         self.fbo.use()
@@ -186,18 +190,18 @@ class RawPhong:
         ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
         lit["m_view"].write(gl(self.view))
         lit["m_proj"].write(gl(self.proj))
-        lit["u_eye"].value = self.eye
-        lit["u_light_pos"].write(lights.tobytes())
+        lit["u_eye"].value = (0.0, 0.0, 0.0)
+        lit["u_light_pos"].write(relative.tobytes())
         lit["u_light_color"].write(light_colors.tobytes())
         for vao, model, color in zip((self.ground, self.sphere), self.models, self.colors):
-            lit["m_model"].write(gl(model))
+            lit["m_model"].write(gl(from_eye(model, self.eye)))
             lit["m_normal"].write(np.linalg.inv(model[:3, :3]).astype("f4").tobytes())  # (M^-1)^T, column-major
             lit["u_color"].value = color
             vao.render(moderngl.TRIANGLES)
         solid["m_view"].write(gl(self.view))
         solid["m_proj"].write(gl(self.proj))
         for position, color in zip(lights, light_colors):
-            solid["m_model"].write(gl(translate(*position) @ scale(0.15, 0.15, 0.15)))
+            solid["m_model"].write(gl(from_eye(translate(*position) @ scale(0.15, 0.15, 0.15), self.eye)))
             solid["u_color"].value = (*color, 1.0)
             self.cube.render(moderngl.TRIANGLES)
         ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
@@ -225,7 +229,8 @@ class RawTexture:
                 texture.write(np.ascontiguousarray(image).tobytes(), level=level)
             texture.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
             self.textures.append(texture)
-        self.view = look_at((0.0, 1.9, 5.5), (0.0, -0.3, 0.0))
+        self.eye = (0.0, 1.9, 5.5)
+        self.view = eye_relative(look_at(self.eye, (0.0, -0.3, 0.0)), self.eye)  # camera-relative (RawPhong)
         self.proj = perspective(45.0, size[0] / size[1], 0.01, 100.0)
 
     def frame(self, k: int) -> np.ndarray:
@@ -240,7 +245,7 @@ class RawTexture:
         p["u_texture"].value = 0
         models = (translate(0.0, -1.0, 0.0), rotate_y(math.radians(30) + 0.5 * t))
         for vao, model, texture in zip((self.ground, self.cube), models, self.textures):
-            p["m_model"].write(gl(model))
+            p["m_model"].write(gl(from_eye(model, self.eye)))
             texture.use(0)
             vao.render(moderngl.TRIANGLES)
         ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)

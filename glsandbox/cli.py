@@ -505,7 +505,7 @@ def cmd_tradeoffs(args: argparse.Namespace) -> int:
     """``glsandbox tradeoffs``: accuracy knobs, timed and compared with a reference (:mod:`glsandbox.measure.tradeoffs`)."""
     from glsandbox.measure.tradeoffs import run
 
-    run(args.out, quick=args.quick, backend=args.backend, runs=args.runs, only=args.knob)
+    run(args.out, quick=args.quick, backend=args.backend, runs=args.runs, only=args.knob, passes=args.passes)
     print(f"wrote {args.out / 'report.md'}, {args.out / 'tradeoffs.csv'}, {args.out / 'tradeoffs.png'}")
     return 0
 
@@ -698,7 +698,9 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         p = add_command(sub, "tradeoffs")
         p.add_argument("--out", type=Path, default=Path("out/tradeoffs"), help="output folder (default out/tradeoffs)")
         p.add_argument("--quick", action="store_true", help="a reduced set at a small size (for CI)")
-        p.add_argument("--runs", type=int, default=5, help="timed runs per setting (at least 5, default 5)")
+        p.add_argument("--runs", type=int, default=5, help="timed rounds per pass (at least 5, default 5)")
+        p.add_argument("--passes", type=int, default=2,
+                       help="independent passes of the rounds, whose medians give each time's spread (at least 2)")
         p.add_argument("--knob", action="append", default=[], metavar="NAME", help="only this knob (repeatable)")
         p.add_argument("--backend", default=None, help="GL backend (default: GLSANDBOX_BACKEND or auto)")
         p.set_defaults(func=cmd_tradeoffs)

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from glsandbox.errors import SandboxError, plain
+from glsandbox.errors import NUMBER_LIMIT, SandboxError, plain
 from glsandbox.meshnormals import face_normals
 from glsandbox.transforms import from_directx_mesh
 
@@ -104,7 +104,8 @@ _PER_PRIMITIVE = {"triangles": 3, "lines": 2}
 def check_mesh_arrays(mesh: Mesh) -> None:
     """Refuse a mesh the renderers would draw torn or fail on, with one line naming the array and value.
 
-    Per-vertex arrays are (N, columns) finite numbers, one row per position;
+    Per-vertex arrays are (N, columns) finite numbers, one row per position,
+    positions within +-NUMBER_LIMIT as a model matrix's entries are;
     an index names a vertex that exists (``0 <= i < N``: the rasterizer would
     read past the vertex buffer and draw a torn picture, the ray tracers
     raise); a list topology gets whole primitives. Checked once, where the
@@ -129,6 +130,13 @@ def check_mesh_arrays(mesh: Mesh) -> None:
         if array.dtype.kind == "f" and not np.isfinite(array).all():
             row = int(np.argwhere(~np.isfinite(array))[0][0])
             raise SandboxError(f"mesh {mesh.name!r}: {field_name}[{row}] is not finite: {plain(array[row])}")
+        if field_name == "positions" and len(array) and np.abs(array).max() > NUMBER_LIMIT:
+            # The bound of a model matrix's entries: float32 (the GPU's) keeps 24 bits, so a
+            # vertex at 1e8 is rounded to 8 units, and its triangle is drawn torn (docs/numerics.md).
+            row = int(np.argmax(np.abs(array).max(axis=1)))
+            raise SandboxError(f"mesh {mesh.name!r}: positions[{row}] = {plain(array[row])} is beyond "
+                               f"+-{NUMBER_LIMIT:g}; keep vertices within +-{NUMBER_LIMIT:g} and place "
+                               "the mesh with its node's model matrix")
         if array is not value:
             object.__setattr__(mesh, field_name, array)  # a frozen dataclass keeping its own array
     if mesh.indices is not None:

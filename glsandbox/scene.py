@@ -139,21 +139,24 @@ class ShadowMap:
     nearest caster seen from the light, ``size`` x ``size`` texels, which a
     lit receiver compares its own distance with.
 
-    ``bias`` (world units) and ``slope_bias`` (world units per unit of
-    ``tan`` of the angle between the surface normal and the light) move the
-    receiver's point towards the light before the comparison: too little and a
-    surface shadows itself in stripes (acne), too much and shadows come loose
-    from their casters (peter-panning). ``pcf`` is the width in texels of the
+    ``bias`` and ``slope_bias`` (per unit of ``tan`` of the angle between the
+    surface normal and the light) move the receiver's point towards the light
+    before the comparison, in *texels*: the map's texel width where the point
+    is (``2·tan(fov/2)·d / size`` at distance ``d`` from the light, the
+    frustum's own fov, :func:`glsandbox.shadowmap.light_frame`), so the same
+    settings hold for a scene of any size anywhere: too little and a surface
+    shadows itself in stripes (acne), too much and shadows come loose from
+    their casters (peter-panning). ``pcf`` is the width in texels of the
     percentage-closer filter (1: one comparison, hard aliased edges; 3: a 3x3
     grid of comparisons averaged). ``fov`` is the light frustum's field of view
-    in degrees: a point light gets one perspective frustum looking from it at
-    the centre of the shadow casters, not a cube map (what lies outside the
-    frustum is lit).
+    in degrees at most: a point light gets one perspective frustum looking from
+    it at the centre of the shadow casters, fitted to them and the receivers,
+    not a cube map (what lies outside the frustum is lit).
     """
 
     size: int = 1024
-    bias: float = 0.02
-    slope_bias: float = 0.02
+    bias: float = 2.5
+    slope_bias: float = 2.5
     pcf: int = 3
     fov: float = 90.0
 
@@ -320,18 +323,21 @@ class Material:
 #: program is compiled with ``NUM_LIGHTS`` (the scene's light count) and, for
 #: a textured material, ``TEXTURED`` defined. An attribute the mesh lacks is
 #: an error (normals excepted: a mesh without them gets face normals).
+#: "World" is camera-relative: the world translated so that the eye is at 0
+#: (formed in float64, so a scene far from the origin keeps its precision;
+#: docs/numerics.md). Directions and distances are the world's.
 SHADER_INPUTS: tuple[tuple[str, str, str, str], ...] = (
     ("in_position", "in vec3", "model", "vertex position"),
     ("in_normal", "in vec3", "model", "vertex normal (face normals if the mesh has none)"),
     ("in_uv", "in vec2", "texture", "texture coordinates (the mesh must have them)"),
     ("in_color", "in vec3", "-", "vertex colour (the mesh must have them)"),
-    ("m_model", "uniform mat4", "model -> world", "the node's model matrix"),
-    ("m_view", "uniform mat4", "world -> view", "the camera's view matrix"),
+    ("m_model", "uniform mat4", "model -> world", "the node's model matrix (world relative to the eye)"),
+    ("m_view", "uniform mat4", "world -> view", "the camera's view matrix (a rotation: the eye is at 0)"),
     ("m_proj", "uniform mat4", "view -> clip", "the projection"),
     ("m_normal", "uniform mat3", "model -> world", "normal matrix, inverse transpose of m_model's 3x3"),
     ("u_color", "uniform vec4", "-", "material colour (rgba, 0..1)"),
-    ("u_eye", "uniform vec3", "world", "camera position"),
-    ("u_light_pos", "uniform vec3[NUM_LIGHTS]", "world", "light positions (only if NUM_LIGHTS > 0)"),
+    ("u_eye", "uniform vec3", "world", "camera position (0: world is relative to the eye)"),
+    ("u_light_pos", "uniform vec3[NUM_LIGHTS]", "world", "light positions, relative to the eye (if NUM_LIGHTS > 0)"),
     ("u_light_color", "uniform vec3[NUM_LIGHTS]", "-", "light colours"),
     ("u_ambient", "uniform float", "-", "material coefficient (0.1)"),
     ("u_diffuse", "uniform float", "-", "material coefficient (0.4)"),

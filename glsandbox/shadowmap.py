@@ -12,14 +12,17 @@ above it) and a second pass.
 
 The light's camera here is one perspective frustum (a point light has no
 direction of its own): from the light towards the centre of the casters'
-bounds, :attr:`ShadowMap.fov` wide. A cube map (six frusta) would cover every
+bounds, fitted to the casters and receivers and at most :attr:`ShadowMap.fov`
+wide (:func:`light_frame`). A cube map (six frusta) would cover every
 direction; this covers what the lessons need, and a point outside the
 frustum is treated as lit. Pure numpy: no GL in here.
 """
 
 from __future__ import annotations
 
+import math
 import weakref
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -114,28 +117,79 @@ def _casters_and_receivers(scene: Scene) -> tuple[list[Node], list[Node]]:
     return [nodes[i] for i in kept[0]], [nodes[i] for i in kept[1]]
 
 
-def light_camera(scene: Scene, light: Light) -> tuple[np.ndarray, np.ndarray]:
-    """The shadow map's view and projection for ``light`` (which has a ShadowMap).
+@dataclass(frozen=True)
+class LightFrame:
+    """A shadow map's light camera: ``view`` and ``proj`` (float64), and ``tan_half``, the
+    tangent of half its field of view. One texel at distance ``d`` from the light is
+    ``2·tan_half·d / size`` wide: the footprint the biases are measured in."""
 
-    The view looks from the light at the centre of the casters' bounds. Near
-    and far enclose every caster and receiver corner in front of the light, so
-    the 24-bit map spends its precision on the scene and not on empty space.
+    view: np.ndarray
+    proj: np.ndarray
+    tan_half: float
+
+    def footprint(self, size: int) -> float:
+        """World width of one of ``size`` texels at unit distance from the light."""
+        return 2.0 * self.tan_half / size
+
+
+#: Room left around the fitted frustum (a share of its half-width): a percentage-closer
+#: filter reads a few texels beyond a corner exactly on its edge.
+FIT_MARGIN = 1.02
+
+
+def _extent(view: np.ndarray, points: np.ndarray) -> float:
+    """``max(|x|, |y|) / depth`` over ``points`` in the light's view (the tangent of the half
+    field of view that holds them); inf when one lies beside or behind the light."""
+    if not len(points):
+        return math.inf
+    local = transforms.transform_points(view, points)
+    depth = -local[:, 2]
+    if np.any(depth <= 0.0):
+        return math.inf
+    return float((np.abs(local[:, :2]).max(axis=1) / depth).max())
+
+
+def light_frame(scene: Scene, light: Light) -> LightFrame:
+    """The shadow map's camera for ``light`` (which has a ShadowMap), fitted to the scene.
+
+    The view looks from the light at the centre of the casters' bounds. The field of
+    view is the narrowest that holds every caster's bounds or every receiver's,
+    whichever is narrower, and at most :attr:`ShadowMap.fov`: only a point inside both
+    can be in shadow, and a frustum fitted to them spends every texel where shadows
+    can fall, at any scale (a scene a thousandth the size gets the same texels). Near
+    and far enclose every caster and receiver corner in front of the light, so the
+    map's depth precision is spent on the scene and not on empty space.
     """
     assert light.shadow is not None
     eye = np.asarray(light.position, dtype=np.float64)
     casting, receiving = _casters_and_receivers(scene)
-    cast = _world_corners(casting)
+    cast, received = _world_corners(casting), _world_corners(receiving)
     target = cast.mean(axis=0) if len(cast) else eye - np.array([0.0, 1.0, 0.0])
     forward = target - eye
-    if np.linalg.norm(forward) < 1e-9:
+    reach = max(float(np.abs(eye).max()), 1.0)
+    if np.linalg.norm(forward) <= 1e-12 * reach:
         forward = np.array([0.0, -1.0, 0.0])
         target = eye + forward
     forward = forward / np.linalg.norm(forward)
     # Any up not along the view works (the map's rotation about its axis does not matter).
     up = (0.0, 0.0, 1.0) if abs(forward[1]) > 0.9 else (0.0, 1.0, 0.0)
     view = transforms.look_at(tuple(eye), tuple(target), up)
-    points = np.concatenate([cast, _world_corners(receiving)])
+    widest = math.tan(math.radians(light.shadow.fov) / 2.0)
+    fitted = min(_extent(view, cast), _extent(view, received)) * FIT_MARGIN
+    if 0.0 < fitted < widest:
+        # Rounded up to a step of 1/8 octave: a caster that turns or moves a little keeps
+        # the same texel grid (no crawling edges frame to frame), at any scale.
+        fitted = 2.0 ** (math.ceil(8.0 * math.log2(fitted)) / 8.0)
+    tan_half = min(widest, fitted) if fitted > 0.0 else widest
+    points = np.concatenate([cast, received])
     depths = -(transforms.transform_points(view, points)[:, 2]) if len(points) else np.array([1.0])
-    far = max(float(depths.max()), 1e-3) * 1.01
+    far = max(float(depths.max()), 1e-9 * reach) * 1.01
     near = max(float(depths.min()) * 0.99, far * 1e-3)
-    return view, transforms.perspective(light.shadow.fov, 1.0, near, far)
+    fov = math.degrees(2.0 * math.atan(tan_half))
+    return LightFrame(view, transforms.perspective(fov, 1.0, near, far), tan_half)
+
+
+def light_camera(scene: Scene, light: Light) -> tuple[np.ndarray, np.ndarray]:
+    """The shadow map's view and projection for ``light`` (:func:`light_frame`)."""
+    frame = light_frame(scene, light)
+    return frame.view, frame.proj

@@ -15,11 +15,12 @@ alone, so ``glsandbox compare shadow_map --set show=map --vary
 renderer=raster,ray`` gives the difference against the exact answer.
 
 The knobs: ``size`` (texels per side: small maps give blocky edges),
-``bias`` and ``slope_bias`` (world units the receiver moves towards the
-light before comparing: at 0 the floor shadows itself in stripes, acne,
+``bias`` and ``slope_bias`` (how far the receiver moves towards the light
+before comparing, in texels of the map where it is, so the same values work
+for a scene of any size: at 0 the floor shadows itself in stripes, acne,
 because a texel's one depth cannot match every point it covers; too much
 and the shadow comes loose from the cube's foot, peter-panning: try
-``bias=0.4``), ``pcf`` (the width of the percentage-closer filter: 1 is
+``bias=50``), ``pcf`` (the width of the percentage-closer filter: 1 is
 one comparison per pixel, hard stairs; 3, 5, 7 average a grid).
 """
 
@@ -70,16 +71,16 @@ class ShadowMapLesson(Lesson):
     order = 75
     animated = True
     contrasts = (("each technique alone: planar (floor only), shadow map, ray-traced", "show=planar,map,ray"),
-                 ("acne, a sound bias, peter-panning", "bias=0,0.02,0.4"),
+                 ("acne, a sound bias, peter-panning", "bias=0,2.5,50"),
                  ("map size: blocky edges at 256, fine at 2048", "size=256,2048"))
     params = (
         Param("show", "all", "planar shadow, shadow map and ray-traced side by side, or one technique alone",
               choices=("all", *TECHNIQUES)),
         Param("size", "1024", "shadow map size in texels per side", choices=("256", "512", "1024", "2048")),
-        Param("bias", 0.02, "constant depth bias, world units towards the light (0: acne)", minimum=0.0,
-              maximum=2.0),
-        Param("slope_bias", 0.02, "bias per unit of tan(angle between normal and light)", minimum=0.0,
-              maximum=2.0),
+        Param("bias", 2.5, "constant depth bias, texels of the map towards the light (0: acne, 50: peter-panning)",
+              minimum=0.0, maximum=200.0),
+        Param("slope_bias", 2.5, "bias in texels per unit of tan(angle between normal and light)", minimum=0.0,
+              maximum=200.0),
         Param("pcf", "3", "percentage-closer filter width in texels (1: one comparison)",
               choices=("1", "3", "5", "7")),
         Param("speed", 0.5, "the cube's turn rate, radians per second"),

@@ -60,6 +60,7 @@ uniform int u_max_depth;    // reflection bounces (REFLECT: > 0)
 uniform int u_cull;         // -1: per node (as the rasterizer), 0: never, 1: always
 uniform bool u_aabb;
 uniform float u_offset;     // SIMPLE_OFFSET (the teaching variant): offset u_offset * max(1, max|P|), not the error bound
+uniform vec3 u_offset_origin;  // SIMPLE_OFFSET: the anchor, so |P| is the world position's, as in the numpy engine
 #if NUM_LIGHTS > 0
 uniform vec3 u_light_pos[NUM_LIGHTS];
 uniform vec3 u_light_color[NUM_LIGHTS];
@@ -624,7 +625,10 @@ float next_float(float x, float dir) {
 vec3 offset_point(Spawn s, vec3 n, vec3 towards) {
     vec3 offset;
 #if SIMPLE_OFFSET
-    offset = u_offset * max(1.0, max(max(abs(s.p.x), abs(s.p.y)), abs(s.p.z))) * s.ng;
+    // |P| of the world position (s.p is relative to the anchor): the knob means one
+    // thing in both engines, a share of where the point sits in the world.
+    vec3 world = s.p + u_offset_origin;
+    offset = u_offset * max(1.0, max(max(abs(world.x), abs(world.y)), abs(world.z))) * s.ng;
 #else
     offset = dot(abs(s.ng), s.err) * s.ng;
 #endif

@@ -63,8 +63,8 @@ class _DrawStep:
         # The constants a program held before this draw last time, and the entries it wrote then (a
         # kept plan draws in the same order every frame: the same ones again).
         self.change: tuple[tuple | None, tuple[tuple[str, bytes], ...]] = (None, ())
-        # The lights this draw was lit by last, and their uniform bytes.
-        self.lights: tuple[tuple[Light, ...] | None, bytes, bytes] = (None, b"", b"")
+        # The lights this draw was lit by last, their uniform bytes, and the pass camera they are relative to.
+        self.lights: tuple[tuple[Light, ...] | None, bytes, bytes, object] = (None, b"", b"", None)
 
 
 @dataclass(frozen=True)

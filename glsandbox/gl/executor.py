@@ -73,15 +73,16 @@ class Executor(GpuMeshes):
         self._overlays: OverlayDrawer | None = None  # made on the first overlay pass
         self._textures = TextureCache(host)
         self._lights: tuple[Light, ...] = ()  # the lights of the frame being drawn (draw_node's default)
-        # u_light_pos and u_light_color bytes by id of the lights tuple (the tuple kept to check): see _light_bytes.
-        self._lights_cache: dict[int, tuple[tuple[Light, ...], bytes, bytes]] = {}
+        # u_light_pos and u_light_color bytes by id of the lights tuple and the pass origin (the tuple kept
+        # to check): see _light_bytes.
+        self._lights_cache: dict[tuple[int, bytes], tuple[tuple[Light, ...], bytes, bytes]] = {}
         # The uniform bytes last written into each program (by program key): see _uniform_writer.
         self._written: dict[str, _Written] = {}
         self._culling: tuple[bool, str] | None = None  # what _set_culling set last (None: not known)
         self._bound_texture: object | None = None  # the material texture on unit 0 in this frame
         self.clear_depth = 1.0  # 0 with reverse-Z (glsandbox.gl.depth)
         self.pass_rect: tuple[int, int, int, int] | None = None  # the pass's viewport in pixels (see render)
-        self.shadow_maps = gl_shadowmap.ShadowMaps(self.ctx)  # the lights' depth textures
+        self.shadow_maps = gl_shadowmap.ShadowMaps(self.ctx, self.raw)  # the lights' depth textures
 
     # --- resources ----------------------------------------------------------
 
@@ -269,9 +270,10 @@ class Executor(GpuMeshes):
         return prepared
 
     @staticmethod
-    def pass_camera(view: np.ndarray, proj: np.ndarray) -> PassCamera:
-        """A pass's camera from its matrices (for runners that look through their own, a light's)."""
-        return PassCamera(view, proj)
+    def pass_camera(view: np.ndarray, proj: np.ndarray, origin: np.ndarray | None = None) -> PassCamera:
+        """A pass's camera from its matrices (for runners that look through their own, a light's),
+        its draws' positions relative to ``origin`` (None: the view's eye; see :class:`PassCamera`)."""
+        return PassCamera(view, proj, origin)
 
     def _viewport_camera(self, camera: Camera, rect: tuple[int, int, int, int], scene: Scene) -> PassCamera:
         """The pass camera of ``camera`` seen in ``rect``. A camera that does not change (a Camera
@@ -283,7 +285,7 @@ class Executor(GpuMeshes):
                 self._cameras.clear()
             aspect = rect[2] / rect[3] if rect[3] else 1.0
             kept = self._cameras[key] = (camera, PassCamera(camera.view(), gl_depth.projection_for(
-                scene, camera.projection(aspect))))
+                scene, camera.projection(aspect)), np.asarray(camera.eye, dtype=np.float64)))
         return kept[1]
 
     def _set_culling(self, cull: bool, front_face: str) -> None:
@@ -368,7 +370,7 @@ class Executor(GpuMeshes):
             written.pop(_CONSTANTS, None)  # a node's own values may have replaced a constant
         if self.primitive_ids:  # the X-ray's id target: which node this draw is
             uniforms["u_node_id"].write(struct.pack("I", self.node_ids.get(node.name, 0)))
-        self._bind_and_render(draw, material, setup)
+        self._bind_and_render(draw, material, setup, camera)
 
     def _prepared_draw(self, node: Node, draw: Draw, material: Material, front_face: str) -> _DrawStep:
         """The prepared draw of ``draw`` (:class:`_DrawStep`): the one kept for it while its
@@ -394,7 +396,7 @@ class Executor(GpuMeshes):
         if type(matrix) is not np.ndarray or matrix.dtype != _FLOAT64:
             matrix = np.asarray(matrix, dtype=np.float64)
         content = matrix.tobytes()
-        data = _MODEL_BYTES[content]
+        data = _MODEL_BYTES[content + camera.origin_bytes]
         if written["m_model"] != data:
             written["m_model"] = data
             uniforms["m_model"].write(data)
@@ -422,9 +424,10 @@ class Executor(GpuMeshes):
                 uniforms["u_eye"].write(data)
             written[_EYE] = camera
         if frame_lights:  # with none, the shader's arrays do not exist (NUM_LIGHTS 0)
-            if step.lights[0] is not frame_lights:  # (lights that do not move: the same tuple every frame)
-                step.lights = (frame_lights, *self._light_bytes(frame_lights))
-            _, light_pos, light_color = step.lights
+            if step.lights[0] is not frame_lights or step.lights[3] is not camera:
+                # (lights that do not move, seen from an eye that does not: the same bytes every frame)
+                step.lights = (frame_lights, *self._light_bytes(frame_lights, camera), camera)
+            _, light_pos, light_color, _ = step.lights
             if written["u_light_pos"] != light_pos:
                 written["u_light_pos"] = light_pos
                 uniforms["u_light_pos"].write(light_pos)
@@ -446,7 +449,7 @@ class Executor(GpuMeshes):
             uniforms[name].write(data)
         written[_CONSTANTS] = constants
 
-    def _bind_and_render(self, draw: Draw, material: Material, setup: _DrawSetup) -> None:
+    def _bind_and_render(self, draw: Draw, material: Material, setup: _DrawSetup, camera: PassCamera) -> None:
         """Bind the draw's textures (unit 0: the material's, unit 1: a shadow map) and draw its
         elements; a blended draw over what is drawn already, without depth writes."""
         texture = material.texture
@@ -454,7 +457,7 @@ class Executor(GpuMeshes):
             self._textures.bind(texture, 0)
             self._bound_texture = texture
         if draw.shadow_map is not None:  # unit 1: the light's shadow map (a depth texture, compared)
-            for name, data in self.shadow_maps.use(draw.shadow_map, SHADOW_MAP_UNIT):
+            for name, data in self.shadow_maps.use(draw.shadow_map, SHADOW_MAP_UNIT, camera.origin):
                 setup.write(name, data)
         vao, gpu = setup.vao, setup.gpu
         if draw.blend:  # over what is drawn already; hidden by it where nearer, but not hiding
@@ -536,17 +539,19 @@ class Executor(GpuMeshes):
 
         return write
 
-    def _light_bytes(self, lights: tuple[Light, ...]) -> tuple[bytes, bytes]:
-        """``u_light_pos`` and ``u_light_color`` bytes of ``lights``, made once per lights tuple: every
-        lit draw of a frame writes the same ones, and lights that do not move (the scene's, and
-        the mirror's reflected ones) keep them from frame to frame."""
-        cached = self._lights_cache.get(id(lights))
+    def _light_bytes(self, lights: tuple[Light, ...], camera: PassCamera) -> tuple[bytes, bytes]:
+        """``u_light_pos`` (relative to ``camera``'s origin, the difference taken in float64) and
+        ``u_light_color`` bytes of ``lights``, made once per lights tuple and origin: every lit
+        draw of a frame writes the same ones, and lights that do not move (the scene's, and the
+        mirror's reflected ones) seen from an eye that does not keep them from frame to frame."""
+        key = (id(lights), camera.origin_bytes)
+        cached = self._lights_cache.get(key)
         if cached is None or cached[0] is not lights:
-            if len(self._lights_cache) >= 8:  # lights that move make a tuple a frame
+            if len(self._lights_cache) >= 8:  # lights or an eye that move make an entry a frame
                 self._lights_cache.clear()
-            cached = self._lights_cache[id(lights)] = (
-                lights, np.array([l.position for l in lights], dtype="f4").tobytes(),
-                np.array([l.color for l in lights], dtype="f4").tobytes())
+            positions = np.array([l.position for l in lights], dtype=np.float64) - camera.origin
+            cached = self._lights_cache[key] = (
+                lights, positions.astype("f4").tobytes(), np.array([l.color for l in lights], dtype="f4").tobytes())
         return cached[1], cached[2]
 
     def unbind_texture(self) -> None:

@@ -111,7 +111,17 @@ _SIGNATURES: dict[str, tuple] = {
     "glClearBufferuiv": (_VOID, _UINT, _INT, ctypes.c_void_p),
     "glReadBuffer": (_VOID, _UINT),
     "glBlitFramebuffer": (_VOID, _INT, _INT, _INT, _INT, _INT, _INT, _INT, _INT, _UINT, _UINT),
+    "glBindTexture": (_VOID, _UINT, _UINT),
+    "glTexImage2D": (_VOID, _UINT, _INT, _INT, _INT, _INT, _INT, _UINT, _UINT, ctypes.c_void_p),
+    "glGetTexLevelParameteriv": (_VOID, _UINT, _INT, _UINT, ctypes.POINTER(_INT)),
+    "glGetError": (_UINT,),
 }
+GL_TEXTURE_2D = 0x0DE1
+GL_TEXTURE_BINDING_2D = 0x8069
+GL_DEPTH_COMPONENT = 0x1902
+GL_FLOAT = 0x1406
+GL_TEXTURE_DEPTH_SIZE = 0x884A
+GL_TEXTURE_DEPTH_TYPE = 0x8C16
 
 
 class RawGL:
@@ -139,6 +149,30 @@ class RawGL:
         value = _INT(0)
         self.glGetIntegerv(pname, ctypes.byref(value))
         return value.value
+
+    def float_depth_texture(self, texture: int, size: tuple[int, int]) -> bool:
+        """Give the 2D texture ``texture`` (moderngl's ``glo``) ``DEPTH_COMPONENT32F`` storage of
+        ``size``, in place of moderngl's 24-bit fixed point; False (its storage as it was) where
+        the context refuses. Restores the binding of the active texture unit."""
+        bound = self.get_integer(GL_TEXTURE_BINDING_2D)
+        while self.glGetError():  # errors left by others are not this call's
+            pass
+        self.glBindTexture(GL_TEXTURE_2D, texture)
+        self.glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT32F, size[0], size[1], 0, GL_DEPTH_COMPONENT,
+                          GL_FLOAT, None)
+        ok = self.glGetError() == 0
+        self.glBindTexture(GL_TEXTURE_2D, bound)
+        return ok
+
+    def texture_depth_bits(self, texture: int) -> tuple[int, bool]:
+        """``(bits, is_float)`` of the 2D depth texture ``texture``'s level 0."""
+        bound = self.get_integer(GL_TEXTURE_BINDING_2D)
+        self.glBindTexture(GL_TEXTURE_2D, texture)
+        bits, kind = _INT(0), _INT(0)
+        self.glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_DEPTH_SIZE, ctypes.byref(bits))
+        self.glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_DEPTH_TYPE, ctypes.byref(kind))
+        self.glBindTexture(GL_TEXTURE_2D, bound)
+        return bits.value, kind.value == GL_FLOAT
 
     def disable_dither(self) -> None:
         """Dithering is on by default in OpenGL; golden images want it off."""

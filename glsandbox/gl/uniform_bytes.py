@@ -16,20 +16,39 @@ from glsandbox.scene import Material
 class PassCamera:
     """A pass's view and projection, with what the draws need from them made
     once per pass instead of once per draw: the uniform bytes, and the eye
-    (only lit draws ask for it)."""
+    (only lit draws ask for it).
 
-    __slots__ = ("view", "proj", "view_bytes", "proj_bytes", "_eye_bytes")
+    Camera-relative: float32 keeps 24 bits, so a model matrix holding a
+    translation of 1e5 rounds it to 0.008 units, and the view's translation
+    undoes it in float32 again: a scene far from the origin shakes and its
+    decals z-fight (docs/numerics.md). So every product that holds a large
+    translation is formed in float64 on the CPU, relative to the pass's
+    ``origin`` (the eye; a shadow map's pass: the light): the shader's
+    ``m_model`` is ``T(-origin) @ model`` (:data:`_MODEL_BYTES`), its ``m_view``
+    ``view @ T(origin)`` (a rotation: no translation left to round), the eye
+    sits at 0 and the lights are relative to it. The shader's "world" is the
+    world moved so that the origin is at 0: lighting, depth and clip are the
+    same (a translation changes no direction or distance).
+    """
 
-    def __init__(self, view: np.ndarray, proj: np.ndarray) -> None:
+    __slots__ = ("view", "proj", "origin", "origin_bytes", "view_bytes", "proj_bytes", "_eye_bytes")
+
+    def __init__(self, view: np.ndarray, proj: np.ndarray, origin: np.ndarray | None = None) -> None:
         self.view, self.proj = view, proj
-        self.view_bytes, self.proj_bytes = transforms.gl_bytes(view), transforms.gl_bytes(proj)
+        view = np.asarray(view, dtype=np.float64)
+        self.origin = eye_position(view) if origin is None else np.asarray(origin, dtype=np.float64)
+        self.origin_bytes = self.origin.tobytes()
+        moved = view.copy()
+        moved[:, 3] += view[:, :3] @ self.origin  # view @ T(origin)
+        self.view_bytes, self.proj_bytes = transforms.gl_bytes(moved), transforms.gl_bytes(proj)
         self._eye_bytes: bytes | None = None
 
     @property
     def eye_bytes(self) -> bytes:
-        """``u_eye``'s uniform bytes: a camera that does not move inverts its view once per run."""
+        """``u_eye``'s uniform bytes: the eye relative to the origin (0 when the origin is the eye)."""
         if self._eye_bytes is None:
-            self._eye_bytes = _eye_bytes(np.asarray(self.view, dtype=np.float64).tobytes())
+            self._eye_bytes = (_eye(np.asarray(self.view, dtype=np.float64).tobytes()) - self.origin).astype(
+                "f4").tobytes()
         return self._eye_bytes
 
 
@@ -68,9 +87,9 @@ def _coefficient_bytes(ambient: float, diffuse: float, specular: float,
 
 
 @functools.lru_cache(maxsize=64)
-def _eye_bytes(view: bytes) -> bytes:
-    """The eye position's uniform bytes for a float64 view matrix given as bytes."""
-    return eye_position(np.frombuffer(view).reshape(4, 4)).astype("f4").tobytes()
+def _eye(view: bytes) -> np.ndarray:
+    """The eye position (float64) of a float64 view matrix given as bytes."""
+    return eye_position(np.frombuffer(view).reshape(4, 4))
 
 
 #: Entries each of :data:`_MODEL_BYTES` and :data:`_NORMAL_BYTES` keeps; past it, it starts
@@ -94,10 +113,30 @@ class _MatrixBytes(dict):
         return data
 
 
-#: ``m_model``'s and ``m_normal``'s uniform bytes by the float64 model matrix's bytes (see
-#: :meth:`Executor.draw_node`): a node that does not move converts its matrix, and inverts it,
-#: once; an array changed in place between frames has other bytes, so it is converted again.
-_MODEL_BYTES = _MatrixBytes(transforms.gl_bytes)
+def _relative_model_bytes(key: bytes) -> bytes:
+    """``m_model``'s bytes for ``key``: a float64 model matrix's 128 bytes, then the pass origin's
+    24 (:class:`PassCamera`): ``T(-origin) @ model`` formed in float64, rounded to float32 once."""
+    matrix = np.frombuffer(key[:128]).reshape(4, 4)
+    relative = matrix - np.outer(np.append(np.frombuffer(key[128:]), 0.0), matrix[3])  # row i − o_i·row 3
+    return transforms.gl_bytes(relative)
+
+
+class _RelativeBytes(dict):
+    """:func:`_relative_model_bytes` by key, each made on its first lookup (a plain subscript)."""
+
+    def __missing__(self, key: bytes) -> bytes:
+        if len(self) >= _MATRICES_KEPT:
+            self.clear()
+        data = self[key] = _relative_model_bytes(key)
+        return data
+
+
+#: ``m_model``'s uniform bytes by the float64 model matrix's bytes and the pass origin's, and
+#: ``m_normal``'s by the model's alone (a translation does not turn a normal) (see
+#: :meth:`Executor.draw_node`): a node that does not move, seen from an eye that does not,
+#: converts its matrix, and inverts it, once; an array changed in place between frames has
+#: other bytes, so it is converted again.
+_MODEL_BYTES = _RelativeBytes()
 _NORMAL_BYTES = _MatrixBytes(lambda matrix: transforms.gl_bytes(transforms.normal_matrix(matrix)))
 
 

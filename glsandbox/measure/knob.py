@@ -30,8 +30,8 @@ from glsandbox.scene import Scene
 if TYPE_CHECKING:
     from glsandbox.measure.render_context import RenderContext
 
-__all__ = ["Knob", "KnobResult", "PixelCount", "Row", "Setting", "all_knobs", "lesson_scene", "median_spread",
-           "register_knob"]
+__all__ = ["Knob", "KnobResult", "PixelCount", "Row", "Setting", "WIDE_SPREAD", "all_knobs", "lesson_scene",
+           "median_spread", "register_knob", "run_spread"]
 
 
 @dataclass(frozen=True)
@@ -142,6 +142,8 @@ class Row:
     image: str = ""
     error_map: str = ""
     count: PixelCount | None = None
+    #: The median of each independent pass of timing rounds (:mod:`glsandbox.measure.tradeoffs`).
+    pass_medians: list[float] = field(default_factory=list)
 
     @property
     def median_ms(self) -> float:
@@ -156,6 +158,31 @@ class Row:
         """How far the median can be trusted: the medians of the odd and the even
         runs apart, as a share of the median of all (:func:`median_spread`)."""
         return median_spread(self.times_ms)
+
+    @property
+    def run_spread(self) -> float:
+        """How far apart independent passes put the median: ``(max − min) / median`` of the
+        pass medians (:func:`run_spread`; inf with fewer than two passes)."""
+        return run_spread(self.pass_medians)
+
+    @property
+    def trusted(self) -> bool:
+        """Whether the passes agree within :data:`WIDE_SPREAD`: else the report gives no figure."""
+        return self.run_spread <= WIDE_SPREAD
+
+
+#: Pass medians further apart than this share of their median: the time is noise, not a figure.
+WIDE_SPREAD = 0.2
+
+
+def run_spread(medians: list[float]) -> float:
+    """``(max − min) / median`` of independent passes' medians (inf with fewer than two):
+    the run-to-run spread a figure is given with. Two passes timed at different moments
+    of one run disagree as two runs of the command do when the machine's load changes."""
+    if len(medians) < 2:
+        return math.inf
+    middle = statistics.median(medians)
+    return (max(medians) - min(medians)) / middle if middle > 0 else 0.0
 
 
 def median_spread(times: list[float]) -> float:

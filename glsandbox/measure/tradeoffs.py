@@ -2,14 +2,30 @@
 
 For each accuracy knob (:mod:`glsandbox.measure.knob`; the built-in ones in
 :mod:`glsandbox.measure.knobs`) the same scene is rendered at every setting
-of the knob and at a reference setting; each setting is timed (median of at
-least five runs, with the spread, runs interleaved across settings so
-machine noise hits all alike; a cheap setting, under :data:`CHEAP_MS`, runs
-again until its median is stable: the odd and even runs' medians within
-:data:`STABLE_SPREAD` of each other, reported as the median's ± spread) and its picture is compared with the
+of the knob and at a reference setting, and its picture is compared with the
 reference by RMSE, PSNR and FLIP (NVIDIA's perceptual error, the
 ``flip-evaluator`` package of the optional ``measure`` extra,
-:mod:`glsandbox.measure.extra`). :func:`run` then writes the report
+:mod:`glsandbox.measure.extra`).
+
+Timing. A load on a shared machine that comes and goes moves a median by
+several times (the same frame measured 1.66 ms, then 8.37 ms a run later),
+so every figure is given with its run-to-run spread:
+
+- :data:`PASSES` independent passes (at least two), each of ``runs`` rounds
+  (at least five); a round renders every setting of every knob once, the
+  knobs taken in turn (:func:`interleave`) and the order reversed every other
+  round, so a burst of load falls on many knobs' settings, not on one knob;
+- in each pass a cheap setting (under :data:`CHEAP_MS`) runs again until its
+  median is stable within the pass (odd and even runs' medians within
+  :data:`STABLE_SPREAD`);
+- the figure is the median of all runs; its spread is how far apart the
+  passes' medians lie (:attr:`~glsandbox.measure.knob.Row.run_spread`), and
+  a setting whose passes differ by more than
+  :data:`~glsandbox.measure.knob.WIDE_SPREAD` gets no figure in the report,
+  only the passes' medians and "too noisy";
+- the machine's load average is printed before and after, and at each pass.
+
+:func:`run` then writes the report
 (:mod:`glsandbox.measure.tradeoffs_report`): ``report.md``,
 ``tradeoffs.csv``, ``tradeoffs.png``, and the pictures compared in
 ``images/`` and their FLIP error maps in ``error_maps/``.
@@ -20,11 +36,13 @@ and listed in the report under "Not measured yet".
 
 from __future__ import annotations
 
+import functools
 import os
 import statistics
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 
@@ -37,7 +55,8 @@ from glsandbox.measure.tradeoffs_report import write_csv, write_plot, write_repo
 from glsandbox.progress import progress
 from glsandbox.progress import say as progress_line
 
-__all__ = ["FULL_SIZE", "QUICK_SIZE", "RUNS", "KnobResult", "Row", "flip_error", "measure_knob", "run"]
+__all__ = ["FULL_SIZE", "PASSES", "QUICK_SIZE", "RUNS", "KnobResult", "Row", "flip_error", "interleave",
+           "load_average", "measure_knob", "measure_knobs", "run", "time_pass"]
 
 #: Runs per setting for the timing (the issue asks for at least five).
 RUNS = 5
@@ -48,6 +67,9 @@ RUNS = 5
 CHEAP_MS = 100.0
 STABLE_SPREAD = 0.05
 MAX_RUNS = 61
+#: Independent passes of the timing rounds: each figure's run-to-run spread is how far
+#: apart the passes' medians lie (:attr:`~glsandbox.measure.knob.Row.run_spread`).
+PASSES = 2
 #: Frame size of the full report, and of ``--quick``.
 FULL_SIZE = (320, 240)
 QUICK_SIZE = (128, 96)
@@ -66,68 +88,123 @@ def _slug(text: str) -> str:
     return "".join(c if c.isalnum() else "_" for c in text.lower()).strip("_").replace("__", "_")
 
 
-def knob_renders(knob: Knob, quick: bool, runs: int) -> int:
-    """How many renders :func:`measure_knob` makes: each setting and the reference, once and ``runs`` times."""
-    return (len(knob.chosen(quick)) + 1) * (runs + 1)
+def knob_renders(knob: Knob, quick: bool, runs: int, passes: int = PASSES) -> int:
+    """How many renders :func:`measure_knob` makes: each setting and the reference, once
+    and ``runs`` times in each of ``passes`` passes."""
+    return (len(knob.chosen(quick)) + 1) * (runs * passes + 1)
+
+
+T = TypeVar("T")
+
+
+def interleave(groups: Sequence[Sequence[T]]) -> list[T]:
+    """The groups' items taken in turn (``[[a1, a2], [b1]]`` -> ``[a1, b1, a2]``): a timing
+    round visits the knobs alternately, so a burst of load on the machine falls on
+    settings of several knobs, not on one knob's settings all together."""
+    out: list[T] = []
+    for depth in range(max((len(g) for g in groups), default=0)):
+        out += [g[depth] for g in groups if depth < len(g)]
+    return out
+
+
+def load_average() -> str:
+    """The machine's load average over 1, 5 and 15 minutes (``n/a`` where the system has none)."""
+    try:
+        return ", ".join(f"{value:.2f}" for value in os.getloadavg())
+    except (AttributeError, OSError):  # Windows
+        return "n/a"
+
+
+def time_pass(renders: Sequence[Callable[[], object]], rounds: int, advance: Callable[[int], object] = lambda n: None,
+              clock: Callable[[], float] = time.perf_counter) -> list[list[float]]:
+    """One pass: ``rounds`` rounds, each calling every render once (in the given order,
+    reversed every other round so no render always follows the same one), then more
+    rounds of the cheap ones (median under :data:`CHEAP_MS`) until their median is stable
+    (:func:`~glsandbox.measure.knob.median_spread` under :data:`STABLE_SPREAD`) or they have
+    :data:`MAX_RUNS` runs. Milliseconds per render."""
+    times: list[list[float]] = [[] for _ in renders]
+
+    def timed(index: int) -> None:
+        start = clock()
+        renders[index]()
+        times[index].append((clock() - start) * 1e3)
+
+    for number in range(rounds):
+        order = range(len(renders)) if number % 2 == 0 else reversed(range(len(renders)))
+        for index in order:
+            timed(index)
+            advance(1)
+    while True:
+        unstable = [i for i, taken in enumerate(times) if statistics.median(taken) < CHEAP_MS
+                    and len(taken) < MAX_RUNS and median_spread(taken) >= STABLE_SPREAD]
+        if not unstable:
+            return times
+        for index in unstable:
+            timed(index)
+
+
+def measure_knobs(knobs: Sequence[Knob], context: RenderContext, out: Path, quick: bool, runs: int = RUNS,
+                  passes: int = PASSES, log: Callable[[str], None] = lambda s: None,
+                  advance: Callable[[int], object] = lambda n: None) -> list[KnobResult]:
+    """Render every knob's settings and reference, time them in ``passes`` independent
+    passes of ``runs`` rounds that alternate across the knobs (:func:`interleave`,
+    :func:`time_pass`), and compare each picture with its knob's reference.
+
+    ``advance(1)`` is called after each of the :func:`knob_renders` renders (a progress bar's ``update``).
+    """
+    groups = [[(knob, setting) for setting in (*knob.chosen(quick), knob.reference)] for knob in knobs]
+    pictures: dict[tuple[str, str], np.ndarray] = {}
+    for knob, setting in (entry for group in groups for entry in group):
+        log(f"  render {knob.name}: {setting.label}")  # the first render warms caches (programs, targets)
+        pictures[knob.name, setting.label] = setting.render(context)
+        advance(1)
+    entries = interleave(groups)
+    renders = [functools.partial(setting.render, context) for _, setting in entries]
+    passes_times = []
+    for number in range(passes):
+        log(f"  timing pass {number + 1}/{passes}: {runs} rounds over {len(knobs)} knob(s), "
+            f"load average {load_average()}")
+        passes_times.append(time_pass(renders, runs, advance))
+    times = {(k.name, s.label): [t for taken in passes_times for t in taken[i]] for i, (k, s) in enumerate(entries)}
+    medians = {(k.name, s.label): [statistics.median(taken[i]) for taken in passes_times]
+               for i, (k, s) in enumerate(entries)}
+    results = []
+    for knob, group in zip(knobs, groups):
+        reference = pictures[knob.name, knob.reference.label]
+        rows = []
+        for _, setting in group:
+            key = (knob.name, setting.label)
+            picture = pictures[key]
+            flip_mean, error_map = flip_error(reference, picture)
+            stem = f"{knob.name}-{_slug(setting.label)}"
+            image_path, map_path = Path("images") / f"{stem}.png", Path("error_maps") / f"{stem}.png"
+            save_png(np.ascontiguousarray(picture), out / image_path)
+            save_png(np.ascontiguousarray(error_map), out / map_path)
+            count = None
+            if setting.count is not None:
+                log(f"  count {knob.count_label} of {setting.label}")
+                count = setting.count(context)
+            rows.append(Row(knob.name, setting.label, setting is knob.reference, times[key],
+                            metrics.rmse(reference, picture), metrics.psnr(reference, picture), flip_mean,
+                            str(image_path), str(map_path), count, medians[key]))
+        results.append(KnobResult(knob, rows))
+    return results
 
 
 def measure_knob(knob: Knob, context: RenderContext, out: Path, quick: bool, runs: int = RUNS,
                  log: Callable[[str], None] = lambda s: None,
-                 advance: Callable[[int], object] = lambda n: None) -> KnobResult:
-    """Render every setting and the reference, time them in interleaved runs, compare with the reference.
-
-    ``advance(1)`` is called after each of the :func:`knob_renders` renders (a progress bar's ``update``).
-    """
-    settings = [*knob.chosen(quick), knob.reference]
-    pictures = []
-    for setting in settings:  # the first render also warms caches (programs, textures, targets)
-        log(f"  render {setting.label}")
-        pictures.append(setting.render(context))
-        advance(1)
-    times: list[list[float]] = [[] for _ in settings]
-    for run in range(runs):
-        log(f"  timing run {run + 1}/{runs}")
-        order = list(range(len(settings)))
-        if run % 2:
-            order.reverse()  # alternate the order so no setting always follows the same one
-        for index in order:
-            start = time.perf_counter()
-            settings[index].render(context)
-            times[index].append((time.perf_counter() - start) * 1e3)
-            advance(1)
-    while True:  # cheap settings: more interleaved runs until their medians are stable
-        unstable = [i for i, taken in enumerate(times) if statistics.median(taken) < CHEAP_MS
-                    and len(taken) < MAX_RUNS and median_spread(taken) >= STABLE_SPREAD]
-        if not unstable:
-            break
-        log(f"  timing {len(unstable)} cheap settings again (median spread >= {STABLE_SPREAD:.0%})")
-        for index in unstable:
-            start = time.perf_counter()
-            settings[index].render(context)
-            times[index].append((time.perf_counter() - start) * 1e3)
-    reference = pictures[-1]
-    rows = []
-    for setting, picture, taken in zip(settings, pictures, times):
-        is_ref = setting is knob.reference
-        flip_mean, error_map = flip_error(reference, picture)
-        stem = f"{knob.name}-{_slug(setting.label)}"
-        image_path, map_path = Path("images") / f"{stem}.png", Path("error_maps") / f"{stem}.png"
-        save_png(np.ascontiguousarray(picture), out / image_path)
-        save_png(np.ascontiguousarray(error_map), out / map_path)
-        count = None
-        if setting.count is not None:
-            log(f"  count {knob.count_label} of {setting.label}")
-            count = setting.count(context)
-        rows.append(Row(knob.name, setting.label, is_ref, taken, metrics.rmse(reference, picture),
-                        metrics.psnr(reference, picture), flip_mean, str(image_path), str(map_path), count))
-    return KnobResult(knob, rows)
+                 advance: Callable[[int], object] = lambda n: None, passes: int = PASSES) -> KnobResult:
+    """:func:`measure_knobs` of one knob."""
+    return measure_knobs([knob], context, out, quick, runs, passes, log, advance)[0]
 
 
 def run(out: Path, quick: bool = False, backend: str | None = None, runs: int = RUNS,
-        only: Sequence[str] = (), log: Callable[[str], None] | None = None) -> list[KnobResult]:
+        only: Sequence[str] = (), log: Callable[[str], None] | None = None, passes: int = PASSES) -> list[KnobResult]:
     """Measure every available knob (or the ``only`` ones) and write the report into ``out``."""
     if runs < 5:
         raise SandboxError(f"--runs {runs}: the timing needs at least 5 runs")
+    if passes < 2:
+        raise SandboxError(f"--passes {passes}: a run-to-run spread needs at least 2 passes")
     say = log or progress_line
     knobs = all_knobs()
     if only:
@@ -145,28 +222,31 @@ def run(out: Path, quick: bool = False, backend: str | None = None, runs: int = 
         raise SandboxError(f"--out {out}: folder is not writable")
     size = QUICK_SIZE if quick else FULL_SIZE
     context = RenderContext(size, backend)
-    results = []
     skipped: dict[str, str] = {}
-    bar = progress(sum(knob_renders(knob, quick, runs) for knob in knobs), "tradeoffs", "render")
-    try:
-        for number, knob in enumerate(knobs, start=1):
-            reason = knob.unavailable()
-            if reason:
-                say(f"[{number}/{len(knobs)}] {knob.name}: skipped ({reason})")
-                skipped[knob.name] = reason
-                bar.update(knob_renders(knob, quick, runs))
-                continue
+    measured = []
+    for number, knob in enumerate(knobs, start=1):
+        reason = knob.unavailable()
+        if reason:
+            say(f"[{number}/{len(knobs)}] {knob.name}: skipped ({reason})")
+            skipped[knob.name] = reason
+        else:
             say(f"[{number}/{len(knobs)}] {knob.name}: {len(knob.chosen(quick))} settings + reference")
-            try:
-                results.append(measure_knob(knob, context, out, quick, runs, lambda text: say(text), bar.update))
-            except OSError as exc:  # its images could not be written
-                raise SandboxError(f"--out {out}: cannot write ({exc.strerror or exc})") from None
+            measured.append(knob)
+    load_before = load_average()
+    bar = progress(sum(knob_renders(knob, quick, runs, passes) for knob in measured), "tradeoffs", "render")
+    try:
+        try:
+            results = measure_knobs(measured, context, out, quick, runs, passes, lambda text: say(text), bar.update)
+        except OSError as exc:  # its images could not be written
+            raise SandboxError(f"--out {out}: cannot write ({exc.strerror or exc})") from None
         host = context.renderer.host
         info = {"renderer": str(host.renderer), "backend": str(host.backend), "size": f"{size[0]}x{size[1]}",
-                "runs": str(runs), "quick": "yes" if quick else "no"}
+                "runs": str(runs), "passes": str(passes), "quick": "yes" if quick else "no",
+                "load": f"{load_before} before, {load_average()} after", "cpus": str(os.cpu_count() or "?")}
     finally:
         bar.close()
         context.close()
+    say(f"tradeoffs: load average (1, 5, 15 min) {info['load']}")
     try:  # a full disk or a folder made read-only meanwhile: one line, no half-written file
         write_csv(results, size, out / "tradeoffs.csv")
         write_report(results, info, out / "report.md", skipped)

@@ -19,14 +19,14 @@ from pathlib import Path
 
 from glsandbox.files import atomic_write, write_text
 from glsandbox.measure import extra
-from glsandbox.measure.knob import KnobResult
+from glsandbox.measure.knob import WIDE_SPREAD, KnobResult, Row
 
 
 __all__ = ["CSV_COLUMNS", "write_csv", "write_plot", "write_report"]
 
 CSV_COLUMNS = ("knob", "setting", "reference", "width", "height", "runs", "time_median_ms", "time_min_ms",
                "time_max_ms", "rmse", "psnr_db", "flip", "count_px", "count_of_px", "count_share", "image",
-               "error_map", "median_spread")
+               "error_map", "median_spread", "passes", "pass_medians_ms", "run_spread", "trusted")
 
 
 def _fmt_psnr(value: float) -> str:
@@ -46,8 +46,18 @@ def write_csv(results: Sequence[KnobResult], size: tuple[int, int], path: Path) 
                              _fmt_psnr(r.psnr), f"{r.flip:.6f}",
                              *(("", "", "") if r.count is None else
                                (r.count.pixels, r.count.of, f"{r.count.share:.6f}")),
-                             r.image, r.error_map, f"{r.median_spread:.4f}"])
+                             r.image, r.error_map, f"{r.median_spread:.4f}", len(r.pass_medians),
+                             " ".join(f"{m:.3f}" for m in r.pass_medians), f"{r.run_spread:.4f}", int(r.trusted)])
     write_text(path, buffer.getvalue())
+
+
+def time_cell(r: Row) -> str:
+    """A setting's time for the report: the median with its run-to-run spread, or, where the
+    passes disagree by more than :data:`~glsandbox.measure.knob.WIDE_SPREAD`, no figure."""
+    passes = ", ".join(f"{m:.2f}" for m in r.pass_medians)
+    if not r.trusted:
+        return f"too noisy (passes {passes} ms: ±{r.run_spread / 2:.0%})"
+    return f"{r.median_ms:.2f} ±{r.run_spread / 2:.0%}"
 
 
 def write_report(results: Sequence[KnobResult], info: Mapping[str, str], path: Path,
@@ -55,26 +65,37 @@ def write_report(results: Sequence[KnobResult], info: Mapping[str, str], path: P
     """``report.md``: a table per knob, then the ``skipped`` knobs (name: why) under "Not measured yet"."""
     lines = ["# Accuracy against time: the tradeoffs report", "",
              f"Renderer: {info['renderer']} ({info['backend']}); frame {info['size']}; "
-             f"{info['runs']} timed runs per setting, interleaved across settings; "
-             f"{'quick set' if info['quick'] == 'yes' else 'full set'}.", "",
-             "Time is the whole frame as a user gets it: render, read back, and for supersampling the "
-             "downsample. Errors are against the knob's reference: RMSE (0..1 scale), PSNR (dB, higher is "
-             "better), FLIP (mean perceptual error, 0..1, lower is better). The plot is `tradeoffs.png`.", ""]
+             f"{info.get('passes', '1')} independent passes of {info['runs']} timed rounds, each round every "
+             f"setting of every knob once, the knobs in turn; "
+             f"{'quick set' if info['quick'] == 'yes' else 'full set'}.", ""]
+    if "load" in info:
+        lines += [f"Load average (1, 5, 15 min) on {info.get('cpus', '?')} CPUs: {info['load']}. A machine "
+                  "busier than its CPUs moves every time; compare runs made at the same load.", ""]
+    lines += ["Time is the whole frame as a user gets it: render, read back, and for supersampling the "
+              "downsample: the median of all runs ± half the spread of the passes' medians (the run-to-run "
+              f"spread); where the passes differ by more than {WIDE_SPREAD:.0%} the time is noise and "
+              "the table says \"too noisy\" instead of a figure. Errors are against the knob's reference: "
+              "RMSE (0..1 scale), PSNR (dB, higher is better), FLIP (mean perceptual error, 0..1, lower is "
+              "better). The plot is `tradeoffs.png`.", ""]
     for result in results:
         knob = result.knob
         counted = f" {knob.count_label} | share of {knob.count_of} |" if knob.count_label else ""
         lines += [f"## {knob.title} (`{knob.name}`)", "", f"Scene: {knob.scene}.  ",
                   f"Reference: {knob.reference_note.rstrip('.')}.", "",
-                  f"| setting | time median (ms) | spread min-max (ms) |{counted} RMSE | PSNR (dB) | FLIP | error map |",
+                  f"| setting | time (ms) | runs min-max (ms) |{counted} RMSE | PSNR (dB) | FLIP | error map |",
                   "|---|---:|---:|" + ("---:|---:|" if knob.count_label else "") + "---:|---:|---:|---|"]
         for r in result.rows:
             low, high = r.spread_ms
             name = (f"{r.setting} (reference)" if r.reference else r.setting).replace("|", "\\|")  # a cell
             count = "" if not knob.count_label else (
                 " - | - |" if r.count is None else f" {r.count.pixels} | {r.count.share:.1%} |")
-            lines.append(f"| {name} | {r.median_ms:.2f} | {low:.2f}-{high:.2f} (median ±{r.median_spread:.1%}, "
-                         f"{len(r.times_ms)} runs) |{count} {r.rmse:.4f} | "
+            lines.append(f"| {name} | {time_cell(r)} | {low:.2f}-{high:.2f} ({len(r.times_ms)} runs) |{count} "
+                         f"{r.rmse:.4f} | "
                          f"{_fmt_psnr(r.psnr)} | {r.flip:.4f} | [map]({r.error_map}) |")
+        noisy = [r.setting for r in result.rows if not r.trusted]
+        if noisy:
+            lines += ["", f"Too noisy to give a time ({len(noisy)} of {len(result.rows)} settings): its passes "
+                          f"differ by more than {WIDE_SPREAD:.0%}; run again on a quieter machine."]
         verdict = result.monotone_ok()
         if verdict is not None:
             chain = " >= ".join(label for label in knob.monotone if any(r.setting == label for r in result.rows))
@@ -114,7 +135,9 @@ def write_plot(results: Sequence[KnobResult], path: Path) -> None:
             ax.errorbar([r.median_ms], [error], xerr=[[r.median_ms - low], [high - r.median_ms]],
                         fmt=marker, color="black" if r.reference else f"C{index % 10}",
                         markersize=12 if r.reference else 7, capsize=3,
-                        label=f"{r.setting} (reference)" if r.reference else r.setting)
+                        mfc="none" if not r.trusted else None,  # hollow: too noisy to read its time
+                        label=(f"{r.setting} (reference)" if r.reference else r.setting)
+                        + ("" if r.trusted else " (time too noisy)"))
         lows, highs = zip(*(r.spread_ms for r in result.rows))
         wide = max(highs) > 4.0 * min(lows)  # a log axis only when times span a few times
         if wide:

@@ -73,7 +73,8 @@ SPHERE_C_GAMMA_GLSL: int = 12
 #: ``"simple"``: the teaching variant, :data:`SIMPLE_OFFSET`.
 OFFSETS: dict[str, bool] = {"bound": False, "simple": True}
 #: The simple offset, the one a first ray tracer writes:
-#: ``SIMPLE_OFFSET·max(1, max|P_i|)`` along the normal. 2⁻¹⁶ is about 256
+#: ``SIMPLE_OFFSET·max(1, max|P_i|)`` along the normal, ``P`` the world position
+#: in both engines (the gpu engine adds its anchor back). 2⁻¹⁶ is about 256
 #: float32 ulps of the point's largest coordinate: no acne, but a fixed share
 #: of ``|P|`` is 1.5 units at 1e5, and a cube's contact shadow on a floor
 #: there is gone (what the ``shadow_offset`` tradeoff knob shows).

@@ -284,9 +284,14 @@ def _keep_first_textures(scene: Scene, world: World) -> None:
         print(line, file=sys.stderr, flush=True)
 
 
+#: Corners :func:`world_anchor` takes its median over, at most (every k-th triangle's first).
+ANCHOR_SAMPLES = 4096
+
+
 def world_anchor(world: World) -> NDArray[np.float64]:
-    """The point the gpu engine's coordinates are relative to: the centre of the
-    nodes' boxes (the origin for an empty world).
+    """The point the gpu engine's coordinates are relative to: the per-axis median of
+    the triangles' first corners (every k-th, at most :data:`ANCHOR_SAMPLES`) and the
+    analytic nodes' centres (the origin for an empty world).
 
     float32 has 24 bits: at 1e5 its spacing is 0.0078, at 1e6 0.0625, so a scene
     traced in world coordinates there loses its shape (ids off on 2.9% and 15%
@@ -294,13 +299,20 @@ def world_anchor(world: World) -> NDArray[np.float64]:
     position is therefore taken relative to this anchor in float64 on the CPU
     (vertices, boxes, lights, the eye, analytic nodes' inverse matrices) and only the
     difference is rounded to float32: the picture at 1e6 is the one at the
-    origin. The anchor is the scene's own centre, not the eye, so a camera
-    moving around the scene keeps the upload (the eye is one uniform)."""
-    if not world.nodes:
+    origin. The anchor is the scene's own, not the eye, so a camera moving
+    around the scene keeps the upload (the eye is one uniform).
+
+    A median, not the centre of the boxes: one stray vertex far away (a triangle
+    at 1e6 beside a quad at the origin) would move a centre half-way there, and
+    the quad, then 5e5 from the anchor, would be rounded to 0.03 units. The median
+    stays with the bulk of the scene; the stray triangle is rounded relative to
+    its own distance, far below a pixel wherever it is seen from the bulk."""
+    centres = [0.5 * (node.box_min + node.box_max) for node in world.nodes if not node.kind.triangles]
+    step = max(1, -(-world.triangle_count // ANCHOR_SAMPLES))
+    points = np.concatenate([world.v0[::step], np.reshape(centres, (-1, 3))])
+    if not len(points):
         return np.zeros(3)
-    lo = np.min([node.box_min for node in world.nodes], axis=0)
-    hi = np.max([node.box_max for node in world.nodes], axis=0)
-    return 0.5 * (lo + hi)
+    return np.median(points, axis=0)
 
 
 def pack_triangles(world: World, anchor: NDArray[np.float64] | None = None,
@@ -840,7 +852,7 @@ class GpuTracer:
             "u_eye": tuple(eye - uploaded.anchor), "u_half": (half_w, half_h), "u_background": tuple(world.background),
             "u_max_depth": int(max_depth),
             "u_cull": -1 if cull_backfaces is None else int(bool(cull_backfaces)), "u_aabb": bool(aabb),
-            "u_offset": SIMPLE_OFFSET,
+            "u_offset": SIMPLE_OFFSET, "u_offset_origin": tuple(uploaded.anchor),
         }
         for name, value in values.items():
             if name in program:

@@ -117,7 +117,9 @@ def render(scene: Scene, size: tuple[int, int], engine: str = "numpy", *, ctx: o
     exact; ``False``: their triangles; see :mod:`glsandbox.raytrace.world`),
     ``offset`` (how secondary rays leave a surface: ``"bound"``, by the hit
     point's rounding-error bound; ``"simple"``, the teaching variant
-    :data:`~glsandbox.raytrace.constants.SIMPLE_OFFSET`).
+    :data:`~glsandbox.raytrace.constants.SIMPLE_OFFSET` times ``max(1, max|P|)`` of the
+    *world* position ``P`` in both engines: the gpu engine, whose points are relative to
+    its anchor, adds the anchor back first).
     ``stats`` (numpy engine) counts the rays and the box and shape tests.
     """
     _check(size, engine, max_depth, offset)

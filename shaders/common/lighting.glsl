@@ -33,8 +33,11 @@ uniform vec3 u_light_color[NUM_LIGHTS];  // vLightColor[]
 // projection @ view: its depth in 0..1 is compared with the map's (the
 // comparison sampler returns 1 where p is at most as far as the nearest
 // caster: lit). The bias is constant + slope · tan(angle between N and L)
-// world units: a surface at a grazing angle to the light spans more depth
-// per texel, so it needs more to stop shadowing itself (acne). Percentage-
+// texels: a texel at distance d from the light is d · u_shadow_footprint
+// wide (2·tan(fov/2)/size), and a surface seen at angle θ from the light
+// spans tan θ texels of depth per texel of width, so a bias counted in
+// texels stops acne at any scale and distance (a scene 1e-4 the size gets
+// 1e-4 the world bias). Percentage-
 // closer filtering averages a SHADOW_PCF x SHADOW_PCF grid of comparisons
 // (1, 3, 5 or 7), one texel apart: edges get soft steps instead of stairs.
 // Outside the light's frustum a point counts as lit.
@@ -42,12 +45,14 @@ uniform sampler2DShadow u_shadow_map;
 uniform mat4 u_shadow_matrix;
 uniform float u_shadow_bias;
 uniform float u_shadow_slope_bias;
-uniform float u_shadow_texel;   // 1 / map size
+uniform float u_shadow_texel;      // 1 / map size
+uniform float u_shadow_footprint;  // a texel's width at unit distance from the light
 
-float shadow_visibility(vec3 position, vec3 normal, vec3 to_light) {
+float shadow_visibility(vec3 position, vec3 normal, vec3 to_light, float distance) {
     float cosine = clamp(dot(normal, to_light), 0.05, 1.0);
     float slope = sqrt(1.0 - cosine * cosine) / cosine;  // tan of the angle, at most about 20
-    vec3 moved = position + to_light * (u_shadow_bias + u_shadow_slope_bias * slope);
+    float texel = distance * u_shadow_footprint;  // the map's texel, in world units, here
+    vec3 moved = position + to_light * texel * (u_shadow_bias + u_shadow_slope_bias * slope);
     vec4 clip = u_shadow_matrix * vec4(moved, 1.0);
     if (clip.w <= 0.0) return 1.0;
     vec3 ndc = clip.xyz / clip.w;
@@ -77,12 +82,13 @@ vec3 shade(vec3 position, vec3 normal, vec3 mesh) {
 #endif
     for (int i = 0; i < NUM_LIGHTS; ++i) {
         vec3 diffuse, specular;
-        vec3 to_light = normalize(u_light_pos[i] - position);
+        vec3 light_offset = u_light_pos[i] - position;
+        vec3 to_light = normalize(light_offset);
         course_light(normal, to_light, to_eye, mesh, u_light_color[i], u_shininess, blinn, diffuse, specular);
         float visible = 1.0;
 #ifdef SHADOW_LIGHT
         // In shadow only the ambient term stays (the ray tracer's rule).
-        if (i == SHADOW_LIGHT) visible = shadow_visibility(position, normal, to_light);
+        if (i == SHADOW_LIGHT) visible = shadow_visibility(position, normal, to_light, length(light_offset));
 #endif
         color += min(u_ambient * mesh + visible * (u_diffuse * diffuse + u_specular * specular), vec3(1.0));
     }

@@ -360,7 +360,10 @@ def test_z_fighting_pixels_per_depth_setting(gl, settings, expect):
     if expect == "none":
         assert fighting == 0
     else:
-        assert fighting > 0.15 * shadow
+        # Transforms formed in float64 relative to the eye (gl.uniform_bytes.PassCamera) leave
+        # the depth buffer as the only rounding: 217 of 907 pixels fight at 60, 65 of 894 at 90
+        # (24-bit standard depth); with no lift 936 of 1003, and 39 of 1003 with reverse-Z.
+        assert fighting > 0.03 * shadow
 
 
 def test_hard_case_lights_draw_no_shadow_at_all(gl):

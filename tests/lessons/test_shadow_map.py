@@ -121,7 +121,7 @@ def test_zero_bias_shows_acne_and_a_large_bias_peter_pans(gl):
     acne = state_mismatch(*states(gl, bias=0.0, slope_bias=0.0, pcf="1"))
     # Acne: the floor shadows itself in stripes, thousands of pixels away from any edge.
     assert acne.off_edge > 5000 > 50 * max(sound.off_edge, 1), (acne, sound)
-    mapped, traced = states(gl, bias=0.4)
+    mapped, traced = states(gl, bias=50.0)
     loose = state_mismatch(mapped, traced)
     # Peter-panning: the thin panel's shadow comes loose from its foot; pixels the
     # rays shadow turn lit (the other way round only along soft PCF edges: 654 against 78).
@@ -157,6 +157,14 @@ def test_gl_state_is_restored_after_a_shadow_map_frame(gl):
 
 
 @pytest.mark.parametrize("settings", [(), ("time=2",), ("show=map", "bias=0", "slope_bias=0", "pcf=1"),
-                                      ("show=map", "bias=0.4")])
+                                      ("show=map", "bias=50")])
 def test_shadow_map_goldens(gl, golden, settings):
     check_lesson_golden(gl, golden, "shadow_map", *settings)
+
+
+def test_the_map_stores_32_bit_float_depth_where_the_context_gives_it(gl):
+    gl.render(ShadowMapLesson(show="map"), SIZE)
+    maps = gl.executor.shadow_maps
+    assert maps.float_depth[0, 1024] is True  # OpenGL 3.3 core has DEPTH_COMPONENT32F
+    texture, _ = maps.target(0, 1024)
+    assert gl.host.raw.texture_depth_bits(texture.glo) == (32, True)

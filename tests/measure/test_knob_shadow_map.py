@@ -15,7 +15,8 @@ def knob():
 def test_the_knob_lists_planar_and_every_map_size_with_and_without_pcf():
     labels = [s.label for s in knob().settings]
     assert labels[0] == "planar shadow (stencil)"
-    assert labels[1:] == [f"shadow map {size}, PCF {pcf}" for size in (256, 512, 1024, 2048) for pcf in (1, 3)]
+    assert labels[1:9] == [f"shadow map {size}, PCF {pcf}" for size in (256, 512, 1024, 2048) for pcf in (1, 3)]
+    assert labels[9:] == [f"shadow map 1024, PCF 3, {where}" for where in ("at 1e5", "at 9e5", "x1e-4 at 1e3")]
     assert set(knob().quick) <= set(labels) and knob().count_label == "wrong-state px"
 
 
@@ -30,3 +31,13 @@ def test_wrong_state_pixels_fall_with_the_map_size_and_the_planar_shadow_misses_
     # stray further from the exact edge than a large map's.
     assert planar > coarse > fine > 0, counts
     assert all(c.of == 192 * 144 for c in counts.values())
+
+
+def test_the_default_map_gives_the_origin_s_states_far_away_and_at_small_scale(gl):
+    context = RenderContext((192, 144))
+    context.gl = LazyRenderer(renderer=gl)
+    settings = {s.label: s for s in knob().settings}
+    here = settings["shadow map 1024, PCF 3"].count(context).pixels
+    for where in ("at 1e5", "at 9e5", "x1e-4 at 1e3"):
+        there = settings[f"shadow map 1024, PCF 3, {where}"].count(context).pixels
+        assert abs(there - here) <= 0.1 * here + 5, (where, there, here)

@@ -96,7 +96,7 @@ def quick_report(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("tradeoffs")
     proc = _run("tradeoffs", "--quick", "--out", str(out))
     assert proc.returncode == 0, proc.stderr
-    assert "[1/" in proc.stderr and "timing run 5/5" in proc.stderr  # progress on stderr
+    assert "[1/" in proc.stderr and "timing pass 2/2" in proc.stderr and "load average" in proc.stderr
     return out
 
 
@@ -121,14 +121,18 @@ def test_tradeoffs_writes_every_file(quick_report: Path) -> None:
 @pytest.mark.slow
 def test_tradeoffs_report_has_a_table_per_knob(quick_report: Path) -> None:
     report = (quick_report / "report.md").read_text(encoding="utf-8")
-    header = "| setting | time median (ms) | spread min-max (ms) | RMSE | PSNR (dB) | FLIP | error map |"
+    header = "| setting | time (ms) | runs min-max (ms) | RMSE | PSNR (dB) | FLIP | error map |"
     assert report.count(header) == 4  # the knobs without a pixel count
-    assert report.count("| setting | time median (ms) | spread min-max (ms) | z-fighting px | share of shadow px | "
+    assert report.count("| setting | time (ms) | runs min-max (ms) | z-fighting px | share of shadow px | "
                         "RMSE | PSNR (dB) | FLIP | error map |") == 1
     for title in ("## Anti-aliasing (`antialiasing`)", "## Lighting model (`lighting`)",
                   "## Texture filtering (`texture_filter`)"):
         assert title in report
     assert "| SSAA 8x (reference) | " in report
+    assert "Load average (1, 5, 15 min) on " in report and " before, " in report
+    for row in _rows(quick_report):  # two passes each; a figure or "too noisy", as the passes agree
+        assert int(row["passes"]) == 2 and len(row["pass_medians_ms"].split()) == 2
+        assert row["trusted"] == str(int(float(row["run_spread"]) <= 0.2))
     assert "Reference: the float64 numpy ray tracer" in report  # lighting's reference
     assert "## Ray tracer engine (`ray_engine`)" in report
     rows = _rows(quick_report)
@@ -273,6 +277,12 @@ def test_the_measure_extra_is_imported_only_by_tradeoffs_at_work() -> None:
     proc = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip() == "[]"
+
+
+def test_tradeoffs_bad_passes_is_one_line() -> None:
+    proc = run_cli("tradeoffs", "--quick", "--passes", "1", "--out", "/nonexistent/x")
+    assert proc.returncode == 2
+    assert proc.stderr.strip() == "error: --passes 1: a run-to-run spread needs at least 2 passes"
 
 
 def test_tradeoffs_bad_runs_is_one_line() -> None:

@@ -1,6 +1,7 @@
 """Scenes far from the origin, shared by the precision knobs and their tests.
 
-:func:`moved` translates a whole Scene (nodes, lights, cameras) by an offset;
+:func:`moved` translates a whole Scene (nodes, lights, cameras) by an offset,
+:func:`placed` scales it first;
 :func:`cube_on_floor` is a unit cube resting on a floor, lit from the side,
 whose shadow starts at its base (a contact shadow); :func:`contact_shadow`
 says which floor pixels a shadow ray darkens.
@@ -40,6 +41,29 @@ def moved(scene: Scene, offset: float) -> Scene:
     camera = cam(scene.camera)
     assert camera is not None
     return dataclasses.replace(scene, nodes=nodes, lights=lights, camera=camera, viewports=viewports)
+
+
+def placed(scene: Scene, offset: float, scale: float = 1.0) -> Scene:
+    """``scene`` scaled by ``scale`` about the origin (cameras' near and far too), then
+    :func:`moved` by ``offset``: the same picture, wherever and however large."""
+    if scale != 1.0:
+        grow = transforms.scale(scale, scale, scale)
+        nodes = tuple(dataclasses.replace(node, model=grow @ np.asarray(node.model)) for node in scene.nodes)
+        lights = tuple(dataclasses.replace(light, position=tuple(scale * np.asarray(light.position)))
+                       for light in scene.lights)
+
+        def cam(camera: Camera | None) -> Camera | None:
+            if camera is None:
+                return None
+            return dataclasses.replace(camera, eye=tuple(scale * np.asarray(camera.eye)),
+                                       target=tuple(scale * np.asarray(camera.target)),
+                                       near=camera.near * scale, far=camera.far * scale)
+
+        viewports = tuple(dataclasses.replace(vp, camera=cam(vp.camera)) for vp in scene.viewports)
+        camera = cam(scene.camera)
+        assert camera is not None
+        scene = dataclasses.replace(scene, nodes=nodes, lights=lights, camera=camera, viewports=viewports)
+    return moved(scene, offset) if offset else scene
 
 
 def cube_on_floor(offset: float = 0.0) -> Scene:

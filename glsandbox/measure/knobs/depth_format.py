@@ -16,12 +16,14 @@ test GREATER), and rounded as the buffer stores it (unsigned normalized:
 whose stored depth does not beat the floor's (a tie included: the floor was
 drawn first) is a z-fighting pixel.
 
-What the model leaves out: a GPU interpolates ``z/w`` in float32 before it
-stores it, which moves the share of fighting pixels but not where fighting
-starts. The rasterizer's two modes drawn on this scene at 96x72 fight where
-the model does (tests/measure/test_precision_knobs.py): 24-bit at near
-0.01 loses all of the decal's inner pixels (the model: 79%), at 0.02 36%
-(57%), at 0.05 and 1 none (none); reverse-Z float none (none).
+What the model leaves out: a GPU computes clip depth and interpolates
+``z/w`` in float32 before it stores it, which moves the share of fighting
+pixels, and the onset where the gap is one buffer step. The rasterizer's two
+modes drawn on this scene at 96x72 (tests/measure/test_precision_knobs.py):
+24-bit at near 0.01 loses all of the decal's inner pixels (the model: 79%);
+at 0.02 18% (57%) and at 0.05 55% (none), where the gap is about one 24-bit
+step and float32 decides the ties; at 1 none (none); reverse-Z float none
+(none).
 """
 
 from __future__ import annotations

@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from glsandbox.measure.knob import Knob, PixelCount, Setting, lesson_scene, register_knob
+from glsandbox.measure.knobs._far import placed
 from glsandbox.measure.render_context import RenderContext
 from glsandbox.measure.shadow_state import shadow_mask, state_mismatch, without_shadows
 from glsandbox.scene import Scene
@@ -35,15 +36,24 @@ def reference_states(c: RenderContext) -> tuple[np.ndarray, np.ndarray]:
     return _REFERENCE[c]
 
 
-def setting(label: str, note: str = "", **values: Any) -> Setting:
-    """A technique drawn for the picture errors, with its pixels of the wrong state counted."""
+def setting(label: str, note: str = "", at: float = 0.0, scale: float = 1.0, **values: Any) -> Setting:
+    """A technique drawn for the picture errors, with its pixels of the wrong state counted;
+    ``at`` and ``scale``: the scene placed there (:func:`~glsandbox.measure.knobs._far.placed`),
+    its picture and states judged against the ones at the origin (they are the same picture)."""
+
+    def drawn(c: RenderContext) -> np.ndarray:
+        return c.raster(placed(scene(**values), at, scale))
 
     def count(c: RenderContext) -> PixelCount:
         unshadowed, traced = reference_states(c)
-        found = state_mismatch(shadow_mask(c.raster(scene(**values)), unshadowed), traced)
+        found = state_mismatch(shadow_mask(drawn(c), unshadowed), traced)
         return PixelCount(found.differ, found.total)
 
-    return Setting(label, lambda c: c.raster(scene(**values)), note, count)
+    return Setting(label, drawn, note, count)
+
+
+#: Where the default map is measured besides the origin: (label, offset, scale).
+PLACES = (("at 1e5", 1e5, 1.0), ("at 9e5", 9e5, 1.0), ("x1e-4 at 1e3", 1e3, 1e-4))
 
 
 KNOB = register_knob(Knob(
@@ -56,11 +66,14 @@ KNOB = register_knob(Knob(
         setting("planar shadow (stencil)", "XMMatrixShadow onto the floor only, black at alpha 0.5", show="planar"),
         *(setting(f"shadow map {size}, PCF {pcf}", show="map", size=str(size), pcf=str(pcf))
           for size in SIZES for pcf in (1, 3)),
+        *(setting(f"shadow map 1024, PCF 3, {where}", "the scene moved (and scaled) as a whole", at=at, scale=scale,
+                  show="map") for where, at, scale in PLACES),
     ),
     reference=Setting("ray tracer, numpy (float64)", lambda c: c.ray(scene(show="map"), "numpy")),
     reference_note=("the float64 numpy ray tracer on the same scene: a shadow ray towards the light from every "
                     "hit, ambient only where it is blocked; one ray per pixel"),
-    quick=("planar shadow (stencil)", "shadow map 256, PCF 1", "shadow map 1024, PCF 3"),
+    quick=("planar shadow (stencil)", "shadow map 256, PCF 1", "shadow map 1024, PCF 3",
+           "shadow map 1024, PCF 3, at 9e5"),
     monotone=tuple(f"shadow map {size}, PCF 1" for size in SIZES),
     count_label="wrong-state px",
     count_of="px",
@@ -73,7 +86,10 @@ KNOB = register_knob(Knob(
         "nearer the exact one. A point light casts hard shadows, which the rays draw exactly, so PCF's soft "
         "band a few texels wide scores worse against them in both counts and FLIP; it is there for the look "
         "(no stairs, no crawling edges as things move), and costs a 3x3 grid of lookups per pixel.",
-        "The bias is the lesson's (0.02 + 0.02 tan θ world units): no acne, no visible peter-panning "
-        "(tests/lessons/test_shadow_map.py counts both).",
+        "The bias is the lesson's (2.5 + 2.5 tan θ texels of the map where the receiver is): no acne, no "
+        "visible peter-panning (tests/lessons/test_shadow_map.py counts both).",
+        "At 1e5, 9e5 and at 1e-4 of the size placed at 1e3 the same settings give the same states as at the "
+        "origin: the transforms are formed in float64 relative to the eye (and the light), the light's "
+        "frustum is fitted to the scene and the bias is counted in texels.",
     ),
 ))
