@@ -7,30 +7,14 @@ import textwrap
 from pathlib import Path
 
 import pytest
-from support import glsandbox
+from support import SPHERE_ANSWER, glsandbox
 
 from glsandbox.errors import SandboxError
 from glsandbox.exercises.catalogue import get
 from glsandbox.exercises.compare import describe
 from glsandbox.grading.rubric import load_rubric
 
-#: The notes' geometric test, right: l, s, m², q; s - q from outside, s + q from inside.
-RIGHT = """\
-import math
-
-
-def intersect_sphere(origin, direction, center, radius):
-    l = [c - o for c, o in zip(center, origin)]
-    s = sum(a * b for a, b in zip(l, direction))
-    ll = sum(a * a for a in l)
-    m2 = ll - s * s
-    if m2 > radius * radius:
-        return None
-    q = math.sqrt(max(radius * radius - m2, 0.0))
-    if ll > radius * radius:
-        return None if s < 0 else s - q
-    return s + q
-"""
+RIGHT = SPHERE_ANSWER
 
 #: The named mistake ``far_root``: s + q from outside too.
 WRONG = RIGHT.replace("return None if s < 0 else s - q", "return None if s < 0 else s + q")
