@@ -1,4 +1,4 @@
-"""Benchmark: the BVH (issue 11) at 1k, 10k, 100k and 1M triangles.
+"""Benchmark: the BVH at 1k, 10k, 100k and 1M triangles.
 
 Run: ``uv run python benchmarks/bvh.py [--sizes 1000,10000] [--model terrain|rock] [--rounds R]``;
 with Embree: ``uv run --group bench python benchmarks/bvh.py``.

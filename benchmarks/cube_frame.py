@@ -8,7 +8,7 @@ colours, depth test and back-face culling, the course camera, a rotation that
 changes every frame) into an 800x600 offscreen framebuffer and read the pixels
 back. The two are measured in alternating rounds in one process, on one
 context, so machine noise hits both alike; the figure is the ratio of medians.
-Goals (issue 24): glsandbox <= 1.05x raw, and at most 50 us of extra main-thread
+Goals: glsandbox <= 1.05x raw, and at most 50 us of extra main-thread
 CPU per frame (the bench's "extra CPU" column). Cold start is process start to the
 first PNG written, for ``glsandbox render`` and for this script's raw path.
 """

@@ -1,6 +1,6 @@
-"""Benchmark: the memory a 1M-triangle ray traced frame adds, the gpu engine against Embree (issue 24).
+"""Benchmark: the memory a 1M-triangle ray traced frame adds, the gpu engine against Embree.
 
-Issue 24's goal: a 1M-triangle frame of the gpu engine takes at most 3x the
+The goal: a 1M-triangle frame of the gpu engine takes at most 3x the
 memory of Embree's. One row, in a group of its own that ``--only "models vs
 Embree"`` also selects: each sample is a fresh child process per side that
 builds :mod:`models`' 1,000,000-triangle terrain scene (the loaded model),
@@ -43,7 +43,7 @@ from typing import Any
 from raytrace import embree_available
 
 GROUP = "ray tracer on models vs Embree: frame memory"
-#: Issue 24's goal: the gpu engine's 1M-triangle frame at most this many times Embree's memory.
+#: The goal: the gpu engine's 1M-triangle frame at most this many times Embree's memory.
 GOAL = 3.0
 LABEL = "1000000"
 MODE = "shadow+bounce"

@@ -14,7 +14,7 @@ panel is text whose numbers change), the raw side does that work too, with its
 own code; what never changes (a constant text panel) is made once, like a mesh.
 The table's last column says whether both draw the same picture; the tests
 (``tests/measure/test_tradeoffs_bench.py``) check each pixel for pixel at 160x120.
-Goals (issue 24): glsandbox <= 1.05x raw, and at most 50 us of extra main-thread
+Goals: glsandbox <= 1.05x raw, and at most 50 us of extra main-thread
 CPU per frame (the bench's "extra CPU" column).
 """
 
@@ -214,7 +214,7 @@ class RawTexture:
     def __init__(self, ctx: moderngl.Context, size: tuple[int, int]) -> None:
         from glsandbox import geometry
         from glsandbox.images import builtin_levels
-        from lessons.texture import ground
+        from glsandbox.lessons.texture import ground
 
         self.ctx, self.size, self.fbo = ctx, size, framebuffer(ctx, size)
         self.program = ctx.program(vertex_shader=TEXTURED_VS, fragment_shader=TEXTURED_FS)
@@ -267,9 +267,9 @@ class RawTransformOrder:
         from PIL import Image, ImageDraw, ImageFont
 
         from glsandbox import geometry
-        from lessons import transform_order as lesson
+        from glsandbox.lessons import transform_order as lesson
 
-        defaults = {p.name: p.default for p in lesson.TransformOrder.params}
+        defaults = {p.name: p.default for p in lesson.TransformOrder.all_params()}
         assert defaults["order"] == "STR" and defaults["view"] == "single" and defaults["overlay"]
         self.speed, self.spin, self.span = defaults["speed"], defaults["spin"], defaults["trail"]
         self.ctx, self.size, self.fbo = ctx, size, framebuffer(ctx, size)
@@ -298,9 +298,15 @@ class RawTransformOrder:
         self.lines_width = max(self.width(text) for text in self.lines)
         self.panel_height = 8 * self.step - 2 + 6  # 8 rows; the width changes with the numbers
         self.panel: moderngl.Texture | None = None
-        figures = np.ascontiguousarray(lesson.figures_panel())
-        self.figures = self._texture(figures.shape[1], figures.shape[0], figures.tobytes())
-        self.figures_at = (4, 3)  # the lesson's (4, -4): its last row the 4th from the bottom
+        # The panels are laid out as the lesson's overlays are (glsandbox.overlay: scaled with the
+        # frame, capped to a share of it), so the raw picture is the lesson's at any size.
+        from glsandbox.overlay import Overlay
+
+        self.region = (0, 0, *size)
+        figures = Overlay("figures", np.ascontiguousarray(lesson.figures_panel()), None, (4, -4))
+        drawn = np.ascontiguousarray(figures.drawn_image(self.region))
+        self.figures = self._texture(drawn.shape[1], drawn.shape[0], drawn.tobytes())
+        self.figures_at = figures.placement(self.region)[:2]
 
     def _texture(self, width: int, height: int, data: bytes) -> moderngl.Texture:
         texture = self.ctx.texture((width, height), 4, data, alignment=1)
@@ -336,13 +342,18 @@ class RawTransformOrder:
         c, s = np.cos(turns), np.sin(turns)
         x, y, z = self.corner
         self.trail_buffer.write(np.stack([c * x + s * z, np.full_like(c, y), c * z - s * x], 1).astype("f4"))
+        from glsandbox.overlay import Overlay
+
         width, pixels = self._matrix_panel(angle, second)
-        if self.panel is None or self.panel.size != (width, self.panel_height):
+        matrix = Overlay("matrix", np.frombuffer(pixels, np.uint8).reshape(self.panel_height, width, 4), None, (4, 4))
+        drawn = np.ascontiguousarray(matrix.drawn_image(self.region))
+        top_left = matrix.placement(self.region)[:2]
+        if self.panel is None or self.panel.size != (drawn.shape[1], drawn.shape[0]):
             if self.panel is not None:
                 self.panel.release()
-            self.panel = self._texture(width, self.panel_height, pixels)
+            self.panel = self._texture(drawn.shape[1], drawn.shape[0], drawn.tobytes())
         else:
-            self.panel.write(pixels, alignment=1)
+            self.panel.write(drawn.tobytes(), alignment=1)
 
         self.fbo.use()
         clear(self.fbo, 0.0, 0.125, 0.6, depth=1.0)
@@ -362,7 +373,6 @@ class RawTransformOrder:
         ctx.disable(moderngl.DEPTH_TEST)
         ctx.enable(moderngl.BLEND)
         ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
-        top_left = (4, self.size[1] - 4 - self.panel_height)  # the lesson's (4, 4) from the top left
         for texture, origin in ((self.panel, top_left), (self.figures, self.figures_at)):
             texture.use(0)
             self.image["u_origin"].value = origin
@@ -394,7 +404,7 @@ class RawMirror:
 
     def __init__(self, ctx: moderngl.Context, size: tuple[int, int]) -> None:
         from glsandbox import geometry
-        from lessons import mirror as lesson
+        from glsandbox.lessons import mirror as lesson
 
         v = {p.name: p.default for p in lesson.MirrorLesson.params}
         assert (v["mirror"], v["shadow"], v["light"], v["depth"], v["offset"]) == \
@@ -576,7 +586,7 @@ class RawShadowMap:
 
     def __init__(self, ctx: moderngl.Context, size: tuple[int, int]) -> None:
         from glsandbox import geometry
-        from lessons import shadow_map as lesson
+        from glsandbox.lessons import shadow_map as lesson
 
         self.ctx, self.size, self.fbo, self.lesson = ctx, size, framebuffer(ctx, size), lesson
         self.depth = ctx.program(vertex_shader=SOLID_VS, fragment_shader=SOLID_FS)

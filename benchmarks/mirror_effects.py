@@ -11,7 +11,7 @@ instead of reverse-Z. Each round renders every configuration for
 one context, so machine noise hits all alike; the figure is the median over
 rounds of the per-frame time, and its ratio to the no-effect frame.
 No assertion: the numbers are for reading; speed goals are never asserted
-(README, "Benchmarks").
+(docs/benchmarks.md).
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from glsandbox.cli import parse_size
 from glsandbox.frame import HeadlessRenderer  # noqa: E402
 from glsandbox.plan import plan  # noqa: E402
-from lessons.mirror import MirrorLesson  # noqa: E402
+from glsandbox.lessons.mirror import MirrorLesson  # noqa: E402
 
 CONFIGS: dict[str, dict[str, object]] = {
     "no effect": dict(mirror="off", shadow="off"),

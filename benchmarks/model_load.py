@@ -1,4 +1,4 @@
-"""Benchmark: loading real models (issue 20): file to drawn first frame, the BVH build, peak memory.
+"""Benchmark: loading real models: file to drawn first frame, the BVH build, peak memory.
 
 Three models, made once per run in a temporary folder (nothing downloaded,
 nothing shipped):
@@ -56,7 +56,7 @@ import numpy as np
 from _bunny import bunny_path
 
 GROUP = "model files: load"
-#: Issue 20's goals: load + first frame against trimesh + raw upload; BVH build against Embree.
+#: The goals: load + first frame against trimesh + raw upload; BVH build against Embree.
 LOAD_GOAL = 3.0
 BUILD_GOAL = 2.0
 BYTES_GOAL = 250

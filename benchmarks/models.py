@@ -1,9 +1,9 @@
-"""Benchmark: the ray tracer on models of about 1k, 10k, 100k and 1M triangles (issue 11).
+"""Benchmark: the ray tracer on models of about 1k, 10k, 100k and 1M triangles.
 
 Per model and mode, each engine is timed against Embree (``embreex``, Intel's
 CPU ray tracer) casting the same rays in the same run, ratio = engine time /
-Embree time (issue 24's goals, printed in the goal column: the gpu engine at
-most 1x, the numpy engine at most 5x; issue 11's were 2x and 50x):
+Embree time (the goals, printed in the goal column: the gpu engine at
+most 1x, the numpy engine at most 5x):
 
 - the models are generated terrains (:func:`glsandbox.meshgen.terrain`: no
   download, the same every run), and the Stanford bunny (56,172 triangles)
@@ -35,11 +35,11 @@ Embree's rays as one Dr.Jit wavefront, against Embree in the same run. Its first
 cast (the warm-up) compiles the kernel; the timed casts reuse it. Without it the
 rows are left out and a line under the table says why.
 
-A first row times building the BVH of the largest model (issue 11's goal: under
+A first row times building the BVH of the largest model (the goal: under
 2 s for 1M triangles) beside Embree building its own for the same triangles.
 
 Under the table (:func:`summarize`): the build time against its goal, each engine's time exponent from 10k to
-1M triangles, ``log(t_1M / t_10k) / log(1M / 10k)`` (issue 11's goal: at most
+1M triangles, ``log(t_1M / t_10k) / log(1M / 10k)`` (the goal: at most
 0.25), and how the shadow+bounce ratios compare with the primary ones
 (goal: within 2x). Without ``embreex`` the module adds no rows and says so.
 """
@@ -67,7 +67,7 @@ from glsandbox.raytrace.world import build_world, camera_rays
 GROUP = "ray tracer on models vs Embree"
 #: Triangle counts of the generated terrains (``--quick``: the first two).
 SIZES = (1_000, 10_000, 100_000, 1_000_000)
-#: Issue 24's goals as time ratios against Embree (issue 11's were 2x and 50x).
+#: The goals as time ratios against Embree.
 GOALS = {"gpu": 1.0, "numpy": 5.0}
 ENGINE_LABELS = {"gpu": "gpu engine (GLSL float32)", "numpy": "numpy engine (float64)"}
 MITSUBA_NOTE = ("ratio = Mitsuba time / Embree time for the same rays; kernel compiled at the warm-up, "
@@ -76,7 +76,7 @@ BACKGROUND = (1.0, 0.0, 1.0, 1.0)  # magenta: no shade of the grey model
 #: How far a ray is turned to test whether it lies within float32 of an edge:
 #: 8 float32 steps at 1 (2^-21 relative), in 8 directions around it.
 EDGE_TURN = 8.0 * 2.0 ** -24
-#: Issue 11's goal for building the BVH of 1M triangles, in seconds.
+#: The goal for building the BVH of 1M triangles, in seconds.
 BUILD_GOAL_S = 2.0
 #: At most this many differing pixels are examined for the edge count.
 EDGE_SAMPLE = 400

@@ -1,4 +1,4 @@
-"""Benchmark: a lesson window frame with and without the live controls (issue 14).
+"""Benchmark: a lesson window frame with and without the live controls.
 
 One glfw window on the window backend (under Xvfb where there is no screen:
 ``xvfb-run glsandbox bench --only panel``), 800x600, the phong lesson: each
@@ -8,7 +8,7 @@ and draws the Dear ImGui panel (:class:`glsandbox.panel.Panel`) before the
 swap. ``glFinish`` ends both, so the time is the frame's and not the queue's.
 The window runs in a child process (see :func:`cases`), driven a frame at a
 time. Without a display the row is skipped with a note. Goal: <= 1.15x
-(measured 1.06x to 1.23x on llvmpipe under Xvfb, frames of about 8 ms: see the README).
+(measured 1.06x to 1.23x on llvmpipe under Xvfb, frames of about 8 ms).
 """
 
 from __future__ import annotations

@@ -23,7 +23,7 @@ use an already compiled program variant (compiled once per variant and
 context). The numpy time includes building the World. Embree (``embreex``, Intel's CPU ray tracer) casts the
 same primary rays against the same world triangles (spheres as their mesh,
 which it needs) with ``scene.run(origins, directions)``: closest hit only, no
-shading, so its figure is an upper bound for the same work. Goals (issue 6):
+shading, so its figure is an upper bound for the same work. Goals:
 gpu >= 1.0x Embree's primary rate, numpy >= 0.1x.
 """
 
@@ -79,7 +79,7 @@ def embree_primary(scene, size: tuple[int, int]) -> Callable[[], object] | None:
 
 #: The scenes ``glsandbox bench`` traces (``--quick``: the first only).
 BENCH_SCENES = ("phong", "ray_phong")
-#: Issue 6's goals as time ratios against Embree: gpu >= 1.0x Embree's ray rate, numpy >= 0.1x.
+#: The goals as time ratios against Embree: gpu >= 1.0x Embree's ray rate, numpy >= 0.1x.
 GOALS = {"gpu": 1.0, "numpy": 10.0}
 EMBREE_MISSING = ("ray tracer vs Embree: skipped: embreex not installed "
                   "(uv run --group bench glsandbox bench); rows show the gpu engine against the numpy engine")

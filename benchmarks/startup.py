@@ -17,7 +17,7 @@ from _scratch import scratch_folder
 
 _TMP = scratch_folder("glsandbox-bench-")
 
-#: Issue 24's goal: cold start (with bytecode compiled) at most this ratio of the raw script's.
+#: The goal: cold start (with bytecode compiled) at most this ratio of the raw script's.
 COLD_START_GOAL = 1.2
 
 

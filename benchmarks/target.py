@@ -3,7 +3,7 @@
 Both sides clear colour and depth the way a frame starts (every channel, alpha 1, then the
 RGB mask: ``_raw.clear``) and read the frame back, at the course's 800x600 and at 1080p.
 The target is what every glsandbox frame is drawn into (``glsandbox.gl.target``): its
-depth buffer comes through raw GL calls, the framebuffer's from moderngl. Goal (issue 24):
+depth buffer comes through raw GL calls, the framebuffer's from moderngl. Goal:
 the target costs what a framebuffer costs at every size (<= 1.05x).
 """
 

@@ -21,7 +21,7 @@ A model file is one call: ``Node("bunny", glsandbox.load_mesh("bunny.obj", fit=T
 :func:`load_model` gives its texture and colour too (:mod:`glsandbox.meshfile`),
 and :mod:`glsandbox.meshgen` makes models without a file.
 
-The layers below (the README's "How it works" table) import downwards only;
+The layers below (the table in docs/how-it-works.md) import downwards only;
 :func:`run` is the one door up to the command line, opened when called.
 """
 

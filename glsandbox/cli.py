@@ -1,4 +1,4 @@
-"""The ``glsandbox`` command, and ``python -m lessons.<module>``.
+"""The ``glsandbox`` command, and ``python -m glsandbox.lessons.<module>``.
 
 ``list``, ``run LESSON``, ``render LESSON --out FILE.png``, ``explain LESSON --pixel X,Y``, ``tour [--out DIR]
 [--lessons DIR]``, ``plan LESSON``, ``compare``, ``new NAME``, ``check LESSON
@@ -176,7 +176,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
     from glsandbox.measure.compare import build_variants, compare_variants, default_out
 
     lesson_cls = find_lesson(args.lesson)
-    out: Path = args.out or default_out(lesson_cls.name)
+    out: Path = args.out or default_out(lesson_cls.name, args.lesson)
     size = _size(args)
     check_writable(out)
     # Everything is parsed and every scene built before a context opens.
@@ -416,6 +416,60 @@ def _checks(args: argparse.Namespace) -> tuple[list, float | None, int | None]:
     return [Check(reference.stem, reference, tuple(args.settings), size, args.samples, tolerances)], None, None
 
 
+def _shard_filter(text: str | None, one: bool) -> Callable[[str], bool]:
+    """``--shard K/N``: which submissions this run grades (:mod:`glsandbox.grading.shards`)."""
+    if text is None:
+        return lambda name: True
+    from glsandbox.grading.shards import in_shard, parse_shard
+
+    if one:
+        raise SandboxError("--shard shares a folder of students among machines; --one grades one student")
+    shard = parse_shard(text)
+    return lambda name: in_shard(name, shard)
+
+
+def cmd_check_merge(argv: list[str]) -> int:
+    """``glsandbox check merge REPORTS...``: the shards' JSON reports as the whole class's reports."""
+    parser = ArgumentParser(prog="glsandbox check merge",
+                            description="Merge the JSON reports of check DIR --shard K/N into the whole class's "
+                                        "reports, as one run would have written them.",
+                            epilog="examples:\n  glsandbox check merge shard-*.json --rubric shading.grading.toml "
+                                   "--json class.json --csv class.csv\n  glsandbox check merge a.json b.json "
+                                   "--golden expected.png --html class.html",
+                            formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("reports", nargs="+", type=Path, metavar="REPORT.json", help="the shards' --json reports")
+    parser.add_argument("--golden", type=Path, default=None, metavar="REF.png", help="the reference they were graded with")
+    parser.add_argument("--rubric", type=Path, default=None, metavar="FILE.toml", help="or the grading file")
+    from glsandbox.grading.reports import REPORTS
+
+    for kind in REPORTS:
+        parser.add_argument(f"--{kind.replace('_', '-')}", dest=kind, type=Path, default=None, metavar="FILE",
+                            help=f"write the {kind.replace('_', ' ')} report")
+    args = parser.parse_args(argv)
+
+    def body() -> int:
+        from glsandbox.grading.check import summary_table
+        from glsandbox.grading.reports import write_reports
+        from glsandbox.grading.rubric import Check, load_rubric
+        from glsandbox.grading.shards import merge_reports
+
+        if (args.golden is None) == (args.rubric is None):
+            raise SandboxError("check merge: give the reference with --golden REF.png or the grading file with "
+                               "--rubric FILE (the one the shards were graded with)")
+        checks = list(load_rubric(args.rubric).checks) if args.rubric else [Check(args.golden.stem, args.golden)]
+        reports = {kind: getattr(args, kind) for kind in REPORTS}
+        for kind, path in reports.items():
+            if path is not None and path.is_dir():
+                raise SandboxError(f"--{kind} {path}: is a folder, expected a file name")
+        results = merge_reports(args.reports, checks)
+        print(summary_table(results))
+        for path in write_reports(results, reports, str(args.rubric or args.golden)):
+            print(f"wrote {path}")
+        return 0 if all(r.status == "PASS" for r in results) else 1
+
+    return run_guarded(body)
+
+
 def cmd_check(args: argparse.Namespace) -> int:
     """``glsandbox check``: render, compare with reference PNGs by the golden rule; 0 all pass, 1 not."""
     from glsandbox.grading.check import Limits, check_folder, check_one, default_jobs, summary_table
@@ -448,9 +502,11 @@ def cmd_check(args: argparse.Namespace) -> int:
         if args.update:
             raise SandboxError(f"--update writes references from the model answer: give one lesson, not the folder {target}")
 
+        from glsandbox.grading import portable
         from glsandbox.grading.layers import describe
 
-        layers_line = describe()  # which layers confine a submission on this machine
+        # which layers confine a submission on this machine
+        layers_line = portable.describe() if portable.wanted() else describe()
         bars = []  # the progress bar, made when the first submission reports (the total known then)
 
         def report(done: int, total: int, result) -> None:
@@ -465,8 +521,9 @@ def cmd_check(args: argparse.Namespace) -> int:
             bars[0].update(1)
 
         try:
+            keep = _shard_filter(args.shard, args.one)
             results = check_folder(target, checks, args.backend, limits, report, getattr(args, "entry", None),
-                                   one=args.one)
+                                   one=args.one, keep=keep)
         finally:
             for bar in bars:
                 bar.close()
@@ -476,6 +533,8 @@ def cmd_check(args: argparse.Namespace) -> int:
         for path in write_reports(results, reports, title):
             print(f"wrote {path}")
         return 0 if all(r.status == "PASS" for r in results) else 1
+    if args.shard is not None:
+        raise SandboxError(f"--shard {args.shard}: shares a folder of submissions among machines; give a folder")
     if any(path is not None for path in reports.values()):
         raise SandboxError(f"--{', --'.join(k.replace('_', '-') for k in REPORTS)} report a folder of submissions; give a folder")
     failed = False
@@ -499,6 +558,16 @@ def cmd_check(args: argparse.Namespace) -> int:
             print(f"  {kind:<8}: {path}")
         failed = failed or not one.match.passed
     return 1 if failed else 0
+
+
+def cmd_gradescope(args: argparse.Namespace) -> int:
+    """``glsandbox gradescope``: the Gradescope autograder zip of a grading file (:mod:`glsandbox.grading.gradescope`)."""
+    from glsandbox.grading.gradescope import build_bundle
+
+    names = build_bundle(args.assignment, args.out, args.wheel)
+    print(f"wrote {args.out}: {', '.join(names)}")
+    print("next: upload it as the assignment's autograder (Gradescope: Configure Autograder, zip file)")
+    return 0
 
 
 def cmd_tradeoffs(args: argparse.Namespace) -> int:
@@ -530,6 +599,38 @@ def cmd_bench(args: argparse.Namespace) -> int:
     from glsandbox.measure.bench import run_all
 
     return run_all(json_path=args.json, quick=args.quick, only=args.only)
+
+
+#: The manual's site configuration in a checkout: beside the package, at the repository's top.
+MKDOCS_CONFIG = Path(__file__).resolve().parent.parent / "mkdocs.yml"
+
+
+def cmd_docs(args: argparse.Namespace) -> int:
+    """``glsandbox docs``: serve the manual's site (MkDocs) locally, or with ``--build`` write it strictly."""
+    import importlib.util
+    import os
+    import subprocess
+
+    if not MKDOCS_CONFIG.is_file():
+        raise SandboxError(f"glsandbox docs builds the manual from a checkout: {MKDOCS_CONFIG} not found "
+                           "(an installed glsandbox has no docs/ folder)")
+    if importlib.util.find_spec("mkdocs") is None:
+        raise SandboxError("glsandbox docs needs the docs dependency group: uv sync, or uv run --group docs "
+                           "glsandbox docs")
+    if not 0 < args.port < 65536:
+        raise SandboxError(f"--port {args.port}: expected a port number 1-65535")
+    if args.build is not None and args.build.exists() and not args.build.is_dir():
+        raise SandboxError(f"--build {args.build}: not a folder")
+    command = [sys.executable, "-m", "mkdocs"]
+    if args.build is not None:
+        command += ["build", "--strict", "--config-file", str(MKDOCS_CONFIG), "--site-dir", str(args.build.resolve())]
+    else:
+        command += ["serve", "--config-file", str(MKDOCS_CONFIG), "--dev-addr", f"127.0.0.1:{args.port}"]
+    env = {**os.environ, "NO_MKDOCS_2_WARNING": "1"}  # the theme's notice about its successor, on every build
+    try:
+        return subprocess.run(command, env=env, cwd=MKDOCS_CONFIG.parent).returncode
+    except KeyboardInterrupt:  # Ctrl+C ends serve
+        return 0
 
 
 #: Each command: (what it does, in one line; examples). ``glsandbox COMMAND --help`` shows both.
@@ -566,6 +667,10 @@ COMMANDS: dict[str, tuple[str, tuple[str, ...]]] = {
                "glsandbox check submissions/ --rubric shading.grading.toml --html marks.html",
                "glsandbox check --one submission/ --rubric shading.grading.toml --student-report mine.html",
                "glsandbox check phong --golden phong.png --update")),
+    "gradescope": ("build a Gradescope autograder zip from a grading file: setup.sh, run_autograder, the "
+                   "checks, their goldens (hidden ones too) and this glsandbox as a wheel",
+                   ("glsandbox gradescope shading.grading.toml --out autograder.zip",
+                    "glsandbox gradescope shading.grading.toml --out autograder.zip --wheel dist/glsandbox-0.1.0-py3-none-any.whl")),
     "tradeoffs": ("time each accuracy knob and compare it with a reference (FLIP, RMSE): report.md, CSV and plot",
                   ("glsandbox tradeoffs --quick", "glsandbox tradeoffs --knob antialiasing --out out/aa")),
     "exercise": ("write the course's functions yourself: list the exercises, start one, check your file "
@@ -575,6 +680,8 @@ COMMANDS: dict[str, tuple[str, tuple[str, ...]]] = {
                   "glsandbox exercise check ray_sphere my_sphere.py --html report.html")),
     "bench": ("run every benchmark in benchmarks/ and print one table of side-by-side ratios",
               ("glsandbox bench --quick", "glsandbox bench --only clear_and_swap --json bench.json")),
+    "docs": ("serve the manual's site locally (MkDocs), or build it into a folder",
+             ("glsandbox docs", "glsandbox docs --port 8001", "glsandbox docs --build site")),
 }
 
 
@@ -588,8 +695,8 @@ def add_command(sub: argparse._SubParsersAction, name: str) -> argparse.Argument
 
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     """The command line's parser: every subcommand, or with ``command`` only that one (what a
-    command line naming it parses: the other nine cost argparse about 1.5 ms of a cold start,
-    issue 24; the one built is the same)."""
+    command line naming it parses: the others cost argparse about 1.5 ms of a cold start;
+    the one built is the same)."""
     from glsandbox.version import __version__
 
     def wanted(name: str) -> bool:
@@ -647,7 +754,8 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         p.add_argument("--vary", action="append", default=[], metavar="KEY=V1,V2,...",
                        help="a parameter and its values, one tile each (twice: a grid)")
         add_render_options(p)
-        p.add_argument("--out", type=Path, default=None, help="the PNG to write (default compare_LESSON.png)")
+        p.add_argument("--out", type=Path, default=None, help="the PNG to write (default compare_LESSON.png; "
+                       "for a lesson file, compare_NAME_py.png or compare_NAME_toml.png)")
         p.set_defaults(func=cmd_compare)
 
     if wanted("new"):
@@ -676,6 +784,9 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         p.add_argument("--one", action="store_true",
                        help="LESSON_OR_DIR is one student's folder (its lesson and helper files; Gradescope's "
                             "/autograder/submission), not a folder of students")
+        p.add_argument("--shard", default=None, metavar="K/N",
+                       help="grade only share K of N (by a stable hash of each submission's name; the same on every "
+                            "machine); merge the shards' --json with: glsandbox check merge REPORTS...")
         p.add_argument("--jobs", type=int, default=None, metavar="N",
                        help="submissions graded at once (default: the CPUs this process may use, by its "
                             "cgroup's quota and affinity)")
@@ -693,6 +804,15 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
                            help=f"folder mode: {text}")
         add_render_options(p, size_default="the reference's size")
         p.set_defaults(func=cmd_check)
+
+    if wanted("gradescope"):
+        p = add_command(sub, "gradescope")
+        p.add_argument("assignment", type=Path, metavar="ASSIGNMENT",
+                       help="a grading file NAME.grading.toml (glsandbox new --assignment NAME writes one)")
+        p.add_argument("--out", type=Path, default=Path("autograder.zip"), help="the zip to write (default autograder.zip)")
+        p.add_argument("--wheel", type=Path, default=None, metavar="FILE",
+                       help="this glsandbox's wheel (default: built from the checkout, or packed from the installed one)")
+        p.set_defaults(func=cmd_gradescope)
 
     if wanted("tradeoffs"):
         p = add_command(sub, "tradeoffs")
@@ -719,19 +839,36 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         p.add_argument("--only", action="append", default=[], metavar="NAME",
                        help="only benchmarks whose name contains NAME (repeatable)")
         p.set_defaults(func=cmd_bench)
+
+    if wanted("docs"):
+        p = add_command(sub, "docs")
+        p.add_argument("--build", type=Path, default=None, metavar="DIR",
+                       help="write the site into DIR (strict: a broken link fails) instead of serving it")
+        p.add_argument("--port", type=int, default=8000, help="the local port to serve on (default 8000)")
+        p.set_defaults(func=cmd_docs)
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
+    from glsandbox import supervise
+
     words = sys.argv[1:] if argv is None else argv
+    if words[:2] == ["check", "merge"]:  # a verb of its own: the shards' reports, not a lesson named merge
+        return cmd_check_merge(words[2:])
+    if argv is None and supervise.CHILD_ENV not in os.environ:
+        source = supervise.user_code_in(words)
+        if source is not None:  # a lesson file of the user's: run in a child that cannot end us quietly
+            return supervise.supervised(words, source)
     named = words[0] if words and words[0] in COMMANDS else None  # else: the whole parser (--help, a mistake)
     args = build_parser(named).parse_args(argv)
-    return run_guarded(lambda: args.func(args))
+    status = run_guarded(lambda: args.func(args))
+    supervise.finished()
+    return status
 
 
 def lesson_main(lesson_cls: type[Lesson], argv: list[str] | None = None) -> int:
     """Entry point of a lesson module: a window, or ``--headless --out FILE.png``."""
-    prog = f"python -m lessons.{lesson_cls.name}"
+    prog = f"python -m glsandbox.lessons.{lesson_cls.name}"
     parser = ArgumentParser(prog=prog, description=f"{lesson_cls.title} ({lesson_cls.course_section}): "
                             "opens it in a window, or renders it headless to a PNG.",
                             epilog=f"examples:\n  {prog}\n  {prog} --headless --out {lesson_cls.name}.png",
@@ -752,7 +889,7 @@ def lesson_main(lesson_cls: type[Lesson], argv: list[str] | None = None) -> int:
             from glsandbox.window import run_window
 
             run_window(lesson, size, args.samples, args.backend,
-                       instead=f"or render it headless: python -m lessons.{lesson_cls.name} --headless --out FILE.png")
+                       instead=f"or render it headless: {prog} --headless --out FILE.png")
         return 0
 
     return run_guarded(body)

@@ -201,7 +201,7 @@ def frame_image_scene(image: np.ndarray, name: str = "live-compare") -> Scene:
     """A scene that only shows ``image`` (H, W, 4) texel for pixel over the whole frame."""
     opaque = image.copy()
     opaque[..., 3] = 255
-    return Scene(name, overlays=(Overlay(name, opaque, None, (0, 0)),))
+    return Scene(name, overlays=(Overlay(name, opaque, None, (0, 0), scalable=False),))
 
 
 def compare_scene(variants: list[compare.Variant], columns: int, size: tuple[int, int], renderer: Any,

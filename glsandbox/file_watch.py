@@ -1,5 +1,5 @@
 """Watching the files a window shows: saving one tells the window to reload it
-(a node's own shader, README "Your own shader"; a lesson file, "Your own lesson").
+(a node's own shader, docs/your-own.md "Your own shader"; a lesson file, "Your own lesson").
 
 A cheap modification-time poll, not a file-system notifier (``watchdog``):
 no extra dependency, the files are a handful (a node's own shader and its

@@ -8,8 +8,13 @@ file or the complete new one, never half of one; two writers of the same name
 never share a temporary file; on any error the temporary file is removed.
 
 Every file glsandbox reads by a name the user gave (scene files, textures,
-shaders) is opened by :func:`open_regular`: a named pipe, a device or a
+shaders) is opened by :func:`open_regular`, in binary mode on every system
+(Windows's ``O_BINARY``: text mode would end a PNG at its first 0x1A byte
+and turn its CR LF signature bytes into LF): a named pipe, a device or a
 folder is refused at once instead of blocking forever or failing later.
+
+A path written inside a file (a scene file's texture, model or shader, a
+grading file's golden) means the same on every system: :func:`written_path`.
 """
 
 from __future__ import annotations
@@ -22,19 +27,19 @@ import stat
 import tempfile
 import time
 from collections.abc import Callable
-from pathlib import Path
+from pathlib import Path, PurePath, PurePosixPath, PureWindowsPath
 from typing import TYPE_CHECKING, BinaryIO
 
 import numpy as np
 from PIL import Image
 
-if TYPE_CHECKING:  # annotations only: numpy.typing is not imported at run time (a cold start, issue 24)
+if TYPE_CHECKING:  # annotations only: numpy.typing is not imported at run time (a cold start)
     import numpy.typing as npt
 
 from glsandbox.errors import SandboxError
 
 __all__ = ["NotARegularFile", "atomic_write", "load_png", "next_numbered", "open_regular", "png_bytes", "read_regular", "save_png",
-           "write_text"]
+           "write_text", "written_path"]
 
 
 #: A file name may have 255 bytes; ``mkstemp`` adds 8 random characters and the suffix.
@@ -96,7 +101,7 @@ def atomic_write(path: str | os.PathLike[str], data: bytes | Callable[[BinaryIO]
             f.flush()
             os.fsync(f.fileno())
         os.chmod(tmp_name, 0o644)  # mkstemp makes 0600; outputs are ordinary files
-        os.replace(tmp_name, target)
+        _replace(tmp_name, target)
     except BaseException:
         try:
             os.unlink(tmp_name)
@@ -104,6 +109,26 @@ def atomic_write(path: str | os.PathLike[str], data: bytes | Callable[[BinaryIO]
             pass
         raise
     return target
+
+
+#: Windows refuses to replace a file another program holds open (an image viewer showing the
+#: last render, an editor, a virus scanner's quick look): tries, and the wait after each.
+REPLACE_TRIES = 10
+REPLACE_WAIT_S = 0.05
+
+
+def _replace(tmp_name: str, target: Path) -> None:
+    """``os.replace``, tried again while the target is held open by another program (Windows:
+    a sharing violation, PermissionError); then one PermissionError that says so."""
+    for attempt in range(REPLACE_TRIES):
+        try:
+            os.replace(tmp_name, target)
+            return
+        except PermissionError:
+            if attempt == REPLACE_TRIES - 1:
+                raise PermissionError(13, f"cannot replace {target}: another program has it open or it is "
+                                          "read-only (close it, or write to another name)", os.fspath(target)) from None
+            time.sleep(REPLACE_WAIT_S)
 
 
 class NotARegularFile(OSError):
@@ -118,6 +143,37 @@ _KINDS = ((stat.S_ISFIFO, "a named pipe (FIFO)"), (stat.S_ISSOCK, "a socket"), (
           (stat.S_ISBLK, "a block device"))
 
 
+#: How a user's file is opened: read only, binary (Windows), without blocking on a pipe (POSIX),
+#: not inherited by child processes.
+READ_FLAGS = (os.O_RDONLY | getattr(os, "O_BINARY", 0) | getattr(os, "O_NONBLOCK", 0)
+              | getattr(os, "O_CLOEXEC", 0) | getattr(os, "O_NOINHERIT", 0))
+
+
+def written_path(text: str, folder: str | os.PathLike[str], *, windows: bool = os.name == "nt") -> Path:
+    """A path written inside a file in ``folder`` (a scene file's ``texture``, ``mesh`` or
+    ``shader``, a grading file's ``golden``), as this system names it.
+
+    Written on any system, it means the same on every one: ``/`` and ``\\`` both
+    separate folders (``textures\\brick.png`` from Windows works on Linux), and a
+    relative path is relative to ``folder``, not the shell's working directory. A
+    drive letter or UNC path (``C:\\course\\brick.png``) is absolute on Windows and
+    refused elsewhere with a :class:`SandboxError`: no other system can reach it.
+    """
+    return Path(_written(text, PureWindowsPath(folder) if windows else PurePosixPath(folder), windows))
+
+
+def _written(text: str, folder: PurePath, windows: bool) -> PurePath:
+    """:func:`written_path` on pure paths (``windows`` picks the flavour, so both are tested anywhere)."""
+    as_windows = PureWindowsPath(text)
+    if windows:
+        return as_windows if as_windows.is_absolute() or as_windows.drive else folder / as_windows
+    if as_windows.drive:
+        raise SandboxError(f"{text!r} is a Windows path (drive {as_windows.drive}): write it relative to the file "
+                           "that names it, with / or \\ between folders")
+    posix = PurePosixPath(text.replace("\\", "/"))
+    return posix if posix.is_absolute() else folder / posix
+
+
 def open_regular(path: str | os.PathLike[str]) -> BinaryIO:
     """Open a regular file for reading (binary), refusing anything else.
 
@@ -128,7 +184,7 @@ def open_regular(path: str | os.PathLike[str]) -> BinaryIO:
     :class:`PermissionError`, :class:`NotARegularFile` or another
     :class:`OSError`.
     """
-    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
+    fd = os.open(path, READ_FLAGS)
     try:
         mode = os.fstat(fd).st_mode
         if stat.S_ISDIR(mode):
@@ -230,7 +286,7 @@ def _png_image(image: npt.ArrayLike) -> Image.Image:
 class _PngBuffer(io.BytesIO):
     """An in-memory file named ``*.png``: Pillow then takes the format from the name and
     imports only its PNG plugin, where ``format="PNG"`` imports five (BMP, GIF, JPEG, PPM
-    and PNG: about 2 ms of every cold start, issue 24). The bytes are the same."""
+    and PNG: about 2 ms of every cold start). The bytes are the same."""
 
     name = "image.png"
 

@@ -112,7 +112,7 @@ def trace_viewports(scene: Scene, size: tuple[int, int], ctx: object | None = No
             image = np.ascontiguousarray(image[rows][:, cols])
         else:
             image = render(single, (w, h), engine, ctx=ctx, **TRACE_OPTIONS)
-        images[i] = Overlay(traced_image_name(i), image, viewport=i, position=(0, 0))
+        images[i] = Overlay(traced_image_name(i), image, viewport=i, position=(0, 0), scalable=False)
     return traced_scene(scene, images)
 
 

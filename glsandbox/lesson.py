@@ -130,7 +130,7 @@ RENDERER = Param("renderer", "raster", "who draws the 3D content: the rasterizer
                  "(the same Scene)", choices=RENDERERS)
 
 
-#: ``--set u.NAME=value``: a uniform of the scene's own shaders (README "Your own shader").
+#: ``--set u.NAME=value``: a uniform of the scene's own shaders (docs/your-own.md, "Your own shader").
 UNIFORM_PREFIX = "u."
 
 
@@ -186,6 +186,11 @@ def camera_from_numbers(base: Camera, numbers: tuple[float, ...]) -> Camera:
 #: fills it with the interactive camera so a window state renders headless exactly.
 CAMERA = Param("camera", "", "replace the lesson's camera: eye x,y,z, target x,y,z[, fov, near, far] "
                "(empty: the lesson's own)", convert=parse_camera)
+
+#: Every lesson has ``overlay``: off drops the text, figures and helper lines drawn on
+#: the picture (a lesson's own, such as a trail, too), leaving the 3D picture alone.
+OVERLAY = Param("overlay", True, "the text, figures and helper lines drawn on the picture "
+                "(off: the 3D picture alone, to compare pixel for pixel)")
 
 
 class Lesson:
@@ -284,6 +289,8 @@ class Lesson:
         motion = self.motion()
         if motion is None:
             return None
+        if motion.overlays and not self.values.get("overlay", True):
+            motion = replace(motion, overlays={})  # overlay=off: the scene has none to change
         cls = type(self)
         last = cls.__dict__.get("_scene_last")  # (values, their types, scene) of the class's last frame
         if last is not None:  # the same values as the last frame's (the common case): no key hashed
@@ -335,7 +342,7 @@ class Lesson:
         :class:`~glsandbox.scene.Motion` promises that :meth:`build` depends on its
         :attr:`values` alone, and that its scene at any time is the one built at another
         time with this motion applied (a static lesson returns an empty ``Motion()``);
-        its frames then pay only for what moves (issue 24). ``tests/core/test_frame_cache.py``
+        its frames then pay only for what moves. ``tests/core/test_frame_cache.py``
         checks every built-in lesson's promise, pixel for pixel, at several times."""
         return None
 
@@ -348,6 +355,8 @@ class Lesson:
         camera = self.values.get("camera")
         if camera:  # --set camera=...: the lens stays the lesson's where not given
             scene = replace(scene, camera=camera_from_numbers(scene.camera, camera))
+        if scene.overlays and not self.values.get("overlay", True):
+            scene = replace(scene, overlays=())
         plan_mode = self.values.get("effects", "needed")  # effects=all: the bench's everything-on plan
         scene = scene if scene.plan_mode == plan_mode else replace(scene, plan_mode=plan_mode)
         uniforms = {k[len(UNIFORM_PREFIX):]: v for k, v in self.values.items() if k.startswith(UNIFORM_PREFIX)}
@@ -369,7 +378,7 @@ class Lesson:
 SCENES_KEPT = 16
 
 #: The parameters every lesson has; a lesson's own may not reuse their names.
-SHARED_PARAMS = (TIME, RENDERER, EFFECTS_PARAM, CAMERA)
+SHARED_PARAMS = (TIME, RENDERER, EFFECTS_PARAM, CAMERA, OVERLAY)
 
 
 def check_lesson_class(cls: type[Lesson]) -> None:
@@ -421,9 +430,15 @@ def built_scene(lesson: Lesson) -> Scene:
     """``lesson.build()``, checked to be a Scene. A :class:`SandboxError` raised in a lesson
     file's ``build()`` (a Scene, Node or Mesh refusing a value) gets the file and line
     it came from in front. (Any other exception is the lesson's own code: its traceback
-    is shown, see README "The rule for a lesson file".)"""
+    is shown, see docs/your-own.md, "The rule for a lesson file".)"""
     try:
         scene = lesson.build()
+    except SystemExit as exc:  # sys.exit() in build(): no picture, and never a quiet exit 0
+        source = lesson_source(type(lesson))
+        line = _user_line(exc, str(source)) if source is not None else 0
+        where = f"{source}:{line}: " if source is not None else ""
+        raise SandboxError(f"{where}{type(lesson).__name__}.build() exited (SystemExit {exc.code}) "
+                           "before its picture") from None
     except SandboxError as exc:
         source = lesson_source(type(lesson))
         line = _user_line(exc, str(source)) if source is not None else 0
@@ -484,47 +499,52 @@ def register(cls: type[Lesson]) -> type[Lesson]:
     return cls
 
 
-#: The course's own lessons: the ``lessons`` package installed beside ``glsandbox``
-#: (site-packages from the wheel, the repository's folder in a checkout).
-BUILTIN_LESSONS = Path(__file__).resolve().parent.parent / "lessons"
+#: The course's own lessons are the package ``glsandbox.lessons``, under glsandbox's own name,
+#: so that a user's ``lessons/`` folder neither hides them nor is hidden by them. The wheel
+#: installs the repository's top-level ``lessons/`` folder as ``glsandbox/lessons/``; a
+#: checkout keeps it at the top, where :class:`CourseLessonsFinder` finds it.
+COURSE_PACKAGE = "glsandbox.lessons"
+_PACKAGE_DIR = Path(__file__).resolve().parent
+BUILTIN_LESSONS = next((folder for folder in (_PACKAGE_DIR / "lessons", _PACKAGE_DIR.parent / "lessons")
+                        if (folder / "__init__.py").is_file()), _PACKAGE_DIR / "lessons")
+
+
+class CourseLessonsFinder:
+    """A ``sys.meta_path`` finder for ``glsandbox.lessons`` in a checkout: the folder is at the
+    repository's top, not inside the package. Asked last, so an installed wheel's
+    ``glsandbox/lessons/`` is found the ordinary way first."""
+
+    def find_spec(self, fullname: str, path: object = None, target: object = None) -> Any:
+        if fullname != COURSE_PACKAGE or not (BUILTIN_LESSONS / "__init__.py").is_file():
+            return None
+        return importlib.util.spec_from_file_location(fullname, BUILTIN_LESSONS / "__init__.py",
+                                                      submodule_search_locations=[str(BUILTIN_LESSONS)])
+
+
+if not any(type(finder).__name__ == CourseLessonsFinder.__name__ for finder in sys.meta_path):
+    sys.meta_path.append(CourseLessonsFinder())
 
 
 def builtin_lessons() -> types.ModuleType:
-    """The built-in ``lessons`` package, imported from :data:`BUILTIN_LESSONS`.
+    """The course's lessons package, ``glsandbox.lessons`` (from :data:`BUILTIN_LESSONS`).
 
-    Not by a search of ``sys.path``: a student's own ``lessons/`` folder in
-    the working directory (first on the path under ``python -m`` and in
-    Jupyter) would shadow the course's. Once imported, ``lessons.<name>``
-    resolves through this package's own folder, so the lessons' imports of
-    each other (``from lessons._scenes import ...``) find the course's too.
+    Not ``lessons`` on ``sys.path``: a student's own ``lessons/`` folder in the
+    working directory (first on the path under ``python -m`` and in Jupyter)
+    would shadow the course's, and the course's would shadow the student's.
     """
-    loaded = sys.modules.get("lessons")
-    if loaded is None:
-        spec = importlib.util.spec_from_file_location("lessons", BUILTIN_LESSONS / "__init__.py",
-                                                      submodule_search_locations=[str(BUILTIN_LESSONS)])
-        if spec is None or spec.loader is None or not (BUILTIN_LESSONS / "__init__.py").is_file():
-            raise SandboxError(f"the course's lessons are missing from {BUILTIN_LESSONS}; reinstall glsandbox")
-        loaded = importlib.util.module_from_spec(spec)
-        sys.modules["lessons"] = loaded
-        try:
-            spec.loader.exec_module(loaded)
-        except BaseException:
-            del sys.modules["lessons"]
+    try:
+        return importlib.import_module(COURSE_PACKAGE)
+    except ModuleNotFoundError as exc:
+        if exc.name != COURSE_PACKAGE:
             raise
-        return loaded
-    folders = [Path(folder).resolve() for folder in getattr(loaded, "__path__", [])]
-    if folders != [BUILTIN_LESSONS]:
-        where = ", ".join(str(f) for f in folders) or "?"
-        raise SandboxError(f"another package named 'lessons' ({where}) was imported before the course's "
-                           f"({BUILTIN_LESSONS}); rename your folder (e.g. my_lessons)")
-    return loaded
+        raise SandboxError(f"the course's lessons are missing from {BUILTIN_LESSONS}; reinstall glsandbox") from None
 
 
 def all_lessons() -> list[type[Lesson]]:
     """Every lesson in the built-in ``lessons`` package, in course order."""
     for module in pkgutil.iter_modules(builtin_lessons().__path__):
         if not module.name.startswith("_"):
-            importlib.import_module(f"lessons.{module.name}")
+            importlib.import_module(f"{COURSE_PACKAGE}.{module.name}")
     return sorted(_REGISTRY.values(), key=lambda c: (c.order, c.name))
 
 
@@ -535,7 +555,7 @@ LESSON_SUFFIXES = (".py", ".toml")
 def find_lesson(name_or_path: str) -> type[Lesson]:
     """A lesson by name, a scene ``.toml`` file or a lesson ``.py`` file; suggest the closest name.
 
-    A built-in lesson lives in the module of its name (``lessons/<name>.py``),
+    A built-in lesson lives in the module of its name (``glsandbox.lessons.<name>``),
     so that module alone is imported; other names look through every lesson.
     """
     path = Path(name_or_path)
@@ -548,9 +568,9 @@ def find_lesson(name_or_path: str) -> type[Lesson]:
     if name_or_path.isidentifier() and not name_or_path.startswith("_"):
         builtin_lessons()
         try:
-            importlib.import_module(f"lessons.{name_or_path}")
+            importlib.import_module(f"{COURSE_PACKAGE}.{name_or_path}")
         except ModuleNotFoundError as exc:
-            if exc.name != f"lessons.{name_or_path}":
+            if exc.name != f"{COURSE_PACKAGE}.{name_or_path}":
                 raise
         if name_or_path in _REGISTRY:
             return _REGISTRY[name_or_path]

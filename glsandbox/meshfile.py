@@ -225,7 +225,14 @@ def load_model(path: str | os.PathLike[str], *, fit: bool = False, normals: str 
     :data:`NORMALS`; ``crease_angle``: in degrees, 0..180, for crease normals.
     Every problem is one :class:`SandboxError` line naming the file (module
     docstring). Cached by path, modification time, size and options.
+    numpy's floating-point warnings (a vertex at 1e300 overflows a cross
+    product) are not printed: the checks on the results say what is wrong.
     """
+    with np.errstate(all="ignore"):
+        return _load_model(path, fit=fit, normals=normals, crease_angle=crease_angle)
+
+
+def _load_model(path: str | os.PathLike[str], *, fit: bool, normals: str, crease_angle: float) -> Model:
     if normals not in NORMALS:
         raise SandboxError(f"unknown normals {normals!r} for a model file; use one of {', '.join(NORMALS)}")
     if isinstance(crease_angle, bool) or not isinstance(crease_angle, (int, float)) \
@@ -414,7 +421,7 @@ def _parts(p: Path, scene: Any) -> list[_Part]:
     looks: dict[int, Look] = {}  # by material object: many meshes may share one (and its big image)
     with _quiet():
         try:
-            for transform, name in _placements(scene.graph):
+            for transform, name in _placements(scene.graph, p):
                 geometry = scene.geometry.get(name)
                 if isinstance(geometry, trimesh.Trimesh):
                     parts.append(_part(geometry, transform, len(parts), looks))
@@ -425,8 +432,12 @@ def _parts(p: Path, scene: Any) -> list[_Part]:
     return parts
 
 
-def _placements(graph: Any) -> list[tuple[NDArray[np.float64], Any]]:
+def _placements(graph: Any, path: Path) -> list[tuple[NDArray[np.float64], Any]]:
     """``(world transform, geometry name)`` of every node with geometry, in trimesh's node order.
+
+    A node that is its own ancestor (glTF nodes whose ``children`` form a cycle,
+    which the glTF spec forbids) is refused naming ``path`` and the node: the
+    walk up its parents would never reach the root.
 
     Asking trimesh's graph (``graph[node]``) walks the path from the root for
     every node and checks a hash of the whole graph on each call: a chain of
@@ -441,7 +452,12 @@ def _placements(graph: Any) -> list[tuple[NDArray[np.float64], Any]]:
 
     def transform_of(node: Any) -> NDArray[np.float64]:
         chain = []  # the node and its ancestors whose transforms are not known yet, deepest first
+        seen = set()
         while node not in world:
+            if node in seen:
+                raise SandboxError(f"model file {path}: node {node!r} is its own ancestor "
+                                   "(its nodes' children form a cycle)")
+            seen.add(node)
             parent = forest.parents.get(node)
             if parent is None:  # not under the root: trimesh would not place it either
                 world[node] = np.eye(4)

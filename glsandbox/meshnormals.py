@@ -55,7 +55,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-if TYPE_CHECKING:  # annotations only: numpy.typing is not imported at run time (a cold start, issue 24)
+if TYPE_CHECKING:  # annotations only: numpy.typing is not imported at run time (a cold start)
     from numpy.typing import NDArray
 
 __all__ = ["BLOCK_FACES", "MODES", "PAIR_LIMIT", "corner_normals", "face_geometry", "face_normals", "normal_groups", "row_ids", "split_vertices",

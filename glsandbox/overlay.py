@@ -39,6 +39,9 @@ class Overlay:
     image: np.ndarray
     viewport: int | None = None
     position: tuple[int, int] = (4, 4)
+    #: Text and figures scale with the region (:func:`overlay_scale`); a picture that
+    #: must land texel for pixel (a traced image, the panel's screen) sets this False.
+    scalable: bool = True
 
     def __post_init__(self) -> None:
         image = np.asarray(self.image)
@@ -50,14 +53,93 @@ class Overlay:
         image.setflags(write=False)
         object.__setattr__(self, "image", image)
 
-    def placement(self, region: tuple[int, int, int, int]) -> tuple[int, int, int, int]:
-        """Where the image lands, as a GL rectangle (x, y from the bottom left, w, h) in pixels."""
-        rx, ry, rw, rh = region
+    def scale(self, region: tuple[int, int, int, int]) -> float:
+        """How much the image grows or shrinks in ``region`` (see :func:`overlay_scale`)."""
+        if not self.scalable:
+            return 1.0
         h, w = self.image.shape[:2]
-        px, py = self.position
+        return overlay_scale(region[2], region[3], w, h)
+
+    def drawn_image(self, region: tuple[int, int, int, int]) -> np.ndarray:
+        """The image as drawn in ``region``: scaled by :meth:`scale` (the same array at 1)."""
+        return scaled_image(self.image, self.scale(region))
+
+    def placement(self, region: tuple[int, int, int, int]) -> tuple[int, int, int, int]:
+        """Where the image lands, as a GL rectangle (x, y from the bottom left, w, h) in pixels:
+        the scaled image (:meth:`drawn_image`), its offset from the corner scaled alike."""
+        rx, ry, rw, rh = region
+        factor = self.scale(region)
+        h, w = self.drawn_image(region).shape[:2]
+        px, py = (round(c * factor) if c >= 0 else -round(-c * factor) for c in self.position)
         left = px if px >= 0 else rw + px - w + 1
         top = py if py >= 0 else rh + py - h + 1
         return rx + left, ry + rh - top - h, w, h
+
+
+#: The frame size (its shorter side, pixels) overlays are drawn for 1:1; a larger frame
+#: grows them by whole texels (sharp text), a smaller one shrinks them.
+REFERENCE_SIZE = 256
+#: The most of its region an overlay may cover, as a share of the region's area, and of
+#: its width and height: past these it is shrunk, so the scene stays visible at any size.
+MAX_AREA_SHARE = 0.16
+MAX_WIDTH_SHARE = 0.6
+MAX_HEIGHT_SHARE = 0.45
+
+
+def overlay_scale(region_w: int, region_h: int, image_w: int, image_h: int) -> float:
+    """The factor an ``image_w`` x ``image_h`` overlay is drawn at in a region of that size.
+
+    It follows the region's shorter side (1 up to :data:`REFERENCE_SIZE`, whole numbers
+    above, so a text's texels stay square), and is capped so the image covers at most
+    :data:`MAX_AREA_SHARE` of the region and :data:`MAX_WIDTH_SHARE` /
+    :data:`MAX_HEIGHT_SHARE` of its sides.
+    """
+    # Below the reference size only the caps shrink it: a short label stays readable.
+    factor = max(1.0, float(np.floor(min(region_w, region_h) / REFERENCE_SIZE)))
+    cap = min(float(np.sqrt(MAX_AREA_SHARE * region_w * region_h / (image_w * image_h))),
+              MAX_WIDTH_SHARE * region_w / image_w, MAX_HEIGHT_SHARE * region_h / image_h)
+    return max(min(factor, cap), 1.0 / max(image_w, image_h))
+
+
+#: Scaled images kept, by (id of the image, size): (the image, kept alive so its id is not reused; the result).
+_SCALED: dict[tuple[int, tuple[int, int]], tuple[np.ndarray, np.ndarray]] = {}
+_SCALED_KEPT = 256
+
+
+def _scaled(image: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    """``image`` resized to ``size`` (w, h): whole-number growth by repeating texels, any
+    other factor by Pillow's box filter on premultiplied colour (no dark fringes)."""
+    h, w = image.shape[:2]
+    if size[0] % w == 0 and size[1] % h == 0 and size[0] // w == size[1] // h:
+        k = size[0] // w
+        out = np.repeat(np.repeat(image, k, axis=0), k, axis=1)
+    else:
+        pre = image.astype(np.float32)
+        pre[..., :3] *= pre[..., 3:4] / 255.0
+        channels = [np.asarray(Image.fromarray(np.ascontiguousarray(pre[..., c])).resize(size, Image.Resampling.BOX))
+                    for c in range(4)]
+        stack = np.dstack(channels)
+        alpha = stack[..., 3:4]
+        stack[..., :3] = np.where(alpha > 0, stack[..., :3] * 255.0 / np.maximum(alpha, 1e-6), 0.0)
+        out = np.clip(np.rint(stack), 0, 255).astype(np.uint8)
+    out.setflags(write=False)
+    return out
+
+
+def scaled_image(image: np.ndarray, factor: float) -> np.ndarray:
+    """``image`` drawn ``factor`` times its size (at least 1x1); the same array at 1."""
+    h, w = image.shape[:2]
+    size = (max(1, round(w * factor)), max(1, round(h * factor)))
+    if size == (w, h):
+        return image
+    key = (id(image), size)
+    entry = _SCALED.get(key)
+    if entry is None or entry[0] is not image:
+        if len(_SCALED) >= _SCALED_KEPT:
+            del _SCALED[next(iter(_SCALED))]
+        entry = (image, _scaled(image, size))
+        _SCALED[key] = entry
+    return entry[1]
 
 
 @lru_cache(maxsize=1)

@@ -308,7 +308,7 @@ def plan(scene: Scene) -> Plan:
 def _traced_plan(scene: Scene, ray: list[int]) -> Plan:
     """The plan of a scene with ray-traced viewports ``ray``: their ``trace`` passes, then
     the plan of the frame the rasterizer draws with their pictures as overlays."""
-    images = {i: Overlay(traced_image_name(i), _PLACEHOLDER, viewport=i, position=(0, 0)) for i in ray}
+    images = {i: Overlay(traced_image_name(i), _PLACEHOLDER, viewport=i, position=(0, 0), scalable=False) for i in ray}
     drawn = plan(traced_scene(scene, images))
     return replace(drawn, passes=(*(trace_pass(scene, i) for i in ray), *drawn.passes),
                    meshes=mesh_notes(scene), notes=renderer_notes(scene), warnings=mesh_warnings(scene))

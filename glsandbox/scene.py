@@ -24,7 +24,7 @@ from glsandbox.errors import NUMBER_LIMIT, SandboxError, check_number, check_num
 from glsandbox.geometry import Mesh
 from glsandbox.overlay import Overlay
 
-if TYPE_CHECKING:  # imported where a scene has a planar effect: a plain render skips it (a cold start, issue 24)
+if TYPE_CHECKING:  # imported where a scene has a planar effect: a plain render skips it (a cold start)
     from glsandbox.planar import Mirror, PlanarShadow
 
 Color = tuple[float, float, float, float]
@@ -313,7 +313,7 @@ class Material:
         return self.shading in LIT_SHADINGS
 
 
-# --- a node's own shader (README "Your own shader") -----------------------------
+# --- a node's own shader (docs/your-own.md, "Your own shader") -----------------------------
 
 #: What the rasterizer gives a node's own shader (``Node.shader``), as
 #: ``(name, GLSL type, space, what)``: the vertex attributes, then the
@@ -361,7 +361,7 @@ def check_uniform_name(name: object, what: str) -> str:
     if not isinstance(name, str) or not _GLSL_NAME.fullmatch(name) or name.startswith("gl_"):
         raise SandboxError(f"{what}: not a GLSL uniform name (letters, digits and _, not gl_...)")
     if name in STANDARD_SHADER_NAMES:
-        raise SandboxError(f"{what}: set by the renderer (the README's table of shader inputs), not by a scene")
+        raise SandboxError(f"{what}: set by the renderer (the manual's table of shader inputs, docs/your-own.md), not by a scene")
     return name
 
 
@@ -617,7 +617,7 @@ class Scene:
             raise SandboxError(f"scene {self.name!r}: samples must be a whole number >= 0, got {plain(self.samples)}")
 
 
-# --- frames that pay only for what moves (issue 24) ------------------------------
+# --- frames that pay only for what moves ------------------------------
 
 
 @dataclass(frozen=True)
@@ -707,7 +707,7 @@ def moved_scene(scene: Scene, motion: Motion) -> Scene:
         if unknown:
             raise SandboxError(f"scene {scene.name!r}: the motion changes overlay "
                                f"{', '.join(map(repr, sorted(unknown)))}, which is not an overlay of the scene")
-        overlays = tuple(Overlay(o.name, images[o.name], o.viewport, o.position) if o.name in images else o
+        overlays = tuple(Overlay(o.name, images[o.name], o.viewport, o.position, o.scalable) if o.name in images else o
                          for o in overlays)
     if motion.lights:
         lights = _moved_lights(scene, motion.lights)

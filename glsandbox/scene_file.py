@@ -1,6 +1,6 @@
 """Scene files: a :class:`~glsandbox.scene.Scene` read from TOML, with line-numbered errors.
 
-The format is the README's "Scene files" section: top-level ``name``,
+The format is docs/commands.md's "Scene files" section: top-level ``name``,
 ``clear_color``, ``depth_test`` and ``depth_mode``, a ``[camera]`` table,
 ``[[nodes]]``, ``[[lights]]`` and ``[[viewports]]`` arrays, and the optional
 ``[mirror]`` and ``[shadow]`` tables that tie the planar effects to nodes by
@@ -34,7 +34,7 @@ import numpy as np
 
 from glsandbox import transforms
 from glsandbox.errors import NUMBER_LIMIT, SandboxError, plain
-from glsandbox.files import check_inside_sandbox, read_user_file
+from glsandbox.files import check_inside_sandbox, read_user_file, written_path
 from glsandbox.geometry import Mesh, builtin_mesh
 from glsandbox.meshfile import CREASE_ANGLE, NORMALS as MESH_NORMALS, Model, ModelPart, is_model_path, load_model
 from glsandbox.planar import Mirror, PlanarShadow
@@ -273,6 +273,15 @@ class _SceneReader:
                 key = next((k for k in ("scale", "translate") if k in data), None)
             raise self.fail("nodes", i, key, message) from None
 
+    def written(self, text: str, table: str, i: int, key: str) -> Path:
+        """A file path written in the scene file, as this system names it (:func:`written_path`:
+        ``/`` or ``\\`` between folders, relative to the scene file); a Windows drive
+        path elsewhere is an error at the key's line."""
+        try:
+            return written_path(text, self.path.parent)
+        except SandboxError as exc:
+            raise self.fail(table, i, key, str(exc)) from None
+
     def shader(self, data: dict[str, Any], i: int) -> tuple[Path | None, dict[str, Any]]:
         """A node's own GLSL file (``shader = "toon.glsl"``, relative to the scene file) and
         its ``[nodes.uniforms]``: numbers, true/false, or lists of 2 to 4 numbers."""
@@ -288,11 +297,9 @@ class _SceneReader:
                 raise fail_uniforms("needs shader = \"<file.glsl>\" (uniforms are the shader's)")
             return None, {}
         text = self.text(data, "shader", "nodes", i)
-        path = Path(text)
         if not text.strip():
             raise self.fail("nodes", i, "shader", "expected a GLSL file path, got an empty text")
-        if not path.is_absolute():
-            path = self.path.parent / path  # relative to the scene file, not the shell
+        path = self.written(text, "nodes", i, "shader")  # relative to the scene file, not the shell
         try:
             check_inside_sandbox(path, "shader file")  # while grading: the submission's own files only
         except SandboxError as exc:
@@ -330,9 +337,7 @@ class _SceneReader:
         assert crease is not None
         if not 0.0 <= crease <= 180.0:
             raise self.fail("nodes", i, "crease_angle", f"expected degrees in 0..180, got {crease:g}")
-        path = Path(mesh_name)
-        if not path.is_absolute():
-            path = self.path.parent / path  # relative to the scene file, not the shell
+        path = self.written(mesh_name, "nodes", i, "mesh")  # relative to the scene file, not the shell
         try:
             return load_model(path, fit=fit, normals=normals, crease_angle=crease)
         except SandboxError as exc:
@@ -376,8 +381,8 @@ class _SceneReader:
             source = data["texture"]
             if not isinstance(source, str):
                 raise self.fail("nodes", i, "texture", f"expected an image name or file path, got {plain(source)}")
-            if source not in BUILTIN_TEXTURES and not Path(source).is_absolute():
-                source = str(self.path.parent / source)  # relative to the scene file, not the shell
+            if source not in BUILTIN_TEXTURES:
+                source = str(self.written(source, "nodes", i, "texture"))  # relative to the scene file
             filter_name = self.text(data, "filter", "nodes", i, default="mip_linear")
             wrap = self.text(data, "wrap", "nodes", i, default="repeat")
             try:

@@ -36,7 +36,7 @@ pyrr stores matrices for row vectors (translation in the last row) and its
 transform-order lesson's tests show). :func:`look_at` and :func:`perspective`
 build pyrr's ``create_look_at`` and ``create_perspective_projection`` here
 with the same operations, transposed into column-vector form, bit for bit (a
-test compares them): importing pyrr cost every start-up about 6 ms (issue 24).
+test compares them): importing pyrr cost every start-up about 6 ms.
 """
 
 from __future__ import annotations

@@ -16,8 +16,11 @@ Course section "Hızlandırma: backface culling, AABB". Nine low-poly spheres
 The table renders the scene with the numpy engine at a small size under six
 combinations and lists the ray-shape and ray-box tests each did (the same
 picture every time) and, with ``timing=on``, the measured time and speed-up.
-The numpy engine computes every lane of a vectorized test anyway, so backface
-culling saves it nothing; the GLSL engine returns early per triangle
+Backface culling skips tests in the numpy engine too: rays that share an
+origin (the primary rays) drop each triangle that faces away from it before
+any test (for a hit ``d·N`` has the sign of ``(V0 − O)·N``), other rays drop
+the pairs with ``d·N > 0`` after that dot product; the count shows the tests
+left and the time falls with it. The GLSL engine returns early per triangle
 (``benchmarks/raytrace.py`` measures both). Below it, with ``rock=on`` (the
 default), the BVH and the AABB alone trace a generated rock of 5,120
 triangles (:data:`ROCK_SIZE`): the shape tests each does and, with

@@ -17,7 +17,7 @@ import sys
 
 import glsandbox
 from glsandbox import Lesson, Scene, register
-from lessons._scenes import demo_scene
+from ._scenes import demo_scene
 
 
 @register

@@ -51,7 +51,7 @@ from glsandbox import (
     transforms,
 )
 from glsandbox.raytrace import SHADOW_EPSILON, Plane, Ray, Sphere, first_hit, in_shadow, reflect, shadow_ray
-from lessons._scenes import KA, KD, KS, demo_scene, dx, lamp, material, sphere
+from ._scenes import KA, KD, KS, demo_scene, dx, lamp, material, sphere
 
 SCENES = ("demo", "exam2013", "exam2012", "far_eye")
 

@@ -171,7 +171,6 @@ class TransformOrder(Lesson):
               choices=transforms.ORDERS, convert=transforms.parse_order),
         Param("speed", 1.0, "R's angle grows by this many radians per second"),
         Param("spin", 1.0, "the centre cube's spin in radians per second"),
-        Param("overlay", True, "the label, matrix, figures and trail (off: pictures compare pixel for pixel)"),
         Param("trail", 2.0, "the trail covers the last this many radians of R", minimum=0.0, maximum=2 * math.pi),
         Param("view", "single", "one order, or all six side by side", choices=("single", "split")),
     )

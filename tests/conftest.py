@@ -18,7 +18,7 @@ from glsandbox.measure.golden import ImageMatch, check_golden
 
 
 # --- golden images ---------------------------------------------------------
-# The rule is glsandbox.measure.golden's (README, "Tests and golden images").
+# The rule is glsandbox.measure.golden's (docs/testing.md).
 # A lesson's goldens live in tests/goldens/<lesson>/<variant>.png (support.GOLDENS_DIR),
 # failure artefacts go to the ignored test-results/ folder.
 
@@ -72,7 +72,7 @@ def golden(request: pytest.FixtureRequest) -> GoldenCheck:
 
 # --- bytecode for subprocesses ----------------------------------------------------
 # Where bytecode writing is off (PYTHONDONTWRITEBYTECODE=1) and nothing compiled the
-# installed packages (`uv sync --compile-bytecode`, README "Tests"), every `glsandbox`
+# installed packages (`uv sync --compile-bytecode`, docs/testing.md), every `glsandbox`
 # subprocess compiles numpy, moderngl, Pillow and glsandbox again (issue 24: `glsandbox
 # render` started in 0.63 s instead of 0.23 s on a quiet machine). The modules this process
 # imported while collecting (the same ones) are compiled once here, and again only when

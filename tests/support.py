@@ -34,11 +34,19 @@ COURSE_BLUE_RGBA8 = (*COURSE_BLUE, 255)
 # --- missing resources: skip locally, fail on CI ----------------------------------------------
 
 
+#: Resources a CI runner's system cannot have (Windows and macOS have no Xvfb, EGL or xdotool),
+#: comma-separated, e.g. ``GLSANDBOX_CI_WITHOUT=Xvfb,EGL,xdotool,named pipes``: they skip
+#: even with CI set (.github/workflows/ci.yml sets it per system); everything else fails.
+CI_WITHOUT = "GLSANDBOX_CI_WITHOUT"
+
+
 def need(resource: str, reason: str) -> None:
     """Skip (locally) or fail (CI) because ``resource`` is unavailable: on CI a missing
-    backend or X server is a broken set-up, never a reason to pass."""
+    backend or X server is a broken set-up, never a reason to pass (unless the runner's
+    system cannot have it: :data:`CI_WITHOUT`)."""
     message = f"{resource} unavailable: {reason}"
-    if os.environ.get("CI"):
+    without = {name.strip() for name in os.environ.get(CI_WITHOUT, "").split(",") if name.strip()}
+    if os.environ.get("CI") and resource not in without:
         pytest.fail(f"{message} (CI is set, so this fails instead of skipping)", pytrace=False)
     pytest.skip(message)
 
@@ -431,6 +439,46 @@ def two_textures_glb(path: Path) -> Path:
         parts.append(square)
     trimesh.Scene(parts).export(path)
     return path
+
+
+def chromium_command(binary: str, profile: Path, size: tuple[int, int]) -> list[str]:
+    """Headless Chromium, offline and quiet, with a fresh profile."""
+    return [binary, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+            "--disable-background-networking", "--disable-component-update", "--disable-sync",
+            "--hide-scrollbars", f"--user-data-dir={profile}", f"--window-size={size[0]},{size[1]}"]
+
+
+# --- a user's own lessons/ package beside the course's ---------------------------------------
+
+#: Run in a folder made by :func:`student_lessons_folder` with ``theirs first`` or ``course first``:
+#: prints the user's ``lessons`` package's file, the course's package's file and the module a
+#: course lesson found by name comes from.
+STUDENT_LESSONS_CHECK = """
+import sys
+def theirs():
+    import lessons, lessons.indexed_cube
+    assert lessons.indexed_cube.MINE == "the user's own", lessons.indexed_cube
+    return lessons.__file__
+def course():
+    import glsandbox, glsandbox.lesson as L
+    cls = L.find_lesson("indexed_cube")
+    L.all_lessons()
+    glsandbox.lesson.builtin_lessons()
+    return sys.modules["glsandbox.lessons"].__file__, cls.__module__
+if sys.argv[1] == "theirs first":
+    mine = theirs(); (package, module) = course()
+else:
+    (package, module) = course(); mine = theirs()
+print(mine, package, module)
+"""
+
+
+def student_lessons_folder(tmp_path: Path) -> Path:
+    """A working directory with a user's own ``lessons`` package, which has an ``indexed_cube`` of its own."""
+    (tmp_path / "lessons").mkdir()
+    (tmp_path / "lessons" / "__init__.py").write_text('"""A student\'s own lessons."""\n')
+    (tmp_path / "lessons" / "indexed_cube.py").write_text('MINE = "the user\'s own"\n')
+    return tmp_path
 
 
 #: A student's right ``ray_sphere`` answer, the notes' geometric test (l, s, m², q; s - q from outside).

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pytest
 from support import REPO_ROOT as REPO
+from support import STUDENT_LESSONS_CHECK, student_lessons_folder
 
 import glsandbox
 from glsandbox import cli
@@ -86,41 +87,24 @@ def test_python_dash_m_glsandbox_is_the_command(tmp_path) -> None:
     assert (proc.returncode, proc.stdout, proc.stderr) == (0, f"glsandbox {glsandbox.__version__}\n", "")
 
 
-def _student_folder(tmp_path: Path, init: str) -> Path:
-    """A working directory with a student's own ``lessons`` package."""
-    (tmp_path / "lessons").mkdir()
-    (tmp_path / "lessons" / "__init__.py").write_text(init)
-    (tmp_path / "lessons" / "indexed_cube.py").write_text("raise SystemExit('the student module was imported')\n")
-    return tmp_path
-
-
-def test_a_students_lessons_folder_does_not_hide_the_course(tmp_path) -> None:
-    folder = _student_folder(tmp_path, "raise SystemExit('the student package was imported')\n")
+def test_a_users_lessons_folder_and_the_courses_lessons_neither_hide_the_other(tmp_path) -> None:
+    folder = student_lessons_folder(tmp_path)
     # python -m puts the working directory first on sys.path, as Jupyter does.
     listed = subprocess.run([sys.executable, "-m", "glsandbox", "list"], capture_output=True, text=True,
                             cwd=folder, timeout=120)
     assert listed.returncode == 0, listed.stderr
     assert listed.stdout.split("\n")[2].startswith("indexed_cube")
-    code = ("import glsandbox.lesson as L; cls = L.find_lesson('indexed_cube'); import lessons; "
-            "print(cls.__module__, lessons.__file__)")
-    found = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=folder, timeout=120)
-    assert found.returncode == 0, found.stderr
-    module, package = found.stdout.split()
-    assert module == "lessons.indexed_cube" and Path(package).parent == REPO / "lessons"
-
-
-def test_a_students_lessons_package_imported_first_is_one_clear_error(tmp_path) -> None:
-    folder = _student_folder(tmp_path, "")
-    code = "import lessons, glsandbox.lesson as L; L.find_lesson('triangle')"
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=folder, timeout=120)
-    last = proc.stderr.strip().splitlines()[-1]
-    assert proc.returncode == 1
-    assert last == (f"glsandbox.errors.SandboxError: another package named 'lessons' ({folder / 'lessons'}) was "
-                    f"imported before the course's ({REPO / 'lessons'}); rename your folder (e.g. my_lessons)")
+    for order in ("theirs first", "course first"):
+        proc = subprocess.run([sys.executable, "-c", STUDENT_LESSONS_CHECK, order], capture_output=True, text=True,
+                              cwd=folder, timeout=120)
+        assert proc.returncode == 0, proc.stderr
+        theirs, course, module = proc.stdout.split()
+        assert Path(theirs) == folder / "lessons" / "__init__.py", order  # the user's own package
+        assert Path(course).parent == REPO / "lessons" and module == "glsandbox.lessons.indexed_cube", order
 
 
 def test_the_lessons_still_run_as_modules_of_the_repository() -> None:
-    proc = subprocess.run([sys.executable, "-m", "lessons.triangle", "--help"], capture_output=True, text=True,
+    proc = subprocess.run([sys.executable, "-m", "glsandbox.lessons.triangle", "--help"], capture_output=True, text=True,
                           cwd=REPO, timeout=60)
     assert proc.returncode == 0 and "--headless" in proc.stdout
 

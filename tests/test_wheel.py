@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 from support import REPO_ROOT as REPO
-from support import need
+from support import STUDENT_LESSONS_CHECK, need, student_lessons_folder
 
 from glsandbox.files import load_png
 
@@ -24,6 +24,11 @@ def run(*args: str, cwd: Path) -> subprocess.CompletedProcess:
     return proc
 
 
+def venv_site(venv: Path) -> Path:
+    """The site-packages folder of a fresh venv."""
+    return next(venv.glob("lib/python3.*/site-packages")).resolve()
+
+
 def test_wheel_installs_in_a_fresh_venv_and_renders_outside_the_repository(tmp_path: Path, gl) -> None:
     uv = shutil.which("uv")
     if uv is None:
@@ -33,7 +38,7 @@ def test_wheel_installs_in_a_fresh_venv_and_renders_outside_the_repository(tmp_p
     wheel = next(dist.glob("glsandbox-*.whl"))
     names = zipfile.ZipFile(wheel).namelist()
     assert "glsandbox/shaders/basic.glsl" in names and "glsandbox/shaders/common/transform.glsl" in names
-    assert "lessons/indexed_cube.py" in names
+    assert "glsandbox/lessons/indexed_cube.py" in names and not any(n.startswith("lessons/") for n in names)
     assert "glsandbox/templates/lesson.py.tmpl" in names and "glsandbox/templates/scene.toml.tmpl" in names
     entry_points = zipfile.ZipFile(wheel).read(next(n for n in names if n.endswith("entry_points.txt"))).decode()
     assert "[pytest11]" in entry_points and "glsandbox = glsandbox.pytest_plugin" in entry_points
@@ -46,7 +51,7 @@ def test_wheel_installs_in_a_fresh_venv_and_renders_outside_the_repository(tmp_p
     elsewhere.mkdir()
     run(str(venv / "bin" / "glsandbox"), "render", "indexed_cube", "--size", "64x48", "--out", "cube.png",
         cwd=elsewhere)
-    run(str(python), "-m", "lessons.triangle", "--headless", "--out", "tri.png", "--size", "64x48", cwd=elsewhere)
+    run(str(python), "-m", "glsandbox.lessons.triangle", "--headless", "--out", "tri.png", "--size", "64x48", cwd=elsewhere)
     assert load_png(elsewhere / "cube.png").shape == (48, 64, 4)
     # glsandbox new reads its templates from the installed package, and what it writes renders
     run(str(venv / "bin" / "glsandbox"), "new", "starter", cwd=elsewhere)
@@ -54,6 +59,15 @@ def test_wheel_installs_in_a_fresh_venv_and_renders_outside_the_repository(tmp_p
         cwd=elsewhere)
     assert load_png(elsewhere / "starter.png").shape == (48, 64, 4)
     assert load_png(elsewhere / "tri.png").shape == (48, 64, 4)
+    # A user's own lessons/ package in the working directory and the installed course's lessons.
+    theirs = tmp_path / "theirs"
+    theirs.mkdir()
+    student_lessons_folder(theirs)
+    run(str(venv / "bin" / "glsandbox"), "render", "indexed_cube", "--size", "64x48", "--out", "cube.png", cwd=theirs)
+    for order in ("theirs first", "course first"):
+        mine, course, module = run(str(python), "-c", STUDENT_LESSONS_CHECK, order, cwd=theirs).stdout.split()
+        assert Path(mine) == theirs / "lessons" / "__init__.py"
+        assert Path(course).parent == venv_site(venv) / "glsandbox" / "lessons" and module == "glsandbox.lessons.indexed_cube"
     # The installed copy found its own shaders, not the repository's.
     located = run(str(python), "-c", "from glsandbox.gl.shaders import shader_root; print(shader_root())",
                   cwd=elsewhere).stdout.strip()

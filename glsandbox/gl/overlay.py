@@ -3,6 +3,7 @@
 Run by :class:`~glsandbox.gl.executor.Executor` for the plan's ``overlay``
 passes. Each image becomes a texture (kept per overlay name and updated when
 its pixels change, so a label that changes every frame reuses one texture),
+scaled to the region's size (:meth:`~glsandbox.overlay.Overlay.drawn_image`),
 and is copied texel for pixel by ``shaders/overlay.glsl`` with straight-alpha
 blending: ``rgb = a*src + (1-a)*dst``. The frame's alpha is not written
 (:data:`glsandbox.gl.target.FRAME_COLOR_MASK`), so the frame stays opaque.
@@ -27,9 +28,9 @@ class OverlayDrawer:
         self._textures: dict[str, tuple[moderngl.Texture, np.ndarray]] = {}
         self._vao: tuple[int, moderngl.VertexArray] | None = None
 
-    def _texture(self, overlay: Overlay) -> moderngl.Texture:
+    def _texture(self, overlay: Overlay, image: np.ndarray) -> moderngl.Texture:
+        """The texture holding ``image``, the overlay's image as drawn (read-only)."""
         entry = self._textures.get(overlay.name)
-        image = overlay.image  # read-only (Overlay makes it so)
         if entry is not None and entry[1] is image:
             return entry[0]  # the same array as last time (a panel made once): nothing to compare
         if entry is not None and entry[1].shape == image.shape and np.array_equal(entry[1], image):
@@ -69,7 +70,7 @@ class OverlayDrawer:
             for draw in step.draws:
                 overlay = by_name[draw.node]
                 rect = overlay.placement(region)
-                self._texture(overlay).use(location=0)
+                self._texture(overlay, overlay.drawn_image(region)).use(location=0)
                 program["u_image"].value = 0
                 program["u_origin"].value = rect[:2]
                 framebuffer.viewport = rect

@@ -163,7 +163,7 @@ def assemble(name: str, stage: str, defines: tuple[tuple[str, str], ...] = (), r
             emit(line, path, line_no)
 
     if user:
-        top = Path(name)
+        top = _shown(Path(name))
     else:
         top = find_shader_file(f"{name}.glsl", roots)
         if not top.is_file():
@@ -195,10 +195,24 @@ def _include(relative: str, including: Path, roots: list[Path], where: str) -> P
     raise SandboxError(f"{where}: #include \"{relative}\" not found (looked in {', '.join(map(str, folders))})")
 
 
+def _shown(path: Path) -> Path:
+    """A user's shader path as errors show it: relative to the working folder when inside it
+    (as lesson file errors are), else as given."""
+    try:
+        return path.resolve().relative_to(Path.cwd().resolve()) if path.is_absolute() else path
+    except (ValueError, OSError):
+        return path
+
+
 def _read_lines(path: Path, included_from: str | None) -> list[str]:
-    """The lines of a shader file; a missing, unreadable or non-UTF-8 file is one error naming it."""
+    """The lines of a shader file; a missing, unreadable, non-UTF-8 file or one holding a NUL
+    byte (which GL would take as the end of the text) is one error naming it."""
     where = f"{included_from}: " if included_from else ""
     raw = read_user_file(path, f"{where}shader file", "a text file")
+    if b"\0" in raw:
+        line = raw[:raw.index(b"\0")].count(b"\n") + 1
+        raise SandboxError(f"{path}:{line}: shader file holds a NUL byte (a binary file, or text cut short?)"
+                           + (f", included from {included_from}" if included_from else ""))
     try:
         return raw.decode("utf-8").splitlines()
     except UnicodeDecodeError as exc:

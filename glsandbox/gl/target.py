@@ -5,7 +5,7 @@ whose depth (24 bits) or packed depth-stencil (24 + 8 bits) attachment comes
 from :mod:`glsandbox.gl.rawgl`. With MSAA the frame is resolved into a
 single-sample framebuffer before it is read back.
 
-Frames are opaque (issue 12): a target's alpha is 1 everywhere, as the
+Frames are opaque: a target's alpha is 1 everywhere, as the
 window shows the frame, so PNGs, goldens and the gallery keep what the
 screen shows. The rule lives here, in :data:`FRAME_COLOR_MASK`.
 """
@@ -38,7 +38,7 @@ def clear_opaque(framebuffer: moderngl.Framebuffer, rgb: tuple[float, float, flo
 
     The clear writes every channel: under a partial mask llvmpipe cannot clear
     by filling, it reads and writes every pixel (+0.5 ms at 800x600, +2 ms at
-    1080p, issue 24). Alpha 1 is what the masked clear kept, so the picture is
+    1080p). Alpha 1 is what the masked clear kept, so the picture is
     the same. moderngl applies a framebuffer's mask at its ``clear()`` and
     ``use()`` only (setting ``color_mask`` alone reaches no GL state), so the
     framebuffer is bound again after the clear (it is the bound one while a

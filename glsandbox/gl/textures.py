@@ -90,7 +90,7 @@ class TextureCache:
         # On Mesa's llvmpipe (22.3) a texture uploaded and mipmapped (glGenerateMipmap renders
         # each level) while a frame is in flight is left so that every later bind of it between
         # two draws flushes the frame and waits for the rasterizer: 4-15 ms of wall time and
-        # +30-50 us of main-thread CPU per frame, for as long as the texture lives (issue 24: the
+        # +30-50 us of main-thread CPU per frame, for as long as the texture lives (the
         # texture lesson's cube). Finishing the queued work first (once per upload) leaves it an
         # ordinary texture; the sampler objects were not the cause, and the pixels are the same.
         self.ctx.finish()

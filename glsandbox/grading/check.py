@@ -27,18 +27,21 @@ import re
 import sys
 import time
 import unicodedata
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
+from PIL import Image
 
 from glsandbox import files
 from glsandbox.errors import SandboxError
 from glsandbox.frame import DEFAULT_SIZE, Frame, HeadlessRenderer
 from glsandbox.lesson import Lesson, entry_point, lesson_files, user_code_error
 from glsandbox.measure.golden import DEFAULT_THRESHOLD, ImageMatch, compare_images, write_artifacts
-from glsandbox.grading.isolate import BROKEN, CRASHED, OOM, TIMEOUT, Job, JobResult, Picture, Render, run_jobs
+from glsandbox.grading.isolate import BROKEN, CRASHED, OOM, TIMEOUT, Job, JobResult, Picture, Render
+from glsandbox.grading.runner import run_jobs
 from glsandbox.grading.kinds import kind_of
 from glsandbox.grading.rubric import Check
 
@@ -83,7 +86,13 @@ def read_reference(path: Path) -> np.ndarray:
         raise SandboxError(f"reference {path}: an empty file, not a PNG image; write it from the model answer "
                            "with --update")
     try:
-        return files.load_png(io.BytesIO(data))
+        with warnings.catch_warnings():
+            # A decompression bomb (a small file that decodes to gigabytes): refused, past
+            # Pillow's warning size too, before its pixels are decoded.
+            warnings.simplefilter("error", Image.DecompressionBombWarning)
+            return files.load_png(io.BytesIO(data))
+    except (Image.DecompressionBombError, Image.DecompressionBombWarning) as exc:
+        raise SandboxError(f"reference {path}: too large to decode safely ({' '.join(str(exc).split())})") from None
     except (OSError, ValueError, SyntaxError):  # Pillow's reason names its buffer object, no use to a reader
         raise SandboxError(f"reference {path}: not a PNG image ({len(data)} bytes that PNG cannot read)") from None
 
@@ -376,7 +385,8 @@ def read_references(checks: Sequence[Check]) -> dict[Path, np.ndarray]:
 
 def check_folder(folder: Path, checks: Sequence[Check], backend: str | None = None, limits: Limits = Limits(),
                  progress: Callable[[int, int, CheckResult], None] = lambda done, total, result: None,
-                 entry: str | None = None, one: bool = False) -> list[CheckResult]:
+                 entry: str | None = None, one: bool = False,
+                 keep: Callable[[str], bool] = lambda name: True) -> list[CheckResult]:
     """Grade every submission in ``folder`` against ``checks``; never stops at a broken one.
 
     ``progress`` hears each submission as it finishes (in the order they
@@ -385,11 +395,13 @@ def check_folder(folder: Path, checks: Sequence[Check], backend: str | None = No
     lesson file's name in a student's folder (the rubric's); ``one``: the
     folder is one student's. A submission that is a symbolic link is BROKEN
     without running; submissions that are the same files are marked
-    (:func:`mark_duplicates`).
+    (:func:`mark_duplicates`). ``keep``: which submissions (by name) this run grades (a shard,
+    :mod:`glsandbox.grading.shards`).
     """
     found = submissions(folder, entry, one)
     if not found or (one and not folder.is_dir()):
         raise SandboxError(f"{folder}: no .py or .toml lesson files (nor subfolders holding one)")
+    found = [e for e in found if keep(e[0])]
     references = read_references(checks)
     renders = _renders(checks, references)
     links = [(name, source) for name, source, _ in found if source.is_symlink()]

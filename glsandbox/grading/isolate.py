@@ -227,7 +227,8 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
 
     The grader becomes a subreaper for the run, so a process a submission
     leaves behind whose supervisor was killed still comes back here, and is
-    killed at the end with everything else the run started.
+    killed at the end with everything else the run started. (:func:`glsandbox.grading.runner.run_jobs`
+    chooses between this and :mod:`glsandbox.grading.portable`.)
     """
     if not hasattr(os, "fork"):
         from glsandbox.errors import SandboxError

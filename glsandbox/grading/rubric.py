@@ -36,7 +36,7 @@ from pathlib import Path
 from typing import Any
 
 from glsandbox.errors import SandboxError, parse_size_text
-from glsandbox.files import read_user_file
+from glsandbox.files import read_user_file, written_path
 from glsandbox.grading.kinds import COMMON_KEYS, kind_of, known
 from glsandbox.measure.golden import DEFAULT_MAX_BAD_SHARE, DEFAULT_THRESHOLD
 
@@ -164,7 +164,10 @@ def _check(entry: dict[str, Any], number: int, path: Path) -> Check:
     golden = entry.get("golden")
     if not isinstance(golden, str) or not golden.lower().endswith(".png"):
         raise SandboxError(f"{where}: golden = {golden!r}: expected the path of a .png file")
-    golden_path = path.parent / golden
+    try:
+        golden_path = written_path(golden, path.parent)  # relative to this file; / or \\ between folders
+    except SandboxError as exc:
+        raise SandboxError(f"{where}: golden: {exc}") from None
     name = entry.get("name", golden_path.stem)
     if not isinstance(name, str) or not name.strip() or not name.isprintable():
         raise SandboxError(f"{where}: name = {name!r}: expected a short printable text")
@@ -243,7 +246,7 @@ def exercise_check(entry: dict[str, Any], where: str, path: Path) -> Check:
 
 #: The starting rubric ``glsandbox new --assignment NAME`` writes beside the model answer.
 STARTER = """\
-# Grading file for the assignment "$name" (see the README, "Grading a class").
+# Grading file for the assignment "$name" (see the manual, docs/grading-a-class.md).
 #   1. write the goldens from the model answer:
 #        glsandbox check $name.py --rubric $name.grading.toml --update
 #   2. grade a folder of submissions (one .py/.toml file or one folder per student):

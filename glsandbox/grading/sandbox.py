@@ -66,7 +66,6 @@ def read_roots(extra: Iterable[str | os.PathLike[str]] = ()) -> list[str]:
 def _base_roots() -> tuple[str, ...]:
     """:func:`read_roots` without the extra folders: the same for every submission of a run, so
     worked out once (in the zygote, before it forks)."""
-    import importlib.util
 
     roots = {sys.prefix, sys.base_prefix, sys.exec_prefix, *SYSTEM_READ,
              str(Path(__file__).resolve().parents[1])}  # the glsandbox package
@@ -75,9 +74,9 @@ def _base_roots() -> tuple[str, ...]:
         if path:
             roots.add(path)
     roots.update(p for p in sys.path if p.endswith(("site-packages", "dist-packages")))
-    spec = importlib.util.find_spec("lessons")  # the course's lessons, which a submission may subclass
-    if spec is not None and spec.submodule_search_locations:
-        roots.update(str(Path(p).resolve()) for p in spec.submodule_search_locations)
+    from glsandbox.lesson import BUILTIN_LESSONS
+
+    roots.add(str(BUILTIN_LESSONS))  # the course's lessons, which a submission may subclass
     from glsandbox.gl.shaders import shader_roots
 
     roots.update(str(p) for p in shader_roots())  # glsandbox's shaders, and GLSANDBOX_SHADER_DIR's

@@ -34,7 +34,7 @@ __all__ = ["PRELOAD", "zygote_main"]
 #: opens a GL context at import).
 PRELOAD = ["glsandbox.grading.worker", "glsandbox.frame", "glsandbox.lesson", "glsandbox.scene_file",
            "glsandbox.grading.sandbox", "glsandbox.gl.context", "glsandbox.gl.shaders", "numpy", "moderngl",
-           "glcontext", "glcontext.egl", "PIL.Image", "lessons"]
+           "glcontext", "glcontext.egl", "PIL.Image", "glsandbox.lessons"]
 
 
 
@@ -63,7 +63,6 @@ def _renderer(job: Job, root: str, target: str, work: str, out: int, ids: tuple[
     from glsandbox.frame import HeadlessRenderer
     from glsandbox.grading import layers
     from glsandbox.grading.sandbox import confine, landlock_abi
-    from glsandbox.lesson import find_lesson, submission_lesson, user_code_error
 
     os.setsid()
     null = os.open(os.devnull, os.O_RDONLY)
@@ -96,41 +95,7 @@ def _renderer(job: Job, root: str, target: str, work: str, out: int, ids: tuple[
         if not confine(root, [root if job.copy else cwd, cwd], cache_writable=job.writes_cache) and kept_reading:
             layers.drop_reading()
         layers.install_seccomp()
-        try:
-            cls = find_lesson(target) if job.source is None else submission_lesson(Path(root) / target, job.entry)
-        except MemoryError as exc:
-            send(out, {"kind": "oom", "index": 0, "error": str(user_code_error(exc)), "all": True})
-            return
-        except SandboxError as exc:
-            send(out, {"kind": "broken", "index": 0, "error": str(exc), "all": True})
-            return
-        except BaseException as exc:  # noqa: BLE001 - anything the submission raised while loading
-            send(out, {"kind": "broken", "index": 0, "error": str(user_code_error(exc)), "all": True})
-            return
-        if job.describe:  # the tour's card: read from the class now, sent as text
-            try:
-                from glsandbox.lesson import lesson_description
-
-                send(out, {"kind": "meta", "title": str(cls.title)[:500], "course_section": str(cls.course_section)[:500],
-                           "description": str(lesson_description(cls))[:2000]})
-            except BaseException:  # noqa: BLE001 - a class whose attributes raise: its card says less
-                pass
-        for index, render in enumerate(job.renders):
-            started = time.perf_counter()
-            try:
-                frame = renderer.render(cls.from_settings(render.settings), render.size, render.samples)
-                image = np.ascontiguousarray(frame.image, dtype=np.uint8)
-                header = {"kind": "image", "index": index, "shape": list(image.shape),
-                          "seconds": time.perf_counter() - started}
-                if job.describe:
-                    header["info"] = {"plan": frame.plan.to_dict(), "plan_text": frame.plan.describe()}
-                send(out, header, image.tobytes())
-            except MemoryError as exc:
-                send(out, {"kind": "oom", "index": index, "error": str(user_code_error(exc))})
-            except SandboxError as exc:
-                send(out, {"kind": "broken", "index": index, "error": str(exc)})
-            except BaseException as exc:  # noqa: BLE001 - KeyboardInterrupt, SystemExit, its own kinds
-                send(out, {"kind": "broken", "index": index, "error": str(user_code_error(exc))})
+        render_job(job, renderer, root, target, out)
     except BaseException:  # noqa: BLE001 - the pipe closed, or worse: the supervisor reports it
         code = 3
     finally:
@@ -140,6 +105,50 @@ def _renderer(job: Job, root: str, target: str, work: str, out: int, ids: tuple[
             except BaseException:  # noqa: BLE001 - replaced or closed by the submission
                 pass
         os._exit(code)  # no atexit handler, no thread, no finaliser of the submission runs
+
+
+def render_job(job: Job, renderer, root: str, target: str, out: int) -> None:
+    """Load the submission's lesson (``target`` in ``root``, or a built-in lesson's name) and send
+    each of the job's pictures on ``out`` as it is drawn, or the error that stopped it: the
+    renderer's work once confined, on either path (this one and :mod:`glsandbox.grading.portable`)."""
+    from glsandbox.errors import SandboxError
+    from glsandbox.lesson import find_lesson, submission_lesson, user_code_error
+
+    try:
+        cls = find_lesson(target) if job.source is None else submission_lesson(Path(root) / target, job.entry)
+    except MemoryError as exc:
+        send(out, {"kind": "oom", "index": 0, "error": str(user_code_error(exc)), "all": True})
+        return
+    except SandboxError as exc:
+        send(out, {"kind": "broken", "index": 0, "error": str(exc), "all": True})
+        return
+    except BaseException as exc:  # noqa: BLE001 - anything the submission raised while loading
+        send(out, {"kind": "broken", "index": 0, "error": str(user_code_error(exc)), "all": True})
+        return
+    if job.describe:  # the tour's card: read from the class now, sent as text
+        try:
+            from glsandbox.lesson import lesson_description
+
+            send(out, {"kind": "meta", "title": str(cls.title)[:500], "course_section": str(cls.course_section)[:500],
+                       "description": str(lesson_description(cls))[:2000]})
+        except BaseException:  # noqa: BLE001 - a class whose attributes raise: its card says less
+            pass
+    for index, render in enumerate(job.renders):
+        started = time.perf_counter()
+        try:
+            frame = renderer.render(cls.from_settings(render.settings), render.size, render.samples)
+            image = np.ascontiguousarray(frame.image, dtype=np.uint8)
+            header = {"kind": "image", "index": index, "shape": list(image.shape),
+                      "seconds": time.perf_counter() - started}
+            if job.describe:
+                header["info"] = {"plan": frame.plan.to_dict(), "plan_text": frame.plan.describe()}
+            send(out, header, image.tobytes())
+        except MemoryError as exc:
+            send(out, {"kind": "oom", "index": index, "error": str(user_code_error(exc))})
+        except SandboxError as exc:
+            send(out, {"kind": "broken", "index": index, "error": str(exc)})
+        except BaseException as exc:  # noqa: BLE001 - KeyboardInterrupt, SystemExit, its own kinds
+            send(out, {"kind": "broken", "index": index, "error": str(user_code_error(exc))})
 
 
 # --- the supervisor (child) ------------------------------------------------------------------

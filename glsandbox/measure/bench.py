@@ -16,7 +16,7 @@ the subject's extra CPU per repetition is a column of its own, steadier than
 wall time on a shared machine (GL drivers' worker threads in this process are
 not in it). Speed goals are printed, never
 asserted: no test depends on a timing, which a busy machine would fail
-(README, "Benchmarks").
+(docs/benchmarks.md).
 
 The same harness drives ``python benchmarks/cube_frame.py`` on its own.
 """
@@ -24,7 +24,10 @@ The same harness drives ``python benchmarks/cube_frame.py`` on its own.
 from __future__ import annotations
 
 import importlib.util
+import datetime
 import json
+import os
+import platform
 import statistics
 import subprocess
 import sys
@@ -50,7 +53,7 @@ from glsandbox.gl.context import headless_order
 
 #: The frame size of the frame benchmarks (the course's 800x600 window).
 FRAME_SIZE = (800, 600)
-#: Goals of a lesson frame against its raw-ModernGL baseline (issue 24): at most this ratio
+#: Goals of a lesson frame against its raw-ModernGL baseline: at most this ratio
 #: of the raw frame's wall time, and at most this much extra main-thread CPU (µs) per frame.
 LESSON_FRAME_GOAL = 1.05
 LESSON_FRAME_CPU_GOAL_US = 50.0
@@ -376,12 +379,20 @@ def run_all(json_path: Path | None = None, quick: bool = False, only: Sequence[s
     for text in env.notes:
         print(text)
     if json_path is not None:
-        data = {"title": title, "renderer": renderer, "rounds": rounds, "quick": quick,
+        data = {"title": title, "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+                "machine": machine(), "renderer": renderer, "rounds": rounds, "quick": quick,
                 "seconds": round(time.perf_counter() - started, 2), "cases": [r.to_dict() for r in results],
                 "notes": list(env.notes)}
         write_text(json_path, json.dumps(data, indent=2) + "\n")
         print(f"wrote {json_path}")
     return 0
+
+
+def machine() -> str:
+    """The machine a run measured on, in one line: system, processor and cores, Python."""
+    cpu = platform.processor() or platform.machine()
+    return (f"{platform.system()} {platform.release()}, {cpu}, {os.cpu_count()} cores, "
+            f"Python {platform.python_version()}")
 
 
 def _quick(case: Case) -> Case:

@@ -14,7 +14,8 @@ rendered one by one at their tile's size and placed in the frame instead
 
 It then tells which variants give identical pictures and how far apart the
 others are. Those figures come from each variant rendered alone at the tile
-size *without its overlays* (labels and matrices differ by design; the 3D
+size *without its overlays* (``overlay=off``: no labels, matrices or helper lines such as
+a trail; labels and matrices differ by design; the 3D
 picture is what is compared), using :mod:`glsandbox.measure.metrics`.
 
 Every value is parsed by its parameter and every scene is built before
@@ -59,6 +60,13 @@ class Variant:
     settings: tuple[tuple[str, str], ...]
     label: str
     scene: Scene
+    #: The same variant with ``overlay=off`` (no text, figures or helper lines such as a
+    #: trail): what the figures compare. None: the scene without its overlays.
+    plain: Scene | None = None
+
+    def bare(self) -> Scene:
+        """The 3D picture alone, as the figures compare it."""
+        return self.plain if self.plain is not None else replace(self.scene, overlays=())
 
 
 @dataclass
@@ -134,7 +142,8 @@ def build_variants(lesson_cls: type[Lesson], varies: list[str], settings: list[s
         values = {**base.values, **{k: by_key[k][t] for k, t in combo}}
         lesson = lesson_cls(**values)
         label = ", ".join(f"{k}={t}" for k, t in combo)
-        variants.append(Variant(tuple(combo), label, lesson.scene()))
+        plain = lesson_cls(**{**values, "overlay": False}).scene() if values.get("overlay", True) else None
+        variants.append(Variant(tuple(combo), label, lesson.scene(), plain))
     columns = len(parsed[0].texts) if len(parsed) == 2 else math.ceil(math.sqrt(len(variants)))
     return variants, columns
 
@@ -310,7 +319,7 @@ def compare_variants(variants: list[Variant], columns: int, size: tuple[int, int
     advance(len(variants))
     alone = []
     for v in variants:
-        alone.append(renderer.render_scene(replace(v.scene, overlays=()), tile).image.copy())
+        alone.append(renderer.render_scene(v.bare(), tile).image.copy())
         advance(1)
     groups = group_identical(alone)
     labels = [v.label for v in variants]
@@ -331,5 +340,10 @@ def difference_image(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.dstack([grey, grey, grey, np.full_like(grey, 255)])
 
 
-def default_out(lesson_name: str) -> Path:
+def default_out(lesson_name: str, given: str | None = None) -> Path:
+    """``compare_LESSON.png``; for a lesson file, its whole name with the dot made ``_``
+    (``compare_my_lesson_py.png``, ``compare_my_lesson_toml.png``), so comparing
+    ``my_lesson.py`` and ``my_lesson.toml`` never writes one file over the other."""
+    if given is not None and Path(given).suffix.lower() in (".py", ".toml"):
+        return Path(f"compare_{Path(given).name.replace('.', '_')}.png")
     return Path(f"compare_{lesson_name}.png")

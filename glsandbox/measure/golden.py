@@ -1,6 +1,6 @@
 """Golden image comparison and diff artefacts.
 
-The rule the tests use against ``tests/goldens/`` (README, "Tests and golden images"):
+The rule the tests use against ``tests/goldens/`` (docs/testing.md):
 
 * Exact match passes.
 * Otherwise a pixel is *bad* when its largest channel difference exceeds

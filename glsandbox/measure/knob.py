@@ -138,7 +138,8 @@ class Row:
     times_ms: list[float]
     rmse: float
     psnr: float
-    flip: float
+    #: Mean FLIP error; None where flip-evaluator is not installed.
+    flip: float | None
     image: str = ""
     error_map: str = ""
     count: PixelCount | None = None

@@ -145,12 +145,13 @@ def time_pass(renders: Sequence[Callable[[], object]], rounds: int, advance: Cal
 
 def measure_knobs(knobs: Sequence[Knob], context: RenderContext, out: Path, quick: bool, runs: int = RUNS,
                   passes: int = PASSES, log: Callable[[str], None] = lambda s: None,
-                  advance: Callable[[int], object] = lambda n: None) -> list[KnobResult]:
+                  advance: Callable[[int], object] = lambda n: None, flip: bool = True) -> list[KnobResult]:
     """Render every knob's settings and reference, time them in ``passes`` independent
     passes of ``runs`` rounds that alternate across the knobs (:func:`interleave`,
     :func:`time_pass`), and compare each picture with its knob's reference.
 
     ``advance(1)`` is called after each of the :func:`knob_renders` renders (a progress bar's ``update``).
+    ``flip=False`` (flip-evaluator missing) leaves FLIP and the error maps out.
     """
     groups = [[(knob, setting) for setting in (*knob.chosen(quick), knob.reference)] for knob in knobs]
     pictures: dict[tuple[str, str], np.ndarray] = {}
@@ -175,27 +176,30 @@ def measure_knobs(knobs: Sequence[Knob], context: RenderContext, out: Path, quic
         for _, setting in group:
             key = (knob.name, setting.label)
             picture = pictures[key]
-            flip_mean, error_map = flip_error(reference, picture)
             stem = f"{knob.name}-{_slug(setting.label)}"
             image_path, map_path = Path("images") / f"{stem}.png", Path("error_maps") / f"{stem}.png"
             save_png(np.ascontiguousarray(picture), out / image_path)
-            save_png(np.ascontiguousarray(error_map), out / map_path)
+            flip_mean: float | None = None
+            if flip:
+                flip_mean, error_map = flip_error(reference, picture)
+                save_png(np.ascontiguousarray(error_map), out / map_path)
             count = None
             if setting.count is not None:
                 log(f"  count {knob.count_label} of {setting.label}")
                 count = setting.count(context)
             rows.append(Row(knob.name, setting.label, setting is knob.reference, times[key],
                             metrics.rmse(reference, picture), metrics.psnr(reference, picture), flip_mean,
-                            str(image_path), str(map_path), count, medians[key]))
+                            str(image_path), str(map_path) if flip else "", count, medians[key]))
         results.append(KnobResult(knob, rows))
     return results
 
 
 def measure_knob(knob: Knob, context: RenderContext, out: Path, quick: bool, runs: int = RUNS,
                  log: Callable[[str], None] = lambda s: None,
-                 advance: Callable[[int], object] = lambda n: None, passes: int = PASSES) -> KnobResult:
+                 advance: Callable[[int], object] = lambda n: None, passes: int = PASSES,
+                 flip: bool = True) -> KnobResult:
     """:func:`measure_knobs` of one knob."""
-    return measure_knobs([knob], context, out, quick, runs, passes, log, advance)[0]
+    return measure_knobs([knob], context, out, quick, runs, passes, log, advance, flip)[0]
 
 
 def run(out: Path, quick: bool = False, backend: str | None = None, runs: int = RUNS,
@@ -213,6 +217,9 @@ def run(out: Path, quick: bool = False, backend: str | None = None, runs: int = 
             raise SandboxError(f"unknown knob {unknown[0]!r}; knobs: {', '.join(k.name for k in knobs)}")
         knobs = [k for k in knobs if k.name in only]
     extra.require_all()  # before anything is rendered or written
+    flip = extra.has_flip()
+    if not flip:
+        say(extra.FLIP_MISSING)
     try:
         for folder in (out, out / "images", out / "error_maps"):
             folder.mkdir(parents=True, exist_ok=True)
@@ -236,7 +243,8 @@ def run(out: Path, quick: bool = False, backend: str | None = None, runs: int = 
     bar = progress(sum(knob_renders(knob, quick, runs, passes) for knob in measured), "tradeoffs", "render")
     try:
         try:
-            results = measure_knobs(measured, context, out, quick, runs, passes, lambda text: say(text), bar.update)
+            results = measure_knobs(measured, context, out, quick, runs, passes, lambda text: say(text), bar.update,
+                                   flip)
         except OSError as exc:  # its images could not be written
             raise SandboxError(f"--out {out}: cannot write ({exc.strerror or exc})") from None
         host = context.renderer.host

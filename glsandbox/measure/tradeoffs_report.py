@@ -43,7 +43,7 @@ def write_csv(results: Sequence[KnobResult], size: tuple[int, int], path: Path) 
             low, high = r.spread_ms
             writer.writerow([r.knob, r.setting, int(r.reference), size[0], size[1], len(r.times_ms),
                              f"{r.median_ms:.3f}", f"{low:.3f}", f"{high:.3f}", f"{r.rmse:.6f}",
-                             _fmt_psnr(r.psnr), f"{r.flip:.6f}",
+                             _fmt_psnr(r.psnr), "" if r.flip is None else f"{r.flip:.6f}",
                              *(("", "", "") if r.count is None else
                                (r.count.pixels, r.count.of, f"{r.count.share:.6f}")),
                              r.image, r.error_map, f"{r.median_spread:.4f}", len(r.pass_medians),
@@ -91,7 +91,8 @@ def write_report(results: Sequence[KnobResult], info: Mapping[str, str], path: P
                 " - | - |" if r.count is None else f" {r.count.pixels} | {r.count.share:.1%} |")
             lines.append(f"| {name} | {time_cell(r)} | {low:.2f}-{high:.2f} ({len(r.times_ms)} runs) |{count} "
                          f"{r.rmse:.4f} | "
-                         f"{_fmt_psnr(r.psnr)} | {r.flip:.4f} | [map]({r.error_map}) |")
+                         f"{_fmt_psnr(r.psnr)} | {'-' if r.flip is None else f'{r.flip:.4f}'} | "
+                         f"{f'[map]({r.error_map})' if r.error_map else '-'} |")
         noisy = [r.setting for r in result.rows if not r.trusted]
         if noisy:
             lines += ["", f"Too noisy to give a time ({len(noisy)} of {len(result.rows)} settings): its passes "
@@ -128,10 +129,12 @@ def write_plot(results: Sequence[KnobResult], path: Path) -> None:
         # One colour and marker per setting, named in the legend: labels written
         # next to the points would overlap where settings cost about the same.
         counted = bool(result.knob.count_label)
+        no_flip = any(r.flip is None for r in result.rows)  # flip-evaluator not installed: RMSE instead
         for index, r in enumerate(result.rows):
             low, high = r.spread_ms
             marker = "*" if r.reference else markers[index % len(markers)]
-            error = (r.count.share if r.count is not None else 0.0) if counted else r.flip
+            error = (r.count.share if r.count is not None else 0.0) if counted else (
+                r.rmse if no_flip else r.flip)
             ax.errorbar([r.median_ms], [error], xerr=[[r.median_ms - low], [high - r.median_ms]],
                         fmt=marker, color="black" if r.reference else f"C{index % 10}",
                         markersize=12 if r.reference else 7, capsize=3,
@@ -147,6 +150,7 @@ def write_plot(results: Sequence[KnobResult], path: Path) -> None:
         ax.set_title(result.knob.title)
         ax.set_xlabel(f"frame time, median and min-max (ms{', log scale' if wide else ''})")
         ax.set_ylabel(f"{result.knob.count_label}, share of {result.knob.count_of}" if counted
+                      else "RMSE vs reference (0 = same; FLIP not installed)" if no_flip
                       else "FLIP error vs reference (0 = same)")
         ax.grid(True, which="both", alpha=0.3)
         ax.margins(x=0.15, y=0.12)

@@ -1,4 +1,4 @@
-"""Counting the z-fighting pixels of a planar shadow (depth precision, issue 5).
+"""Counting the z-fighting pixels of a planar shadow (depth precision).
 
 A planar shadow lies on (or ``lift`` above) its receiver's plane; where the
 depth buffer cannot tell the two apart, the receiver wins the depth test in

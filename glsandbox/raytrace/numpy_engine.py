@@ -242,15 +242,21 @@ def _top_level(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_m
             idx = rays[idx]
         if idx.size == 0:
             continue
-        if stats is not None:
-            stats.tests += idx.size * max(node.count, 1)
-        if cut_out:  # every triangle, the nearest hit on a drawn texel
+        if node.kind.triangles and (cut_out or one_sided):
+            # Every triangle (on a drawn texel, when cut out); with culling, the pairs facing
+            # away are skipped after a dot product and only the tests run are counted.
             rows = slice(node.start, node.start + node.count)
+            tested: list[int] = []
             t, j = nearest_watertight(world.v0[rows], world.v1[rows], world.v2[rows], _rows(o, idx), d[idx],
-                                      cull_backfaces=one_sided,
-                                      accept=_drawn_texels(world, k, _rows(o, idx), d[idx], t_max))
+                                      cull_backfaces=one_sided, tested=tested,
+                                      accept=_drawn_texels(world, k, _rows(o, idx), d[idx], t_max) if cut_out
+                                      else None)
             j = np.where(j >= 0, j + node.start, -1)
+            if stats is not None:
+                stats.tests += tested[0] if one_sided else idx.size * max(node.count, 1)
         else:
+            if stats is not None:
+                stats.tests += idx.size * max(node.count, 1)
             t, j = _hit_node(world, k, _rows(o, idx), d[idx], one_sided)
         better = t < best_t[idx]
         sel = idx[better]

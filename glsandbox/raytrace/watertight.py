@@ -244,8 +244,8 @@ def watertight_pairs(setup: RaySetup, rays: NDArray[np.intp], v0: NDArray[np.flo
 
 def nearest_watertight(v0: NDArray[np.float64], v1: NDArray[np.float64], v2: NDArray[np.float64],
                        origins: ArrayLike, directions: ArrayLike, cull_backfaces: bool = False,
-                       chunk_pairs: int = 1 << 14, accept: Callable[..., NDArray[np.bool_]] | None = None
-                       ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
+                       chunk_pairs: int = 1 << 14, accept: Callable[..., NDArray[np.bool_]] | None = None,
+                       tested: list[int] | None = None) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
     """Nearest hit of each ray over *every* triangle (no BVH): ``(t, index)``, ``(inf, −1)``
     for a miss, the lower index winning a tie (the course's ``min_indis``). The
     numpy engine's per-node scan (``bvh=False``): the watertight test, so a ray
@@ -254,7 +254,13 @@ def nearest_watertight(v0: NDArray[np.float64], v1: NDArray[np.float64], v2: NDA
     block of rays at a time, about ``chunk_pairs`` pairs a block.
 
     ``accept(rays, triangles, t)``: which hits count (the any-hit filter of
-    :func:`~glsandbox.raytrace.bvh_traverse.any_hit`); the nearest of those wins."""
+    :func:`~glsandbox.raytrace.bvh_traverse.any_hit`); the nearest of those wins.
+
+    ``cull_backfaces`` (course "Hızlandırma 1: Backface Culling"): a pair whose
+    triangle faces away from the ray, ``d·N > 0`` with ``N = (V1−V0)×(V2−V0)``,
+    is skipped after that one dot product and never reaches the test (which
+    would cull it: front faces have ``d·N < 0``; edge-on pairs are left to it).
+    ``tested``: the number of ray-triangle tests actually run is appended."""
     o, d = broadcast_rays(origins, directions)
     n, m = d.shape[0], v0.shape[0]
     best_t = np.full(n, np.inf)
@@ -262,12 +268,31 @@ def nearest_watertight(v0: NDArray[np.float64], v1: NDArray[np.float64], v2: NDA
     keep = np.flatnonzero(nondegenerate(v0, v1, v2))
     if n == 0 or keep.size == 0:
         return best_t, best_i
+    normals = np.cross(v1[keep] - v0[keep], v2[keep] - v0[keep]) if cull_backfaces else None
+    if normals is not None and (o.shape[0] == 1 or not (o != o[0]).any()):
+        # One origin for every ray (primary rays): a hit P = O + t·d (t > 0) on the plane has
+        # d·N = (P − O)·N / t = (V0 − O)·N / t, so the triangle faces every ray that can hit it
+        # alike: a triangle facing away from O is dropped for the whole block at once.
+        keep = keep[np.einsum("ij,ij->i", v0[keep] - o[0], normals) <= 0.0]
+        normals = None
+        if keep.size == 0:
+            if tested is not None:
+                tested.append(0)
+            return best_t, best_i
     setup = ray_setup(o, d)
     step = max(1, chunk_pairs // keep.size)
+    done = 0
     for lo in range(0, n, step):
         rays = np.arange(lo, min(n, lo + step))
-        t, _, _ = watertight_pairs(setup, np.repeat(rays, keep.size), v0, v1, v2, np.tile(keep, rays.size),
-                                   cull_backfaces, barycentrics=False)
+        pair_rays, pair_tris = np.repeat(rays, keep.size), np.tile(keep, rays.size)
+        if normals is None:
+            t, _, _ = watertight_pairs(setup, pair_rays, v0, v1, v2, pair_tris, cull_backfaces, barycentrics=False)
+        else:  # the facing test first: only pairs that may face the ray are tested
+            facing = np.flatnonzero((d[rays] @ normals.T).reshape(-1) <= 0.0)
+            t = np.full(pair_rays.shape[0], np.inf)
+            t[facing], _, _ = watertight_pairs(setup, pair_rays[facing], v0, v1, v2, pair_tris[facing], True,
+                                               barycentrics=False)
+            done += facing.size
         if accept is not None:
             hit = np.flatnonzero(np.isfinite(t))
             if hit.size:
@@ -277,4 +302,6 @@ def nearest_watertight(v0: NDArray[np.float64], v1: NDArray[np.float64], v2: NDA
         j = np.argmin(t, axis=1)  # the first minimum: the lowest index on a tie
         best_t[rays] = t[np.arange(rays.size), j]
         best_i[rays] = np.where(np.isfinite(best_t[rays]), keep[j], -1)
+    if tested is not None:
+        tested.append(done if normals is not None else n * int(keep.size))
     return best_t, best_i

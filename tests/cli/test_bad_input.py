@@ -47,7 +47,7 @@ def test_argparse_mistakes_are_one_line() -> None:
 
 
 def test_a_lesson_module_reports_argparse_mistakes_in_one_line() -> None:
-    proc = subprocess.run([sys.executable, "-m", "lessons.indexed_cube", "--no-such-flag"], capture_output=True,
+    proc = subprocess.run([sys.executable, "-m", "glsandbox.lessons.indexed_cube", "--no-such-flag"], capture_output=True,
                           text=True, cwd=REPO, timeout=60)
     assert_user_error(proc, "--no-such-flag")
 
@@ -192,6 +192,6 @@ def test_no_display_errors_offer_what_the_command_can_do() -> None:
     assert_user_error(proc, "glsandbox render indexed_cube --out FILE.png")
     assert "--headless" not in proc.stderr
     # A lesson module has --headless.
-    proc = subprocess.run([sys.executable, "-m", "lessons.triangle"], capture_output=True, text=True, cwd=REPO,
+    proc = subprocess.run([sys.executable, "-m", "glsandbox.lessons.triangle"], capture_output=True, text=True, cwd=REPO,
                           env={**os.environ, **env}, timeout=60)
-    assert_user_error(proc, "python -m lessons.triangle --headless --out FILE.png")
+    assert_user_error(proc, "python -m glsandbox.lessons.triangle --headless --out FILE.png")

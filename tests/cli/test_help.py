@@ -100,5 +100,5 @@ def test_a_lesson_module_says_what_it_does_with_examples(capsys) -> None:
     assert stop.value.code == 0
     text = capsys.readouterr().out
     assert "opens it in a window, or renders it headless to a PNG." in " ".join(text.split())
-    assert text.rstrip().endswith("examples:\n  python -m lessons.triangle\n"
-                                  "  python -m lessons.triangle --headless --out triangle.png")
+    assert text.rstrip().endswith("examples:\n  python -m glsandbox.lessons.triangle\n"
+                                  "  python -m glsandbox.lessons.triangle --headless --out triangle.png")

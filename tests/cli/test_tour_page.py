@@ -20,7 +20,7 @@ import subprocess
 from pathlib import Path
 
 import pytest
-from support import EXAMPLES_DIR, run_cli
+from support import EXAMPLES_DIR, chromium_command, run_cli
 
 pytestmark = pytest.mark.slow
 PHONE = (390, 844)
@@ -49,13 +49,6 @@ window.addEventListener("load", () => {
   if (window.parent !== window) window.parent.postMessage(document.title, "*");
 });
 </script>"""
-
-
-def chromium_command(binary: str, profile: Path, size: tuple[int, int]) -> list[str]:
-    """Headless Chromium, offline and quiet, with a fresh profile."""
-    return [binary, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-            "--disable-background-networking", "--disable-component-update", "--disable-sync",
-            "--hide-scrollbars", f"--user-data-dir={profile}", f"--window-size={size[0]},{size[1]}"]
 
 
 #: Chromium's narrowest window.

@@ -142,7 +142,7 @@ def test_a_lesson_file_may_subclass_a_builtin_lesson(tmp_path: Path) -> None:
     import sys
 
     path = tmp_path / "my_triangle.py"
-    path.write_text("from lessons.triangle import Triangle\n\nclass MyTriangle(Triangle):\n    name = 'my_triangle'\n")
+    path.write_text("from glsandbox.lessons.triangle import Triangle\n\nclass MyTriangle(Triangle):\n    name = 'my_triangle'\n")
     script = ("import sys; from glsandbox.lesson import find_lesson; "
               "cls = find_lesson(sys.argv[1]); base = find_lesson('triangle'); "
               "print(cls.__name__, cls.name, issubclass(cls, base), base.name)")

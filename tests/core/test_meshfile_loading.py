@@ -269,3 +269,36 @@ def test_the_peak_memory_of_a_load_stays_near_its_budget(tmp_path: Path) -> None
     finally:
         tracemalloc.stop()
     assert peak / 200_000 <= BYTES_PER_TRIANGLE + 32, f"{peak / 200_000:.0f} bytes per triangle"
+
+
+def _gltf_with_nodes(path: Path, nodes: list[dict]) -> Path:
+    """A one-triangle glTF (buffer inline) whose scene starts at node 0 with ``nodes``."""
+    import base64
+    import json
+    import struct
+
+    data = struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0)
+    path.write_text(json.dumps({
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": nodes,
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
+        "bufferViews": [{"buffer": 0, "byteLength": 36}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                       "min": [0, 0, 0], "max": [1, 1, 0]}]}))
+    return path
+
+
+@pytest.mark.parametrize("nodes, node", [
+    ([{"name": "loop", "mesh": 0, "children": [0]}], "loop"),  # its own child
+    ([{"name": "a", "mesh": 0, "children": [1]}, {"name": "b", "mesh": 0, "children": [0]}], "a"),  # each other's
+], ids=["self", "pair"])
+def test_a_gltf_whose_nodes_form_a_cycle_is_refused_naming_the_file_and_the_node(tmp_path: Path, nodes, node) -> None:
+    from glsandbox.meshfile import load_model
+
+    path = _gltf_with_nodes(tmp_path / "cycle.gltf", nodes)
+    with pytest.raises(SandboxError) as caught:
+        load_model(path)
+    message = str(caught.value)
+    assert str(path) in message and repr(node) in message and "cycle" in message and "\n" not in message
+    ok = _gltf_with_nodes(tmp_path / "tree.gltf", [{"name": "a", "mesh": 0, "children": [1]}, {"name": "b", "mesh": 0}])
+    assert sum(len(part.mesh.triangle_indices()) for part in load_model(ok).parts) == 2

@@ -124,20 +124,25 @@ def test_the_copied_set_line_renders_the_window_picture_pixel_for_pixel(window_e
 
 
 def test_f1_hides_the_panel_and_the_screen_then_shows_the_frame(window_env: str, tmp_path: Path, gl) -> None:
+    # Under load a fixed sleep after a key may grab the screen before the window has drawn
+    # the next frame: each grab waits instead for the state it expects (the frame, or
+    # anything else with the panel), failing only if it never comes.
+    headless = gl.render(find_lesson("triangle")(), SIZE).image[..., :3]
     win = PanelWindow(window_env, tmp_path, "lessons.triangle")
+
+    def grab():
+        return np.ascontiguousarray(win.screen()[:SIZE[1], :SIZE[0]])
+
     try:
         win.wait_title(lambda t: "fps" in t)
-        shown = win.screen()[:SIZE[1], :SIZE[0]]
+        shown = win._wait(lambda: (g := grab()) is not None and not np.array_equal(g, headless) and [g])[0]
         win.key("F1")
-        time.sleep(0.3)
-        hidden = win.screen()[:SIZE[1], :SIZE[0]]
+        hidden = win._wait(lambda: (g := grab()) is not None and np.array_equal(g, headless) and [g])[0]
         win.key("F1")
-        time.sleep(0.3)
-        again = win.screen()[:SIZE[1], :SIZE[0]]
+        again = win._wait(lambda: (g := grab()) is not None and not np.array_equal(g, headless) and [g])[0]
     finally:
         code = win.close()
     assert code == 0
-    headless = gl.render(find_lesson("triangle")(), SIZE).image[..., :3]
     np.testing.assert_array_equal(hidden, headless)
     assert not np.array_equal(shown, headless)  # the panel was over the frame
     np.testing.assert_array_equal(again, shown)

@@ -14,8 +14,8 @@ from glsandbox import passes as plan_passes
 from glsandbox.errors import SandboxError
 from glsandbox.gl import passes as gl_passes, rawgl
 from glsandbox.plan import PASS_KINDS, Pass, plan
-from lessons.mirror import MirrorLesson
-from lessons.shadow_map import ShadowMapLesson
+from glsandbox.lessons.mirror import MirrorLesson
+from glsandbox.lessons.shadow_map import ShadowMapLesson
 
 SIZE = (128, 128)
 
@@ -176,7 +176,7 @@ def test_a_frame_leaves_no_sampler_object_or_depth_test_even_when_a_pass_raises(
     incomplete: texelFetch reads zeros). The texture lesson's ground is drawn (its sampler
     bound, depth test on) before the cube's missing image stops the frame."""
     from glsandbox.errors import SandboxError
-    from lessons.texture import TextureLesson
+    from glsandbox.lessons.texture import TextureLesson
 
     gl.render(TextureLesson(filter="mip_linear"), (32, 32))
     assert gl.host.raw.sampler_bindings() == (0, 0, 0, 0)

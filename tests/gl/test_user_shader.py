@@ -1,4 +1,4 @@
-"""A node's own shader (README "Your own shader"): scene files, Python, the
+"""A node's own shader (docs/your-own.md, "Your own shader"): scene files, Python, the
 errors that name the user's file, --set u.NAME, reload and the file watch,
 the ray tracer's note, and the toon example."""
 
@@ -134,10 +134,10 @@ def test_scene_file_mistakes_name_the_line_and_key(folder: Path, old: str, new: 
         load_scene(folder / "scene.toml")
 
 
-def test_the_readme_table_lists_exactly_the_inputs_the_renderer_gives() -> None:
-    readme = (REPO / "README.md").read_text()
+def test_the_docs_table_lists_exactly_the_inputs_the_renderer_gives() -> None:
+    readme = (REPO / "docs" / "your-own.md").read_text(encoding="utf-8")
     section = readme[readme.index("## Your own shader"):]
-    section = section[:section.index("\n## ", 4)]
+    section = section.split("\n## ", 1)[0]
     rows = re.findall(r"^\| `(\w+)` \| `([^`]+)` \|", section, flags=re.M)
     assert rows == [(name, glsl) for name, glsl, *_ in SHADER_INPUTS]
 

@@ -142,7 +142,7 @@ def hostile_kinds(ref: Path, results: Path, subs: Path) -> dict[str, tuple[str, 
 
 def kernel_enforced(kinds: dict[str, tuple[str, str, str]]) -> dict[str, tuple[str, str, str]]:
     """The kinds that go around Python (ctypes) are stopped by Landlock: the file ones from ABI 1,
-    signals from ABI 6. Without it they are out of what this machine can guarantee (README)."""
+    signals from ABI 6. Without it they are out of what this machine can guarantee (docs/grading.md)."""
     abi = landlock_abi()
     return {name: kind for name, kind in kinds.items()
             if "ctypes_" not in name or (abi >= 6 if "kill" in name else abi >= 1)}

@@ -19,8 +19,8 @@ from glsandbox.measure.zfighting import count_z_fighting, flat_receiver, shade_m
 from glsandbox.plan import plan
 from glsandbox.planar import Mirror, PlanarShadow, shadow_casters
 from glsandbox.scene import Scene
-from lessons.mirror import MirrorLesson
-from lessons.phong import PhongLesson
+from glsandbox.lessons.mirror import MirrorLesson
+from glsandbox.lessons.phong import PhongLesson
 
 RNG = np.random.default_rng(5)
 SIZE = (256, 256)

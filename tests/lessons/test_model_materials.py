@@ -21,7 +21,7 @@ RENDERERS = {"raster": dict(view="raster"), "ray": dict(view="ray"),
 
 
 def frame_and_scene(gl, path: Path, renderer: str, **values: object) -> tuple[np.ndarray, Scene]:
-    from lessons.model import ModelLesson
+    from glsandbox.lessons.model import ModelLesson
 
     lesson = ModelLesson(mesh=str(path), **RENDERERS[renderer], **values)
     return gl.render(lesson, SIZE).image.astype(int), lesson.scene()
@@ -92,7 +92,7 @@ def test_an_obj_with_two_usemtl_groups_shows_each_kd(gl, tmp_path: Path, rendere
 @pytest.mark.parametrize("shading", ["phong", "gouraud"])
 @pytest.mark.parametrize("renderer", RENDERERS)
 def test_ply_vertex_colours_tint_the_lit_colour(gl, tmp_path: Path, renderer: str, shading: str) -> None:
-    from lessons.model import ModelLesson
+    from glsandbox.lessons.model import ModelLesson
 
     lesson = ModelLesson(mesh=str(coloured_ply(tmp_path / "c.ply")), **RENDERERS[renderer])
     scene = lesson.scene()
@@ -130,7 +130,7 @@ def test_the_turning_model_is_traced_coarse_and_a_still_one_at_full_resolution()
     """The window's rule (InteractiveResolution): a picture that moves (here the model turning,
     not the camera) is traced coarse, so a big model keeps the window answering."""
     from glsandbox.frame import InteractiveResolution
-    from lessons.model import ModelLesson
+    from glsandbox.lessons.model import ModelLesson
 
     motion = InteractiveResolution(moving=0.25, settle=0.3)
     assert motion.resolution(ModelLesson(time=0.0).scene(), now=0.0) == 1.0
@@ -168,7 +168,7 @@ def test_up_z_stands_a_z_up_file_upright(tmp_path: Path) -> None:
     """A tall thin box along the file's z: with up=z the lesson turns it so that it stands along y."""
     import trimesh
 
-    from lessons.model import ModelLesson
+    from glsandbox.lessons.model import ModelLesson
 
     trimesh.creation.box((0.2, 0.2, 2.0)).export(tmp_path / "post.stl")
     for up, axis in (("y", 2), ("z", 1)):

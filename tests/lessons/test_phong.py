@@ -16,7 +16,7 @@ from glsandbox import geometry, transforms
 from glsandbox.errors import SandboxError
 from glsandbox.plan import plan
 from glsandbox.scene import Camera, Light, Material, Node, Scene
-from lessons.phong import LIGHT_COLORS, PhongLesson, light_positions
+from glsandbox.lessons.phong import LIGHT_COLORS, PhongLesson, light_positions
 
 RED = (1.0, 0.0, 0.0, 1.0)
 FAR = 1.0e4  # a point light this far away lights a small patch from one direction

@@ -13,7 +13,7 @@ from glsandbox.raytrace import render
 
 def panel_rows(scene: str) -> str:
     """The rows the lesson's panel prints for one of its scenes (re-computed by the lesson's module)."""
-    import lessons.ray_phong as module
+    import glsandbox.lessons.ray_phong as module
 
     return "\n".join(getattr(module, scene)("x")[1])
 

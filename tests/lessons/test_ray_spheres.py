@@ -7,7 +7,7 @@ from support import check_lesson_golden
 
 
 def test_sphere_figures():
-    from lessons.ray_spheres import figures
+    from glsandbox.lessons.ray_spheres import figures
 
     spheres = "\n".join(figures())
     assert "s = 80, m^2 = 3600, q = 45" in spheres and "t = s - q = 35 (stable: 35), P = (0, 21, 28)" in spheres

@@ -7,7 +7,7 @@ from support import check_lesson_golden
 
 
 def test_triangle_figures():
-    from lessons.ray_triangle import panels
+    from glsandbox.lessons.ray_triangle import panels
 
     triangle = "\n".join(panels(False)[1])
     assert "D = 72; ray (0,0,1): t = 90, triangle: miss" in triangle

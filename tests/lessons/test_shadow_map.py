@@ -14,8 +14,8 @@ from glsandbox.errors import SandboxError
 from glsandbox.measure.shadow_state import shadow_mask, state_mismatch, without_shadows
 from glsandbox.plan import plan
 from glsandbox.scene import Light, ShadowMap
-from lessons.shadow_map import ShadowMapLesson
-from lessons.phong import PhongLesson
+from glsandbox.lessons.shadow_map import ShadowMapLesson
+from glsandbox.lessons.phong import PhongLesson
 
 SIZE = (256, 256)
 

@@ -22,7 +22,7 @@ from glsandbox.errors import SandboxError
 from glsandbox.images import MIP_COLORS, QUADRANT_COLORS, labels, load_image, mip_levels
 from glsandbox.plan import plan
 from glsandbox.scene import Camera, Material, Node, Scene, Texture
-from lessons.texture import TextureLesson, course_uv_table
+from glsandbox.lessons.texture import TextureLesson, course_uv_table
 
 FILL_DISTANCE = 1.0 / math.tan(math.radians(22.5))
 

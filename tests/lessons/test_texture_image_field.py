@@ -1,7 +1,7 @@
 """The texture lesson's image field: a refused path is one line, and in the window it stays red (issue 22).
 
 Typing a bad image path into the panel closed the window with exit 2; the
-README promised the refusal in red, as the model lesson's mesh field does.
+The manual promised the refusal in red, as the model lesson's mesh field does.
 """
 
 from __future__ import annotations

@@ -13,7 +13,7 @@ import pytest
 from glsandbox import transforms
 from glsandbox.errors import SandboxError
 from glsandbox.plan import plan
-from lessons.transform_order import TransformOrder, order_classes, second_cube_model
+from glsandbox.lessons.transform_order import TransformOrder, order_classes, second_cube_model
 
 SIZE = (256, 256)
 #: The classes the course claims: at time 0 only the order of S and T matters;
@@ -173,7 +173,7 @@ def test_golden_split_view(gl, golden) -> None:
 
 
 def test_the_trail_is_the_top_corner_under_each_recent_model() -> None:
-    from lessons.transform_order import TRAIL_POINT, trail_mesh
+    from glsandbox.lessons.transform_order import TRAIL_POINT, trail_mesh
 
     for order in transforms.ORDERS:
         trail = trail_mesh(order, 1.3, 2.0).positions

@@ -101,7 +101,8 @@ def test_cli_refuses_bad_values_with_exit_2_and_writes_nothing(tmp_path: Path, c
     assert not out.exists()
 
 
-@pytest.mark.parametrize(("lesson", "vary"), [("mirror", "mirror=stencil,off,no_stencil"), ("phong", "lights=0,2")])
+@pytest.mark.parametrize(("lesson", "vary"), [("mirror", "mirror=stencil,off,no_stencil"), ("mirror", "shadow=on,off"),
+                                             ("phong", "lights=0,2")])
 def test_variants_that_cannot_share_a_frame_are_stitched_tile_by_tile(gl, lesson: str, vary: str) -> None:
     # A mirror owns the frame's stencil; lights belong to a whole scene: such
     # variants are rendered alone at the tile size and placed in the frame.
@@ -130,3 +131,15 @@ def test_an_empty_grid_cell_is_black_even_on_a_reused_target(gl) -> None:
     image = gl.render_scene(compose(variants, columns, size), size).image
     assert (image[100:, 200:, :3] == 0).all()
     assert image[:100, :200, :3].any()
+
+
+def test_at_time_zero_the_six_orders_give_the_readmes_two_pictures_with_their_trails_left_out(gl) -> None:
+    """The figures compare ``overlay=off`` renders: a lesson's trail (a line mesh, no
+    Overlay) stays out as the report says, so S and R commuting shows at time 0."""
+    variants, columns = build_variants(find_lesson("transform_order"), [ORDERS], ["time=0"])
+    assert all(v.plain is not None and not any(n.name.startswith("trail") for n in v.plain.nodes)
+               for v in variants)
+    assert any(n.name.startswith("trail") for n in variants[0].scene.nodes)  # the tiles keep them
+    result = compare_variants(variants, columns, (384, 256), gl)
+    assert len(result.groups) == 2
+    assert "without overlays" in result.report()

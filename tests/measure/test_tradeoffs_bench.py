@@ -258,16 +258,38 @@ def test_a_knob_that_cannot_run_is_listed_as_not_measured_yet(tmp_path: Path) ->
     assert "## Not measured yet\n\n- `embree`: embreex is not installed\n" in report
 
 
-@pytest.mark.parametrize("missing", ["flip_evaluator", "matplotlib"])
-def test_tradeoffs_without_the_measure_extra_is_one_line(tmp_path: Path, monkeypatch, capsys, missing: str) -> None:
+def test_tradeoffs_without_matplotlib_is_one_line(tmp_path: Path, monkeypatch, capsys) -> None:
     from glsandbox.cli import main
 
-    monkeypatch.setitem(sys.modules, missing, None)  # as if not installed: importing it raises ImportError
+    monkeypatch.setitem(sys.modules, "matplotlib", None)  # as if not installed: importing it raises ImportError
     out = tmp_path / "tradeoffs"
     assert main(["tradeoffs", "--quick", "--out", str(out)]) == 2
-    assert capsys.readouterr().err == ("error: glsandbox tradeoffs needs flip-evaluator and matplotlib (the "
-                                       "'measure' extra): uv run --extra measure glsandbox tradeoffs\n")
+    assert capsys.readouterr().err == ("error: glsandbox tradeoffs needs matplotlib (the 'measure' extra, with "
+                                       "flip-evaluator): uv run --extra measure glsandbox tradeoffs\n")
     assert not out.exists()  # refused before anything was written
+
+
+def test_tradeoffs_without_flip_says_so_in_one_line_and_measures_the_rest(tmp_path: Path, monkeypatch, capsys,
+                                                                         gl) -> None:
+    """flip-evaluator has no wheel for some systems and Pythons: the FLIP column and error maps
+    are left out, RMSE and PSNR and the times are measured, the plot shows RMSE."""
+    import csv
+
+    from glsandbox.cli import main
+    from glsandbox.measure.extra import FLIP_MISSING
+
+    monkeypatch.setitem(sys.modules, "flip_evaluator", None)
+    out = tmp_path / "tradeoffs"
+    assert main(["tradeoffs", "--quick", "--knob", "antialiasing", "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert err.count(FLIP_MISSING) == 1 and "FLIP column" in FLIP_MISSING
+    rows = list(csv.DictReader((out / "tradeoffs.csv").open(encoding="utf-8")))
+    assert len(rows) >= 3 and all(r["flip"] == "" and r["error_map"] == "" for r in rows)
+    assert all(float(r["rmse"]) >= 0 for r in rows) and any(float(r["rmse"]) > 0 for r in rows)
+    report = (out / "report.md").read_text(encoding="utf-8")
+    table = [line for line in report.splitlines() if line.startswith("| ") and "setting" not in line]
+    assert table and all(line.endswith("| - | - |") for line in table)  # FLIP and error map left out
+    assert not list((out / "error_maps").glob("*.png")) and (out / "tradeoffs.png").is_file()
 
 
 def test_the_measure_extra_is_imported_only_by_tradeoffs_at_work() -> None:

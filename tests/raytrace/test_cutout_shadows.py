@@ -2,7 +2,7 @@
 transparent on its left half hangs over a floor, lit from up and to the right. Both ray engines
 (each path: scan and BVH), the planar shadow and the shadow map darken the floor where
 the square's opaque half shadows it, and nowhere else; a blended square and a cut-out
-cut away everywhere cast no shadow in any of them (README, "Materials: a model as its
+cut away everywhere cast no shadow in any of them (docs/models.md, "Materials: a model as its
 file describes it")."""
 
 from __future__ import annotations

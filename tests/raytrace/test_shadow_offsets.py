@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from glsandbox.raytrace import SHADOW_EPSILON, Plane, Ray, Sphere, first_hit, in_shadow, shadow_ray
-from lessons.ray_phong import far_eye, self_shadowed
+from glsandbox.lessons.ray_phong import far_eye, self_shadowed
 
 
 @pytest.mark.parametrize("eye_distance", [10.0, 1e4, 1e6, 1e7, 1e9])

@@ -1,4 +1,4 @@
-"""Depth precision (course section "The stencil Test": ``shadowOffsetY``; issue 5):
+"""Depth precision (course section "The stencil Test": ``shadowOffsetY``):
 the planar shadow against its floor, near plane, lift, polygon offset and
 reverse-Z; the error is the z-fighting pixels of the shadow
 (:mod:`glsandbox.measure.zfighting`)."""

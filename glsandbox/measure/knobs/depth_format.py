@@ -1,5 +1,5 @@
-"""Depth-buffer formats (course section "The stencil Test": ``shadowOffsetY``;
-issue 21): 16-bit, 24-bit and 32-bit float storage, standard and reverse-Z,
+"""Depth-buffer formats (course section "The stencil Test": ``shadowOffsetY``):
+16-bit, 24-bit and 32-bit float storage, standard and reverse-Z,
 at several near/far ratios, against the depth test done in float64.
 
 The :mod:`~glsandbox.measure.knobs.depth` knob draws the mirror lesson with

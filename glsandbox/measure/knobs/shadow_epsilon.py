@@ -1,5 +1,5 @@
 """Shadow-ray epsilons in the course's own ray tracer (course section "Gölge
-testi"; issue 21): acne against lost contact shadows.
+testi"): acne against lost contact shadows.
 
 The ``shadow_offset`` knob renders with the engines, whose watertight test
 refuses a ``t`` below its own error bound, so a shadow ray there never meets

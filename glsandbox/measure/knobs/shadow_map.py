@@ -1,4 +1,4 @@
-"""Shadow techniques (issue 23): the planar shadow and shadow maps of four sizes,
+"""Shadow techniques: the planar shadow and shadow maps of four sizes,
 with and without percentage-closer filtering, against the ray tracer's exact
 shadow rays on the ``shadow_map`` lesson's scene. The error counted in pixels
 is the share whose lit/shadowed state differs from the rays'

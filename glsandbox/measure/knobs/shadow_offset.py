@@ -1,4 +1,4 @@
-"""Shadow-ray offsets (course section "Gölge testi"; issue 21): a fixed share of
+"""Shadow-ray offsets (course section "Gölge testi"): a fixed share of
 ``|P|`` against a bound on the hit point's rounding error, with a cube standing
 on a floor moved from the origin to 1e6. The error counted is the floor's
 shadow pixels that come out wrong: contact shadow lost (an offset too big

@@ -1,5 +1,5 @@
 """The planar shadow matrix and the stencil mirror (course section "The stencil
-Test"; issue 5) against the ray tracer's shadows and reflections (issue 6)."""
+Test") against the ray tracer's shadows and reflections."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Ray-sphere tests (course section "Işın-Küre kesim testi"; issue 21): the
+"""Ray-sphere tests (course section "Işın-Küre kesim testi"): the
 course's geometric test against the numerically stable quadratic (Ray Tracing
 Gems, chapter 7), on a unit sphere seen from farther and farther away.
 

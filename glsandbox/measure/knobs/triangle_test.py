@@ -1,4 +1,4 @@
-"""Ray-triangle tests (course section "Işın-Üçgen kesim testi"; issue 21):
+"""Ray-triangle tests (course section "Işın-Üçgen kesim testi"):
 Möller–Trumbore against the watertight test, on rays aimed exactly at the
 vertices and edges of a closed mesh from inside it, with the mesh at the
 origin and moved far from it.
@@ -64,8 +64,8 @@ def aimed_rays(size: tuple[int, int], at: float) -> tuple[Triangles, NDArray[np.
 
 def moller_trumbore_float32(tris: Triangles, origins: NDArray[np.float64], directions: NDArray[np.float64],
                             block: int = 2048) -> NDArray[np.float64]:
-    """Möller–Trumbore as a float32 shader runs it (the gpu engine's scan path before
-    issue 21): corners, origins and directions rounded to float32 in world space and
+    """Möller–Trumbore as a float32 shader runs it (the gpu engine's scan path in
+    world space): corners, origins and directions rounded to float32 in world space and
     every product in float32. The nearest ``t`` per ray, ``inf`` for none. The same
     steps as :func:`glsandbox.raytrace.triangle.moller_trumbore_many`: ``p = d × e2``,
     ``det = e1·p``, ``s = O − V0``, ``u = s·p/det``, ``q = s × e1``, ``v = d·q/det``,
@@ -149,7 +149,7 @@ KNOB = register_knob(Knob(
         "both after rounding; the watertight test forms a shared edge's edge function from the same "
         "products in both triangles, recomputed exactly when it rounds to 0, so it never leaks, at any "
         "offset. It costs a little more per ray (the shear, the permutation, the error bound on t).",
-        "float32 is Möller–Trumbore as the gpu engine's scan ran it before issue 21: world coordinates "
+        "float32 is Möller–Trumbore as a world-space float32 scan runs it: world coordinates "
         "rounded to float32. Far from the origin the rounded corners and eyes sit on a coarse grid where "
         "the subtractions are exact, so its leaks change with the offset rather than grow.",
     ),

@@ -1,4 +1,4 @@
-"""The README's code runs as written."""
+"""The manual's tutorial code runs as written (docs/your-own.md, docs/how-it-works.md)."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from glsandbox.files import load_png
 
 
 def test_the_readme_lesson_of_your_own_renders(tmp_path: Path, gl) -> None:
-    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    text = (ROOT / "docs" / "how-it-works.md").read_text(encoding="utf-8")
     code = re.search(r"A lesson of your own is a Lesson subclass:\n\n```python\n(.*?)```", text, re.S).group(1)
     script = tmp_path / "spin.py"
     script.write_text(code, encoding="utf-8")
@@ -28,7 +28,7 @@ def test_the_readme_lesson_of_your_own_renders(tmp_path: Path, gl) -> None:
 
 
 def tutorial_section() -> str:
-    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    text = (ROOT / "docs" / "your-own.md").read_text(encoding="utf-8")
     return re.search(r"## Your own lesson, step by step\n(.*?)\n## ", text, re.S).group(1)
 
 
@@ -74,3 +74,27 @@ def test_the_readme_tutorial_works_step_by_step(tmp_path: Path, gl) -> None:
         image = load_png(mine / picture)
         assert len({tuple(px) for px in image.reshape(-1, 4)[::7]}) > 20, picture  # a picture, not a clear colour
     assert "1 passed" in proc.stdout  # the fixture checked goldens/my_lesson.png
+
+
+def test_the_readme_model_commands_run_as_written_from_the_repository(tmp_path: Path, gl) -> None:
+    """Every ``glsandbox render model`` line of the README and docs/models.md, run from
+    the repository's root (a fresh clone) with only ``--out`` moved and a small size:
+    the model they name ships with the package."""
+    import shlex
+
+    from support import run_cli
+
+    texts = (ROOT / "README.md").read_text(encoding="utf-8") + (ROOT / "docs" / "models.md").read_text(encoding="utf-8")
+    commands = [line.split("#")[0].split() for line in texts.splitlines()
+                if line.startswith("uv run glsandbox render model")]
+    assert len(commands) >= 4
+    for i, words in enumerate(commands):
+        args = words[3:]
+        if any("/path/to/" in a for a in args):
+            continue
+        out = args.index("--out")
+        args[out + 1] = str(tmp_path / f"{i}.png")
+        proc = run_cli(*args, "--size", "64x48", cwd=ROOT)
+        assert proc.returncode == 0, (shlex.join(words), proc.stderr)
+        assert load_png(tmp_path / f"{i}.png").shape == (48, 64, 4)
+    assert any("mesh=glsandbox/models/boulder.obj" in " ".join(w) for w in commands)

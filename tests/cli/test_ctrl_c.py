@@ -1,0 +1,59 @@
+"""Ctrl-C ends the long commands within 2 s with exit 130 and nothing half-written:
+SIGINT sent to the command's process alone, and to its whole process group (what a
+terminal's Ctrl-C does)."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from support import REPO_ROOT
+
+#: (name, arguments given the out folder, seconds to let it work first)
+COMMANDS = [
+    ("tour", lambda out: ["tour", "--out", str(out / "tour"), "--size", "64x48"], 4.0),
+    ("check_update", lambda out: ["check", "ray_acceleration", "--golden", str(out / "ref.png"), "--update"], 2.5),
+    ("tradeoffs", lambda out: ["tradeoffs", "--quick", "--out", str(out / "report")], 6.0),
+    ("bench", lambda out: ["bench", "--quick", "--json", str(out / "bench.json")], 6.0),
+]
+
+
+def _interrupt(args: list[str], wait: float, group: bool) -> tuple[int, float, str]:
+    """Start ``glsandbox ARGS`` in a session of its own, SIGINT it after ``wait`` s:
+    (exit status, seconds from the signal to the exit, output)."""
+    proc = subprocess.Popen([sys.executable, "-m", "glsandbox.cli", *args], stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True, cwd=REPO_ROOT, start_new_session=True)
+    time.sleep(wait)
+    assert proc.poll() is None, proc.communicate()[0]  # still working when the key is pressed
+    start = time.monotonic()
+    if group:
+        os.killpg(proc.pid, signal.SIGINT)
+    else:
+        proc.send_signal(signal.SIGINT)
+    try:
+        out, _ = proc.communicate(timeout=20)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        out, _ = proc.communicate()
+    return proc.returncode, time.monotonic() - start, out
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("group", [False, True], ids=["main_process", "process_group"])
+@pytest.mark.parametrize(("name", "make_args", "wait"), COMMANDS, ids=[c[0] for c in COMMANDS])
+def test_ctrl_c_ends_the_command_within_2_s_with_exit_130(tmp_path: Path, name, make_args, wait, group,
+                                                          gl) -> None:
+    code, seconds, out = _interrupt(make_args(tmp_path), wait, group)
+    assert code == 130 and seconds < 2.0, (code, seconds, out[-500:])
+    assert "Traceback" not in out
+    if name == "check_update":
+        assert not (tmp_path / "ref.png").exists()  # no reference half-written
+    if name == "bench":
+        assert not (tmp_path / "bench.json").exists()
+    # No temporary file of an atomic write left behind.
+    assert not [p for p in tmp_path.rglob("*") if p.is_file() and ".tmp" in p.name], list(tmp_path.rglob("*"))
