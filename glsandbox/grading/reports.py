@@ -79,18 +79,13 @@ def json_text(results: Sequence[CheckResult], title: str) -> str:
                                     "digest": r.digest, "same_as": [shown(n) for n in r.same_as]}
         if len(r.outcomes) == 1:
             entry.update({k: v for k, v in _figures(r.outcomes[0]).items() if k != "status"})
-<<<<<<< HEAD
+            entry["detail"] = r.outcomes[0].detail()
             if r.outcomes[0].cases:
                 entry["cases"] = r.outcomes[0].cases
         else:
             entry["checks"] = [{"check": o.check.name, "points": o.points, "of": o.check.points, **_figures(o),
-                                **({"cases": o.cases} if o.cases else {})} for o in r.outcomes]
-=======
-            entry["detail"] = r.outcomes[0].detail()
-        else:
-            entry["checks"] = [{"check": o.check.name, "points": o.points, "of": o.check.points, **_figures(o),
-                                "detail": o.detail()} for o in r.outcomes]
->>>>>>> main
+                                "detail": o.detail(), **({"cases": o.cases} if o.cases else {})}
+                               for o in r.outcomes]
         submissions.append(entry)
     c = {k.lower().replace(" ", "_"): v for k, v in counts(results).items()}
     return json.dumps({"reference": title, **c, "submissions": submissions}, indent=2) + "\n"
@@ -129,15 +124,10 @@ def gradescope_text(results: Sequence[CheckResult], title: str) -> str:
     for r in results:
         for o in r.outcomes:
             name = o.check.name if len(results) == 1 else f"{r.shown}: {o.check.name}"
-<<<<<<< HEAD
             output = f"{o.status}: {o.detail() if o.student is None else o.student}".rstrip(": ")
-            if r.output and o.status != PASS:
-=======
-            output = f"{o.status}: {o.detail()}".rstrip(": ")
             if o.check.hidden:  # shown after publishing: its outcome and points, never its figures or output
-                output = o.status
+                output = o.status if o.student is None else output  # an exercise group: counts, case names
             elif r.output and o.status != PASS:
->>>>>>> main
                 output += "\nlast lines printed:\n" + "\n".join(_output(r))
             tests.append({"name": name, "score": o.points, "max_score": o.check.points, "output": output,
                           "status": "passed" if o.status == PASS else "failed",
