@@ -428,8 +428,8 @@ def _shard_filter(text: str | None, one: bool) -> Callable[[str], bool]:
     return lambda name: in_shard(name, shard)
 
 
-def cmd_check_merge(argv: list[str]) -> int:
-    """``glsandbox check merge REPORTS...``: the shards' JSON reports as the whole class's reports."""
+def check_merge_parser() -> ArgumentParser:
+    """The parser of ``glsandbox check merge``, a verb of its own (:func:`main` sends it here before the others)."""
     parser = ArgumentParser(prog="glsandbox check merge",
                             description="Merge the JSON reports of check DIR --shard K/N into the whole class's "
                                         "reports, as one run would have written them.",
@@ -445,7 +445,14 @@ def cmd_check_merge(argv: list[str]) -> int:
     for kind in REPORTS:
         parser.add_argument(f"--{kind.replace('_', '-')}", dest=kind, type=Path, default=None, metavar="FILE",
                             help=f"write the {kind.replace('_', ' ')} report")
-    args = parser.parse_args(argv)
+    return parser
+
+
+def cmd_check_merge(argv: list[str]) -> int:
+    """``glsandbox check merge REPORTS...``: the shards' JSON reports as the whole class's reports."""
+    from glsandbox.grading.reports import REPORTS
+
+    args = check_merge_parser().parse_args(argv)
 
     def body() -> int:
         from glsandbox.grading.check import summary_table
@@ -693,10 +700,46 @@ def add_command(sub: argparse._SubParsersAction, name: str) -> argparse.Argument
                           formatter_class=argparse.RawDescriptionHelpFormatter)
 
 
+def _check_options(p: argparse.ArgumentParser) -> None:
+    """``glsandbox check``'s options: one lesson, a folder of submissions, or one student's folder."""
+    p.add_argument("lesson", metavar="LESSON_OR_DIR",
+                   help="a lesson name, .py or .toml file, or a folder of them (one line each, and a table)")
+    p.add_argument("--golden", type=Path, default=None, metavar="REF.png", help="the reference image")
+    p.add_argument("--rubric", type=Path, default=None, metavar="FILE.toml",
+                   help="a grading file: several checks, each with its golden, settings and points")
+    p.add_argument("--exercise", default=None, metavar="NAME",
+                   help="grade students' functions on an exercise (glsandbox exercise list): every case "
+                        "group, one point each, hidden groups included")
+    p.add_argument("--update", action="store_true",
+                   help="write the references when missing or different (a passing one is kept)")
+    p.add_argument("--tolerance", action="append", default=[], metavar="KEY=VALUE",
+                   help="threshold=LEVELS (default 2) or max_bad_share=FRACTION (default 0.0005); repeatable")
+    p.add_argument("--one", action="store_true",
+                   help="LESSON_OR_DIR is one student's folder (its lesson and helper files; Gradescope's "
+                        "/autograder/submission), not a folder of students")
+    p.add_argument("--jobs", type=int, default=None, metavar="N",
+                   help="submissions graded at once (default: the CPUs this process may use, by its "
+                        "cgroup's quota and affinity)")
+    p.add_argument("--timeout", type=float, default=None, metavar="SECONDS",
+                   help="time for each picture of a submission (default 30)")
+    p.add_argument("--memory", type=int, default=None, metavar="MB",
+                   help="memory (address space) of each submission (default 2048)")
+    for kind, text in (("csv", "the figures as CSV"), ("json", "the figures as JSON"),
+                       ("html", "a page: a row per student with reference | submission | difference"),
+                       ("junit", "JUnit XML (what CI systems read)"),
+                       ("gradescope", "Gradescope's results.json"),
+                       ("student_report", "the student's page: no hidden check's reference, difference or "
+                                          "figures")):
+        p.add_argument(f"--{kind.replace('_', '-')}", dest=kind, type=Path, default=None, metavar="FILE",
+                       help=f"folder mode: {text}")
+    add_render_options(p, size_default="the reference's size")
+    p.set_defaults(func=cmd_check)
+
+
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     """The command line's parser: every subcommand, or with ``command`` only that one (what a
-    command line naming it parses: the others cost argparse about 1.5 ms of a cold start;
-    the one built is the same)."""
+    command line naming it parses: the others cost argparse about 1.5 ms of a cold start; the
+    one built is the same)."""
     from glsandbox.version import __version__
 
     def wanted(name: str) -> bool:
@@ -768,42 +811,7 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         p.set_defaults(func=cmd_new)
 
     if wanted("check"):
-        p = add_command(sub, "check")
-        p.add_argument("lesson", metavar="LESSON_OR_DIR",
-                       help="a lesson name, .py or .toml file, or a folder of them (one line each, and a table)")
-        p.add_argument("--golden", type=Path, default=None, metavar="REF.png", help="the reference image")
-        p.add_argument("--rubric", type=Path, default=None, metavar="FILE.toml",
-                       help="a grading file: several checks, each with its golden, settings and points")
-        p.add_argument("--exercise", default=None, metavar="NAME",
-                       help="grade students' functions on an exercise (glsandbox exercise list): every case "
-                            "group, one point each, hidden groups included")
-        p.add_argument("--update", action="store_true",
-                       help="write the references when missing or different (a passing one is kept)")
-        p.add_argument("--tolerance", action="append", default=[], metavar="KEY=VALUE",
-                       help="threshold=LEVELS (default 2) or max_bad_share=FRACTION (default 0.0005); repeatable")
-        p.add_argument("--one", action="store_true",
-                       help="LESSON_OR_DIR is one student's folder (its lesson and helper files; Gradescope's "
-                            "/autograder/submission), not a folder of students")
-        p.add_argument("--shard", default=None, metavar="K/N",
-                       help="grade only share K of N (by a stable hash of each submission's name; the same on every "
-                            "machine); merge the shards' --json with: glsandbox check merge REPORTS...")
-        p.add_argument("--jobs", type=int, default=None, metavar="N",
-                       help="submissions graded at once (default: the CPUs this process may use, by its "
-                            "cgroup's quota and affinity)")
-        p.add_argument("--timeout", type=float, default=None, metavar="SECONDS",
-                       help="time for each picture of a submission (default 30)")
-        p.add_argument("--memory", type=int, default=None, metavar="MB",
-                       help="memory (address space) of each submission (default 2048)")
-        for kind, text in (("csv", "the figures as CSV"), ("json", "the figures as JSON"),
-                           ("html", "a page: a row per student with reference | submission | difference"),
-                           ("junit", "JUnit XML (what CI systems read)"),
-                           ("gradescope", "Gradescope's results.json"),
-                           ("student_report", "the student's page: no hidden check's reference, difference or "
-                                              "figures")):
-            p.add_argument(f"--{kind.replace('_', '-')}", dest=kind, type=Path, default=None, metavar="FILE",
-                           help=f"folder mode: {text}")
-        add_render_options(p, size_default="the reference's size")
-        p.set_defaults(func=cmd_check)
+        _check_options(add_command(sub, "check"))
 
     if wanted("gradescope"):
         p = add_command(sub, "gradescope")

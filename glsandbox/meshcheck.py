@@ -71,6 +71,8 @@ def checked_data(p: Path, data: bytes, file_type: str) -> bytes:
             _check_ply_lines(p, data, header_end, elements)
     elif file_type == "off":
         _check_off(p, data)
+    elif file_type == "stl":
+        _check_stl(p, data)
     elif file_type == "obj" and not data.isascii():  # (ASCII is UTF-8: no decoding to find out)
         try:
             data.decode("utf-8")
@@ -156,6 +158,19 @@ def _size(n: int) -> str:
 def _suggest(n: int) -> str:
     """A value for the variable that covers ``n`` bytes, in whole gigabytes."""
     return f"{-(-n // (1 << 30))}G"
+
+
+# --- STL --------------------------------------------------------------------
+
+
+def _check_stl(p: Path, data: bytes) -> None:
+    """An STL is binary (an 80-byte header, a triangle count n, then 50 bytes a triangle: exactly
+    84 + 50·n bytes) or ASCII (``solid`` first). Anything else is refused here, not left to the
+    reader, which may take arbitrary bytes for an ASCII file with no facets."""
+    binary = len(data) >= 84 and len(data) == 84 + 50 * int.from_bytes(data[80:84], "little")
+    if not binary and not data.lstrip()[:5].lower() == b"solid":
+        raise SandboxError(f"model file {p}: not a readable STL file: neither binary (84 + 50 bytes a triangle, "
+                           f"{len(data)} bytes here) nor ASCII (no 'solid' first)")
 
 
 # --- PLY --------------------------------------------------------------------

@@ -1,4 +1,5 @@
-"""Counting the z-fighting pixels of a planar shadow (depth precision).
+"""Counting the z-fighting pixels of a planar shadow (course section "XMMatrixShadow,
+shadowOffsetY": the shadow lifted against z-fighting).
 
 A planar shadow lies on (or ``lift`` above) its receiver's plane; where the
 depth buffer cannot tell the two apart, the receiver wins the depth test in

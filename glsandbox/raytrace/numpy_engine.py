@@ -242,7 +242,7 @@ def _top_level(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_m
             idx = rays[idx]
         if idx.size == 0:
             continue
-        if node.kind.triangles and (cut_out or one_sided):
+        if node.kind.triangles and (cut_out or one_sided) and "triangles" not in world.hit_tests:
             # Every triangle (on a drawn texel, when cut out); with culling, the pairs facing
             # away are skipped after a dot product and only the tests run are counted.
             rows = slice(node.start, node.start + node.count)

@@ -1,8 +1,12 @@
-"""The interactive window under Xvfb: open a lesson, send keys, read the screen, quit."""
+"""The interactive window: its error and frame-rate bookkeeping, and under Xvfb: open a lesson,
+send keys, read the screen, quit."""
 
 from __future__ import annotations
 
+import os
 import shutil
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -14,10 +18,12 @@ from support import REPO_ROOT as REPO
 from glsandbox.files import load_png
 from glsandbox.lesson import find_lesson
 from glsandbox.measure.golden import compare_images
+from glsandbox.window import FrameRate, LessonErrors
 
-pytestmark = pytest.mark.slow  # windows under Xvfb
+slow = pytest.mark.slow  # windows under Xvfb
 
 
+@slow
 def test_window_shows_the_lesson_saves_screenshots_resizes_and_quits(window_env: str, tmp_path: Path,
                                                                       gl) -> None:
     win = LessonWindow(window_env, tmp_path, "lessons.indexed_cube", "--size", "320x240", "--set", "speed=0")
@@ -53,6 +59,7 @@ def test_window_shows_the_lesson_saves_screenshots_resizes_and_quits(window_env:
     assert code == 0
 
 
+@slow
 def test_window_has_the_buffers_the_plan_asks_for(window_env: str, tmp_path: Path, gl) -> None:
     # Reverse-Z needs a float depth buffer, which a window's own framebuffer
     # does not have (24-bit integers); far away without polygon offset the
@@ -70,10 +77,11 @@ def test_window_has_the_buffers_the_plan_asks_for(window_env: str, tmp_path: Pat
         code = win.close()
     assert code == 0
     headless = gl.render(find_lesson("mirror").from_settings(settings), (320, 240), samples=4).image
-    np.testing.assert_array_equal(shot, headless)  # alpha too: both opaque (issue 12)
+    np.testing.assert_array_equal(shot, headless)  # alpha too: both opaque
     assert (shot[..., 3] == 255).all()
 
 
+@slow
 def test_r_reloads_shaders_and_a_broken_one_keeps_the_last_good_program(window_env: str, tmp_path: Path) -> None:
     shaders = tmp_path / "shaders"
     shutil.copytree(REPO / "shaders", shaders)
@@ -104,8 +112,9 @@ def test_r_reloads_shaders_and_a_broken_one_keeps_the_last_good_program(window_e
     assert "error: shader does not compile" in win.proc.stderr.read()
 
 
+@slow
 def test_a_model_file_renders_in_the_window_through_both_renderers(window_env: str, tmp_path: Path, gl) -> None:
-    """Issue 11's "a model file renders in a window": a scene file naming an STL, opened with
+    """A scene file naming an STL, opened with
     ``glsandbox run``, ray traced (the gpu engine through the BVH: 1,280 triangles) and
     rasterized; each window screenshot matches the headless render of the same settings."""
     import trimesh
@@ -131,3 +140,33 @@ def test_a_model_file_renders_in_the_window_through_both_renderers(window_env: s
         assert compare_images(shot, headless).passed, renderer
         centre, corner = shot[60, 80].astype(int), shot[5, 5].astype(int)
         assert centre[0] > centre[2] + 30 and corner[2] > corner[0] + 100, renderer  # an orange ball on blue
+
+
+def test_lesson_errors_show_the_first_kind_set_and_print_each_new_error_once(capsys) -> None:
+    errors = LessonErrors()
+    assert errors.report("draw", "bad value") == "bad value"
+    assert errors.report("file", "lesson.py:3: oops") == "lesson.py:3: oops"  # the file's error comes first
+    assert errors.report("draw", "bad value") == "lesson.py:3: oops"
+    assert capsys.readouterr().err == "error: bad value\nerror: lesson.py:3: oops\n"  # the repeat not printed
+    assert errors.report("file", "") == "bad value"  # the file reads again: the draw error shows
+    assert errors.report("draw", "") == ""
+    assert capsys.readouterr().err == ""
+
+
+def test_frame_rate_counts_frames_over_half_second_windows() -> None:
+    rate = FrameRate(every=0.5, start=10.0)
+    assert [rate.tick(10.0 + 0.1 * k) for k in range(1, 5)] == [False] * 4 and rate.fps == 0.0
+    assert rate.tick(10.5) and rate.fps == pytest.approx(10.0)  # five frames in 0.5 s
+    assert not rate.tick(10.9) and rate.tick(11.5) and rate.fps == pytest.approx(2.0)
+
+
+@slow
+def test_max_frames_ends_the_window_after_that_many_frames(xvfb_display: str, tmp_path: Path) -> None:
+    script = ("from glsandbox.lesson import find_lesson\n"
+              "from glsandbox.window import run_window\n"
+              "run_window(find_lesson('triangle')(), (64, 48), max_frames=3)\n"
+              "print('done')\n")
+    # Without max_frames the window would wait for ESC and the run time out.
+    proc = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "DISPLAY": xvfb_display})
+    assert (proc.returncode, proc.stdout) == (0, "done\n"), proc.stderr

@@ -1,9 +1,11 @@
 """Fixtures of the ray tracer's tests: ``engine_path``, every path a render can take
-(tests/conftest.py's ``engine`` is the two engines; this splits each into scan and BVH)."""
+(tests/conftest.py's ``engine`` is the two engines; this splits each into scan and BVH),
+and ``strict_floats``."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import warnings
+from collections.abc import Callable, Iterator
 
 import numpy as np
 import pytest
@@ -37,3 +39,11 @@ def engine_path(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch)
             return render(scene, size, bvh=path == "numpy-bvh", **options)
     trace.path = path  # type: ignore[attr-defined]
     return trace
+
+
+@pytest.fixture
+def strict_floats() -> Iterator[None]:
+    """Any floating-point warning (a 0/0, an overflow) fails the test instead of passing silently."""
+    with np.errstate(all="raise"), warnings.catch_warnings():
+        warnings.simplefilter("error")
+        yield
