@@ -501,6 +501,8 @@ def cmd_check(args: argparse.Namespace) -> int:
     if any(c.kind == "exercise" for c in checks):
         from glsandbox.grading.exercise import check_command
 
+        if args.shard is not None:
+            raise SandboxError(f"--shard {args.shard}: shares pictures among machines; grade an exercise in one run")
         return check_command(target, checks, limits, reports, str(args.rubric or args.exercise),
                              getattr(args, "entry", None), args.one, args.update)
     if args.one and not target.is_dir():
@@ -717,6 +719,9 @@ def _check_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--one", action="store_true",
                    help="LESSON_OR_DIR is one student's folder (its lesson and helper files; Gradescope's "
                         "/autograder/submission), not a folder of students")
+    p.add_argument("--shard", default=None, metavar="K/N",
+                   help="grade only share K of N (by a stable hash of each submission's name; the same on every "
+                        "machine); merge the shards' --json with: glsandbox check merge REPORTS...")
     p.add_argument("--jobs", type=int, default=None, metavar="N",
                    help="submissions graded at once (default: the CPUs this process may use, by its "
                         "cgroup's quota and affinity)")
