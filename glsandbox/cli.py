@@ -391,6 +391,12 @@ def _checks(args: argparse.Namespace) -> tuple[list, float | None, int | None]:
     """The checks of ``check``: a rubric's, or one from --golden, --set, --size and --tolerance."""
     from glsandbox.grading.rubric import Check, load_rubric, parse_tolerances
 
+    if getattr(args, "exercise", None) is not None:
+        if args.golden is not None or args.rubric is not None:
+            raise SandboxError(f"--exercise {args.exercise}: grades by the exercise's cases; drop --golden and --rubric")
+        from glsandbox.grading.exercise import default_check
+
+        return [default_check(args.exercise)], None, None
     if (args.golden is None) == (args.rubric is None):
         raise SandboxError("check: give the reference with --golden REF.png or a grading file with --rubric FILE "
                            "(one of the two)")
@@ -492,6 +498,13 @@ def cmd_check(args: argparse.Namespace) -> int:
         if path is not None and path.is_dir():
             raise SandboxError(f"--{kind} {path}: is a folder, expected a file name")
     target = Path(args.lesson)
+    if any(c.kind == "exercise" for c in checks):
+        from glsandbox.grading.exercise import check_command
+
+        if args.shard is not None:
+            raise SandboxError(f"--shard {args.shard}: shares pictures among machines; grade an exercise in one run")
+        return check_command(target, checks, limits, reports, str(args.rubric or args.exercise),
+                             getattr(args, "entry", None), args.one, args.update)
     if args.one and not target.is_dir():
         raise SandboxError(f"--one {target}: expected a student's folder (a lesson and its helper files)")
     if target.is_dir():
@@ -696,6 +709,9 @@ def _check_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--golden", type=Path, default=None, metavar="REF.png", help="the reference image")
     p.add_argument("--rubric", type=Path, default=None, metavar="FILE.toml",
                    help="a grading file: several checks, each with its golden, settings and points")
+    p.add_argument("--exercise", default=None, metavar="NAME",
+                   help="grade students' functions on an exercise (glsandbox exercise list): every case "
+                        "group, one point each, hidden groups included")
     p.add_argument("--update", action="store_true",
                    help="write the references when missing or different (a passing one is kept)")
     p.add_argument("--tolerance", action="append", default=[], metavar="KEY=VALUE",

@@ -479,3 +479,21 @@ def student_lessons_folder(tmp_path: Path) -> Path:
     (tmp_path / "lessons" / "__init__.py").write_text('"""A student\'s own lessons."""\n')
     (tmp_path / "lessons" / "indexed_cube.py").write_text('MINE = "the user\'s own"\n')
     return tmp_path
+
+
+#: A student's right ``ray_sphere`` answer, the notes' geometric test (l, s, m², q; s - q from outside).
+SPHERE_ANSWER = """
+import math
+
+def intersect_sphere(origin, direction, center, radius):
+    l = [c - o for c, o in zip(center, origin)]
+    s = sum(a * b for a, b in zip(l, direction))
+    l2 = sum(a * a for a in l)
+    m2 = l2 - s * s
+    if m2 > radius * radius:
+        return None
+    q = math.sqrt(radius * radius - m2)
+    if l2 > radius * radius:
+        return None if s < 0 else s - q
+    return s + q
+"""

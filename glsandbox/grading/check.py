@@ -126,6 +126,9 @@ class Outcome:
     seconds: float = 0.0
     artifacts: dict[str, Path] = field(default_factory=dict)
     thumb: np.ndarray | None = None
+    #: An exercise check's cases (the teacher's reports), and what a student may read (None: :meth:`detail`).
+    cases: list[dict] = field(default_factory=list)
+    student: str | None = None
 
     @property
     def points(self) -> float:

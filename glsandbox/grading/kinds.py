@@ -2,8 +2,9 @@
 
 A kind names the ``[[check]]`` keys it reads besides the common ones
 (``name``, ``points``, ``hidden``, ``kind``) and judges what a submission
-sent back for one check. Today's kind is ``picture``: a rendered image
-against a reference PNG, by the golden rule (:func:`glsandbox.measure.golden.compare_images`).
+sent back for one check. ``picture``: a rendered image
+against a reference PNG, by the golden rule (:func:`glsandbox.measure.golden.compare_images`);
+``exercise``: a student's function against an exercise's cases (:mod:`glsandbox.grading.exercise`).
 """
 
 from __future__ import annotations
@@ -75,5 +76,12 @@ def judge_picture(check: Check, image: np.ndarray, expected: np.ndarray) -> Verd
     return Verdict(match.passed, match)
 
 
+def judge_exercise(check: Check, image: np.ndarray, expected: np.ndarray) -> Verdict:
+    """The ``exercise`` kind is graded case by case (:mod:`glsandbox.grading.exercise`), not by a picture."""
+    raise TypeError(f"check {check.name!r} is an exercise: glsandbox.grading.exercise grades it")
+
+
+register_kind(CheckKind("exercise", frozenset({"exercise"}), judge_exercise,
+                        "a student's function against an exercise's cases, points per case group"))
 register_kind(CheckKind("picture", frozenset({"golden", "set", "size", "samples", "renderer", "tolerance"}),
                         judge_picture, "a rendered picture against a reference PNG"))

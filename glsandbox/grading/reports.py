@@ -80,9 +80,12 @@ def json_text(results: Sequence[CheckResult], title: str) -> str:
         if len(r.outcomes) == 1:
             entry.update({k: v for k, v in _figures(r.outcomes[0]).items() if k != "status"})
             entry["detail"] = r.outcomes[0].detail()
+            if r.outcomes[0].cases:
+                entry["cases"] = r.outcomes[0].cases
         else:
             entry["checks"] = [{"check": o.check.name, "points": o.points, "of": o.check.points, **_figures(o),
-                                "detail": o.detail()} for o in r.outcomes]
+                                "detail": o.detail(), **({"cases": o.cases} if o.cases else {})}
+                               for o in r.outcomes]
         submissions.append(entry)
     c = {k.lower().replace(" ", "_"): v for k, v in counts(results).items()}
     return json.dumps({"reference": title, **c, "submissions": submissions}, indent=2) + "\n"
@@ -121,9 +124,9 @@ def gradescope_text(results: Sequence[CheckResult], title: str) -> str:
     for r in results:
         for o in r.outcomes:
             name = o.check.name if len(results) == 1 else f"{r.shown}: {o.check.name}"
-            output = f"{o.status}: {o.detail()}".rstrip(": ")
+            output = f"{o.status}: {o.detail() if o.student is None else o.student}".rstrip(": ")
             if o.check.hidden:  # shown after publishing: its outcome and points, never its figures or output
-                output = o.status
+                output = o.status if o.student is None else output  # an exercise group: counts, case names
             elif r.output and o.status != PASS:
                 output += "\nlast lines printed:\n" + "\n".join(_output(r))
             tests.append({"name": name, "score": o.points, "max_score": o.check.points, "output": output,
@@ -243,7 +246,7 @@ def student_text(results: Sequence[CheckResult], title: str) -> str:
             rows_html.append(
                 f'<tr><td>{html.escape(o.check.name)}</td><td>{points(o.points)} / {points(o.check.points)}</td>'
                 f'<td style="background:{_COLOURS.get(o.status, "#fff")}">{html.escape(o.status)}: '
-                f'{html.escape(o.detail())}</td>'
+                f'{html.escape(o.detail() if o.student is None else o.student)}</td>'
                 f"<td>{_img(ref, 'reference')}{_img(o.thumb, 'yours')}{_img(diff, 'difference')}</td></tr>")
         visible = [o for o in r.outcomes if not o.check.hidden]
         score = f"{points(sum(o.points for o in visible))} / {points(sum(o.check.points for o in visible))}"

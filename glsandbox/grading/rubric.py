@@ -20,6 +20,11 @@ per check and gives each student a score out of the total. The file::
     tolerance = { threshold = 2, max_bad_share = 0.0005 }
     hidden = false          # true: Gradescope shows it to the student only after publishing
 
+    [[check]]
+    exercise = "ray_sphere" # a student's function (glsandbox exercise list); kind = "exercise" inferred
+    points = { visible = 2, hidden = 3 }   # per case group; "hidden": the hidden groups not named, split evenly
+                                           # (one number: split evenly over every group)
+
 Every mistake in the file is one line naming the file, the check and the key.
 """
 
@@ -55,6 +60,9 @@ class Check:
     hidden: bool = False
     #: The kind of check (:mod:`glsandbox.grading.kinds`): how what comes back is judged.
     kind: str = "picture"
+    #: An ``exercise`` check's exercise name, and its points per case group (in the exercise's order).
+    exercise: str = ""
+    group_points: tuple[tuple[str, float], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -140,7 +148,7 @@ def load_rubric(path: Path) -> Rubric:
 
 def _check(entry: dict[str, Any], number: int, path: Path) -> Check:
     where = f"{path}: check {number}"
-    kind_name = entry.get("kind", "picture")
+    kind_name = entry.get("kind", "exercise" if "exercise" in entry else "picture")
     try:
         kind = kind_of(kind_name) if isinstance(kind_name, str) else None
     except KeyError:
@@ -151,6 +159,8 @@ def _check(entry: dict[str, Any], number: int, path: Path) -> Check:
     unknown = sorted(set(entry) - allowed)
     if unknown:
         raise SandboxError(f"{where}: unknown key {unknown[0]!r} (expected {', '.join(sorted(allowed))})")
+    if kind.name == "exercise":
+        return exercise_check(entry, where, path)
     golden = entry.get("golden")
     if not isinstance(golden, str) or not golden.lower().endswith(".png"):
         raise SandboxError(f"{where}: golden = {golden!r}: expected the path of a .png file")
@@ -188,6 +198,50 @@ def _check(entry: dict[str, Any], number: int, path: Path) -> Check:
         raise SandboxError(f"{where}: hidden = {hidden!r}: expected true or false")
     return Check(name.strip(), golden_path, tuple(settings), size_value, samples, tolerances, float(points), hidden,
                  kind.name)
+
+
+def group_points(points: Any, groups: list[str], where: str) -> tuple[tuple[str, float], ...]:
+    """An exercise check's points per case group: one number split evenly over ``groups``, or a table
+    of group names (``hidden``: the hidden groups not named, split evenly; a group not named and no
+    ``hidden``: 0 points)."""
+    def number(value: Any, key: str) -> float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value <= 1e6:
+            raise SandboxError(f"{where}: {key} = {value!r}: expected a number, 0 or more")
+        return float(value)
+
+    if not isinstance(points, dict):
+        total = number(points, "points")
+        return tuple((g, total / len(groups)) for g in groups)
+    for key in points:
+        if key not in groups and key != "hidden":
+            raise SandboxError(f"{where}: points.{key}: no case group {key!r} (the groups: {', '.join(groups)}, "
+                               "or hidden for the hidden ones not named)")
+    named = {key: number(value, f"points.{key}") for key, value in points.items()}
+    rest = [g for g in groups if g not in named and g != "visible"]
+    share = named.get("hidden", 0.0) / len(rest) if rest else 0.0
+    return tuple((g, named[g] if g in named else 0.0 if g == "visible" else share) for g in groups)
+
+
+def exercise_check(entry: dict[str, Any], where: str, path: Path) -> Check:
+    """A ``[[check]]`` of kind ``exercise``: the exercise (checked against the catalogue), its name,
+    its points per case group and ``hidden``."""
+    from glsandbox.exercises.catalogue import MODULES, get
+
+    name = entry.get("exercise")
+    if not isinstance(name, str) or name not in MODULES:
+        raise SandboxError(f"{where}: exercise = {name!r}: expected one of {', '.join(MODULES)}")
+    exercise = get(name)
+    title = entry.get("name", name)
+    if not isinstance(title, str) or not title.strip() or not title.isprintable():
+        raise SandboxError(f"{where}: name = {title!r}: expected a short printable text")
+    where = f"{path}: check {title!r}"
+    groups = list(dict.fromkeys(case.group for case in exercise.cases(True)))
+    split = group_points(entry.get("points", len(groups)), groups, where)
+    hidden = entry.get("hidden", False)
+    if not isinstance(hidden, bool):
+        raise SandboxError(f"{where}: hidden = {hidden!r}: expected true or false")
+    return Check(title.strip(), path.parent / f"{name}.exercise", points=sum(p for _, p in split), hidden=hidden,
+                 kind="exercise", exercise=name, group_points=split)
 
 
 #: The starting rubric ``glsandbox new --assignment NAME`` writes beside the model answer.

@@ -5,26 +5,12 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from support import assert_user_error, run_cli
+from support import SPHERE_ANSWER, assert_user_error, run_cli
 
 from glsandbox.exercises import all_exercises
 from glsandbox.exercises.states import STATE_EXERCISES
 
-SPHERE = '''
-import math
-
-def intersect_sphere(origin, direction, center, radius):
-    l = [c - o for c, o in zip(center, origin)]
-    s = sum(a * b for a, b in zip(l, direction))
-    l2 = sum(a * a for a in l)
-    m2 = l2 - s * s
-    if m2 > radius * radius:
-        return None
-    q = math.sqrt(radius * radius - m2)
-    if l2 > radius * radius:
-        return None if s < 0 else s - q
-    return s + q
-'''
+SPHERE = SPHERE_ANSWER
 
 
 def test_list_gives_a_line_per_exercise_with_its_section_and_signature() -> None:

@@ -64,7 +64,7 @@ def test_a_rubric_is_read_with_every_key(tmp_path: Path) -> None:
     ("memory = 'lots'\n[[check]]\ngolden = 'a.png'\n", "memory = 'lots'"),
     ("jobs = 2\n[[check]]\ngolden = 'a.png'\n", "unknown key 'jobs'"),
     ("[[check]\n", "not valid TOML"),
-    ("[[check]]\nkind = 'sound'\ngolden = 'a.png'\n", "check 1: kind = 'sound': expected one of picture"),
+    ("[[check]]\nkind = 'sound'\ngolden = 'a.png'\n", "check 1: kind = 'sound': expected one of exercise, picture"),
 ])
 def test_every_rubric_mistake_is_one_line_naming_the_file(tmp_path: Path, text: str, fragment: str) -> None:
     path = tmp_path / "grading.toml"
