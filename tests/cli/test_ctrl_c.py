@@ -14,22 +14,31 @@ from pathlib import Path
 import pytest
 from support import REPO_ROOT
 
-#: (name, arguments given the out folder, seconds to let it work first)
+#: (name, arguments given the out folder, seconds to let it work first, or the line it prints
+#: once it is working: the tour is interrupted after its first lesson, however fast the machine)
 COMMANDS = [
-    ("tour", lambda out: ["tour", "--out", str(out / "tour"), "--size", "64x48"], 4.0),
+    ("tour", lambda out: ["tour", "--out", str(out / "tour"), "--size", "640x480"], "[1/15]"),
     ("check_update", lambda out: ["check", "ray_acceleration", "--golden", str(out / "ref.png"), "--update"], 2.5),
     ("tradeoffs", lambda out: ["tradeoffs", "--quick", "--out", str(out / "report")], 6.0),
     ("bench", lambda out: ["bench", "--quick", "--json", str(out / "bench.json")], 6.0),
 ]
 
 
-def _interrupt(args: list[str], wait: float, group: bool) -> tuple[int, float, str]:
-    """Start ``glsandbox ARGS`` in a session of its own, SIGINT it after ``wait`` s:
-    (exit status, seconds from the signal to the exit, output)."""
+def _interrupt(args: list[str], wait: float | str, group: bool) -> tuple[int, float, str]:
+    """Start ``glsandbox ARGS`` in a session of its own, SIGINT it after ``wait`` s (or once it
+    has printed a line starting with ``wait``): (exit status, seconds from the signal to the exit, output)."""
     proc = subprocess.Popen([sys.executable, "-m", "glsandbox.cli", *args], stdout=subprocess.PIPE,
                             stderr=subprocess.STDOUT, text=True, cwd=REPO_ROOT, start_new_session=True)
-    time.sleep(wait)
-    assert proc.poll() is None, proc.communicate()[0]  # still working when the key is pressed
+    seen = ""
+    if isinstance(wait, str):
+        assert proc.stdout is not None
+        for line in proc.stdout:  # blocks until the command prints its line (or ends)
+            seen += line
+            if line.lstrip().startswith(wait):
+                break
+    else:
+        time.sleep(wait)
+    assert proc.poll() is None, seen + proc.communicate()[0]  # still working when the key is pressed
     start = time.monotonic()
     if group:
         os.killpg(proc.pid, signal.SIGINT)
@@ -40,7 +49,7 @@ def _interrupt(args: list[str], wait: float, group: bool) -> tuple[int, float, s
     except subprocess.TimeoutExpired:
         os.killpg(proc.pid, signal.SIGKILL)
         out, _ = proc.communicate()
-    return proc.returncode, time.monotonic() - start, out
+    return proc.returncode, time.monotonic() - start, seen + out
 
 
 @pytest.mark.slow

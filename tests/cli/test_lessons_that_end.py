@@ -63,7 +63,11 @@ def test_tour_and_run_of_a_lesson_that_ends_itself_never_exit_0(tmp_path: Path, 
     path = _lesson(folder, case)
     proc = glsandbox("tour", "--lessons", str(folder), "--out", str(tmp_path / "tour"), "--size", "32x24",
                      cwd=tmp_path)
-    assert proc.returncode == 1 and proc.stderr.strip().splitlines()[-1].startswith("error: "), proc.stderr
+    # The tour renders each lesson isolated (as check does): the lesson's line says how it ended,
+    # the last line names it, exit 1.
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 1 and lines[-1] == f"tour: failed: {path.stem}", proc.stderr
+    assert any(f"{path.stem}: FAILED: CRASHED" in line for line in lines), proc.stderr
     proc = glsandbox("run", str(path), cwd=tmp_path, env={"DISPLAY": ""})
     assert proc.returncode in (1, 2) and "error: " in proc.stderr, proc.stderr
 

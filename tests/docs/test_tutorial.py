@@ -70,7 +70,7 @@ def test_the_readme_tutorial_works_step_by_step(tmp_path: Path, gl) -> None:
             ran.append(words[2:4])
     assert ["glsandbox", "new"] in ran and ["glsandbox", "check"] in ran and ["pytest", "test_my_lesson.py"] in ran
     mine = tmp_path / "mine"
-    for picture in ("my_lesson.png", "my_scene.png", "compare_my_lesson.png", "goldens/my_lesson.png"):
+    for picture in ("my_lesson.png", "my_scene.png", "compare_my_lesson_py.png", "goldens/my_lesson.png"):
         image = load_png(mine / picture)
         assert len({tuple(px) for px in image.reshape(-1, 4)[::7]}) > 20, picture  # a picture, not a clear colour
     assert "1 passed" in proc.stdout  # the fixture checked goldens/my_lesson.png

@@ -455,4 +455,4 @@ def test_saving_the_shader_reloads_it_in_the_window(folder: Path, xvfb_display: 
         code = win.close()
     assert code == 0
     err = win.proc.stderr.read()
-    assert "shaders reloaded" in err and f"error: shader does not compile: {shader}:12:" in err
+    assert "shaders reloaded" in err and f"error: shader does not compile: {shader.name}:12:" in err  # relative to the working folder
