@@ -18,7 +18,9 @@ from support import REPO_ROOT
 #: once it is working: the tour is interrupted after its first lesson, however fast the machine)
 COMMANDS = [
     ("tour", lambda out: ["tour", "--out", str(out / "tour"), "--size", "640x480"], "[1/15]"),
-    ("check_update", lambda out: ["check", "ray_acceleration", "--golden", str(out / "ref.png"), "--update"], 2.5),
+    # A large picture, so that the reference is still being rendered when the key is pressed.
+    ("check_update", lambda out: ["check", "ray_acceleration", "--golden", str(out / "ref.png"), "--update",
+                                  "--size", "3200x2400"], 2.0),
     ("tradeoffs", lambda out: ["tradeoffs", "--quick", "--out", str(out / "report")], 6.0),
     ("bench", lambda out: ["bench", "--quick", "--json", str(out / "bench.json")], 6.0),
 ]
