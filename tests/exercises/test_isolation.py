@@ -4,6 +4,8 @@ run, and nothing of glsandbox (the references, the hidden answers) can be reache
 from __future__ import annotations
 
 import json
+import os
+import sys
 import time
 from pathlib import Path
 
@@ -109,6 +111,7 @@ def test_the_kernel_refuses_reading_the_reference_even_past_python(hostile) -> N
     from glsandbox.grading.sandbox import landlock_abi
 
     if landlock_abi() < 1:
+        assert not (sys.platform == "linux" and os.environ.get("CI")), "CI's Linux has Landlock: it must close this"
         pytest.skip("no Landlock in this kernel: the audit hook alone refuses the read")
     answer = hostile.call(["ctypes"])
     assert answer.status == VALUE and answer.value == -1  # open(2) failed: EACCES
