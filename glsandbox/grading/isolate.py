@@ -222,6 +222,22 @@ class _Running:
     pid: int = 0
 
 
+def settle(job: Job, result: JobResult, pending: deque[Job], retried: set[int], results: dict[int, JobResult],
+           done: Callable[[JobResult], object]) -> bool:
+    """A finished job's result, in either isolation path: queued once more when it found no GL
+    (a driver can fail now and then), else kept and handed to ``done``. True when the run must
+    stop: no GL the second time either."""
+    if result.no_gl and job.index not in retried:
+        retried.add(job.index)
+        pending.appendleft(job)
+        return False
+    results[job.index] = result
+    if result.no_gl:
+        return True
+    done(result)
+    return False
+
+
 def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None]) -> list[JobResult]:
     """Run every job, ``workers`` at once; ``done`` is called as each finishes; results in job order.
 
@@ -276,15 +292,8 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
                     killpg(entry.pid)
                 del running[fd]
                 os.close(fd)
-                result = _result(entry.job, message)
-                if result.no_gl and entry.job.index not in retried:  # once more: a driver can fail now and then
-                    retried.add(entry.job.index)
-                    pending.appendleft(entry.job)
-                    continue
-                results[entry.job.index] = result
-                if result.no_gl:
+                if settle(entry.job, _result(entry.job, message), pending, retried, results, done):
                     return [results[j.index] for j in jobs if j.index in results]
-                done(result)
     finally:
         for fd, entry in running.items():
             if entry.pid:

@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from glsandbox.grading.isolate import (BROKEN, CRASHED, OOM, TIMEOUT, Job, JobResult, Picture, Reader, _job_data,
-                                       job_from, send)
+                                       job_from, send, settle)
 
 __all__ = ["wanted", "describe", "run_jobs_portable", "child_main", "tree_rss"]
 
@@ -310,15 +310,8 @@ def run_jobs_portable(jobs: Sequence[Job], workers: int, done: Callable[[JobResu
                     continue
                 running.remove(entry)
                 entry.close()
-                result = entry.result()
-                if result.no_gl and entry.job.index not in retried:  # once more: a driver can fail now and then
-                    retried.add(entry.job.index)
-                    pending.appendleft(entry.job)
-                    continue
-                results[entry.job.index] = result
-                if result.no_gl:
+                if settle(entry.job, entry.result(), pending, retried, results, done):
                     return [results[j.index] for j in jobs if j.index in results]
-                done(result)
     finally:
         for entry in running:
             entry.close()
