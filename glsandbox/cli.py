@@ -594,6 +594,8 @@ def cmd_explain(args: argparse.Namespace) -> int:
     from glsandbox.story import parse_pixel, pixel_story
 
     lesson = _lesson(args)
+    if args.exercise:
+        return _explain_exercise(args, lesson)
     lazy = LazyRenderer(args.backend)  # opened only for a rasterised pixel
     try:
         story = pixel_story(lesson.scene(), _size(args), parse_pixel(args.pixel), lesson.name, lambda: lazy.renderer)
@@ -601,6 +603,31 @@ def cmd_explain(args: argparse.Namespace) -> int:
         lazy.close()
     print(story.to_json() if args.json else story.text)
     return 0
+
+
+def _explain_exercise(args: argparse.Namespace, lesson: Lesson) -> int:
+    """``explain ... --exercise NAME FILE.py``: the student's function, run in its confined process,
+    traced beside the reference; exit 0 when the traces agree, 1 when they part (like diff)."""
+    from glsandbox.exercises.catalogue import get
+    from glsandbox.exercises.check import static_check
+    from glsandbox.exercises.isolation import Isolated
+    from glsandbox.story import parse_pixel
+    from glsandbox.story.exercise import explain_with_function, render_exercise_story, traced_kind
+
+    name, file = args.exercise
+    exercise = get(name)
+    traced_kind(exercise)
+    pixel, size = parse_pixel(args.pixel), _size(args)
+    path = Path(file)
+    static_check(path, exercise)
+    with Isolated(path, exercise.function) as caller:
+        story = explain_with_function(lesson.scene(), size, pixel, exercise, caller, lesson.name)
+        if caller.load_error:  # it did not load (raised at import): bad input, not a trace
+            raise SandboxError(f"{path}: {caller.load_error}")
+    import json
+
+    print(json.dumps(story.to_dict(), indent=1, ensure_ascii=False) if args.json else render_exercise_story(story))
+    return 0 if story.agree else 1
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
@@ -658,7 +685,8 @@ COMMANDS: dict[str, tuple[str, tuple[str, ...]]] = {
                 "Phong's terms, the reflections and the 8-bit colour",
                 ("glsandbox explain ray_spheres --pixel 320,240",
                  "glsandbox explain ray_phong --set scene=exam2013 --pixel 300,200 --size 640x480",
-                 "glsandbox explain mirror --set renderer=ray_numpy --pixel 100,100 --json")),
+                 "glsandbox explain mirror --set renderer=ray_numpy --pixel 100,100 --json",
+                 "glsandbox explain ray_spheres --pixel 320,240 --exercise ray_sphere my_sphere.py")),
     "tour": ("render every lesson headless into a folder, with a gallery page (index.html) and tour.json",
              ("glsandbox tour", "glsandbox tour --out gallery --size 320x240",
               "glsandbox tour --lessons submissions/ --out checked")),
@@ -741,6 +769,22 @@ def _check_options(p: argparse.ArgumentParser) -> None:
     p.set_defaults(func=cmd_check)
 
 
+def add_explain_options(p: argparse.ArgumentParser) -> None:
+    """``glsandbox explain``'s arguments."""
+    p.add_argument("lesson", metavar="LESSON", help="a lesson name, a lesson .py file or a scene .toml file")
+    p.add_argument("--pixel", required=True, metavar="X,Y", help="the pixel, x from the left, y from the top")
+    p.add_argument("--size", default=None, help=f"frame size WxH (default {DEFAULT_SIZE[0]}x{DEFAULT_SIZE[1]})")
+    p.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
+                   help="a lesson parameter (repeatable); every lesson has time=SECONDS")
+    p.add_argument("--json", action="store_true", help="print the raw record as JSON instead of the story")
+    p.add_argument("--exercise", nargs=2, default=None, metavar=("NAME", "FILE.py"),
+                   help="trace the pixel with your function of the exercise NAME (run confined) beside the "
+                        "reference; exit 1 when the traces part")
+    p.add_argument("--backend", default=None, help=f"a rasterised pixel: one of {', '.join(BACKENDS)} "
+                   "(default: GLSANDBOX_BACKEND or auto)")
+    p.set_defaults(func=cmd_explain)
+
+
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     """The command line's parser: every subcommand, or with ``command`` only that one (what a
     command line naming it parses: the others cost argparse about 1.5 ms of a cold start; the
@@ -774,16 +818,7 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         p.set_defaults(func=func)
 
     if wanted("explain"):
-        p = add_command(sub, "explain")
-        p.add_argument("lesson", metavar="LESSON", help="a lesson name, a lesson .py file or a scene .toml file")
-        p.add_argument("--pixel", required=True, metavar="X,Y", help="the pixel, x from the left, y from the top")
-        p.add_argument("--size", default=None, help=f"frame size WxH (default {DEFAULT_SIZE[0]}x{DEFAULT_SIZE[1]})")
-        p.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
-                       help="a lesson parameter (repeatable); every lesson has time=SECONDS")
-        p.add_argument("--json", action="store_true", help="print the raw record as JSON instead of the story")
-        p.add_argument("--backend", default=None, help=f"a rasterised pixel: one of {', '.join(BACKENDS)} "
-                       "(default: GLSANDBOX_BACKEND or auto)")
-        p.set_defaults(func=cmd_explain)
+        add_explain_options(add_command(sub, "explain"))
 
     if wanted("tour"):
         p = add_command(sub, "tour")

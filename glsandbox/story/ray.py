@@ -29,7 +29,7 @@ The engine's nearest hit decides the story; the per-node tests are each node's o
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -222,8 +222,8 @@ def locate_pixel(scene: Scene, size: tuple[int, int], pixel: tuple[int, int]) ->
 class _Recorder:
     """The probe: keeps a copy of every step's arrays, in order (one ray, so row 0)."""
 
-    def __init__(self) -> None:
-        self.events: list[tuple[str, dict[str, Any]]] = []
+    def __init__(self, events: list[tuple[str, dict[str, Any]]] | None = None) -> None:
+        self.events: list[tuple[str, dict[str, Any]]] = events if events is not None else []
 
     def __call__(self, step: str, **values: Any) -> None:
         kept: dict[str, Any] = {}
@@ -236,28 +236,40 @@ class _Recorder:
         self.events.append((step, kept))
 
 
-def explain_ray_pixel(scene: Scene, size: tuple[int, int], pixel: tuple[int, int], title: str = "") -> PixelTrace:
+def explain_ray_pixel(scene: Scene, size: tuple[int, int], pixel: tuple[int, int], title: str = "", *,
+                      hit_tests: dict[str, Any] | None = None, simple: bool = False,
+                      events: list[tuple[str, dict[str, Any]]] | None = None, traced: bool = False) -> PixelTrace:
     """The story of frame pixel ``pixel = (x, y)`` (row 0 at the top) of ``scene`` traced at
     ``size``: the numpy engine's float64 path, with the options frames are traced with
     (:data:`glsandbox.plan.TRACE_OPTIONS`). The pixel must lie in a ray-traced viewport
-    (``renderer=ray`` or ``ray_numpy``)."""
+    (``renderer=ray`` or ``ray_numpy``).
+
+    ``hit_tests`` replaces a node kind's test as :func:`~glsandbox.raytrace.numpy_engine.render_viewport`'s
+    does (an exercise's function; no BVH then), ``simple`` takes the course's simple offset for
+    secondary rays, and ``events``, when given, receives the engine's recorded steps in order
+    (:mod:`glsandbox.story.exercise` compares two of them). ``traced`` traces a rasterised
+    viewport's pixel too (as the numpy engine would draw it: an exercise's lesson picture)."""
     index, (lx, ly), (w, h) = locate_pixel(scene, size, pixel)
     vp = scene.viewports[index]
-    if vp.renderer == "raster":
+    if vp.renderer == "raster" and not traced:
         raise SandboxError(f"--pixel {pixel[0]},{pixel[1]}: viewport {index} is rasterised; "
                            "its story is the X-ray's (glsandbox.story.raster), or trace it with --set renderer=ray_numpy")
     single = single_viewport(scene, index)
-    world, accel = numpy_engine._world_of(single, 0, True, True)
+    world, accel = numpy_engine._world_of(single, 0, True, not hit_tests)
+    if hit_tests:
+        world, accel = replace(world, hit_tests=dict(hit_tests)), None
     eye, dirs = numpy_engine._rays_of(single, 0, w, h)
     row = ly * w + lx
     max_depth = int(TRACE_OPTIONS["max_depth"])
     shadows = bool(TRACE_OPTIONS["shadows"])
-    recorder = _Recorder()
+    recorder = _Recorder(events)
     rgb = numpy_engine._trace(world, eye, dirs[row:row + 1], max_depth, shadows, None, True, RenderStats(), accel,
-                              OFFSETS["bound"], probe=recorder)
-    bounces = _bounces(world, recorder.events, shadows)
+                              OFFSETS["simple"] if simple else OFFSETS["bound"], probe=recorder)
+    recorder.events.append(("end", {}))  # what a hit test handed in is asked after this is not the trace's
+    bounces = _bounces(world, [e for e in recorder.events if e[0] not in ("call", "end")], shadows)
     return PixelTrace(title=title or scene.name, pixel=(int(pixel[0]), int(pixel[1])), size=(int(size[0]), int(size[1])),
-                      viewport=index, local_pixel=(lx, ly), viewport_size=(w, h), renderer=vp.renderer,
+                      viewport=index, local_pixel=(lx, ly), viewport_size=(w, h),
+                      renderer="ray_numpy" if vp.renderer == "raster" else vp.renderer,
                       max_depth=max_depth, background=_vec(world.background), bounces=bounces, color=_vec(rgb),
                       rgba8=[int(v) for v in to_rgba8(rgb)[0]], notes=overlays_over(scene, size, pixel))
 

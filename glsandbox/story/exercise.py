@@ -1,0 +1,449 @@
+"""A pixel's story with a student's function: their trace beside the reference's, and where they part.
+
+``glsandbox explain LESSON --pixel X,Y --exercise NAME FILE.py`` traces the pixel
+twice through the numpy engine (:func:`glsandbox.story.ray.explain_ray_pixel`), once
+with the exercise's reference and once with the student's function as the hit test of
+its kind of node (the engine's ``hit_tests`` seam, as the exercise's lesson picture
+uses it: ``intersect_sphere`` for the spheres, ``intersect_triangle`` for the meshes'
+triangles). Both use the course's simple offset for secondary rays, as the lesson
+picture does. Every call of the function is logged in the trace's order, between the
+engine's steps, so the two traces are two lists of facts:
+
+- each call's answer (which node, which ray: the primary or a reflected ray at its
+  depth, or a light's shadow ray, course "Gölge testi");
+- each ray's nearest hit (``min_indis``: the node, its ``t``, the triangle);
+- each light's shadow verdict and each hit's local colour (course "Phong boyama modeli");
+- the pixel's 8-bit colour.
+
+:func:`compare_traces` walks them side by side and names the first fact where they
+part: "intersect_sphere returned t = 125 where the reference has 35". The student's
+function is only called through ``caller`` (an object with the isolation's
+``batch(inputs)``: their confined process, or in a notebook their own function);
+nothing of theirs is imported here.
+"""
+
+from __future__ import annotations
+
+import math
+import textwrap
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from glsandbox.errors import SandboxError
+from glsandbox.exercises.base import Exercise
+from glsandbox.exercises.compare import WrongType, describe, matches, normalize
+from glsandbox.scene import Scene
+from glsandbox.story.ray import PixelTrace, ShapeTest, explain_ray_pixel
+from glsandbox.story.text import num, render_story, vec
+
+__all__ = ["Divergence", "ExerciseStory", "TRACED_KINDS", "compare_traces", "explain_with_function", "traced_kind"]
+
+#: The tolerance two traces' numbers agree within (relative, and absolute near 0): a
+#: correct geometric sphere test and the engine's stable one differ by rounding only.
+REL, ABS = 1e-9, 1e-9
+
+#: The node kind (the engine's ``hit_tests`` name) each exercise's function is the test of.
+TRACED_KINDS = {"sphere": "sphere", "triangles": "triangles"}
+
+
+def traced_kind(exercise: Exercise) -> str:
+    """The engine's node kind ``exercise``'s function traces, refusing one the tracer cannot plug in."""
+    if exercise.lesson is None or exercise.lesson.kind not in TRACED_KINDS:
+        from glsandbox.exercises.catalogue import all_exercises
+
+        known = ", ".join(e.name for e in all_exercises() if e.lesson is not None)
+        raise SandboxError(f"--exercise {exercise.name}: its function is not a hit test the ray tracer can use; "
+                           f"the exercises it traces: {known}")
+    return TRACED_KINDS[exercise.lesson.kind]
+
+
+class _Direct:
+    """The reference as a caller (trusted code, in this process): the same ``batch`` as the isolation's."""
+
+    def __init__(self, function: Any) -> None:
+        self.function = function
+
+    def batch(self, inputs: list[tuple[Any, ...]]) -> tuple[list[Any], dict[int, str]]:
+        return [self.function(*args) for args in inputs], {}
+
+
+class _Seam:
+    """A caller's function as the engine's hit test of one node kind, each call logged into
+    ``events`` (until the trace's ``end``) as ``("call", {...})`` with the inputs and answers."""
+
+    def __init__(self, exercise: Exercise, caller: Any, events: list[tuple[str, dict[str, Any]]]) -> None:
+        self.exercise, self.caller, self.events = exercise, caller, events
+        self.error = ""
+
+    def _answers(self, inputs: list[tuple[Any, ...]]) -> list[Any]:
+        """Each input's answer, normalized: a value, or an ``error: ...`` string."""
+        if not inputs:
+            return []
+        batch = self.caller.batch(inputs) if not self.error else None
+        if batch is None or not isinstance(batch, tuple):
+            self.error = self.error or f"your function stopped answering ({getattr(batch, 'error', '')})"
+            return [f"error: {self.error}"] * len(inputs)
+        values, errors = batch
+        out: list[Any] = []
+        for i, value in enumerate(values):
+            if i in errors:
+                out.append(f"error: {errors[i]}")
+                continue
+            try:
+                out.append(normalize(value, self.exercise.returns))
+            except WrongType as exc:
+                out.append(f"error: {exc}")
+        return out
+
+    def _log(self, kind: str, inputs: list[tuple[Any, ...]], answers: list[Any], **more: Any) -> None:
+        if not (self.events and self.events[-1][0] == "end"):
+            self.events.append(("call", {"kind": kind, "inputs": inputs, "answers": answers, **more}))
+
+    @staticmethod
+    def _t(answer: Any) -> float:
+        return float(answer) if isinstance(answer, (int, float)) and not isinstance(answer, bool) and answer > 0 \
+            else math.inf
+
+    def sphere(self, o: NDArray[np.float64], d: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Rays in the unit sphere's own space: ``intersect_sphere(O, d/|d|, (0,0,0), 1) / |d|``."""
+        lengths = np.linalg.norm(d, axis=1)
+        unit = d / lengths[:, None]
+        inputs = [(tuple(a), tuple(b), (0.0, 0.0, 0.0), 1.0) for a, b in zip(o.tolist(), unit.tolist(), strict=True)]
+        answers = self._answers(inputs)
+        self._log("sphere", inputs, answers, lengths=lengths.tolist())
+        return np.asarray([self._t(a) for a in answers]) / lengths
+
+    def triangles(self, o: NDArray[np.float64], d: NDArray[np.float64], v0: NDArray[np.float64],
+                  v1: NDArray[np.float64], v2: NDArray[np.float64], one_sided: bool
+                  ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
+        """Every ray against every triangle of a node; the nearest, and which (culling is the engine's)."""
+        n, m = d.shape[0], v0.shape[0]
+        tris = [(tuple(a), tuple(b), tuple(c)) for a, b, c in zip(v0.tolist(), v1.tolist(), v2.tolist(), strict=True)]
+        rays = list(zip(map(tuple, o.tolist()), map(tuple, d.tolist()), strict=True))
+        inputs = [(*ray, *tri) for ray in rays for tri in tris]
+        answers = self._answers(inputs)
+        self._log("triangles", inputs, answers, triangles=m, first=v0[0].tolist() if m else None)
+        t = np.asarray([self._t(a) for a in answers]).reshape(n, m)
+        if one_sided:  # N·Rd > 0 is dropped, as the lesson picture drops it
+            t = np.where(d @ np.cross(v1 - v0, v2 - v0).T > 0.0, np.inf, t)
+        j = np.argmin(t, axis=1) if m else np.zeros(n, dtype=np.intp)
+        best = t[np.arange(n), j] if m else np.full(n, np.inf)
+        return best, np.where(np.isfinite(best), j, -1)
+
+
+@dataclass
+class Fact:
+    """One step of a trace as compared: where it is (``where``), what (``what``) and its value."""
+
+    where: str
+    what: str
+    value: Any
+    call: dict[str, Any] | None = None  # a function call's inputs and answer
+
+
+@dataclass
+class Divergence:
+    """The first fact where the two traces part: ``message`` names it with both values."""
+
+    index: int
+    where: str
+    message: str
+    in_function: bool
+    depth: int | None = None
+
+
+@dataclass
+class ExerciseStory:
+    """Both traces of one pixel, their facts and the first divergence (None: they agree)."""
+
+    exercise: str
+    function: str
+    reference: PixelTrace
+    yours: PixelTrace
+    divergence: Divergence | None
+    facts: int
+    error: str = ""
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def agree(self) -> bool:
+        return self.divergence is None
+
+    @property
+    def rgba8(self) -> list[int]:
+        return list(self.yours.rgba8)
+
+    @property
+    def title(self) -> str:
+        return self.yours.title
+
+    @property
+    def pixel(self) -> tuple[int, int]:
+        return self.yours.pixel
+
+    def to_dict(self) -> dict[str, Any]:
+        from dataclasses import asdict
+
+        return {"exercise": self.exercise, "function": self.function, "agree": self.agree,
+                "divergence": None if self.divergence is None else asdict(self.divergence),
+                "facts": self.facts, "reference": self.reference.to_dict(), "yours": self.yours.to_dict(),
+                "error": self.error}
+
+
+def _node_of_sphere_call(world_nodes: list[Any], origin: tuple[float, ...], world_o: NDArray[np.float64]) -> Any:
+    """The sphere node whose own space takes the world origin ``world_o`` to the call's ``origin``."""
+    for node in world_nodes:
+        if node.kind.value != "sphere":
+            continue
+        inv = node.inverse
+        if np.allclose(inv[:3, :3] @ world_o + inv[:3, 3], origin, rtol=1e-12, atol=1e-12):
+            return node
+    return None
+
+
+def _facts(events: list[tuple[str, dict[str, Any]]], trace: PixelTrace, nodes: list[Any], function: str
+           ) -> list[Fact]:
+    """A trace's events as facts, each call labelled with its ray (known at the next engine step)."""
+    facts: list[Fact] = []
+    pending: list[dict[str, Any]] = []
+    depth = 0
+
+    def label(where: str, world_o: NDArray[np.float64] | None, world_d: NDArray[np.float64] | None) -> None:
+        for call in pending:
+            for i, (args, answer) in enumerate(zip(call["inputs"], call["answers"], strict=True)):
+                info = {"kind": call["kind"], "args": args, "answer": answer, "ray": where}
+                if call["kind"] == "sphere":
+                    node = _node_of_sphere_call(nodes, args[0], world_o) if world_o is not None else None
+                    info["node"] = node.name if node is not None else "a sphere"
+                    if world_d is not None and node is not None:
+                        own_d = node.inverse[:3, :3] @ world_d
+                        # the call's t is along the own space's unit direction; the scene's distance
+                        # along the world's unit direction is t·|d_world|/|M⁻¹d_world| (an affine map keeps t)
+                        info["scale"] = float(np.linalg.norm(world_d) / np.linalg.norm(own_d))
+                    what = f"{function} on {info['node']}"
+                else:
+                    m = max(int(call["triangles"]), 1)
+                    info["triangle"] = i % m
+                    info["node"] = str(call.get("node_name") or "a mesh")
+                    what = f"{function} on {info['node']}, triangle {i % m}"
+                facts.append(Fact(where, what, answer, info))
+        pending.clear()
+
+    for step, v in events:
+        if step == "call":
+            pending.append(v)
+        elif step == "ray":
+            depth = int(v["depth"])
+            where = "the primary ray" if depth == 0 else f"the ray of depth {depth}"
+            o = np.asarray(v["origin"], dtype=np.float64).reshape(-1, 3)[0]
+            d = np.asarray(v["direction"], dtype=np.float64).reshape(-1, 3)[0]
+            label(where, o, d)
+            node = int(v["node"][0])
+            hit = None if node < 0 else (nodes[node].name, float(v["t"][0]), int(v["tri"][0]))
+            facts.append(Fact(where, "the nearest hit (min_indis)", hit))
+        elif step == "light":
+            index = int(v["index"])
+            where = f"the shadow ray towards light {index} (depth {depth})"
+            start = None if v.get("start") is None else np.asarray(v["start"], dtype=np.float64)[0]
+            label(where, start, None if start is None else trace_light(trace, index) - start)
+            if v.get("blocked") is not None:
+                facts.append(Fact(where, "in shadow", bool(v["blocked"][0])))
+        elif step == "local":
+            facts.append(Fact(f"the hit at depth {depth}", "the local colour", [float(c) for c in
+                                                                                np.asarray(v["local"])[0]]))
+    facts.append(Fact("the pixel", "the 8-bit colour", list(trace.rgba8)))
+    return facts
+
+
+def trace_light(trace: PixelTrace, index: int) -> NDArray[np.float64]:
+    """Light ``index``'s position, from the first bounce that lists it."""
+    for bounce in trace.bounces:
+        for light in bounce.lights:
+            if light.index == index:
+                return np.asarray(light.position, dtype=np.float64)
+    return np.zeros(3)
+
+
+def _same(a: Any, b: Any) -> bool:
+    if isinstance(a, str) or isinstance(b, str):
+        return a == b
+    if isinstance(a, tuple) and isinstance(b, tuple) and len(a) == 3 and isinstance(a[0], str):
+        return a[0] == b[0] and a[2] == b[2] and matches(a[1], b[1], REL, ABS)
+    if a is None or b is None:
+        return a is b
+    return matches(a, b, REL, ABS)
+
+
+def _say(value: Any) -> str:
+    if isinstance(value, str):
+        return value
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, float):
+        return f"t = {num(value)}"
+    if value is None:
+        return "None"
+    return describe(value)
+
+
+def _call_message(function: str, mine: Fact, ref: Fact) -> str:
+    info, other = mine.call or {}, ref.call or {}
+    got, want = info.get("answer"), other.get("answer")
+    args = ", ".join(vec(a) if isinstance(a, (tuple, list)) else num(a) for a in info.get("args", ()))
+    text = (f"{function} returned {_say(got)} where the reference has {_say(want).removeprefix('t = ')} "
+            f"({info.get('node')}, {mine.where})")
+    scale = info.get("scale")
+    if info.get("kind") == "sphere" and scale:
+        def world(v: Any) -> str:
+            return f"t = {num(v * scale)}" if isinstance(v, float) else _say(v)
+        text = (f"{function} returned {world(got)} where the reference has {world(want).removeprefix('t = ')} "
+                f"({info.get('node')}, {mine.where}); called in the sphere's own space, where it is the unit "
+                f"sphere: {function}({args}) = {_say(got)}, the reference {_say(want)}")
+    elif info.get("kind") == "triangles":
+        text += f"; called as {function}({args})"
+    return text
+
+
+def compare_traces(mine: list[Fact], ref: list[Fact], function: str) -> Divergence | None:
+    """The first fact where ``mine`` and ``ref`` part, named with both values; None when they agree."""
+    for i, (a, b) in enumerate(zip(mine, ref, strict=False)):
+        if a.where != b.where or a.what != b.what:
+            return Divergence(i, a.where, f"the traces take different paths: yours has {a.what} ({a.where}) "
+                              f"where the reference has {b.what} ({b.where})", a.call is not None or b.call is not None)
+        if not _same(a.value, b.value):
+            if a.call is not None:
+                return Divergence(i, a.where, _call_message(function, a, b), True)
+            if a.what.startswith("the nearest hit"):
+                def hit(v: Any) -> str:
+                    return "nothing" if v is None else f"{v[0]} at t = {num(v[1])}"
+                message = f"{a.where} hits {hit(a.value)} where the reference hits {hit(b.value)}"
+            else:
+                message = f"{a.what} of {a.where} is {_say(a.value)} where the reference has {_say(b.value)}"
+            return Divergence(i, a.where, message, False)
+    if len(mine) != len(ref):
+        i = min(len(mine), len(ref))
+        longer = "yours" if len(mine) > len(ref) else "the reference's"
+        rest = (mine if len(mine) > len(ref) else ref)[i]
+        return Divergence(i, rest.where, f"{longer} trace goes on: {rest.what} ({rest.where})", rest.call is not None)
+    return None
+
+
+def _tested_by_function(trace: PixelTrace, facts: list[Fact], kind: str, function: str) -> None:
+    """The student's trace's shape tests of the replaced kind say what their function returned."""
+    engine_kind = "sphere" if kind == "sphere" else "mesh"
+    for bounce in trace.bounces:
+        where = "the primary ray" if bounce.depth == 0 else f"the ray of depth {bounce.depth}"
+        answers = {f.call["node"]: f.call["answer"] for f in facts if f.call and f.where == where}
+        for k, test in enumerate(bounce.tests):
+            if test.kind != engine_kind or test.verdict == "box":
+                continue
+            said = f"t = {num(test.t)} along the ray as cast" if test.t is not None else \
+                _say(answers.get(test.node)) + " (no hit)"
+            bounce.tests[k] = ShapeTest(test.node, test.kind, "hit" if test.t is not None else "miss",
+                                        f"your {function} gave {said}", test.t, test.triangle)
+
+
+def explain_with_function(scene: Scene, size: tuple[int, int], pixel: tuple[int, int], exercise: Exercise,
+                          caller: Any, title: str = "") -> ExerciseStory:
+    """Pixel ``pixel`` of ``scene`` traced with ``exercise``'s reference and with ``caller``'s function
+    (see the module docstring)."""
+    kind = traced_kind(exercise)
+    ref_events: list[tuple[str, dict[str, Any]]] = []
+    ref_seam = _Seam(exercise, _Direct(exercise.reference), ref_events)
+    reference = explain_ray_pixel(scene, size, pixel, title, hit_tests={kind: getattr(ref_seam, kind)}, simple=True,
+                                  events=ref_events, traced=True)
+    my_events: list[tuple[str, dict[str, Any]]] = []
+    seam = _Seam(exercise, caller, my_events)
+    yours = explain_ray_pixel(scene, size, pixel, title, hit_tests={kind: getattr(seam, kind)}, simple=True,
+                              events=my_events, traced=True)
+    nodes = _world_nodes(scene, reference.viewport)
+    _name_meshes(nodes, ref_events, my_events)
+    ref_facts = _facts(ref_events, reference, nodes, exercise.function)
+    my_facts = _facts(my_events, yours, nodes, exercise.function)
+    _tested_by_function(yours, my_facts, kind, exercise.function)
+    divergence = compare_traces(my_facts, ref_facts, exercise.function)
+    return ExerciseStory(exercise.name, exercise.function, reference, yours, divergence, len(my_facts), seam.error)
+
+
+def _world_nodes(scene: Scene, viewport: int) -> list[Any]:
+    from glsandbox.frame import single_viewport
+    from glsandbox.raytrace import numpy_engine
+
+    world, _ = numpy_engine._world_of(single_viewport(scene, viewport), 0, True, False)
+    return _WorldNodes(world)
+
+
+class _WorldNodes(list):
+    """The world's nodes, with its triangles' first vertices (a triangle call names its mesh by them)."""
+
+    def __init__(self, world: Any) -> None:
+        super().__init__(world.nodes)
+        self.world = world
+
+
+def _name_meshes(nodes: Any, *event_lists: list[tuple[str, dict[str, Any]]]) -> None:
+    world = nodes.world
+    for events in event_lists:
+        for step, v in events:
+            if step == "call" and v["kind"] == "triangles" and v["first"] is not None:
+                for node in world.nodes:
+                    if node.kind.triangles and node.count and np.array_equal(world.v0[node.start], v["first"]):
+                        v["node_name"] = node.name
+                        break
+
+
+# --- the two traces side by side -----------------------------------------------------------
+
+COLUMN = 60
+
+
+def _blocks(text: str) -> list[list[str]]:
+    """A story's lines grouped by numbered step (a step and its indented lines)."""
+    blocks: list[list[str]] = []
+    for line in text.split("\n"):
+        if not blocks or (line[:1].isdigit() and ". " in line[:5]):
+            blocks.append([line])
+        else:
+            blocks[-1].append(line)
+    return blocks
+
+
+def _wrapped(block: list[str]) -> list[str]:
+    out: list[str] = []
+    for line in block:
+        indent = len(line) - len(line.lstrip(" "))
+        out.extend(textwrap.wrap(line, COLUMN, subsequent_indent=" " * (indent + 3), drop_whitespace=True) or [""])
+    return out
+
+
+def side_by_side(left: str, right: str, titles: tuple[str, str]) -> list[str]:
+    """Two stories in two columns, step beside step (the shorter block padded)."""
+    lines = [f"{titles[0]:<{COLUMN}} │ {titles[1]}", f"{'─' * COLUMN}─┼─{'─' * COLUMN}"]
+    a, b = _blocks(left), _blocks(right)
+    for k in range(max(len(a), len(b))):
+        wa = _wrapped(a[k]) if k < len(a) else []
+        wb = _wrapped(b[k]) if k < len(b) else []
+        for i in range(max(len(wa), len(wb))):
+            x = wa[i] if i < len(wa) else ""
+            y = wb[i] if i < len(wb) else ""
+            mark = "│" if x == y else "┃"
+            lines.append(f"{x:<{COLUMN}} {mark} {y}".rstrip())
+    return lines
+
+
+def render_exercise_story(story: ExerciseStory) -> str:
+    """The verdict first, then the two traces side by side (a heavy bar where a line differs)."""
+    if story.divergence is None:
+        head = [f"{story.function}: your trace and the reference's agree at every step ({story.facts} steps, "
+                "every call of your function among them)"]
+    else:
+        d = story.divergence
+        head = [f"first difference, step {d.index + 1} of the trace: {d.message}"]
+    if story.error:
+        head.append(f"note: {story.error}")
+    columns = side_by_side(render_story(story.yours), render_story(story.reference),
+                           (f"yours ({story.function} from your file)", "the reference"))
+    return "\n".join([*head, "", *columns])
