@@ -39,7 +39,7 @@ from glsandbox.scene import Scene
 from glsandbox.story.ray import PixelTrace, ShapeTest, explain_ray_pixel
 from glsandbox.story.text import num, render_story, vec
 
-__all__ = ["Divergence", "ExerciseStory", "TRACED_KINDS", "compare_traces", "explain_with_function", "traced_kind"]
+__all__ = ["TRACED_KINDS", "Divergence", "ExerciseStory", "compare_traces", "explain_with_function", "traced_kind"]
 
 #: The tolerance two traces' numbers agree within (relative, and absolute near 0): a
 #: correct geometric sphere test and the engine's stable one differ by rounding only.

@@ -14,13 +14,18 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from support import assert_user_error, run_cli
 
 from glsandbox.errors import SandboxError
 from glsandbox.exercises.catalogue import all_exercises, get
 from glsandbox.exercises.lesson_view import THRESHOLD, render_lesson
 from glsandbox.notebook import scene_of
-from glsandbox.story.exercise import _Direct, explain_with_function, render_exercise_story, traced_kind
-from support import assert_user_error, run_cli
+from glsandbox.story.exercise import (
+    _Direct,
+    explain_with_function,
+    render_exercise_story,
+    traced_kind,
+)
 
 TRACED = [e for e in all_exercises() if e.lesson is not None]
 
@@ -40,7 +45,7 @@ CORRECT = {"ray_sphere": "geometric", "ray_triangle": "moller_trumbore"}
 CASES = [(e.name, m.name) for e in TRACED for m in e.mistakes]
 
 
-def _where_it_shows(exercise, mistake):  # noqa: ANN001, ANN202
+def _where_it_shows(exercise, mistake):
     """``(scene, size, pixel)``: a pixel of the lesson picture the mistake changes, else ``SEEN_FROM``."""
     view = exercise.lesson
     if (exercise.name, mistake.name) in SEEN_FROM:
