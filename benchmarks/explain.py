@@ -60,7 +60,32 @@ def cases(env) -> list:
 
             out.append(Case(GROUP, f"one pixel, {cls.name} (rasterised)", None, Side("explain", run_raster), repeat=1,
                             unit="ms", note=f"goal < {GOAL_S:g} s"))
+    out.extend(exercise_cases(env))
     out.extend(xray_cases(env))
+    return out
+
+
+def exercise_cases(env) -> list:
+    """``explain --exercise``: a pixel traced twice (the reference's and a function's, here the notes'
+    geometric test in this process: the confined process's start is the grader's, not the trace's)."""
+    from glsandbox.exercises.catalogue import get
+    from glsandbox.lesson import find_lesson
+    from glsandbox.measure.bench import Case, Side
+    from glsandbox.story.exercise import _Direct, explain_with_function
+
+    out = []
+    for name, lesson, variant in (("ray_sphere", "ray_spheres", "geometric"),
+                                  ("ray_triangle", "indexed_cube", "moller_trumbore")):
+        exercise = get(name)
+        scene = find_lesson(lesson)().scene()
+        caller = _Direct(exercise.extra["variants"][variant])
+        pixel = (env.size[0] // 2, env.size[1] // 2)
+
+        def run(k: int, scene=scene, exercise=exercise, caller=caller, pixel=pixel) -> list[int]:
+            return explain_with_function(replace(scene), env.size, pixel, exercise, caller).rgba8
+
+        out.append(Case(GROUP, f"one pixel, {lesson} --exercise {name}", None, Side("explain", run), repeat=1,
+                        unit="ms", note=f"goal < {GOAL_S:g} s"))
     return out
 
 

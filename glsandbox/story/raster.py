@@ -44,7 +44,7 @@ def explain_raster_pixel(renderer: FrameRenderer, scene: Scene, size: tuple[int,
                          title: str = "") -> RasterTrace:
     """Draw ``scene``'s frame with its X-ray and tell pixel ``(x, y)`` (row 0 at the top) pass by pass."""
     index, _, _ = locate_pixel(scene, size, pixel)
-    x = xray(renderer, scene, size)
+    x = xray(renderer, scene, size, trace=False)  # the pixel is rasterised: the traced viewports are not its
     rows = pixel_passes(x, pixel)
     for row, picture in zip(rows, x.passes):
         step = picture.step

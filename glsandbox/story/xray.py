@@ -90,9 +90,11 @@ def id_renderer(renderer: FrameRenderer) -> FrameRenderer:
     return kept
 
 
-def xray(renderer: FrameRenderer, scene: Scene, size: tuple[int, int]) -> XRay:
+def xray(renderer: FrameRenderer, scene: Scene, size: tuple[int, int], trace: bool = True) -> XRay:
     """Draw one frame of ``scene`` at ``size`` on ``renderer``'s context and keep the target after
-    every pass, with the primitive ids (:func:`id_renderer`)."""
+    every pass, with the primitive ids (:func:`id_renderer`). ``trace=False`` leaves the
+    ray-traced viewports blank (their clear colour; the passes are the same): a rasterised
+    pixel's story needs only its own viewport, and tracing another one costs more than the frame."""
     notes = []
     if scene.samples:
         notes.append(f"drawn without MSAA (the scene asks for {scene.samples}x): a multisampled "
@@ -129,10 +131,31 @@ def xray(renderer: FrameRenderer, scene: Scene, size: tuple[int, int]) -> XRay:
     if any(vp.renderer != "raster" for vp in scene.viewports):
         from glsandbox.frame import trace_viewports
 
-        traced = trace_viewports(scene, size, drawer.host.ctx)
+        traced = trace_viewports(scene, size, drawer.host.ctx) if trace else _blank_traced(scene, size, notes)
     _, target = drawer.draw(traced, size, after_pass=after_pass)
     frame = np.array(target.read())
     return XRay(pictures, frame, notes, [node.name for node in traced.nodes])
+
+
+def _blank_traced(scene: Scene, size: tuple[int, int], notes: list[str]) -> Scene:
+    """``scene`` as :func:`~glsandbox.frame.trace_viewports` makes it, each traced image its viewport's
+    clear colour (the same passes, nothing traced)."""
+    from glsandbox.overlay import Overlay
+    from glsandbox.plan import traced_image_name, traced_scene
+
+    images = {}
+    for i, vp in enumerate(scene.viewports):
+        w, h = vp.pixels(*size)[2:]
+        if vp.renderer != "raster" and w > 0 and h > 0:
+            blank = np.zeros((h, w, 4), dtype=np.uint8)
+            blank[...] = np.round(np.clip(np.asarray(vp.clear_color if vp.clear_color is not None else scene.clear_color,
+                                                  dtype=np.float64), 0.0, 1.0) * 255.0)
+            blank[..., 3] = 255
+            images[i] = Overlay(traced_image_name(i), blank, viewport=i, position=(0, 0), scalable=False)
+    if images:
+        notes.append(f"the ray-traced viewport{'s' if len(images) > 1 else ''} "
+                     f"{', '.join(str(i) for i in images)} left untraced (its clear colour): this pixel is not in it")
+    return traced_scene(scene, images)
 
 
 # --- pictures ------------------------------------------------------------------

@@ -82,3 +82,19 @@ def test_notebook_explain_of_a_rasterised_pixel(gl) -> None:
     story = glsandbox.explain("mirror", (40, 30), (80, 60))
     assert "mark mirror viewport 0" in repr(story) and "<pre" in story._repr_html_()
     assert story.rgba8 == gl.render(find_lesson("mirror")(), (80, 60)).image[30, 40].tolist()
+
+
+def test_a_rasterised_pixel_beside_a_traced_viewport_leaves_it_untraced(gl) -> None:
+    """The model lesson's traced viewport is not the raster pixel's: its story draws the same passes
+    with that viewport left blank, and tells the pixel as the whole frame shows it."""
+    scene = find_lesson("model")().scene()
+    traced = [i for i, vp in enumerate(scene.viewports) if vp.renderer != "raster"]
+    raster = next(i for i, vp in enumerate(scene.viewports) if vp.renderer == "raster")
+    assert traced, "the model lesson has a ray-traced viewport beside its raster one"
+    vx, vy, w, h = scene.viewports[raster].pixels(*SIZE)
+    pixel = (vx + w // 2, SIZE[1] - vy - h // 2 - 1)
+    trace = explain_raster_pixel(gl, scene, SIZE, pixel)
+    normal = gl.render_scene(scene, SIZE).image
+    assert trace.rgba8 == normal[pixel[1], pixel[0]].tolist()
+    assert [row["name"] for row in trace.passes] == [p.name for p in xray(gl, scene, SIZE).passes]
+    assert any("left untraced" in note for note in trace.notes)
