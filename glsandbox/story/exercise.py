@@ -359,6 +359,7 @@ def explain_with_function(scene: Scene, size: tuple[int, int], pixel: tuple[int,
     seam = _Seam(exercise, caller, my_events)
     yours = explain_ray_pixel(scene, size, pixel, title, hit_tests={kind: getattr(seam, kind)}, simple=True,
                               events=my_events, traced=True)
+    reference.renderer = yours.renderer = "ray_numpy"  # both traced by the numpy engine, as the lesson picture is
     nodes = _world_nodes(scene, reference.viewport)
     _name_meshes(nodes, ref_events, my_events)
     ref_facts = _facts(ref_events, reference, nodes, exercise.function)
@@ -441,7 +442,7 @@ def render_exercise_story(story: ExerciseStory) -> str:
                 "every call of your function among them)"]
     else:
         d = story.divergence
-        head = [f"first difference, step {d.index + 1} of the trace: {d.message}"]
+        head = [f"first difference: {d.message}"]
     if story.error:
         head.append(f"note: {story.error}")
     columns = side_by_side(render_story(story.yours), render_story(story.reference),

@@ -93,7 +93,7 @@ def test_the_notes_worked_example_is_named_in_the_scene_units() -> None:
                                                "(big, the primary ray)")
     assert story.reference.bounces[0].t == pytest.approx(35.0) and story.yours.bounces[0].t == pytest.approx(125.0)
     text = render_exercise_story(story)
-    assert text.splitlines()[0].startswith("first difference, step 1 of the trace: intersect_sphere returned t = 125")
+    assert text.splitlines()[0].startswith("first difference: intersect_sphere returned t = 125")
     left, right = text.splitlines()[2].split(" │ ")  # the two columns' titles, aligned
     assert left.startswith("yours") and right == "the reference"
     assert any("your intersect_sphere gave t = 125" in line for line in text.splitlines())
@@ -120,7 +120,7 @@ def test_the_command_runs_the_file_confined_and_exits_like_diff(tmp_path: Path) 
     where = ("ray_spheres", "--set", "camera=0,0,0,0,0.6,-0.8", "--size", "401x301", "--pixel", "200,150")
     differ = run_cli("explain", *where, "--exercise", "ray_sphere", str(far))
     assert differ.returncode == 1, differ.stderr
-    assert differ.stdout.startswith("first difference, step 1 of the trace: intersect_sphere returned t = 125 "
+    assert differ.stdout.startswith("first difference: intersect_sphere returned t = 125 "
                                     "where the reference has 35")
     agree = run_cli("explain", *where, "--exercise", "ray_sphere", str(good), "--json")
     assert agree.returncode == 0, agree.stderr
