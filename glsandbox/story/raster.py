@@ -14,8 +14,9 @@ from typing import Any
 
 from glsandbox.frame import FrameRenderer
 from glsandbox.scene import Scene
+from glsandbox.story.fragment import blend_values, fragment_values
 from glsandbox.story.ray import locate_pixel
-from glsandbox.story.text import num
+from glsandbox.story.text import num, vec
 from glsandbox.story.xray import cleared_depth, pixel_passes, xray
 
 __all__ = ["RasterTrace", "explain_raster_pixel", "render_raster_story"]
@@ -56,12 +57,39 @@ def explain_raster_pixel(renderer: FrameRenderer, scene: Scene, size: tuple[int,
         # The stencil test (course: DrawReflectionDSS): stencil & mask compared with ref & mask.
         row["stencil_passes"] = None if state is None or before is None else \
             (state.test == "always" or (before & state.mask) == (state.ref & state.mask))
+        wrote_here = "colour" in row["wrote"] or "depth" in row["wrote"]
+        row["fragment"] = fragment_values(scene, size, pixel, index, step.kind, row["node"], row["triangle"]) \
+            if wrote_here and row.get("node") and row.get("triangle") is not None else None
+        row["blend"] = blend_values(scene, step.kind, row["color_before"], row["color"]) \
+            if "colour" in row["wrote"] else None
     return RasterTrace(title or scene.name, (int(pixel[0]), int(pixel[1])), (int(size[0]), int(size[1])), index,
                        rows, [int(v) for v in x.frame[pixel[1], pixel[0]]], cleared_depth(x), x.notes)
 
 
 def _rgb(c: list[int]) -> str:
     return "(" + ", ".join(str(v) for v in c[:3]) + ")"
+
+
+def _fragment_lines(row: dict[str, Any]) -> list[str]:
+    """What the shader saw (the interpolated values) and a blend's inputs, under a pass's line."""
+    lines = []
+    f = row.get("fragment")
+    if f:
+        w = ", ".join(num(x, 4) for x in f["uvw"])
+        seen = [f"world position {vec(f['position'])}"]
+        if f.get("normal_unit"):
+            seen.append(f"normal {vec(f['normal_unit'], 4)} (normalized; interpolated length "
+                        f"{num(sum(x * x for x in f['normal']) ** 0.5, 4)})")
+        if f.get("uv") is not None:
+            seen.append(f"uv {vec(f['uv'], 4)}")
+        lines.append(f"   the shader saw (perspective-correct weights {w} of vertices "
+                     f"{', '.join(str(i) for i in f['vertices'])}): " + ", ".join(seen) + f"; depth {num(f['depth'])}")
+    b = row.get("blend")
+    if b:
+        lines.append(f"   blend src·a + dst·(1 − a): src {vec(b['source'], 3)}, a = {num(b['alpha'], 3)} "
+                     f"({b['alpha8']}/255 in the 8-bit target), dst "
+                     f"{_rgb(b['destination'])} → {_rgb(b['result'])} (read back {_rgb(b['read_back'])})")
+    return lines
 
 
 def render_raster_story(trace: RasterTrace) -> str:
@@ -113,5 +141,6 @@ def render_raster_story(trace: RasterTrace) -> str:
             text += "; " + ", ".join(f"{name} kept ({num(row[name]) if name == 'depth' else row[name]})"
                                      for name in kept)
         lines.append(f"{head}: {text}")
+        lines.extend(_fragment_lines(row))
     lines.append(f"{len(trace.passes) + 1}. Final colour: {_rgb(trace.rgba8)} in 8-bit levels")
     return "\n".join(lines)
