@@ -532,7 +532,7 @@ def cmd_check(args: argparse.Namespace) -> int:
         try:
             keep = _shard_filter(args.shard, args.one)
             results = check_folder(target, checks, args.backend, limits, report, getattr(args, "entry", None),
-                                   one=args.one, keep=keep)
+                                   one=args.one, keep=keep, explain=args.explain)
         finally:
             for bar in bars:
                 bar.close()
@@ -744,6 +744,9 @@ def _check_options(p: argparse.ArgumentParser) -> None:
                    help="write the references when missing or different (a passing one is kept)")
     p.add_argument("--tolerance", action="append", default=[], metavar="KEY=VALUE",
                    help="threshold=LEVELS (default 2) or max_bad_share=FRACTION (default 0.0005); repeatable")
+    p.add_argument("--explain", action="store_true",
+                   help="tell each failed picture's first differing pixel (glsandbox explain, in the submission's "
+                        "confined renderer) in the HTML reports")
     p.add_argument("--one", action="store_true",
                    help="LESSON_OR_DIR is one student's folder (its lesson and helper files; Gradescope's "
                         "/autograder/submission), not a folder of students")

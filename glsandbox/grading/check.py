@@ -129,6 +129,10 @@ class Outcome:
     #: An exercise check's cases (the teacher's reports), and what a student may read (None: :meth:`detail`).
     cases: list[dict] = field(default_factory=list)
     student: str | None = None
+    #: A failed picture's first differing pixel (x, y from the top; row by row), and its story in the
+    #: submission's own frame (``check --explain``: told in the submission's confined renderer).
+    first_difference: tuple[int, int] | None = None
+    story: str = ""
 
     @property
     def points(self) -> float:
@@ -368,7 +372,45 @@ def _outcome(check: Check, picture: Picture, expected: np.ndarray, name: str) ->
     if not verdict.passed and verdict.match is not None:
         paths = _artifacts(picture.image, expected, check.tolerances, results_dir(check), file_stem(name))
     return Outcome(check, PASS if verdict.passed else FAIL, verdict.match, error=verdict.detail,
-                   seconds=picture.seconds, artifacts=paths, thumb=_thumbnail(picture.image))
+                   seconds=picture.seconds, artifacts=paths, thumb=_thumbnail(picture.image),
+                   first_difference=None if verdict.passed else first_difference(picture.image, expected, check))
+
+
+def first_difference(actual: np.ndarray, expected: np.ndarray, check: Check) -> tuple[int, int] | None:
+    """The first pixel, row by row from the top, whose largest channel differs by more than the
+    check's threshold (None when the shapes differ or none does)."""
+    if actual.shape != expected.shape:
+        return None
+    threshold = int(check.tolerances.get("threshold", DEFAULT_THRESHOLD))
+    delta = np.abs(actual[..., :3].astype(np.int16) - expected[..., :3].astype(np.int16)).max(axis=2)
+    rows, cols = np.nonzero(delta > threshold)
+    return (int(cols[0]), int(rows[0])) if rows.size else None
+
+
+def explain_failures(entries: Sequence[tuple[str, Path, Job]], finished: dict[str, CheckResult],
+                     checks: Sequence[Check], jobs: int) -> None:
+    """``check --explain``: each failed picture's first differing pixel told in the submission's own
+    frame, by a second confined run of it that renders the failed checks again with their pixel
+    (:attr:`Render.explain`); the story is the submission's output, kept as text (:attr:`Outcome.story`)."""
+    again, wanted = [], {}
+    for name, _, job in entries:
+        result = finished.get(name)
+        failed = [(k, o) for k, o in enumerate(result.outcomes) if o.first_difference is not None] if result else []
+        if failed:
+            renders = tuple(replace(job.renders[k], explain=o.first_difference) for k, o in failed)
+            again.append(replace(job, renders=renders))
+            wanted[job.index] = (name, [k for k, _ in failed])
+    if not again:
+        return
+
+    def done(result: JobResult) -> None:
+        name, indices = wanted[result.job.index]
+        for k, picture in zip(indices, result.pictures, strict=True):
+            story = picture.info.get("story") if picture.image is not None else None
+            finished[name].outcomes[k].story = story if isinstance(story, str) else \
+                f"(no story: {shown(picture.error) or 'the second run sent none'})"
+
+    run_jobs(again, jobs, done)
 
 
 def read_references(checks: Sequence[Check]) -> dict[Path, np.ndarray]:
@@ -386,7 +428,7 @@ def read_references(checks: Sequence[Check]) -> dict[Path, np.ndarray]:
 def check_folder(folder: Path, checks: Sequence[Check], backend: str | None = None, limits: Limits = Limits(),
                  progress: Callable[[int, int, CheckResult], None] = lambda done, total, result: None,
                  entry: str | None = None, one: bool = False,
-                 keep: Callable[[str], bool] = lambda name: True) -> list[CheckResult]:
+                 keep: Callable[[str], bool] = lambda name: True, explain: bool = False) -> list[CheckResult]:
     """Grade every submission in ``folder`` against ``checks``; never stops at a broken one.
 
     ``progress`` hears each submission as it finishes (in the order they
@@ -396,7 +438,8 @@ def check_folder(folder: Path, checks: Sequence[Check], backend: str | None = No
     folder is one student's. A submission that is a symbolic link is BROKEN
     without running; submissions that are the same files are marked
     (:func:`mark_duplicates`). ``keep``: which submissions (by name) this run grades (a shard,
-    :mod:`glsandbox.grading.shards`).
+    :mod:`glsandbox.grading.shards`). ``explain``: each failed picture's first differing pixel is
+    told (:func:`explain_failures`).
     """
     found = submissions(folder, entry, one)
     if not found or (one and not folder.is_dir()):
@@ -429,6 +472,8 @@ def check_folder(folder: Path, checks: Sequence[Check], backend: str | None = No
     no_gl = next((r.no_gl for r in results if r.no_gl), "")
     if no_gl:  # the machine's problem, not every submission's
         raise SandboxError(no_gl)
+    if explain:
+        explain_failures(entries, finished, checks, limits.jobs)
     ordered = [finished[name] for name, _, _ in found]
     mark_duplicates(ordered)
     return ordered

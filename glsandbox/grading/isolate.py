@@ -67,6 +67,9 @@ class Render:
     settings: tuple[str, ...]
     size: tuple[int, int]
     samples: int = 0
+    #: A pixel (x, y from the top) whose story (``glsandbox explain``) comes back with the picture:
+    #: told in the renderer, of the submission's own scene, as text (a failed picture's first difference).
+    explain: tuple[int, int] | None = None
 
 
 @dataclass(frozen=True)
@@ -131,6 +134,17 @@ def send(fd: int, header: dict, payload: bytes = b"") -> None:
         view = view[os.write(fd, view):]
 
 
+#: The most of a pixel's story a submission's renderer may send back (characters).
+STORY_LIMIT = 6000
+
+
+def story_of(header: dict) -> dict:
+    """A picture message's story (``Render.explain``), as the grader keeps it: text, cut to
+    :data:`STORY_LIMIT` (it comes from the submission's process: untrusted, shown escaped)."""
+    story = header.get("story")
+    return {"story": story[:STORY_LIMIT]} if isinstance(story, str) else {}
+
+
 class Reader:
     """The framed messages of the renderer's pipe, read as they arrive."""
 
@@ -162,12 +176,14 @@ def _job_data(job: Job) -> dict:
     return {"index": job.index, "source": job.source, "target": job.target, "backend": job.backend,
             "timeout": job.timeout, "memory_mb": job.memory_mb, "copy": job.copy, "writes_cache": job.writes_cache,
             "entry": job.entry, "describe": job.describe,
-            "renders": [{"settings": list(r.settings), "size": list(r.size), "samples": r.samples}
-                        for r in job.renders]}
+            "renders": [{"settings": list(r.settings), "size": list(r.size), "samples": r.samples,
+                         "explain": None if r.explain is None else list(r.explain)} for r in job.renders]}
 
 
 def job_from(data: dict) -> Job:
-    renders = tuple(Render(tuple(r["settings"]), tuple(r["size"]), r["samples"]) for r in data.pop("renders"))
+    renders = tuple(Render(tuple(r["settings"]), tuple(r["size"]), r["samples"],
+                           None if r.get("explain") is None else (int(r["explain"][0]), int(r["explain"][1])))
+                    for r in data.pop("renders"))
     return Job(renders=renders, **data)
 
 

@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from glsandbox.grading.isolate import (BROKEN, CRASHED, OOM, TIMEOUT, Job, JobResult, Picture, Reader, _job_data,
-                                       job_from, send, settle)
+                                       job_from, send, settle, story_of)
 
 __all__ = ["wanted", "describe", "run_jobs_portable", "child_main", "tree_rss"]
 
@@ -244,6 +244,7 @@ class _Submission:
                 picture.seconds = float(header.get("seconds", 0.0))
                 if self.job.describe and isinstance(header.get("info"), dict):
                     picture.info = header["info"]
+                picture.info = {**picture.info, **story_of(header)}
             else:
                 picture.status = OOM if kind == "oom" else BROKEN
                 picture.error = str(header.get("error", ""))[:500]

@@ -156,6 +156,22 @@ def _img(image, alt: str) -> str:
     return f'<img src="data:image/png;base64,{data}" alt="{html.escape(alt)}">'
 
 
+def _story(o: Outcome) -> str:
+    """A failed picture's first differing pixel and its story (``check --explain``), folded: the
+    submission's own frame told by its own renderer, so escaped as its output is. The student's
+    page calls it for the checks it shows only (never a hidden one)."""
+    if o.first_difference is None or not o.story:
+        return ""
+    x, y = o.first_difference
+    return (f'<details class="story"><summary>why pixel {x},{y} (the first that differs) looks as it does in the '
+            f"submission</summary><pre>{html.escape(shown_text(o.story))}</pre></details>")
+
+
+def shown_text(text: str) -> str:
+    """Lines of untrusted text, each escaped as names are (:func:`shown`)."""
+    return "\n".join(shown(line) for line in text.splitlines())
+
+
 def html_text(results: Sequence[CheckResult], title: str) -> str:
     """One self-contained page: a row per student, reference | submission | difference per check,
     the score, the outcome's colour and the error line; click a heading to sort."""
@@ -182,7 +198,7 @@ def html_text(results: Sequence[CheckResult], title: str) -> str:
             text = html.escape(f"{o.status}: {o.detail()}")
             cells.append(f'<td style="background:{_COLOURS.get(o.status, "#fff")}">'
                          f"{_img(ref, 'reference')}{_img(o.thumb, 'submission')}{_img(diff, 'difference')}"
-                         f'<div class="detail">{text}</div></td>')
+                         f'<div class="detail">{text}</div>{_story(o)}</td>')
         output = (f'<details><summary>output</summary><pre>{html.escape(chr(10).join(_output(r)))}</pre></details>'
                   if r.output else "")
         same = (f'<div class="same">same files as {html.escape(", ".join(map(shown, r.same_as)))}</div>'
@@ -199,7 +215,7 @@ body {{ font-family: sans-serif; margin: 1.5em; }}
 table {{ border-collapse: collapse; }} th, td {{ border: 1px solid #bbb; padding: 4px; vertical-align: top; }}
 th {{ cursor: pointer; background: #eee; }} img {{ image-rendering: pixelated; margin-right: 2px; }}
 .detail {{ font-size: 80%; max-width: 40em; word-break: break-all; }} .name {{ font-family: monospace; }}
-.same {{ color: #b00; font-weight: bold; }}
+.same {{ color: #b00; font-weight: bold; }} .story pre {{ font-size: 75%; white-space: pre-wrap; max-width: 60em; }}
 </style></head><body>
 <h1>glsandbox check: {html.escape(title)}</h1>
 <p>{len(results)} submissions: {html.escape(summary)}</p>
@@ -246,7 +262,7 @@ def student_text(results: Sequence[CheckResult], title: str) -> str:
             rows_html.append(
                 f'<tr><td>{html.escape(o.check.name)}</td><td>{points(o.points)} / {points(o.check.points)}</td>'
                 f'<td style="background:{_COLOURS.get(o.status, "#fff")}">{html.escape(o.status)}: '
-                f'{html.escape(o.detail() if o.student is None else o.student)}</td>'
+                f'{html.escape(o.detail() if o.student is None else o.student)}{_story(o)}</td>'
                 f"<td>{_img(ref, 'reference')}{_img(o.thumb, 'yours')}{_img(diff, 'difference')}</td></tr>")
         visible = [o for o in r.outcomes if not o.check.hidden]
         score = f"{points(sum(o.points for o in visible))} / {points(sum(o.check.points for o in visible))}"
@@ -261,7 +277,7 @@ def student_text(results: Sequence[CheckResult], title: str) -> str:
 <style>
 body {{ font-family: sans-serif; margin: 1.5em; }}
 table {{ border-collapse: collapse; }} th, td {{ border: 1px solid #bbb; padding: 4px; vertical-align: top; }}
-img {{ image-rendering: pixelated; margin-right: 2px; }}
+img {{ image-rendering: pixelated; margin-right: 2px; }} .story pre {{ font-size: 75%; white-space: pre-wrap; }}
 </style></head><body>
 <h1>glsandbox check</h1>
 {chr(10).join(sections)}

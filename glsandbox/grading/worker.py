@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from glsandbox.grading import layers
-from glsandbox.grading.isolate import (BROKEN, CRASHED, OOM, TAIL_LINES, TAIL_WIDTH, TIMEOUT, Job, Picture, Reader,
-                                       job_from, send)
+from glsandbox.grading.isolate import (BROKEN, CRASHED, OOM, STORY_LIMIT, TAIL_LINES, TAIL_WIDTH, TIMEOUT, Job, Picture,
+                                       Reader, job_from, send, story_of)
 from glsandbox.grading.processes import kill_tree, killpg, set_subreaper, wait_briefly
 from glsandbox.grading.warm import quiet
 
@@ -142,6 +142,8 @@ def render_job(job: Job, renderer, root: str, target: str, out: int) -> None:
                       "seconds": time.perf_counter() - started}
             if job.describe:
                 header["info"] = {"plan": frame.plan.to_dict(), "plan_text": frame.plan.describe()}
+            if render.explain is not None:
+                header["story"] = _story(cls, render, renderer)
             send(out, header, image.tobytes())
         except MemoryError as exc:
             send(out, {"kind": "oom", "index": index, "error": str(user_code_error(exc))})
@@ -149,6 +151,20 @@ def render_job(job: Job, renderer, root: str, target: str, out: int) -> None:
             send(out, {"kind": "broken", "index": index, "error": str(exc)})
         except BaseException as exc:  # noqa: BLE001 - KeyboardInterrupt, SystemExit, its own kinds
             send(out, {"kind": "broken", "index": index, "error": str(user_code_error(exc))})
+
+
+def _story(cls, render, renderer) -> str:  # noqa: ANN001 - the submission's class, a Render, its renderer
+    """The story of ``render.explain``'s pixel in the submission's own frame (``glsandbox explain``),
+    or the line saying why there is none; told here, in the confined renderer."""
+    from glsandbox.frame import with_samples
+    from glsandbox.story import pixel_story
+
+    try:
+        scene = with_samples(cls.from_settings(render.settings).scene(), render.samples)
+        story = pixel_story(scene, tuple(render.size), tuple(render.explain), cls.name, lambda: renderer)
+        return story.text[:STORY_LIMIT]
+    except BaseException as exc:  # noqa: BLE001 - the submission's scene may raise anything
+        return f"(no story: {str(exc)[:300]})"
 
 
 # --- the supervisor (child) ------------------------------------------------------------------
@@ -240,6 +256,7 @@ def _collect(job: Job, pid: int, fd: int, meta: dict | None = None) -> list[Pict
                     picture.seconds = float(header.get("seconds", 0.0))
                     if job.describe and isinstance(header.get("info"), dict):
                         picture.info = header["info"]
+                    picture.info = {**picture.info, **story_of(header)}
                 else:
                     picture.status = OOM if kind == "oom" else BROKEN
                     picture.error = str(header.get("error", ""))[:500]

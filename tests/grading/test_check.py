@@ -232,3 +232,62 @@ def test_submissions_with_their_own_shader_files(tmp_path: Path, gl) -> None:
     broken = next(line for line in proc.stdout.splitlines() if "] BROKEN" in line)
     # The student's line names the shader as the student wrote it, relative to their folder.
     assert "BROKEN c_cem: shader does not compile: ball.glsl:" in broken, broken
+
+
+CUBE = 'name = "cube"\n[camera]\neye = [2, 1.5, 3]\n[[nodes]]\nmesh = "cube"\n'
+
+
+def test_explain_tells_a_failed_pictures_first_differing_pixel(tmp_path: Path, gl) -> None:
+    """``check --explain``: the wrong submission's first differing pixel (row by row) is told in its own
+    frame by its confined renderer, in the HTML page; the right one has no story."""
+    from support import run_cli
+
+    (tmp_path / "model.toml").write_text(CUBE)
+    ref = tmp_path / "ref.png"
+    assert run_cli("check", str(tmp_path / "model.toml"), "--golden", str(ref), "--update", "--size",
+                   "64x48").returncode == 0
+    subs = tmp_path / "subs"
+    subs.mkdir()
+    (subs / "right.toml").write_text(CUBE)
+    (subs / "wrong.toml").write_text(CUBE.replace('mesh = "cube"', 'mesh = "sphere"'))
+    page = tmp_path / "r.html"
+    proc = run_cli("check", str(subs), "--golden", str(ref), "--explain", "--html", str(page))
+    assert proc.returncode == 1, proc.stderr
+    text = page.read_text()
+    assert text.count("(the first that differs)") == 1
+    pixel = re.search(r"why pixel (\d+),(\d+) \(the first that differs\)", text)
+    assert pixel is not None
+    assert f"wrong: pixel {pixel[1]},{pixel[2]} of 64x48, rasterised" in text  # its own story, pass by pass
+    assert "Final colour" in text
+    portable = tmp_path / "p.html"  # the portable path (a teacher's laptop) brings the story back too
+    assert run_cli("check", str(subs), "--golden", str(ref), "--explain", "--html", str(portable),
+                   env={"GLSANDBOX_ISOLATION": "portable"}).returncode == 1
+    assert f"why pixel {pixel[1]},{pixel[2]} (the first that differs)" in portable.read_text()
+
+
+def test_the_first_difference_is_the_first_pixel_past_the_threshold_row_by_row(tmp_path: Path) -> None:
+    from glsandbox.grading.check import first_difference
+    from glsandbox.grading.rubric import Check
+
+    expected = np.zeros((4, 5, 4), np.uint8)
+    actual = expected.copy()
+    actual[1, 3, 0] = 2  # within the default threshold (2 levels)
+    actual[2, 1, 1] = 30
+    actual[3, 0, 2] = 30
+    check = Check("c", tmp_path / "c.png")
+    assert first_difference(actual, expected, check) == (1, 2)
+    assert first_difference(actual, expected, Check("c", tmp_path / "c.png", tolerances={"threshold": 40})) is None
+    assert first_difference(actual[:3], expected, check) is None
+
+
+def test_a_hidden_checks_story_is_not_on_the_students_page(tmp_path: Path) -> None:
+    from glsandbox.grading.check import CheckResult, Outcome
+    from glsandbox.grading.reports import student_text
+    from glsandbox.grading.rubric import Check
+
+    shown_check, hidden_check = Check("shown", tmp_path / "a.png"), Check("hidden", tmp_path / "b.png", hidden=True)
+    outcomes = [Outcome(shown_check, "FAIL", first_difference=(3, 4), story="SHOWN STORY <b>"),
+                Outcome(hidden_check, "FAIL", first_difference=(5, 6), story="HIDDEN STORY")]
+    page = student_text([CheckResult("ann", tmp_path / "ann", outcomes)], "t")
+    assert "why pixel 3,4" in page and "SHOWN STORY &lt;b&gt;" in page
+    assert "HIDDEN STORY" not in page and "5,6" not in page
