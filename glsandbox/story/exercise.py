@@ -35,6 +35,7 @@ from numpy.typing import NDArray
 from glsandbox.errors import SandboxError
 from glsandbox.exercises.base import Exercise
 from glsandbox.exercises.compare import WrongType, describe, matches, normalize
+from glsandbox.exercises.lesson_view import _Calls
 from glsandbox.scene import Scene
 from glsandbox.story.ray import PixelTrace, ShapeTest, explain_ray_pixel
 from glsandbox.story.text import num, render_story, vec
@@ -70,13 +71,15 @@ class _Direct:
         return [self.function(*args) for args in inputs], {}
 
 
-class _Seam:
-    """A caller's function as the engine's hit test of one node kind, each call logged into
-    ``events`` (until the trace's ``end``) as ``("call", {...})`` with the inputs and answers."""
+class _Seam(_Calls):
+    """A caller's function as the engine's hit test of one node kind (the lesson picture's
+    :class:`~glsandbox.exercises.lesson_view._Calls`: the rays taken to the function's plain
+    arguments), each call logged into ``events`` (until the trace's ``end``) as ``("call", {...})``
+    with its inputs and answers."""
 
     def __init__(self, exercise: Exercise, caller: Any, events: list[tuple[str, dict[str, Any]]]) -> None:
-        self.exercise, self.caller, self.events = exercise, caller, events
-        self.error = ""
+        super().__init__(exercise, caller)
+        self.events = events
 
     def _answers(self, inputs: list[tuple[Any, ...]]) -> list[Any]:
         """Each input's answer, normalized: a value, or an ``error: ...`` string."""
@@ -98,40 +101,20 @@ class _Seam:
                 out.append(f"error: {exc}")
         return out
 
-    def _log(self, kind: str, inputs: list[tuple[Any, ...]], answers: list[Any], **more: Any) -> None:
-        if not (self.events and self.events[-1][0] == "end"):
-            self.events.append(("call", {"kind": kind, "inputs": inputs, "answers": answers, **more}))
+    def values(self, inputs: list[tuple]) -> list[float]:
+        """``t`` of each input (``inf`` for None, a failure or the wrong type), the call logged."""
+        answers = self._answers(inputs)
+        if inputs and not (self.events and self.events[-1][0] == "end"):
+            sphere = len(inputs[0]) == 4  # (origin, direction, center, radius); a triangle's has v0, v1, v2
+            self.events.append(("call", {"kind": "sphere" if sphere else "triangles", "inputs": inputs,
+                                         "answers": answers, "triangles": len(inputs),  # one ray: a call a node
+                                         "first": None if sphere else list(inputs[0][2])}))
+        return [self._t(a) for a in answers]
 
     @staticmethod
     def _t(answer: Any) -> float:
         return float(answer) if isinstance(answer, (int, float)) and not isinstance(answer, bool) and answer > 0 \
             else math.inf
-
-    def sphere(self, o: NDArray[np.float64], d: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Rays in the unit sphere's own space: ``intersect_sphere(O, d/|d|, (0,0,0), 1) / |d|``."""
-        lengths = np.linalg.norm(d, axis=1)
-        unit = d / lengths[:, None]
-        inputs = [(tuple(a), tuple(b), (0.0, 0.0, 0.0), 1.0) for a, b in zip(o.tolist(), unit.tolist(), strict=True)]
-        answers = self._answers(inputs)
-        self._log("sphere", inputs, answers, lengths=lengths.tolist())
-        return np.asarray([self._t(a) for a in answers]) / lengths
-
-    def triangles(self, o: NDArray[np.float64], d: NDArray[np.float64], v0: NDArray[np.float64],
-                  v1: NDArray[np.float64], v2: NDArray[np.float64], one_sided: bool
-                  ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
-        """Every ray against every triangle of a node; the nearest, and which (culling is the engine's)."""
-        n, m = d.shape[0], v0.shape[0]
-        tris = [(tuple(a), tuple(b), tuple(c)) for a, b, c in zip(v0.tolist(), v1.tolist(), v2.tolist(), strict=True)]
-        rays = list(zip(map(tuple, o.tolist()), map(tuple, d.tolist()), strict=True))
-        inputs = [(*ray, *tri) for ray in rays for tri in tris]
-        answers = self._answers(inputs)
-        self._log("triangles", inputs, answers, triangles=m, first=v0[0].tolist() if m else None)
-        t = np.asarray([self._t(a) for a in answers]).reshape(n, m)
-        if one_sided:  # N·Rd > 0 is dropped, as the lesson picture drops it
-            t = np.where(d @ np.cross(v1 - v0, v2 - v0).T > 0.0, np.inf, t)
-        j = np.argmin(t, axis=1) if m else np.zeros(n, dtype=np.intp)
-        best = t[np.arange(n), j] if m else np.full(n, np.inf)
-        return best, np.where(np.isfinite(best), j, -1)
 
 
 @dataclass
