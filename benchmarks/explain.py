@@ -71,14 +71,14 @@ def exercise_cases(env) -> list:
     from glsandbox.exercises.catalogue import get
     from glsandbox.lesson import find_lesson
     from glsandbox.measure.bench import Case, Side
-    from glsandbox.story.exercise import _Direct, explain_with_function
+    from glsandbox.story.exercise import Direct, explain_with_function
 
     out = []
     for name, lesson, variant in (("ray_sphere", "ray_spheres", "geometric"),
                                   ("ray_triangle", "indexed_cube", "moller_trumbore")):
         exercise = get(name)
         scene = find_lesson(lesson)().scene()
-        caller = _Direct(exercise.extra["variants"][variant])
+        caller = Direct(exercise.extra["variants"][variant])
         pixel = (env.size[0] // 2, env.size[1] // 2)
 
         def run(k: int, scene=scene, exercise=exercise, caller=caller, pixel=pixel) -> list[int]:

@@ -88,11 +88,13 @@ def parse_pixel(text: str) -> tuple[int, int]:
 
 
 def explain(lesson_or_scene: Any, pixel: tuple[int, int] | str, size: tuple[int, int] | None = None,
-            **params: Any) -> Story:
+            exercise: tuple[str, Callable[..., Any]] | None = None, **params: Any) -> Story:
     """The story of one pixel of a lesson (a name, class or instance, with ``params`` as
     ``glsandbox.show`` takes them) or a :class:`Scene`, framed at ``size`` (default
     640x480): ``glsandbox.explain("ray_spheres", (320, 240))``. A rasterised pixel is drawn
-    on the notebook helpers' shared headless renderer."""
+    on the notebook helpers' shared headless renderer. ``exercise=(NAME, function)`` traces the
+    pixel with your function (called here, in your own kernel) beside the reference, as
+    ``glsandbox explain --exercise`` does (:mod:`glsandbox.story.exercise`)."""
     from glsandbox.frame import DEFAULT_SIZE
 
     if isinstance(pixel, str):
@@ -101,5 +103,15 @@ def explain(lesson_or_scene: Any, pixel: tuple[int, int] | str, size: tuple[int,
 
     scene, title = scene_of(lesson_or_scene, "explain", **params)
     frame = tuple(size) if size is not None else DEFAULT_SIZE
+    if exercise is not None:
+        from glsandbox.exercises.catalogue import get
+        from glsandbox.story.exercise import Direct, explain_with_function, render_exercise_story
+
+        name, function = exercise
+        if not callable(function):
+            raise SandboxError(f"explain: exercise=(NAME, function) takes a function, got {type(function).__name__}")
+        told = explain_with_function(scene, (int(frame[0]), int(frame[1])), (int(pixel[0]), int(pixel[1])),
+                                     get(name), Direct(function), title)
+        return Story(told, render_exercise_story(told))
 
     return pixel_story(scene, (int(frame[0]), int(frame[1])), (int(pixel[0]), int(pixel[1])), title, shared_renderer)

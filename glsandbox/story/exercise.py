@@ -40,7 +40,7 @@ from glsandbox.scene import Scene
 from glsandbox.story.ray import PixelTrace, ShapeTest, explain_ray_pixel
 from glsandbox.story.text import num, render_story, vec
 
-__all__ = ["TRACED_KINDS", "Divergence", "ExerciseStory", "compare_traces", "explain_with_function", "traced_kind"]
+__all__ = ["TRACED_KINDS", "Direct", "Divergence", "ExerciseStory", "compare_traces", "explain_with_function", "traced_kind"]
 
 #: The tolerance two traces' numbers agree within (relative, and absolute near 0): a
 #: correct geometric sphere test and the engine's stable one differ by rounding only.
@@ -61,14 +61,23 @@ def traced_kind(exercise: Exercise) -> str:
     return TRACED_KINDS[exercise.lesson.kind]
 
 
-class _Direct:
-    """The reference as a caller (trusted code, in this process): the same ``batch`` as the isolation's."""
+class Direct:
+    """A function called in this process (the reference, or in a notebook the student's own, in
+    their kernel): the same ``batch`` as the isolation's, an exception being that input's error."""
 
     def __init__(self, function: Any) -> None:
         self.function = function
 
     def batch(self, inputs: list[tuple[Any, ...]]) -> tuple[list[Any], dict[int, str]]:
-        return [self.function(*args) for args in inputs], {}
+        values: list[Any] = []
+        errors: dict[int, str] = {}
+        for i, args in enumerate(inputs):
+            try:
+                values.append(self.function(*args))
+            except Exception as exc:  # noqa: BLE001 - the function's own
+                values.append(None)
+                errors[i] = f"{type(exc).__name__}: {exc}"[:300]
+        return values, errors
 
 
 class _Seam(_Calls):
@@ -335,7 +344,7 @@ def explain_with_function(scene: Scene, size: tuple[int, int], pixel: tuple[int,
     (see the module docstring)."""
     kind = traced_kind(exercise)
     ref_events: list[tuple[str, dict[str, Any]]] = []
-    ref_seam = _Seam(exercise, _Direct(exercise.reference), ref_events)
+    ref_seam = _Seam(exercise, Direct(exercise.reference), ref_events)
     reference = explain_ray_pixel(scene, size, pixel, title, hit_tests={kind: getattr(ref_seam, kind)}, simple=True,
                                   events=ref_events, traced=True)
     my_events: list[tuple[str, dict[str, Any]]] = []

@@ -21,7 +21,7 @@ from glsandbox.exercises.catalogue import all_exercises, get
 from glsandbox.exercises.lesson_view import THRESHOLD, render_lesson
 from glsandbox.notebook import scene_of
 from glsandbox.story.exercise import (
-    _Direct,
+    Direct,
     explain_with_function,
     render_exercise_story,
     traced_kind,
@@ -52,7 +52,7 @@ def _where_it_shows(exercise, mistake):
         lesson, camera = SEEN_FROM[(exercise.name, mistake.name)]
         return scene_of(lesson, "explain", camera=camera, overlay="off")[0], view.size, (view.size[0] // 2,
                                                                                          view.size[1] // 2)
-    result = render_lesson(exercise, _Direct(mistake.function))
+    result = render_lesson(exercise, Direct(mistake.function))
     w = view.size[0]
     yours, reference = result.image[:, :w, :3].astype(int), result.image[:, w + 4:2 * w + 4, :3].astype(int)
     ys, xs = np.nonzero(np.abs(yours - reference).max(axis=2) > THRESHOLD)
@@ -72,12 +72,12 @@ def test_the_first_divergence_is_in_the_mutated_function(name: str, mistake: str
     exercise = get(name)
     wrong = next(m for m in exercise.mistakes if m.name == mistake)
     scene, size, pixel = _where_it_shows(exercise, wrong)
-    story = explain_with_function(scene, size, pixel, exercise, _Direct(wrong.function))
+    story = explain_with_function(scene, size, pixel, exercise, Direct(wrong.function))
     assert story.divergence is not None, f"{mistake} at {pixel}: the traces agree"
     assert story.divergence.in_function, story.divergence.message
     assert story.divergence.message.startswith(f"{exercise.function} returned "), story.divergence.message
     assert "where the reference has" in story.divergence.message
-    right = explain_with_function(scene, size, pixel, exercise, _Direct(exercise.extra["variants"][CORRECT[name]]))
+    right = explain_with_function(scene, size, pixel, exercise, Direct(exercise.extra["variants"][CORRECT[name]]))
     assert right.agree, right.divergence
     assert right.yours.rgba8 == right.reference.rgba8
 
@@ -87,7 +87,7 @@ def test_the_notes_worked_example_is_named_in_the_scene_units() -> None:
     exercise = get("ray_sphere")
     far_root = next(m for m in exercise.mistakes if m.name == "far_root").function
     scene, _ = scene_of("ray_spheres", "explain", camera="0,0,0,0,0.6,-0.8")
-    story = explain_with_function(scene, (401, 301), (200, 150), exercise, _Direct(far_root))
+    story = explain_with_function(scene, (401, 301), (200, 150), exercise, Direct(far_root))
     assert story.divergence is not None and story.divergence.index == 0
     assert story.divergence.message.startswith("intersect_sphere returned t = 125 where the reference has 35 "
                                                "(big, the primary ray)")
@@ -132,3 +132,21 @@ def test_the_command_runs_the_file_confined_and_exits_like_diff(tmp_path: Path) 
     broken.write_text("raise RuntimeError('at import')\ndef intersect_sphere(origin, direction, center, radius):\n"
                       "    return None\n")
     assert_user_error(run_cli("explain", *where, "--exercise", "ray_sphere", str(broken)), "broken.py")
+
+
+def test_the_notebook_traces_a_function_of_the_kernel() -> None:
+    import glsandbox
+
+    exercise = get("ray_sphere")
+    far_root = next(m for m in exercise.mistakes if m.name == "far_root").function
+    story = glsandbox.explain("ray_spheres", (200, 150), (401, 301), exercise=("ray_sphere", far_root),
+                              camera="0,0,0,0,0.6,-0.8")
+    assert story.text.startswith("first difference: intersect_sphere returned t = 125 where the reference has 35")
+    assert story.rgba8 == story.record.yours.rgba8 and "<pre" in story._repr_html_()
+
+    def raises(origin, direction, center, radius):
+        raise ValueError("not yet")
+
+    broken = glsandbox.explain("ray_spheres", (200, 150), (401, 301), exercise=("ray_sphere", raises),
+                               camera="0,0,0,0,0.6,-0.8")
+    assert "intersect_sphere returned error: ValueError: not yet where the reference has 35" in broken.text
