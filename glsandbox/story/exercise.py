@@ -352,8 +352,9 @@ def explain_with_function(scene: Scene, size: tuple[int, int], pixel: tuple[int,
     yours = explain_ray_pixel(scene, size, pixel, title, hit_tests={kind: getattr(seam, kind)}, simple=True,
                               events=my_events, traced=True)
     reference.renderer = yours.renderer = "ray_numpy"  # both traced by the numpy engine, as the lesson picture is
-    nodes = _world_nodes(scene, reference.viewport)
-    _name_meshes(nodes, ref_events, my_events)
+    world = _world(scene, reference.viewport)
+    nodes = list(world.nodes)
+    _name_meshes(world, ref_events, my_events)
     ref_facts = _facts(ref_events, reference, nodes, exercise.function)
     my_facts = _facts(my_events, yours, nodes, exercise.function)
     _tested_by_function(yours, my_facts, kind, exercise.function)
@@ -361,24 +362,16 @@ def explain_with_function(scene: Scene, size: tuple[int, int], pixel: tuple[int,
     return ExerciseStory(exercise.name, exercise.function, reference, yours, divergence, len(my_facts), seam.error)
 
 
-def _world_nodes(scene: Scene, viewport: int) -> list[Any]:
+def _world(scene: Scene, viewport: int) -> Any:
+    """The numpy engine's World of ``viewport`` (its nodes, their triangles), as the traces built it."""
     from glsandbox.frame import single_viewport
     from glsandbox.raytrace import numpy_engine
 
-    world, _ = numpy_engine._world_of(single_viewport(scene, viewport), 0, True, False)
-    return _WorldNodes(world)
+    return numpy_engine._world_of(single_viewport(scene, viewport), 0, True, False)[0]
 
 
-class _WorldNodes(list):
-    """The world's nodes, with its triangles' first vertices (a triangle call names its mesh by them)."""
-
-    def __init__(self, world: Any) -> None:
-        super().__init__(world.nodes)
-        self.world = world
-
-
-def _name_meshes(nodes: Any, *event_lists: list[tuple[str, dict[str, Any]]]) -> None:
-    world = nodes.world
+def _name_meshes(world: Any, *event_lists: list[tuple[str, dict[str, Any]]]) -> None:
+    """Each triangle call's node, by its first triangle's first vertex (the node's rows of the World)."""
     for events in event_lists:
         for step, v in events:
             if step == "call" and v["kind"] == "triangles" and v["first"] is not None:
