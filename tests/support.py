@@ -326,7 +326,7 @@ def check_lesson_golden(gl, golden, name: str, *settings: str, size: tuple[int, 
     return image
 
 
-# --- model files with materials (tests/core/test_meshfile_materials.py, tests/lessons/test_model_materials.py) ---
+# --- model files with materials (tests/mesh/test_load_materials.py, tests/lessons/test_model_materials.py) ---
 # Each is small, lies in the box -1..1 (so the model lesson's fit leaves it as it is, up to a
 # shift in z), and has its parts at known places, so a test can read each part's colour from a frame.
 

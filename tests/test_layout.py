@@ -18,24 +18,23 @@ ROOT = Path(__file__).resolve().parents[1]
 
 #: Lowest first. A module may import its own layer and the ones above it in this list.
 LAYERS: list[tuple[str, tuple[str, ...]]] = [
-    ("core", ("glsandbox.errors", "glsandbox.transforms", "glsandbox.meshnormals", "glsandbox.meshlooks",
-              "glsandbox.geometry",
-              "glsandbox.meshgen", "glsandbox.files", "glsandbox.file_watch", "glsandbox.progress",
-              "glsandbox.version")),
+    ("core", ("glsandbox.errors", "glsandbox.transforms", "glsandbox.mesh.normals", "glsandbox.mesh.looks",
+              "glsandbox.mesh.precheck", "glsandbox.geometry", "glsandbox.mesh.generate", "glsandbox.files",
+              "glsandbox.progress", "glsandbox.version")),
+    # glsandbox.mesh: its package and the model-file loader here, the rest of it in the core
     ("scene data", ("glsandbox.scene", "glsandbox.planar", "glsandbox.images",
-                    "glsandbox.overlay", "glsandbox.meshfile", "glsandbox.meshcheck")),
+                    "glsandbox.overlay", "glsandbox.mesh")),
     ("scene logic", ("glsandbox.scene_file", "glsandbox.shadowmap", "glsandbox.passes", "glsandbox.plan_variants",
                      "glsandbox.plan_notes", "glsandbox.plan", "glsandbox.camera", "glsandbox.lesson")),
     ("renderers", ("glsandbox.gl", "glsandbox.raytrace")),
     ("one frame", ("glsandbox.frame",)),
-    ("window and measuring", ("glsandbox.window", "glsandbox.panel", "glsandbox.controls", "glsandbox.notebook",
-                              "glsandbox.notebook_view", "glsandbox.course_page", "glsandbox.lesson_pages", "glsandbox.measure",
-                              # an exercise's data, its catalogue and its pictures (the course page lists them)
-                              "glsandbox.exercises.base", "glsandbox.exercises.fields", "glsandbox.exercises.compare",
-                              "glsandbox.exercises.plain",
-                              "glsandbox.exercises.catalogue", "glsandbox.exercises.probe",
-                              "glsandbox.exercises.lesson_view", "glsandbox.exercises.runner",
-                              "glsandbox.exercises.dxmath", "glsandbox.story")),
+    ("app and measuring", ("glsandbox.app", "glsandbox.course_page", "glsandbox.lesson_pages", "glsandbox.measure",
+                           # an exercise's data, its catalogue and its pictures (the course page lists them)
+                           "glsandbox.exercises.base", "glsandbox.exercises.fields", "glsandbox.exercises.compare",
+                           "glsandbox.exercises.plain",
+                           "glsandbox.exercises.catalogue", "glsandbox.exercises.probe",
+                           "glsandbox.exercises.lesson_view", "glsandbox.exercises.runner",
+                           "glsandbox.exercises.dxmath", "glsandbox.story")),
     ("grading", ("glsandbox.grading", "glsandbox.exercises")),
     ("command line", ("glsandbox.cli", "glsandbox.supervise", "glsandbox.pytest_plugin", "glsandbox.__main__")),
 ]

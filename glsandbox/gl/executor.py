@@ -17,9 +17,9 @@ import numpy as np
 
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh, with_face_normals
-from glsandbox.gl import depth as gl_depth, passes as gl_passes, shadowmap as gl_shadowmap
+from glsandbox.gl import depth as gl_depth, passes as gl_passes, shadow_textures
 from glsandbox.gl.context import GLHost
-from glsandbox.gl.overlay import OverlayDrawer
+from glsandbox.gl.overlay_drawer import OverlayDrawer
 from glsandbox.gl.shaders import compile_with_sources, declared_uniforms, source_files
 from glsandbox.gl.textures import TextureCache
 from glsandbox.gl.passes import FrameState
@@ -82,7 +82,7 @@ class Executor(GpuMeshes):
         self._bound_texture: object | None = None  # the material texture on unit 0 in this frame
         self.clear_depth = 1.0  # 0 with reverse-Z (glsandbox.gl.depth)
         self.pass_rect: tuple[int, int, int, int] | None = None  # the pass's viewport in pixels (see render)
-        self.shadow_maps = gl_shadowmap.ShadowMaps(self.ctx, self.raw)  # the lights' depth textures
+        self.shadow_maps = shadow_textures.ShadowMaps(self.ctx, self.raw)  # the lights' depth textures
 
     # --- resources ----------------------------------------------------------
 
@@ -334,7 +334,7 @@ class Executor(GpuMeshes):
         """Draw one node of the frame being rendered with ``draw``'s program,
         culling as ``draw`` says, seen through ``camera`` (the pass's).
 
-        The planar passes (:mod:`glsandbox.gl.planar`) override what they
+        The planar passes (:mod:`glsandbox.gl.planar_state`) override what they
         change: ``model`` replaces the node's model matrix, ``front_face`` the
         winding rule of front faces, ``lights`` the frame's lights and
         ``material`` the node's (a mirror's reflection: ``R @ model``,

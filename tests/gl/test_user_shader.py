@@ -21,7 +21,7 @@ from glsandbox.errors import SandboxError
 from glsandbox.files import load_png
 from glsandbox.frame import HeadlessRenderer
 from glsandbox.geometry import builtin_mesh
-from glsandbox.file_watch import FileWatch
+from glsandbox.app.file_watch import FileWatch
 from glsandbox.lesson import find_lesson
 from glsandbox.plan import plan
 from glsandbox.scene import SHADER_INPUTS, Motion, Node, Scene, moved_scene

@@ -229,7 +229,7 @@ def test_plans_without_effects_are_unchanged():
 
 
 def test_planar_passes_carry_their_stencil_state_as_structure():
-    # The executor sets exactly these numbers (glsandbox.gl.planar.set_stencil).
+    # The executor sets exactly these numbers (glsandbox.gl.planar_state.set_stencil).
     from glsandbox.plan import StencilState
 
     stencils = {s.kind: s.stencil for s in plan(MirrorLesson().scene()).passes}
@@ -249,9 +249,9 @@ def test_gl_planar_does_not_import_the_executor():
     import ast
     from pathlib import Path
 
-    import glsandbox.gl.planar
+    import glsandbox.gl.planar_state
 
-    tree = ast.parse(Path(glsandbox.gl.planar.__file__).read_text(encoding="utf-8"))
+    tree = ast.parse(Path(glsandbox.gl.planar_state.__file__).read_text(encoding="utf-8"))
     imported = {alias.name for node in ast.walk(tree) if isinstance(node, ast.Import) for alias in node.names}
     imported |= {f"{node.module}.{alias.name}" if node.module else alias.name
                  for node in ast.walk(tree) if isinstance(node, ast.ImportFrom) for alias in node.names}

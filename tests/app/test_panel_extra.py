@@ -9,7 +9,7 @@ import tomllib
 import pytest
 from support import REPO_ROOT, LessonWindow
 
-from glsandbox import panel
+from glsandbox.app import panel
 
 
 def test_without_imgui_bundle_the_window_gets_a_stand_in(monkeypatch) -> None:

@@ -7,7 +7,7 @@ import shlex
 import pytest
 
 from glsandbox.camera import CameraInput
-from glsandbox.controls import (Clock, LiveCompare, camera_numbers, control_for, lesson_controls, number_range,
+from glsandbox.app.controls import (Clock, LiveCompare, camera_numbers, control_for, lesson_controls, number_range,
                                 set_line, to_text)
 from glsandbox.errors import SandboxError
 from glsandbox.lesson import all_lessons, find_lesson
@@ -98,7 +98,7 @@ def test_live_compare_builds_the_compare_variants_from_the_current_values() -> N
 
 
 def test_the_session_keeps_the_drawn_frame_not_later_edits() -> None:
-    from glsandbox.controls import Session
+    from glsandbox.app.controls import Session
     from glsandbox.plan import plan
 
     lesson = find_lesson("phong")(speed=0.0)

@@ -1,4 +1,4 @@
-"""A model file's materials as loaded (glsandbox.meshfile, glsandbox.meshlooks): one part per
+"""A model file's materials as loaded (glsandbox.mesh.load, glsandbox.mesh.looks): one part per
 material with its colour, texture, alpha mode and sidedness; what the file holds that is not
 drawn, one warning line each; and the plan, which shows blending and two-sided lighting only
 for a part that asks. Every model is written by the test (trimesh or by hand)."""
@@ -14,8 +14,8 @@ import pytest
 import trimesh
 
 import glsandbox
-from glsandbox.meshlooks import is_closed
-from glsandbox.meshnormals import row_ids
+from glsandbox.mesh.looks import is_closed
+from glsandbox.mesh.normals import row_ids
 from support import (CUBE_OBJ, coloured_ply, gltf_part, masked_glb, quad, reversed_obj, two_material_glb,
                      two_usemtl_obj)
 from glsandbox.plan import plan

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from glsandbox.meshgen import icosphere, rock, terrain, terrain_cells_for
+from glsandbox.mesh.generate import icosphere, rock, terrain, terrain_cells_for
 
 
 def triangles(mesh) -> np.ndarray:

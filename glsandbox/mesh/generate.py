@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from glsandbox.geometry import Mesh
-from glsandbox.meshnormals import corner_normals, unique_vertices
+from glsandbox.mesh.normals import corner_normals, unique_vertices
 
 __all__ = ["icosphere", "rock", "terrain", "terrain_cells_for"]
 
@@ -103,7 +103,7 @@ def rock(subdivisions: int = 5, *, seed: int = 0, roughness: float = 0.2) -> Mes
 
 def _with_normals(name: str, positions: NDArray[np.float64], faces: NDArray[np.intp],
                   uvs: NDArray[np.float64] | None = None) -> Mesh:
-    """A mesh with crease-angle normals (:mod:`glsandbox.meshnormals`), vertices split where they differ."""
+    """A mesh with crease-angle normals (:mod:`glsandbox.mesh.normals`), vertices split where they differ."""
     normals = corner_normals(positions, faces).reshape(-1, 3)
     corner_vertex = faces.reshape(-1)
     rows = [positions[corner_vertex], normals]

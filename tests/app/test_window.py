@@ -18,7 +18,7 @@ from support import REPO_ROOT as REPO
 from glsandbox.files import load_png
 from glsandbox.lesson import find_lesson
 from glsandbox.measure.golden import compare_images
-from glsandbox.window import FrameRate, LessonErrors
+from glsandbox.app.window import FrameRate, LessonErrors
 
 slow = pytest.mark.slow  # windows under Xvfb
 
@@ -163,7 +163,7 @@ def test_frame_rate_counts_frames_over_half_second_windows() -> None:
 @slow
 def test_max_frames_ends_the_window_after_that_many_frames(xvfb_display: str, tmp_path: Path) -> None:
     script = ("from glsandbox.lesson import find_lesson\n"
-              "from glsandbox.window import run_window\n"
+              "from glsandbox.app.window import run_window\n"
               "run_window(find_lesson('triangle')(), (64, 48), max_frames=3)\n"
               "print('done')\n")
     # Without max_frames the window would wait for ESC and the run time out.

@@ -7,10 +7,10 @@ screenshot, R to reload shaders (and a lesson file), the shared camera keys
 frame is drawn exactly as headless draws it
 (:class:`glsandbox.frame.FrameRenderer`, into an offscreen target with the
 plan's buffers) and its colour copied onto the window, so the window shows the
-headless pixels. The live controls (:mod:`glsandbox.panel`, the optional
+headless pixels. The live controls (:mod:`glsandbox.app.panel`, the optional
 ``panel`` extra) are drawn over the copy, never into the frame, and change the
 lesson's values, the clock, MSAA and live compare
-(:class:`glsandbox.controls.Session`).
+(:class:`glsandbox.app.controls.Session`).
 """
 
 from __future__ import annotations
@@ -25,9 +25,9 @@ from typing import Any
 import numpy as np
 
 from glsandbox.camera import CameraInput
-from glsandbox.controls import Clock, Session, compare_scene
+from glsandbox.app.controls import Clock, Session, compare_scene
 from glsandbox.errors import SandboxError
-from glsandbox.file_watch import FileWatch
+from glsandbox.app.file_watch import FileWatch
 from glsandbox.files import next_numbered, save_png
 from glsandbox.frame import DEFAULT_SIZE, FrameRenderer, InteractiveResolution, with_samples
 from glsandbox.gl.context import open_context
@@ -112,7 +112,7 @@ class Window:
                  instead: str | None = None) -> None:
         import glfw
 
-        from glsandbox.panel import open_panel  # imgui only where a window opens (not for headless commands)
+        from glsandbox.app.panel import open_panel  # imgui only where a window opens (not for headless commands)
 
         self.glfw = glfw
         self.name = lesson.name

@@ -5,7 +5,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from glsandbox.file_watch import FileWatch, stamp
+from glsandbox.app.file_watch import FileWatch, stamp
 
 
 def test_stamp_is_time_and_size_or_none_while_missing(tmp_path: Path) -> None:

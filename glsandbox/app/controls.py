@@ -1,7 +1,7 @@
 """The live controls' model: what the window's panel and the notebook helpers show and change.
 
-Free of imgui and GL, so it is tested on its own. :mod:`glsandbox.panel` draws
-it with Dear ImGui in the window; :mod:`glsandbox.notebook` with ipywidgets.
+Free of imgui and GL, so it is tested on its own. :mod:`glsandbox.app.panel` draws
+it with Dear ImGui in the window; :mod:`glsandbox.app.notebook` with ipywidgets.
 
 - :func:`control_for`: the widget that fits a parameter (choice -> combo,
   bool -> checkbox, number -> slider with a range, order -> the six orders,

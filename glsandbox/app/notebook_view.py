@@ -12,7 +12,7 @@ fed by the browser instead of glfw. Under the picture a play button and a
 slider set the lesson's ``time``.
 
 This module needs the ``notebook`` extra (jupyter_rfb and ipywidgets);
-:func:`glsandbox.notebook.view` imports it and says what to install when it
+:func:`glsandbox.app.notebook.view` imports it and says what to install when it
 is missing.
 """
 
@@ -152,7 +152,7 @@ class ViewParts(NamedTuple):
 
 
 def make_view(lesson: Lesson, renderer_source: Any, size: tuple[int, int]) -> ViewParts:
-    """The canvas above a play button and a time slider; :func:`glsandbox.notebook.view` boxes them."""
+    """The canvas above a play button and a time slider; :func:`glsandbox.app.notebook.view` boxes them."""
     canvas = LessonCanvas(lesson, renderer_source, size)
     end = max(TIME_RANGE_SECONDS, lesson.time)
     slider = ipywidgets.FloatSlider(value=lesson.time, min=0.0, max=end, step=PLAY_STEP_SECONDS,

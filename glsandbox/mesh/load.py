@@ -5,7 +5,7 @@
 :class:`~glsandbox.geometry.Mesh` (positions, normals, uvs and vertex colours
 where the file has them) with its material as the file gives it (base
 colour, base colour texture in memory as a :class:`~glsandbox.scene.Texture`,
-alpha mode and cutoff, sidedness: :mod:`glsandbox.meshlooks`), and what
+alpha mode and cutoff, sidedness: :mod:`glsandbox.mesh.looks`), and what
 loading did. :meth:`Model.nodes` makes one scene node per part;
 :func:`load_mesh` is all parts as one mesh. No format is parsed here: trimesh
 reads them (``process=False``: the file's vertices and faces as written,
@@ -17,7 +17,7 @@ conventions and checks it.
   triangles' winding swapped so fronts stay counter-clockwise.
 - **Normals** (``normals=``): ``"auto"`` takes the file's vertex normals when
   it has usable ones (OBJ ``vn``, PLY ``nx ny nz``, glTF ``NORMAL``) and
-  otherwise makes them with the crease angle (:mod:`glsandbox.meshnormals`,
+  otherwise makes them with the crease angle (:mod:`glsandbox.mesh.normals`,
   30° by default: a cube keeps its edges, a scanned surface looks smooth);
   ``"file"`` insists on the file's; ``"crease"``, ``"smooth"`` and ``"flat"``
   always compute them that way. STL's per-facet normals are not vertex
@@ -40,8 +40,8 @@ cannot read (garbage, truncated), no faces, vertices that are NaN or infinite,
 face indices out of range; before trimesh reads it, an ASCII PLY or OFF cut
 short or with a face line that does not match its count, and a model that
 needs more memory than ``GLSANDBOX_MODEL_MEMORY`` allows
-(:mod:`glsandbox.meshcheck`). Time and memory are linear in the triangles:
-normals and vertices are made by :mod:`glsandbox.meshnormals` (integer ids,
+(:mod:`glsandbox.mesh.precheck`). Time and memory are linear in the triangles:
+normals and vertices are made by :mod:`glsandbox.mesh.normals` (integer ids,
 no per-position square work), a glTF's nodes placed once each, the per-face
 steps done in blocks (about 155-190 bytes per triangle of numpy's arrays at the peak, from the parsed
 file to the first frame). An OBJ's text is trimesh's largest cost: its parse peaks at about 8 bytes
@@ -74,9 +74,9 @@ from numpy.typing import NDArray
 from glsandbox.errors import SandboxError
 from glsandbox.files import open_user_file
 from glsandbox.geometry import Mesh
-from glsandbox.meshcheck import MEMORY_ENV, check_memory, checked_data, claimed_triangles, needed_bytes
-from glsandbox.meshlooks import Look, file_warnings, is_closed, look_of, warning_data
-from glsandbox.meshnormals import face_geometry, normal_groups, row_ids, split_vertices
+from glsandbox.mesh.precheck import MEMORY_ENV, check_memory, checked_data, claimed_triangles, needed_bytes
+from glsandbox.mesh.looks import Look, file_warnings, is_closed, look_of, warning_data
+from glsandbox.mesh.normals import face_geometry, normal_groups, row_ids, split_vertices
 from glsandbox.scene import Material, Node, Texture
 
 __all__ = ["CREASE_ANGLE", "FORMATS", "NORMALS", "Model", "ModelPart", "fit_mesh", "is_model_path", "load_mesh",
@@ -87,7 +87,7 @@ FORMATS: dict[str, str] = {".obj": "obj", ".ply": "ply", ".stl": "stl", ".off": 
                            ".glb": "glb"}
 
 #: How normals are made (module docstring): from the file when it has them, else crease; only
-#: the file's; or always computed (:data:`glsandbox.meshnormals.MODES`).
+#: the file's; or always computed (:data:`glsandbox.mesh.normals.MODES`).
 NORMALS = ("auto", "file", "crease", "smooth", "flat")
 
 #: The default crease angle in degrees: faces meeting at a sharper angle keep a hard edge.
@@ -151,7 +151,7 @@ class Model:
     dropped_faces: int
     #: Where the normals came from: ``"file"``, ``"crease 30°"``, ``"smooth"`` or ``"flat"``.
     normals: str
-    #: Whether the triangles close a volume (:func:`glsandbox.meshlooks.is_closed`; True for glTF,
+    #: Whether the triangles close a volume (:func:`glsandbox.mesh.looks.is_closed`; True for glTF,
     #: which says per material whether back faces are seen).
     closed: bool = True
 
@@ -350,7 +350,7 @@ def _reason(exc: BaseException) -> str:
 
 class _Source:
     """The file's bytes as trimesh reads them: a binary file from memory; an OBJ as its text,
-    decoded here (:func:`glsandbox.meshcheck.checked_data` made it UTF-8, as trimesh would decode
+    decoded here (:func:`glsandbox.mesh.precheck.checked_data` made it UTF-8, as trimesh would decode
     it) and handed over at trimesh's one ``read()``: trimesh copies the text as it cleans it up,
     and no copy of it is kept here (an OBJ's text is the reader's largest array)."""
 
@@ -627,7 +627,7 @@ def _group_mesh(p: Path, file_type: str, parts: list[_Part], position_ids: NDArr
                 part_name: str | None) -> tuple[_Arrays | None, int, int, str]:
     """One mesh for parts that share a material: ``(its arrays, triangles, degenerate faces
     dropped, how its normals were made)``; none when every face was degenerate. ``position_ids``:
-    the parts' vertices numbered by position (:func:`glsandbox.meshnormals.row_ids`)."""
+    the parts' vertices numbered by position (:func:`glsandbox.mesh.normals.row_ids`)."""
     offsets = np.cumsum([0] + [part.positions.shape[0] for part in parts])
     positions, faces = _all_parts(parts, offsets)
     # Optional attributes: a part without them gets neutral values when another has them.
@@ -711,8 +711,8 @@ def _normal_groups(p: Path, positions: NDArray[np.float64], faces: NDArray[np.in
                    position_ids: NDArray[np.intp], geometry: tuple[NDArray[np.float64], NDArray[np.float64]],
                    ) -> tuple[NDArray[np.intp], NDArray[np.float64], str]:
     """Corner normals as ``(group (C,), unit normals (G, 3))`` (corner ``c`` has ``normals[group[c]]``,
-    :func:`glsandbox.meshnormals.normal_groups`), and how they were made. ``geometry``: the faces'
-    unit normals and corner angles (:func:`glsandbox.meshnormals.face_geometry`; no angles when
+    :func:`glsandbox.mesh.normals.normal_groups`), and how they were made. ``geometry``: the faces'
+    unit normals and corner angles (:func:`glsandbox.mesh.normals.face_geometry`; no angles when
     the file's normals were expected)."""
     if mode in ("auto", "file"):
         usable = None

@@ -8,7 +8,7 @@ where the surface should look sharp:
 - ``"flat"``: every corner takes its face's normal (faceted shading);
 - ``"smooth"``: every corner takes the average over *all* faces at that
   position (one normal per position: a cube looks like a blob);
-- ``"crease"`` (the default of :mod:`glsandbox.meshfile`): a corner averages
+- ``"crease"`` (the default of :mod:`glsandbox.mesh.load`): a corner averages
   only the faces around its position whose normals are within
   ``crease_angle`` degrees of its own face's normal: curved surfaces look
   smooth and edges sharper than the angle stay sharp (a cube keeps its

@@ -16,7 +16,7 @@ import trimesh
 
 from glsandbox import Camera, Light, Material, Node, Scene, Viewport, geometry, transforms
 from glsandbox.lesson import scene_file_lesson
-from glsandbox.meshnormals import normal_groups, row_ids
+from glsandbox.mesh.normals import normal_groups, row_ids
 
 
 def test_meshes_without_normals_get_face_normals_once() -> None:

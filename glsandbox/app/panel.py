@@ -1,6 +1,6 @@
 """The window's live controls: a Dear ImGui panel (``imgui-bundle``) on the window's own context.
 
-:mod:`glsandbox.window` draws each frame into an offscreen target, copies it
+:mod:`glsandbox.app.window` draws each frame into an offscreen target, copies it
 onto the window, and only then calls :meth:`Panel.draw`: the panel is drawn
 over the window's framebuffer, never into the frame, so F12 screenshots (read
 from the target) and headless renders never include it. F1 hides it.
@@ -30,7 +30,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from glsandbox.controls import (SAMPLE_CHOICES, Control, LiveCompare, Session, control_for, lesson_controls,
+from glsandbox.app.controls import (SAMPLE_CHOICES, Control, LiveCompare, Session, control_for, lesson_controls,
                                 parse_value, to_text)
 from glsandbox.errors import SandboxError
 from glsandbox.files import write_text

@@ -73,7 +73,7 @@ def test_widget_text_fields_report_a_bad_value_and_keep_the_picture(gl) -> None:
 @pytest.mark.parametrize("helper, module", [("widget", "ipywidgets"), ("view", "jupyter_rfb")])
 def test_without_the_notebook_extra_the_helpers_say_what_to_install(monkeypatch, helper: str, module: str) -> None:
     monkeypatch.setitem(sys.modules, module, None)  # `import MODULE` raises ImportError
-    monkeypatch.delitem(sys.modules, "glsandbox.notebook_view", raising=False)  # imported again, without it
+    monkeypatch.delitem(sys.modules, "glsandbox.app.notebook_view", raising=False)  # imported again, without it
     with pytest.raises(SandboxError) as caught:
         getattr(glsandbox, helper)("phong")
     assert str(caught.value) == (f"glsandbox.{helper} needs {module}: install the notebook extra "

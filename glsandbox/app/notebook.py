@@ -12,7 +12,7 @@ All render headless on one shared :class:`~glsandbox.frame.HeadlessRenderer`
 ``glsandbox render`` writes. :func:`widget` and :func:`view` need the optional
 ``notebook`` extra (ipywidgets, jupyter_rfb); without it, they raise one
 :class:`SandboxError` line. The widgets are the window panel's
-(:mod:`glsandbox.controls`): a combo becomes a dropdown, a checkbox a
+(:mod:`glsandbox.app.controls`): a combo becomes a dropdown, a checkbox a
 checkbox, a number a slider with the same range.
 
 A widget lives only while its kernel runs: a saved notebook shown on a web
@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from glsandbox.controls import Control, lesson_controls, to_text
+from glsandbox.app.controls import Control, lesson_controls, to_text
 from glsandbox.errors import SandboxError
 from glsandbox.files import png_bytes
 from glsandbox.frame import DEFAULT_SIZE, FrameRenderer, LazyRenderer, with_samples
@@ -199,7 +199,7 @@ def view(lesson: str | type[Lesson] | Lesson, size: tuple[int, int] = (480, 360)
     ``.time`` (the slider) and ``.play``. Needs the ``notebook`` extra."""
     widgets = _ipywidgets("view")
     try:
-        from glsandbox.notebook_view import make_view
+        from glsandbox.app.notebook_view import make_view
     except ImportError:
         raise SandboxError(NOTEBOOK_MISSING.format(helper="view", module="jupyter_rfb")) from None
     current = make_lesson(lesson, **params)

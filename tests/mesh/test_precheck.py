@@ -1,4 +1,4 @@
-"""Model files checked before they are read (glsandbox.meshcheck): ASCII PLY and OFF cut short or with a
+"""Model files checked before they are read (glsandbox.mesh.precheck): ASCII PLY and OFF cut short or with a
 face line that does not match its count, an OFF without its header, refused in one line naming the file
 and line; a Latin-1 OBJ and a file whose name is not UTF-8 load."""
 
@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from glsandbox.errors import SandboxError
-from glsandbox.meshfile import load_model
+from glsandbox.mesh.load import load_model
 from support import assert_user_error, need, run_cli
 
 PLY_HEAD = ("ply\nformat ascii 1.0\ncomment made by hand\nelement vertex 3\nproperty float x\nproperty float y\n"

@@ -1,6 +1,6 @@
 """How a model file's parts look: their materials, and what of the file is not drawn.
 
-:mod:`glsandbox.meshfile` reads a file into parts (trimesh's meshes); this
+:mod:`glsandbox.mesh.load` reads a file into parts (trimesh's meshes); this
 module turns each part's trimesh material into a :class:`Look` (the fields a
 :class:`~glsandbox.scene.Material` takes from it) and says, in words, what
 the file asks for that glsandbox does not draw, so that a user is told
@@ -40,7 +40,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .meshnormals import BLOCK_FACES
+from glsandbox.mesh.normals import BLOCK_FACES
 
 __all__ = ["Look", "file_warnings", "is_closed", "look_of", "warning_data"]
 
@@ -158,7 +158,7 @@ def is_closed(positions: NDArray[np.float64], faces: NDArray[np.int64],
     the edges' hashes must equal the sum of the reversed edges' (mod 2⁶⁴). Two
     different multisets agree by chance with odds of about 2⁻⁶⁴; then an open mesh
     would be culled as if closed. ``position_ids``: equal exactly where the positions are
-    (:func:`glsandbox.meshnormals.row_ids`), when the caller has them: each id is hashed
+    (:func:`glsandbox.mesh.normals.row_ids`), when the caller has them: each id is hashed
     instead of each position's bits."""
     if faces.shape[0] == 0:
         return False

@@ -1,6 +1,6 @@
 """Model files checked before a reader builds anything from them: text formats line by line, and size.
 
-trimesh reads the formats (:mod:`glsandbox.meshfile`), but a text file cut
+trimesh reads the formats (:mod:`glsandbox.mesh.load`), but a text file cut
 short, or with a face line that does not hold the vertex count it starts
 with, reads as *part* of a model without a word. So before trimesh sees
 them:

@@ -1,4 +1,4 @@
-"""Model files (glsandbox.meshfile): every format through trimesh, normals, uvs, textures, fit, the cache,
+"""Model files (glsandbox.mesh.load): every format through trimesh, normals, uvs, textures, fit, the cache,
 degenerate faces, and flat normals for lit meshes that have none."""
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from support import CUBE_OBJ, quadrant_image, textured_quad_glb
 
 from glsandbox import geometry
 from glsandbox.errors import SandboxError
-from glsandbox.meshfile import fit_mesh, is_model_path, load_mesh, load_model
+from glsandbox.mesh.load import fit_mesh, is_model_path, load_mesh, load_model
 
 def write(path: Path, text: str) -> Path:
     path.write_text(text)

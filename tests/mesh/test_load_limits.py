@@ -17,10 +17,10 @@ import trimesh
 
 from glsandbox import meshgen
 from glsandbox.errors import SandboxError
-from glsandbox.meshcheck import (BYTES_PER_TRIANGLE, MEMORY_ENV, OBJ_BYTES_PER_FILE_BYTE, OBJ_BYTES_PER_LINE,
+from glsandbox.mesh.precheck import (BYTES_PER_TRIANGLE, MEMORY_ENV, OBJ_BYTES_PER_FILE_BYTE, OBJ_BYTES_PER_LINE,
                                  needed_bytes)
-from glsandbox.meshfile import load_model
-from glsandbox.meshnormals import corner_normals, face_normals
+from glsandbox.mesh.load import load_model
+from glsandbox.mesh.normals import corner_normals, face_normals
 from support import assert_user_error, run_cli
 
 
@@ -293,7 +293,7 @@ def _gltf_with_nodes(path: Path, nodes: list[dict]) -> Path:
     ([{"name": "a", "mesh": 0, "children": [1]}, {"name": "b", "mesh": 0, "children": [0]}], "a"),  # each other's
 ], ids=["self", "pair"])
 def test_a_gltf_whose_nodes_form_a_cycle_is_refused_naming_the_file_and_the_node(tmp_path: Path, nodes, node) -> None:
-    from glsandbox.meshfile import load_model
+    from glsandbox.mesh.load import load_model
 
     path = _gltf_with_nodes(tmp_path / "cycle.gltf", nodes)
     with pytest.raises(SandboxError) as caught:
