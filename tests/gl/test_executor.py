@@ -1,4 +1,5 @@
-"""What the executor keeps between draws and frames (issue 24) never changes a picture.
+"""The raster executor (glsandbox/gl/executor.py): what it keeps between draws and frames never
+changes a picture, and it refuses what it cannot draw.
 
 A program keeps its uniform values, so the executor writes a uniform only when its
 bytes differ from the last ones written into that program; the lights' bytes are
@@ -13,9 +14,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from glsandbox import geometry
 from glsandbox.frame import FrameRenderer
 from glsandbox.lesson import find_lesson
 from glsandbox.plan import plan
+from glsandbox.scene import Node, Scene, Viewport
 
 SIZE = (80, 60)
 #: Lessons with lights (reflected ones too: the mirror), textures, overlays and split viewports.
@@ -162,3 +165,14 @@ def test_a_reflected_and_flattened_node_moved_in_place_is_drawn_where_it_is_now(
     assert not np.array_equal(before, after)
     copied = replace(held, nodes=tuple(replace(n, model=model.copy()) if n.name == "cube" else n for n in held.nodes))
     assert np.array_equal(after, fresh_frame(gl, copied))  # a new array: nothing kept can stand in for it
+
+
+def test_the_executor_draws_raster_viewports_only(gl) -> None:
+    scene = Scene("ray", nodes=(Node("cube", geometry.cube()),), viewports=(Viewport(renderer="ray_numpy"),))
+    target = gl.host.ctx.simple_framebuffer(SIZE)
+    try:
+        with pytest.raises(ValueError, match="the executor draws raster viewports only"):
+            gl.executor.render(scene, target, SIZE)
+    finally:
+        target.release()
+
