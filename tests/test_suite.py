@@ -89,7 +89,6 @@ NOT_YET_NAMED = {
     "measure/knobs/triangle_test",
     "measure/tradeoffs",
     "measure/tradeoffs_report",
-    "mesh/looks",
     "overlay",
     "raytrace/bvh_traverse",
     "raytrace/world",
