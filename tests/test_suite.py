@@ -89,7 +89,6 @@ NOT_YET_NAMED = {
     "measure/knobs/triangle_test",
     "measure/tradeoffs",
     "measure/tradeoffs_report",
-    "overlay",
     "raytrace/bvh_traverse",
     "raytrace/world",
     "story/coverage",
