@@ -90,7 +90,6 @@ NOT_YET_NAMED = {
     "measure/tradeoffs",
     "measure/tradeoffs_report",
     "raytrace/bvh_traverse",
-    "raytrace/world",
     "story/coverage",
     "story/raster",
     "story/ray",
