@@ -425,7 +425,7 @@ def masked_glb(path: Path) -> Path:
 
 def two_textures_glb(path: Path) -> Path:
     """Two squares side by side with a texture each (white factor): red pixels on the left
-    part, blue on the right (the boat of issue 20: several textures, each part its own)."""
+    part, blue on the right (a boat of several textures, each part its own)."""
     import trimesh
     from PIL import Image
 

@@ -108,7 +108,7 @@ def test_a_texture_drawn_with_another_filter_is_sampled_with_it(gl) -> None:
 
 
 def test_a_kept_plan_drawn_with_other_parts_draws_those_parts(gl) -> None:
-    """The executor prepares each plan's passes and draws once (issue 24) and keeps them while
+    """The executor prepares each plan's passes and draws once and keeps them while
     the plan object is the same. One plan drawn in turn with scenes that differ in a material's
     colour, a texture's image, a mesh, the lights and the frame's size draws each as a fresh renderer
     draws it: what was prepared is found again only for the same material, mesh and size."""

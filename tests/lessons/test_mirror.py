@@ -314,7 +314,7 @@ def test_gl_state_is_restored_after_every_effect_pass(gl):
     plain = PhongLesson()
     before = gl.render(plain, SIZE).image.copy()
     before_state = gl.host.raw.state_snapshot()
-    # Frames are drawn with alpha writes off (glsandbox.gl.target.FRAME_COLOR_MASK, issue 12): that
+    # Frames are drawn with alpha writes off (glsandbox.gl.target.FRAME_COLOR_MASK): that
     # is the colour mask a frame leaves, and the one the planar passes restore (the mirror's marking
     # turns all colour writes off; put back to (1, 1, 1, 1) the glass and shadow would write alpha).
     assert before_state["color_writemask"] == (1, 1, 1, 0)

@@ -1,4 +1,4 @@
-"""Loading model files in linear time and bounded memory (issue 20): crease normals as the pairwise rule
+"""Loading model files in linear time and bounded memory: crease normals as the pairwise rule
 says on ordinary meshes, a fan and a repeated triangle that load in time linear in their size, a chain of
 nested glTF nodes, and a model too big for the memory limit refused in one line before it is loaded."""
 
