@@ -63,9 +63,7 @@ NOT_YET_NAMED = {
     "supervise",  # through tests/cli/test_lessons_that_end.py
     "gl/gpu_meshes",
     "gl/osmesa",
-    "gl/overlay_drawer",
     "gl/rawgl",
-    "gl/shadow_textures",
     "gl/textures",
     "gl/user_shaders",
     "grading/isolate",
