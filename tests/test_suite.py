@@ -64,8 +64,6 @@ NOT_YET_NAMED = {
     "gl/gpu_meshes",
     "gl/osmesa",
     "gl/rawgl",
-    "gl/textures",
-    "gl/user_shaders",
     "grading/isolate",
     "grading/kinds",
     "grading/processes",

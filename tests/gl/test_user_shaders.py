@@ -1,4 +1,4 @@
-"""A node's own shader (docs/your-own.md, "Your own shader"): scene files, Python, the
+"""A node's own shader (glsandbox/gl/user_shaders.py; docs/your-own.md, "Your own shader"): scene files, Python, the
 errors that name the user's file, --set u.NAME, reload and the file watch,
 the ray tracer's note, and the toon example."""
 
