@@ -97,6 +97,30 @@ def test_every_package_module_has_a_layer():
     assert not unplaced, f"modules missing from the layer table (docs/how-it-works.md and LAYERS): {unplaced}"
 
 
+#: Folders whose modules are entries of one registry, each named after its entry (a pass kind on
+#: both sides, a ray-traced shape, a knob, an exercise): their names may be others' too.
+REGISTRY_FOLDERS = ("glsandbox.passes.", "glsandbox.gl.passes.", "glsandbox.raytrace.shapes.",
+                    "glsandbox.measure.knobs.", "glsandbox.exercises.catalogue.")
+#: Names two layers still share, each for a job of its own: this list only shrinks.
+SHARED_NAMES_NOT_YET = {"base", "errors", "ray", "runner"}
+
+
+def test_no_module_name_is_used_in_two_layers():
+    """A name says one job: the GL side of a scene-data module is named for what it does with it
+    (``planar`` and ``gl.planar_state``), not after the data again."""
+    by_name: dict[str, set[int]] = {}
+    for module in graph():
+        if not module.startswith("glsandbox.") or (module + ".").startswith(REGISTRY_FOLDERS):
+            continue  # (the registries' own packages too: passes and gl.passes are one pair)
+        layer = layer_of(module)
+        if layer is not None:
+            by_name.setdefault(module.rsplit(".", 1)[1], set()).add(layer)
+    shared = sorted(name for name, layers in by_name.items() if len(layers) > 1 and name not in SHARED_NAMES_NOT_YET)
+    assert shared == [], f"module names used in two layers (rename one for its job): {shared}"
+    stale = sorted(name for name in SHARED_NAMES_NOT_YET if len(by_name.get(name, ())) < 2)
+    assert stale == [], f"take these off SHARED_NAMES_NOT_YET: {stale}"
+
+
 def test_imports_point_down_only():
     upward = []
     for module, targets in graph().items():
