@@ -3,7 +3,7 @@
 Run: ``uv run python benchmarks/bvh.py [--sizes 1000,10000] [--model terrain|rock] [--rounds R]``;
 with Embree: ``uv run --group bench python benchmarks/bvh.py``.
 
-Per model size (a generated model, :mod:`glsandbox.meshgen`: no download):
+Per model size (a generated model, :mod:`glsandbox.mesh.generate`: no download):
 
 - **build**: :func:`~glsandbox.raytrace.bvh.build_bvh` (binned SAH), wall and
   CPU seconds (the CPU figure is steadier on a shared machine);

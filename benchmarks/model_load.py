@@ -216,7 +216,7 @@ path = Path(sys.argv[1])
 #: parse (``meshfile._trimesh_scene``, wrapped) and of all that follows it (glsandbox's own part), what is
 #: held after, and the loaded model's arrays.
 _GLSANDBOX_MEMORY = _MEASURE_PRELUDE + """
-import trimesh, glsandbox, glsandbox.meshfile as meshfile
+import trimesh, glsandbox, glsandbox.mesh.load as meshfile
 from glsandbox.measure.bench import BenchEnv
 import model_load
 env = BenchEnv()

@@ -5,7 +5,7 @@ CPU ray tracer) casting the same rays in the same run, ratio = engine time /
 Embree time (the goals, printed in the goal column: the gpu engine at
 most 1x, the numpy engine at most 5x):
 
-- the models are generated terrains (:func:`glsandbox.meshgen.terrain`: no
+- the models are generated terrains (:func:`glsandbox.mesh.generate.terrain`: no
   download, the same every run), and the Stanford bunny (56,172 triangles)
   when ``pymeshlab`` is installed (the ``bench`` group: it ships the bunny
   inside its wheel);

@@ -19,7 +19,7 @@ def cases(env) -> list:
     try:
         from jupyter_rfb._utils import array2compressed
 
-        from glsandbox.notebook_view import LessonCanvas
+        from glsandbox.app.notebook_view import LessonCanvas
     except ImportError:
         env.note("notebook_view: no jupyter_rfb (the notebook extra): no view rows")
         return []

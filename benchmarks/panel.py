@@ -3,8 +3,8 @@
 One glfw window on the window backend (under Xvfb where there is no screen:
 ``xvfb-run glsandbox bench --only panel``), 800x600, the phong lesson: each
 frame draws the lesson into its target, copies it onto the window and swaps,
-exactly as :func:`glsandbox.window.run_window` does; the subject also lays out
-and draws the Dear ImGui panel (:class:`glsandbox.panel.Panel`) before the
+exactly as :func:`glsandbox.app.window.run_window` does; the subject also lays out
+and draws the Dear ImGui panel (:class:`glsandbox.app.panel.Panel`) before the
 swap. ``glFinish`` ends both, so the time is the frame's and not the queue's.
 The window runs in a child process (see :func:`cases`), driven a frame at a
 time. Without a display the row is skipped with a note. Goal: <= 1.15x
@@ -23,7 +23,7 @@ LESSON = "phong"
 def cases(env: Any) -> list:
     from glsandbox.gl.context import window_unavailable
     from glsandbox.measure.bench import Case, Side
-    from glsandbox.panel import panel_available
+    from glsandbox.app.panel import panel_available
 
     if not panel_available():
         env.note("skipped: panel (window frame with the live controls): imgui-bundle is not installed "
@@ -63,11 +63,11 @@ def serve(size: tuple[int, int]) -> None:
     import glfw
 
     from glsandbox.camera import CameraInput
-    from glsandbox.controls import Clock, Session
+    from glsandbox.app.controls import Clock, Session
     from glsandbox.frame import FrameRenderer
     from glsandbox.gl.context import open_context
     from glsandbox.lesson import find_lesson
-    from glsandbox.panel import Panel
+    from glsandbox.app.panel import Panel
 
     host = open_context("window", window=True, size=size, title="glsandbox: bench panel")
     glfw.swap_interval(0)  # no wait for a vertical blank: the frame's own time

@@ -18,8 +18,8 @@ and the ray tracer (:mod:`glsandbox.raytrace`) traces the same Scene::
         raise SystemExit(glsandbox.run(OneCube))   # a window, or --headless --out cube.png
 
 A model file is one call: ``Node("bunny", glsandbox.load_mesh("bunny.obj", fit=True))``;
-:func:`load_model` gives its texture and colour too (:mod:`glsandbox.meshfile`),
-and :mod:`glsandbox.meshgen` makes models without a file.
+:func:`load_model` gives its texture and colour too (:mod:`glsandbox.mesh.load`),
+and :mod:`glsandbox.mesh.generate` makes models without a file.
 
 The layers below (the table in docs/how-it-works.md) import downwards only;
 :func:`run` is the one door up to the command line, opened when called.
@@ -68,12 +68,12 @@ _LAZY = {
     "exercise": ("glsandbox.exercises", "exercise"),
     "Mirror": ("glsandbox.planar", "Mirror"),
     "PlanarShadow": ("glsandbox.planar", "PlanarShadow"),
-    "meshgen": ("glsandbox.meshgen", None),
+    "meshgen": ("glsandbox.mesh.generate", None),
     "check_texture_source": ("glsandbox.images", "check_texture_source"),
-    "Model": ("glsandbox.meshfile", "Model"),
-    "fit_mesh": ("glsandbox.meshfile", "fit_mesh"),
-    "load_mesh": ("glsandbox.meshfile", "load_mesh"),
-    "load_model": ("glsandbox.meshfile", "load_model"),
+    "Model": ("glsandbox.mesh.load", "Model"),
+    "fit_mesh": ("glsandbox.mesh.load", "fit_mesh"),
+    "load_mesh": ("glsandbox.mesh.load", "load_mesh"),
+    "load_model": ("glsandbox.mesh.load", "load_model"),
 }
 
 
@@ -106,8 +106,8 @@ def run(lesson_cls: type[Lesson], argv: list[str] | None = None) -> int:
 
 def show(lesson_or_scene: object, *args: object, **params: object) -> object:
     """A lesson (name, class or instance, with ``--set``-style ``params``) or a Scene rendered
-    headless as a picture that Jupyter shows inline (:mod:`glsandbox.notebook`, imported when called)."""
-    from glsandbox.notebook import show as _show
+    headless as a picture that Jupyter shows inline (:mod:`glsandbox.app.notebook`, imported when called)."""
+    from glsandbox.app.notebook import show as _show
 
     return _show(lesson_or_scene, *args, **params)
 
@@ -122,14 +122,14 @@ def explain(lesson_or_scene: object, *args: object, **params: object) -> object:
 
 def widget(lesson: object, *args: object, **params: object) -> object:
     """The lesson's parameters as ipywidgets (the ``notebook`` extra) over its picture, re-rendered on change."""
-    from glsandbox.notebook import widget as _widget
+    from glsandbox.app.notebook import widget as _widget
 
     return _widget(lesson, *args, **params)
 
 
 def view(lesson: object, *args: object, **params: object) -> object:
     """A live view of the lesson in Jupyter (the ``notebook`` extra): drag to orbit, wheel to zoom,
-    a play button and a time slider (:func:`glsandbox.notebook.view`)."""
-    from glsandbox.notebook import view as _view
+    a play button and a time slider (:func:`glsandbox.app.notebook.view`)."""
+    from glsandbox.app.notebook import view as _view
 
     return _view(lesson, *args, **params)

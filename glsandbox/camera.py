@@ -238,7 +238,7 @@ CAMERA_KEYS = ("w", "a", "s", "d", "z", "x", "left", "right", "up", "down")
 class CameraInput:
     """The window's camera: idle until the user moves it, then it overrides the scene's.
 
-    Kept free of glfw so it can be tested; :func:`glsandbox.window.run_window`
+    Kept free of glfw so it can be tested; :func:`glsandbox.app.window.run_window`
     feeds it key names, drags (pixels) and scroll clicks.
     """
 

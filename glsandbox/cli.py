@@ -165,7 +165,7 @@ def cmd_render(args: argparse.Namespace) -> int:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from glsandbox.window import run_window  # glfw and the panel only where a window opens
+    from glsandbox.app.window import run_window  # glfw and the panel only where a window opens
 
     run_window(_lesson(args), _size(args), args.samples, args.backend)
     return 0
@@ -937,7 +937,7 @@ def lesson_main(lesson_cls: type[Lesson], argv: list[str] | None = None) -> int:
             frame = render_to_file(lesson, out, size, args.samples, args.backend)
             print(f"wrote {out} ({size[0]}x{size[1]}, {frame.seconds * 1000:.1f} ms)")
         else:
-            from glsandbox.window import run_window
+            from glsandbox.app.window import run_window
 
             run_window(lesson, size, args.samples, args.backend,
                        instead=f"or render it headless: {prog} --headless --out FILE.png")

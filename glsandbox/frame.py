@@ -16,7 +16,7 @@ a ``trace`` pass per ray-traced viewport first, saying who traces it and how,
 then the raster passes, and as notes what the ray tracer ignores of the scene.
 
 :class:`HeadlessRenderer` opens a context of its own and reads frames back;
-the window (:mod:`glsandbox.window`) copies the target onto the screen.
+the window (:mod:`glsandbox.app.window`) copies the target onto the screen.
 """
 
 from __future__ import annotations

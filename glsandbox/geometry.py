@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from glsandbox.errors import NUMBER_LIMIT, SandboxError, plain
-from glsandbox.meshnormals import face_normals
+from glsandbox.mesh.normals import face_normals
 from glsandbox.transforms import from_directx_mesh
 
 #: Primitive topologies a mesh can use (the course's D3D11_PRIMITIVE_TOPOLOGY_*).
@@ -186,7 +186,7 @@ def with_face_normals(mesh: Mesh) -> Mesh:
     A vertex shared by faces that point different ways cannot carry one
     normal for all of them (the course's 8-vertex cube), so the triangles are
     un-indexed: each gets its own three vertices carrying its face normal
-    ``(V1 − V0) × (V2 − V0)``, normalised (:func:`glsandbox.meshnormals.face_normals`;
+    ``(V1 − V0) × (V2 − V0)``, normalised (:func:`glsandbox.mesh.normals.face_normals`;
     zero for a zero-area triangle, which covers no pixel). Uvs and colours
     follow their corners. A mesh that has normals, or no triangles, comes back
     as it is. Meshes are immutable, so the result is made once per mesh object.

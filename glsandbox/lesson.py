@@ -2,7 +2,7 @@
 
 A lesson turns its parameter values (always including ``time``) into a
 :class:`~glsandbox.scene.Scene`. Rendering, windows and the CLI are elsewhere
-(:mod:`glsandbox.frame`, :mod:`glsandbox.window`, :mod:`glsandbox.cli`); a lesson is only data and maths,
+(:mod:`glsandbox.frame`, :mod:`glsandbox.app.window`, :mod:`glsandbox.cli`); a lesson is only data and maths,
 so it renders the same moment exactly, headless or in a window.
 """
 

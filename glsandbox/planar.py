@@ -4,7 +4,7 @@ Course section "The stencil Test": ``MarkMirrorDSS``, ``DrawReflectionDSS``,
 ``XMMatrixReflect``, ``CullClockwise``, ``XMMatrixShadow`` and
 ``shadowOffsetY``. These are plain data, like the rest of the Scene; the
 matrices come from :mod:`glsandbox.transforms`, the passes from
-:func:`glsandbox.plan.plan`, and the GL state from :mod:`glsandbox.gl.planar`.
+:func:`glsandbox.plan.plan`, and the GL state from :mod:`glsandbox.gl.planar_state`.
 No GL here.
 """
 

@@ -218,7 +218,7 @@ class Texture:
 
     ``image``, when given, is the picture itself, in memory: an ``(H, W, 4)``
     uint8 RGBA array, row 0 at the top (a model file's base colour texture,
-    :mod:`glsandbox.meshfile`). ``source`` then only names it (in plans and
+    :mod:`glsandbox.mesh.load`). ``source`` then only names it (in plans and
     errors); textures are told apart by ``digest``, a hash of the pixels,
     made once here (the array is made read-only).
     """

@@ -36,7 +36,7 @@ from glsandbox import transforms
 from glsandbox.errors import NUMBER_LIMIT, SandboxError, plain
 from glsandbox.files import check_inside_sandbox, read_user_file, written_path
 from glsandbox.geometry import Mesh, builtin_mesh
-from glsandbox.meshfile import CREASE_ANGLE, NORMALS as MESH_NORMALS, Model, ModelPart, is_model_path, load_model
+from glsandbox.mesh.load import CREASE_ANGLE, NORMALS as MESH_NORMALS, Model, ModelPart, is_model_path, load_model
 from glsandbox.planar import Mirror, PlanarShadow
 from glsandbox.scene import (BUILTIN_TEXTURES, COURSE_BLUE, DEPTH_MODES, SHADINGS, Camera, Color, Light, Material,
                              Node, Scene, ShadowMap, Texture, Viewport, check_uniforms)
@@ -46,7 +46,7 @@ _MATERIAL_NUMBERS = ("ambient", "diffuse", "specular", "shininess")
 #: A material's alpha and sides (glsandbox.scene.Material; a model file's parts bring their own).
 _MATERIAL_LOOKS = ("alpha_mode", "alpha_cutoff", "double_sided", "vertex_colors")
 
-#: Keys only a node whose mesh is a model file takes (:mod:`glsandbox.meshfile`).
+#: Keys only a node whose mesh is a model file takes (:mod:`glsandbox.mesh.load`).
 _MODEL_FILE_KEYS = ("fit", "mesh_normals", "crease_angle", "up")
 #: A model file's up axis (``up = "z"`` stands a Z-up scan upright: z becomes y).
 _UP_AXES = ("y", "z")

@@ -326,7 +326,7 @@ def check_lesson_golden(gl, golden, name: str, *settings: str, size: tuple[int, 
     return image
 
 
-# --- model files with materials (tests/core/test_meshfile_materials.py, tests/lessons/test_model_materials.py) ---
+# --- model files with materials (tests/mesh/test_load_materials.py, tests/lessons/test_model_materials.py) ---
 # Each is small, lies in the box -1..1 (so the model lesson's fit leaves it as it is, up to a
 # shift in z), and has its parts at known places, so a test can read each part's colour from a frame.
 
@@ -425,7 +425,7 @@ def masked_glb(path: Path) -> Path:
 
 def two_textures_glb(path: Path) -> Path:
     """Two squares side by side with a texture each (white factor): red pixels on the left
-    part, blue on the right (the boat of issue 20: several textures, each part its own)."""
+    part, blue on the right (a boat of several textures, each part its own)."""
     import trimesh
     from PIL import Image
 

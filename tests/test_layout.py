@@ -18,24 +18,23 @@ ROOT = Path(__file__).resolve().parents[1]
 
 #: Lowest first. A module may import its own layer and the ones above it in this list.
 LAYERS: list[tuple[str, tuple[str, ...]]] = [
-    ("core", ("glsandbox.errors", "glsandbox.transforms", "glsandbox.meshnormals", "glsandbox.meshlooks",
-              "glsandbox.geometry",
-              "glsandbox.meshgen", "glsandbox.files", "glsandbox.file_watch", "glsandbox.progress",
-              "glsandbox.version")),
+    ("core", ("glsandbox.errors", "glsandbox.transforms", "glsandbox.mesh.normals", "glsandbox.mesh.looks",
+              "glsandbox.mesh.precheck", "glsandbox.geometry", "glsandbox.mesh.generate", "glsandbox.files",
+              "glsandbox.progress", "glsandbox.version")),
+    # glsandbox.mesh: its package and the model-file loader here, the rest of it in the core
     ("scene data", ("glsandbox.scene", "glsandbox.planar", "glsandbox.images",
-                    "glsandbox.overlay", "glsandbox.meshfile", "glsandbox.meshcheck")),
+                    "glsandbox.overlay", "glsandbox.mesh")),
     ("scene logic", ("glsandbox.scene_file", "glsandbox.shadowmap", "glsandbox.passes", "glsandbox.plan_variants",
                      "glsandbox.plan_notes", "glsandbox.plan", "glsandbox.camera", "glsandbox.lesson")),
     ("renderers", ("glsandbox.gl", "glsandbox.raytrace")),
     ("one frame", ("glsandbox.frame",)),
-    ("window and measuring", ("glsandbox.window", "glsandbox.panel", "glsandbox.controls", "glsandbox.notebook",
-                              "glsandbox.notebook_view", "glsandbox.course_page", "glsandbox.lesson_pages", "glsandbox.measure",
-                              # an exercise's data, its catalogue and its pictures (the course page lists them)
-                              "glsandbox.exercises.base", "glsandbox.exercises.fields", "glsandbox.exercises.compare",
-                              "glsandbox.exercises.plain",
-                              "glsandbox.exercises.catalogue", "glsandbox.exercises.probe",
-                              "glsandbox.exercises.lesson_view", "glsandbox.exercises.runner",
-                              "glsandbox.exercises.dxmath", "glsandbox.story")),
+    ("app and measuring", ("glsandbox.app", "glsandbox.course_page", "glsandbox.lesson_pages", "glsandbox.measure",
+                           # an exercise's data, its catalogue and its pictures (the course page lists them)
+                           "glsandbox.exercises.base", "glsandbox.exercises.fields", "glsandbox.exercises.compare",
+                           "glsandbox.exercises.plain",
+                           "glsandbox.exercises.catalogue", "glsandbox.exercises.probe",
+                           "glsandbox.exercises.lesson_view", "glsandbox.exercises.runner",
+                           "glsandbox.exercises.dxmath", "glsandbox.story")),
     ("grading", ("glsandbox.grading", "glsandbox.exercises")),
     ("command line", ("glsandbox.cli", "glsandbox.supervise", "glsandbox.pytest_plugin", "glsandbox.__main__")),
 ]
@@ -96,6 +95,30 @@ def graph() -> dict[str, frozenset[str]]:
 def test_every_package_module_has_a_layer():
     unplaced = [m for m in graph() if m.startswith("glsandbox.") and layer_of(m) is None]
     assert not unplaced, f"modules missing from the layer table (docs/how-it-works.md and LAYERS): {unplaced}"
+
+
+#: Folders whose modules are entries of one registry, each named after its entry (a pass kind on
+#: both sides, a ray-traced shape, a knob, an exercise): their names may be others' too.
+REGISTRY_FOLDERS = ("glsandbox.passes.", "glsandbox.gl.passes.", "glsandbox.raytrace.shapes.",
+                    "glsandbox.measure.knobs.", "glsandbox.exercises.catalogue.")
+#: Names two layers still share, each for a job of its own: this list only shrinks.
+SHARED_NAMES_NOT_YET = {"base", "errors", "ray", "runner"}
+
+
+def test_no_module_name_is_used_in_two_layers():
+    """A name says one job: the GL side of a scene-data module is named for what it does with it
+    (``planar`` and ``gl.planar_state``), not after the data again."""
+    by_name: dict[str, set[int]] = {}
+    for module in graph():
+        if not module.startswith("glsandbox.") or (module + ".").startswith(REGISTRY_FOLDERS):
+            continue  # (the registries' own packages too: passes and gl.passes are one pair)
+        layer = layer_of(module)
+        if layer is not None:
+            by_name.setdefault(module.rsplit(".", 1)[1], set()).add(layer)
+    shared = sorted(name for name, layers in by_name.items() if len(layers) > 1 and name not in SHARED_NAMES_NOT_YET)
+    assert shared == [], f"module names used in two layers (rename one for its job): {shared}"
+    stale = sorted(name for name in SHARED_NAMES_NOT_YET if len(by_name.get(name, ())) < 2)
+    assert stale == [], f"take these off SHARED_NAMES_NOT_YET: {stale}"
 
 
 def test_imports_point_down_only():

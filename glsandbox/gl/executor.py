@@ -8,7 +8,7 @@ says and nothing more; choosing passes is :func:`glsandbox.plan.plan`'s job.
 from __future__ import annotations
 
 import struct
-from collections.abc import Callable, Collection, Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from types import MappingProxyType
 
@@ -17,16 +17,15 @@ import numpy as np
 
 from glsandbox.errors import SandboxError
 from glsandbox.geometry import Mesh, with_face_normals
-from glsandbox.gl import depth as gl_depth, passes as gl_passes, shadowmap as gl_shadowmap
+from glsandbox.gl import depth as gl_depth, passes as gl_passes, shadow_textures
 from glsandbox.gl.context import GLHost
-from glsandbox.gl.overlay import OverlayDrawer
+from glsandbox.gl.overlay_drawer import OverlayDrawer
 from glsandbox.gl.shaders import compile_with_sources, declared_uniforms, source_files
 from glsandbox.gl.textures import TextureCache
 from glsandbox.gl.passes import FrameState
 from glsandbox.gl.gpu_meshes import GpuMeshes, _mesh_key, _moved_key
-from glsandbox.gl.uniform_bytes import (_CAMERA, _CONSTANTS, _EYE, _FLOAT64, _MODEL_BYTES, _NORMAL_BYTES,
-                                        PassCamera, _constants_change, material_constants,
-                                        _Uniforms, _Written)
+from glsandbox.gl.uniform_bytes import _CONSTANTS, PassCamera, material_constants, _Uniforms, _Written
+from glsandbox.gl.uniform_writes import LightBytes, uniform_writer, write_constants, write_lighting, write_matrices
 from glsandbox.gl.draw_steps import _DrawSetup, _DrawStep, _PreparedFrame, _Steps
 from glsandbox.gl.user_shaders import UserProgram, check_user_draw
 from glsandbox.passes.base import SHADOW_MAP_UNIT, Draw, Pass, ProgramVariant
@@ -73,16 +72,14 @@ class Executor(GpuMeshes):
         self._overlays: OverlayDrawer | None = None  # made on the first overlay pass
         self._textures = TextureCache(host)
         self._lights: tuple[Light, ...] = ()  # the lights of the frame being drawn (draw_node's default)
-        # u_light_pos and u_light_color bytes by id of the lights tuple and the pass origin (the tuple kept
-        # to check): see _light_bytes.
-        self._lights_cache: dict[tuple[int, bytes], tuple[tuple[Light, ...], bytes, bytes]] = {}
-        # The uniform bytes last written into each program (by program key): see _uniform_writer.
+        self._light_bytes = LightBytes()  # u_light_pos and u_light_color bytes, kept while the lights stay
+        # The uniform bytes last written into each program (by program key): see uniform_writer.
         self._written: dict[str, _Written] = {}
         self._culling: tuple[bool, str] | None = None  # what _set_culling set last (None: not known)
         self._bound_texture: object | None = None  # the material texture on unit 0 in this frame
         self.clear_depth = 1.0  # 0 with reverse-Z (glsandbox.gl.depth)
         self.pass_rect: tuple[int, int, int, int] | None = None  # the pass's viewport in pixels (see render)
-        self.shadow_maps = gl_shadowmap.ShadowMaps(self.ctx, self.raw)  # the lights' depth textures
+        self.shadow_maps = shadow_textures.ShadowMaps(self.ctx, self.raw)  # the lights' depth textures
 
     # --- resources ----------------------------------------------------------
 
@@ -334,7 +331,7 @@ class Executor(GpuMeshes):
         """Draw one node of the frame being rendered with ``draw``'s program,
         culling as ``draw`` says, seen through ``camera`` (the pass's).
 
-        The planar passes (:mod:`glsandbox.gl.planar`) override what they
+        The planar passes (:mod:`glsandbox.gl.planar_state`) override what they
         change: ``model`` replaces the node's model matrix, ``front_face`` the
         winding rule of front faces, ``lights`` the frame's lights and
         ``material`` the node's (a mirror's reflection: ``R @ model``,
@@ -358,11 +355,12 @@ class Executor(GpuMeshes):
         if step.culling != self._culling:
             self._set_culling(draw.cull_back_faces, front_face)
         written, uniforms = setup.written, setup.uniforms
-        self._write_matrices(setup, written, uniforms, node.model if model is None else model, camera)
+        write_matrices(setup, written, uniforms, node.model if model is None else model, camera)
         if step.lit:
-            self._write_lighting(step, written, uniforms, camera, self._lights if lights is None else lights)
+            write_lighting(step, written, uniforms, camera, self._lights if lights is None else lights,
+                           self._light_bytes)
         if written[_CONSTANTS] is not step.constants:  # another material's were written since
-            self._write_constants(step, written, uniforms)
+            write_constants(step, written, uniforms)
         if own:
             program = setup.program
             for name, value in own.items():
@@ -387,67 +385,6 @@ class Executor(GpuMeshes):
             else:
                 return self._draw_step(key, node, draw, material, front_face)
         return step
-
-    @staticmethod
-    def _write_matrices(setup: _DrawSetup, written: _Written, uniforms: _Uniforms, matrix: np.ndarray,
-                        camera: PassCamera) -> None:
-        """``m_model`` (and ``m_normal``, its inverse transpose: course "Lighting"), then the pass
-        camera's ``m_view`` and ``m_proj`` where the program holds another camera's."""
-        if type(matrix) is not np.ndarray or matrix.dtype != _FLOAT64:
-            matrix = np.asarray(matrix, dtype=np.float64)
-        content = matrix.tobytes()
-        data = _MODEL_BYTES[content + camera.origin_bytes]
-        if written["m_model"] != data:
-            written["m_model"] = data
-            uniforms["m_model"].write(data)
-        if written[_CAMERA] is not camera:  # (a pass's draws share its camera)
-            if camera.view_bytes != written["m_view"]:
-                written["m_view"] = camera.view_bytes
-                uniforms["m_view"].write(camera.view_bytes)
-            if camera.proj_bytes != written["m_proj"]:
-                written["m_proj"] = camera.proj_bytes
-                uniforms["m_proj"].write(camera.proj_bytes)
-            written[_CAMERA] = camera
-        if setup.normal:
-            data = _NORMAL_BYTES[content]
-            if written["m_normal"] != data:
-                written["m_normal"] = data
-                uniforms["m_normal"].write(data)
-
-    def _write_lighting(self, step: _DrawStep, written: _Written, uniforms: _Uniforms, camera: PassCamera,
-                        frame_lights: tuple[Light, ...]) -> None:
-        """A lit draw's eye position and lights (course "Lighting": ``vEyePos``, the light loop)."""
-        if written[_EYE] is not camera:
-            data = camera.eye_bytes
-            if written["u_eye"] != data:
-                written["u_eye"] = data
-                uniforms["u_eye"].write(data)
-            written[_EYE] = camera
-        if frame_lights:  # with none, the shader's arrays do not exist (NUM_LIGHTS 0)
-            if step.lights[0] is not frame_lights or step.lights[3] is not camera:
-                # (lights that do not move, seen from an eye that does not: the same bytes every frame)
-                step.lights = (frame_lights, *self._light_bytes(frame_lights, camera), camera)
-            _, light_pos, light_color, _ = step.lights
-            if written["u_light_pos"] != light_pos:
-                written["u_light_pos"] = light_pos
-                uniforms["u_light_pos"].write(light_pos)
-            if written["u_light_color"] != light_color:
-                written["u_light_color"] = light_color
-                uniforms["u_light_color"].write(light_color)
-
-    @staticmethod
-    def _write_constants(step: _DrawStep, written: _Written, uniforms: _Uniforms) -> None:
-        """The material's constant uniforms, only the bytes that differ from the program's."""
-        constants = step.constants
-        last = written[_CONSTANTS]
-        change = step.change
-        if change[0] is not last or last is None:
-            change = (last, _constants_change(written, last, constants))
-            step.change = change
-        for name, data in change[1]:
-            written[name] = data
-            uniforms[name].write(data)
-        written[_CONSTANTS] = constants
 
     def _bind_and_render(self, draw: Draw, material: Material, setup: _DrawSetup, camera: PassCamera) -> None:
         """Bind the draw's textures (unit 0: the material's, unit 1: a shadow map) and draw its
@@ -497,6 +434,7 @@ class Executor(GpuMeshes):
             return setup
         program = self._programs[program_key][1]
         members = self._members(program_key)
+        written = self._written.setdefault(program_key, _Written())
         drawn = with_face_normals(mesh) if mesh.normals is None and "in_normal" in members else mesh
         origin = mesh_origin(mesh)
         if origin is not None and drawn is mesh:  # (face normals made for a moved mesh: a mesh of its own)
@@ -507,52 +445,17 @@ class Executor(GpuMeshes):
                 self._moved_gpu_mesh(mesh, origin)
                 return setup
             vao, gpu = self._vao(mesh, program_key)
-            setup = _DrawSetup(origin, program, members, self._uniform_writer(program_key, program, members),
-                               _moved_key(origin), vao, gpu, "m_normal" in members,
-                               self._uniforms(program_key), self._written.setdefault(program_key, _Written()))
+            setup = _DrawSetup(origin, program, members, uniform_writer(written, program, members),
+                               _moved_key(origin), vao, gpu, "m_normal" in members, self._uniforms(program_key), written)
             self._setups[moved_key] = setup
             return setup
         vao, gpu = self._vao(drawn, program_key)
         if len(self._setups) >= self.SETUPS_KEPT:  # new meshes every frame (a trail): start again
             self._setups.clear()
-        setup = _DrawSetup(mesh, program, members, self._uniform_writer(program_key, program, members), _mesh_key(drawn), vao, gpu,
-                           "m_normal" in members, self._uniforms(program_key), self._written.setdefault(program_key, _Written()))
+        setup = _DrawSetup(mesh, program, members, uniform_writer(written, program, members), _mesh_key(drawn), vao, gpu,
+                           "m_normal" in members, self._uniforms(program_key), written)
         self._setups[(program_key, id(mesh))] = setup
         return setup
-
-    def _uniform_writer(self, program_key: str, program: moderngl.Program,
-                        members: Collection[str]) -> Callable[[str, bytes], None]:
-        """``write(name, data)`` for one program: the bytes go to GL only where the program has the
-        uniform (a term the compiler removed has none) and they differ from what was written last.
-        A program keeps its uniform values between draws and frames, so what does not change (the
-        view while the camera stands, lights, materials, a wall's model) is written once."""
-        written = self._written.setdefault(program_key, _Written())
-        uniforms: dict[str, moderngl.Uniform] = {}
-
-        def write(name: str, data: bytes) -> None:
-            if written.get(name) != data and name in members:
-                uniform = uniforms.get(name)
-                if uniform is None:
-                    uniform = uniforms[name] = program[name]
-                uniform.write(data)
-                written[name] = data
-
-        return write
-
-    def _light_bytes(self, lights: tuple[Light, ...], camera: PassCamera) -> tuple[bytes, bytes]:
-        """``u_light_pos`` (relative to ``camera``'s origin, the difference taken in float64) and
-        ``u_light_color`` bytes of ``lights``, made once per lights tuple and origin: every lit
-        draw of a frame writes the same ones, and lights that do not move (the scene's, and the
-        mirror's reflected ones) seen from an eye that does not keep them from frame to frame."""
-        key = (id(lights), camera.origin_bytes)
-        cached = self._lights_cache.get(key)
-        if cached is None or cached[0] is not lights:
-            if len(self._lights_cache) >= 8:  # lights or an eye that move make an entry a frame
-                self._lights_cache.clear()
-            positions = np.array([l.position for l in lights], dtype=np.float64) - camera.origin
-            cached = self._lights_cache[key] = (
-                lights, positions.astype("f4").tobytes(), np.array([l.color for l in lights], dtype="f4").tobytes())
-        return cached[1], cached[2]
 
     def unbind_texture(self) -> None:
         """Leave texture unit 0 without the frame's sampler object (the overlays and the next user

@@ -39,7 +39,7 @@ GL_DITHER = 0x0BD0
 GL_STENCIL_TEST = 0x0B90
 GL_TEXTURE_WRAP_S = 0x2802
 GL_TEXTURE_WRAP_T = 0x2803
-# Stencil, depth and clip state (the mirror and shadow passes, glsandbox.gl.planar; reverse-Z, glsandbox.gl.depth).
+# Stencil, depth and clip state (the mirror and shadow passes, glsandbox.gl.planar_state; reverse-Z, glsandbox.gl.depth).
 GL_DEPTH_COMPONENT32F = 0x8CAC
 GL_DEPTH32F_STENCIL8 = 0x8CAD
 GL_NEVER, GL_LESS, GL_EQUAL, GL_LEQUAL, GL_GREATER, GL_NOTEQUAL, GL_GEQUAL, GL_ALWAYS = range(0x0200, 0x0208)

@@ -143,7 +143,7 @@ class Pass:
     #: (:mod:`glsandbox.exercises.states`); None: the pass kind's own (no depth writes
     #: for ``mark_mirror`` and ``planar_shadow``, clockwise front faces for ``reflection``,
     #: source-alpha blending for ``planar_shadow``). ``blend`` is (source, destination)
-    #: factor names of :data:`glsandbox.gl.planar.BLEND_FACTORS`.
+    #: factor names of :data:`glsandbox.gl.planar_state.BLEND_FACTORS`.
     depth_write: bool | None = None
     front_face: str | None = None
     blend: tuple[str, str] | None = None

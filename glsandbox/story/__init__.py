@@ -99,7 +99,7 @@ def explain(lesson_or_scene: Any, pixel: tuple[int, int] | str, size: tuple[int,
 
     if isinstance(pixel, str):
         pixel = parse_pixel(pixel)
-    from glsandbox.notebook import scene_of, shared_renderer
+    from glsandbox.app.notebook import scene_of, shared_renderer
 
     scene, title = scene_of(lesson_or_scene, "explain", **params)
     frame = tuple(size) if size is not None else DEFAULT_SIZE

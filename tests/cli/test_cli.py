@@ -225,8 +225,8 @@ def test_tour_lessons_dir_renders_each_file_and_goes_on_past_a_broken_one(tmp_pa
 # path (glsandbox/__init__, scene, overlay, cli, lesson, ...) brings it back into sys.modules here.
 # pyrr: transforms builds its two matrices itself; hashlib (OpenSSL): the mesh digests use BLAKE2's
 # own module; Pillow's other format plugins: a PNG is written by name (files.png_bytes).
-LAZY_AT_RENDER = ("glsandbox.meshfile", "glsandbox.meshgen", "glsandbox.meshlooks", "glsandbox.course_page",
-                  "glsandbox.grading.rubric", "glsandbox.measure.golden", "glsandbox.window", "glsandbox.raytrace",
+LAZY_AT_RENDER = ("glsandbox.mesh.load", "glsandbox.mesh.generate", "glsandbox.mesh.looks", "glsandbox.course_page",
+                  "glsandbox.grading.rubric", "glsandbox.measure.golden", "glsandbox.app.window", "glsandbox.raytrace",
                   "glsandbox.camera", "glsandbox.planar", "trimesh", "tqdm", "imgui", "PIL.ImageDraw",
                   "PIL.ImageFont", "tomllib", "difflib", "json", "html", "pyrr", "hashlib", "PIL.BmpImagePlugin",
                   "PIL.GifImagePlugin", "PIL.JpegImagePlugin", "PIL.PpmImagePlugin")

@@ -309,7 +309,7 @@ def test_a_mesh_without_what_its_material_reads_is_named_in_the_file(tmp_path: P
     # The executor refused it while drawing, naming neither the file nor the node.
     assert error_of(tmp_path, '[[nodes]]\nmesh = "quad_list"\ntexture = "checker"\n').startswith(
         "scene.toml:3: nodes[0].texture: node 'node0': mesh 'quad_list' has no uv data, which a texture needs")
-    # A lit mesh without normals is no mistake: both renderers shade it flat (tests/core/test_meshnormals.py).
+    # A lit mesh without normals is no mistake: both renderers shade it flat (tests/mesh/test_normals.py).
 
 
 def test_a_flattened_lit_node_names_the_file_and_the_node(tmp_path: Path) -> None:

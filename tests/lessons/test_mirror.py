@@ -17,7 +17,7 @@ from glsandbox import transforms
 from glsandbox.errors import SandboxError
 from glsandbox.measure.zfighting import count_z_fighting, flat_receiver, shade_mask
 from glsandbox.plan import plan
-from glsandbox.planar import Mirror, PlanarShadow, shadow_casters
+from glsandbox.planar import Mirror, PlanarShadow
 from glsandbox.scene import Scene
 from glsandbox.lessons.mirror import MirrorLesson
 from glsandbox.lessons.phong import PhongLesson
@@ -126,53 +126,6 @@ def test_light_below_the_plane_culls_the_shadow_pass():
     assert step.draws == () and "light is below the receiver plane" in step.describe()
 
 
-def test_caster_above_a_point_light_is_culled():
-    # The cube's top is at 0.6 + 0.6 = 1.2; a light at 1.0 has vertices above it.
-    step = [p for p in plan(MirrorLesson(ly=1.0).scene()).passes if p.kind == "planar_shadow"][0]
-    assert step.draws == () and "cube culled" in step.describe()
-    shadow = PlanarShadow("floor", (0, 1, 0, 0), (0, 2, 0, 1), ("box",))
-    box = (np.eye(4), np.array([[0, 1.9, 0], [0, 2.0, 0], [1, 0.5, 0]]))
-    assert shadow_casters(shadow, {"box": box}).culled[0][0] == "box"
-    assert shadow_casters(shadow, {"box": (transforms.translate(0, -0.2, 0), box[1])}).kept == ("box",)
-
-
-def test_the_casters_box_decides_as_their_vertices_do():
-    # A read-only mesh array is checked from its bounding box first (planar._below_by_box, once per
-    # frame for a moving caster); a writable copy goes by its vertices alone. Moved and turned so
-    # that the top vertex lands at, just under and just over the light's height: the same decisions
-    # and reasons, and the box alone keeps the casters clearly below.
-    from glsandbox.planar import _below_by_box
-
-    light_y = 2.0
-    shadow = PlanarShadow("floor", (0, 1, 0, 0), (0.3, light_y, -0.2, 1), ("part",))
-    # A box's corners and points inside it: the box is the points' own, so its bound is their top.
-    half = RNG.uniform(0.2, 0.6, 3)
-    corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * half
-    points = np.vstack([corners, RNG.uniform(-half, half, (32, 3))]) + RNG.uniform(-1, 1, 3)
-    frozen = points.copy()
-    frozen.setflags(write=False)
-    kept_by_box = 0
-    for _ in range(300):
-        turn = transforms.rotate_y(RNG.uniform(0, 6.3)) @ transforms.rotate_x(RNG.uniform(0, 6.3))
-        model = turn @ transforms.scale(*RNG.uniform(0.2, 2.0, 3))
-        top = float(np.max(transforms.transform_points(model, points)[:, 1]))
-        model = transforms.translate(0.0, light_y - top + RNG.choice([-0.3, -1e-6, -1e-10, 0.0, 1e-10, 0.2]), 0.0) @ model
-        exact = shadow_casters(shadow, {"part": (model, points)})
-        assert shadow_casters(shadow, {"part": (model, frozen)}) == exact
-        if _below_by_box(shadow.plane, shadow.height, model, frozen):
-            assert exact.kept == ("part",)
-            kept_by_box += 1
-    assert kept_by_box > 0
-    lesson = MirrorLesson().scene()
-    cube = next(node for node in lesson.nodes if node.name == "cube")
-    assert _below_by_box(lesson.planar_shadow.plane, lesson.planar_shadow.height, cube.model, cube.mesh.positions)
-    # What the box cannot tell, the vertices decide: a writable array, a projective model.
-    projective = np.eye(4)
-    projective[3] = (0.0, 0.1, 0.0, 1.0)
-    assert not _below_by_box(shadow.plane, shadow.height, np.eye(4), points)
-    assert not _below_by_box(shadow.plane, shadow.height, projective, frozen)
-
-
 def test_reverse_z_maps_near_to_one_and_far_to_zero():
     proj = transforms.reverse_z(transforms.perspective(45.0, 1.0, 0.01, 100.0))
     for z, depth in ((-0.01, 1.0), (-100.0, 0.0)):
@@ -229,7 +182,7 @@ def test_plans_without_effects_are_unchanged():
 
 
 def test_planar_passes_carry_their_stencil_state_as_structure():
-    # The executor sets exactly these numbers (glsandbox.gl.planar.set_stencil).
+    # The executor sets exactly these numbers (glsandbox.gl.planar_state.set_stencil).
     from glsandbox.plan import StencilState
 
     stencils = {s.kind: s.stencil for s in plan(MirrorLesson().scene()).passes}
@@ -241,22 +194,6 @@ def test_planar_passes_carry_their_stencil_state_as_structure():
     assert leaky["reflection"] is None and leaky["planar_shadow"] is None
     with pytest.raises(SandboxError, match="stencil test 'less'"):
         StencilState("less", 0)
-
-
-def test_gl_planar_does_not_import_the_executor():
-    # The executor imports the planar passes; they reach it only through the
-    # NodeDrawer protocol, so no import (not even for typing) goes back.
-    import ast
-    from pathlib import Path
-
-    import glsandbox.gl.planar
-
-    tree = ast.parse(Path(glsandbox.gl.planar.__file__).read_text(encoding="utf-8"))
-    imported = {alias.name for node in ast.walk(tree) if isinstance(node, ast.Import) for alias in node.names}
-    imported |= {f"{node.module}.{alias.name}" if node.module else alias.name
-                 for node in ast.walk(tree) if isinstance(node, ast.ImportFrom) for alias in node.names}
-    imported |= {node.module for node in ast.walk(tree) if isinstance(node, ast.ImportFrom) and node.module}
-    assert not any("executor" in name for name in imported), sorted(imported)
 
 
 def test_compare_cannot_compose_whole_frame_effects_so_it_stitches_them():
@@ -377,7 +314,7 @@ def test_gl_state_is_restored_after_every_effect_pass(gl):
     plain = PhongLesson()
     before = gl.render(plain, SIZE).image.copy()
     before_state = gl.host.raw.state_snapshot()
-    # Frames are drawn with alpha writes off (glsandbox.gl.target.FRAME_COLOR_MASK, issue 12): that
+    # Frames are drawn with alpha writes off (glsandbox.gl.target.FRAME_COLOR_MASK): that
     # is the colour mask a frame leaves, and the one the planar passes restore (the mirror's marking
     # turns all colour writes off; put back to (1, 1, 1, 1) the glass and shadow would write alpha).
     assert before_state["color_writemask"] == (1, 1, 1, 0)

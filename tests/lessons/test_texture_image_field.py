@@ -16,7 +16,7 @@ import pytest
 from support import LessonWindow, need, run_cli
 
 from glsandbox import SandboxError
-from glsandbox.controls import parse_value
+from glsandbox.app.controls import parse_value
 from glsandbox.files import save_png
 from glsandbox.lesson import find_lesson
 

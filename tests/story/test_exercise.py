@@ -19,7 +19,7 @@ from support import assert_user_error, run_cli
 from glsandbox.errors import SandboxError
 from glsandbox.exercises.catalogue import all_exercises, get
 from glsandbox.exercises.lesson_view import THRESHOLD, render_lesson
-from glsandbox.notebook import scene_of
+from glsandbox.app.notebook import scene_of
 from glsandbox.story.exercise import (
     Direct,
     explain_with_function,

@@ -100,7 +100,7 @@ def unknown_habits(step: Pass) -> tuple[frozenset[str], frozenset[str] | None]:
 
 
 def stencil_set(step: Pass) -> frozenset[str]:
-    """A planar pass with a stencil state sets all of the stencil group (:func:`glsandbox.gl.planar.set_stencil`)."""
+    """A planar pass with a stencil state sets all of the stencil group (:func:`glsandbox.gl.planar_state.set_stencil`)."""
     return frozenset({"stencil"}) if step.stencil is not None else NO_STATE
 
 

@@ -1,10 +1,10 @@
-"""The ``mark_mirror`` pass's runner (:func:`glsandbox.gl.planar.mark_mirror`): it sets the
+"""The ``mark_mirror`` pass's runner (:func:`glsandbox.gl.planar_state.mark_mirror`): it sets the
 stencil and both write masks, and leaves them changed."""
 
 from __future__ import annotations
 
 from glsandbox.gl.passes import Runner, stencil_set
-from glsandbox.gl.planar import mark_mirror
+from glsandbox.gl.planar_state import mark_mirror
 from glsandbox.passes.base import Pass
 
 

@@ -1,10 +1,10 @@
-"""The ``mirror_surface`` pass's runner (:func:`glsandbox.gl.planar.mirror_surface`): it sets
+"""The ``mirror_surface`` pass's runner (:func:`glsandbox.gl.planar_state.mirror_surface`): it sets
 its blending and leaves it on."""
 
 from __future__ import annotations
 
 from glsandbox.gl.passes import Runner
-from glsandbox.gl.planar import mirror_surface
+from glsandbox.gl.planar_state import mirror_surface
 from glsandbox.passes.base import Pass
 
 _BLEND = frozenset({"blend"})

@@ -1,5 +1,5 @@
 """The ``overlay`` pass's runner: labels and figures blended over the frame
-(:mod:`glsandbox.gl.overlay`, which puts blending and the scissor back itself)."""
+(:mod:`glsandbox.gl.overlay_drawer`, which puts blending and the scissor back itself)."""
 
 from __future__ import annotations
 

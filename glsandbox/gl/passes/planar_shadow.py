@@ -1,11 +1,11 @@
-"""The ``planar_shadow`` pass's runner (:func:`glsandbox.gl.planar.planar_shadow`): it sets the
+"""The ``planar_shadow`` pass's runner (:func:`glsandbox.gl.planar_state.planar_shadow`): it sets the
 stencil (where it has a stencil state) and its blending, and leaves depth writes off and the
 polygon offset set."""
 
 from __future__ import annotations
 
 from glsandbox.gl.passes import Runner, stencil_set
-from glsandbox.gl.planar import planar_shadow
+from glsandbox.gl.planar_state import planar_shadow
 from glsandbox.passes.base import Pass
 
 

@@ -1,11 +1,11 @@
-"""The ``reflection`` pass's runner (:func:`glsandbox.gl.planar.reflection`): it sets the
+"""The ``reflection`` pass's runner (:func:`glsandbox.gl.planar_state.reflection`): it sets the
 stencil where it has a stencil state, and leaves it so (and the depth mask, where it turns
 depth writes off)."""
 
 from __future__ import annotations
 
 from glsandbox.gl.passes import Runner, stencil_set
-from glsandbox.gl.planar import reflection
+from glsandbox.gl.planar_state import reflection
 from glsandbox.passes.base import Pass
 
 

@@ -24,7 +24,8 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from glsandbox import meshgen, transforms
+from glsandbox import transforms
+from glsandbox.mesh import generate as meshgen
 from glsandbox.measure.knob import Knob, PixelCount, Setting, register_knob
 from glsandbox.measure.knobs._far import DIRECTION
 from glsandbox.measure.render_context import RenderContext
