@@ -71,7 +71,7 @@ def exercise_cases(env) -> list:
     from glsandbox.exercises.catalogue import get
     from glsandbox.lesson import find_lesson
     from glsandbox.measure.bench import Case, Side
-    from glsandbox.story.exercise import Direct, explain_with_function
+    from glsandbox.story.divergence import Direct, explain_with_function
 
     out = []
     for name, lesson, variant in (("ray_sphere", "ray_spheres", "geometric"),

@@ -612,7 +612,7 @@ def _explain_exercise(args: argparse.Namespace, lesson: Lesson) -> int:
     from glsandbox.exercises.check import static_check
     from glsandbox.exercises.isolation import Isolated
     from glsandbox.story import parse_pixel
-    from glsandbox.story.exercise import explain_with_function, render_exercise_story, traced_kind
+    from glsandbox.story.divergence import explain_with_function, render_exercise_story, traced_kind
 
     name, file = args.exercise
     exercise = get(name)

@@ -94,7 +94,7 @@ def explain(lesson_or_scene: Any, pixel: tuple[int, int] | str, size: tuple[int,
     640x480): ``glsandbox.explain("ray_spheres", (320, 240))``. A rasterised pixel is drawn
     on the notebook helpers' shared headless renderer. ``exercise=(NAME, function)`` traces the
     pixel with your function (called here, in your own kernel) beside the reference, as
-    ``glsandbox explain --exercise`` does (:mod:`glsandbox.story.exercise`)."""
+    ``glsandbox explain --exercise`` does (:mod:`glsandbox.story.divergence`)."""
     from glsandbox.frame import DEFAULT_SIZE
 
     if isinstance(pixel, str):
@@ -105,7 +105,7 @@ def explain(lesson_or_scene: Any, pixel: tuple[int, int] | str, size: tuple[int,
     frame = tuple(size) if size is not None else DEFAULT_SIZE
     if exercise is not None:
         from glsandbox.exercises.catalogue import get
-        from glsandbox.story.exercise import Direct, explain_with_function, render_exercise_story
+        from glsandbox.story.divergence import Direct, explain_with_function, render_exercise_story
 
         name, function = exercise
         if not callable(function):

@@ -247,7 +247,7 @@ def explain_ray_pixel(scene: Scene, size: tuple[int, int], pixel: tuple[int, int
     ``hit_tests`` replaces a node kind's test as :func:`~glsandbox.raytrace.numpy_engine.render_viewport`'s
     does (an exercise's function; no BVH then), ``simple`` takes the course's simple offset for
     secondary rays, and ``events``, when given, receives the engine's recorded steps in order
-    (:mod:`glsandbox.story.exercise` compares two of them). ``traced`` traces a rasterised
+    (:mod:`glsandbox.story.divergence` compares two of them). ``traced`` traces a rasterised
     viewport's pixel too (as the numpy engine would draw it: an exercise's lesson picture)."""
     index, (lx, ly), (w, h) = locate_pixel(scene, size, pixel)
     vp = scene.viewports[index]

@@ -20,7 +20,7 @@ from glsandbox.errors import SandboxError
 from glsandbox.exercises.catalogue import all_exercises, get
 from glsandbox.exercises.lesson_view import THRESHOLD, render_lesson
 from glsandbox.app.notebook import scene_of
-from glsandbox.story.exercise import (
+from glsandbox.story.divergence import (
     Direct,
     explain_with_function,
     render_exercise_story,
