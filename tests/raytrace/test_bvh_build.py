@@ -3,13 +3,16 @@ logarithmically deep and cheap by the SAH; the build's work grows linearly with 
 
 from __future__ import annotations
 
+import hashlib
 import math
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from glsandbox import meshgen
+from glsandbox.meshfile import load_mesh
 from glsandbox.raytrace import bvh as bvh_module
 from glsandbox.raytrace.bvh import LEAF_SIZE, SMALL, build_bvh, build_threads, mesh_world_triangles, sah_cost
 
@@ -173,3 +176,41 @@ def test_the_builder_makes_the_same_trees(make, leaf_size: int, nodes: int, dept
     bvh = build_bvh(*make(), leaf_size=leaf_size)
     assert (bvh.node_total, bvh.depth, sah_cost(bvh)) == (nodes, depth, sah)
     assert leaves_hold_every_triangle_once(bvh)
+
+
+def node_digest(bvh) -> str:
+    """A blake2b digest of the tree's node arrays (boxes, children or triangle runs, the stored
+    triangles' order): two trees have the same one when they are the same arrays, byte for byte."""
+    h = hashlib.blake2b(digest_size=12)
+    for field in ("node_min", "node_max", "node_first", "node_count", "tri_index"):
+        h.update(np.ascontiguousarray(getattr(bvh, field)).tobytes())
+    return h.hexdigest()
+
+
+BOULDER = Path(__file__).resolve().parents[2] / "glsandbox" / "models" / "boulder.obj"
+
+#: The node arrays the builder makes (their digest) on the shipped model and generated meshes:
+#: the full sweep (rock, terrain), a cloud, a terrain big enough for sampled levels (nodes of
+#: SAMPLED_ONLY triangles and more), and the same built in parts (PART_MIN lowered: the parts'
+#: numbering). A faster builder must make these same arrays; one that chooses other cuts changes
+#: them (and TREES says whether its SAH is better).
+NODE_ARRAYS = [
+    ("boulder", lambda: mesh_world_triangles(load_mesh(BOULDER)), None, "97a8c9288e8d550f1ffc3eab"),
+    ("rock5", lambda: mesh_world_triangles(meshgen.rock(5)), None, "66ab87e7ec40f2ce355a168f"),
+    ("terrain64", lambda: mesh_world_triangles(meshgen.terrain(64)), None, "72f66cf6c2f428ae5ee919cd"),
+    ("random20000", lambda: random_triangles(20000, 3), None, "4bb1cee14ed0ae22181e7912"),
+    ("terrain40k", lambda: mesh_world_triangles(meshgen.terrain(meshgen.terrain_cells_for(40_000))), None,
+     "47bb5869507f5aa104016408"),
+    ("terrain40k parts", lambda: mesh_world_triangles(meshgen.terrain(meshgen.terrain_cells_for(40_000))), 4096,
+     "641aff7ce44b3032f772525f"),
+]
+
+
+@pytest.mark.parametrize(("make", "part_min", "digest"), [t[1:] for t in NODE_ARRAYS], ids=[t[0] for t in NODE_ARRAYS])
+def test_the_builder_makes_the_same_node_arrays(make, part_min: int | None, digest: str, monkeypatch) -> None:
+    if part_min is not None:
+        monkeypatch.setattr(bvh_module, "PART_MIN", part_min)
+    bvh = build_bvh(*make(), threads=1)
+    assert node_digest(bvh) == digest
+    if part_min is not None:  # parts built in threads: the same arrays
+        assert node_digest(build_bvh(*make(), threads=2)) == digest
