@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from glsandbox import meshgen
-from glsandbox.meshfile import load_mesh
+from glsandbox.mesh.load import load_mesh
 from glsandbox.raytrace import bvh as bvh_module
 from glsandbox.raytrace.bvh import LEAF_SIZE, SMALL, build_bvh, build_threads, mesh_world_triangles, sah_cost
 
