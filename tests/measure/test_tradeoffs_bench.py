@@ -374,6 +374,25 @@ def test_raw_baseline_draws_the_lessons_picture(gl, name: str) -> None:
         assert np.array_equal(drawn, expected), f"{name} at time {0.01 * k}"
 
 
+def test_raw_cube_draws_the_indexed_cube_lessons_picture(gl) -> None:
+    """The indexed cube's raw frame (benchmarks/cube_frame.py) equals glsandbox's pixel for pixel
+    at several moments, and leaves the shared context's state as it found it."""
+    from glsandbox.lesson import find_lesson
+
+    def state() -> dict[str, object]:
+        return {key: value for key, value in gl.host.raw.state_snapshot().items() if key != "depth_writemask"}
+
+    size = (160, 120)
+    raw = _benchmark_module("cube_frame.py").RawCube(gl.host.ctx, size)
+    lesson = find_lesson("indexed_cube")()
+    for t in (0.3, 0.67, 1.8):
+        expected = gl.render(lesson.at(t), size).image.copy()
+        before = state()
+        drawn = np.array(raw.frame(t))
+        assert state() == before, "the raw cube frame left GL state changed"
+        assert np.array_equal(drawn, expected), f"indexed_cube at time {t}"
+
+
 # --- the ray tracer's benchmark cases (benchmarks/raytrace.py) ------------------------------
 
 
