@@ -83,7 +83,7 @@ RENDERER_TITLES = {"raster": "rasterizer", "ray": "ray tracer (GLSL)", "ray_nump
 
 @functools.cache
 def generated(name: str) -> Mesh:
-    """A generated model, made once (the window rebuilds the scene every frame: the same Mesh
+    """A generated model, made once (a changed value builds the scene again: the same Mesh
     object keeps its GPU buffers)."""
     return GENERATED[name]()
 
