@@ -409,9 +409,10 @@ class RawTransformOrder:
         return read(self.fbo, self.size)
 
 
-def _lit_draw(vao: moderngl.VertexArray, model: np.ndarray, color: tuple) -> tuple:
-    """A lit draw's vertex array, model matrix, normal matrix ((M^-1)^T, column-major) and colour."""
-    return vao, gl(model), _normal(model), color
+def _lit_draw(vao: moderngl.VertexArray, model: np.ndarray, color: tuple, eye: np.ndarray) -> tuple:
+    """A lit draw's vertex array, model matrix (relative to ``eye``), normal matrix ((M^-1)^T,
+    column-major) and colour."""
+    return vao, gl(from_eye(model, eye)), _normal(model), color
 
 
 class RawMirror:
@@ -460,7 +461,10 @@ class RawMirror:
                 (back_piece(side, high, glass_half + side / 2, high / 2), wall),
                 (back_piece(2 * glass_half, glass_low, 0.0, glass_low / 2), wall),
                 (back_piece(2 * glass_half, high - glass_high, 0.0, (glass_high + high) / 2), wall)]
-        self.glass_model = gl(back_piece(2 * glass_half, glass_high - glass_low, 0.0, (glass_low + glass_high) / 2))
+        direction = np.asarray(lesson.EYE_DIRECTION) / np.linalg.norm(lesson.EYE_DIRECTION)
+        eye = self.eye = np.asarray(lesson.TARGET) + v["distance"] * direction
+        self.glass_model = gl(from_eye(back_piece(2 * glass_half, glass_high - glass_low, 0.0,
+                                                  (glass_low + glass_high) / 2), eye))
         self.glass_color = lesson.GLASS_COLOR
 
         # R: the reflection through the glass's plane n·p + d = 0 (|n| = 1): p - 2 (n·p + d) n.
@@ -477,24 +481,22 @@ class RawMirror:
         self.flatten = translate(*(v["lift"] * floor_plane[:3])) @ (
             float(floor_plane @ light) * np.eye(4) - np.outer(light, floor_plane))
         self.shadow_color = lesson.SHADOW_COLOR
-        self.lights = tuple(np.asarray(p[:3], "f4").tobytes() for p in (light, self.reflect @ light))
+        self.lights = tuple(np.asarray(p[:3] - eye, "f4").tobytes() for p in (light, self.reflect @ light))
 
         # The draws that do not move, their matrices made once: seen and reflected.
         light_model = translate(*light[:3]) @ scale(*(lesson.LIGHT_CUBE_SCALE,) * 3)
-        self.room = [_lit_draw(lit_plane, model, color) for model, color in room]
-        self.reflected_room = [_lit_draw(lit_plane, self.reflect @ model, color) for model, color in room[:2]]
-        self.light_draws = [(light_cube, gl(m)) for m in (light_model, self.reflect @ light_model)]
+        self.room = [_lit_draw(lit_plane, model, color, eye) for model, color in room]
+        self.reflected_room = [_lit_draw(lit_plane, self.reflect @ model, color, eye) for model, color in room[:2]]
+        self.light_draws = [(light_cube, gl(from_eye(m, eye))) for m in (light_model, self.reflect @ light_model)]
         self.cube_color = (1.0, 0.5, 0.15, 1.0)
         self.cube_at, self.cube_half, self.speed = lesson.CUBE_CENTRE, lesson.CUBE_HALF, v["speed"]
 
-        direction = np.asarray(lesson.EYE_DIRECTION) / np.linalg.norm(lesson.EYE_DIRECTION)
-        eye = np.asarray(lesson.TARGET) + v["distance"] * direction
-        view = gl(look_at(eye, lesson.TARGET))
+        view = gl(eye_relative(look_at(eye, lesson.TARGET), eye))  # camera-relative, as glsandbox draws (RawPhong)
         proj = gl(reverse_z(perspective(v["fov"], size[0] / size[1], v["near"], v["far"])))
         for program in (self.lit, self.solid):  # the camera never moves: set once
             program["m_view"].write(view)
             program["m_proj"].write(proj)
-        self.lit["u_eye"].write(eye.astype("f4").tobytes())
+        self.lit["u_eye"].value = (0.0, 0.0, 0.0)
         self.lit["u_light_color"].write(np.ones(3, "f4").tobytes())
 
     def _lit(self, draws: list) -> None:
@@ -522,7 +524,7 @@ class RawMirror:
         ctx, raw, lit = self.ctx, self.gl, self.lit
         h = self.cube_half
         cube = translate(*self.cube_at) @ rotate_y(0.5 + self.speed * t) @ scale(h, h, h)
-        seen, mirrored = (_lit_draw(self.lit_cube, m, self.cube_color) for m in (cube, self.reflect @ cube))
+        seen, mirrored = (_lit_draw(self.lit_cube, m, self.cube_color, self.eye) for m in (cube, self.reflect @ cube))
 
         self.fbo.use()
         raw.ClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE)  # reverse-Z: depth 0..1 as is, near 1, far 0
@@ -562,7 +564,7 @@ class RawMirror:
         raw.DepthMask(0)
         ctx.polygon_offset = (1.0, 1.0)
         ctx.disable(moderngl.CULL_FACE)
-        self._solid(self.shadow_cube, gl(self.flatten @ cube), self.shadow_color)
+        self._solid(self.shadow_cube, gl(from_eye(self.flatten @ cube, self.eye)), self.shadow_color)
         # OpenGL's defaults again.
         raw.Disable(GL_STENCIL_TEST)
         self._stencil(0xFF, GL_ALWAYS, 0, 0xFF, GL_KEEP)
