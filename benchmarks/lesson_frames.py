@@ -688,7 +688,7 @@ class RawShadowMap:
             depth["m_model"].write(cube_model if model is None else model)
             depth_vao.render(moderngl.TRIANGLES)
         self.fbo.use()  # pass 2: lit, each pixel compared with the map
-        self.fbo.clear(*self.lesson.CLEAR, depth=1.0)
+        clear(self.fbo, *self.lesson.CLEAR[:3], depth=1.0)  # every channel, then the draws' mask (_raw.clear)
         self.map.use(1)
         lit["u_light_matrix"].write(light_matrix)
         for _, lit_vao, model, normal, color in self.draws:
