@@ -88,6 +88,12 @@ def generated(name: str) -> Mesh:
     return GENERATED[name]()
 
 
+@functools.cache
+def fitted(name: str) -> Mesh:
+    """A generated model fitted into -1..1, made once (:meth:`ModelLesson.motion` asks every frame)."""
+    return glsandbox.fit_mesh(generated(name))
+
+
 def check_mesh(text: str) -> str:
     """``--set mesh=...``: a generated or shipped model's name, or a model file that loads (the error names it)."""
     if text not in GENERATED and text not in SHIPPED:
@@ -135,8 +141,7 @@ class ModelLesson(Lesson):
         source = self.values["mesh"]
         fit = bool(self.values["fit"])
         if source in GENERATED:
-            mesh = generated(source)
-            shown = glsandbox.fit_mesh(mesh) if fit else mesh
+            shown = fitted(source) if fit else generated(source)
             return source, (("model", shown, Material(color=MODEL_COLOR, **MATERIAL)),)
         source = str(SHIPPED.get(source, source))
         loaded = glsandbox.load_model(source, fit=fit)
