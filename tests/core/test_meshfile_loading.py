@@ -307,7 +307,9 @@ def test_a_gltf_whose_nodes_form_a_cycle_is_refused_naming_the_file_and_the_node
 def test_a_groups_position_ids_are_renumbered_in_their_order() -> None:
     # Each material's mesh numbers its positions 0.. in the file's order: its arrays are sized by
     # its own positions, not the whole file's (a glTF of many nodes was quadratic), with the same result.
-    from glsandbox.meshfile import _compact_ids
+    import inspect
+
+    _compact_ids = inspect.getmodule(load_model)._compact_ids  # (the loader's own module)
 
     ids = np.array([7, 3, 7, 12, 3, 40], dtype=np.intp)
     assert _compact_ids(ids).tolist() == [1, 0, 1, 2, 0, 3]
