@@ -27,16 +27,23 @@ from pathlib import Path
 import moderngl
 import numpy as np
 
-from _raw import VERTEX_COLOR_FS, VERTEX_COLOR_VS, clear, opaque
+from _raw import (VERTEX_COLOR_FS, VERTEX_COLOR_VS, clear, eye_relative, framebuffer, from_eye, gl, look_at, perspective,
+                  read, rotate_y)
 
 SIZE = (800, 600)
 
 
 class RawCube:
-    """A hand-written ModernGL frame with no glsandbox code at all."""
+    """A hand-written ModernGL frame with no glsandbox code at all.
 
-    def __init__(self, ctx: moderngl.Context) -> None:
-        self.ctx = ctx
+    Lean, as a careful hand-written program: the shaders, buffers, view and projection are made
+    and written once at set-up; per frame the spinning model matrix only. Camera-relative as
+    glsandbox draws (``_raw.eye_relative``): the view without its translation, the model
+    ``T(-eye) @ R`` formed in float64, so both round the same numbers to float32 (identical pixels).
+    """
+
+    def __init__(self, ctx: moderngl.Context, size: tuple[int, int] = SIZE) -> None:
+        self.ctx, self.size = ctx, size
         # The course cube already converted to OpenGL (z mirrored, two indices swapped).
         positions = np.array([(-1, 1, 1), (1, 1, 1), (1, 1, -1), (-1, 1, -1),
                               (-1, -1, 1), (1, -1, 1), (1, -1, -1), (-1, -1, -1)], dtype="f4")
@@ -48,32 +55,21 @@ class RawCube:
         self.vao = ctx.vertex_array(self.program, [(ctx.buffer(positions.tobytes()), "3f", "in_position"),
                                                    (ctx.buffer(colors.tobytes()), "3f", "in_color")],
                                     index_buffer=ctx.buffer(indices.tobytes()))
-        self.fbo = opaque(ctx.framebuffer(color_attachments=[ctx.renderbuffer(SIZE, 4)],
-                                          depth_attachment=ctx.depth_renderbuffer(SIZE)))  # as glsandbox's frames
-        f = 1 / np.tan(np.radians(22.5))
-        near, far, aspect = 0.01, 100.0, SIZE[0] / SIZE[1]
-        proj = np.array([[f / aspect, 0, 0, 0], [0, f, 0, 0],
-                         [0, 0, (far + near) / (near - far), 2 * far * near / (near - far)], [0, 0, -1, 0]])
-        eye = np.array([0.0, 3.0, 10.0])
-        fwd = -eye / np.linalg.norm(eye)
-        right = np.cross(fwd, (0, 1, 0))
-        right /= np.linalg.norm(right)
-        up = np.cross(right, fwd)
-        view = np.eye(4)
-        view[0, :3], view[1, :3], view[2, :3] = right, up, -fwd
-        view[:3, 3] = -view[:3, :3] @ eye
-        self.program["m_view"].write(view.T.astype("f4").tobytes())
-        self.program["m_proj"].write(proj.T.astype("f4").tobytes())
+        self.fbo = framebuffer(ctx, size)  # as glsandbox's frames
+        self.eye = (0.0, 3.0, 10.0)
+        self.program["m_view"].write(gl(eye_relative(look_at(self.eye, (0.0, 0.0, 0.0)), self.eye)))
+        self.program["m_proj"].write(gl(perspective(45.0, size[0] / size[1], 0.01, 100.0)))
+        self.model = self.program["m_model"]
 
     def frame(self, t: float) -> np.ndarray:
-        c, s = np.cos(-t), np.sin(-t)
-        model = np.array([[c, 0, s, 0], [0, 1, 0, 0], [-s, 0, c, 0], [0, 0, 0, 1]], dtype="f4")
+        """The frame at time ``t`` as (H, W, 4) uint8, top row first."""
         self.fbo.use()
         clear(self.fbo, 0.0, 0.125, 0.6, depth=1.0)
         self.ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
-        self.program["m_model"].write(model.T.tobytes())
+        self.model.write(gl(from_eye(rotate_y(-t), self.eye)))
         self.vao.render(moderngl.TRIANGLES)
-        return np.frombuffer(self.fbo.read(components=4, alignment=1), dtype=np.uint8)
+        self.ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
+        return read(self.fbo, self.size)
 
 
 def cold_start(command: list[str]) -> float:
@@ -95,7 +91,7 @@ def cases(env) -> list:
         return renderer.render(lesson.at(0.3 + 0.01 * k), SIZE).image
 
     def theirs(k: int) -> np.ndarray:
-        return raw.frame(0.3 + 0.01 * k).reshape(SIZE[1], SIZE[0], 4)[::-1]
+        return raw.frame(0.3 + 0.01 * k)
 
     return [Case("frame vs raw ModernGL", "indexed_cube", Side("raw ModernGL", theirs), Side("glsandbox", ours),
                  repeat=100, goal=LESSON_FRAME_GOAL,
@@ -113,7 +109,7 @@ def main() -> int:
         from PIL import Image
 
         ctx = moderngl.create_standalone_context(backend="egl")
-        pixels = RawCube(ctx).frame(0.0).reshape(SIZE[1], SIZE[0], 4)[::-1]
+        pixels = RawCube(ctx).frame(0.0)
         Image.fromarray(pixels).save(args.raw_once)
         return 0
 

@@ -126,7 +126,11 @@ class RawClear:
 
 
 class RawTriangle:
-    """triangle: the quad as a 4-vertex strip (left viewport) and a 6-vertex list (right), culled."""
+    """triangle: the quad as a 4-vertex strip (left viewport) and a 6-vertex list (right), culled.
+
+    Lean: the model (identity), view and colour are written once at set-up; per frame only each
+    viewport's projection (one program serves both, their aspects differ), prepared as bytes once.
+    """
 
     def __init__(self, ctx: moderngl.Context, size: tuple[int, int]) -> None:
         from glsandbox import geometry
@@ -137,29 +141,37 @@ class RawTriangle:
         self.list = _vao(ctx, self.program, geometry.quad_list())
         half = round(size[0] / 2)
         self.rects = ((0, 0, half, size[1]), (half, 0, size[0] - half, size[1]))
-        self.view = gl(look_at((0, 0, 3), (0, 0, 0)))
-        self.projs = [gl(perspective(45.0, r[2] / r[3], 0.01, 100.0)) for r in self.rects]
+        projs = [gl(perspective(45.0, r[2] / r[3], 0.01, 100.0)) for r in self.rects]
+        self.passes = tuple(zip(self.rects, projs, (self.strip, self.list),
+                                (moderngl.TRIANGLE_STRIP, moderngl.TRIANGLES)))
+        self.program["m_model"].write(gl(np.eye(4)))
+        self.program["m_view"].write(gl(look_at((0, 0, 3), (0, 0, 0))))
+        self.program["u_color"].value = (1.0, 0.55, 0.1, 1.0)
+        self.proj = self.program["m_proj"]
 
     def frame(self, k: int) -> np.ndarray:
-        ctx, p = self.ctx, self.program
-        self.fbo.use()
+        ctx, fbo = self.ctx, self.fbo
+        fbo.use()
         ctx.enable(moderngl.CULL_FACE)
-        for rect, proj, vao, mode in zip(self.rects, self.projs, (self.strip, self.list),
-                                         (moderngl.TRIANGLE_STRIP, moderngl.TRIANGLES)):
-            clear(self.fbo, 0.0, 0.125, 0.6, viewport=rect)
-            self.fbo.viewport = rect
-            p["m_model"].write(gl(np.eye(4)))
-            p["m_view"].write(self.view)
-            p["m_proj"].write(proj)
-            p["u_color"].value = (1.0, 0.55, 0.1, 1.0)
+        for rect, proj, vao, mode in self.passes:
+            clear(fbo, 0.0, 0.125, 0.6, viewport=rect)
+            fbo.viewport = rect
+            self.proj.write(proj)
             vao.render(mode)
-        self.fbo.viewport = (0, 0, *self.size)
+        fbo.viewport = (0, 0, *self.size)
         ctx.disable(moderngl.CULL_FACE)
-        return read(self.fbo, self.size)
+        return read(fbo, self.size)
 
 
 class RawPhong:
-    """phong: lit ground and ellipsoid (two lights, per-pixel Phong), two unlit light cubes."""
+    """phong: lit ground and ellipsoid (two lights, per-pixel Phong), two unlit light cubes.
+
+    Lean, as a careful hand-written program: the camera (view, projection, eye), the light
+    colours, and the ground's and ellipsoid's model and normal matrices ((M^-1)^T, which never
+    move) are converted, inverted and written once at set-up; the draws that share a program keep
+    what they wrote. Per frame: the two orbiting lights (positions and their cubes' models) and
+    the model, normal matrix and colour that differ between the two lit draws.
+    """
 
     def __init__(self, ctx: moderngl.Context, size: tuple[int, int]) -> None:
         from glsandbox import geometry
@@ -167,49 +179,60 @@ class RawPhong:
         self.ctx, self.size, self.fbo = ctx, size, framebuffer(ctx, size)
         self.lit = ctx.program(vertex_shader=PHONG_VS, fragment_shader=phong_fs(2))
         self.solid = ctx.program(vertex_shader=SOLID_VS, fragment_shader=SOLID_FS)
-        self.ground = _vao(ctx, self.lit, geometry.plane(12.0), with_normals=True)
-        self.sphere = _vao(ctx, self.lit, geometry.sphere(), with_normals=True)
+        ground = _vao(ctx, self.lit, geometry.plane(12.0), with_normals=True)
+        sphere = _vao(ctx, self.lit, geometry.sphere(), with_normals=True)
         self.cube = _vao(ctx, self.solid, geometry.cube())
-        self.eye = (0.0, 2.5, 8.0)
+        self.eye = np.array((0.0, 2.5, 8.0))
         # Camera-relative, as glsandbox draws: the view without its translation, models and
         # lights relative to the eye (formed in float64), the eye at 0.
-        self.view = eye_relative(look_at(self.eye, (0, 0, 0)), self.eye)
-        self.proj = perspective(45.0, size[0] / size[1], 0.01, 100.0)
-        self.models = [translate(0, -1.2, 0), rotate_y(math.radians(30)) @ scale(1.8, 0.7, 0.9)]
-        self.colors = [(0.6, 0.6, 0.6, 1.0), (1.0, 0.25, 0.2, 1.0)]
+        view = gl(eye_relative(look_at(self.eye, (0, 0, 0)), self.eye))
+        proj = gl(perspective(45.0, size[0] / size[1], 0.01, 100.0))
+        for program in (self.lit, self.solid):
+            program["m_view"].write(view)
+            program["m_proj"].write(proj)
+        self.lit["u_eye"].value = (0.0, 0.0, 0.0)
+        self.light_colors = np.array([(1, 1, 1), (1, 1, 0)], "f4")
+        self.lit["u_light_color"].write(self.light_colors.tobytes())
+        self.cube_colors = tuple((*map(float, c), 1.0) for c in self.light_colors)
+        models = [translate(0, -1.2, 0), rotate_y(math.radians(30)) @ scale(1.8, 0.7, 0.9)]
+        colors = [(0.6, 0.6, 0.6, 1.0), (1.0, 0.25, 0.2, 1.0)]
+        self.draws = tuple((vao, gl(from_eye(m, self.eye)), _normal(m), c)
+                           for vao, m, c in zip((ground, sphere), models, colors))
+        self.cube_scale = scale(0.15, 0.15, 0.15)
+        self.uniforms = tuple(self.lit[n] for n in ("m_model", "m_normal", "u_color"))
+        self.light_pos, self.solid_model, self.solid_color = (
+            self.lit["u_light_pos"], self.solid["m_model"], self.solid["u_color"])
 
     def frame(self, k: int) -> np.ndarray:
         t = 0.01 * k
         angles = (math.pi / 3 + 0.8 * t, math.pi - math.pi / 3 - 0.8 * t)
         lights = np.array([(3.0 * math.cos(a), 1.5, 3.0 * math.sin(a)) for a in angles])
-        relative = (lights - self.eye).astype("f4")
-        light_colors = np.array([(1, 1, 1), (1, 1, 0)], "f4")
-        ctx, lit, solid = self.ctx, self.lit, self.solid
-        self.fbo.use()
-        clear(self.fbo, 0.0, 0.125, 0.6, depth=1.0)
+        ctx, fbo = self.ctx, self.fbo
+        fbo.use()
+        clear(fbo, 0.0, 0.125, 0.6, depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
-        lit["m_view"].write(gl(self.view))
-        lit["m_proj"].write(gl(self.proj))
-        lit["u_eye"].value = (0.0, 0.0, 0.0)
-        lit["u_light_pos"].write(relative.tobytes())
-        lit["u_light_color"].write(light_colors.tobytes())
-        for vao, model, color in zip((self.ground, self.sphere), self.models, self.colors):
-            lit["m_model"].write(gl(from_eye(model, self.eye)))
-            lit["m_normal"].write(np.linalg.inv(model[:3, :3]).astype("f4").tobytes())  # (M^-1)^T, column-major
-            lit["u_color"].value = color
+        relative = lights - self.eye
+        self.light_pos.write(relative.astype("f4").tobytes())
+        model, normal, color = self.uniforms
+        for vao, model_bytes, normal_bytes, rgba in self.draws:
+            model.write(model_bytes)
+            normal.write(normal_bytes)
+            color.value = rgba
             vao.render(moderngl.TRIANGLES)
-        solid["m_view"].write(gl(self.view))
-        solid["m_proj"].write(gl(self.proj))
-        for position, color in zip(lights, light_colors):
-            solid["m_model"].write(gl(from_eye(translate(*position) @ scale(0.15, 0.15, 0.15), self.eye)))
-            solid["u_color"].value = (*color, 1.0)
+        for position, rgba in zip(relative, self.cube_colors):  # T(-eye) T(p) S = T(p - eye) S
+            self.solid_model.write(gl(translate(*position) @ self.cube_scale))
+            self.solid_color.value = rgba
             self.cube.render(moderngl.TRIANGLES)
         ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
-        return read(self.fbo, self.size)
+        return read(fbo, self.size)
 
 
 class RawTexture:
-    """texture: the checkered ground (grazing) and the labelled cube24, trilinear, repeat."""
+    """texture: the checkered ground (grazing) and the labelled cube24, trilinear, repeat.
+
+    Lean: the camera, the colour, the sampler's unit and the ground's model matrix (it never
+    moves) are written or converted once at set-up; per frame the turning cube's model only.
+    """
 
     def __init__(self, ctx: moderngl.Context, size: tuple[int, int]) -> None:
         from glsandbox import geometry
@@ -230,26 +253,27 @@ class RawTexture:
             texture.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
             self.textures.append(texture)
         self.eye = (0.0, 1.9, 5.5)
-        self.view = eye_relative(look_at(self.eye, (0.0, -0.3, 0.0)), self.eye)  # camera-relative (RawPhong)
-        self.proj = perspective(45.0, size[0] / size[1], 0.01, 100.0)
+        p = self.program
+        p["m_view"].write(gl(eye_relative(look_at(self.eye, (0.0, -0.3, 0.0)), self.eye)))  # camera-relative
+        p["m_proj"].write(gl(perspective(45.0, size[0] / size[1], 0.01, 100.0)))
+        p["u_color"].value = (1.0, 1.0, 1.0, 1.0)
+        p["u_texture"].value = 0
+        self.ground_model = gl(from_eye(translate(0.0, -1.0, 0.0), self.eye))
+        self.model = p["m_model"]
 
     def frame(self, k: int) -> np.ndarray:
         t = 0.01 * k
-        ctx, p = self.ctx, self.program
-        self.fbo.use()
-        clear(self.fbo, 0.55, 0.7, 0.9, depth=1.0)
+        ctx, fbo = self.ctx, self.fbo
+        fbo.use()
+        clear(fbo, 0.55, 0.7, 0.9, depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
-        p["m_view"].write(gl(self.view))
-        p["m_proj"].write(gl(self.proj))
-        p["u_color"].value = (1.0, 1.0, 1.0, 1.0)
-        p["u_texture"].value = 0
-        models = (translate(0.0, -1.0, 0.0), rotate_y(math.radians(30) + 0.5 * t))
-        for vao, model, texture in zip((self.ground, self.cube), models, self.textures):
-            p["m_model"].write(gl(from_eye(model, self.eye)))
+        cube_model = gl(from_eye(rotate_y(math.radians(30) + 0.5 * t), self.eye))
+        for vao, model, texture in zip((self.ground, self.cube), (self.ground_model, cube_model), self.textures):
+            self.model.write(model)
             texture.use(0)
             vao.render(moderngl.TRIANGLES)
         ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
-        return read(self.fbo, self.size)
+        return read(fbo, self.size)
 
 
 class RawTransformOrder:
@@ -385,9 +409,10 @@ class RawTransformOrder:
         return read(self.fbo, self.size)
 
 
-def _lit_draw(vao: moderngl.VertexArray, model: np.ndarray, color: tuple) -> tuple:
-    """A lit draw's vertex array, model matrix, normal matrix ((M^-1)^T, column-major) and colour."""
-    return vao, gl(model), np.linalg.inv(model[:3, :3]).astype("f4").tobytes(), color
+def _lit_draw(vao: moderngl.VertexArray, model: np.ndarray, color: tuple, eye: np.ndarray) -> tuple:
+    """A lit draw's vertex array, model matrix (relative to ``eye``), normal matrix ((M^-1)^T,
+    column-major) and colour."""
+    return vao, gl(from_eye(model, eye)), _normal(model), color
 
 
 class RawMirror:
@@ -436,7 +461,10 @@ class RawMirror:
                 (back_piece(side, high, glass_half + side / 2, high / 2), wall),
                 (back_piece(2 * glass_half, glass_low, 0.0, glass_low / 2), wall),
                 (back_piece(2 * glass_half, high - glass_high, 0.0, (glass_high + high) / 2), wall)]
-        self.glass_model = gl(back_piece(2 * glass_half, glass_high - glass_low, 0.0, (glass_low + glass_high) / 2))
+        direction = np.asarray(lesson.EYE_DIRECTION) / np.linalg.norm(lesson.EYE_DIRECTION)
+        eye = self.eye = np.asarray(lesson.TARGET) + v["distance"] * direction
+        self.glass_model = gl(from_eye(back_piece(2 * glass_half, glass_high - glass_low, 0.0,
+                                                  (glass_low + glass_high) / 2), eye))
         self.glass_color = lesson.GLASS_COLOR
 
         # R: the reflection through the glass's plane n·p + d = 0 (|n| = 1): p - 2 (n·p + d) n.
@@ -453,24 +481,22 @@ class RawMirror:
         self.flatten = translate(*(v["lift"] * floor_plane[:3])) @ (
             float(floor_plane @ light) * np.eye(4) - np.outer(light, floor_plane))
         self.shadow_color = lesson.SHADOW_COLOR
-        self.lights = tuple(np.asarray(p[:3], "f4").tobytes() for p in (light, self.reflect @ light))
+        self.lights = tuple(np.asarray(p[:3] - eye, "f4").tobytes() for p in (light, self.reflect @ light))
 
         # The draws that do not move, their matrices made once: seen and reflected.
         light_model = translate(*light[:3]) @ scale(*(lesson.LIGHT_CUBE_SCALE,) * 3)
-        self.room = [_lit_draw(lit_plane, model, color) for model, color in room]
-        self.reflected_room = [_lit_draw(lit_plane, self.reflect @ model, color) for model, color in room[:2]]
-        self.light_draws = [(light_cube, gl(m)) for m in (light_model, self.reflect @ light_model)]
+        self.room = [_lit_draw(lit_plane, model, color, eye) for model, color in room]
+        self.reflected_room = [_lit_draw(lit_plane, self.reflect @ model, color, eye) for model, color in room[:2]]
+        self.light_draws = [(light_cube, gl(from_eye(m, eye))) for m in (light_model, self.reflect @ light_model)]
         self.cube_color = (1.0, 0.5, 0.15, 1.0)
         self.cube_at, self.cube_half, self.speed = lesson.CUBE_CENTRE, lesson.CUBE_HALF, v["speed"]
 
-        direction = np.asarray(lesson.EYE_DIRECTION) / np.linalg.norm(lesson.EYE_DIRECTION)
-        eye = np.asarray(lesson.TARGET) + v["distance"] * direction
-        view = gl(look_at(eye, lesson.TARGET))
+        view = gl(eye_relative(look_at(eye, lesson.TARGET), eye))  # camera-relative, as glsandbox draws (RawPhong)
         proj = gl(reverse_z(perspective(v["fov"], size[0] / size[1], v["near"], v["far"])))
         for program in (self.lit, self.solid):  # the camera never moves: set once
             program["m_view"].write(view)
             program["m_proj"].write(proj)
-        self.lit["u_eye"].write(eye.astype("f4").tobytes())
+        self.lit["u_eye"].value = (0.0, 0.0, 0.0)
         self.lit["u_light_color"].write(np.ones(3, "f4").tobytes())
 
     def _lit(self, draws: list) -> None:
@@ -498,7 +524,7 @@ class RawMirror:
         ctx, raw, lit = self.ctx, self.gl, self.lit
         h = self.cube_half
         cube = translate(*self.cube_at) @ rotate_y(0.5 + self.speed * t) @ scale(h, h, h)
-        seen, mirrored = (_lit_draw(self.lit_cube, m, self.cube_color) for m in (cube, self.reflect @ cube))
+        seen, mirrored = (_lit_draw(self.lit_cube, m, self.cube_color, self.eye) for m in (cube, self.reflect @ cube))
 
         self.fbo.use()
         raw.ClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE)  # reverse-Z: depth 0..1 as is, near 1, far 0
@@ -538,7 +564,7 @@ class RawMirror:
         raw.DepthMask(0)
         ctx.polygon_offset = (1.0, 1.0)
         ctx.disable(moderngl.CULL_FACE)
-        self._solid(self.shadow_cube, gl(self.flatten @ cube), self.shadow_color)
+        self._solid(self.shadow_cube, gl(from_eye(self.flatten @ cube, self.eye)), self.shadow_color)
         # OpenGL's defaults again.
         raw.Disable(GL_STENCIL_TEST)
         self._stencil(0xFF, GL_ALWAYS, 0, 0xFF, GL_KEEP)
@@ -583,7 +609,13 @@ void main() {
 class RawShadowMap:
     """shadow_map (show=map): the two passes by hand. The casters' depth from the light into a
     1024² depth texture (a perspective frustum from the light at the centre of the casters' bounds,
-    near and far around every corner), then the lit pass comparing each pixel with it, 3x3 PCF."""
+    near and far around every corner), then the lit pass comparing each pixel with it, 3x3 PCF.
+
+    Lean: the camera, the light, the map's unit and texel, and the floor's, sphere's and panel's
+    model and normal matrices and world-space box corners (they never move) are made and written
+    once at set-up. Per frame: the turning cube's model, the light's frustum (it bounds the cube
+    too, so it follows it) and the uniforms that differ between draws of one program.
+    """
 
     def __init__(self, ctx: moderngl.Context, size: tuple[int, int]) -> None:
         from glsandbox import geometry
@@ -600,26 +632,38 @@ class RawShadowMap:
         meshes = {"floor": geometry.plane(1.0), "cube": geometry.cube24(), "sphere": geometry.sphere(),
                   "panel": geometry.cube24()}
         self.names = tuple(meshes)
-        self.lit_vaos = {k: _vao(ctx, self.lit, m, with_normals=True) for k, m in meshes.items()}
-        self.depth_vaos = {k: _vao(ctx, self.depth, m) for k, m in meshes.items()}
+        lit_vaos = {k: _vao(ctx, self.lit, m, with_normals=True) for k, m in meshes.items()}
+        depth_vaos = {k: _vao(ctx, self.depth, m) for k, m in meshes.items()}
         # Each mesh's bounding box corners (model space), for the light's frustum.
-        self.corners = {k: np.array([[(m.positions.min(0), m.positions.max(0))[i >> a & 1][a] for a in range(3)]
-                                     for i in range(8)]) for k, m in meshes.items()}
+        corners = {k: np.c_[np.array([[(m.positions.min(0), m.positions.max(0))[i >> a & 1][a] for a in range(3)]
+                                      for i in range(8)]), np.ones(8)] for k, m in meshes.items()}
+        self.cube_corners = corners["cube"]
+        h = lesson.CUBE_HALF
+        self.cube_place = (translate(*lesson.CUBE_AT), scale(h, h, h))
+        fixed = {"floor": scale(lesson.FLOOR_SIZE, 1.0, lesson.FLOOR_SIZE),
+                 "sphere": translate(*lesson.SPHERE[0]) @ scale(*(lesson.SPHERE[1],) * 3),
+                 "panel": translate(*lesson.PANEL[0]) @ scale(*lesson.PANEL[1])}
+        # The world-space corners of what never moves, in draw order round the cube's.
+        self.points_before = [(corners[k] @ fixed[k].T)[:, :3] for k in self.names[:self.names.index("cube")]]
+        self.points_after = [(corners[k] @ fixed[k].T)[:, :3] for k in self.names[self.names.index("cube") + 1:]]
+        self.light = np.asarray(lesson.LIGHT, dtype=np.float64)
+        # Each draw: its vertex arrays, then (None for the cube: per frame) its model and normal bytes.
+        self.draws = tuple((depth_vaos[k], lit_vaos[k], *((gl(fixed[k]), _normal(fixed[k])) if k in fixed else
+                                                          (None, None)), (*lesson.COLORS[k], 1.0))
+                           for k in self.names)
+        self.depth["m_view"].write(gl(np.eye(4)))
+        lit = self.lit
+        lit["u_map"].value = 1
+        lit["u_texel"].value = 1.0 / 1024
         eye, target = lesson.SINGLE_VIEW
-        self.eye, self.view = eye, look_at(eye, target)
-        self.proj = perspective(lesson.FOV, size[0] / size[1], lesson.NEAR, lesson.FAR)
+        lit["m_view"].write(gl(look_at(eye, target)))
+        lit["m_proj"].write(gl(perspective(lesson.FOV, size[0] / size[1], lesson.NEAR, lesson.FAR)))
+        lit["u_eye"].value = eye
+        lit["u_light_pos"].value = lesson.LIGHT
+        lit["u_light_color"].value = (1.0, 1.0, 1.0)
 
-    def models(self, t: float) -> dict[str, np.ndarray]:
-        les = self.lesson
-        h = les.CUBE_HALF
-        return {"floor": scale(les.FLOOR_SIZE, 1.0, les.FLOOR_SIZE),
-                "cube": translate(*les.CUBE_AT) @ rotate_y(0.4 + 0.5 * t) @ scale(h, h, h),
-                "sphere": translate(*les.SPHERE[0]) @ scale(*(les.SPHERE[1],) * 3),
-                "panel": translate(*les.PANEL[0]) @ scale(*les.PANEL[1])}
-
-    def light_matrix(self, models: dict[str, np.ndarray]) -> np.ndarray:
-        light = np.asarray(self.lesson.LIGHT, dtype=np.float64)
-        points = np.concatenate([(np.c_[self.corners[k], np.ones(8)] @ models[k].T)[:, :3] for k in self.names])
+    def light_matrix(self, points: np.ndarray) -> np.ndarray:
+        light = self.light
         target = points.mean(axis=0)
         forward = (target - light) / np.linalg.norm(target - light)
         view = look_at(light, target, (0.0, 0.0, 1.0) if abs(forward[1]) > 0.9 else (0.0, 1.0, 0.0))
@@ -630,35 +674,35 @@ class RawShadowMap:
 
     def frame(self, k: int) -> np.ndarray:
         ctx, depth, lit = self.ctx, self.depth, self.lit
-        models = self.models(0.01 * k)
-        light_matrix = self.light_matrix(models)
+        at, size = self.cube_place
+        t = 0.01 * k
+        cube = at @ rotate_y(0.4 + 0.5 * t) @ size
+        points = np.concatenate([*self.points_before, (self.cube_corners @ cube.T)[:, :3], *self.points_after])
+        light_matrix = gl(self.light_matrix(points))
+        cube_model, cube_normal = gl(cube), _normal(cube)
         ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
         self.map_fbo.use()  # pass 1: depth only, from the light
         self.map_fbo.clear(depth=1.0)
-        depth["m_view"].write(gl(np.eye(4)))
-        depth["m_proj"].write(gl(light_matrix))
-        for name in self.names:
-            depth["m_model"].write(gl(models[name]))
-            self.depth_vaos[name].render(moderngl.TRIANGLES)
+        depth["m_proj"].write(light_matrix)
+        for depth_vao, _, model, _, _ in self.draws:
+            depth["m_model"].write(cube_model if model is None else model)
+            depth_vao.render(moderngl.TRIANGLES)
         self.fbo.use()  # pass 2: lit, each pixel compared with the map
-        self.fbo.clear(*self.lesson.CLEAR, depth=1.0)
+        clear(self.fbo, *self.lesson.CLEAR[:3], depth=1.0)  # every channel, then the draws' mask (_raw.clear)
         self.map.use(1)
-        lit["u_map"].value = 1
-        lit["u_texel"].value = 1.0 / 1024
-        lit["u_light_matrix"].write(gl(light_matrix))
-        lit["m_view"].write(gl(self.view))
-        lit["m_proj"].write(gl(self.proj))
-        lit["u_eye"].value = self.eye
-        lit["u_light_pos"].value = self.lesson.LIGHT
-        lit["u_light_color"].value = (1.0, 1.0, 1.0)
-        for name in self.names:
-            model = models[name]
-            lit["m_model"].write(gl(model))
-            lit["m_normal"].write(np.linalg.inv(model[:3, :3]).astype("f4").tobytes())
-            lit["u_color"].value = (*self.lesson.COLORS[name], 1.0)
-            self.lit_vaos[name].render(moderngl.TRIANGLES)
+        lit["u_light_matrix"].write(light_matrix)
+        for _, lit_vao, model, normal, color in self.draws:
+            lit["m_model"].write(cube_model if model is None else model)
+            lit["m_normal"].write(cube_normal if normal is None else normal)
+            lit["u_color"].value = color
+            lit_vao.render(moderngl.TRIANGLES)
         ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
         return read(self.fbo, self.size)
+
+
+def _normal(model: np.ndarray) -> bytes:
+    """The normal matrix's bytes: (M^-1)^T in column-major is M^-1 in row-major."""
+    return np.linalg.inv(model[:3, :3]).astype("f4").tobytes()
 
 
 RAW_BASELINES = {"clear_and_swap": RawClear, "triangle": RawTriangle, "phong": RawPhong, "texture": RawTexture,

@@ -96,6 +96,60 @@ def fan() -> Path:
 
 MODELS = {"bunny": bunny_path, "bunny 1.27M": big_bunny, "fan 1M": fan}
 
+#: Linear loads: the sizes of the two files a growth row loads (``--quick``: a quarter of each).
+REPEATED_TRIANGLES = (250_000, 1_000_000)
+CHAIN_NODES = (1_000, 4_000)
+#: The goal of a growth row: four times the size in at most this many times the time (linear: 4x;
+#: a quadratic step makes it 16x).
+GROWTH_GOAL = 4.6
+
+
+@cache
+def repeated_obj(n: int) -> Path:
+    """An OBJ that lists one triangle ``n`` times, its three vertices too (every vertex repeated)."""
+    path = _TMP / f"repeated_{n}.obj"
+    path.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n" * n)
+    return path
+
+
+@cache
+def node_chain(n: int) -> Path:
+    """A glTF of ``n`` nested nodes, each moved 1 along x from its parent and holding one triangle."""
+    import base64
+
+    positions = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=np.float32).tobytes()
+    nodes = [{"translation": [1.0, 0.0, 0.0], "mesh": 0, **({"children": [i + 1]} if i + 1 < n else {})}
+             for i in range(n)]
+    gltf = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": nodes,
+            "buffers": [{"byteLength": 36,
+                         "uri": "data:application/octet-stream;base64," + base64.b64encode(positions).decode()}],
+            "bufferViews": [{"buffer": 0, "byteLength": 36}],
+            "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                           "min": [0, 0, 0], "max": [1, 1, 0]}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}]}
+    path = _TMP / f"chain_{n}.gltf"
+    path.write_text(json.dumps(gltf))
+    return path
+
+
+def growth_cases(env: Any, case: Any, side: Any) -> list:
+    """Every load stays linear: ``load_model`` of a file against the same kind four times as large,
+    side by side in one run (the ratio: the large one's time over the small one's; goal
+    :data:`GROWTH_GOAL`). A new crease angle each time: the load cache is bypassed."""
+    from glsandbox import load_model
+
+    def load(make: Any, n: int) -> Any:
+        return lambda _: load_model(make(n), crease_angle=30.0 + 1e-6 * next(_ANGLES))
+
+    found = []
+    for what, make, sizes, unit in (("repeated-triangle OBJ", repeated_obj, REPEATED_TRIANGLES, "triangles"),
+                                    ("nested glTF nodes", node_chain, CHAIN_NODES, "nodes")):
+        small, large = (n // 4 for n in sizes) if env.quick else sizes
+        found.append(case(GROUP, f"4x the size, {what}", side(f"load_model, {small:,} {unit}", load(make, small)),
+                          side(f"load_model, {large:,} {unit}", load(make, large)), repeat=1, unit="s",
+                          goal=GROWTH_GOAL, note="linear: 4x the time; a step quadratic in the size: 16x"))
+    return found
+
 RAW_VS = """#version 330 core
 in vec3 in_position; void main() { gl_Position = vec4(in_position * 0.5, 1.0); }"""
 RAW_FS = """#version 330 core
@@ -155,6 +209,7 @@ def cases(env: Any) -> list:
                           Side("glsandbox load_model + first frame", lambda _, p=path: glsandbox_load_and_draw(env, p())),
                           repeat=1, unit="s", goal=LOAD_GOAL,
                           note="load: file to a drawable mesh with normals; first frame: upload and draw"))
+    found += growth_cases(env, Case, Side)
     try:
         from raytrace import embree_available
     except ImportError:  # run from elsewhere than benchmarks/

@@ -474,6 +474,12 @@ class SceneFileLesson(Lesson):
 
         return load_scene(self.path)
 
+    def motion(self) -> Motion:
+        """Nothing moves: the file is read and its scene built once per set of values, and its
+        frames keep their plan (a saved file is read again by a new lesson class,
+        :func:`reload_lesson`)."""
+        return Motion()
+
 
 def scene_file_lesson(path: Path) -> type[Lesson]:
     """A lesson class for one scene file; the file is validated now."""

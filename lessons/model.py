@@ -44,6 +44,7 @@ from glsandbox import (
     Light,
     Material,
     Mesh,
+    Motion,
     Node,
     Overlay,
     Param,
@@ -82,9 +83,15 @@ RENDERER_TITLES = {"raster": "rasterizer", "ray": "ray tracer (GLSL)", "ray_nump
 
 @functools.cache
 def generated(name: str) -> Mesh:
-    """A generated model, made once (the window rebuilds the scene every frame: the same Mesh
+    """A generated model, made once (a changed value builds the scene again: the same Mesh
     object keeps its GPU buffers)."""
     return GENERATED[name]()
+
+
+@functools.cache
+def fitted(name: str) -> Mesh:
+    """A generated model fitted into -1..1, made once (:meth:`ModelLesson.motion` asks every frame)."""
+    return glsandbox.fit_mesh(generated(name))
 
 
 def check_mesh(text: str) -> str:
@@ -134,8 +141,7 @@ class ModelLesson(Lesson):
         source = self.values["mesh"]
         fit = bool(self.values["fit"])
         if source in GENERATED:
-            mesh = generated(source)
-            shown = glsandbox.fit_mesh(mesh) if fit else mesh
+            shown = fitted(source) if fit else generated(source)
             return source, (("model", shown, Material(color=MODEL_COLOR, **MATERIAL)),)
         source = str(SHIPPED.get(source, source))
         loaded = glsandbox.load_model(source, fit=fit)
@@ -148,16 +154,27 @@ class ModelLesson(Lesson):
             parts.append((name, part.mesh, material))
         return Path(source).name, tuple(parts)
 
-    def build(self) -> Scene:
-        label, parts = self.model()
+    def placement(self, parts: tuple[tuple[str, Mesh, Material], ...]) -> tuple[np.ndarray, np.ndarray]:
+        """The model's matrix at this time (its turn about y) and the floor's, just under the
+        turned model's lowest point."""
         # --set up=z: a Z-up file (a scan, CAD) stood upright: z becomes y (a -90° turn about x).
         upright = transforms.rotate_x(-math.pi / 2) if self.values["up"] == "z" else np.eye(4)
         turn = transforms.rotate_y(float(self.values["speed"]) * self.time) @ upright
         low = min((float(transforms.transform_points(turn, mesh.positions)[:, 1].min())
                    for _, mesh, _ in parts if mesh.vertex_count), default=-1.0)
+        return turn, transforms.translate(0.0, min(low, -1.0) - 0.01, 0.0)
+
+    def motion(self) -> Motion:
+        """Time turns the model and moves the floor under it; the rest is built once."""
+        _, parts = self.model()
+        turn, floor = self.placement(parts)
+        return Motion(models={"floor": floor, **{name: turn for name, _, _ in parts}})
+
+    def build(self) -> Scene:
+        label, parts = self.model()
+        turn, floor = self.placement(parts)
         nodes = [
-            Node("floor", geometry.plane(12.0), transforms.translate(0.0, min(low, -1.0) - 0.01, 0.0),
-                 Material(color=FLOOR_COLOR, **MATERIAL)),
+            Node("floor", geometry.plane(12.0), floor, Material(color=FLOOR_COLOR, **MATERIAL)),
             *(Node(name, mesh, turn, material) for name, mesh, material in parts),
         ]
         view = self.values["view"]

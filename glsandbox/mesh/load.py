@@ -566,8 +566,10 @@ def _model(p: Path, file_type: str, parts: list[_Part], fit: bool, normals_mode:
     for members in groups.values():
         look = members[0].look
         ids = [position_ids[offsets[index[id(part)]]:offsets[index[id(part)] + 1]] for part in members]
-        mesh, kept, lost, how = _group_mesh(p, file_type, members, ids[0] if len(ids) == 1 else np.concatenate(ids),
-                                            normals_mode, crease,
+        group_ids = ids[0] if len(ids) == 1 else np.concatenate(ids)
+        if len(groups) > 1:  # numbered 0.. within the group (its arrays are sized by the largest id)
+            group_ids = _compact_ids(group_ids)
+        mesh, kept, lost, how = _group_mesh(p, file_type, members, group_ids, normals_mode, crease,
                                             look.name if len(groups) > 1 else None)
         dropped += lost
         if mesh is not None:
@@ -678,6 +680,18 @@ def _group_mesh(p: Path, file_type: str, parts: list[_Part], position_ids: NDArr
     mesh = _Arrays(name, positions.take(chosen, axis=0), indices, normals,
                    None if uvs is None else uvs.take(chosen, axis=0), colors, tuple(notes))
     return mesh, int(faces.shape[0]), dropped, how
+
+
+def _compact_ids(ids: NDArray[np.intp]) -> NDArray[np.intp]:
+    """``ids`` renumbered 0, 1, ... in the same order (equal stay equal, smaller stay smaller).
+
+    The normals and vertices of a group size their arrays by its largest position id; with the
+    file's numbering every group of a file of many materials (a glTF of many nodes) would pay for
+    the whole file's positions, quadratic in the parts. An order-kept renumbering changes no
+    result: only equality and order of the ids are used."""
+    if ids.size == 0:
+        return ids
+    return np.unique(ids, return_inverse=True)[1].reshape(-1).astype(np.intp, copy=False)
 
 
 def _all_parts(parts: list[_Part], offsets: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:

@@ -278,7 +278,12 @@ def test_tradeoffs_without_flip_says_so_in_one_line_and_measures_the_rest(tmp_pa
     from glsandbox.cli import main
     from glsandbox.measure.extra import FLIP_MISSING
 
+    from glsandbox.measure import tradeoffs
+
     monkeypatch.setitem(sys.modules, "flip_evaluator", None)
+    # The columns are what is checked here: the cheap settings' extra rounds until their medians are
+    # stable (tests/measure/test_tradeoffs_timing.py) are left out, the five rounds kept.
+    monkeypatch.setattr(tradeoffs, "MAX_RUNS", 5)
     out = tmp_path / "tradeoffs"
     assert main(["tradeoffs", "--quick", "--knob", "antialiasing", "--out", str(out)]) == 0
     err = capsys.readouterr().err
@@ -372,6 +377,25 @@ def test_raw_baseline_draws_the_lessons_picture(gl, name: str) -> None:
         drawn = np.array(raw.frame(k))
         assert state() == before, f"{name}: the raw frame left GL state changed"
         assert np.array_equal(drawn, expected), f"{name} at time {0.01 * k}"
+
+
+def test_raw_cube_draws_the_indexed_cube_lessons_picture(gl) -> None:
+    """The indexed cube's raw frame (benchmarks/cube_frame.py) equals glsandbox's pixel for pixel
+    at several moments, and leaves the shared context's state as it found it."""
+    from glsandbox.lesson import find_lesson
+
+    def state() -> dict[str, object]:
+        return {key: value for key, value in gl.host.raw.state_snapshot().items() if key != "depth_writemask"}
+
+    size = (160, 120)
+    raw = _benchmark_module("cube_frame.py").RawCube(gl.host.ctx, size)
+    lesson = find_lesson("indexed_cube")()
+    for t in (0.3, 0.67, 1.8):
+        expected = gl.render(lesson.at(t), size).image.copy()
+        before = state()
+        drawn = np.array(raw.frame(t))
+        assert state() == before, "the raw cube frame left GL state changed"
+        assert np.array_equal(drawn, expected), f"indexed_cube at time {t}"
 
 
 # --- the ray tracer's benchmark cases (benchmarks/raytrace.py) ------------------------------

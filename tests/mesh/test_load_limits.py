@@ -302,3 +302,15 @@ def test_a_gltf_whose_nodes_form_a_cycle_is_refused_naming_the_file_and_the_node
     assert str(path) in message and repr(node) in message and "cycle" in message and "\n" not in message
     ok = _gltf_with_nodes(tmp_path / "tree.gltf", [{"name": "a", "mesh": 0, "children": [1]}, {"name": "b", "mesh": 0}])
     assert sum(len(part.mesh.triangle_indices()) for part in load_model(ok).parts) == 2
+
+
+def test_a_groups_position_ids_are_renumbered_in_their_order() -> None:
+    # Each material's mesh numbers its positions 0.. in the file's order: its arrays are sized by
+    # its own positions, not the whole file's (a glTF of many nodes was quadratic), with the same result.
+    import inspect
+
+    _compact_ids = inspect.getmodule(load_model)._compact_ids  # (the loader's own module)
+
+    ids = np.array([7, 3, 7, 12, 3, 40], dtype=np.intp)
+    assert _compact_ids(ids).tolist() == [1, 0, 1, 2, 0, 3]
+    assert _compact_ids(np.zeros(0, dtype=np.intp)).size == 0
