@@ -36,6 +36,7 @@ from glsandbox import transforms
 from glsandbox.errors import NUMBER_LIMIT, SandboxError, plain
 from glsandbox.files import check_inside_sandbox, read_user_file, written_path
 from glsandbox.geometry import Mesh, builtin_mesh
+from glsandbox.images import load_image
 from glsandbox.meshfile import CREASE_ANGLE, NORMALS as MESH_NORMALS, Model, ModelPart, is_model_path, load_model
 from glsandbox.planar import Mirror, PlanarShadow
 from glsandbox.scene import (BUILTIN_TEXTURES, COURSE_BLUE, DEPTH_MODES, SHADINGS, Camera, Color, Light, Material,
@@ -390,6 +391,11 @@ class _SceneReader:
             except SandboxError as exc:
                 bad = "filter" if "filter" in str(exc) else "wrap" if "wrap" in str(exc) else "texture"
                 raise self.fail("nodes", i, bad, str(exc)) from None
+            if texture.is_file:
+                try:  # loaded now, so a missing or broken image is an error at this line, not in a frame
+                    load_image(texture.source)
+                except SandboxError as exc:
+                    raise self.fail("nodes", i, "texture", str(exc)) from None
         elif "filter" in data or "wrap" in data:
             raise self.fail("nodes", i, "filter" if "filter" in data else "wrap", "needs texture = \"<image>\"")
         color = self.color(data, "color", "nodes", i, default=(1.0, 1.0, 1.0, 1.0))
