@@ -393,7 +393,7 @@ class _SceneReader:
                 raise self.fail("nodes", i, bad, str(exc)) from None
             if texture.is_file:
                 try:  # loaded now, so a missing or broken image is an error at this line, not in a frame
-                    load_image(texture.source)
+                    check_image_file(Path(texture.source))
                 except SandboxError as exc:
                     raise self.fail("nodes", i, "texture", str(exc)) from None
         elif "filter" in data or "wrap" in data:
@@ -546,6 +546,28 @@ class _SceneReader:
             planar_shadow=self.planar_shadow(data["shadow"], known, lights) if "shadow" in data else None,
             depth_mode=depth_mode,
         )
+
+
+#: Image files that loaded, by (path, size, modification time): a window reads its scene
+#: file every frame, and decodes an unchanged texture only the first time.
+_IMAGES_LOADED: dict[tuple[str, int, int], None] = {}
+_IMAGES_KEPT = 64
+
+
+def check_image_file(path: Path) -> None:
+    """That ``path`` loads as an image (:func:`load_image`), else its one-line :class:`SandboxError`."""
+    try:
+        stat = path.stat()
+        key = (str(path.resolve()), stat.st_size, stat.st_mtime_ns)
+    except OSError:
+        key = None  # not there or not readable: load_image says which
+    if key is not None and key in _IMAGES_LOADED:
+        return
+    load_image(path)
+    if key is not None:
+        if len(_IMAGES_LOADED) >= _IMAGES_KEPT:
+            del _IMAGES_LOADED[next(iter(_IMAGES_LOADED))]
+        _IMAGES_LOADED[key] = None
 
 
 def _shadow_light_is(light: tuple[float, ...], position: tuple[float, float, float]) -> bool:
