@@ -101,7 +101,6 @@ NOT_YET_NAMED = {
     "measure/tradeoffs",
     "measure/tradeoffs_report",
     "meshlooks",
-    "overlay",
     "passes/clear",
     "passes/draw",
     "passes/mark_mirror",
