@@ -84,3 +84,17 @@ def test_the_exam_scenes_draw_their_question_over_the_picture(gl, renderer, whic
         assert not any(figure_pixels(without, on.scene(), color)), (which, color)
     assert [o.name for o in off.scene().overlays] == ["figures"]
     assert cls.from_settings([f"scene={which}", "overlay=off"]).scene().overlays == ()
+
+
+def test_a_pixel_story_says_when_the_exam_figure_lies_over_the_pixel():
+    from glsandbox.overlay import project_segment
+    from glsandbox.story.ray import overlays_over
+
+    scene = find_lesson("ray_phong")(scene="exam2013").scene()
+    size = (320, 240)
+    eye_ray = scene.overlays[0].lines[0]
+    (x0, y0), (x1, y1) = project_segment(scene.camera.projection(4 / 3) @ scene.camera.view(),
+                                         eye_ray.start, eye_ray.end, size)
+    on_the_ray = (round((x0 + x1) / 2), round((y0 + y1) / 2))
+    assert any("'exam rays'" in note for note in overlays_over(scene, size, on_the_ray))
+    assert not any("'exam rays'" in note for note in overlays_over(scene, size, (300, 230)))
