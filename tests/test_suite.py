@@ -112,7 +112,6 @@ NOT_YET_NAMED = {
     "passes/trace",
     "planar",
     "raytrace/bvh_traverse",
-    "raytrace/watertight",
     "raytrace/world",
     "story/coverage",
     "story/raster",
