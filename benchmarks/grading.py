@@ -169,10 +169,15 @@ def grade_class(folder: Path, ref: Path, jobs: int = 2) -> dict[str, object]:
 
     sampler = threading.Thread(target=sample, daemon=True)
     sampler.start()
-    _, errors = proc.communicate()
+    try:
+        _, errors = proc.communicate()
+    finally:  # also on Ctrl-C: no sampler left running into the interpreter's exit, no check left behind
+        done.set()
+        sampler.join()
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
     seconds = time.perf_counter() - started
-    done.set()
-    sampler.join()
     if proc.returncode not in (0, 1):
         raise RuntimeError(f"check ended with {proc.returncode}: {errors.decode(errors='replace')[-400:]}")
     time.sleep(0.5)  # a process being reaped is not one left behind

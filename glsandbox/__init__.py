@@ -32,7 +32,7 @@ from glsandbox.errors import SandboxError
 from glsandbox.version import __version__
 from glsandbox.geometry import Mesh
 from glsandbox.lesson import Lesson, Param, register
-from glsandbox.overlay import Overlay, text_image
+from glsandbox.overlay import Overlay, WorldLine, WorldLines, WorldMark, text_image
 from glsandbox.scene import (
     COURSE_BLUE,
     DEPTH_MODES,
@@ -54,7 +54,7 @@ from glsandbox.scene import (
 __all__ = [
     "COURSE_BLUE", "DEPTH_MODES", "LIT_SHADINGS", "NORMAL_MODES", "TEXTURE_FILTERS", "TEXTURE_WRAPS",
     "Camera", "Lesson", "Light", "Material", "Mesh", "Mirror", "Model", "Motion", "Node", "Overlay", "Param", "PlanarShadow",
-    "SandboxError", "Scene", "ShadowMap", "Texture", "Viewport",
+    "SandboxError", "Scene", "ShadowMap", "Texture", "Viewport", "WorldLine", "WorldLines", "WorldMark",
     "__version__", "camera", "check_texture_source", "exercise", "explain", "fit_mesh", "geometry", "load_mesh", "load_model", "meshgen", "register", "run",
     "show", "text_image", "transforms", "view", "widget",
 ]

@@ -34,6 +34,8 @@ from glsandbox.scene import Scene
 EXIT_USAGE = 2
 #: What a Unix tool exits with when its reader went away (128 + SIGPIPE).
 EXIT_BROKEN_PIPE = 141
+#: What a Unix tool exits with on Ctrl-C (128 + SIGINT).
+EXIT_INTERRUPTED = 130
 
 
 class ArgumentParser(argparse.ArgumentParser):
@@ -59,7 +61,7 @@ def run_guarded(body: Callable[[], int]) -> int:
         return EXIT_USAGE
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
     except BrokenPipeError:
         # Python would flush stdout again at exit and complain: point it at /dev/null.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
@@ -914,7 +916,37 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser(named).parse_args(argv)
     status = run_guarded(lambda: args.func(args))
     supervise.finished()
+    if status == EXIT_INTERRUPTED and argv is None:  # the process's own command line: end it now
+        end_interrupted()
     return status
+
+
+def end_interrupted() -> NoReturn:
+    """End the process after Ctrl-C, exit 130, once the command has unwound (its ``finally``
+    blocks and ``with`` exits ran: atomic writes removed their temporary files, contexts were
+    released).
+
+    Python's own exit would go on to tear the interpreter down: free every module and
+    object (GL objects after their context), then run the C libraries' exit handlers (Mesa's,
+    which join the driver's threads). The interrupt can have left any of them half-way (a
+    module whose import it cut short, a GL object between two calls, a helper thread still
+    running), and an abort there (SIGABRT: exit -6 where 130 was due) is what an interrupted
+    ``bench`` sometimes ended with. So only the Python exit handlers run (``atexit``:
+    temporary folders, thread pools) and the process ends there; a second Ctrl-C (the
+    process group's) is ignored meanwhile."""
+    import atexit
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        atexit._run_exitfuncs()
+    finally:
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except (OSError, ValueError):
+                pass
+        os._exit(EXIT_INTERRUPTED)
 
 
 def lesson_main(lesson_cls: type[Lesson], argv: list[str] | None = None) -> int:

@@ -10,8 +10,9 @@ text with Pillow's built-in font, so no font file is needed.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
 from PIL import Image
@@ -63,6 +64,11 @@ class Overlay:
     def drawn_image(self, region: tuple[int, int, int, int]) -> np.ndarray:
         """The image as drawn in ``region``: scaled by :meth:`scale` (the same array at 1)."""
         return scaled_image(self.image, self.scale(region))
+
+    def seen_by(self, camera: Any, region: tuple[int, int, int, int]) -> Overlay:
+        """The overlay as drawn through ``camera`` in ``region``: itself (a :class:`WorldLines`
+        projects its lines there)."""
+        return self
 
     def placement(self, region: tuple[int, int, int, int]) -> tuple[int, int, int, int]:
         """Where the image lands, as a GL rectangle (x, y from the bottom left, w, h) in pixels:
@@ -203,3 +209,184 @@ def _text_image(rows: tuple[str | tuple[str, ...], ...], color: RGBA, panel: RGB
     pixels = np.asarray(image, dtype=np.uint8).copy()
     pixels.setflags(write=False)
     return pixels
+
+
+# --- lines in the world, drawn over the frame -------------------------------------------
+
+Point = tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class WorldLine:
+    """A segment from ``start`` to ``end`` (world coordinates) drawn over the frame in ``color``;
+    ``dashed`` for a part the question rules out (a shadow ray past its blocker)."""
+
+    start: Point
+    end: Point
+    color: RGBA
+    dashed: bool = False
+
+    def __post_init__(self) -> None:
+        _set_points(self, "start", "end")
+
+
+@dataclass(frozen=True)
+class WorldMark:
+    """A dot at ``point`` (world coordinates) with ``text`` beside it (to its right, or its
+    left with ``left``: away from a line that passes on that side)."""
+
+    point: Point
+    text: str
+    color: RGBA
+    left: bool = False
+
+    def __post_init__(self) -> None:
+        _set_points(self, "point")
+
+
+def _set_points(item: object, *names: str) -> None:
+    """A line's or mark's points as three finite floats each, its colour as four bytes
+    (plain tuples: a figure's image is kept by its lines and marks)."""
+    for name in names:
+        point = tuple(float(v) for v in np.asarray(getattr(item, name), dtype=np.float64).ravel())
+        if len(point) != 3 or not all(np.isfinite(point)):
+            raise SandboxError(f"{type(item).__name__} {name}: expected three finite numbers, got {getattr(item, name)!r}")
+        object.__setattr__(item, name, point)
+    color = tuple(int(c) for c in getattr(item, "color"))
+    if len(color) != 4 or not all(0 <= c <= 255 for c in color):
+        raise SandboxError(f"{type(item).__name__} color: expected four numbers 0-255 (RGBA), got {color!r}")
+    object.__setattr__(item, "color", color)
+
+
+#: A transparent texel: what a :class:`WorldLines` holds until a camera projects it.
+_NOTHING = np.zeros((1, 1, 4), dtype=np.uint8)
+
+
+@dataclass(frozen=True, eq=False)
+class WorldLines(Overlay):
+    """Segments and marked points in the world, drawn over the frame where the camera sees them.
+
+    A figure of the question over the picture: rays, the points they hit, the light. It is
+    projected through the frame's camera when drawn (:meth:`seen_by`), so it stays on its
+    points as the camera moves, and it lies over the picture whoever drew that (the
+    rasterizer or a ray tracer: their traced image is an overlay underneath). Drawn over
+    everything, never hidden by the scene: a ray inside a sphere still shows.
+    """
+
+    image: np.ndarray = field(default_factory=lambda: _NOTHING)
+    position: tuple[int, int] = (0, 0)
+    scalable: bool = False
+    lines: tuple[WorldLine, ...] = ()
+    marks: tuple[WorldMark, ...] = ()
+
+    def seen_by(self, camera: Any, region: tuple[int, int, int, int]) -> Overlay:
+        """The figure as ``camera`` (a :class:`~glsandbox.scene.Camera`) sees it in ``region``:
+        an image the region's size, placed over it."""
+        w, h = region[2], region[3]
+        clip = camera.projection(w / max(h, 1)) @ camera.view()
+        image = _figure(self.lines, self.marks, tuple(map(float, clip.ravel())), (w, h))
+        return Overlay(self.name, image, self.viewport, (0, 0), scalable=False)
+
+
+def project_segment(clip: np.ndarray, start: Sequence[float], end: Sequence[float],
+                    size: tuple[int, int]) -> tuple[tuple[float, float], tuple[float, float]] | None:
+    """The part of the segment the camera sees, as two pixel positions (x right, y down from the
+    top left), or None when none of it is in view.
+
+    ``clip`` is projection x view (the course's View and Projection). Clipped in clip space,
+    before the divide by w, as the rasterizer clips a triangle: on the segment
+    ``p(s) = a + s(b - a)``, 0 <= s <= 1, each inequality ``-w <= x <= w``, ``-w <= y <= w`` and
+    ``w > 0`` is linear in s, so each cuts the range of s at one point (Liang-Barsky); a point
+    behind the eye never reaches the divide.
+    """
+    a = clip @ np.array([*start, 1.0])
+    b = clip @ np.array([*end, 1.0])
+    low, high = 0.0, 1.0
+    tiny = 1e-9 * max(abs(a[3]), abs(b[3]), 1.0)
+    for fa, fb in ((a[3] + a[0], b[3] + b[0]), (a[3] - a[0], b[3] - b[0]), (a[3] + a[1], b[3] + b[1]),
+                   (a[3] - a[1], b[3] - b[1]), (a[3] - tiny, b[3] - tiny)):
+        if fa < 0.0 and fb < 0.0:
+            return None
+        if fa < 0.0:
+            low = max(low, fa / (fa - fb))
+        elif fb < 0.0:
+            high = min(high, fa / (fa - fb))
+    if low > high:
+        return None
+    w, h = size
+
+    def pixel(q: np.ndarray) -> tuple[float, float]:
+        x, y = q[0] / q[3], q[1] / q[3]  # normalised device coordinates, -1..1
+        return (x + 1.0) * 0.5 * w, (1.0 - y) * 0.5 * h
+
+    return pixel(a + low * (b - a)), pixel(a + high * (b - a))
+
+
+#: Dark edge drawn under every line and dot, so a figure reads on a bright surface too.
+EDGE_COLOR: RGBA = (0, 0, 0, 200)
+
+
+#: Below this frame size (its shorter side, pixels) a figure shows its lines and dots only:
+#: the labels would cover them (the lesson's text panel says the numbers).
+MIN_LABELLED_SIZE = 200
+
+
+def line_width(size: tuple[int, int]) -> int:
+    """A figure's line width in pixels: 2 up to a 320-pixel frame, then growing with it."""
+    return max(2, round(min(size) / 160))
+
+
+@lru_cache(maxsize=16)
+def _figure(lines: tuple[WorldLine, ...], marks: tuple[WorldMark, ...], clip: tuple[float, ...],
+            size: tuple[int, int]) -> np.ndarray:
+    """The figure's image for one camera and region size (read-only; an unchanged camera
+    gets the same array, so the overlay's texture is not uploaded again)."""
+    from PIL import ImageDraw
+
+    matrix = np.array(clip).reshape(4, 4)
+    width = line_width(size)
+    canvas = Image.new("RGBA", size, (0, 0, 0, 0))
+    draw = ImageDraw.Draw(canvas)
+    for edge in (True, False):
+        for line in lines:
+            ends = project_segment(matrix, line.start, line.end, size)
+            if ends is None:
+                continue
+            color, thick = (EDGE_COLOR, width + 2) if edge else (line.color, width)
+            for a, b in _dashes(*ends, 4 * width, 3 * width) if line.dashed else [ends]:
+                draw.line([a, b], fill=color, width=thick)
+    radius = 2 * width
+    seen = [(mark, ends[0]) for mark in marks if (ends := project_segment(matrix, mark.point, mark.point, size))]
+    for mark, (x, y) in seen:
+        draw.ellipse([x - radius - 1, y - radius - 1, x + radius + 1, y + radius + 1], fill=EDGE_COLOR)
+        draw.ellipse([x - radius, y - radius, x + radius, y + radius], fill=mark.color)
+    if min(size) < MIN_LABELLED_SIZE:
+        return _frozen(canvas)
+    factor = max(1, int(min(size) // REFERENCE_SIZE))  # as text panels grow: by whole texels
+    for mark, (x, y) in seen:  # the labels over every line and dot
+        if mark.text:
+            label = Image.fromarray(scaled_image(text_image([mark.text], color=mark.color), factor))
+            lx = x - radius - 2 - label.width if mark.left else x + radius + 2
+            lx = int(min(max(lx, 0), max(size[0] - label.width, 0)))
+            ly = int(min(max(y - label.height - radius, 0), max(size[1] - label.height, 0)))
+            canvas.alpha_composite(label, (lx, ly))
+    return _frozen(canvas)
+
+
+def _frozen(canvas: Image.Image) -> np.ndarray:
+    """A canvas as a read-only RGBA array."""
+    pixels = np.asarray(canvas, dtype=np.uint8).copy()
+    pixels.setflags(write=False)
+    return pixels
+
+
+def _dashes(a: tuple[float, float], b: tuple[float, float], dash: float, gap: float) -> list:
+    """The pieces of a dashed line from pixel ``a`` to pixel ``b``."""
+    length = float(np.hypot(b[0] - a[0], b[1] - a[1]))
+    pieces, s = [], 0.0
+    while s < length:
+        e = min(s + dash, length)
+        pieces.append(((a[0] + (b[0] - a[0]) * s / length, a[1] + (b[1] - a[1]) * s / length),
+                       (a[0] + (b[0] - a[0]) * e / length, a[1] + (b[1] - a[1]) * e / length)))
+        s = e + gap
+    return pieces

@@ -36,6 +36,7 @@ from glsandbox import transforms
 from glsandbox.errors import NUMBER_LIMIT, SandboxError, plain
 from glsandbox.files import check_inside_sandbox, read_user_file, written_path
 from glsandbox.geometry import Mesh, builtin_mesh
+from glsandbox.images import load_image
 from glsandbox.mesh.load import CREASE_ANGLE, NORMALS as MESH_NORMALS, Model, ModelPart, is_model_path, load_model
 from glsandbox.planar import Mirror, PlanarShadow
 from glsandbox.scene import (BUILTIN_TEXTURES, COURSE_BLUE, DEPTH_MODES, SHADINGS, Camera, Color, Light, Material,
@@ -390,6 +391,11 @@ class _SceneReader:
             except SandboxError as exc:
                 bad = "filter" if "filter" in str(exc) else "wrap" if "wrap" in str(exc) else "texture"
                 raise self.fail("nodes", i, bad, str(exc)) from None
+            if texture.is_file:
+                try:  # loaded now, so a missing or broken image is an error at this line, not in a frame
+                    check_image_file(Path(texture.source))
+                except SandboxError as exc:
+                    raise self.fail("nodes", i, "texture", str(exc)) from None
         elif "filter" in data or "wrap" in data:
             raise self.fail("nodes", i, "filter" if "filter" in data else "wrap", "needs texture = \"<image>\"")
         color = self.color(data, "color", "nodes", i, default=(1.0, 1.0, 1.0, 1.0))
@@ -540,6 +546,28 @@ class _SceneReader:
             planar_shadow=self.planar_shadow(data["shadow"], known, lights) if "shadow" in data else None,
             depth_mode=depth_mode,
         )
+
+
+#: Image files that loaded, by (path, size, modification time): a window reads its scene
+#: file every frame, and decodes an unchanged texture only the first time.
+_IMAGES_LOADED: dict[tuple[str, int, int], None] = {}
+_IMAGES_KEPT = 64
+
+
+def check_image_file(path: Path) -> None:
+    """That ``path`` loads as an image (:func:`load_image`), else its one-line :class:`SandboxError`."""
+    try:
+        stat = path.stat()
+        key = (str(path.resolve()), stat.st_size, stat.st_mtime_ns)
+    except OSError:
+        key = None  # not there or not readable: load_image says which
+    if key is not None and key in _IMAGES_LOADED:
+        return
+    load_image(path)
+    if key is not None:
+        if len(_IMAGES_LOADED) >= _IMAGES_KEPT:
+            del _IMAGES_LOADED[next(iter(_IMAGES_LOADED))]
+        _IMAGES_LOADED[key] = None
 
 
 def _shadow_light_is(light: tuple[float, ...], position: tuple[float, float, float]) -> bool:

@@ -45,6 +45,9 @@ from glsandbox import (
     Overlay,
     Param,
     Scene,
+    WorldLine,
+    WorldLines,
+    WorldMark,
     geometry,
     register,
     text_image,
@@ -61,7 +64,23 @@ def fmt(v) -> str:
     return "(" + ", ".join(f"{round(float(x), 9) + 0.0:.6g}" for x in v) + ")"
 
 
-def exam2013(name: str) -> tuple[Scene, list[str]]:
+#: The figure's colours (RGBA), each far from the scene's own: the eye's ray, the reflected
+#: ray, the shadow ray up to what it meets, the hit points, the light.
+RAY_COLOR = (255, 225, 0, 255)
+REFLECTED_COLOR = (0, 230, 255, 255)
+SHADOW_RAY_COLOR = (255, 120, 0, 255)
+LIT_COLOR = (90, 255, 90, 255)
+BLOCKED_COLOR = (255, 60, 200, 255)
+POINT_COLOR = (255, 255, 255, 255)
+LIGHT_COLOR = (255, 255, 150, 255)
+
+
+def along(ray: Ray, t: float) -> tuple[float, float, float]:
+    """The point at ``t`` on ``ray`` (its direction is a unit vector: t is a distance)."""
+    return tuple(float(o + t * d) for o, d in zip(ray.origin, ray.direction))  # type: ignore[return-value]
+
+
+def exam2013(name: str) -> tuple[Scene, list[str], WorldLines]:
     red, blue, light = Sphere(dx((80, 15, 0)), 10.0), Sphere(dx((72, 121, 0)), 35.0), dx((100, 117, 0))
     ray = Ray((0.0, 0.0, 0.0), dx((0.96, 0.28, 0.0)))
     hit = first_hit(ray, [red, blue])
@@ -79,10 +98,28 @@ def exam2013(name: str) -> tuple[Scene, list[str]]:
              sphere("blue", tuple(blue.center), 35.0, material((0.15, 0.25, 0.9))),
              lamp(0, light, 2.0))
     camera = Camera(eye=(70.0, 30.0, 170.0), target=(76.0, 55.0, 0.0), fov_y=55.0, far=1000.0)
-    return Scene(name, nodes=nodes, camera=camera, lights=(Light(light),), clear_color=(0.08, 0.08, 0.12, 1.0)), rows
+    # The question drawn over the picture: the ray to the red hit, the reflection to the blue
+    # one, and the shadow ray towards the light (inside the blue sphere), solid up to the
+    # blue sphere that blocks it and dashed beyond, where the light is not reached.
+    point, blocked = tuple(map(float, hit.point)), along(to_light, t_block)
+    verdict = "IN SHADOW" if in_shadow(hit, light, [red, blue]) else "lit"
+    figure = WorldLines("exam rays", lines=(
+        WorldLine(ray.origin, point, RAY_COLOR),
+        WorldLine(point, along(bounce, t_blue), REFLECTED_COLOR),
+        WorldLine(point, blocked, SHADOW_RAY_COLOR),
+        WorldLine(blocked, light, BLOCKED_COLOR, dashed=True),
+    ), marks=(
+        WorldMark(ray.origin, "eye ray", RAY_COLOR, left=True),
+        WorldMark(point, f"hit t={hit.t:.4g}", POINT_COLOR),
+        WorldMark(along(bounce, t_blue), f"reflected: blue t={t_blue:.4g}", REFLECTED_COLOR, left=True),
+        WorldMark(blocked, f"blocked t={t_block:.4g} < {distance:.4g}: {verdict}", BLOCKED_COLOR),
+        WorldMark(light, "light", LIGHT_COLOR),
+    ))
+    scene = Scene(name, nodes=nodes, camera=camera, lights=(Light(light),), clear_color=(0.08, 0.08, 0.12, 1.0))
+    return scene, rows, figure
 
 
-def exam2012(name: str) -> tuple[Scene, list[str]]:
+def exam2012(name: str) -> tuple[Scene, list[str], WorldLines]:
     light, point = dx((0, 10, -29)), dx((0, -8, -5))
     normal = dx((0.0, -0.6, 0.8))
     plane = Plane.through(normal, dx((0, 20, -34)))
@@ -99,9 +136,21 @@ def exam2012(name: str) -> tuple[Scene, list[str]]:
                   material((0.7, 0.7, 0.75)), cull_back_faces=False)
     floor = Node("floor", geometry.plane(80.0), transforms.translate(0.0, -8.0, 0.0), material((0.6, 0.55, 0.45)))
     marker = sphere("P", point, 0.6, material((0.9, 0.2, 0.2)))
-    camera = Camera(eye=(30.0, 8.0, -20.0), target=(0.0, 0.0, 15.0), fov_y=60.0, far=500.0)
+    camera = Camera(eye=(30.0, 8.0, -20.0), target=(0.0, 3.0, 17.0), fov_y=60.0, far=500.0)
     nodes = (floor, tilted, marker, lamp(0, light, 0.6))
-    return Scene(name, nodes=nodes, camera=camera, lights=(Light(light),), clear_color=(0.08, 0.08, 0.12, 1.0)), rows
+    # The question drawn over the picture: the shadow ray reaches the light (solid) before the
+    # plane, which it meets only beyond it (dashed): nothing blocks it, P is lit.
+    crossing = along(Ray(point, to_light.direction), t_plane)
+    figure = WorldLines("exam rays", lines=(
+        WorldLine(point, light, LIT_COLOR),
+        WorldLine(light, crossing, BLOCKED_COLOR, dashed=True),
+    ), marks=(
+        WorldMark(point, "P", POINT_COLOR),
+        WorldMark(light, f"light at {distance:.4g}: LIT", LIGHT_COLOR),
+        WorldMark(crossing, f"plane t={t_plane:.4g}", BLOCKED_COLOR, left=True),
+    ))
+    scene = Scene(name, nodes=nodes, camera=camera, lights=(Light(light),), clear_color=(0.08, 0.08, 0.12, 1.0))
+    return scene, rows, figure
 
 
 def self_shadowed(eye_distance: float, epsilon: float | None, count: int = 400) -> int:
@@ -148,18 +197,23 @@ class RayPhong(Lesson):
     order = 140
     contrasts = (("raster against ray: the same Scene rasterized and ray traced", "renderer=raster,ray"),)
     defaults = {"renderer": "ray"}
-    params = (Param("scene", "demo", "which scene", choices=SCENES),)
+    params = (Param("scene", "demo", "which scene", choices=SCENES),
+              Param("exam_rays", True, "the exam scenes: draw the question's rays, hits and light over the picture"))
 
     def build(self) -> Scene:
         which = self.values["scene"]
+        figures: tuple[WorldLines, ...] = ()
         if which == "demo":
             scene = demo_scene(self.name)
             rows = [f"Phong ka={KA} kd={KD} ks={KS} (sum 1), shadows, reflections to depth 2"]
+        elif which == "far_eye":
+            scene, rows = far_eye(self.name)
         else:
-            scene, rows = {"exam2013": exam2013, "exam2012": exam2012, "far_eye": far_eye}[which](self.name)
+            scene, rows, figure = {"exam2013": exam2013, "exam2012": exam2012}[which](self.name)
+            figures = (figure,) if self.values["exam_rays"] else ()
         from dataclasses import replace
 
-        return replace(scene, overlays=(Overlay("figures", text_image(rows), None, (4, 4)),))
+        return replace(scene, overlays=(*figures, Overlay("figures", text_image(rows), None, (4, 4))))
 
 
 if __name__ == "__main__":

@@ -217,6 +217,58 @@ def wait_for(path: Path, timeout: float = 20.0) -> Path:
 
 # --- files and scenes several modules use ------------------------------------------------------
 
+#: A shader of the user's with a uniform of each kind the panel gives a widget of its own:
+#: a number, a colour, two numbers and an on/off (``UNIFORM_SCENE`` sets them).
+UNIFORM_SHADER = """\
+#version 330 core
+#include "common/transform.glsl"
+uniform float gain;
+uniform vec3 base_color;
+uniform vec2 offset;
+uniform bool flat_look;
+#if defined(VERTEX_SHADER)
+in vec3 in_position;
+void main() { gl_Position = m_proj * m_view * m_model * vec4(in_position, 1.0); }
+#elif defined(FRAGMENT_SHADER)
+out vec4 frag_color;
+void main() {
+    vec3 shift = flat_look ? vec3(offset, 0.0) : vec3(0.0);
+    frag_color = vec4(clamp(base_color * gain + shift, 0.0, 1.0), 1.0);
+}
+#endif
+"""
+
+#: Two cubes drawn with ``UNIFORM_SHADER``, each with its own uniforms (the first node's are the panel's).
+UNIFORM_SCENE = """\
+[camera]
+eye = [1, 1.5, 6]
+target = [1, 0, 0]
+
+[[nodes]]
+mesh = "cube24"
+shader = "own.glsl"
+
+[nodes.uniforms]
+gain = 0.5
+base_color = [1, 0.5, 0]
+offset = [0.1, 0.2]
+flat_look = true
+
+[[nodes]]
+mesh = "cube24"
+translate = [2.5, 0, 0]
+shader = "own.glsl"
+uniforms = { gain = 2.0, base_color = [0, 0, 0.4], offset = [0, 0], flat_look = false }
+"""
+
+
+def write_uniform_scene(folder: Path) -> Path:
+    """``UNIFORM_SCENE`` and its shader written into ``folder``: the scene file's path."""
+    (folder / "own.glsl").write_text(UNIFORM_SHADER)
+    (folder / "own.toml").write_text(UNIFORM_SCENE)
+    return folder / "own.toml"
+
+
 #: A lesson file: a spinning cube whose name clashes with a built-in lesson (which it must not shadow).
 SPIN = '''
 import glsandbox

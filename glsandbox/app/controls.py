@@ -6,6 +6,8 @@ it with Dear ImGui in the window; :mod:`glsandbox.app.notebook` with ipywidgets.
 - :func:`control_for`: the widget that fits a parameter (choice -> combo,
   bool -> checkbox, number -> slider with a range, order -> the six orders,
   other text -> a text field);
+- :func:`uniform_controls`: the widgets of a scene's own shader uniforms
+  (:func:`shader_uniforms`), typed from their values;
 - :func:`to_text`: a value back to the ``--set`` text its parameter parses,
   and :func:`set_line`, the command-line tail that renders a window's state
   headless (``glsandbox render LESSON <line>``);
@@ -24,10 +26,10 @@ import numpy as np
 
 from glsandbox.camera import CameraInput
 from glsandbox.errors import NUMBER_LIMIT
-from glsandbox.lesson import Lesson, Param
+from glsandbox.lesson import UNIFORM_PREFIX, Lesson, Param, parse_uniform_text, uniform_param
 from glsandbox.measure import compare
 from glsandbox.overlay import Overlay, text_image
-from glsandbox.scene import Scene
+from glsandbox.scene import Scene, check_uniform_value
 from glsandbox.transforms import ORDERS, parse_order
 
 #: MSAA sample counts offered by the panel (0: off).
@@ -38,7 +40,8 @@ SECTION_PARAMS = ("time", "renderer", "effects", "camera")
 
 @dataclass(frozen=True)
 class Control:
-    """One widget: ``kind`` is combo, checkbox, slider_int, slider_float or text."""
+    """One widget: ``kind`` is combo, checkbox, slider_int, slider_float or text; for a shader's
+    uniform also color (a colour picker) or drag_floats (2 to 4 numbers)."""
 
     param: Param
     kind: str
@@ -78,6 +81,54 @@ def lesson_controls(lesson: Lesson) -> list[Control]:
     return [control_for(p, lesson.values[p.name]) for p in shown]
 
 
+def shader_uniforms(scene: Scene) -> dict[str, Any]:
+    """The uniforms of the scene's own shaders, by name, with the value the frame gives them:
+    a ``--set u.NAME`` override, else the first node's own (``[nodes.uniforms]`` in a scene file)."""
+    found: dict[str, Any] = {}
+    for node in scene.nodes:
+        for name, value in node.uniforms.items():
+            found.setdefault(name, value)
+    found.update((name, value) for name, value in scene.uniform_overrides.items() if name in found)
+    return found
+
+
+#: What a uniform's name holds when its widget is a colour picker (3 or 4 numbers, each 0..1).
+COLOR_WORDS = ("color", "colour")
+
+
+def uniform_controls(uniforms: dict[str, Any]) -> list[Control]:
+    """The widgets of a scene's shader uniforms (:func:`shader_uniforms`), typed from their values:
+    on/off -> checkbox; a number -> float slider (range as :func:`number_range`); 3 or 4 numbers
+    named ``*color*`` -> colour picker (``color``); other 2 to 4 numbers -> drag-floats
+    (``drag_floats``). Each is the parameter ``u.NAME`` (``--set u.NAME=...``), its default the
+    scene's value; a change goes into the lesson's values, which the next frame draws."""
+    controls = []
+    for name, value in uniforms.items():
+        param = Param(f"{UNIFORM_PREFIX}{name}", value, f"the shader's uniform {name}", convert=parse_uniform_text)
+        if isinstance(value, bool):
+            controls.append(Control(param, "checkbox"))
+        elif isinstance(value, tuple):
+            colour = len(value) in (3, 4) and any(word in name.lower() for word in COLOR_WORDS)
+            controls.append(Control(param, "color" if colour else "drag_floats", (), 0.0, 1.0))
+        else:
+            low, high = number_range(param, value)
+            controls.append(Control(param, "slider_float", (), low, high))
+    return controls
+
+
+def uniform_value(control: Control, new: Any) -> Any:
+    """What a uniform's widget gave (a bool, a float, a list of floats) as the value the scene
+    keeps (:func:`~glsandbox.scene.check_uniform_value`): a colour's numbers within 0..1."""
+    if control.kind == "checkbox":
+        return bool(new)
+    if control.kind in ("color", "drag_floats"):
+        numbers = [float(v) for v in new]
+        if control.kind == "color":
+            numbers = [min(max(v, 0.0), 1.0) for v in numbers]
+        return check_uniform_value(tuple(numbers), control.param.name)
+    return check_uniform_value(float(new), control.param.name)
+
+
 def to_text(param: Param, value: Any) -> str:
     """The ``--set`` text that ``param.parse`` turns back into ``value``.
 
@@ -115,6 +166,9 @@ def set_line(lesson: Lesson, size: tuple[int, int], samples: int = 0,
         value = values.get(param.name)
         if value != defaults.get(param.name) and not (param.name == "camera" and not value):
             parts += ["--set", f"{param.name}={to_text(param, value)}"]
+    for key, value in values.items():  # the shader's uniforms set in the panel: u.NAME
+        if key.startswith(UNIFORM_PREFIX):
+            parts += ["--set", f"{key}={to_text(uniform_param(key), value)}"]
     return " ".join(shlex.quote(p) for p in parts)
 
 
@@ -180,10 +234,15 @@ class Session:
     lesson_error: str = ""
     #: What the last frame drew: the lesson at its time, the frame size, MSAA, the camera and the plan.
     drawn: tuple[Lesson, tuple[int, int], int, tuple[float, ...] | None, Any] | None = None
+    #: The uniforms of the last frame's own shaders (:func:`shader_uniforms`): the panel's sliders.
+    uniforms: dict[str, Any] = field(default_factory=dict)
 
-    def record(self, size: tuple[int, int], plan: Any) -> None:
-        """Note the frame just drawn (cheap: the texts below are made only when shown)."""
+    def record(self, size: tuple[int, int], plan: Any, scene: Scene | None = None) -> None:
+        """Note the frame just drawn (cheap: the texts below are made only when shown) and,
+        given the lesson's ``scene`` it drew, the uniforms of its own shaders."""
         self.drawn = (self.lesson.at(self.lesson.time), size, self.samples, camera_numbers(self.camera), plan)
+        if scene is not None:
+            self.uniforms = shader_uniforms(scene)
 
     def drawn_line(self) -> str:
         """The ``--set`` line that renders the last frame headless (see :func:`set_line`)."""
@@ -227,4 +286,5 @@ def parse_value(param: Param, text: str) -> Any:
 
 
 __all__ = ["SAMPLE_CHOICES", "Clock", "Control", "LiveCompare", "Session", "camera_numbers", "compare_scene", "control_for",
-           "frame_image_scene", "lesson_controls", "number_range", "parse_value", "set_line", "to_text"]
+           "frame_image_scene", "lesson_controls", "number_range", "parse_value", "set_line", "shader_uniforms", "to_text",
+           "uniform_controls", "uniform_value"]

@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from glsandbox.app.controls import (SAMPLE_CHOICES, Control, LiveCompare, Session, control_for, lesson_controls,
-                                parse_value, to_text)
+                                    parse_value, to_text, uniform_controls, uniform_value)
 from glsandbox.errors import SandboxError
 from glsandbox.files import write_text
 
@@ -256,6 +256,11 @@ class Panel:
         for control in controls:
             if control.param.name not in RENDER_PARAMS:
                 self._control(session, control)
+        uniforms = uniform_controls(session.uniforms)
+        if uniforms:
+            imgui.separator_text("shader uniforms")
+            for control in uniforms:
+                self._uniform(session, control)
         imgui.separator_text("renderer")
         for control in controls:
             if control.param.name in RENDER_PARAMS:
@@ -296,6 +301,29 @@ class Panel:
             imgui.set_item_tooltip(param.help)
         if changed:
             values[name] = new
+            self.message = ""
+
+    def _uniform(self, session: Session, control: Control) -> None:
+        """One uniform of the scene's own shader (``u.NAME``); a change goes into the lesson's
+        values, and the next frame draws the scene with it (as ``--set u.NAME=...`` does)."""
+        imgui = self.imgui
+        name, values = control.param.name, session.lesson.values
+        value = values.get(name, control.param.default)
+        if control.kind == "checkbox":
+            changed, new = imgui.checkbox(name, bool(value))
+        elif control.kind == "slider_float":
+            changed, new = imgui.slider_float(name, float(value), control.low, control.high, "%.3g")
+        elif control.kind == "color":
+            edit = imgui.color_edit3 if len(value) == 3 else imgui.color_edit4
+            changed, new = edit(name, [float(v) for v in value])
+        else:  # 2 to 4 numbers: dragged, at a speed that fits their size
+            speed = 0.01 * max(1.0, max(abs(float(v)) for v in value))
+            changed, new = getattr(imgui, f"drag_float{len(value)}")(name, [float(v) for v in value], speed)
+        self._item(name)
+        if imgui.is_item_hovered():
+            imgui.set_item_tooltip(f"{control.param.help} (--set {name}=...)")
+        if changed:
+            values[name] = uniform_value(control, new)
             self.message = ""
 
     def _time(self, session: Session, now: float) -> None:

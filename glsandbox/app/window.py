@@ -187,7 +187,8 @@ class Window:
         """Draw the lesson into its target, copy it onto the window, the panel over it, swap."""
         session = self.session
         # The camera keys' camera, once moved, replaces the scene's.
-        scene = self.camera.apply(with_samples(self.lesson_scene(), session.samples))
+        own = self.lesson_scene()
+        scene = self.camera.apply(with_samples(own, session.samples))
         scene = _live_compare(session, self.renderer, size) or scene
         frame_plan, target = self.draw(scene, size)
         if self.shoot:
@@ -197,7 +198,7 @@ class Window:
             self.explain_next = False
             self.explain(scene, size)
             target.framebuffer.use()
-        session.record(size, frame_plan)
+        session.record(size, frame_plan, own)  # own: the lesson's scene, whose uniforms the panel shows
         self.host.raw.blit_color(target.resolved().glo, self.host.ctx.screen.glo, size)
         self.host.ctx.screen.use()
         self.draw_panel()

@@ -61,6 +61,8 @@ class OverlayDrawer:
         """Draw the overlays named by ``step`` into ``framebuffer`` (``size`` pixels)."""
         region = (0, 0, *size) if step.viewport < 0 else scene.viewports[step.viewport].pixels(*size)
         by_name = {o.name: o for o in scene.overlays}
+        viewport = scene.viewports[step.viewport] if step.viewport >= 0 else None
+        camera = viewport.camera if viewport is not None and viewport.camera is not None else scene.camera
         vao = self._vertex_array(program)
         self.ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
         self.ctx.enable(moderngl.BLEND)
@@ -68,7 +70,7 @@ class OverlayDrawer:
         framebuffer.scissor = region
         try:
             for draw in step.draws:
-                overlay = by_name[draw.node]
+                overlay = by_name[draw.node].seen_by(camera, region)  # a figure in the world: projected now
                 rect = overlay.placement(region)
                 self._texture(overlay, overlay.drawn_image(region)).use(location=0)
                 program["u_image"].value = 0

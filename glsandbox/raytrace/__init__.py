@@ -64,6 +64,7 @@ from glsandbox.raytrace.triangle import (
     moller_trumbore_many,
 )
 from glsandbox.raytrace.vec import cross, dot, length, normalize
+from glsandbox.raytrace.watertight import aimed_rays, nearest_by
 from glsandbox.raytrace.world import camera_rays, course_image_plane
 
 __all__ = [
@@ -84,6 +85,7 @@ __all__ = [
     "Sphere",
     "Triangle",
     "TriangleBatch",
+    "aimed_rays",
     "bvh_for_mesh",
     "camera_rays",
     "course_image_plane",
@@ -94,6 +96,7 @@ __all__ = [
     "in_shadow",
     "length",
     "moller_trumbore_many",
+    "nearest_by",
     "nearest_hit",
     "nearest_hit_many",
     "normalize",

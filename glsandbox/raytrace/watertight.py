@@ -44,6 +44,8 @@ rule, see :func:`nondegenerate`).
 
 from __future__ import annotations
 
+import functools
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -53,7 +55,8 @@ from numpy.typing import ArrayLike, NDArray
 from glsandbox.raytrace.base import broadcast_rays
 from glsandbox.raytrace.triangle import DEGENERATE_SIN, watertight_t_bound
 
-__all__ = ["RaySetup", "nearest_watertight", "nondegenerate", "ray_setup", "watertight_pairs"]
+__all__ = ["RaySetup", "aimed_rays", "nearest_by", "nearest_watertight", "nondegenerate", "ray_setup",
+           "watertight_pairs"]
 
 #: Veltkamp's splitting constant for float64: 2^27 + 1 cuts a double into two
 #: halves of 26 bits whose pairwise products are exact.
@@ -305,3 +308,53 @@ def nearest_watertight(v0: NDArray[np.float64], v1: NDArray[np.float64], v2: NDA
     if tested is not None:
         tested.append(done if normals is not None else n * int(keep.size))
     return best_t, best_i
+
+
+# --- the probe of a closed mesh: rays aimed at its vertices and edges -------------------------
+
+#: Where each edge is aimed at, as a share of the way along it (0.5: the midpoint).
+EDGE_POINTS = (0.3, 0.5, 0.71)
+#: The way the probe's mesh is moved from the origin (``at`` times this).
+AWAY = (0.99, 0.7, -0.4)
+
+Triangles = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
+
+
+@functools.lru_cache(maxsize=8)
+def aimed_rays(size: tuple[int, int], at: float = 0.0) -> tuple[Triangles, NDArray[np.float64], NDArray[np.float64]]:
+    """A closed mesh's world triangles and ``width·height`` rays ``(origins, directions)`` (float64)
+    that must all hit it: the icosphere subdivided once (80 triangles, radius 2, turned so
+    no edge lies along an axis), moved by ``at·AWAY``; each ray from one of a few eyes inside
+    it (within 0.4 of its centre, the same eyes at every offset) to a vertex or a point of an
+    edge, every vertex and edge point in turn, ``t = 1`` there. A ray that finds no triangle
+    slipped through a crack: what the watertight test never lets happen. The rays the
+    ``triangle_test`` row of ``glsandbox tradeoffs`` and ``ray_triangle --set timing=on`` time."""
+    from glsandbox import meshgen, transforms
+
+    mesh = meshgen.icosphere(1)
+    model = transforms.translate(*(at * np.array(AWAY))) @ transforms.rotate_y(0.3) @ transforms.scale(2.0, 2.0, 2.0)
+    world = transforms.transform_points(model, np.asarray(mesh.positions, dtype=np.float64))
+    tris = np.asarray(mesh.indices, dtype=np.intp).reshape(-1, 3)
+    edges = np.array(sorted({tuple(sorted((int(t[k]), int(t[(k + 1) % 3])))) for t in tris for k in range(3)}))
+    targets = np.concatenate([world] + [world[edges[:, 0]] + f * (world[edges[:, 1]] - world[edges[:, 0]])
+                                        for f in EDGE_POINTS])
+    count = size[0] * size[1]
+    eyes = at * np.array(AWAY) + np.random.default_rng(21).uniform(-0.4, 0.4, (math.ceil(count / len(targets)), 3))
+    origins = np.repeat(eyes, len(targets), axis=0)[:count]
+    directions = np.tile(targets, (len(eyes), 1))[:count] - origins
+    return (world[tris[:, 0]], world[tris[:, 1]], world[tris[:, 2]]), origins, directions
+
+
+def nearest_by(test: str, tris: Triangles, origins: NDArray[np.float64],
+               directions: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The nearest ``t`` of each ray over every triangle (``inf``: none), by ``test``: ``"watertight"``
+    (:func:`nearest_watertight`) or ``"mt64"`` (Möller–Trumbore in float64,
+    :meth:`~glsandbox.raytrace.triangle.TriangleBatch.nearest_many`): the vectorised scans
+    the numpy engine runs, every pair tested."""
+    if test == "watertight":
+        return nearest_watertight(*tris, origins, directions)[0]
+    if test == "mt64":
+        from glsandbox.raytrace.triangle import TriangleBatch
+
+        return TriangleBatch(*tris).nearest_many(origins, directions)[0]
+    raise ValueError(f"unknown triangle test {test!r}; use watertight or mt64")

@@ -281,8 +281,10 @@ def overlays_over(scene: Scene, size: tuple[int, int], pixel: tuple[int, int]) -
     x, gl_y = pixel[0], height - 1 - pixel[1]  # overlays are placed in GL's rows (y up)
     lines = []
     for overlay in scene.overlays:
-        region = scene.viewports[overlay.viewport].pixels(width, height) if overlay.viewport is not None \
-            else (0, 0, width, height)
+        viewport = scene.viewports[overlay.viewport] if overlay.viewport is not None else None
+        region = viewport.pixels(width, height) if viewport is not None else (0, 0, width, height)
+        # A figure in the world (the exam's rays) is drawn where the camera sees it.
+        overlay = overlay.seen_by(viewport.camera if viewport is not None and viewport.camera else scene.camera, region)
         ox, oy, ow, oh = overlay.placement(region)
         if ox <= x < ox + ow and oy <= gl_y < oy + oh and overlay.image[oy + oh - 1 - gl_y, x - ox, 3] > 0:
             lines.append(f"the overlay {overlay.name!r} is drawn over this pixel: the frame shows it here, "

@@ -5,10 +5,11 @@ from __future__ import annotations
 import shlex
 
 import pytest
+from support import write_uniform_scene
 
 from glsandbox.camera import CameraInput
-from glsandbox.app.controls import (Clock, LiveCompare, camera_numbers, control_for, lesson_controls, number_range,
-                                set_line, to_text)
+from glsandbox.app.controls import (Clock, LiveCompare, Session, camera_numbers, control_for, lesson_controls,
+                                number_range, set_line, shader_uniforms, to_text, uniform_controls, uniform_value)
 from glsandbox.errors import SandboxError
 from glsandbox.lesson import all_lessons, find_lesson
 from glsandbox.transforms import ORDERS
@@ -108,3 +109,47 @@ def test_the_session_keeps_the_drawn_frame_not_later_edits() -> None:
     lesson.values["specular"] = False  # a panel edit after the frame: the next frame's
     assert session.drawn_line() == "--size 320x240 --samples 2 --set speed=0.0"
     assert session.plan_text() == plan(find_lesson("phong")(speed=0.0).scene()).describe()
+
+
+def scene_file_with_uniforms(tmp_path):
+    from glsandbox.lesson import scene_file_lesson
+
+    return scene_file_lesson(write_uniform_scene(tmp_path))
+
+
+def test_a_scene_files_uniforms_get_widgets_typed_from_their_values(tmp_path) -> None:
+    cls = scene_file_with_uniforms(tmp_path)
+    lesson = cls()
+    uniforms = shader_uniforms(lesson.scene())
+    assert uniforms == {"gain": 0.5, "base_color": (1.0, 0.5, 0.0), "offset": (0.1, 0.2), "flat_look": True}
+    controls = {c.param.name: c for c in uniform_controls(uniforms)}
+    assert {name: c.kind for name, c in controls.items()} == {
+        "u.gain": "slider_float", "u.base_color": "color", "u.offset": "drag_floats", "u.flat_look": "checkbox"}
+    gain = controls["u.gain"]
+    assert (gain.low, gain.high) == number_range(gain.param, 0.5) == (-2.0, 2.0)
+    assert controls["u.base_color"].param.default == (1.0, 0.5, 0.0)
+    # A widget's output becomes the value --set u.NAME would give, and the next scene has it.
+    assert uniform_value(controls["u.base_color"], [0.2, 1.5, -0.1]) == (0.2, 1.0, 0.0)
+    assert uniform_value(controls["u.offset"], [3, -4]) == (3.0, -4.0)
+    assert uniform_value(gain, 1) == 1.0 and uniform_value(controls["u.flat_look"], 0) is False
+    lesson.values["u.gain"] = uniform_value(gain, 1.25)
+    lesson.values["u.base_color"] = (0.0, 1.0, 0.0)
+    moved = shader_uniforms(lesson.scene())
+    assert moved["gain"] == 1.25 and moved["base_color"] == (0.0, 1.0, 0.0) and moved["offset"] == (0.1, 0.2)
+    # The window's copied line carries them: rendering it headless gives the same uniforms.
+    args = shlex.split(set_line(lesson, (64, 48)))
+    settings = [args[i + 1] for i, a in enumerate(args) if a == "--set"]
+    assert "u.gain=1.25" in settings and "u.base_color=0.0,1.0,0.0" in settings
+    assert shader_uniforms(cls.from_settings(settings).scene()) == moved
+
+
+def test_the_session_keeps_the_drawn_scenes_uniforms_and_a_scene_without_gets_none(tmp_path) -> None:
+    lesson = scene_file_with_uniforms(tmp_path)()
+    session = Session(lesson, Clock(0.0, 0.0), 0, CameraInput())
+    assert session.uniforms == {} and uniform_controls(session.uniforms) == []
+    session.record((64, 48), None, lesson.scene())
+    assert set(session.uniforms) == {"gain", "base_color", "offset", "flat_look"}
+    session.record((64, 48), None, find_lesson("phong")().scene())
+    assert session.uniforms == {}
+    with pytest.raises(SandboxError, match="u.offset"):
+        uniform_value(uniform_controls({"offset": (0.0, 0.0)})[0], [float("inf"), 0.0])

@@ -53,6 +53,18 @@ class PanelWindow(LessonWindow):
         self._xdotool("mousemove", "--sync", str(SIZE[0] + 50), str(SIZE[1] + 50))  # off the window: no tooltip
         time.sleep(0.2)  # a few frames: the press and release reach ImGui one frame apart
 
+    def hold(self, label: str, seconds: float = 0.4) -> None:
+        """Press on the middle of the widget's frame and hold a few frames (a slider takes the
+        value under the mouse only while its button stays down), then let go."""
+        x0, y0, x1, y1 = self._wait(lambda: self.items().get(label))
+        self._xdotool("mousemove", "--sync", str(int(x0 + 0.4 * (x1 - x0))), str(int((y0 + y1) / 2)))
+        self._xdotool("mousedown", "1")
+        time.sleep(seconds)
+        self._xdotool("mouseup", "1")
+        time.sleep(0.3)
+        self._xdotool("mousemove", "--sync", str(SIZE[0] + 50), str(SIZE[1] + 50))  # off the window: no tooltip
+        time.sleep(0.2)
+
     def shot(self) -> np.ndarray:
         """F12: the window's frame as drawn (never the panel)."""
         self.shots += 1
@@ -192,3 +204,37 @@ def test_the_panel_bench_row_without_a_display_says_why_in_one_line() -> None:
     assert proc.stderr.strip().splitlines() == [
         "error: --only panel: no benchmark case matched (see glsandbox bench); skipped: panel (window frame with "
         "the live controls): no display; run under Xvfb, e.g. xvfb-run glsandbox bench --only panel"]
+
+
+def test_a_scene_files_shader_uniforms_get_sliders_that_redraw_the_frame(window_env: str, tmp_path: Path,
+                                                                         gl) -> None:
+    """``glsandbox run scene.toml``: the shader's [nodes.uniforms] are widgets of their kinds; the
+    gain slider, pressed and held, redraws the frame with the new value, and the copied --set line
+    (``u.gain=...``) renders it headless pixel for pixel."""
+    from support import write_uniform_scene
+
+    from glsandbox.lesson import scene_file_lesson
+
+    scene = write_uniform_scene(tmp_path)
+    win = PanelWindow(window_env, tmp_path, "glsandbox.cli", "run", str(scene))
+    try:
+        win.wait_title(lambda t: "fps" in t)
+        items = win._wait(lambda: (found := win.items()) and "u.gain" in found and found)
+        before = win.shot()
+        win.hold("u.gain")  # on the slider, left of its label: somewhere in its range, -2..2
+        after = win.shot()
+        win.click("Time & camera")
+        win.click("copy --set line")
+    finally:
+        code = win.close()
+    assert code == 0
+    assert {"u.gain", "u.base_color", "u.offset", "u.flat_look"} <= set(items)
+    assert not np.array_equal(before, after)
+    lines = [ln for ln in win.proc.stderr.read().splitlines() if ln.startswith("set line: ")]
+    args = shlex.split(lines[-1].removeprefix("set line: "))
+    settings = [args[i + 1] for i, a in enumerate(args) if a == "--set"]
+    gain = [s for s in settings if s.startswith("u.gain=")]
+    assert gain and float(gain[0].split("=")[1]) != 0.5, settings
+    headless = gl.render(scene_file_lesson(scene).from_settings(settings), SIZE).image
+    np.testing.assert_array_equal(after, headless)
+    np.testing.assert_array_equal(before, gl.render(scene_file_lesson(scene)(), SIZE).image)

@@ -68,3 +68,43 @@ def test_ctrl_c_ends_the_command_within_2_s_with_exit_130(tmp_path: Path, name, 
         assert not (tmp_path / "bench.json").exists()
     # No temporary file of an atomic write left behind.
     assert not [p for p in tmp_path.rglob("*") if p.is_file() and ".tmp" in p.name], list(tmp_path.rglob("*"))
+
+
+#: A command interrupted in a process whose interpreter teardown would abort (as a C library's exit
+#: handler or a finaliser that finds its state cut short by the interrupt does): ``list`` raises
+#: KeyboardInterrupt, a module-level object aborts when the teardown frees it.
+TEARDOWN_ABORTS = """
+import atexit, os, sys
+from pathlib import Path
+import glsandbox.cli as cli
+
+class Teardown:
+    def __del__(self):
+        os.abort()
+
+keep = Teardown()
+mark = Path(sys.argv[1])
+atexit.register(lambda: mark.write_text("atexit ran"))
+
+def interrupted(args):
+    raise KeyboardInterrupt
+
+cli.cmd_list = interrupted
+sys.argv = ["glsandbox", "list"]
+sys.exit(cli.main())
+"""
+
+
+def test_ctrl_c_ends_with_130_after_the_exit_handlers_never_in_the_interpreters_teardown(tmp_path: Path) -> None:
+    """An interrupted command's process ends once the command has unwound and the Python exit
+    handlers ran: 130, never the SIGABRT (-6) of a teardown the interrupt left half-way."""
+    mark = tmp_path / "atexit.txt"
+    proc = subprocess.run([sys.executable, "-c", TEARDOWN_ABORTS, str(mark)], capture_output=True, text=True,
+                          cwd=REPO_ROOT, timeout=60)
+    assert proc.returncode == 130, (proc.returncode, proc.stderr[-500:])
+    assert proc.stderr.strip().splitlines() == ["interrupted"]
+    assert mark.read_text() == "atexit ran"
+    # The same process through Python's own exit aborts: what the test guards against.
+    plain = TEARDOWN_ABORTS.replace("sys.exit(cli.main())", "cli.run_guarded(lambda: interrupted(None))")
+    assert subprocess.run([sys.executable, "-c", plain, str(mark)], capture_output=True, cwd=REPO_ROOT,
+                          timeout=60).returncode == -6

@@ -101,7 +101,16 @@ wrap = "clamp"
 """
 
 
+def wood(tmp_path: Path) -> None:
+    """The image the LIT scene names, so that it loads (a scene file's texture is read with it)."""
+    from PIL import Image
+
+    (tmp_path / "images").mkdir(exist_ok=True)
+    Image.new("RGBA", (4, 4), (120, 80, 40, 255)).save(tmp_path / "images/wood.png")
+
+
 def test_lit_textured_nodes_load_with_paths_relative_to_the_scene_file(tmp_path: Path) -> None:
+    wood(tmp_path)
     node = load_scene(write(tmp_path, LIT)).nodes[0]
     m = node.material
     assert (m.shading, m.ambient, m.diffuse, m.specular, m.shininess, m.normals) == (
@@ -124,8 +133,31 @@ def test_lit_textured_nodes_load_with_paths_relative_to_the_scene_file(tmp_path:
     ],
 )
 def test_material_errors_name_the_line(tmp_path: Path, change: tuple[str, str], expected: str) -> None:
+    wood(tmp_path)
     with pytest.raises(SandboxError, match=expected):
         load_scene(write(tmp_path, LIT.replace(*change)))
+
+
+@pytest.mark.parametrize(("make", "reason"), [
+    (None, "not found"),
+    (lambda p: p.write_bytes(b"not a picture"), "is not an image Pillow can read"),
+    (lambda p: p.mkdir(), "is a folder, expected an image file"),
+])
+def test_a_texture_that_fails_to_load_names_the_scene_file_and_line(tmp_path: Path, make, reason: str) -> None:
+    (tmp_path / "images").mkdir()
+    if make is not None:
+        make(tmp_path / "images" / "wood.png")
+    message = error_of(tmp_path, LIT)
+    assert message.startswith("scene.toml:11: nodes[0].texture: texture file "), message
+    assert "images/wood.png" in message and reason in message
+
+
+def test_a_scene_files_missing_texture_is_one_error_line_through_the_cli(tmp_path: Path) -> None:
+    path = write(tmp_path, '[[nodes]]\nmesh = "cube24"\n\ntexture = "box"\n')
+    out = tmp_path / "x.png"
+    assert_user_error(run_cli("render", str(path), "--size", "16x16", "--out", str(out)),
+                      f"{path}:4: nodes[0].texture: texture file {tmp_path / 'box'} not found")
+    assert not out.exists()
 
 
 def test_a_lit_scene_file_renders_lit(tmp_path: Path, gl) -> None:

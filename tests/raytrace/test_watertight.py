@@ -1,16 +1,22 @@
 """The watertight test on many (ray, triangle) pairs (glsandbox/raytrace/watertight.py): the same
 float64 arithmetic as the scalar test, so the same ``t`` bit for bit; no ray slips between two
 triangles that share an edge; back faces skipped with culling; triangles without area never hit
-(Woop, Benthin & Wald 2013; the course's "Işın-Üçgen kesim testi")."""
+(Woop, Benthin & Wald 2013; the course's "Işın-Üçgen kesim testi").
+
+Also the scan's probe (:func:`glsandbox.raytrace.aimed_rays`): rays aimed at the vertices and edges of
+a closed mesh from inside it, and the two vectorised scans the report and ``ray_triangle`` time."""
 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import given, settings, strategies as st
 
+from glsandbox.raytrace import aimed_rays, nearest_by
 from glsandbox.raytrace.ray import Ray
 from glsandbox.raytrace.triangle import Triangle
 from glsandbox.raytrace.watertight import nearest_watertight, nondegenerate
+
 
 # A unit quad in the plane z = 0 as two triangles sharing the diagonal (0,0)-(1,1), both facing +z.
 QUAD = np.array([[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]],
@@ -66,3 +72,24 @@ def test_each_pairs_t_is_the_scalar_tests_bit_for_bit(values: list[float]) -> No
         assert index.tolist() == [-1] or scalar is not None
         return
     assert index.tolist() == [0] and t[0] == scalar
+
+
+def test_every_aimed_ray_hits_the_closed_mesh_at_the_point_it_aims_at() -> None:
+    tris, origins, directions = aimed_rays((32, 24))
+    assert origins.shape == directions.shape == (32 * 24, 3) and tris[0].shape == (80, 3)
+    t = nearest_by("watertight", tris, origins, directions)
+    assert np.all(np.isfinite(t))  # from inside a closed mesh no ray escapes
+    # The point aimed at is on the surface, so the nearest hit is there (t = 1), never beyond it.
+    assert np.all(t <= 1.0 + 1e-9) and np.median(t) == pytest.approx(1.0, abs=1e-9)
+    # Moller-Trumbore finds the same hits wherever it finds one.
+    mt = nearest_by("mt64", tris, origins, directions)
+    found = np.isfinite(mt)
+    assert found.mean() > 0.9 and np.allclose(mt[found], t[found], rtol=0, atol=1e-9)
+
+
+def test_the_probe_moves_with_the_mesh_and_unknown_tests_are_refused() -> None:
+    (a, _, _), origins, _ = aimed_rays((16, 12))
+    (b, _, _), moved, _ = aimed_rays((16, 12), 1e3)
+    assert np.allclose(b - a, 1e3 * np.array([0.99, 0.7, -0.4])) and np.allclose(moved - origins, b[0] - a[0])
+    with pytest.raises(ValueError, match="unknown triangle test 'mt32'"):
+        nearest_by("mt32", *aimed_rays((4, 3)))

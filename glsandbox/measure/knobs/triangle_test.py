@@ -18,49 +18,27 @@ the frame time divided by the pixels is the time per ray of the test alone.
 
 from __future__ import annotations
 
-import functools
-import math
-
 import numpy as np
 from numpy.typing import NDArray
 
-from glsandbox import transforms
-from glsandbox.mesh import generate as meshgen
 from glsandbox.measure.knob import Knob, PixelCount, Setting, register_knob
-from glsandbox.measure.knobs._far import DIRECTION
 from glsandbox.measure.render_context import RenderContext
-from glsandbox.raytrace.triangle import TriangleBatch
-from glsandbox.raytrace.watertight import nearest_watertight
+from glsandbox.raytrace import watertight
 
 #: The closed mesh: the icosphere subdivided once (42 vertices, 120 edges, 80
 #: triangles), radius 2, turned so no edge lies along an axis.
 SUBDIVISIONS = 1
-#: Where each edge is aimed at, as a share of the way along it (0.5: the midpoint).
-EDGE_POINTS = (0.3, 0.5, 0.71)
+EDGE_POINTS = watertight.EDGE_POINTS
 #: Hit and leak colours of a ray's pixel.
 HIT, LEAK = (200, 200, 200, 255), (255, 0, 0, 255)
 
-Triangles = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
+Triangles = watertight.Triangles
 
 
-@functools.lru_cache(maxsize=8)
 def aimed_rays(size: tuple[int, int], at: float) -> tuple[Triangles, NDArray[np.float64], NDArray[np.float64]]:
-    """The mesh's world triangles moved by ``at·DIRECTION``, and ``width·height`` rays
-    ``(origins, directions)`` in float64: each from one of a few eyes inside the mesh
-    (within 0.4 of its centre, the same eyes at every offset) to a vertex or a point of
-    an edge, every vertex and edge point in turn. ``t = 1`` at the point aimed at."""
-    mesh = meshgen.icosphere(SUBDIVISIONS)
-    model = transforms.translate(*(at * DIRECTION)) @ transforms.rotate_y(0.3) @ transforms.scale(2.0, 2.0, 2.0)
-    world = transforms.transform_points(model, np.asarray(mesh.positions, dtype=np.float64))
-    tris = np.asarray(mesh.indices, dtype=np.intp).reshape(-1, 3)
-    edges = np.array(sorted({tuple(sorted((int(t[k]), int(t[(k + 1) % 3])))) for t in tris for k in range(3)}))
-    targets = np.concatenate([world] + [world[edges[:, 0]] + f * (world[edges[:, 1]] - world[edges[:, 0]])
-                                        for f in EDGE_POINTS])
-    count = size[0] * size[1]
-    eyes = at * DIRECTION + np.random.default_rng(21).uniform(-0.4, 0.4, (math.ceil(count / len(targets)), 3))
-    origins = np.repeat(eyes, len(targets), axis=0)[:count]
-    directions = np.tile(targets, (len(eyes), 1))[:count] - origins
-    return (world[tris[:, 0]], world[tris[:, 1]], world[tris[:, 2]]), origins, directions
+    """The probe's triangles and rays (:func:`glsandbox.raytrace.watertight.aimed_rays`: moved along
+    its ``AWAY``, the far knobs' :data:`~glsandbox.measure.knobs._far.DIRECTION`)."""
+    return watertight.aimed_rays(size, at)
 
 
 def moller_trumbore_float32(tris: Triangles, origins: NDArray[np.float64], directions: NDArray[np.float64],
@@ -97,10 +75,8 @@ def moller_trumbore_float32(tris: Triangles, origins: NDArray[np.float64], direc
 def nearest_t(test: str, tris: Triangles, origins: NDArray[np.float64],
               directions: NDArray[np.float64]) -> NDArray[np.float64]:
     """The nearest ``t`` of each ray over every triangle by ``test`` (``inf``: it leaked)."""
-    if test == "watertight":  # the course's vectorized watertight scan
-        return nearest_watertight(*tris, origins, directions)[0]
-    if test == "mt64":  # the course's vectorized Möller–Trumbore, float64
-        return TriangleBatch(*tris).nearest_many(origins, directions)[0]
+    if test in ("watertight", "mt64"):  # the course's vectorised scans, float64 (ray_triangle times these)
+        return watertight.nearest_by(test, tris, origins, directions)
     return moller_trumbore_float32(tris, origins, directions)
 
 
