@@ -329,7 +329,8 @@ def aimed_rays(size: tuple[int, int], at: float = 0.0) -> tuple[Triangles, NDArr
     edge, every vertex and edge point in turn, ``t = 1`` there. A ray that finds no triangle
     slipped through a crack: what the watertight test never lets happen. The rays the
     ``triangle_test`` row of ``glsandbox tradeoffs`` and ``ray_triangle --set timing=on`` time."""
-    from glsandbox import meshgen, transforms
+    from glsandbox import transforms
+    from glsandbox.mesh import generate as meshgen
 
     mesh = meshgen.icosphere(1)
     model = transforms.translate(*(at * np.array(AWAY))) @ transforms.rotate_y(0.3) @ transforms.scale(2.0, 2.0, 2.0)
