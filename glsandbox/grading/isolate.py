@@ -62,11 +62,13 @@ _HEADER = struct.Struct("!4sIQ")  # magic, JSON header length, payload length
 
 @dataclass(frozen=True)
 class Render:
-    """One picture to render: the lesson's ``--set`` values, the size and MSAA samples."""
+    """One picture to render: the lesson's ``--set`` values, the size and MSAA samples, and a
+    nudge of the camera (a reference's margin, :data:`glsandbox.measure.margin.NUDGES`; none: ``()``)."""
 
     settings: tuple[str, ...]
     size: tuple[int, int]
     samples: int = 0
+    nudge: tuple[float, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -162,12 +164,13 @@ def _job_data(job: Job) -> dict:
     return {"index": job.index, "source": job.source, "target": job.target, "backend": job.backend,
             "timeout": job.timeout, "memory_mb": job.memory_mb, "copy": job.copy, "writes_cache": job.writes_cache,
             "entry": job.entry, "describe": job.describe,
-            "renders": [{"settings": list(r.settings), "size": list(r.size), "samples": r.samples}
-                        for r in job.renders]}
+            "renders": [{"settings": list(r.settings), "size": list(r.size), "samples": r.samples,
+                         "nudge": list(r.nudge)} for r in job.renders]}
 
 
 def job_from(data: dict) -> Job:
-    renders = tuple(Render(tuple(r["settings"]), tuple(r["size"]), r["samples"]) for r in data.pop("renders"))
+    renders = tuple(Render(tuple(r["settings"]), tuple(r["size"]), r["samples"], tuple(r.get("nudge", ())))
+                    for r in data.pop("renders"))
     return Job(renders=renders, **data)
 
 
