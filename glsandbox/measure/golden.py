@@ -147,12 +147,11 @@ class ImageMatch:
             )
         if self.identical:
             return f"{verdict}: identical ({self.total_pixels} pixels)"
-        inside = (f" ({self.margin_pixels} pixels inside the reference's margin)"
-                  if self.with_margin else "")
+        inside = f" {self.margin_pixels} differing inside the reference's margin," if self.with_margin else ""
         return (
             f"{verdict}: {self.bad_pixels} bad of {self.total_pixels} pixels"
             f" ({self.bad_share:.4%}, allowed {self.max_bad_share:.4%}),"
-            f" max channel diff {self.max_diff} (threshold {self.threshold}{inside}),"
+            f" max channel diff {self.max_diff} (threshold {self.threshold}),{inside}"
             f" RMSE {self.rmse:.5f}, PSNR {self.psnr:.2f} dB"
         )
 

@@ -64,7 +64,7 @@ def test_the_golden_rule_with_a_margin_allows_each_pixel_its_own_difference_and_
     assert not plain.passed and plain.bad_pixels == 1
     within = compare_images(actual, expected, max_bad_share=0.0, margin=margin)
     assert within.passed and within.bad_pixels == 0 and within.margin_pixels == 1
-    assert "1 pixels inside the reference's margin" in within.summary()
+    assert "(threshold 2), 1 differing inside the reference's margin, RMSE" in within.summary()
 
     margin[10, 10] = 5  # a margin smaller than the difference does not excuse it
     assert compare_images(actual, expected, max_bad_share=0.0, margin=margin).bad_pixels == 1
