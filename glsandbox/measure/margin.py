@@ -44,7 +44,7 @@ only where a move of an eighth of a pixel changes the model answer itself,
 and only by as much as that move changes it. A wrong submission (a wrong
 colour, light, transform or shader) differs inside its surfaces, where the
 margin is 0, and fails as before; only the pixels on a decision boundary,
-typically a few percent of a picture (``benchmarks/margin_share.py``), may
+typically a few percent of a picture (``benchmarks/_margin_share.py`` prints the share per lesson), may
 differ, by at most the amount the nudge showed.
 """
 
@@ -65,8 +65,8 @@ from glsandbox.errors import SandboxError
 from glsandbox.lesson import Lesson
 from glsandbox.scene import Camera, Scene, moved_scene
 
-__all__ = ["NUDGES", "margin_path", "nudged_scene", "nudged_image", "margin_from", "inside_share",
-           "save_margin", "read_margin"]
+__all__ = ["NUDGES", "margin_path", "nudged_camera", "nudged_scene", "nudged_image", "margin_from", "inside_share",
+           "save_margin", "read_margin", "lesson_margin", "share_rows"]
 
 #: How far a nudge moves the camera, in pixels at the image centre.
 STEP = 0.125
@@ -172,3 +172,24 @@ def read_margin(reference: Path, shape: tuple[int, ...]) -> np.ndarray | None:
         raise
     except (OSError, ValueError, SyntaxError):
         raise SandboxError(f"margin {path}: not a PNG image ({len(data)} bytes that PNG cannot read)") from None
+
+
+def lesson_margin(renderer, lesson: Lesson, size: tuple[int, int], samples: int = 0,
+                  threshold: int = 2) -> tuple[np.ndarray, np.ndarray]:
+    """``lesson``'s picture and its margin, drawn in this process by ``renderer`` (what
+    ``check --update`` writes, without the isolation a student's code needs)."""
+    reference = renderer.render(lesson, size, samples).image
+    nudged = [nudged_image(renderer, lesson, size, samples, nudge) for nudge in NUDGES]
+    return reference, margin_from(reference, nudged, threshold)
+
+
+def share_rows(renderer, lessons: Sequence[type[Lesson]], size: tuple[int, int]) -> list[tuple[str, float, int, int]]:
+    """For each lesson at its defaults: (name, share of pixels inside the margin, the median and
+    the largest allowance among them, in levels)."""
+    rows = []
+    for cls in lessons:
+        _, margin = lesson_margin(renderer, cls(), size)
+        inside = margin[margin > 0]
+        rows.append((cls.name, inside_share(margin), int(np.median(inside)) if inside.size else 0,
+                     int(inside.max()) if inside.size else 0))
+    return rows

@@ -12,8 +12,8 @@ from glsandbox.files import save_png
 from glsandbox.lesson import find_lesson
 from glsandbox.measure import golden
 from glsandbox.measure.golden import compare_images, write_artifacts
-from glsandbox.measure.margin import (NUDGES, inside_share, margin_from, margin_path, nudged_camera, nudged_image,
-                                      read_margin, save_margin)
+from glsandbox.measure.margin import (NUDGES, inside_share, lesson_margin, margin_from, margin_path, nudged_camera,
+                                      nudged_image, read_margin, save_margin, share_rows)
 from glsandbox.scene import Camera
 
 
@@ -129,3 +129,25 @@ def test_the_nudged_pictures_of_a_lesson_mark_its_edges_not_its_surfaces(gl) -> 
     assert 0.002 < share < 0.06, share  # a thin share: the silhouettes and the horizon
     # the sky above the lights and the ground in front are far from every decision
     assert not margin[:25].any() and not margin[100:].any()
+
+
+def test_a_lesson_near_decisions_everywhere_still_fails_every_wrong_setting(gl) -> None:
+    """The texture lesson's far checkerboard is near a texel decision in a third of its pixels;
+    a wrong filter, wrap or tiling still fails by far more than the allowed share."""
+    lesson = find_lesson("texture")
+    size = (160, 120)
+    reference, margin = lesson_margin(gl, lesson(), size)
+    assert 0.1 < inside_share(margin) < 0.5
+    assert compare_images(gl.render(lesson(), size).image, reference, margin=margin).identical
+    for wrong in ("filter=mip_nearest", "wrap=clamp", "tile=3.1", "image=checker"):
+        image = gl.render(lesson.from_settings([wrong]), size).image
+        match = compare_images(image, reference, margin=margin)
+        assert not match.passed and match.bad_share > 0.02, (wrong, match.summary())
+
+
+def test_the_share_rows_name_each_lesson_with_its_share_and_allowances(gl) -> None:
+    rows = share_rows(gl, [find_lesson("clear_and_swap"), find_lesson("phong")], (80, 60))
+    assert [r[0] for r in rows] == ["clear_and_swap", "phong"]
+    assert rows[0][1:] == (0.0, 0, 0)  # a cleared screen decides nothing
+    name, share, median, largest = rows[1]
+    assert 0.0 < share < 0.1 and 2 < median <= largest <= 255
