@@ -553,6 +553,7 @@ def cmd_check(args: argparse.Namespace) -> int:
             print(f"{args.lesson}: {one.status}: {one.error}")
             failed = True
             continue
+        margin_line = ""  # with --update: the margin written beside the reference
         if one.margin_share is not None:
             from glsandbox.measure.margin import margin_path
 

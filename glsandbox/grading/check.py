@@ -487,7 +487,7 @@ def render_isolated(spec: str, checks: Sequence[Check], sizes: Sequence[tuple[in
     pictures, for the margins)."""
     renders = tuple(Render(c.settings, size, c.samples) for c, size in zip(checks, sizes))
     if model_answer:
-        renders += tuple(Render(c.settings, size, c.samples, nudge) for c, size in zip(checks, sizes)
+        renders += tuple(Render(c.settings, size, c.samples, nudge=nudge) for c, size in zip(checks, sizes)
                          for nudge in NUDGES)
     path = Path(spec)
     if spec.endswith((".py", ".toml")):

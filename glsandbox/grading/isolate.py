@@ -169,7 +169,7 @@ def _job_data(job: Job) -> dict:
 
 
 def job_from(data: dict) -> Job:
-    renders = tuple(Render(tuple(r["settings"]), tuple(r["size"]), r["samples"], tuple(r.get("nudge", ())))
+    renders = tuple(Render(tuple(r["settings"]), tuple(r["size"]), r["samples"], nudge=tuple(r.get("nudge", ())))
                     for r in data.pop("renders"))
     return Job(renders=renders, **data)
 
