@@ -555,15 +555,24 @@ def cmd_check(args: argparse.Namespace) -> int:
             print(f"{args.lesson}: {one.status}: {one.error}")
             failed = True
             continue
+        margin_line = ""  # with --update: the margin written beside the reference
+        if one.margin_share is not None:
+            from glsandbox.measure.margin import margin_path
+
+            margin_line = (f"wrote margin {margin_path(reference)} ({one.margin_share:.2%} of its pixels near a "
+                           "decision may differ)")
         if one.updated == "written":
             print(f"wrote reference {reference}")
+            print(margin_line)
             continue
         print(f"{args.lesson}: {one.match.summary()}")
         if one.updated == "rewritten":
             print(f"rewrote reference {reference}")
+            print(margin_line)
             continue
         if one.updated == "unchanged":
             print(f"reference {reference} unchanged (it passes)")
+            print(margin_line)
             continue
         for kind, path in one.artifacts.items():
             print(f"  {kind:<8}: {path}")

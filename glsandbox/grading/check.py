@@ -40,6 +40,7 @@ from glsandbox.errors import SandboxError
 from glsandbox.frame import DEFAULT_SIZE, Frame, HeadlessRenderer
 from glsandbox.lesson import Lesson, entry_point, lesson_files, user_code_error
 from glsandbox.measure.golden import DEFAULT_THRESHOLD, ImageMatch, compare_images, write_artifacts
+from glsandbox.measure.margin import NUDGES, inside_share, margin_from, margin_path, read_margin, save_margin
 from glsandbox.grading.isolate import BROKEN, CRASHED, OOM, TIMEOUT, Job, JobResult, Picture, Render
 from glsandbox.grading.runner import run_jobs
 from glsandbox.grading.kinds import kind_of
@@ -205,19 +206,20 @@ def _thumbnail(image: np.ndarray) -> np.ndarray:
 
 
 def judge(actual: np.ndarray, expected: np.ndarray, tolerances: dict[str, float], artifacts_dir: Path,
-          artifact_name: str) -> tuple[ImageMatch, dict[str, Path]]:
-    """Compare; on a failure write ``<name>-actual.png``, ``-expected.png``, ``-diff.png`` into ``artifacts_dir``."""
-    match = compare_images(actual, expected, **tolerances)
+          artifact_name: str, margin: np.ndarray | None = None) -> tuple[ImageMatch, dict[str, Path]]:
+    """Compare (with the reference's ``margin`` when it has one); on a failure write
+    ``<name>-actual.png``, ``-expected.png``, ``-diff.png`` into ``artifacts_dir``."""
+    match = compare_images(actual, expected, **tolerances, margin=margin)
     if match.passed:
         return match, {}
-    return match, _artifacts(actual, expected, tolerances, artifacts_dir, artifact_name)
+    return match, _artifacts(actual, expected, tolerances, artifacts_dir, artifact_name, margin)
 
 
 def _artifacts(actual: np.ndarray, expected: np.ndarray, tolerances: dict[str, float], artifacts_dir: Path,
-               artifact_name: str) -> dict[str, Path]:
+               artifact_name: str, margin: np.ndarray | None = None) -> dict[str, Path]:
     try:
         return write_artifacts(actual, expected, artifacts_dir, artifact_name,
-                               threshold=int(tolerances.get("threshold", DEFAULT_THRESHOLD)))
+                               threshold=int(tolerances.get("threshold", DEFAULT_THRESHOLD)), margin=margin)
     except OSError as exc:
         raise SandboxError(f"{artifacts_dir}: cannot write the diff images ({exc.strerror or exc})") from None
 
@@ -355,22 +357,26 @@ LINK_ERROR = "is a link (a submission is its own files, not a link to others')"
 
 
 def _outcomes(result: JobResult, checks: Sequence[Check], references: dict[Path, np.ndarray],
-              name: str) -> list[Outcome]:
+              name: str, margins: dict[Path, np.ndarray | None] | None = None) -> list[Outcome]:
     outcomes = []
     for check, picture in zip(checks, result.pictures):
-        outcomes.append(_outcome(check, picture, references[check.golden], name))
+        outcomes.append(_outcome(check, picture, references[check.golden], name,
+                                 (margins or {}).get(check.golden)))
     return outcomes
 
 
-def _outcome(check: Check, picture: Picture, expected: np.ndarray, name: str) -> Outcome:
-    """What came back for ``check``, judged by its kind (:mod:`glsandbox.grading.kinds`); a failed
-    comparison's pictures go into :func:`results_dir`."""
+def _outcome(check: Check, picture: Picture, expected: np.ndarray, name: str,
+             margin: np.ndarray | None = None) -> Outcome:
+    """What came back for ``check``, judged by its kind (:mod:`glsandbox.grading.kinds`; a picture
+    with its reference's ``margin`` when there is one); a failed comparison's pictures go into
+    :func:`results_dir`."""
     if picture.image is None:
         return Outcome(check, picture.status or CRASHED, error=shown(picture.error), seconds=picture.seconds)
-    verdict = kind_of(check.kind).judge(check, picture.image, expected)
+    extra = {"margin": margin} if margin is not None else {}
+    verdict = kind_of(check.kind).judge(check, picture.image, expected, **extra)
     paths: dict[str, Path] = {}
     if not verdict.passed and verdict.match is not None:
-        paths = _artifacts(picture.image, expected, check.tolerances, results_dir(check), file_stem(name))
+        paths = _artifacts(picture.image, expected, check.tolerances, results_dir(check), file_stem(name), margin)
     return Outcome(check, PASS if verdict.passed else FAIL, verdict.match, error=verdict.detail,
                    seconds=picture.seconds, artifacts=paths, thumb=_thumbnail(picture.image),
                    first_difference=None if verdict.passed else first_difference(picture.image, expected, check))
@@ -425,6 +431,12 @@ def read_references(checks: Sequence[Check]) -> dict[Path, np.ndarray]:
     return references
 
 
+def read_margins(references: dict[Path, np.ndarray]) -> dict[Path, np.ndarray | None]:
+    """Each reference's margin (``NAME.margin.png`` beside it, :mod:`glsandbox.measure.margin`),
+    None where it has none; read by the grader, like the references."""
+    return {path: read_margin(path, image.shape) for path, image in references.items()}
+
+
 def check_folder(folder: Path, checks: Sequence[Check], backend: str | None = None, limits: Limits = Limits(),
                  progress: Callable[[int, int, CheckResult], None] = lambda done, total, result: None,
                  entry: str | None = None, one: bool = False,
@@ -446,6 +458,7 @@ def check_folder(folder: Path, checks: Sequence[Check], backend: str | None = No
         raise SandboxError(f"{folder}: no .py or .toml lesson files (nor subfolders holding one)")
     found = [e for e in found if keep(e[0])]
     references = read_references(checks)
+    margins = read_margins(references)
     renders = _renders(checks, references)
     links = [(name, source) for name, source, _ in found if source.is_symlink()]
     entries = submission_jobs([e for e in found if not e[1].is_symlink()], renders, backend, limits, entry)
@@ -465,7 +478,7 @@ def check_folder(folder: Path, checks: Sequence[Check], backend: str | None = No
 
     def done(result: JobResult) -> None:
         name, path = by_index[result.job.index]
-        record(CheckResult(name, path, _outcomes(result, checks, references, name),
+        record(CheckResult(name, path, _outcomes(result, checks, references, name, margins),
                            [shown(line) for line in result.output]))
 
     results = run_jobs([job for _, _, job in entries], limits.jobs, done) if entries else []
@@ -514,8 +527,13 @@ def render_submissions(folder: Path, size: tuple[int, int], samples: int, backen
 def render_isolated(spec: str, checks: Sequence[Check], sizes: Sequence[tuple[int, int]],
                     backend: str | None, limits: Limits, model_answer: bool = False) -> JobResult:
     """One lesson (a name or a file) rendered once per check in an isolated child, its folder as its root
-    (``model_answer``: its compiled shaders are kept in Mesa's cache, for the submissions)."""
+    (``model_answer``: its compiled shaders are kept in Mesa's cache, for the submissions, and each
+    check's picture is followed, after all of them, by its :data:`~glsandbox.measure.margin.NUDGES`
+    pictures, for the margins)."""
     renders = tuple(Render(c.settings, size, c.samples) for c, size in zip(checks, sizes))
+    if model_answer:
+        renders += tuple(Render(c.settings, size, c.samples, nudge=nudge) for c, size in zip(checks, sizes)
+                         for nudge in NUDGES)
     path = Path(spec)
     if spec.endswith((".py", ".toml")):
         job = Job(0, str(path.resolve()), path.name, renders, backend, limits.timeout, limits.memory, copy=False,
@@ -543,6 +561,8 @@ class OneCheck:
     updated: str = ""
     status: str = ""
     error: str = ""
+    #: With ``--update``: the share of the reference's pixels inside the margin written beside it.
+    margin_share: float | None = None
 
 
 def check_one(spec: str, checks: Sequence[Check], update: bool, backend: str | None = None,
@@ -567,23 +587,43 @@ def check_one(spec: str, checks: Sequence[Check], update: bool, backend: str | N
         if missing is not None:
             raise SandboxError(f"reference {missing.golden} not found; write it with --update")
     out = []
-    for check, picture in zip(checks, result.pictures):
+    for index, (check, picture) in enumerate(zip(checks, result.pictures)):
         if picture.image is None:
             out.append(OneCheck(check, status=picture.status, error=shown(picture.error)))
             continue
         expected = existing.get(check.golden)
         if expected is None:
             _write_reference(picture.image, check.golden)
-            out.append(OneCheck(check, updated="written"))
+            one = OneCheck(check, updated="written")
         elif update:
             match = compare_images(picture.image, expected, **check.tolerances)
             if not match.passed:
                 _write_reference(picture.image, check.golden)
-            out.append(OneCheck(check, match, updated="unchanged" if match.passed else "rewritten"))
+            one = OneCheck(check, match, updated="unchanged" if match.passed else "rewritten")
         else:
-            match, paths = judge(picture.image, expected, check.tolerances, check.golden.parent, check.golden.stem)
+            margin = read_margin(check.golden, expected.shape)
+            match, paths = judge(picture.image, expected, check.tolerances, check.golden.parent, check.golden.stem,
+                                 margin)
             out.append(OneCheck(check, match, paths))
+            continue
+        reference = picture.image if one.updated != "unchanged" else expected
+        nudged = result.pictures[len(checks) + index * len(NUDGES):len(checks) + (index + 1) * len(NUDGES)]
+        one.margin_share = _write_margin(check, reference, nudged)
+        out.append(one)
     return out
+
+
+def _write_margin(check: Check, reference: np.ndarray, nudged: Sequence[Picture]) -> float:
+    """The margin of a reference just written or kept, from the model answer's nudged pictures,
+    written beside it (:mod:`glsandbox.measure.margin`); the share of its pixels inside."""
+    failed = next((p for p in nudged if p.image is None), None)
+    if failed is not None:
+        raise SandboxError(f"margin {margin_path(check.golden)}: a nudged picture of the model answer did not "
+                           f"render ({failed.status}: {shown(failed.error)})")
+    threshold = int(check.tolerances.get("threshold", DEFAULT_THRESHOLD))
+    margin = margin_from(reference, [p.image for p in nudged], threshold)
+    save_margin(margin, margin_path(check.golden))
+    return inside_share(margin)
 
 
 def _write_reference(image: np.ndarray, path: Path) -> None:

@@ -40,6 +40,7 @@ from pathlib import Path
 from glsandbox import files
 from glsandbox.errors import SandboxError
 from glsandbox.grading.check import read_references
+from glsandbox.measure.margin import margin_path
 from glsandbox.grading.rubric import Check, Rubric, load_rubric
 
 __all__ = ["build_bundle", "bundle_rubric", "glsandbox_wheel", "RUBRIC_NAME", "SETUP_SH", "RUN_AUTOGRADER"]
@@ -256,6 +257,9 @@ def build_bundle(assignment: Path, out: Path, wheel: Path | None = None) -> list
             (RUBRIC_NAME, bundle_rubric(rubric, goldens).encode(), 0o644)]
         entries += [(name, files.read_user_file(path, "reference", "a .png file"), 0o644)
                     for path, name in goldens.items()]
+        # each golden's margin beside it, under the bundle's name (glsandbox.measure.margin)
+        entries += [(str(margin_path(name)), files.read_user_file(margin_path(path), "margin", "a .png file"), 0o644)
+                    for path, name in goldens.items() if margin_path(path).exists()]
         entries.append((built.name, built.read_bytes(), 0o644))
 
         def write(handle) -> None:

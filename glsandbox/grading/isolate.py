@@ -62,7 +62,8 @@ _HEADER = struct.Struct("!4sIQ")  # magic, JSON header length, payload length
 
 @dataclass(frozen=True)
 class Render:
-    """One picture to render: the lesson's ``--set`` values, the size and MSAA samples."""
+    """One picture to render: the lesson's ``--set`` values, the size and MSAA samples, and a
+    nudge of the camera (a reference's margin, :data:`glsandbox.measure.margin.NUDGES`; none: ``()``)."""
 
     settings: tuple[str, ...]
     size: tuple[int, int]
@@ -70,6 +71,7 @@ class Render:
     #: A pixel (x, y from the top) whose story (``glsandbox explain``) comes back with the picture:
     #: told in the renderer, of the submission's own scene, as text (a failed picture's first difference).
     explain: tuple[int, int] | None = None
+    nudge: tuple[float, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -177,12 +179,14 @@ def _job_data(job: Job) -> dict:
             "timeout": job.timeout, "memory_mb": job.memory_mb, "copy": job.copy, "writes_cache": job.writes_cache,
             "entry": job.entry, "describe": job.describe,
             "renders": [{"settings": list(r.settings), "size": list(r.size), "samples": r.samples,
-                         "explain": None if r.explain is None else list(r.explain)} for r in job.renders]}
+                         "explain": None if r.explain is None else list(r.explain),
+                         "nudge": list(r.nudge)} for r in job.renders]}
 
 
 def job_from(data: dict) -> Job:
     renders = tuple(Render(tuple(r["settings"]), tuple(r["size"]), r["samples"],
-                           None if r.get("explain") is None else (int(r["explain"][0]), int(r["explain"][1])))
+                           None if r.get("explain") is None else (int(r["explain"][0]), int(r["explain"][1])),
+                           nudge=tuple(r.get("nudge", ())))
                     for r in data.pop("renders"))
     return Job(renders=renders, **data)
 

@@ -41,12 +41,13 @@ class CheckKind:
     """One kind of check: its name in a rubric, the keys it reads, and its judge.
 
     ``judge(check, image, expected)`` judges what the submission sent back
-    for ``check`` against the reference the grader read for it.
+    for ``check`` against the reference the grader read for it (a picture's
+    judge is also given ``margin=``, the reference's, where it has one).
     """
 
     name: str
     keys: frozenset[str]
-    judge: Callable[[Check, np.ndarray, np.ndarray], Verdict]
+    judge: Callable[..., Verdict]
     summary: str = ""
 
 
@@ -70,9 +71,11 @@ def known() -> list[str]:
     return sorted(KINDS)
 
 
-def judge_picture(check: Check, image: np.ndarray, expected: np.ndarray) -> Verdict:
-    """The ``picture`` kind: the rendered image against the reference by the check's tolerances."""
-    match = compare_images(image, expected, **check.tolerances)
+def judge_picture(check: Check, image: np.ndarray, expected: np.ndarray,
+                  margin: np.ndarray | None = None) -> Verdict:
+    """The ``picture`` kind: the rendered image against the reference by the check's tolerances,
+    and the reference's per-pixel ``margin`` (:mod:`glsandbox.measure.margin`) when it has one."""
+    match = compare_images(image, expected, **check.tolerances, margin=margin)
     return Verdict(match.passed, match)
 
 

@@ -136,11 +136,19 @@ def render_job(job: Job, renderer, root: str, target: str, out: int) -> None:
     for index, render in enumerate(job.renders):
         started = time.perf_counter()
         try:
-            frame = renderer.render(cls.from_settings(render.settings), render.size, render.samples)
-            image = np.ascontiguousarray(frame.image, dtype=np.uint8)
+            if render.nudge:  # a model answer's picture for its margin
+                from glsandbox.measure.margin import nudged_image
+
+                frame = None
+                image = nudged_image(renderer, cls.from_settings(render.settings), render.size, render.samples,
+                                     render.nudge)
+            else:
+                frame = renderer.render(cls.from_settings(render.settings), render.size, render.samples)
+                image = frame.image
+            image = np.ascontiguousarray(image, dtype=np.uint8)
             header = {"kind": "image", "index": index, "shape": list(image.shape),
                       "seconds": time.perf_counter() - started}
-            if job.describe:
+            if job.describe and frame is not None:
                 header["info"] = {"plan": frame.plan.to_dict(), "plan_text": frame.plan.describe()}
             if render.explain is not None:
                 header["story"] = _story(cls, render, renderer)

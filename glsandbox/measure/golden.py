@@ -103,6 +103,9 @@ class ImageMatch:
         expected_shape: shape of the expected array.
         updated: set by :func:`check_golden` when it (re)wrote the golden; the
             other figures then describe the image that was replaced.
+        margin_pixels: pixels that differ by more than ``threshold`` where the
+            reference's margin allows more (:mod:`glsandbox.measure.margin`).
+        with_margin: whether a margin took part.
     """
 
     passed: bool
@@ -117,6 +120,8 @@ class ImageMatch:
     actual_shape: tuple[int, ...] = ()
     expected_shape: tuple[int, ...] = ()
     updated: bool = False
+    margin_pixels: int = 0
+    with_margin: bool = False
 
     @property
     def shape_mismatch(self) -> bool:
@@ -142,10 +147,11 @@ class ImageMatch:
             )
         if self.identical:
             return f"{verdict}: identical ({self.total_pixels} pixels)"
+        inside = f" {self.margin_pixels} differing inside the reference's margin," if self.with_margin else ""
         return (
             f"{verdict}: {self.bad_pixels} bad of {self.total_pixels} pixels"
             f" ({self.bad_share:.4%}, allowed {self.max_bad_share:.4%}),"
-            f" max channel diff {self.max_diff} (threshold {self.threshold}),"
+            f" max channel diff {self.max_diff} (threshold {self.threshold}),{inside}"
             f" RMSE {self.rmse:.5f}, PSNR {self.psnr:.2f} dB"
         )
 
@@ -164,24 +170,27 @@ def _check_image(image: npt.ArrayLike, what: str) -> np.ndarray:
     return arr
 
 
-def _close(x: np.ndarray, y: np.ndarray, threshold: int) -> np.ndarray:
+def _close(x: np.ndarray, y: np.ndarray, threshold: int | np.ndarray) -> np.ndarray:
     """Whether every channel of ``x`` and ``y`` (uint8, channels last) is within ``threshold``.
 
     Returns a bool array with the channel axis dropped. ``max - min`` is
     ``|x - y|`` without leaving uint8. For RGBA the four per-channel booleans
     are read as one uint32, equal to 0x01010101 exactly when all are true,
     which is several times faster than a reduction over a length-4 axis.
+    ``threshold`` is one number, or one per pixel (uint8, the shape of ``x``
+    without its channel axis: a margin, :mod:`glsandbox.measure.margin`).
     """
     d = np.maximum(x, y)
     d -= np.minimum(x, y)
-    ok = d <= min(threshold, 255)
+    ok = d <= (min(threshold, 255) if np.isscalar(threshold) else threshold[..., None])
     if ok.shape[-1] == 4:
         return ok.view(np.uint32)[..., 0] == 0x01010101
     return ok.all(axis=-1)
 
 
 def _bad_mask(
-    actual: np.ndarray, expected: np.ndarray, threshold: int, *, dense: bool | None = None
+    actual: np.ndarray, expected: np.ndarray, threshold: int, *, dense: bool | None = None,
+    margin: np.ndarray | None = None,
 ) -> np.ndarray:
     """Boolean (H, W) mask of bad pixels for two same-shape uint8 (H, W, C) images.
 
@@ -189,8 +198,12 @@ def _bad_mask(
     When they are few (the usual case for a near miss) the 3x3 neighbours of
     just those pixels are gathered; when they are many, whole shifted images
     are compared, which is cheaper per pixel. ``dense`` forces either path
-    (for tests); both give the same mask.
+    (for tests); both give the same mask. ``margin`` (uint8 (H, W)): each
+    pixel's own threshold where it is larger (a pixel near a decision, in
+    both the direct comparison and its neighbourhood's).
     """
+    if margin is not None:
+        threshold = np.maximum(margin, np.uint8(min(threshold, 255)))
     candidates = ~_close(actual, expected, threshold)
     n = int(np.count_nonzero(candidates))
     if n == 0:
@@ -215,11 +228,12 @@ def _bad_mask(
     ys, xs = np.nonzero(candidates)
     a_px = actual[ys, xs]  # (n, C)
     e_px = expected[ys, xs]
+    near = threshold if np.isscalar(threshold) else threshold[ys, xs]
     a_hit = np.zeros(n, dtype=bool)
     e_hit = np.zeros(n, dtype=bool)
     for dy, dx in offsets:
-        a_hit |= _close(a_px, e_pad[ys + dy, xs + dx], threshold)
-        e_hit |= _close(e_px, a_pad[ys + dy, xs + dx], threshold)
+        a_hit |= _close(a_px, e_pad[ys + dy, xs + dx], near)
+        e_hit |= _close(e_px, a_pad[ys + dy, xs + dx], near)
     bad = np.zeros_like(candidates)
     bad[ys, xs] = ~(a_hit & e_hit)
     return bad
@@ -231,6 +245,7 @@ def compare_images(
     *,
     threshold: int = DEFAULT_THRESHOLD,
     max_bad_share: float = DEFAULT_MAX_BAD_SHARE,
+    margin: npt.ArrayLike | None = None,
 ) -> ImageMatch:
     """Compare two uint8 RGBA images of shape (H, W, 4) with the golden rule.
 
@@ -240,6 +255,9 @@ def compare_images(
         threshold: largest channel difference, in levels, that still matches.
         max_bad_share: largest share (0..1) of bad pixels that still passes;
             the comparison fails when ``bad_share > max_bad_share``.
+        margin: the reference's margin (uint8, (H, W) of ``expected``;
+            :mod:`glsandbox.measure.margin`): a pixel's own threshold where
+            it is larger than ``threshold``.
 
     Returns:
         A :class:`ImageMatch`. Different shapes give ``passed=False`` with a
@@ -255,11 +273,13 @@ def compare_images(
         raise ValueError(f"threshold must be >= 0, got {threshold}")
     if not 0.0 <= max_bad_share <= 1.0:
         raise ValueError(f"max_bad_share must be within 0..1, got {max_bad_share}")
+    allowance = _check_margin(margin, e.shape)
     common = dict(
         threshold=int(threshold),
         max_bad_share=float(max_bad_share),
         actual_shape=tuple(a.shape),
         expected_shape=tuple(e.shape),
+        with_margin=allowance is not None,
     )
     total = int(e.shape[0] * e.shape[1])
 
@@ -286,7 +306,10 @@ def compare_images(
             **common,
         )
 
-    bad = int(np.count_nonzero(_bad_mask(a, e, int(threshold))))
+    bad = int(np.count_nonzero(_bad_mask(a, e, int(threshold), margin=allowance)))
+    inside = 0
+    if allowance is not None:
+        inside = int(np.count_nonzero((allowance > threshold) & ~_close(a, e, int(threshold))))
     share = bad / total if total else 0.0
     return ImageMatch(
         passed=share <= max_bad_share,
@@ -296,8 +319,19 @@ def compare_images(
         bad_share=share,
         max_diff=int(metrics.max_abs_diff(a, e)),
         rmse=metrics.rmse(a, e),
+        margin_pixels=inside,
         **common,
     )
+
+
+def _check_margin(margin: npt.ArrayLike | None, shape: tuple[int, ...]) -> np.ndarray | None:
+    """``margin`` as uint8 (H, W) of an image of ``shape``, or None."""
+    if margin is None:
+        return None
+    m = np.asarray(margin)
+    if m.dtype != np.uint8 or m.shape != tuple(shape[:2]):
+        raise ValueError(f"margin has dtype {m.dtype} and shape {m.shape}; expected uint8 {tuple(shape[:2])}")
+    return m
 
 
 # --------------------------------------------------------------------------
@@ -320,7 +354,8 @@ def _as_rgba(image: np.ndarray) -> np.ndarray:
     return out
 
 
-def _diff_image(actual: np.ndarray, expected: np.ndarray, threshold: int) -> np.ndarray:
+def _diff_image(actual: np.ndarray, expected: np.ndarray, threshold: int,
+                margin: np.ndarray | None = None) -> np.ndarray:
     """Opaque RGBA picture of where and how much two images differ.
 
     Background: the expected image as greyscale dimmed to 30 %. Over it, the
@@ -347,7 +382,7 @@ def _diff_image(actual: np.ndarray, expected: np.ndarray, threshold: int) -> np.
     amp_rgb = np.maximum(amp[:, :, :3], amp[:, :, 3:4])
     region = np.maximum(amp_rgb, dim[:, :, None]).astype(np.uint8)
     if oh and ow:
-        region[_bad_mask(a, e, threshold)] = _MAGENTA
+        region[_bad_mask(a, e, threshold, margin=margin if a.shape == e.shape else None)] = _MAGENTA
     out[:oh, :ow, :3] = region
     return out
 
@@ -365,6 +400,7 @@ def write_artifacts(
     name: str,
     *,
     threshold: int = DEFAULT_THRESHOLD,
+    margin: np.ndarray | None = None,
 ) -> dict[str, Path]:
     """Write ``<name>-actual.png``, ``<name>-expected.png`` and ``<name>-diff.png``.
 
@@ -372,7 +408,8 @@ def write_artifacts(
     created. The diff image shows the expected image as a dimmed greyscale,
     differences amplified ten times, and bad pixels (same rule and
     ``threshold`` as :func:`compare_images`) in magenta. Images of different
-    sizes are drawn over the overlapping area; the rest is magenta.
+    sizes are drawn over the overlapping area; the rest is magenta. ``margin``:
+    the reference's, as :func:`compare_images` takes it.
 
     Returns:
         ``{"actual": path, "expected": path, "diff": path}``.
@@ -388,7 +425,7 @@ def write_artifacts(
     }
     files.save_png(a, paths["actual"])
     files.save_png(e, paths["expected"])
-    files.save_png(_diff_image(a, e, threshold), paths["diff"])
+    files.save_png(_diff_image(a, e, threshold, _check_margin(margin, e.shape)), paths["diff"])
     return paths
 
 

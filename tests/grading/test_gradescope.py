@@ -137,7 +137,7 @@ def test_the_bundle_grades_a_right_a_wrong_and_a_hostile_submission(tmp_path: Pa
         modes = {i.filename: (i.external_attr >> 16) & 0o777 for i in z.infolist()}
         setup = z.read("setup.sh").decode()
     assert {"setup.sh", "run_autograder", "assignment.grading.toml", "goldens/1-still.png",
-            "goldens/2-secret.png"} <= set(names)
+            "goldens/2-secret.png", "goldens/1-still.margin.png", "goldens/2-secret.margin.png"} <= set(names)
     assert any(n.startswith("glsandbox-") and n.endswith(".whl") for n in names)
     assert modes["setup.sh"] & stat.S_IXUSR and modes["run_autograder"] & stat.S_IXUSR
     assert "uv\" python install 3.12" in setup and "libegl1" in setup and "apt-get update" in setup
