@@ -85,6 +85,11 @@ _ON_BACKEND = (
 )
 
 
+def renderer_backend(renderer: Any) -> str:
+    """The backend the renderer's context is on (``egl``, ``osmesa``, ...)."""
+    return renderer.host.backend
+
+
 def shadow_depth_formats(renderer: Any) -> set[bool]:
     """Whether each shadow map the renderer has drawn holds 32-bit float depth (else 24-bit fixed)."""
     return set(renderer.executor.shadow_maps.float_depth.values())

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from support import on_backend, shadow_depth_formats
+from support import on_backend, renderer_backend, shadow_depth_formats
 
 from glsandbox.measure import far_raster
 from glsandbox.measure.far_raster import OFFSETS, SMALL
@@ -50,8 +50,10 @@ def far(backend, gl_renderer) -> dict:
     :class:`~glsandbox.measure.far_raster.ShadowState` on ``backend``, and whether its shadow
     maps held float depth, measured in one go (one subprocess for the other backend)."""
     calls = ([(far_raster.id_shift, place) for place in PLACE_VALUES]
-             + [(far_raster.shadow_state, place) for place in PLACE_VALUES] + [(shadow_depth_formats, ())])
-    found = on_backend(backend, gl_renderer, calls)
+             + [(far_raster.shadow_state, place) for place in PLACE_VALUES] + [(shadow_depth_formats, ()),
+                                                                               (renderer_backend, ())])
+    *found, on = on_backend(backend, gl_renderer, calls)
+    assert on == backend
     n = len(PLACE_VALUES)
     return {"ids": dict(zip(PLACE_VALUES, found[:n])), "shadow": dict(zip(PLACE_VALUES, found[n:2 * n])),
             "float_depth": found[-1], "backend": backend}

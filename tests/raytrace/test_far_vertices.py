@@ -51,13 +51,22 @@ def test_a_stray_vertex_leaves_the_quad_drawn_right_by_the_numpy_engine(layout) 
     assert changed_pixels(render(stray_scene(LAYOUTS[layout]), SIZE), alone) == 0
 
 
+@pytest.fixture(scope="module")
+def drawn(backend, gl_renderer) -> dict[tuple[str, str], np.ndarray]:
+    """The quad alone and each layout, by (renderer, layout), rasterized and gpu-traced on
+    ``backend`` (one subprocess for the other backend)."""
+    layouts = {"alone": {"quad": QUAD}, **LAYOUTS}
+    keys = [(draw, name) for draw in ("raster", "gpu") for name in layouts]
+    images = on_backend(backend, gl_renderer, [
+        (raster_image if draw == "raster" else gpu_image, (SIZE, stray_scene, layouts[name])) for draw, name in keys])
+    return dict(zip(keys, images))
+
+
 @pytest.mark.parametrize("layout", LAYOUTS)
-def test_a_stray_vertex_leaves_the_quad_drawn_right_by_the_rasterizer_and_the_gpu_engine(backend, gl, layout) -> None:
-    raster_alone, raster, gpu_alone, gpu = on_backend(backend, gl, [
-        (draw, (SIZE, stray_scene, parts)) for draw in (raster_image, gpu_image)
-        for parts in ({"quad": QUAD}, LAYOUTS[layout])])
-    for alone in (raster_alone, gpu_alone):
-        assert np.count_nonzero(alone[..., :3].max(axis=-1)) > 150  # the quad
-    assert np.array_equal(raster, raster_alone), f"{backend}, {layout}: the rasterizer's quad changed"
-    lost = changed_pixels(gpu, gpu_alone)
+def test_a_stray_vertex_leaves_the_quad_drawn_right_by_the_rasterizer_and_the_gpu_engine(drawn, backend,
+                                                                                         layout) -> None:
+    for draw in ("raster", "gpu"):
+        assert np.count_nonzero(drawn[draw, "alone"][..., :3].max(axis=-1)) > 150  # the quad
+    assert np.array_equal(drawn["raster", layout], drawn["raster", "alone"]), f"{backend}, {layout}: the rasterizer"
+    lost = changed_pixels(drawn["gpu", layout], drawn["gpu", "alone"])
     assert lost == 0, f"{backend}, {layout}: {lost} of the gpu engine's quad pixels changed"
