@@ -14,9 +14,10 @@ import subprocess
 import sys
 import time
 import warnings
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -58,6 +59,91 @@ def backend_available(name: str) -> str | None:
             f"h = open_context({name!r}); h.release()")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     return None if proc.returncode == 0 else (proc.stderr.strip().splitlines() or ["failed"])[-1]
+
+
+# --- a measurement on each headless backend ----------------------------------------------------
+# OSMesa and EGL must not be mixed in one process: a figure wanted from the backend the session's
+# renderer is not on is measured in a subprocess of its own, by the same functions.
+
+Call = tuple[Any, tuple]  # (function, args): function(renderer, *args), a module-level function
+
+
+def measure_calls(renderer: Any, calls: list[Call]) -> list[Any]:
+    """``function(renderer, *args)`` for each call, in order, with ``renderer``'s context current."""
+    renderer.host.make_current()
+    return [function(renderer, *args) for function, args in calls]
+
+
+_ON_BACKEND = (
+    "import pickle, sys\n"
+    "from glsandbox.frame import HeadlessRenderer\n"
+    "from support import measure_calls\n"
+    "backend, calls, out = pickle.loads(sys.stdin.buffer.read())\n"
+    "with HeadlessRenderer(backend) as renderer:\n"
+    "    results = measure_calls(renderer, calls)\n"
+    "open(out, 'wb').write(pickle.dumps(results))\n"
+)
+
+
+def renderer_backend(renderer: Any) -> str:
+    """The backend the renderer's context is on (``egl``, ``osmesa``, ...)."""
+    return renderer.host.backend
+
+
+def shadow_depth_formats(renderer: Any) -> set[bool]:
+    """Whether each shadow map the renderer has drawn holds 32-bit float depth (else 24-bit fixed)."""
+    return set(renderer.executor.shadow_maps.float_depth.values())
+
+
+def raster_image(renderer: Any, size: tuple[int, int], scene: Callable[..., Any], *args: Any) -> np.ndarray:
+    """The rasterized picture of ``scene(*args)`` (``scene`` a module-level function: scenes do not pickle)."""
+    return renderer.render_scene(scene(*args), size).image
+
+
+def gpu_image(renderer: Any, size: tuple[int, int], scene: Callable[..., Any], *args: Any) -> np.ndarray:
+    """The gpu ray engine's picture of ``scene(*args)`` on the renderer's context."""
+    from glsandbox.raytrace import render
+
+    return render(scene(*args), size, "gpu", ctx=renderer.host.ctx)
+
+
+def gpu_contact_kept(renderer: Any, offset: float, choice: str) -> float:
+    """:func:`glsandbox.measure.far_raster.contact_kept` for the gpu engine on the renderer's context."""
+    from glsandbox.measure.far_raster import contact_kept
+
+    return contact_kept(offset, choice, "gpu", renderer.host.ctx)
+
+
+def shadow_knob_counts(renderer: Any, size: tuple[int, int], labels: tuple[str, ...]) -> dict[str, Any]:
+    """The ``shadow_map`` tradeoffs knob's count for each setting in ``labels``, at ``size``."""
+    from glsandbox.frame import LazyRenderer
+    from glsandbox.measure.knob import all_knobs
+    from glsandbox.measure.render_context import RenderContext
+
+    context = RenderContext(size)
+    context.gl = LazyRenderer(renderer=renderer)  # shared, not closed here
+    settings = {s.label: s for s in next(k for k in all_knobs() if k.name == "shadow_map").settings}
+    return {label: settings[label].count(context) for label in labels}
+
+
+def on_backend(backend: str, session_renderer: Any, calls: list[Call]) -> list[Any]:
+    """The results of ``calls`` (:func:`measure_calls`) on a headless renderer of ``backend``: the
+    session's own when it is on ``backend``, else a new one in a subprocess (arguments and
+    results pickled; a module-level function of glsandbox or of this module)."""
+    import pickle
+    import tempfile
+
+    if session_renderer.host.backend == backend:
+        return measure_calls(session_renderer, calls)
+    with tempfile.TemporaryDirectory() as folder:
+        out = Path(folder) / "results.pickle"
+        env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(TESTS_DIR), str(REPO_ROOT)])}
+        proc = subprocess.run([sys.executable, "-c", _ON_BACKEND], input=pickle.dumps((backend, calls, str(out))),
+                              capture_output=True, env=env, cwd=REPO_ROOT, timeout=600)
+        if proc.returncode != 0:
+            pytest.fail(f"measuring on {backend} failed: {proc.stderr.decode(errors='replace')[-2000:]}",
+                        pytrace=False)
+        return pickle.loads(out.read_bytes())
 
 
 # --- the command line ------------------------------------------------------------------------
@@ -347,6 +433,17 @@ def far_triangle_scene(count: int = 70_000):
     material = Material(color=(0.9, 0.2, 0.2, 1.0), shading="solid")
     return Scene("far_triangle", nodes=(Node("big", mesh, np.eye(4), material),),
                  camera=Camera(eye=(0.0, 0.0, 5.0), target=(0.0, 0.0, 0.0)), lights=(Light((0.0, 3.0, 3.0)),),
+                 clear_color=(0.0, 0.0, 0.0, 1.0))
+
+
+def stray_scene(parts: dict[str, np.ndarray]):
+    """One unlit node per ``name: positions`` (tests/raytrace/test_far_vertices.py's quad and stray
+    triangle), seen from 2.5 in front of the origin."""
+    from glsandbox import Camera, Material, Mesh, Node, Scene
+
+    material = Material(color=(0.9, 0.4, 0.2, 1.0))
+    nodes = tuple(Node(name, Mesh(name, positions), np.eye(4), material) for name, positions in parts.items())
+    return Scene("stray", nodes=nodes, camera=Camera(eye=(0.0, 0.0, 2.5), target=(0.0, 0.0, 0.0)),
                  clear_color=(0.0, 0.0, 0.0, 1.0))
 
 

@@ -1,6 +1,7 @@
 """The GitHub Actions workflow: actionlint finds nothing in it, and it runs what the project
 claims (every system and Python of pyproject's classifiers, the fast tests, the tour and its
-pictures uploaded, a software OpenGL on Windows, the strict docs build)."""
+pictures uploaded, a software OpenGL on Windows, the strict docs build, the fast tests at the
+dependency floors for each set of floors)."""
 
 from __future__ import annotations
 
@@ -68,3 +69,26 @@ def test_the_jobs_run_the_fast_tests_and_the_tour_and_upload_its_pictures() -> N
     assert mesa["if"] == "runner.os == 'Windows'"  # Windows runners have no OpenGL driver of their own
     assert jobs["test"]["env"]["CI"] == "true"
     assert any("glsandbox docs --build" in step.get("run", "") for step in jobs["docs"]["steps"])
+
+
+def test_the_floors_job_runs_the_fast_tests_at_every_set_of_floors() -> None:
+    from packaging.requirements import Requirement
+
+    job = yaml.safe_load(WORKFLOW.read_text(encoding="utf-8"))["jobs"]["floors"]
+    assert job["env"]["UV_RESOLUTION"] == "lowest-direct" and job["env"]["CI"] == "true"
+    assert any('pytest -m "not slow"' in step.get("run", "") for step in job["steps"])
+    project = tomllib.loads((REPO_ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    requirements = [Requirement(text) for text in (*project["project"]["dependencies"],
+                                                  *(t for group in project["project"]["optional-dependencies"].values()
+                                                    for t in group),
+                                                  *(t for group in project["dependency-groups"].values() for t in group))]
+    claimed = sorted(c.rsplit(" :: ", 1)[1] for c in project["project"]["classifiers"]
+                     if c.count("::") == 2 and "Python :: 3." in c)
+
+    def floors(version: str) -> tuple[str, ...]:
+        """The floors that apply on Python ``version`` (pyproject's python_version markers)."""
+        return tuple(str(r) for r in requirements if r.marker is None or r.marker.evaluate({"python_version": version}))
+
+    wanted = {floors(version) for version in claimed}
+    covered = {floors(version) for version in job["strategy"]["matrix"]["python"]}
+    assert len(wanted) >= 2 and covered == wanted  # below 3.13 and from 3.13 on, today

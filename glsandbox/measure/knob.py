@@ -30,8 +30,8 @@ from glsandbox.scene import Scene
 if TYPE_CHECKING:
     from glsandbox.measure.render_context import RenderContext
 
-__all__ = ["Knob", "KnobResult", "PixelCount", "Row", "Setting", "WIDE_SPREAD", "all_knobs", "lesson_scene",
-           "median_spread", "register_knob", "run_spread"]
+__all__ = ["BUSY_LOAD_PER_CPU", "Knob", "KnobResult", "PixelCount", "Row", "Setting", "WIDE_SPREAD", "all_knobs",
+           "lesson_scene", "machine_busy", "median_spread", "register_knob", "run_spread"]
 
 
 @dataclass(frozen=True)
@@ -145,6 +145,8 @@ class Row:
     count: PixelCount | None = None
     #: The median of each independent pass of timing rounds (:mod:`glsandbox.measure.tradeoffs`).
     pass_medians: list[float] = field(default_factory=list)
+    #: Why the machine was too busy for any time to be a figure (:func:`machine_busy`), else None.
+    busy: str | None = None
 
     @property
     def median_ms(self) -> float:
@@ -168,12 +170,29 @@ class Row:
 
     @property
     def trusted(self) -> bool:
-        """Whether the passes agree within :data:`WIDE_SPREAD`: else the report gives no figure."""
-        return self.run_spread <= WIDE_SPREAD
+        """Whether the passes agree within :data:`WIDE_SPREAD` on a machine that was not too
+        busy (:func:`machine_busy`): else the report gives no figure."""
+        return self.run_spread <= WIDE_SPREAD and self.busy is None
 
 
 #: Pass medians further apart than this share of their median: the time is noise, not a figure.
 WIDE_SPREAD = 0.2
+
+
+#: A 1-minute load average above this many runnable threads per CPU: the machine was too busy.
+#: The run itself adds up to one thread per CPU (llvmpipe's) and its own, so an idle machine
+#: stays under 2 per CPU; above it other work shares the cores with every frame, and passes
+#: that agree within one run still disagree with the next run (three quick runs at a load of
+#: 12 on 2 CPUs: SSAA 4x timed 36.6 ms ±1%, then 5.8 ms ±3%, then 82 ms).
+BUSY_LOAD_PER_CPU = 2.0
+
+
+def machine_busy(loads: list[float], cpus: int) -> str | None:
+    """Why no time measured at these 1-minute load averages (one per pass) on ``cpus`` CPUs is
+    a figure, or None: the highest above :data:`BUSY_LOAD_PER_CPU` per CPU."""
+    if not loads or max(loads) <= BUSY_LOAD_PER_CPU * cpus:
+        return None
+    return f"machine busy: load {max(loads):.1f} on {cpus} CPU{'s' if cpus != 1 else ''}"
 
 
 def run_spread(medians: list[float]) -> float:

@@ -23,7 +23,11 @@ so every figure is given with its run-to-run spread:
   a setting whose passes differ by more than
   :data:`~glsandbox.measure.knob.WIDE_SPREAD` gets no figure in the report,
   only the passes' medians and "too noisy";
-- the machine's load average is printed before and after, and at each pass.
+- the machine's load average is printed before and after, and at each pass;
+  where it passes :data:`~glsandbox.measure.knob.BUSY_LOAD_PER_CPU` runnable
+  threads per CPU at a pass's start or end, no time is a figure ("too noisy:
+  machine busy"): passes that agree within such a run still disagree with the
+  next run.
 
 :func:`run` then writes the report
 (:mod:`glsandbox.measure.tradeoffs_report`): ``report.md``,
@@ -49,7 +53,7 @@ import numpy as np
 from glsandbox.errors import SandboxError
 from glsandbox.files import save_png
 from glsandbox.measure import extra, metrics
-from glsandbox.measure.knob import Knob, KnobResult, Row, all_knobs, median_spread
+from glsandbox.measure.knob import Knob, KnobResult, Row, all_knobs, machine_busy, median_spread
 from glsandbox.measure.render_context import RenderContext
 from glsandbox.measure.tradeoffs_report import write_csv, write_plot, write_report
 from glsandbox.progress import progress
@@ -115,6 +119,14 @@ def load_average() -> str:
         return "n/a"
 
 
+def one_minute_load() -> list[float]:
+    """``[the 1-minute load average]``, or ``[]`` where the system has none (Windows)."""
+    try:
+        return [os.getloadavg()[0]]
+    except (AttributeError, OSError):
+        return []
+
+
 def time_pass(renders: Sequence[Callable[[], object]], rounds: int, advance: Callable[[int], object] = lambda n: None,
               clock: Callable[[], float] = time.perf_counter) -> list[list[float]]:
     """One pass: ``rounds`` rounds, each calling every render once (in the given order,
@@ -161,11 +173,14 @@ def measure_knobs(knobs: Sequence[Knob], context: RenderContext, out: Path, quic
         advance(1)
     entries = interleave(groups)
     renders = [functools.partial(setting.render, context) for _, setting in entries]
-    passes_times = []
+    passes_times, loads = [], []
     for number in range(passes):
         log(f"  timing pass {number + 1}/{passes}: {runs} rounds over {len(knobs)} knob(s), "
             f"load average {load_average()}")
+        loads += one_minute_load()
         passes_times.append(time_pass(renders, runs, advance))
+        loads += one_minute_load()
+    busy = machine_busy(loads, os.cpu_count() or 1)
     times = {(k.name, s.label): [t for taken in passes_times for t in taken[i]] for i, (k, s) in enumerate(entries)}
     medians = {(k.name, s.label): [statistics.median(taken[i]) for taken in passes_times]
                for i, (k, s) in enumerate(entries)}
@@ -189,7 +204,7 @@ def measure_knobs(knobs: Sequence[Knob], context: RenderContext, out: Path, quic
                 count = setting.count(context)
             rows.append(Row(knob.name, setting.label, setting is knob.reference, times[key],
                             metrics.rmse(reference, picture), metrics.psnr(reference, picture), flip_mean,
-                            str(image_path), str(map_path) if flip else "", count, medians[key]))
+                            str(image_path), str(map_path) if flip else "", count, medians[key], busy))
         results.append(KnobResult(knob, rows))
     return results
 

@@ -19,14 +19,14 @@ from pathlib import Path
 
 from glsandbox.files import atomic_write, write_text
 from glsandbox.measure import extra
-from glsandbox.measure.knob import WIDE_SPREAD, KnobResult, Row
+from glsandbox.measure.knob import BUSY_LOAD_PER_CPU, WIDE_SPREAD, KnobResult, Row
 
 
 __all__ = ["CSV_COLUMNS", "write_csv", "write_plot", "write_report"]
 
 CSV_COLUMNS = ("knob", "setting", "reference", "width", "height", "runs", "time_median_ms", "time_min_ms",
                "time_max_ms", "rmse", "psnr_db", "flip", "count_px", "count_of_px", "count_share", "image",
-               "error_map", "median_spread", "passes", "pass_medians_ms", "run_spread", "trusted")
+               "error_map", "median_spread", "passes", "pass_medians_ms", "run_spread", "trusted", "busy")
 
 
 def _fmt_psnr(value: float) -> str:
@@ -47,16 +47,19 @@ def write_csv(results: Sequence[KnobResult], size: tuple[int, int], path: Path) 
                              *(("", "", "") if r.count is None else
                                (r.count.pixels, r.count.of, f"{r.count.share:.6f}")),
                              r.image, r.error_map, f"{r.median_spread:.4f}", len(r.pass_medians),
-                             " ".join(f"{m:.3f}" for m in r.pass_medians), f"{r.run_spread:.4f}", int(r.trusted)])
+                             " ".join(f"{m:.3f}" for m in r.pass_medians), f"{r.run_spread:.4f}", int(r.trusted),
+                             r.busy or ""])
     write_text(path, buffer.getvalue())
 
 
 def time_cell(r: Row) -> str:
     """A setting's time for the report: the median with its run-to-run spread, or, where the
-    passes disagree by more than :data:`~glsandbox.measure.knob.WIDE_SPREAD`, no figure."""
+    passes disagree by more than :data:`~glsandbox.measure.knob.WIDE_SPREAD` or the machine
+    was too busy (:func:`~glsandbox.measure.knob.machine_busy`), no figure."""
     passes = ", ".join(f"{m:.2f}" for m in r.pass_medians)
     if not r.trusted:
-        return f"too noisy (passes {passes} ms: ±{r.run_spread / 2:.0%})"
+        why = f"{r.busy}; " if r.busy else ""
+        return f"too noisy ({why}passes {passes} ms: ±{r.run_spread / 2:.0%})"
     return f"{r.median_ms:.2f} ±{r.run_spread / 2:.0%}"
 
 
@@ -73,7 +76,8 @@ def write_report(results: Sequence[KnobResult], info: Mapping[str, str], path: P
                   "busier than its CPUs moves every time; compare runs made at the same load.", ""]
     lines += ["Time is the whole frame as a user gets it: render, read back, and for supersampling the "
               "downsample: the median of all runs ± half the spread of the passes' medians (the run-to-run "
-              f"spread); where the passes differ by more than {WIDE_SPREAD:.0%} the time is noise and "
+              f"spread); where the passes differ by more than {WIDE_SPREAD:.0%}, or the load average passed "
+              f"{BUSY_LOAD_PER_CPU:g} runnable threads a CPU while the passes ran, the time is noise and "
               "the table says \"too noisy\" instead of a figure. Errors are against the knob's reference: "
               "RMSE (0..1 scale), PSNR (dB, higher is better), FLIP (mean perceptual error, 0..1, lower is "
               "better). The plot is `tradeoffs.png`.", ""]
@@ -94,7 +98,11 @@ def write_report(results: Sequence[KnobResult], info: Mapping[str, str], path: P
                          f"{_fmt_psnr(r.psnr)} | {'-' if r.flip is None else f'{r.flip:.4f}'} | "
                          f"{f'[map]({r.error_map})' if r.error_map else '-'} |")
         noisy = [r.setting for r in result.rows if not r.trusted]
-        if noisy:
+        busy = next((r.busy for r in result.rows if r.busy), None)
+        if busy:
+            lines += ["", f"Too noisy to give a time: {busy}, more than {BUSY_LOAD_PER_CPU:g} runnable threads a "
+                          "CPU while it was timed; run again on a quieter machine."]
+        elif noisy:
             lines += ["", f"Too noisy to give a time ({len(noisy)} of {len(result.rows)} settings): its passes "
                           f"differ by more than {WIDE_SPREAD:.0%}; run again on a quieter machine."]
         verdict = result.monotone_ok()

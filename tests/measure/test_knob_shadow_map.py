@@ -1,7 +1,10 @@
 """The shadow-map knob of ``glsandbox tradeoffs`` (glsandbox/measure/knobs/shadow_map.py):
-its settings and its wrong-state count, measured at a small size against the ray tracer."""
+its settings and its wrong-state count, measured at a small size against the ray tracer (far
+away and at small scale on both headless backends: support.on_backend)."""
 
 from __future__ import annotations
+
+from support import on_backend, shadow_knob_counts
 
 from glsandbox.frame import LazyRenderer
 from glsandbox.measure.knob import all_knobs
@@ -33,11 +36,11 @@ def test_wrong_state_pixels_fall_with_the_map_size_and_the_planar_shadow_misses_
     assert all(c.of == 192 * 144 for c in counts.values())
 
 
-def test_the_default_map_gives_the_origin_s_states_far_away_and_at_small_scale(gl):
-    context = RenderContext((192, 144))
-    context.gl = LazyRenderer(renderer=gl)
-    settings = {s.label: s for s in knob().settings}
-    here = settings["shadow map 1024, PCF 3"].count(context).pixels
-    for where in ("at 1e5", "at 9e5", "x1e-4 at 1e3"):
-        there = settings[f"shadow map 1024, PCF 3, {where}"].count(context).pixels
-        assert abs(there - here) <= 0.1 * here + 5, (where, there, here)
+def test_the_default_map_gives_the_origin_s_states_far_away_and_at_small_scale(backend, gl):
+    default = "shadow map 1024, PCF 3"
+    labels = (default, *(f"{default}, {where}" for where in ("at 1e5", "at 9e5", "x1e-4 at 1e3")))
+    [counts] = on_backend(backend, gl, [(shadow_knob_counts, ((192, 144), labels))])
+    here = counts[default].pixels
+    for label in labels[1:]:
+        there = counts[label].pixels
+        assert abs(there - here) <= 0.1 * here + 5, (backend, label, there, here)

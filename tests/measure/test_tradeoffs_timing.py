@@ -1,6 +1,6 @@
 """How ``glsandbox tradeoffs`` times (glsandbox/measure/tradeoffs.py): rounds that take the
 knobs in turn, independent passes whose medians give each figure's run-to-run spread, and a
-report that gives no figure where the passes disagree. Fake settings with a fake clock:
+report that gives no figure where the passes disagree or the machine was too busy. Fake settings with a fake clock:
 nothing is rendered and no time is measured."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 from glsandbox.measure import tradeoffs
-from glsandbox.measure.knob import Knob, Row, Setting, run_spread
+from glsandbox.measure.knob import Knob, Row, Setting, machine_busy, run_spread
 from glsandbox.measure.tradeoffs_report import time_cell, write_report
 
 
@@ -69,9 +69,43 @@ def test_run_spread_is_the_passes_medians_apart() -> None:
     assert math.isinf(run_spread([2.0]))
 
 
-def row(medians: list[float]) -> Row:
+def row(medians: list[float], busy: str | None = None) -> Row:
     return Row("k", "MSAA 4x", False, [m for m in medians for _ in range(5)], 0.01, 40.0, 0.02,
-               "images/a.png", "error_maps/a.png", None, medians)
+               "images/a.png", "error_maps/a.png", None, medians, busy)
+
+
+def test_the_machine_is_busy_above_two_runnable_threads_a_cpu() -> None:
+    assert machine_busy([3.9, 4.0], 2) is None  # this run's own threads on an idle 2-CPU machine
+    assert machine_busy([3.9, 12.11], 2) == "machine busy: load 12.1 on 2 CPUs"  # any pass's start or end
+    assert machine_busy([2.5], 1) == "machine busy: load 2.5 on 1 CPU"
+    assert machine_busy([], 2) is None  # no load average (Windows): the passes' spread alone decides
+
+
+def test_passes_that_agree_on_a_busy_machine_give_no_figure(tmp_path) -> None:
+    busy = row([36.6, 36.8], "machine busy: load 12.1 on 2 CPUs")
+    assert row([36.6, 36.8]).trusted and not busy.trusted
+    assert time_cell(busy) == "too noisy (machine busy: load 12.1 on 2 CPUs; passes 36.60, 36.80 ms: ±0%)"
+    knob = Knob("k", "A knob", "phong", (Setting("MSAA 4x", lambda c: None),), Setting("ref", lambda c: None), "r")
+    from glsandbox.measure.knob import KnobResult
+
+    info = {"renderer": "llvmpipe", "backend": "egl", "size": "128x96", "runs": "5", "passes": "2", "quick": "yes"}
+    write_report([KnobResult(knob, [busy])], info, tmp_path / "report.md")
+    report = (tmp_path / "report.md").read_text(encoding="utf-8")
+    assert ("Too noisy to give a time: machine busy: load 12.1 on 2 CPUs, more than 2 runnable threads a CPU "
+            "while it was timed") in report
+
+
+def test_measure_knobs_reads_the_load_at_each_pass_and_marks_a_busy_run(tmp_path, monkeypatch) -> None:
+    loads = iter([1.0, 1.5, 9.0, 1.0])  # the second pass started on a busy machine
+    monkeypatch.setattr(tradeoffs, "one_minute_load", lambda: [next(loads)])
+    monkeypatch.setattr(tradeoffs.os, "cpu_count", lambda: 2)
+    setting = Setting("s", lambda context: np.zeros((4, 4, 4), np.uint8))
+    knob = Knob("k", "k", "phong", (setting,), Setting("ref", lambda context: np.zeros((4, 4, 4), np.uint8)), "r")
+    for folder in ("images", "error_maps"):
+        (tmp_path / folder).mkdir()
+    [result] = tradeoffs.measure_knobs([knob], None, tmp_path, quick=False, runs=5, passes=2, flip=False)
+    assert {r.busy for r in result.rows} == {"machine busy: load 9.0 on 2 CPUs"}
+    assert not any(r.trusted for r in result.rows)
 
 
 def test_a_time_whose_passes_disagree_gets_no_figure(tmp_path) -> None:

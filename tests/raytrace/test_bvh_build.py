@@ -155,7 +155,7 @@ def random_triangles(n: int, seed: int) -> tuple[np.ndarray, np.ndarray, np.ndar
     return a, b, c
 
 
-#: The trees the builder makes, by their SAH figure (exact: the float sah_cost() returns), node
+#: The trees the builder makes, by their SAH figure (the float sah_cost() returns, to 1e-12), node
 #: count and depth: binned levels, sampled levels (nodes of SAMPLED_ONLY triangles and more), the
 #: no-gain and all-in-one-bin cuts (the fan), the full sweep of small nodes, and leaf sizes 1 and 8.
 #: Any change to how the builder chooses its cuts changes these; a change to how it is written must not.
@@ -174,7 +174,9 @@ TREES = [
                          ids=[t[0] for t in TREES])
 def test_the_builder_makes_the_same_trees(make, leaf_size: int, nodes: int, depth: int, sah: float) -> None:
     bvh = build_bvh(*make(), leaf_size=leaf_size)
-    assert (bvh.node_total, bvh.depth, sah_cost(bvh)) == (nodes, depth, sah)
+    # The SAH figure to 1e-12: numpy's releases add in different orders (1.26, the floor below
+    # Python 3.13, differs from 2.x in the last bit), while another cut moves it far more.
+    assert (bvh.node_total, bvh.depth) == (nodes, depth) and sah_cost(bvh) == pytest.approx(sah, rel=1e-12, abs=0)
     assert leaves_hold_every_triangle_once(bvh)
 
 

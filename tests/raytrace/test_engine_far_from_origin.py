@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from support import gpu_contact_kept, on_backend
 
 from glsandbox import Camera, Light, Material, Node, Scene
 from glsandbox.lesson import find_lesson
@@ -61,6 +62,15 @@ def test_both_offsets_hold_at_the_origin_in_each_engine(engine, reference_shadow
 def test_the_bound_offset_keeps_the_contact_shadow_at_1e5_in_each_engine(engine, reference_shadow) -> None:
     _, shadowed = shadow_mask(lambda *a, **k: engine.render(*a, **k), 1e5, offset="bound")
     assert np.count_nonzero(shadowed & reference_shadow) >= 0.95 * np.count_nonzero(reference_shadow)
+
+
+def test_the_gpu_engine_s_offsets_mean_the_same_far_away_on_each_backend(backend, gl) -> None:
+    # The two tests above for the gpu engine on both headless backends (EGL and OSMesa):
+    # the share of the origin's contact shadow kept (far_raster.contact_kept).
+    simple_1e5, simple_1e6, bound_1e5 = on_backend(backend, gl, [
+        (gpu_contact_kept, (1e5, "simple")), (gpu_contact_kept, (1e6, "simple")), (gpu_contact_kept, (1e5, "bound"))])
+    assert simple_1e5 < 0.5 and simple_1e6 < 0.5, f"{backend}: simple kept {simple_1e5:.0%}, {simple_1e6:.0%}"
+    assert bound_1e5 >= 0.95, f"{backend}: bound kept {bound_1e5:.0%} at 1e5"
 
 
 @pytest.mark.parametrize("name", ["ray_phong", "ray_spheres", "indexed_cube", "phong", "ray_acceleration", "mirror",

@@ -26,6 +26,9 @@ coord = st.floats(-100, 100, allow_nan=False, allow_infinity=False, allow_subnor
 vec3 = st.tuples(coord, coord, coord).map(lambda v: np.array(v, dtype=np.float64))
 nonzero_vec3 = vec3.filter(lambda v: bool(np.any(v)))
 power = st.integers(-40, 40)
+#: Where a ray aims across a triangle's edges: the coordinates' rule, so that no direction
+#: component is tiny enough to meet subnormal numbers once a product is scaled by 2^-40.
+edge_fraction = st.floats(-0.2, 1.2, allow_subnormal=False).map(lambda x: 0.0 if abs(x) < 1e-3 else x)
 unit_interval = st.floats(0, 1, allow_nan=False)
 
 
@@ -63,8 +66,8 @@ def test_scaling_a_plane_scene_by_a_power_of_two_scales_t_exactly(
 @given(
     v=st.tuples(vec3, vec3, vec3),
     origin=vec3,
-    u=st.floats(-0.2, 1.2),
-    w=st.floats(-0.2, 1.2),
+    u=edge_fraction,
+    w=edge_fraction,
     cull=st.booleans(),
     k=power,
 )
