@@ -165,17 +165,6 @@ def _copy_submission(source: Path, into: Path) -> Path:
     return into
 
 
-def _hand_over(work: str, folders: list[str], ids: tuple[int, int]) -> None:
-    """Make ``folders`` (and all in them) ``ids``'s; ``work`` above them only passable by others."""
-    uid, gid = ids
-    os.chmod(work, 0o711)
-    for folder in folders:
-        os.lchown(folder, uid, gid)
-        for base, dirs, names in os.walk(folder):
-            for name in dirs + names:
-                os.lchown(os.path.join(base, name), uid, gid)
-
-
 @functools.cache
 def _python_readable() -> bool:
     from glsandbox.grading.layers import python_readable_by_others
@@ -294,7 +283,7 @@ def _supervise(job: Job, out: int) -> None:
             root, target = str(Path(job.source).parent), job.target
         ids = layers.submission_ids(os.getpid()) if job.copy else None
         if ids is not None:  # its own copy and working folder, owned by the user it runs as
-            _hand_over(work, [root, os.path.join(work, "cwd")], ids)
+            layers.hand_over(work, [root, os.path.join(work, "cwd")], ids)
         read_end, write_end = os.pipe()
         pid = os.fork()
         if pid == 0:  # the renderer: no GL context here, or the warm template's, checked safe to fork
