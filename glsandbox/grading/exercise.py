@@ -31,7 +31,7 @@ from glsandbox.grading.check import (BROKEN, FAIL, PASS, TIMEOUT, CheckResult, L
                                      shown, submission_digest)
 from glsandbox.grading.rubric import Check, group_points
 
-__all__ = ["default_check", "grade_file", "grade_folder", "exercise_submissions", "check_command"]
+__all__ = ["default_check", "grade_file", "grade_folder", "exercise_submissions", "check_command", "with_exercises"]
 
 #: The wrong cases a group's line names (its report's cases list every one).
 SHOWN = 2
@@ -56,10 +56,13 @@ def _defines(path: Path, function: str) -> bool:
 
 
 def entry_file(folder: Path, function: str, entry: str | None) -> Path:
-    """The file of a student's folder that holds the function; a one-line error when none or several."""
-    if entry is not None:
-        return folder / entry
+    """The file of a student's folder that holds the function: ``entry`` where it defines it (else the
+    one file that does), its only ``.py`` file, or the one defining it; a one-line error when none or several."""
     candidates = sorted(p for p in folder.glob("*.py") if p.is_file() and not p.is_symlink())
+    if entry is not None:  # the rubric's (a lesson's, in a grading file of pictures and exercises too)
+        chosen = folder / entry
+        defining = [p for p in candidates if _defines(p, function)]
+        return defining[0] if not _defines(chosen, function) and len(defining) == 1 else chosen
     if len(candidates) == 1:
         return candidates[0]
     defining = [p for p in candidates if _defines(p, function)]
@@ -173,6 +176,39 @@ def grade_folder(folder: Path, checks: Sequence[Check], limits: Limits = Limits(
     return results
 
 
+def _source(folder: Path, path: Path, one: bool) -> Path:
+    """A picture result's submission (its file, link or subfolder of ``folder``) from its lesson's path."""
+    if one or path == folder:
+        return folder
+    try:
+        relative = path.relative_to(folder)
+    except ValueError:
+        return path
+    return folder / relative.parts[0]
+
+
+def with_exercises(result: CheckResult, folder: Path, checks: Sequence[Check], limits: Limits = Limits(),
+                   entry: str | None = None, one: bool = False) -> CheckResult:
+    """A grading file of pictures and exercises: ``result`` (graded on its picture checks) given
+    the outcomes of its exercise checks too, every outcome in the grading file's order. The
+    submission is the same file or folder (in a folder, the exercise's function is the file
+    that defines it, the lesson the rubric's ``entry`` or the one no other imports)."""
+    source = _source(folder, result.path, one)
+    outcomes: list[Outcome] = []
+    for check in checks:
+        if check.kind != "exercise":
+            outcomes += [o for o in result.outcomes if o.check is check]
+        elif source.is_symlink():
+            outcomes += [Outcome(replace(check, name=f"{check.name}: {g}", points=p,
+                                         hidden=check.hidden or g != "visible"), BROKEN,
+                                 error=f"{shown(str(source))}: is a link (a submission is its own files)")
+                         for g, p in check.group_points]
+        else:
+            outcomes += grade_file([check], source, limits, entry)
+    result.outcomes = outcomes
+    return result
+
+
 def check_command(target: Path, checks: Sequence[Check], limits: Limits, reports: dict[str, Path | None],
                   title: str, entry: str | None = None, one: bool = False, update: bool = False) -> int:
     """``glsandbox check DIR|FILE.py --exercise NAME`` (or a rubric of ``exercise`` checks): a line per
@@ -182,8 +218,8 @@ def check_command(target: Path, checks: Sequence[Check], limits: Limits, reports
     from glsandbox.grading.reports import REPORTS, write_reports
 
     if any(c.kind != "exercise" for c in checks):
-        raise SandboxError(f"{title}: a grading file's checks are all pictures or all exercises; "
-                           "put the exercise checks in a grading file of their own")
+        raise SandboxError(f"{title}: check_command grades exercise checks only (glsandbox check grades a "
+                           "grading file of both: its pictures, then with_exercises)")
     if update:
         raise SandboxError("--update writes picture references; an exercise's references are its own cases")
     if not target.exists():
