@@ -42,6 +42,7 @@ caller's own process (a notebook: the student's own kernel).
 
 from __future__ import annotations
 
+import atexit
 import itertools
 import json
 import os
@@ -51,6 +52,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -154,6 +156,35 @@ def import_path(denied: Sequence[str], site: str | os.PathLike[str]) -> list[str
     return path
 
 
+_SHARED_LOCK = threading.Lock()
+_SHARED: dict[tuple, Any] = {}
+
+
+def _shared_import_path(denied: Sequence[str]) -> list[str]:
+    """:func:`import_path` made once per grader process, its folder of links shared by every
+    student's process (the grader's, root's where the grader is root, readable by all and
+    writable by none of them; removed when the grader ends): a class's hundred processes
+    then make and remove no hundred folders of links."""
+    key = ("path", tuple(denied))
+    with _SHARED_LOCK:
+        if key not in _SHARED:
+            folder = tempfile.mkdtemp(prefix="glsandbox-exercise-site-")
+            os.chmod(folder, 0o755)
+            atexit.register(shutil.rmtree, folder, ignore_errors=True)
+            _SHARED[key] = import_path(denied, Path(folder) / "site")
+            os.chmod(Path(folder) / "site", 0o755)
+        return list(_SHARED[key])
+
+
+def _shared_roots(allowed: Sequence[str], denied: Sequence[str]) -> list[str]:
+    """:func:`readable_roots`, worked out once per grader process for the same folders."""
+    key = ("roots", tuple(allowed), tuple(denied))
+    with _SHARED_LOCK:
+        if key not in _SHARED:
+            _SHARED[key] = readable_roots(allowed, denied)
+        return list(_SHARED[key])
+
+
 def readable_roots(allowed: Sequence[str], denied: Sequence[str]) -> list[str]:
     """``allowed``, with every folder that holds a denied path replaced by its other entries
     (recursively): Landlock grants folders, it cannot grant a folder but one of its entries."""
@@ -242,7 +273,7 @@ class Isolated:
         self.copy = folder / self.path.name
         shutil.copyfile(self.path, self.copy)
         shutil.copyfile(runner.__file__, Path(self.work) / "runner.py")
-        self.path_list = import_path(self.denied, Path(self.work) / "site")
+        self.path_list = _shared_import_path(self.denied)
         self.site_roots = [os.path.realpath(p) for p in sys.path if p.endswith(("site-packages", "dist-packages"))]
         self.ids, self.keep_reading = _user(next(_SEEDS))
 
@@ -270,10 +301,10 @@ class Isolated:
         executable = getattr(sys, "_base_executable", None) or sys.executable
         system: tuple[str, ...] = _SYSTEM
         if self.keep_reading:  # reading as root does: of /etc only what others may read (no /etc/shadow)
-            from glsandbox.grading.layers import others_may_read
+            from glsandbox.grading.sandbox import others_may_read
 
             system = tuple(p for p in _SYSTEM if p != "/etc") + others_may_read("/etc")
-        reads = readable_roots([sys.base_prefix, sys.prefix, sys.exec_prefix, *system, *config["path"], *self.site_roots,
+        reads = _shared_roots([sys.base_prefix, sys.prefix, sys.exec_prefix, *system, *config["path"], *self.site_roots,
                                 os.path.dirname(os.path.realpath(executable))], self.denied)
         env = {"PATH": "/usr/bin:/bin", "LANG": "C.UTF-8", "PYTHONHASHSEED": "0", "OPENBLAS_NUM_THREADS": "1",
                "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "HOME": self.work}

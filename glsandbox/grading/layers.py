@@ -26,13 +26,11 @@ them this machine has.
 from __future__ import annotations
 
 import ctypes
-import functools
 import os
 import struct
 import sys
 
-__all__ = ["minimal_environment", "submission_ids", "hand_over", "reading_kept", "others_may_read",
-           "drop_privileges", "close_network",
+__all__ = ["minimal_environment", "submission_ids", "hand_over", "reading_kept", "drop_privileges", "close_network",
            "install_seccomp", "describe"]
 
 #: The environment a renderer keeps (by prefix): the drivers', the locale's and glsandbox's own.
@@ -125,32 +123,6 @@ def reading_kept() -> bool:
     from glsandbox.grading.sandbox import landlock_abi
 
     return not python_readable_by_others() and landlock_abi() >= 1
-
-
-@functools.lru_cache(maxsize=None)
-def others_may_read(root: str) -> tuple[str, ...]:
-    """The parts of ``root`` (a small folder: ``/etc``) a user with no account may read: the whole
-    folder where all in it is readable by others, else its entries so, recursively (a link by
-    what it points to). With the capability of reading any file kept, Landlock granting these
-    instead of ``root`` keeps a root-only file (``/etc/shadow``, a private key) unreadable."""
-    import stat
-
-    try:
-        mode = os.stat(root).st_mode
-    except OSError:
-        return ()
-    if not stat.S_ISDIR(mode):
-        return (root,) if mode & 0o004 else ()
-    if mode & 0o005 != 0o005 or os.path.islink(root):  # a link to a folder: not followed
-        return ()
-    try:
-        names = sorted(os.listdir(root))
-    except OSError:
-        return ()
-    parts = [(os.path.join(root, n), others_may_read(os.path.join(root, n))) for n in names]
-    if all(found == (path,) for path, found in parts):
-        return (root,)
-    return tuple(p for _, found in parts for p in found)
 
 
 def drop_privileges(ids: tuple[int, int], keep_reading: bool, across_exec: bool = False) -> str:

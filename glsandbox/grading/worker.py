@@ -92,7 +92,8 @@ def _renderer(job: Job, root: str, target: str, work: str, out: int, ids: tuple[
         if ids is not None:  # Python only root may read: reading kept, bounded by Landlock below
             kept_reading = not _python_readable() and landlock_abi() >= 1
             layers.drop_privileges(ids, keep_reading=kept_reading)
-        if not confine(root, [root if job.copy else cwd, cwd], cache_writable=job.writes_cache) and kept_reading:
+        if not confine(root, [root if job.copy else cwd, cwd], cache_writable=job.writes_cache,
+                       others_only=kept_reading) and kept_reading:
             layers.drop_reading()
         layers.install_seccomp()
         render_job(job, renderer, root, target, out)
