@@ -500,7 +500,8 @@ def cmd_check(args: argparse.Namespace) -> int:
         if path is not None and path.is_dir():
             raise SandboxError(f"--{kind} {path}: is a folder, expected a file name")
     target = Path(args.lesson)
-    if any(c.kind == "exercise" for c in checks):
+    exercises = [c for c in checks if c.kind == "exercise"]
+    if exercises and len(exercises) == len(checks):
         from glsandbox.grading.exercise import check_command
 
         if args.shard is not None:
@@ -521,6 +522,10 @@ def cmd_check(args: argparse.Namespace) -> int:
         bars = []  # the progress bar, made when the first submission reports (the total known then)
 
         def report(done: int, total: int, result) -> None:
+            if exercises:  # a grading file of pictures and exercises: the functions graded as each arrives
+                from glsandbox.grading.exercise import with_exercises
+
+                with_exercises(result, target, checks, limits, getattr(args, "entry", None), args.one)
             if not bars:  # the first line of the output (none when the run stops with an error)
                 say(layers_line, file=sys.stdout)
                 bars.append(progress(total, "check", "submission"))
@@ -533,7 +538,8 @@ def cmd_check(args: argparse.Namespace) -> int:
 
         try:
             keep = _shard_filter(args.shard, args.one)
-            results = check_folder(target, checks, args.backend, limits, report, getattr(args, "entry", None),
+            pictures = [c for c in checks if c.kind != "exercise"]
+            results = check_folder(target, pictures, args.backend, limits, report, getattr(args, "entry", None),
                                    one=args.one, keep=keep, explain=args.explain)
         finally:
             for bar in bars:
@@ -549,7 +555,14 @@ def cmd_check(args: argparse.Namespace) -> int:
     if any(path is not None for path in reports.values()):
         raise SandboxError(f"--{', --'.join(k.replace('_', '-') for k in REPORTS)} report a folder of submissions; give a folder")
     failed = False
-    for one in check_one(args.lesson, checks, args.update, args.backend, limits):
+    if exercises and not args.update:  # the model answer's functions, as a student's would be graded
+        from glsandbox.grading.exercise import grade_file
+
+        # the lesson's folder: its function is the file that defines it (the lesson itself, or beside it)
+        for o in grade_file(exercises, target.parent, limits, target.name):
+            print(f"{args.lesson}: {o.status} {o.check.name} ({o.points:g}/{o.check.points:g}): {o.detail()}")
+            failed = failed or o.status != "PASS"
+    for one in check_one(args.lesson, [c for c in checks if c.kind != "exercise"], args.update, args.backend, limits):
         reference = one.check.golden
         if one.status:
             print(f"{args.lesson}: {one.status}: {one.error}")

@@ -18,7 +18,16 @@ that:
   programs and signalling others;
 - has no network: the grader's layers (:mod:`glsandbox.grading.layers`) give it
   a network namespace of its own and a seccomp filter refusing sockets but
-  local Unix ones, where the system has them.
+  local Unix ones, where the system has them;
+- when the grader is root (Gradescope, CI), runs as a user with no account,
+  exactly as a picture submission's renderer does
+  (:func:`~glsandbox.grading.layers.submission_ids`,
+  :func:`~glsandbox.grading.layers.drop_privileges`): its private folder is
+  that user's. Where the Python installation is readable by root alone, the
+  user keeps the one capability of reading any file, through the ``execve``,
+  and only where Landlock bounds those reads
+  (:func:`~glsandbox.grading.layers.reading_kept`); where neither, the
+  process stays root (the layers line says so).
 
 Each call has its own deadline. A call that does not answer in time is
 TIMEOUT and the process is killed (the next call starts a fresh one); one
@@ -33,6 +42,8 @@ caller's own process (a notebook: the student's own kernel).
 
 from __future__ import annotations
 
+import atexit
+import itertools
 import json
 import os
 import select
@@ -41,6 +52,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -53,6 +65,9 @@ from glsandbox.grading.processes import kill_tree, killpg
 __all__ = ["Answer", "InProcess", "Isolated", "Limits", "VALUE", "ERROR", "TIMEOUT", "CRASHED"]
 
 VALUE, ERROR, TIMEOUT, CRASHED = "value", "error", "timeout", "crashed"
+
+#: A number per process this grader starts: two students' functions graded at once are two users.
+_SEEDS = itertools.count(1)
 
 #: System folders the student's interpreter reads (shared libraries, locale, devices).
 _SYSTEM = ("/usr", "/lib", "/lib32", "/lib64", "/etc", "/dev", "/proc", "/sys", "/opt")
@@ -141,6 +156,35 @@ def import_path(denied: Sequence[str], site: str | os.PathLike[str]) -> list[str
     return path
 
 
+_SHARED_LOCK = threading.Lock()
+_SHARED: dict[tuple, Any] = {}
+
+
+def _shared_import_path(denied: Sequence[str]) -> list[str]:
+    """:func:`import_path` made once per grader process, its folder of links shared by every
+    student's process (the grader's, root's where the grader is root, readable by all and
+    writable by none of them; removed when the grader ends): a class's hundred processes
+    then make and remove no hundred folders of links."""
+    key = ("path", tuple(denied))
+    with _SHARED_LOCK:
+        if key not in _SHARED:
+            folder = tempfile.mkdtemp(prefix="glsandbox-exercise-site-")
+            os.chmod(folder, 0o755)
+            atexit.register(shutil.rmtree, folder, ignore_errors=True)
+            _SHARED[key] = import_path(denied, Path(folder) / "site")
+            os.chmod(Path(folder) / "site", 0o755)
+        return list(_SHARED[key])
+
+
+def _shared_roots(allowed: Sequence[str], denied: Sequence[str]) -> list[str]:
+    """:func:`readable_roots`, worked out once per grader process for the same folders."""
+    key = ("roots", tuple(allowed), tuple(denied))
+    with _SHARED_LOCK:
+        if key not in _SHARED:
+            _SHARED[key] = readable_roots(allowed, denied)
+        return list(_SHARED[key])
+
+
 def readable_roots(allowed: Sequence[str], denied: Sequence[str]) -> list[str]:
     """``allowed``, with every folder that holds a denied path replaced by its other entries
     (recursively): Landlock grants folders, it cannot grant a folder but one of its entries."""
@@ -159,11 +203,28 @@ def readable_roots(allowed: Sequence[str], denied: Sequence[str]) -> list[str]:
     return out
 
 
-def _restrict(reads: list[str], writes: list[str], limits: Limits) -> Callable[[], None]:
-    """What the child does after fork and before the interpreter starts."""
+def _user(seed: int) -> tuple[tuple[int, int] | None, bool]:
+    """The user a student's process runs as (None: this one's, not root) and whether it keeps
+    reading as root does: the picture renderer's rule (:mod:`glsandbox.grading.layers`), save
+    that a fresh interpreter must be able to start, so without either way it stays this user."""
+    from glsandbox.grading.layers import python_readable_by_others, reading_kept, submission_ids
+
+    ids = submission_ids(os.getpid() * 4099 + seed)
+    if ids is None:
+        return None, False
+    keep = reading_kept()
+    if not keep and not python_readable_by_others():
+        return None, False
+    return ids, keep
+
+
+def _restrict(reads: list[str], writes: list[str], limits: Limits, ids: tuple[int, int] | None = None,
+              keep_reading: bool = False) -> Callable[[], None]:
+    """What the child does after fork and before the interpreter starts: its session, limits, no
+    network, ``ids``'s user (the grader is root), the kernel's file rules and the socket filter."""
     import resource
 
-    from glsandbox.grading.layers import close_network, install_seccomp
+    from glsandbox.grading.layers import close_network, drop_privileges, install_seccomp
     from glsandbox.grading.sandbox import _landlock  # the grader's kernel rules, shared (one place)
 
     def setup() -> None:
@@ -175,7 +236,9 @@ def _restrict(reads: list[str], writes: list[str], limits: Limits) -> Callable[[
                 resource.setrlimit(limit, (value, value))
             except (ValueError, OSError):
                 pass
-        close_network()  # a network namespace with nothing up, where the system lets us
+        close_network()  # a network namespace with nothing up, where the system lets us (as root: first)
+        if ids is not None:
+            drop_privileges(ids, keep_reading, across_exec=True)
         _landlock(reads, writes)
         install_seccomp()  # no socket but a local Unix one
 
@@ -210,8 +273,9 @@ class Isolated:
         self.copy = folder / self.path.name
         shutil.copyfile(self.path, self.copy)
         shutil.copyfile(runner.__file__, Path(self.work) / "runner.py")
-        self.path_list = import_path(self.denied, Path(self.work) / "site")
+        self.path_list = _shared_import_path(self.denied)
         self.site_roots = [os.path.realpath(p) for p in sys.path if p.endswith(("site-packages", "dist-packages"))]
+        self.ids, self.keep_reading = _user(next(_SEEDS))
 
     def __enter__(self) -> Isolated:
         return self
@@ -230,8 +294,17 @@ class Isolated:
         fd, config_path = tempfile.mkstemp(dir=self.work, suffix=".json")
         with os.fdopen(fd, "w") as handle:
             json.dump(config, handle)
+        if self.ids is not None:  # its private folder (copy, runner, config), owned by the user it runs as
+            from glsandbox.grading.layers import hand_over
+
+            hand_over(self.work, [self.work], self.ids)
         executable = getattr(sys, "_base_executable", None) or sys.executable
-        reads = readable_roots([sys.base_prefix, sys.prefix, sys.exec_prefix, *_SYSTEM, *config["path"], *self.site_roots,
+        system: tuple[str, ...] = _SYSTEM
+        if self.keep_reading:  # reading as root does: of /etc only what others may read (no /etc/shadow)
+            from glsandbox.grading.sandbox import others_may_read
+
+            system = tuple(p for p in _SYSTEM if p != "/etc") + others_may_read("/etc")
+        reads = _shared_roots([sys.base_prefix, sys.prefix, sys.exec_prefix, *system, *config["path"], *self.site_roots,
                                 os.path.dirname(os.path.realpath(executable))], self.denied)
         env = {"PATH": "/usr/bin:/bin", "LANG": "C.UTF-8", "PYTHONHASHSEED": "0", "OPENBLAS_NUM_THREADS": "1",
                "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "HOME": self.work}
@@ -241,7 +314,7 @@ class Isolated:
                 [executable, "-I", "-S", "-B", os.path.join(self.work, "runner.py"), config_path],
                 stdin=subprocess.DEVNULL, stdout=log, stderr=log, cwd=self.work, env=env,
                 pass_fds=(requests_read, answers_write),
-                preexec_fn=_restrict(reads, [self.work, "/dev/null"], self.limits))  # noqa: PLW1509
+                preexec_fn=_restrict(reads, [self.work, "/dev/null"], self.limits, self.ids, self.keep_reading))  # noqa: PLW1509
         finally:
             log.close()
             os.close(requests_read)

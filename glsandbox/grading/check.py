@@ -677,20 +677,32 @@ def duplicate_groups(results: Sequence[CheckResult]) -> list[list[str]]:
     return groups
 
 
-def time_in_process(folder: Path, checks: Sequence[Check], backend: str | None = None) -> float:
-    """Seconds to grade ``folder`` in this process, with no isolation (the benchmark's baseline:
-    how ``check`` graded before each submission had a process of its own)."""
+def time_in_process(folder: Path, checks: Sequence[Check], backend: str | None = None,
+                    shared_context: bool = False) -> float:
+    """Seconds to grade ``folder`` in this process, with no isolation (the benchmark's baselines).
+
+    Without ``shared_context``: a fresh GL context per submission (how ``check``
+    graded before each submission had a process of its own). With it: one
+    context for every submission, opened before the clock starts, the
+    cheapest honest way to grade in one process (what it saves, each
+    isolated renderer must pay or inherit from the zygote's warm template)."""
     from glsandbox.lesson import submission_lesson
 
     references = read_references(checks)
     renders = _renders(checks, references)
+    shared = HeadlessRenderer(backend) if shared_context else None
     started = time.perf_counter()
-    for _name, path in lesson_files(folder):
-        try:
-            cls = submission_lesson(path)
-            for check, render in zip(checks, renders):
-                image = render_lesson(cls.from_settings(render.settings), render.size, render.samples, backend).image
-                compare_images(image, references[check.golden], **check.tolerances)
-        except SandboxError:
-            pass
-    return time.perf_counter() - started
+    try:
+        for _name, path in lesson_files(folder):
+            try:
+                cls = submission_lesson(path)
+                for check, render in zip(checks, renders):
+                    image = render_lesson(cls.from_settings(render.settings), render.size, render.samples, backend,
+                                          renderer=shared).image
+                    compare_images(image, references[check.golden], **check.tolerances)
+            except SandboxError:
+                pass
+        return time.perf_counter() - started
+    finally:
+        if shared is not None:
+            shared.close()

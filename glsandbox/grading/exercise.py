@@ -29,9 +29,10 @@ from glsandbox.exercises.catalogue import get
 from glsandbox.exercises.isolation import Limits as ExerciseLimits
 from glsandbox.grading.check import (BROKEN, FAIL, PASS, TIMEOUT, CheckResult, Limits, Outcome, mark_duplicates,
                                      shown, submission_digest)
-from glsandbox.grading.rubric import Check, group_points
+from glsandbox.grading import states
+from glsandbox.grading.rubric import Check, exercise_groups, group_points
 
-__all__ = ["default_check", "grade_file", "grade_folder", "exercise_submissions", "check_command"]
+__all__ = ["default_check", "grade_file", "grade_folder", "exercise_submissions", "check_command", "with_exercises"]
 
 #: The wrong cases a group's line names (its report's cases list every one).
 SHOWN = 2
@@ -39,8 +40,7 @@ SHOWN = 2
 
 def default_check(name: str, where: str = "--exercise") -> Check:
     """The check ``check DIR --exercise NAME`` grades by: every case group, one point each."""
-    exercise = get(name)
-    groups = list(dict.fromkeys(case.group for case in exercise.cases(True)))
+    groups = exercise_groups(name)
     split = group_points(float(len(groups)), groups, where)
     return Check(name, Path(f"{name}.exercise"), points=float(len(groups)), kind="exercise", exercise=name,
                  group_points=split)
@@ -56,10 +56,13 @@ def _defines(path: Path, function: str) -> bool:
 
 
 def entry_file(folder: Path, function: str, entry: str | None) -> Path:
-    """The file of a student's folder that holds the function; a one-line error when none or several."""
-    if entry is not None:
-        return folder / entry
+    """The file of a student's folder that holds the function: ``entry`` where it defines it (else the
+    one file that does), its only ``.py`` file, or the one defining it; a one-line error when none or several."""
     candidates = sorted(p for p in folder.glob("*.py") if p.is_file() and not p.is_symlink())
+    if entry is not None:  # the rubric's (a lesson's, in a grading file of pictures and exercises too)
+        chosen = folder / entry
+        defining = [p for p in candidates if _defines(p, function)]
+        return defining[0] if not _defines(chosen, function) and len(defining) == 1 else chosen
     if len(candidates) == 1:
         return candidates[0]
     defining = [p for p in candidates if _defines(p, function)]
@@ -126,6 +129,9 @@ def grade_file(checks: Sequence[Check], source: Path, limits: Limits = Limits(),
 
     outcomes: list[Outcome] = []
     for check in checks:
+        if states.is_state(check.exercise):  # tables, never run: drawn on the grader's context
+            outcomes += states.grade_tables(check, source)
+            continue
         exercise = get(check.exercise)
         started = time.perf_counter()
         try:
@@ -167,10 +173,47 @@ def grade_folder(folder: Path, checks: Sequence[Check], limits: Limits = Limits(
         progress(len(done), len(found), result)
         return result
 
-    with ThreadPoolExecutor(max(1, limits.jobs)) as pool:
-        results = list(pool.map(grade, found))
+    if any(states.is_state(c.exercise) for c in checks):  # one GL context: this thread only
+        results = [grade(item) for item in found]
+        states.close()
+    else:
+        with ThreadPoolExecutor(max(1, limits.jobs)) as pool:
+            results = list(pool.map(grade, found))
     mark_duplicates(results)
     return results
+
+
+def _source(folder: Path, path: Path, one: bool) -> Path:
+    """A picture result's submission (its file, link or subfolder of ``folder``) from its lesson's path."""
+    if one or path == folder:
+        return folder
+    try:
+        relative = path.relative_to(folder)
+    except ValueError:
+        return path
+    return folder / relative.parts[0]
+
+
+def with_exercises(result: CheckResult, folder: Path, checks: Sequence[Check], limits: Limits = Limits(),
+                   entry: str | None = None, one: bool = False) -> CheckResult:
+    """A grading file of pictures and exercises: ``result`` (graded on its picture checks) given
+    the outcomes of its exercise checks too, every outcome in the grading file's order. The
+    submission is the same file or folder (in a folder, the exercise's function is the file
+    that defines it, the lesson the rubric's ``entry`` or the one no other imports)."""
+    source = _source(folder, result.path, one)
+    outcomes: list[Outcome] = []
+    for check in checks:
+        if check.kind != "exercise":
+            outcomes += [o for o in result.outcomes if o.check is check]
+        elif source.is_symlink():
+            outcomes += [Outcome(replace(check, name=f"{check.name}: {g}", points=p,
+                                         hidden=check.hidden or g != "visible"), BROKEN,
+                                 error=f"{shown(str(source))}: is a link (a submission is its own files)")
+                         for g, p in check.group_points]
+        else:
+            outcomes += grade_file([check], source, limits, entry)
+    result.outcomes = outcomes
+    return result
 
 
 def check_command(target: Path, checks: Sequence[Check], limits: Limits, reports: dict[str, Path | None],
@@ -182,8 +225,8 @@ def check_command(target: Path, checks: Sequence[Check], limits: Limits, reports
     from glsandbox.grading.reports import REPORTS, write_reports
 
     if any(c.kind != "exercise" for c in checks):
-        raise SandboxError(f"{title}: a grading file's checks are all pictures or all exercises; "
-                           "put the exercise checks in a grading file of their own")
+        raise SandboxError(f"{title}: check_command grades exercise checks only (glsandbox check grades a "
+                           "grading file of both: its pictures, then with_exercises)")
     if update:
         raise SandboxError("--update writes picture references; an exercise's references are its own cases")
     if not target.exists():

@@ -14,7 +14,8 @@ Specifications"). The bundle holds:
   grading file, writing ``results.json`` (and, should glsandbox refuse the
   submission outright, a ``results.json`` that says why, score 0);
 - ``assignment.grading.toml``: the grading file with every check, hidden
-  ones included, its goldens in ``goldens/`` beside it;
+  ones included, its goldens in ``goldens/`` beside it (an exercise check
+  has none: its cases, hidden ones too, are the wheel's);
 - the wheel.
 
 The root is ``/autograder`` unless ``GLSANDBOX_AUTOGRADER_ROOT`` names
@@ -127,6 +128,12 @@ def bundle_rubric(rubric: Rubric, goldens: dict[Path, str]) -> str:
     if rubric.entry is not None:
         lines.append(f"entry = {_toml_string(rubric.entry)}")
     for check in rubric.checks:
+        if check.kind == "exercise":  # no golden: the exercise's own cases, its points per case group
+            groups = ", ".join(f"{_toml_string(g)} = {p!r}" for g, p in check.group_points)
+            lines += ["", "[[check]]", f"kind = {_toml_string(check.kind)}", f"name = {_toml_string(check.name)}",
+                      f"exercise = {_toml_string(check.exercise)}", f"points = {{ {groups} }}",
+                      f"hidden = {'true' if check.hidden else 'false'}"]
+            continue
         lines += ["", "[[check]]", f"kind = {_toml_string(check.kind)}", f"name = {_toml_string(check.name)}",
                   f"golden = {_toml_string(goldens[check.golden])}", f"points = {check.points!r}",
                   f"hidden = {'true' if check.hidden else 'false'}"]
@@ -145,6 +152,8 @@ def _golden_names(checks: tuple[Check, ...]) -> dict[Path, str]:
     """Each golden's name in the bundle: ``goldens/<n>-<stem>.png`` (two checks may share one)."""
     names: dict[Path, str] = {}
     for check in checks:
+        if check.kind == "exercise":
+            continue
         if check.golden not in names:
             stem = "".join(c if c.isalnum() or c in "._-" else "_" for c in check.golden.stem)[:60] or "golden"
             names[check.golden] = f"goldens/{len(names) + 1}-{stem}.png"
@@ -248,7 +257,7 @@ def build_bundle(assignment: Path, out: Path, wheel: Path | None = None) -> list
         raise SandboxError(f"{assignment}: expected a grading file (NAME.grading.toml; see glsandbox new --assignment)")
     _check_out(out)
     rubric = load_rubric(assignment)
-    read_references(list(rubric.checks))  # each golden present and a PNG, before anything is written
+    read_references([c for c in rubric.checks if c.kind != "exercise"])  # each golden a PNG, before any writing
     goldens = _golden_names(rubric.checks)
     with tempfile.TemporaryDirectory(prefix="glsandbox-gradescope-") as scratch:
         built = glsandbox_wheel(Path(scratch), wheel)

@@ -30,8 +30,8 @@ import os
 import struct
 import sys
 
-__all__ = ["minimal_environment", "submission_ids", "drop_privileges", "close_network", "install_seccomp",
-           "describe"]
+__all__ = ["minimal_environment", "submission_ids", "hand_over", "reading_kept", "drop_privileges", "close_network",
+           "install_seccomp", "describe"]
 
 #: The environment a renderer keeps (by prefix): the drivers', the locale's and glsandbox's own.
 ENV_KEPT = ("PATH", "HOME", "LANG", "LC_", "TZ", "DISPLAY", "WAYLAND_", "XDG_", "MESA_", "LIBGL_", "GALLIUM_",
@@ -42,7 +42,8 @@ ENV_KEPT = ("PATH", "HOME", "LANG", "LC_", "TZ", "DISPLAY", "WAYLAND_", "XDG_", 
 NO_ACCOUNT_BASE, NO_ACCOUNT_COUNT = 1_870_000_000, 1 << 20
 
 _CLONE_NEWUSER, _CLONE_NEWNET = 0x10000000, 0x40000000
-_PR_SET_KEEPCAPS, _PR_SET_NO_NEW_PRIVS, _PR_SET_SECCOMP = 8, 38, 22
+_PR_SET_KEEPCAPS, _PR_SET_NO_NEW_PRIVS, _PR_SET_SECCOMP, _PR_CAP_AMBIENT = 8, 38, 22, 47
+_PR_CAP_AMBIENT_RAISE = 2
 _CAP_DAC_READ_SEARCH = 2
 _CAPABILITY_VERSION_3 = 0x20080522
 
@@ -95,20 +96,40 @@ def python_readable_by_others() -> bool:
     return bool(os.stat(stdlib).st_mode & 0o004)
 
 
-def _capset(effective: int, permitted: int) -> bool:
+def _capset(effective: int, permitted: int, inheritable: int = 0) -> bool:
     libc = _libc()
     if libc is None:
         return False
     header = struct.pack("II", _CAPABILITY_VERSION_3, 0)
-    data = struct.pack("IIIIII", effective & 0xFFFFFFFF, permitted & 0xFFFFFFFF, 0,
-                       effective >> 32, permitted >> 32, 0)
+    data = struct.pack("IIIIII", effective & 0xFFFFFFFF, permitted & 0xFFFFFFFF, inheritable & 0xFFFFFFFF,
+                       effective >> 32, permitted >> 32, inheritable >> 32)
     return libc.capset(ctypes.c_char_p(header), ctypes.c_char_p(data)) == 0
 
 
-def drop_privileges(ids: tuple[int, int], keep_reading: bool) -> str:
+def hand_over(work: str, folders: list[str], ids: tuple[int, int]) -> None:
+    """Make ``folders`` (and all in them) ``ids``'s; ``work`` above them only passable by others."""
+    uid, gid = ids
+    os.chmod(work, 0o711)
+    for folder in folders:
+        os.lchown(folder, uid, gid)
+        for base, dirs, names in os.walk(folder):
+            for name in dirs + names:
+                os.lchown(os.path.join(base, name), uid, gid)
+
+
+def reading_kept() -> bool:
+    """Whether a submission's user keeps the capability to read any file: only where the Python
+    installation is readable by root alone (it could not run else) and Landlock bounds the reads."""
+    from glsandbox.grading.sandbox import landlock_abi
+
+    return not python_readable_by_others() and landlock_abi() >= 1
+
+
+def drop_privileges(ids: tuple[int, int], keep_reading: bool, across_exec: bool = False) -> str:
     """Become ``ids`` for good (no way back); ``keep_reading`` keeps only the capability to read
-    any file (for a Python only root may read; call it only where Landlock will bound the reads).
-    Returns what was done, for the layers line."""
+    any file (for a Python only root may read; call it only where Landlock will bound the reads),
+    and ``across_exec`` keeps it through the ``execve`` of a fresh interpreter too (an ambient
+    capability: the exercises' process). Returns what was done, for the layers line."""
     libc = _libc()
     uid, gid = ids
     if keep_reading and libc is not None:
@@ -118,7 +139,9 @@ def drop_privileges(ids: tuple[int, int], keep_reading: bool) -> str:
     os.setresuid(uid, uid, uid)
     if keep_reading and libc is not None:
         bit = 1 << _CAP_DAC_READ_SEARCH
-        if _capset(bit, bit):
+        if _capset(bit, bit, bit if across_exec else 0):
+            if across_exec:
+                libc.prctl(_PR_CAP_AMBIENT, _PR_CAP_AMBIENT_RAISE, _CAP_DAC_READ_SEARCH, 0, 0)
             return f"uid {uid}, reading as root does"
     return f"uid {uid}"
 

@@ -25,6 +25,10 @@ per check and gives each student a score out of the total. The file::
     points = { visible = 2, hidden = 3 }   # per case group; "hidden": the hidden groups not named, split evenly
                                            # (one number: split evenly over every group)
 
+    [[check]]
+    exercise = "mirror_states"             # a state exercise: points per leak kind
+    points = { reflection_outside = 2, shadow_twice = 1 }
+
 Every mistake in the file is one line naming the file, the check and the key.
 """
 
@@ -222,20 +226,31 @@ def group_points(points: Any, groups: list[str], where: str) -> tuple[tuple[str,
     return tuple((g, named[g] if g in named else 0.0 if g == "visible" else share) for g in groups)
 
 
+def exercise_groups(name: str) -> list[str]:
+    """An exercise's case groups, in its order: a function exercise's (``visible`` first), or a
+    state exercise's leak kinds."""
+    from glsandbox.exercises.catalogue import get
+    from glsandbox.exercises.states import STATE_EXERCISES
+
+    if name in STATE_EXERCISES:
+        return list(STATE_EXERCISES[name].groups)
+    return list(dict.fromkeys(case.group for case in get(name).cases(True)))
+
+
 def exercise_check(entry: dict[str, Any], where: str, path: Path) -> Check:
     """A ``[[check]]`` of kind ``exercise``: the exercise (checked against the catalogue), its name,
     its points per case group and ``hidden``."""
     from glsandbox.exercises.catalogue import MODULES, get
+    from glsandbox.exercises.states import STATE_EXERCISES
 
     name = entry.get("exercise")
-    if not isinstance(name, str) or name not in MODULES:
-        raise SandboxError(f"{where}: exercise = {name!r}: expected one of {', '.join(MODULES)}")
-    exercise = get(name)
+    if not isinstance(name, str) or (name not in MODULES and name not in STATE_EXERCISES):
+        raise SandboxError(f"{where}: exercise = {name!r}: expected one of {', '.join([*MODULES, *STATE_EXERCISES])}")
     title = entry.get("name", name)
     if not isinstance(title, str) or not title.strip() or not title.isprintable():
         raise SandboxError(f"{where}: name = {title!r}: expected a short printable text")
     where = f"{path}: check {title!r}"
-    groups = list(dict.fromkeys(case.group for case in exercise.cases(True)))
+    groups = exercise_groups(name)
     split = group_points(entry.get("points", len(groups)), groups, where)
     hidden = entry.get("hidden", False)
     if not isinstance(hidden, bool):

@@ -41,7 +41,7 @@ from pathlib import Path
 
 from glsandbox import files
 
-__all__ = ["confine", "read_roots", "landlock_abi"]
+__all__ = ["confine", "read_roots", "landlock_abi", "others_may_read"]
 
 #: System folders every process reads (shared libraries, fonts, locale, devices).
 SYSTEM_READ = ("/usr", "/lib", "/lib32", "/lib64", "/etc", "/dev", "/proc", "/sys", "/opt")
@@ -81,6 +81,32 @@ def _base_roots() -> tuple[str, ...]:
 
     roots.update(str(p) for p in shader_roots())  # glsandbox's shaders, and GLSANDBOX_SHADER_DIR's
     return tuple(sorted({os.path.realpath(r) for r in roots if os.path.isdir(r)}))
+
+
+@functools.lru_cache(maxsize=None)
+def others_may_read(root: str) -> tuple[str, ...]:
+    """The parts of ``root`` (a small folder: ``/etc``) a user with no account may read: the whole
+    folder where all in it is readable by others, else its entries so, recursively (a link by
+    what it points to). With the capability of reading any file kept, Landlock granting these
+    instead of ``root`` keeps a root-only file (``/etc/shadow``, a private key) unreadable."""
+    import stat
+
+    try:
+        mode = os.stat(root).st_mode
+    except OSError:
+        return ()
+    if not stat.S_ISDIR(mode):
+        return (root,) if mode & 0o004 else ()
+    if mode & 0o005 != 0o005 or os.path.islink(root):  # a link to a folder: not followed
+        return ()
+    try:
+        names = sorted(os.listdir(root))
+    except OSError:
+        return ()
+    parts = [(os.path.join(root, n), others_may_read(os.path.join(root, n))) for n in names]
+    if all(found == (path,) for path, found in parts):
+        return (root,)
+    return tuple(p for _, found in parts for p in found)
 
 
 def shader_cache_dirs() -> list[str]:
@@ -239,12 +265,15 @@ def _landlock(reads: Sequence[str], writes: Sequence[str]) -> bool:
 
 
 def confine(submission: str | os.PathLike[str], private: Sequence[str | os.PathLike[str]],
-            cache_writable: bool = False) -> bool:
+            cache_writable: bool = False, others_only: bool = False) -> bool:
     """Confine this process to reading ``submission`` (and :func:`read_roots`) and writing only ``private``.
 
     Mesa's shader cache is read, and written only with ``cache_writable``
     (the model answer, rendered by ``--update``): a submission that could
     write it could plant compiled code that its neighbours' renderers load.
+    ``others_only``: the process kept the capability of reading any file
+    (:func:`glsandbox.grading.layers.drop_privileges`), so of ``/etc`` only
+    what any user may read is granted (:func:`others_may_read`).
     Irreversible: call it in the child that renders a submission, never in
     the grader. Returns whether the kernel enforces it too (Landlock).
     """
@@ -254,6 +283,8 @@ def confine(submission: str | os.PathLike[str], private: Sequence[str | os.PathL
     # /proc: its own entries only (/proc/self resolves to them), never another process's
     own_proc = [f"/proc/{os.getpid()}", *(p for p in PROC_READ if os.path.exists(p))]
     reads = [r for r in read_roots([root, *cache]) if r != "/proc"] + own_proc
+    if others_only:  # reading as root does: no root-only file of /etc (shadow, private keys)
+        reads = [r for r in reads if r != "/etc"] + list(others_may_read("/etc"))
     from glsandbox.gl.shaders import shader_roots
 
     files.set_sandbox_root(root, also=(*writes, *shader_roots()))

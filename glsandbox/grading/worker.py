@@ -92,7 +92,8 @@ def _renderer(job: Job, root: str, target: str, work: str, out: int, ids: tuple[
         if ids is not None:  # Python only root may read: reading kept, bounded by Landlock below
             kept_reading = not _python_readable() and landlock_abi() >= 1
             layers.drop_privileges(ids, keep_reading=kept_reading)
-        if not confine(root, [root if job.copy else cwd, cwd], cache_writable=job.writes_cache) and kept_reading:
+        if not confine(root, [root if job.copy else cwd, cwd], cache_writable=job.writes_cache,
+                       others_only=kept_reading) and kept_reading:
             layers.drop_reading()
         layers.install_seccomp()
         render_job(job, renderer, root, target, out)
@@ -187,17 +188,6 @@ def _copy_submission(source: Path, into: Path) -> Path:
         into.mkdir()
         shutil.copy2(source, into / source.name, follow_symlinks=False)
     return into
-
-
-def _hand_over(work: str, folders: list[str], ids: tuple[int, int]) -> None:
-    """Make ``folders`` (and all in them) ``ids``'s; ``work`` above them only passable by others."""
-    uid, gid = ids
-    os.chmod(work, 0o711)
-    for folder in folders:
-        os.lchown(folder, uid, gid)
-        for base, dirs, names in os.walk(folder):
-            for name in dirs + names:
-                os.lchown(os.path.join(base, name), uid, gid)
 
 
 @functools.cache
@@ -319,7 +309,7 @@ def _supervise(job: Job, out: int) -> None:
             root, target = str(Path(job.source).parent), job.target
         ids = layers.submission_ids(os.getpid()) if job.copy else None
         if ids is not None:  # its own copy and working folder, owned by the user it runs as
-            _hand_over(work, [root, os.path.join(work, "cwd")], ids)
+            layers.hand_over(work, [root, os.path.join(work, "cwd")], ids)
         read_end, write_end = os.pipe()
         pid = os.fork()
         if pid == 0:  # the renderer: no GL context here, or the warm template's, checked safe to fork

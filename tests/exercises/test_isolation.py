@@ -202,3 +202,49 @@ def intersect_sphere(origin, direction, center, radius):
     result = check_file(get("ray_sphere"), _submission(tmp_path, body), hidden=True, probe_size=64)
     assert all(c.status == PASS for c in result.cases), [c for c in result.cases if c.status != PASS]
     assert result.probe.agrees
+
+
+WHO = '''
+import os
+
+def f(path):
+    try:
+        with open(path, "rb") as handle:
+            read = len(handle.read())
+    except OSError as exc:
+        read = -exc.errno
+    status = open("/proc/self/status").read()
+    effective = int(status.split("CapEff:")[1].split()[0], 16)
+    return [os.getuid(), os.geteuid(), os.getgid(), os.stat(__file__).st_uid, read, effective]
+'''
+
+
+@pytest.mark.skipif(not hasattr(os, "geteuid") or os.geteuid() != 0, reason="the grader is root only under root")
+def test_under_a_root_grader_the_function_runs_as_a_user_with_no_account(tmp_path) -> None:
+    """As a picture submission's renderer: a uid no account has, owning its own copy, with at most
+    the one capability of reading (where Python is root's alone), bounded so that a root-only
+    file, beside the submission or in /etc, stays unreadable."""
+    from glsandbox.grading.layers import reading_kept
+
+    secret = tmp_path / "teacher_only.txt"
+    secret.write_text("the hidden cases")
+    secret.chmod(0o600)
+    os.chown(secret, 0, 0)
+    path = tmp_path / "who.py"
+    path.write_text(WHO)
+    with Isolated(path, "f") as caller:
+        answer = caller.call([str(secret)])
+        shadow = caller.call(["/etc/shadow"]) if os.path.exists("/etc/shadow") else None
+        other = Isolated(path, "f")
+        try:
+            second = other.call(["/dev/null"])
+        finally:
+            other.close()
+    assert answer.status == VALUE, answer
+    uid, euid, gid, owner, read, effective = answer.value
+    assert uid != 0 and euid == uid and gid != 0 and owner == uid
+    assert read < 0  # refused: EACCES
+    assert effective == (1 << 2 if reading_kept() else 0)  # CAP_DAC_READ_SEARCH at most, no other power
+    if shadow is not None and not os.stat("/etc/shadow").st_mode & 0o004:
+        assert shadow.status == VALUE and shadow.value[4] < 0, shadow
+    assert second.status == VALUE and second.value[0] not in (0, uid)  # two processes: two users

@@ -144,3 +144,59 @@ def test_check_one_file_exercise_exit_codes(tmp_path: Path) -> None:
     assert unknown.returncode == 2 and "no exercise 'ray_cube'" in unknown.stderr
     both = glsandbox("check", "right.py", "--exercise", "ray_sphere", "--golden", "a.png", cwd=tmp_path)
     assert both.returncode == 2 and "drop --golden" in both.stderr
+
+
+SCENE = 'name = "cube"\n[camera]\neye = [2, 1.5, 3]\n[[nodes]]\nmesh = "cube"\n'
+
+MIXED = """\
+entry = "scene.toml"
+
+[[check]]
+name = "still"
+golden = "goldens/still.png"
+size = "64x48"
+points = 1
+
+[[check]]
+exercise = "ray_sphere"
+name = "sphere"
+points = { visible = 2, hidden = 3 }
+"""
+
+
+def test_one_grading_file_mixes_pictures_and_exercises(tmp_path: Path, gl) -> None:
+    """A student's folder holds the scene and the function: the picture checks render the rubric's
+    entry, the exercise checks grade the file that defines the function; the points add up."""
+    teacher = tmp_path / "teacher"
+    teacher.mkdir()
+    (teacher / "scene.toml").write_text(SCENE)
+    (teacher / "sphere.py").write_text(RIGHT)
+    rubric = teacher / "mixed.grading.toml"
+    rubric.write_text(MIXED)
+    made = glsandbox("check", str(teacher / "scene.toml"), "--rubric", str(rubric), "--update", cwd=tmp_path)
+    assert made.returncode == 0 and (teacher / "goldens" / "still.png").is_file(), made.stdout + made.stderr
+    folder = tmp_path / "class"
+    for name, scene, function in (("right", SCENE, RIGHT), ("wrong_picture", SCENE.replace("cube\"\n", "sphere\"\n"), RIGHT),
+                                  ("wrong_function", SCENE, WRONG), ("no_function", SCENE, None)):
+        (folder / name).mkdir(parents=True)
+        (folder / name / "scene.toml").write_text(scene)
+        if function is not None:
+            (folder / name / "sphere.py").write_text(function)
+    (folder / "linked").symlink_to(folder / "right")
+    data, gs = tmp_path / "marks.json", tmp_path / "results.json"
+    proc = glsandbox("check", str(folder), "--rubric", str(rubric), "--jobs", "2", "--json", str(data),
+                     "--gradescope", str(gs), cwd=tmp_path)
+    assert proc.returncode == 1, proc.stdout + proc.stderr
+    marks = {s["name"]: s for s in json.loads(data.read_text())["submissions"]}
+    checks = {n: {c["check"]: c["status"] for c in s["checks"]} for n, s in marks.items()}
+    assert list(checks["right"]) == ["still", *(f"sphere: {g}" for g in GROUPS)]  # the grading file's order
+    assert set(checks["right"].values()) == {"PASS"} and marks["right"]["score"] == pytest.approx(6.0)
+    assert checks["wrong_picture"]["still"] == "FAIL" and marks["wrong_picture"]["score"] == pytest.approx(5.0)
+    assert checks["wrong_function"]["still"] == "PASS" and checks["wrong_function"]["sphere: visible"] == "FAIL"
+    assert marks["wrong_function"]["score"] == pytest.approx(6.0 - 2.0 - 0.6)  # far_root, as graded alone
+    assert checks["no_function"]["still"] == "PASS" and marks["no_function"]["score"] == pytest.approx(1.0)
+    assert set(checks["linked"].values()) == {"BROKEN"} and marks["linked"]["score"] == 0
+    tests = {t["name"]: t for t in json.loads(gs.read_text())["tests"]}
+    assert tests["right: still"]["max_score"] == 1 and tests["right: sphere: inside"]["visibility"] == "after_published"
+    one = glsandbox("check", str(folder / "right" / "scene.toml"), "--rubric", str(rubric), cwd=folder / "right")
+    assert one.returncode == 0 and "PASS sphere: visible" in one.stdout, one.stdout + one.stderr

@@ -227,3 +227,78 @@ def test_an_installed_glsandbox_is_packed_back_into_the_same_wheel(tmp_path: Pat
         record = z.read(next(n for n in z.namelist() if n.endswith("/RECORD"))).decode()
     assert again == original  # every file of the package, its lessons and shaders, byte for byte
     assert all(f"{name},sha256=" in record for name in again)
+
+
+EXERCISE_RUBRIC = """timeout = 4
+[[check]]
+exercise = "ray_sphere"
+name = "sphere"
+points = { visible = 2, hidden = 3 }
+"""
+
+#: An exercise's hostile student: forges the results, reads the grader's environment and the
+#: bundle, then never answers.
+HOSTILE_FUNCTION = '''
+import os
+
+ROOT = {root!r}
+
+
+def intersect_sphere(origin, direction, center, radius):
+    for attempt in (lambda: open(ROOT + "/results/results.json", "w").write('{{"score": 100}}'),
+                    lambda: open(ROOT + "/results/forged.txt", "w").write("x"),
+                    lambda: open("/proc/self/environ").read(), lambda: open("/proc/1/environ").read(),
+                    lambda: open(ROOT + "/source/assignment.grading.toml").read()):
+        try:
+            text = str(attempt())
+            if "tok-" in text or "ray_sphere" in text:  # the grader's secret, or the bundle's grading file
+                return 35.0
+        except Exception:
+            pass
+    if any("tok-" in v for v in os.environ.values()):
+        return 35.0
+    while True:
+        pass
+'''
+
+
+@pytest.mark.slow
+def test_the_bundle_grades_an_exercise_rubric(tmp_path: Path) -> None:
+    """An exercise rubric's bundle (no goldens: the cases are the wheel's), run on a right, a wrong
+    (the far root) and a hostile function: results.json valid, one test per case group."""
+    from support import SPHERE_ANSWER
+
+    teacher = tmp_path / "teacher"
+    teacher.mkdir()
+    rubric = teacher / "sphere.grading.toml"
+    rubric.write_text(EXERCISE_RUBRIC)
+    bundle = tmp_path / "autograder.zip"
+    proc = run_cli("gradescope", str(rubric), "--out", str(bundle))
+    assert proc.returncode == 0, proc.stderr
+    with zipfile.ZipFile(bundle) as z:
+        names = z.namelist()
+        bundled = z.read("assignment.grading.toml").decode()
+    assert not any(n.startswith("goldens/") for n in names) and 'exercise = "ray_sphere"' in bundled
+    wrong = SPHERE_ANSWER.replace("return None if s < 0 else s - q", "return None if s < 0 else s + q")
+    assert wrong != SPHERE_ANSWER
+    outcomes = {}
+    for name, text in (("right", SPHERE_ANSWER), ("wrong", wrong), ("hostile", None)):
+        root = tmp_path / name
+        unpack(bundle, root)
+        body = text if text is not None else HOSTILE_FUNCTION.format(root=str(root))
+        (root / "submission" / "sphere.py").write_text(body)
+        outcomes[name] = run_autograder(root)
+        assert not (root / "results" / "forged.txt").exists()
+    print(json.dumps(outcomes, indent=2))  # the report's record of the three results.json
+    groups = ["visible", "inside", "behind", "edge", "surface", "scale"]
+    for results in outcomes.values():
+        tests = results["tests"]
+        assert [t["name"] for t in tests] == [f"sphere: {g}" for g in groups]
+        assert [t["visibility"] for t in tests] == ["visible"] + ["after_published"] * 5
+        assert sum(t["max_score"] for t in tests) == pytest.approx(5.0)
+    assert outcomes["right"]["score"] == pytest.approx(5.0)
+    assert outcomes["wrong"]["score"] == pytest.approx(5.0 - 2.0 - 0.6)  # far_root: the notes' examples and scale
+    assert "far_root" in outcomes["wrong"]["tests"][0]["output"]
+    hostile = outcomes["hostile"]
+    assert hostile["score"] == 0 and all(t["status"] == "failed" for t in hostile["tests"])
+    assert SECRET not in json.dumps(hostile)

@@ -82,6 +82,7 @@ class Spy(Lesson):
         except OSError as exc:
             udp = f"refused:{{exc.errno}}"
         print("N", listing, tcp, udp, os.getuid(), os.stat(__file__).st_uid, flush=True)
+        print("S", "r" if by_ctypes("/etc/shadow") is not None else "-", flush=True)
         here = Path("scene.toml")
         here.write_text({scene!r})
         return load_scene(here)
@@ -160,6 +161,8 @@ def test_the_submission_sees_no_other_process_and_no_network(tmp_path: Path, gl)
         assert seen["reached"] is False and tcp.startswith("refused"), tcp
     if layers._probe()[0]:
         assert udp.startswith("refused"), udp
+    if os.path.exists("/etc/shadow") and not os.stat("/etc/shadow").st_mode & 0o004:
+        assert seen["S"] == "-"  # a root-only file: even where reading as root does is kept
     if os.geteuid() == 0:
         assert int(uid) != 0 and int(owner) == int(uid)  # a user with no account, owning its own copy
     else:

@@ -24,11 +24,15 @@ class StateExercise:
     name: str
     section: str
     holds: str
+    #: Its case groups when graded for a class (a rubric's ``points`` keys): one per leak kind.
+    groups: tuple[str, ...] = ()
 
 
 #: The state exercises by name.
 STATE_EXERCISES: dict[str, StateExercise] = {
     "mirror_states": StateExercise(
         "mirror_states", "The stencil Test: MarkMirrorDSS, DrawReflectionDSS",
-        "MARK_MIRROR_DSS, DRAW_REFLECTION_DSS, REFLECTED_RASTERIZER, SHADOW_BLEND, SHADOW_DSS, SHADOW_LIFT"),
+        "MARK_MIRROR_DSS, DRAW_REFLECTION_DSS, REFLECTED_RASTERIZER, SHADOW_BLEND, SHADOW_DSS, SHADOW_LIFT",
+        # the leak map's kinds (mirror.CLASSES but "as the reference"), in its order
+        ("reflection_outside", "reflection_wrong", "reflection_missing", "shadow_twice", "shadow_missing", "other")),
 }
