@@ -1,4 +1,4 @@
-"""The precision knobs of ``glsandbox tradeoffs`` (issue 21) measure what they say:
+"""The precision knobs of ``glsandbox tradeoffs`` measure what they say:
 the simple shadow offset loses the contact shadow far from the origin and the
 error bound does not; world-space float32 differs from float64 at 1e5 and
 anchored coordinates do not; cheap settings' medians are judged stable."""
