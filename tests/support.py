@@ -497,3 +497,11 @@ def intersect_sphere(origin, direction, center, radius):
         return None if s < 0 else s - q
     return s + q
 """
+
+
+def course_ray(lesson: str, direction: str, *settings: str):
+    """The centre pixel of an odd-sized frame whose camera sits at the origin looking along
+    ``direction`` (a glsandbox.story.Story): that pixel's ray is the notes' ray from (0, 0, 0)."""
+    from glsandbox.story import explain
+
+    return explain(lesson, (200, 150), (401, 301), camera=f"0,0,0,{direction}", **dict(s.split("=") for s in settings))

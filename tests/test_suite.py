@@ -86,10 +86,6 @@ NOT_YET_NAMED = {
     "measure/tradeoffs",
     "measure/tradeoffs_report",
     "raytrace/bvh_traverse",
-    "story/coverage",
-    "story/raster",
-    "story/ray",
-    "story/text",
 }
 
 
