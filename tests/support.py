@@ -505,3 +505,12 @@ def course_ray(lesson: str, direction: str, *settings: str):
     from glsandbox.story import explain
 
     return explain(lesson, (200, 150), (401, 301), camera=f"0,0,0,{direction}", **dict(s.split("=") for s in settings))
+
+
+def knob_counts(knob, size: tuple[int, int]) -> dict:
+    """Each setting's (and the reference's) pixel count of a tradeoffs knob that counts without
+    rendering (its ``count`` reads only ``context.size``), by label."""
+    from types import SimpleNamespace
+
+    context = SimpleNamespace(size=size)
+    return {s.label: s.count(context) for s in (*knob.settings, knob.reference)}

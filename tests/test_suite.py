@@ -59,7 +59,6 @@ PURE_DATA = {"version", "raytrace/errors", "raytrace/shape_kind", "gl/draw_steps
 NOT_YET_NAMED = {
     "grading/runner",  # through tests/grading/test_portable.py
     "lesson_pages",  # through tests/docs/ (the built lesson pages)
-    "measure/bench_tables",  # through tests/docs/ (the benchmarks page)
     "supervise",  # through tests/cli/test_lessons_that_end.py
     "gl/gpu_meshes",
     "gl/osmesa",
@@ -68,33 +67,45 @@ NOT_YET_NAMED = {
     "grading/kinds",
     "grading/processes",
     "grading/worker",
-    "measure/extra",
-    "measure/knob",
-    "measure/knobs/_far",
-    "measure/knobs/antialiasing",
-    "measure/knobs/depth",
-    "measure/knobs/depth_format",
-    "measure/knobs/lighting",
-    "measure/knobs/ray_engine",
-    "measure/knobs/shadow_epsilon",
-    "measure/knobs/shadow_map",
-    "measure/knobs/shadow_offset",
-    "measure/knobs/shadows_mirror",
-    "measure/knobs/sphere_test",
-    "measure/knobs/texture_filter",
-    "measure/knobs/triangle_test",
-    "measure/tradeoffs",
-    "measure/tradeoffs_report",
     "raytrace/bvh_traverse",
 }
 
 
+#: Folders of one-entry modules (a knob each), tested together by one parametrised file whose
+#: ``MODULES`` lists every module of the folder (that file fails on a module it does not list);
+#: a module there may have its own ``test_<name>.py`` as well, for what only it does.
+TESTED_TOGETHER = {"measure/knobs": TESTS_DIR / "measure" / "knobs" / "test_every_knob.py"}
+
+
+def listed_modules(test_file: Path) -> tuple[str, ...]:
+    """The names in a parametrised test file's module-level ``MODULES = (...)``."""
+    for node in ast.parse(test_file.read_text(encoding="utf-8")).body:
+        if isinstance(node, ast.Assign) and [getattr(t, "id", None) for t in node.targets] == ["MODULES"]:
+            return tuple(ast.literal_eval(node.value))
+    return ()
+
+
 def named_test_file(module: str) -> list[Path]:
     """Where ``glsandbox/<module>.py``'s tests live: ``tests/<sub>/test_<name>.py`` for a
-    module in a sub-package; ``tests/core/``, ``tests/cli/`` or ``tests/`` for a top-level one."""
+    module in a sub-package; ``tests/core/``, ``tests/cli/`` or ``tests/`` for a top-level one.
+    A private module's leading ``_`` is dropped (``knobs/_far.py``: ``test_far.py``); a module
+    of a :data:`TESTED_TOGETHER` folder is also tested by that folder's file when it is listed."""
     *folders, name = module.split("/")
+    stem = name.lstrip("_")
     places = ["/".join(folders)] if folders else ["core", "cli", "."]
-    return [TESTS_DIR / place / f"test_{name}.py" for place in places if (TESTS_DIR / place / f"test_{name}.py").is_file()]
+    found = [TESTS_DIR / place / f"test_{stem}.py" for place in places]
+    found = [path for path in found if path.is_file()]
+    together = TESTED_TOGETHER.get("/".join(folders))
+    if together is not None and together.is_file() and name in listed_modules(together):
+        found.append(together)
+    return found
+
+
+def test_a_folder_tested_together_names_only_the_modules_its_file_lists() -> None:
+    assert named_test_file("measure/knobs/lighting") == [TESTED_TOGETHER["measure/knobs"]]
+    assert TESTED_TOGETHER["measure/knobs"] in named_test_file("measure/knobs/shadow_map")  # and its own file
+    assert named_test_file("measure/knobs/not_listed") == []
+    assert named_test_file("measure/knobs/_far") == [TESTS_DIR / "measure" / "knobs" / "test_far.py"]
 
 
 def package_modules() -> list[str]:
