@@ -67,7 +67,6 @@ NOT_YET_NAMED = {
     "grading/kinds",
     "grading/processes",
     "grading/worker",
-    "raytrace/bvh_traverse",
 }
 
 
