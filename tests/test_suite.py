@@ -58,8 +58,6 @@ PURE_DATA = {"version", "raytrace/errors", "raytrace/shape_kind", "gl/draw_steps
 #: (a module that gains its file, or goes, must leave it; a new module must bring its file).
 NOT_YET_NAMED = {
     "grading/runner",  # through tests/grading/test_portable.py
-    "lesson_pages",  # through tests/docs/ (the built lesson pages)
-    "supervise",  # through tests/cli/test_lessons_that_end.py
     "gl/gpu_meshes",
     "gl/osmesa",
     "gl/rawgl",
