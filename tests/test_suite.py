@@ -58,9 +58,6 @@ PURE_DATA = {"version", "raytrace/errors", "raytrace/shape_kind", "gl/draw_steps
 #: (a module that gains its file, or goes, must leave it; a new module must bring its file).
 NOT_YET_NAMED = {
     "grading/runner",  # through tests/grading/test_portable.py
-    "gl/gpu_meshes",
-    "gl/osmesa",
-    "gl/rawgl",
     "grading/isolate",
     "grading/kinds",
     "grading/processes",
