@@ -54,15 +54,6 @@ def test_no_test_module_imports_another_or_conftest() -> None:
 #: Modules with no logic of their own (a version string, an error type, a record of a kind's parts,
 #: the executor's records of a prepared draw and frame).
 PURE_DATA = {"version", "raytrace/errors", "raytrace/shape_kind", "gl/draw_steps"}
-#: Modules with logic still tested only through others' test files: this list only shrinks
-#: (a module that gains its file, or goes, must leave it; a new module must bring its file).
-NOT_YET_NAMED = {
-    "grading/runner",  # through tests/grading/test_portable.py
-    "grading/isolate",
-    "grading/kinds",
-    "grading/processes",
-    "grading/worker",
-}
 
 
 #: Folders of one-entry modules (a knob each), tested together by one parametrised file whose
@@ -114,7 +105,7 @@ NOT_YET_PACKAGES = ("exercises/",)
 
 def test_every_module_with_logic_has_a_test_file_named_after_it() -> None:
     modules = [m for m in package_modules() if not m.startswith(NOT_YET_PACKAGES)]
-    unnamed = [m for m in modules if not named_test_file(m) and m not in PURE_DATA | NOT_YET_NAMED]
+    unnamed = [m for m in modules if not named_test_file(m) and m not in PURE_DATA]
     assert unnamed == [], "add tests/<layer>/test_<module>.py for: " + ", ".join(unnamed)
-    stale = sorted(m for m in PURE_DATA | NOT_YET_NAMED if m not in modules or named_test_file(m))
-    assert stale == [], f"take these off the lists (gone, or their test file exists): {stale}"
+    stale = sorted(m for m in PURE_DATA if m not in modules or named_test_file(m))
+    assert stale == [], f"take these off PURE_DATA (gone, or their test file exists): {stale}"
