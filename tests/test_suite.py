@@ -117,9 +117,6 @@ NOT_YET_NAMED = {
     "exercises/base",  # through tests/exercises/test_compare.py and test_variants.py
     "exercises/report",  # through tests/exercises/test_commands.py (check's report)
     "exercises/runner",  # through tests/exercises/test_catalogue.py and every exercise check
-    "exercises/states/command",  # through tests/exercises/test_states.py (the check command)
-    "exercises/states/mirror",  # through tests/exercises/test_states.py
-    "exercises/states/tables",  # through tests/exercises/test_states.py
 }
 
 
