@@ -111,17 +111,11 @@ def package_modules() -> list[str]:
                   if p.name not in ("__init__.py", "__main__.py"))
 
 
-#: Modules with logic still tested only through others' test files: this list only shrinks
-#: (a module that gains its file, or goes, must leave it; a new module must bring its file).
-NOT_YET_NAMED = {
-    "exercises/base",  # through tests/exercises/test_compare.py and test_variants.py
-    "exercises/runner",  # through tests/exercises/test_catalogue.py and every exercise check
-}
 
 
 def test_every_module_with_logic_has_a_test_file_named_after_it() -> None:
     modules = package_modules()
-    unnamed = [m for m in modules if not named_test_file(m) and m not in PURE_DATA | NOT_YET_NAMED]
+    unnamed = [m for m in modules if not named_test_file(m) and m not in PURE_DATA]
     assert unnamed == [], "add tests/<layer>/test_<module>.py for: " + ", ".join(unnamed)
-    stale = sorted(m for m in PURE_DATA | NOT_YET_NAMED if m not in modules or named_test_file(m))
-    assert stale == [], f"take these off the lists (gone, or their test file exists): {stale}"
+    stale = sorted(m for m in PURE_DATA if m not in modules or named_test_file(m))
+    assert stale == [], f"take these off PURE_DATA (gone, or their test file exists): {stale}"
