@@ -8,13 +8,7 @@ import math
 import pytest
 
 from glsandbox.measure import knob as knob_module
-from glsandbox.measure.knob import Knob, KnobResult, Row, Setting, all_knobs, median_spread, register_knob, run_spread
-
-
-def test_run_spread_is_the_passes_medians_apart() -> None:
-    assert math.isclose(run_spread([1.66, 8.37]), (8.37 - 1.66) / 5.015)
-    assert math.isclose(run_spread([2.0, 2.1, 2.0]), 0.1 / 2.0)
-    assert math.isinf(run_spread([2.0]))
+from glsandbox.measure.knob import Knob, KnobResult, Row, Setting, all_knobs, median_spread, register_knob
 
 
 def test_median_spread_is_the_odd_and_even_runs_medians_apart() -> None:

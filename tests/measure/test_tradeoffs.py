@@ -1,13 +1,17 @@
 """How ``glsandbox tradeoffs`` times (glsandbox/measure/tradeoffs.py): rounds that take the
-knobs in turn, and independent passes whose medians give each figure's run-to-run spread. Fake settings with a fake clock:
+knobs in turn, independent passes whose medians give each figure's run-to-run spread, and a
+report that gives no figure where the passes disagree. Fake settings with a fake clock:
 nothing is rendered and no time is measured."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from glsandbox.measure import tradeoffs
-from glsandbox.measure.knob import Knob, Setting
+from glsandbox.measure.knob import Knob, Row, Setting, run_spread
+from glsandbox.measure.tradeoffs_report import time_cell, write_report
 
 
 def test_interleave_takes_the_knobs_in_turn() -> None:
@@ -57,3 +61,29 @@ def test_measure_knobs_alternates_rounds_across_knobs_and_keeps_each_pass_median
     for result in results:
         for row in result.rows:
             assert len(row.pass_medians) == 2 and len(row.times_ms) >= 10
+
+
+def test_run_spread_is_the_passes_medians_apart() -> None:
+    assert math.isclose(run_spread([1.66, 8.37]), (8.37 - 1.66) / 5.015)
+    assert math.isclose(run_spread([2.0, 2.1, 2.0]), 0.1 / 2.0)
+    assert math.isinf(run_spread([2.0]))
+
+
+def row(medians: list[float]) -> Row:
+    return Row("k", "MSAA 4x", False, [m for m in medians for _ in range(5)], 0.01, 40.0, 0.02,
+               "images/a.png", "error_maps/a.png", None, medians)
+
+
+def test_a_time_whose_passes_disagree_gets_no_figure(tmp_path) -> None:
+    assert time_cell(row([1.66, 1.70])) == "1.68 ±1%"
+    assert time_cell(row([1.66, 8.37])) == "too noisy (passes 1.66, 8.37 ms: ±67%)"
+    knob = Knob("k", "A knob", "phong", (Setting("MSAA 4x", lambda c: None),), Setting("ref", lambda c: None), "r")
+    from glsandbox.measure.knob import KnobResult
+
+    info = {"renderer": "llvmpipe", "backend": "egl", "size": "128x96", "runs": "5", "passes": "2", "quick": "yes",
+            "load": "3.10, 2.50, 2.00 before, 3.20, 2.60, 2.00 after", "cpus": "2"}
+    write_report([KnobResult(knob, [row([1.66, 8.37])])], info, tmp_path / "report.md")
+    report = (tmp_path / "report.md").read_text(encoding="utf-8")
+    assert "| MSAA 4x | too noisy (passes 1.66, 8.37 ms: ±67%) |" in report
+    assert "Too noisy to give a time (1 of 1 settings)" in report
+    assert "Load average (1, 5, 15 min) on 2 CPUs: 3.10, 2.50, 2.00 before, 3.20, 2.60, 2.00 after." in report

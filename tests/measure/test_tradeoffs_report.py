@@ -1,37 +1,41 @@
-"""What ``glsandbox tradeoffs`` writes (glsandbox/measure/tradeoffs_report.py): a time cell with its
-run-to-run spread, or no figure where the passes disagree; the CSV's columns. Hand-made rows:
-nothing is rendered and no time is measured."""
+"""What ``glsandbox tradeoffs`` writes (glsandbox/measure/tradeoffs_report.py): whether a knob's
+errors fall along its order, the knobs not measured and why, the CSV's columns. Hand-made rows:
+nothing is rendered and no time is measured. (A time cell and its spread: test_tradeoffs.py.)"""
 
 from __future__ import annotations
 
 import csv
 
 from glsandbox.measure.knob import Knob, KnobResult, Row, Setting
-from glsandbox.measure.tradeoffs_report import CSV_COLUMNS, time_cell, write_csv, write_report
+from glsandbox.measure.tradeoffs_report import CSV_COLUMNS, write_csv, write_report
 
 
-def row(medians: list[float]) -> Row:
-    return Row("k", "MSAA 4x", False, [m for m in medians for _ in range(5)], 0.01, 40.0, 0.02,
-               "images/a.png", "error_maps/a.png", None, medians)
+def row(setting: str, rmse: float, reference: bool = False) -> Row:
+    return Row("k", setting, reference, [2.0] * 5, rmse, 40.0, None, pass_medians=[2.0, 2.0])
 
 
-def test_a_time_whose_passes_disagree_gets_no_figure(tmp_path) -> None:
-    assert time_cell(row([1.66, 1.70])) == "1.68 ±1%"
-    assert time_cell(row([1.66, 8.37])) == "too noisy (passes 1.66, 8.37 ms: ±67%)"
-    knob = Knob("k", "A knob", "phong", (Setting("MSAA 4x", lambda c: None),), Setting("ref", lambda c: None), "r")
-    info = {"renderer": "llvmpipe", "backend": "egl", "size": "128x96", "runs": "5", "passes": "2", "quick": "yes",
-            "load": "3.10, 2.50, 2.00 before, 3.20, 2.60, 2.00 after", "cpus": "2"}
-    write_report([KnobResult(knob, [row([1.66, 8.37])])], info, tmp_path / "report.md")
-    report = (tmp_path / "report.md").read_text(encoding="utf-8")
-    assert "| MSAA 4x | too noisy (passes 1.66, 8.37 ms: ±67%) |" in report
-    assert "Too noisy to give a time (1 of 1 settings)" in report
-    assert "Load average (1, 5, 15 min) on 2 CPUs: 3.10, 2.50, 2.00 before, 3.20, 2.60, 2.00 after." in report
+KNOB = Knob("k", "A knob", "phong", tuple(Setting(s, lambda c: None) for s in ("low", "a | b", "high")),
+            Setting("ref", lambda c: None), "r", monotone=("low", "high"))
+INFO = {"renderer": "llvmpipe", "backend": "egl", "size": "128x96", "runs": "5", "passes": "2", "quick": "yes"}
+
+
+def test_the_report_says_whether_errors_fall_along_the_knobs_order(tmp_path) -> None:
+    falls = KnobResult(KNOB, [row("low", 0.3), row("a | b", 0.2), row("high", 0.1), row("ref", 0.0, True)])
+    grows = KnobResult(KNOB, [row("low", 0.1), row("high", 0.3), row("ref", 0.0, True)])
+    write_report([falls], INFO, tmp_path / "falls.md")
+    write_report([grows], INFO, tmp_path / "grows.md", skipped={"k": "x", "other": "needs embree"})
+    falls_text, grows_text = ((tmp_path / f"{n}.md").read_text(encoding="utf-8") for n in ("falls", "grows"))
+    assert "Error order low >= high (RMSE): holds." in falls_text
+    assert "Error order low >= high (RMSE): DOES NOT HOLD." in grows_text
+    assert "| a \\| b | " in falls_text and "| ref (reference) | " in falls_text  # a "|" in a label is escaped
+    assert "## Not measured yet\n\n- `other`: needs embree" in grows_text and "`k`: x" not in grows_text
+    assert "Not measured yet" not in falls_text
 
 
 def test_the_csv_has_a_row_per_setting_in_its_columns(tmp_path) -> None:
     knob = Knob("k", "A knob", "phong", (Setting("MSAA 4x", lambda c: None),), Setting("ref", lambda c: None), "r")
     reference = Row("k", "ref", True, [2.0, 2.0, 2.0], 0.0, float("inf"), None, pass_medians=[2.0, 2.0])
-    write_csv([KnobResult(knob, [row([1.66, 1.70]), reference])], (128, 96), tmp_path / "t.csv")
+    write_csv([KnobResult(knob, [row("MSAA 4x", 0.01), reference])], (128, 96), tmp_path / "t.csv")
     with (tmp_path / "t.csv").open(encoding="utf-8", newline="") as f:
         rows = list(csv.DictReader(f))
     assert tuple(rows[0]) == CSV_COLUMNS and [r["setting"] for r in rows] == ["MSAA 4x", "ref"]
