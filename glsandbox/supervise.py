@@ -40,8 +40,9 @@ def user_code_in(words: list[str]) -> str | None:
             if word.startswith("--lessons="):
                 return word.partition("=")[2]
         return None
-    target = next((w for w in words[1:] if not w.startswith("-")), None)
-    return target if target is not None and target.endswith(".py") and Path(target).is_file() else None
+    # The first lesson file among the words, wherever it is: an option's value may come before it
+    # (``render --size 32x24 mine.py``). Supervising a command that needed none costs a process only.
+    return next((w for w in words[1:] if not w.startswith("-") and w.endswith(".py") and Path(w).is_file()), None)
 
 
 def finished() -> None:

@@ -73,7 +73,7 @@ def golden(request: pytest.FixtureRequest) -> GoldenCheck:
 # --- bytecode for subprocesses ----------------------------------------------------
 # Where bytecode writing is off (PYTHONDONTWRITEBYTECODE=1) and nothing compiled the
 # installed packages (`uv sync --compile-bytecode`, docs/testing.md), every `glsandbox`
-# subprocess compiles numpy, moderngl, Pillow and glsandbox again (issue 24: `glsandbox
+# subprocess compiles numpy, moderngl, Pillow and glsandbox again (`glsandbox
 # render` started in 0.63 s instead of 0.23 s on a quiet machine). The modules this process
 # imported while collecting (the same ones) are compiled once here, and again only when
 # their source is newer.

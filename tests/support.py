@@ -646,3 +646,48 @@ def intersect_sphere(origin, direction, center, radius):
         return None if s < 0 else s - q
     return s + q
 """
+
+
+def course_ray(lesson: str, direction: str, *settings: str):
+    """The centre pixel of an odd-sized frame whose camera sits at the origin looking along
+    ``direction`` (a glsandbox.story.Story): that pixel's ray is the notes' ray from (0, 0, 0)."""
+    from glsandbox.story import explain
+
+    return explain(lesson, (200, 150), (401, 301), camera=f"0,0,0,{direction}", **dict(s.split("=") for s in settings))
+
+
+def knob_counts(knob, size: tuple[int, int]) -> dict:
+    """Each setting's (and the reference's) pixel count of a tradeoffs knob that counts without
+    rendering (its ``count`` reads only ``context.size``), by label."""
+    from types import SimpleNamespace
+
+    context = SimpleNamespace(size=size)
+    return {s.label: s.count(context) for s in (*knob.settings, knob.reference)}
+
+
+# --- the BVH's random triangles and rays (tests/raytrace/) -----------------------------------
+
+
+def triangle_soup(seed: int, count: int, spread: float = 4.0, size: float = 0.6) -> tuple[np.ndarray, ...]:
+    """``count`` random triangles, some of them degenerate and some duplicated."""
+    rng = np.random.default_rng(seed)
+    a = rng.uniform(-spread, spread, (count, 3))
+    b = a + rng.normal(0.0, size, (count, 3))
+    c = a + rng.normal(0.0, size, (count, 3))
+    if count >= 6:
+        c[0] = b[0]  # a repeated corner: zero area
+        c[1] = a[1] + 2.0 * (b[1] - a[1])  # collinear: zero area
+        a[2], b[2], c[2] = a[3], b[3], c[3]  # a duplicate: a tie at every t
+    return a, b, c
+
+
+def random_rays(seed: int, count: int, spread: float = 6.0) -> tuple[np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(seed + 1000)
+    return rng.uniform(-spread, spread, (count, 3)), rng.normal(size=(count, 3))
+
+
+def assert_same_hits(got, want) -> None:
+    np.testing.assert_array_equal(got.triangle, want.triangle)
+    np.testing.assert_array_equal(got.t, want.t)
+    np.testing.assert_array_equal(got.u, want.u)
+    np.testing.assert_array_equal(got.v, want.v)

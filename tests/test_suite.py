@@ -54,51 +54,56 @@ def test_no_test_module_imports_another_or_conftest() -> None:
 #: Modules with no logic of their own (a version string, an error type, a record of a kind's parts,
 #: the executor's records of a prepared draw and frame).
 PURE_DATA = {"version", "raytrace/errors", "raytrace/shape_kind", "gl/draw_steps"}
-#: Modules with logic still tested only through others' test files: this list only shrinks
-#: (a module that gains its file, or goes, must leave it; a new module must bring its file).
-NOT_YET_NAMED = {
-    "grading/runner",  # through tests/grading/test_portable.py
-    "lesson_pages",  # through tests/docs/ (the built lesson pages)
-    "measure/bench_tables",  # through tests/docs/ (the benchmarks page)
-    "supervise",  # through tests/cli/test_lessons_that_end.py
-    "gl/gpu_meshes",
-    "gl/osmesa",
-    "gl/rawgl",
-    "grading/isolate",
-    "grading/kinds",
-    "grading/processes",
-    "grading/worker",
-    "measure/extra",
-    "measure/knob",
-    "measure/knobs/_far",
-    "measure/knobs/antialiasing",
-    "measure/knobs/depth",
-    "measure/knobs/depth_format",
-    "measure/knobs/lighting",
-    "measure/knobs/ray_engine",
-    "measure/knobs/shadow_epsilon",
-    "measure/knobs/shadow_map",
-    "measure/knobs/shadow_offset",
-    "measure/knobs/shadows_mirror",
-    "measure/knobs/sphere_test",
-    "measure/knobs/texture_filter",
-    "measure/knobs/triangle_test",
-    "measure/tradeoffs",
-    "measure/tradeoffs_report",
-    "raytrace/bvh_traverse",
-    "story/coverage",
-    "story/raster",
-    "story/ray",
-    "story/text",
+
+
+def listed_modules(test_file: Path) -> tuple[str, ...]:
+    """The names in a parametrised test file's module-level ``MODULES = (...)``."""
+    for node in ast.parse(test_file.read_text(encoding="utf-8")).body:
+        if isinstance(node, ast.Assign) and [getattr(t, "id", None) for t in node.targets] == ["MODULES"]:
+            return tuple(ast.literal_eval(node.value))
+    return ()
+
+
+def catalogue_modules(test_file: Path) -> tuple[str, ...]:
+    """The exercises' registry (``glsandbox.exercises.catalogue.MODULES``), which their test file runs over."""
+    from glsandbox.exercises.catalogue import MODULES
+
+    return MODULES
+
+
+#: Folders of one-entry modules (a knob, an exercise), each tested together by one parametrised
+#: file over every module a list names: the file's own ``MODULES = (...)``, or the registry's
+#: (that file fails on a module of the folder the list leaves out). A module there may have its
+#: own ``test_<name>.py`` as well, for what only it does.
+TESTED_TOGETHER = {
+    "measure/knobs": (TESTS_DIR / "measure" / "knobs" / "test_every_knob.py", listed_modules),
+    "exercises/catalogue": (TESTS_DIR / "exercises" / "test_catalogue.py", catalogue_modules),
 }
 
 
 def named_test_file(module: str) -> list[Path]:
     """Where ``glsandbox/<module>.py``'s tests live: ``tests/<sub>/test_<name>.py`` for a
-    module in a sub-package; ``tests/core/``, ``tests/cli/`` or ``tests/`` for a top-level one."""
+    module in a sub-package; ``tests/core/``, ``tests/cli/`` or ``tests/`` for a top-level one.
+    A private module's leading ``_`` is dropped (``knobs/_far.py``: ``test_far.py``); a module
+    of a :data:`TESTED_TOGETHER` folder is also tested by that folder's file when it is listed."""
     *folders, name = module.split("/")
+    stem = name.lstrip("_")
     places = ["/".join(folders)] if folders else ["core", "cli", "."]
-    return [TESTS_DIR / place / f"test_{name}.py" for place in places if (TESTS_DIR / place / f"test_{name}.py").is_file()]
+    found = [TESTS_DIR / place / f"test_{stem}.py" for place in places]
+    found = [path for path in found if path.is_file()]
+    together, listed = TESTED_TOGETHER.get("/".join(folders), (None, None))
+    if together is not None and together.is_file() and name in listed(together):
+        found.append(together)
+    return found
+
+
+def test_a_folder_tested_together_names_only_the_modules_its_file_lists() -> None:
+    knobs = TESTED_TOGETHER["measure/knobs"][0]
+    assert named_test_file("measure/knobs/lighting") == [knobs]
+    assert knobs in named_test_file("measure/knobs/shadow_map")  # and its own file
+    assert named_test_file("exercises/catalogue/ray_sphere") == [TESTED_TOGETHER["exercises/catalogue"][0]]
+    assert named_test_file("measure/knobs/not_listed") == []
+    assert named_test_file("measure/knobs/_far") == [TESTS_DIR / "measure" / "knobs" / "test_far.py"]
 
 
 def package_modules() -> list[str]:
@@ -106,14 +111,11 @@ def package_modules() -> list[str]:
                   if p.name not in ("__init__.py", "__main__.py"))
 
 
-#: Packages just landed whose tests are still being laid out (``exercises/``: one module per
-#: exercise, tested together in tests/exercises/test_catalogue.py), read again once they settle.
-NOT_YET_PACKAGES = ("exercises/",)
 
 
 def test_every_module_with_logic_has_a_test_file_named_after_it() -> None:
-    modules = [m for m in package_modules() if not m.startswith(NOT_YET_PACKAGES)]
-    unnamed = [m for m in modules if not named_test_file(m) and m not in PURE_DATA | NOT_YET_NAMED]
+    modules = package_modules()
+    unnamed = [m for m in modules if not named_test_file(m) and m not in PURE_DATA]
     assert unnamed == [], "add tests/<layer>/test_<module>.py for: " + ", ".join(unnamed)
-    stale = sorted(m for m in PURE_DATA | NOT_YET_NAMED if m not in modules or named_test_file(m))
-    assert stale == [], f"take these off the lists (gone, or their test file exists): {stale}"
+    stale = sorted(m for m in PURE_DATA if m not in modules or named_test_file(m))
+    assert stale == [], f"take these off PURE_DATA (gone, or their test file exists): {stale}"

@@ -1,4 +1,4 @@
-"""Hostile files (issue 12): named pipes and folders where a file belongs, 16-bit and oversized
+"""Hostile files: named pipes and folders where a file belongs, 16-bit and oversized
 images, shaders that are not UTF-8. Each is one ``error:`` line and exit 2 (or, for the 16-bit
 image, the right pixels), never a hang, a warning or a traceback."""
 

@@ -1,5 +1,5 @@
 """Hostile input at the command line: one ``error:`` line and exit 2, or a clean stop; never a
-traceback, never a half-written file or an empty folder left behind (issue 12).
+traceback, never a half-written file or an empty folder left behind.
 
 Runs are in this process (``support.run_cli``) but where the process is the point: a closed
 pipe, a lesson module's own entry point, the OSMesa library path, no display."""

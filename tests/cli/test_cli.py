@@ -220,7 +220,7 @@ def test_tour_lessons_dir_renders_each_file_and_goes_on_past_a_broken_one(tmp_pa
     assert_user_error(run_cli("tour", "--lessons", str(tmp_path / "none"), "--out", str(out)), "not a folder")
 
 
-# What a plain `glsandbox render` leaves out of its cold start (issue 24: start-up <= 1.2x a raw
+# What a plain `glsandbox render` leaves out of its cold start (the goal: start-up <= 1.2x a raw
 # ModernGL script): each is imported where it is used, and an eager import anywhere on the render
 # path (glsandbox/__init__, scene, overlay, cli, lesson, ...) brings it back into sys.modules here.
 # pyrr: transforms builds its two matrices itself; hashlib (OpenSSL): the mesh digests use BLAKE2's

@@ -1,4 +1,4 @@
-"""Property-based fuzzing of the command line's contract (issue 12).
+"""Property-based fuzzing of the command line's contract.
 
 Scene files, ``--set`` values and texture images are generated (valid, half
 valid and hostile), the CLI runs in this process, and every run must end in

@@ -31,7 +31,7 @@ def test_every_subcommand_has_a_summary_and_examples() -> None:
 
 @pytest.mark.parametrize("name", SUBCOMMANDS)
 def test_a_command_lines_parser_is_the_whole_parsers_subcommand(name: str) -> None:
-    # main() builds only the subcommand a command line names (issue 24: a cold start): the same
+    # main() builds only the subcommand a command line names (a cold start): the same
     # options, help and parse of its examples as the whole parser's.
     def subcommand(parser):
         (sub,) = [a for a in parser._actions if a.dest == "command"]

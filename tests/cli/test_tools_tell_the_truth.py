@@ -1,4 +1,4 @@
-"""``plan``, ``list -v`` and ``render`` say what happens (issue 22), run in this process."""
+"""``plan``, ``list -v`` and ``render`` say what happens, run in this process."""
 
 from __future__ import annotations
 

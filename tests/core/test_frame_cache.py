@@ -1,4 +1,4 @@
-"""Frames that pay only for what changed (issue 24): a lesson's Motion, the kept Scene and plan.
+"""Frames that pay only for what changed: a lesson's Motion, the kept Scene and plan.
 
 A lesson that says what ``time`` moves (:meth:`glsandbox.Lesson.motion`) builds its scene
 once per set of its other values and per frame only moves it
@@ -324,7 +324,7 @@ def test_a_moved_overlay_shows_its_new_image(gl):
     assert np.array_equal(gl.render_scene(moved, SIZE).image, gl.render_scene(fresh, SIZE).image)
 
 
-# --- headless frames moved only by time: the motion handed over (issue 24) -----------------------
+# --- headless frames moved only by time: the motion handed over ------------------------------
 
 
 def _counting_moved_scenes(monkeypatch) -> list:

@@ -1,4 +1,4 @@
-"""A student's plain mistakes in a lesson file are one line (issue 18), in every command and in Python.
+"""A student's plain mistakes in a lesson file are one line, in every command and in Python.
 
 Each mistake below was a 26-46-line traceback from inside glsandbox, or a torn
 picture with exit 0. Now each command that loads the lesson (render with each

@@ -1,4 +1,4 @@
-"""The plan of a frame with ray-traced viewports tells the truth (issue 22).
+"""The plan of a frame with ray-traced viewports tells the truth.
 
 ``glsandbox plan ray_phong --set renderer=ray`` listed a 24-bit depth buffer and
 Phong draw passes, while the frame is a ray-traced picture under an overlay.

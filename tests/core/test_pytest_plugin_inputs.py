@@ -1,4 +1,4 @@
-"""The pytest plugin's fixture takes what a user hands it with care (issue 18).
+"""The pytest plugin's fixture takes what a user hands it with care.
 
 ``settings`` as a dict or a list works; a mistake in the call fails the test
 with one line ``glsandbox_golden: ...`` (no traceback from inside glsandbox),

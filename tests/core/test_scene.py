@@ -1,4 +1,4 @@
-"""Bad values in the scene's dataclasses (issue 12, second part), used by lessons and
+"""Bad values in the scene's dataclasses, used by lessons and
 scene files alike: finite values within NUMBER_LIMIT, a lens the rasterizer and the ray
 tracer both accept, lit nodes with normals, meshes with what their material reads.
 (Scene files' own mistakes: tests/core/test_scene_file.py.)"""

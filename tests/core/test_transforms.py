@@ -47,7 +47,7 @@ def test_perspective_matches_the_textbook_formula() -> None:
 
 
 def test_look_at_and_perspective_are_pyrrs_matrices_bit_for_bit() -> None:
-    # transforms builds them itself (importing pyrr cost every cold start ~6 ms, issue 24):
+    # transforms builds them itself (importing pyrr cost every cold start ~6 ms):
     # the same operations as pyrr's, so every lesson's pixels stay as they were.
     import warnings
 

@@ -22,8 +22,10 @@ from glsandbox.lesson_pages import lesson_page
 README_LIMIT = 400
 #: A reference to the project's tracker: "issue 21", "issues 20 and 24", "issue #6", "PR #3".
 ISSUE_REFERENCE = re.compile(r"\b(?:issues?|PR|pull request)\s+#?\d+", re.I)
-#: Where user-facing text and code live (the tests and the changelog may tell history).
-CHECKED = ("glsandbox", "lessons", "docs", "shaders", "benchmarks", "examples")
+#: Where text and code live: everything but the changelog, which tells the history.
+CHECKED = ("glsandbox", "lessons", "docs", "shaders", "benchmarks", "examples", "tests")
+#: This file: the pattern's own examples below name issues on purpose.
+PATTERN_EXAMPLES = Path(__file__).resolve()
 SUFFIXES = {".py", ".md", ".glsl", ".toml", ".tmpl", ".html", ".txt", ".yml"}
 FENCE = re.compile(r"^```(\w*)[^\n]*\n(.*?)^```", re.S | re.M)
 
@@ -62,7 +64,8 @@ def test_the_readme_is_a_front_door() -> None:
 
 def test_no_page_or_module_names_an_issue() -> None:
     files = [REPO_ROOT / "README.md"] + [p for folder in CHECKED for p in (REPO_ROOT / folder).rglob("*")
-                                         if p.suffix in SUFFIXES and p.is_file() and "__pycache__" not in p.parts]
+                                         if p.suffix in SUFFIXES and p.is_file() and "__pycache__" not in p.parts
+                                         and p.resolve() != PATTERN_EXAMPLES]
     found = [f"{p.relative_to(REPO_ROOT)}:{n}: {line.strip()[:100]}" for p in files
              for n, line in enumerate(p.read_text(encoding="utf-8", errors="replace").splitlines(), 1)
              if ISSUE_REFERENCE.search(line)]

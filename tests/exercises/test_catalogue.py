@@ -1,14 +1,17 @@
-"""Every exercise in the catalogue: its reference passes its cases, its starter and each of its
-named mistakes fail, the mistakes are told apart by their probe pictures."""
+"""Every exercise in the catalogue (glsandbox/exercises/catalogue/, one module each): its reference
+passes its cases, its starter and each of its named mistakes fail, the mistakes are told apart by
+their probe pictures, and the catalogue lists every module of its folder."""
 
 from __future__ import annotations
 
 import itertools
+import pkgutil
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from glsandbox.exercises import all_exercises, get
+from glsandbox.exercises import all_exercises, catalogue, get
 from glsandbox.exercises.catalogue import MODULES
 from glsandbox.exercises.check import PASS, check_function
 from glsandbox.exercises.compare import judge
@@ -98,6 +101,8 @@ def test_correct_variants_pass_every_case(name: str) -> None:
 
 
 def test_the_catalogue_lists_every_exercise_once_in_course_order() -> None:
+    folder = Path(catalogue.__file__).parent  # (tests/test_suite.py counts a listed module as tested here)
+    assert sorted(NAMES) == sorted(m.name for m in pkgutil.iter_modules([str(folder)])), "list it in MODULES"
     exercises = all_exercises()
     assert [e.name for e in exercises] == NAMES
     assert len({e.function for e in exercises}) == len(exercises)

@@ -1,4 +1,4 @@
-"""Limits on a user's shader text, checked before the driver sees it (issue 18).
+"""Limits on a user's shader text, checked before the driver sees it.
 
 An ``#include`` chain 3,000 files deep was a RecursionError traceback;
 ``float a[100000000];`` kept llvmpipe compiling for minutes (or aborted the

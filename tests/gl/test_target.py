@@ -1,4 +1,4 @@
-"""Frames are opaque (issue 12): every pixel's alpha is 255, as the window shows it.
+"""Frames are opaque: every pixel's alpha is 255, as the window shows it.
 
 The rule is :data:`glsandbox.gl.target.FRAME_COLOR_MASK`: every clear writes a
 target's alpha as 1 (:func:`glsandbox.gl.target.clear_opaque`) and no draw writes it, so the mirror's blended glass and shadow, an

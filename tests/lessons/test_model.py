@@ -253,7 +253,7 @@ def test_model_lesson_plan_is_pinned() -> None:
         "programs:",
         "  overlay",
         "  phong[NUM_LIGHTS=2]",
-        "passes:",  # viewport 1 is ray-traced (issue 22: the plan says so, and draws nothing there)
+        "passes:",  # viewport 1 is ray-traced (the plan says so, and draws nothing there)
         "  1. trace viewport 1 (GLSL ray tracer, float32, 1 primary ray per pixel, shadow rays to 2 lights, "
         "shown as overlay raytrace/1): floor (phong); model (phong)",
         "  2. clear viewport 0: colour (0.12, 0.14, 0.2, 1) + depth",

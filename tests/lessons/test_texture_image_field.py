@@ -1,4 +1,4 @@
-"""The texture lesson's image field: a refused path is one line, and in the window it stays red (issue 22).
+"""The texture lesson's image field: a refused path is one line, and in the window it stays red.
 
 Typing a bad image path into the panel closed the window with exit 2; the
 The manual promised the refusal in red, as the model lesson's mesh field does.

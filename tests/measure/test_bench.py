@@ -1,4 +1,4 @@
-"""glsandbox.measure.bench: the extra main-thread CPU column and its goal (issue 24)."""
+"""glsandbox.measure.bench: the extra main-thread CPU column and its goal."""
 
 from __future__ import annotations
 

@@ -197,7 +197,7 @@ def test_depth_knob_counts_z_fighting_pixels(quick_report: Path) -> None:
 
 @pytest.mark.slow
 def test_precision_knobs_in_the_quick_report(quick_report: Path) -> None:
-    # What precision costs (issue 21): each new knob's counts in the report order as the numerics say.
+    # What precision costs: each new knob's counts in the report order as the numerics say.
     rows = {(r["knob"], r["setting"]): r for r in _rows(quick_report)}
 
     def count(knob: str, setting: str) -> int:
@@ -472,7 +472,7 @@ def test_model_cases_cover_every_size_mode_and_engine(monkeypatch) -> None:
     assert [c.name for c in found[1:5]] == ["1,000 tris, primary, numpy", "1,000 tris, primary, gpu",
                                            "1,000 tris, shadow+bounce, numpy", "1,000 tris, shadow+bounce, gpu"]
     assert len(found) == 1 + 4 * len(module.SIZES)
-    assert {c.goal for c in found[1:]} == {1.0, 5.0}  # issue 24's goals
+    assert {c.goal for c in found[1:]} == {1.0, 5.0}  # the start-up and frame-time goals
 
 
 def test_model_cases_without_mitsuba_leave_its_rows_out_and_say_why(monkeypatch) -> None:

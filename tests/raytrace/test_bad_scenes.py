@@ -1,4 +1,4 @@
-"""The ray tracer on hostile but legal scenes (issue 12): nodes flattened by a scale of 0 (or
+"""The ray tracer on hostile but legal scenes: nodes flattened by a scale of 0 (or
 nearly), tiny nodes, one texture on the GLSL engine, and tracers freed with their contexts."""
 
 from __future__ import annotations

@@ -83,7 +83,7 @@ def test_the_gpu_engine_draws_lesson_scenes_at_1e5_as_the_numpy_engine(gl, name)
     far = np.abs(cpu[..., :3] - gpu[..., :3]).max(axis=-1) > 3
     # Float32 may move an edge or a shadow boundary by a hair, so a pixel whose ray
     # grazes one may flip: single pixels on boundaries, never a patch. Measured: 0
-    # pixels on each of these scenes (in world-space float32 before issue 21: 118 on
+    # pixels on each of these scenes (in world-space float32, as the engine once traced: 118 on
     # ray_phong, 29 on phong, 56 on model, 1,322 on texture). So at most 0.05% of the
     # image (9 of 19,200 pixels) and no differing pixel whose 8 neighbours all differ:
     # a 1% hole in any object, or a lost shadow, fails both.

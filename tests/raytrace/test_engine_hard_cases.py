@@ -3,7 +3,7 @@ tracers: rays aimed exactly at the vertices and edges of closed meshes, a whole
 view from inside a closed mesh, with the scene at the origin and moved to 1e3,
 1e5 and 1e6. A watertight test traced in coordinates that do not lose their
 bits far from the origin never misses; Möller–Trumbore in float32 world
-coordinates (the gpu scan before issue 21) missed 0.5-17% of these rays."""
+coordinates (the gpu scan's old way) missed 0.5-17% of these rays."""
 
 from __future__ import annotations
 

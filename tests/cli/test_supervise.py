@@ -1,12 +1,16 @@
-"""A lesson file that ends its process before its picture (``sys.exit``, ``os._exit``, a
-crash) is one ``error:`` line naming it, exit 1 or 2, never a quiet exit 0."""
+"""A lesson file's commands run supervised (glsandbox/supervise.py): a lesson that ends its process
+before its picture (``sys.exit``, ``os._exit``, a crash) is one ``error:`` line naming it, exit 1
+or 2, never a quiet exit 0; which command lines import user code; the child's word on its pipe."""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
 from support import glsandbox
+
+from glsandbox import supervise
 
 LESSON = '''import glsandbox
 from glsandbox import Lesson, Material, Node, Scene, geometry
@@ -80,3 +84,34 @@ def test_a_lesson_that_renders_is_unchanged_by_the_supervision(tmp_path: Path, g
     assert proc.returncode == 0 and out.exists(), proc.stderr
     proc = glsandbox("render", str(tmp_path / "missing.py"), "--out", str(out), cwd=tmp_path)
     assert proc.returncode == 2 and proc.stderr.startswith("error: "), proc.stderr
+
+
+def test_only_commands_that_import_a_lesson_file_are_supervised(tmp_path: Path) -> None:
+    mine = tmp_path / "mine.py"
+    mine.write_text("")
+    assert supervise.user_code_in(["render", "--size", "32x24", str(mine)]) == str(mine)
+    assert supervise.user_code_in(["run", str(mine)]) == str(mine)
+    assert supervise.user_code_in(["render", "phong"]) is None  # a built-in lesson
+    assert supervise.user_code_in(["render", str(tmp_path / "missing.py")]) is None  # the command says it is missing
+    assert supervise.user_code_in(["plan", str(mine)]) is None and supervise.user_code_in([]) is None
+    assert supervise.user_code_in(["tour", "--lessons", "folder"]) == "folder"
+    assert supervise.user_code_in(["tour", "--lessons=folder"]) == "folder"
+    assert supervise.user_code_in(["tour", "--out", "x"]) is None and supervise.user_code_in(["tour", "--lessons"]) is None
+
+
+def test_the_child_says_done_once_on_its_pipe(monkeypatch) -> None:
+    read_end, write_end = os.pipe()
+    monkeypatch.setenv(supervise.CHILD_ENV, str(write_end))
+    supervise.finished()
+    assert os.read(read_end, 16) == b"done" and os.read(read_end, 16) == b""  # written, then closed
+    assert supervise.CHILD_ENV not in os.environ  # a second call (or a grandchild) writes nothing
+    supervise.finished()
+    os.close(read_end)
+
+
+def test_a_lesson_file_after_the_options_is_supervised_too(tmp_path: Path, gl) -> None:
+    path = _lesson(tmp_path, "os_exit_on_import")
+    out = tmp_path / "out.png"
+    proc = glsandbox("render", "--size", "32x24", "--out", str(out), str(path), cwd=tmp_path)
+    _assert_one_line(proc, (1,), path.name, "ended the process (exit status 0")
+    assert not out.exists()

@@ -13,9 +13,9 @@ from glsandbox.lesson import find_lesson
 from glsandbox.plan import TRACE_OPTIONS
 from glsandbox.raytrace.render import render
 from glsandbox.scene import Scene
-from glsandbox.story import Story, explain, parse_pixel
+from glsandbox.story import explain, parse_pixel
 from glsandbox.story.ray import explain_ray_pixel, locate_pixel
-from support import EXAMPLES_DIR
+from support import EXAMPLES_DIR, course_ray
 
 #: Every ray lesson (its scenes), and raster lessons and a scene file traced by the numpy engine.
 CASES = [
@@ -62,12 +62,6 @@ def test_replayed_trace_is_the_rendered_pixel(name: str, settings: tuple[str, ..
     assert checked >= 40
 
 
-def course_ray(lesson: str, direction: str, *settings: str) -> Story:
-    """The centre pixel of an odd-sized frame whose camera sits at the origin looking along
-    ``direction``: that pixel's ray is the notes' ray from (0, 0, 0)."""
-    return explain(lesson, (200, 150), (401, 301), camera=f"0,0,0,{direction}", **dict(s.split("=") for s in settings))
-
-
 def test_worked_example_4_sphere_t_35() -> None:
     story = course_ray("ray_spheres", "0,0.6,-0.8")
     first = story.record.bounces[0]
@@ -94,17 +88,6 @@ def test_exam_2013_shadow_and_reflection() -> None:
     assert light.term == pytest.approx(light.ambient, abs=0)  # in shadow, the ambient term alone
     assert red.next == "reflection" and blue.direction == pytest.approx([0, 1, 0], abs=1e-9)
     assert blue.hit == "blue" and blue.t == pytest.approx(65, abs=1e-9)
-
-
-@pytest.mark.parametrize("fixture,lesson,direction,settings", [
-    ("ray_spheres_t35.txt", "ray_spheres", "0,0.6,-0.8", ()),
-    ("ray_phong_exam2013.txt", "ray_phong", "0.96,0.28,0", ("scene=exam2013",)),
-])
-def test_golden_traces(fixture: str, lesson: str, direction: str, settings: tuple[str, ...]) -> None:
-    from support import TESTS_DIR
-
-    expected = (TESTS_DIR / "story" / "traces" / fixture).read_text(encoding="utf-8")
-    assert course_ray(lesson, direction, *settings).text + "\n" == expected
 
 
 def test_mesh_misses_say_why() -> None:

@@ -1,0 +1,104 @@
+"""The grader's side of the process tree (glsandbox/grading/isolate.py), without a tree: framed
+messages on a pipe, a job through the zygote's JSON and back, a result read from a message (the
+private folder's path said as the submission's own), and a job with no GL retried once.
+(The whole tree on hostile submissions: test_isolation.py.)"""
+
+from __future__ import annotations
+
+import os
+from collections import deque
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from glsandbox.grading.isolate import (CRASHED, STORY_LIMIT, Job, JobResult, Picture, Reader, Render, _job_data,
+                                       _result, job_from, send, settle, story_of)
+
+JOB = Job(3, "/subs/ann/spin.py", "spin.py", (Render(("time=1",), (4, 2)), Render((), (2, 2), 4, explain=(1, 0))),
+          timeout=5.0, describe=True)
+
+
+def _read_all(fd: int, limit: int = 1 << 20) -> list[tuple[dict, bytes]]:
+    reader, found = Reader(fd), []
+    while not reader.closed:
+        reader.pump(5.0)
+        found += list(reader.messages(limit))
+    return found
+
+
+def test_framed_messages_arrive_whole_and_in_order() -> None:
+    read_end, write_end = os.pipe()
+    try:
+        send(write_end, {"kind": "pid", "pid": 7})
+        send(write_end, {"kind": "result"}, b"\x00\x01" * 1000)
+        os.close(write_end)
+        assert _read_all(read_end) == [({"kind": "pid", "pid": 7}, b""), ({"kind": "result"}, b"\x00\x01" * 1000)]
+    finally:
+        os.close(read_end)
+
+
+def test_a_half_message_waits_and_a_malformed_or_oversized_one_is_refused() -> None:
+    read_end, write_end = os.pipe()
+    try:
+        send(write_end, {"kind": "image"}, b"x" * 100)
+        reader = Reader(read_end)
+        reader.pump(5.0)
+        whole = bytes(reader.buffer)
+        reader.buffer = bytearray(whole[:-1])  # one byte short
+        assert list(reader.messages(1000)) == [] and len(reader.buffer) == len(whole) - 1
+        reader.buffer = bytearray(whole)
+        with pytest.raises(ValueError, match="malformed"):
+            list(reader.messages(99))  # a payload past the limit
+        reader.buffer = bytearray(b"XXXX" + whole[4:])
+        with pytest.raises(ValueError, match="malformed"):
+            list(reader.messages(1000))
+    finally:
+        os.close(read_end)
+        os.close(write_end)
+
+
+def test_a_job_goes_to_the_zygote_and_back_unchanged() -> None:
+    assert job_from(_job_data(JOB)) == JOB
+
+
+def test_a_story_is_text_cut_to_its_limit() -> None:
+    assert story_of({"story": "x" * (STORY_LIMIT + 10)}) == {"story": "x" * STORY_LIMIT}
+    assert story_of({"story": ["not", "text"]}) == {} and story_of({}) == {}
+
+
+def test_no_result_is_a_crash_of_every_picture() -> None:
+    result = _result(JOB, None)
+    assert [p.status for p in result.pictures] == [CRASHED, CRASHED]
+    assert _result(JOB, ({"kind": "result"}, b"")).pictures[0].error == "its grading process ended without a result"
+    assert _result(JOB, ({"no_gl": "no EGL"}, b"")).no_gl == "no EGL"
+
+
+def test_a_result_reads_its_pictures_and_says_the_submissions_own_path(tmp_path: Path) -> None:
+    folder = tmp_path / "ann"
+    folder.mkdir()
+    job = Job(0, str(folder), "spin.py", JOB.renders)
+    image = np.arange(2 * 4 * 4, dtype=np.uint8).reshape(2, 4, 4)
+    header = {"root": "/tmp/private-xyz", "output": ["loading /tmp/private-xyz/spin.py"],
+              "meta": {"title": "T" * 3000, "description": "in /tmp/private-xyz"},
+              "pictures": [{"shape": [2, 4, 4], "seconds": 0.5, "info": {"plan": "p"}},
+                           {"status": "BROKEN", "error": "/tmp/private-xyz/spin.py:3: NameError"}]}
+    result = _result(job, (header, image.tobytes()))
+    first, second = result.pictures
+    assert np.array_equal(first.image, image) and first.seconds == 0.5 and first.info == {"plan": "p"}
+    assert second.image is None and second.error == f"{folder}/spin.py:3: NameError"
+    assert result.output == [f"loading {folder}/spin.py"]
+    assert len(result.meta["title"]) == 2000 and result.meta["description"] == f"in {folder}"
+    assert result.meta["course_section"] == ""
+
+
+def test_no_gl_is_retried_once_then_stops_the_run() -> None:
+    pending, retried, results, done = deque(), set(), {}, []
+    no_gl = JobResult(JOB, [], no_gl="no EGL")
+    assert settle(JOB, no_gl, pending, retried, results, done.append) is False
+    assert list(pending) == [JOB] and results == {}  # queued again, first in line
+    pending.clear()
+    assert settle(JOB, no_gl, pending, retried, results, done.append) is True  # the second time: stop
+    assert results == {3: no_gl} and done == []
+    fine = JobResult(Job(4, None, "phong", ()), [Picture()])
+    assert settle(fine.job, fine, pending, retried, results, done.append) is False and done == [fine]
