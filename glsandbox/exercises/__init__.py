@@ -7,7 +7,7 @@ until the teacher runs them, a probe picture of where the student's answers
 differ from the reference's over a dense field of inputs, and named
 mistakes that turn a failing pattern into a sentence.
 
-- :mod:`~glsandbox.exercises.base`: the data (Exercise, Case, Mistake, Probe);
+- :mod:`~glsandbox.exercises.definition`: the data (Exercise, Case, Mistake, Probe);
 - :mod:`~glsandbox.exercises.catalogue`: the registry (:func:`get`, :func:`all_exercises`);
 - :mod:`~glsandbox.exercises.isolation`: the student's function in a confined process;
 - :mod:`~glsandbox.exercises.check`: the cases judged, the mistakes matched, a plain record;

@@ -75,7 +75,7 @@ from glsandbox.images import texture_levels
 from glsandbox.plan import traced_reflectivity
 from glsandbox.raytrace import shapes
 from glsandbox.raytrace.constants import LENGTH_TINY, SQUARES_UNDERFLOW
-from glsandbox.raytrace.errors import RayTraceError
+from glsandbox.raytrace.raytrace_error import RayTraceError
 from glsandbox.raytrace.shape_kind import ShapeKind
 from glsandbox.scene import MIN_SCALE, Camera, Node, Scene, Texture
 

@@ -1,7 +1,7 @@
 """The student's process: load one file, call one function on the inputs it is sent.
 
 Run as a script by :mod:`glsandbox.exercises.isolation` (``python -I -S -B
-runner.py CONFIG``), never imported by glsandbox: it uses the standard
+student_process.py CONFIG``), never imported by glsandbox: it uses the standard
 library only, so nothing of glsandbox (least of all the reference
 implementations) is ever loaded here. Its import path is set from the
 config (the standard library and the third-party packages, without
