@@ -36,7 +36,7 @@ def cases(env) -> list:
     from glsandbox.lesson import all_lessons
     from glsandbox.measure.bench import Case, Side
     from glsandbox.story.raster import explain_raster_pixel
-    from glsandbox.story.ray import explain_ray_pixel
+    from glsandbox.story.ray_pixel import explain_ray_pixel
 
     out = []
     size = env.size

@@ -21,13 +21,13 @@ import numpy as np
 from glsandbox.geometry import Mesh
 from glsandbox.overlay import Overlay
 from glsandbox.passes import PASS_KINDS
-from glsandbox.passes.base import SHADOW_MAP_UNIT, Draw, Pass, ProgramVariant, StencilState, describe_draws
 from glsandbox.passes.clear import clear_pass
 from glsandbox.passes.draw import draw_pass
 from glsandbox.passes.mark_mirror import mark_mirror_pass
 from glsandbox.passes.mirror_surface import mirror_surface_pass
 from glsandbox.passes.order import farthest_first, mirrored_eye
 from glsandbox.passes.overlay import OVERLAY_PROGRAM, overlay_passes
+from glsandbox.passes.plan_parts import SHADOW_MAP_UNIT, Draw, Pass, ProgramVariant, StencilState, describe_draws
 from glsandbox.passes.planar_effects import (CUTOUT_SHADOW_PROGRAM, MARK_MIRROR_STENCIL, MIRROR_STENCIL_BIT,
                                              PLANAR_SHADOW_PROGRAM, PLANAR_SHADOW_STENCIL,
                                              PLANAR_SHADOW_STENCIL_BIT, REFLECTION_STENCIL, caster_program,

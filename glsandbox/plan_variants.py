@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import functools
 
-from glsandbox.passes.base import ProgramVariant
+from glsandbox.passes.plan_parts import ProgramVariant
 from glsandbox.scene import Node
 
 

@@ -53,7 +53,7 @@ def test_no_test_module_imports_another_or_conftest() -> None:
 
 #: Modules with no logic of their own (a version string, an error type, a record of a kind's parts,
 #: the executor's records of a prepared draw and frame).
-PURE_DATA = {"version", "raytrace/errors", "raytrace/shape_kind", "gl/draw_steps"}
+PURE_DATA = {"version", "raytrace/raytrace_error", "raytrace/shape_kind", "gl/draw_steps"}
 
 
 def listed_modules(test_file: Path) -> tuple[str, ...]:

@@ -7,12 +7,18 @@ until the teacher runs them, a probe picture of where the student's answers
 differ from the reference's over a dense field of inputs, and named
 mistakes that turn a failing pattern into a sentence.
 
-- :mod:`~glsandbox.exercises.base`: the data (Exercise, Case, Mistake, Probe);
+- :mod:`~glsandbox.exercises.definition`: the data (Exercise, Case, Mistake, Probe);
 - :mod:`~glsandbox.exercises.catalogue`: the registry (:func:`get`, :func:`all_exercises`);
-- :mod:`~glsandbox.exercises.isolation`: the student's function in a confined process;
-- :mod:`~glsandbox.exercises.check`: the cases judged, the mistakes matched, a plain record;
+- :mod:`~glsandbox.exercises.isolation`: the student's function in a confined process
+  (:mod:`~glsandbox.exercises.student_process`, the script that process runs);
+- :mod:`~glsandbox.exercises.check`: the cases judged (:mod:`~glsandbox.exercises.compare`), the
+  mistakes matched (written with :mod:`~glsandbox.exercises.plain`), a plain record;
+- :mod:`~glsandbox.exercises.fields`: the probe pictures' fields of inputs;
+  :mod:`~glsandbox.exercises.dxmath`: the course's DirectXMath matrices made from the engine's;
+- :mod:`~glsandbox.exercises.states`: the state exercises (a lesson's Direct3D 11 state tables);
 - :mod:`~glsandbox.exercises.probe`, :mod:`~glsandbox.exercises.lesson_view`: the pictures;
-- :mod:`~glsandbox.exercises.report`, :mod:`~glsandbox.exercises.starter`: what people read.
+- :mod:`~glsandbox.exercises.report`, :mod:`~glsandbox.exercises.starter`: what people read;
+- :mod:`~glsandbox.exercises.commands`: ``glsandbox exercise list | start | check``.
 
 In a notebook, :func:`exercise` checks a function of the kernel's own
 (``glsandbox.exercise("ray_sphere", my_function)``) and shows the report.

@@ -25,9 +25,9 @@ from pathlib import Path
 from typing import Any
 
 from glsandbox.errors import SandboxError
-from glsandbox.exercises import runner
-from glsandbox.exercises.base import Case, Exercise, Mistake
+from glsandbox.exercises import student_process
 from glsandbox.exercises.compare import WrongType, describe, judge, matches, normalize
+from glsandbox.exercises.definition import Case, Exercise, Mistake
 from glsandbox.exercises.isolation import CRASHED, ERROR, TIMEOUT, VALUE, Answer, InProcess, Isolated, Limits
 from glsandbox.exercises.probe import ProbeResult, probe_picture
 
@@ -147,7 +147,7 @@ def _call_text(exercise: Exercise, args: Sequence[Any]) -> str:
 
 def _plain(value: Any) -> Any:
     """A reference's or a mistake's answer as the student's would arrive (plain JSON data)."""
-    return runner._encode(value)
+    return student_process._encode(value)
 
 
 _GOT = {ERROR: "it raised", TIMEOUT: "no answer", CRASHED: "its process ended"}

@@ -1,7 +1,7 @@
 """Judging one answer against the expected one, with the tolerance its case states.
 
 An answer comes back from the student's process as JSON (see
-:mod:`glsandbox.exercises.runner`): numbers, ``null``, ``true``/``false``,
+:mod:`glsandbox.exercises.student_process`): numbers, ``null``, ``true``/``false``,
 lists, or ``{"__type__": ..., "repr": ...}`` for anything else. :func:`normalize`
 turns it into the exercise's kind of value or says, in words, why it is not
 one (the wrong type, a NaN, a vector of four); :func:`matches` compares.
@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from glsandbox.exercises.base import Case
+from glsandbox.exercises.definition import Case
 
 __all__ = ["normalize", "matches", "judge", "describe"]
 

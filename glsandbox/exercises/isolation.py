@@ -2,7 +2,7 @@
 
 The seam between the exercises and the grader's isolation. A
 :class:`Isolated` function is the submission's file, copied into a private
-folder and loaded by :mod:`glsandbox.exercises.runner` (standard library
+folder and loaded by :mod:`glsandbox.exercises.student_process` (standard library
 only) in a fresh interpreter (``python -I -S -B``, a clean environment)
 that:
 
@@ -34,7 +34,7 @@ TIMEOUT and the process is killed (the next call starts a fresh one); one
 that ends the process (``os._exit``, a signal, memory) is CRASHED; an
 exception is ERROR with its line. After :attr:`Limits.restarts` such
 endings the remaining calls are not run. The expected answers and the
-references stay in the caller's process: the runner is sent arguments.
+references stay in the caller's process: the student's process is sent arguments.
 
 :class:`InProcess` is the same interface for a function object in the
 caller's own process (a notebook: the student's own kernel).
@@ -59,7 +59,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from glsandbox.exercises import runner
+from glsandbox.exercises import student_process
 from glsandbox.grading.processes import kill_tree, killpg
 
 __all__ = ["Answer", "InProcess", "Isolated", "Limits", "VALUE", "ERROR", "TIMEOUT", "CRASHED"]
@@ -272,7 +272,7 @@ class Isolated:
         folder.mkdir()
         self.copy = folder / self.path.name
         shutil.copyfile(self.path, self.copy)
-        shutil.copyfile(runner.__file__, Path(self.work) / "runner.py")
+        shutil.copyfile(student_process.__file__, Path(self.work) / "student_process.py")
         self.path_list = _shared_import_path(self.denied)
         self.site_roots = [os.path.realpath(p) for p in sys.path if p.endswith(("site-packages", "dist-packages"))]
         self.ids, self.keep_reading = _user(next(_SEEDS))
@@ -294,7 +294,7 @@ class Isolated:
         fd, config_path = tempfile.mkstemp(dir=self.work, suffix=".json")
         with os.fdopen(fd, "w") as handle:
             json.dump(config, handle)
-        if self.ids is not None:  # its private folder (copy, runner, config), owned by the user it runs as
+        if self.ids is not None:  # its private folder (copy, script, config), owned by the user it runs as
             from glsandbox.grading.layers import hand_over
 
             hand_over(self.work, [self.work], self.ids)
@@ -311,7 +311,7 @@ class Isolated:
         log = open(os.path.join(self.work, "output.txt"), "ab")  # noqa: SIM115 - closed below
         try:
             self.process = subprocess.Popen(
-                [executable, "-I", "-S", "-B", os.path.join(self.work, "runner.py"), config_path],
+                [executable, "-I", "-S", "-B", os.path.join(self.work, "student_process.py"), config_path],
                 stdin=subprocess.DEVNULL, stdout=log, stderr=log, cwd=self.work, env=env,
                 pass_fds=(requests_read, answers_write),
                 preexec_fn=_restrict(reads, [self.work, "/dev/null"], self.limits, self.ids, self.keep_reading))  # noqa: PLW1509
@@ -474,7 +474,7 @@ class InProcess:
 
     def call(self, args: Sequence[Any]) -> Answer:
         try:
-            return Answer(VALUE, value=runner._encode(self.function(*args)))
+            return Answer(VALUE, value=student_process._encode(self.function(*args)))
         except Exception as exc:  # noqa: BLE001 - the student's
             return Answer(ERROR, error=f"{type(exc).__name__}: {exc}"[:300])
 

@@ -19,8 +19,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from glsandbox.exercises.base import Exercise
 from glsandbox.exercises.compare import WrongType, normalize
+from glsandbox.exercises.definition import Exercise
 
 __all__ = ["LessonResult", "render_lesson", "sphere_scene", "triangle_scene"]
 

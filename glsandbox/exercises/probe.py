@@ -1,7 +1,7 @@
 """The probe picture: the student's function and the reference over a dense field of inputs.
 
 Each pixel of a square picture is one input (a ray of a grid, a normal of a
-hemisphere, ...; the exercise's :class:`~glsandbox.exercises.base.Probe` says
+hemisphere, ...; the exercise's :class:`~glsandbox.exercises.definition.Probe` says
 which). The pixel's colour says how the two answers compare:
 
 ========================  ==========================================================
@@ -26,9 +26,9 @@ from typing import Any
 
 import numpy as np
 
-from glsandbox.exercises import runner
-from glsandbox.exercises.base import Exercise
+from glsandbox.exercises import student_process
 from glsandbox.exercises.compare import WrongType, matches, normalize
+from glsandbox.exercises.definition import Exercise
 
 __all__ = ["CLASSES", "COLOURS", "ProbeResult", "classify", "picture", "probe_picture", "reference_values"]
 
@@ -103,8 +103,8 @@ class ProbeResult:
 def reference_values(exercise: Exercise, inputs: list[tuple[Any, ...]]) -> list[Any]:
     """The reference's answers on the field, as plain data (vectorized where the exercise can)."""
     if exercise.probe.reference_many is not None:
-        return [runner._encode(v) for v in exercise.probe.reference_many(inputs)]
-    return [runner._encode(exercise.reference(*args)) for args in inputs]
+        return [student_process._encode(v) for v in exercise.probe.reference_many(inputs)]
+    return [student_process._encode(exercise.reference(*args)) for args in inputs]
 
 
 def _present(value: Any) -> bool:

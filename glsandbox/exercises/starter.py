@@ -6,7 +6,7 @@
 
 from __future__ import annotations
 
-from glsandbox.exercises.base import Exercise
+from glsandbox.exercises.definition import Exercise
 
 __all__ = ["starter"]
 

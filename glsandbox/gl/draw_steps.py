@@ -13,7 +13,7 @@ from glsandbox.geometry import Mesh
 from glsandbox.gl.gpu_meshes import _GpuMesh
 from glsandbox.gl.passes import RunPass
 from glsandbox.gl.user_shaders import UserProgram
-from glsandbox.passes.base import Draw, Pass
+from glsandbox.passes.plan_parts import Draw, Pass
 from glsandbox.plan import Plan
 from glsandbox.scene import Light, Material, Scene
 

@@ -28,7 +28,7 @@ from glsandbox.gl.uniform_bytes import _CONSTANTS, PassCamera, material_constant
 from glsandbox.gl.uniform_writes import LightBytes, uniform_writer, write_constants, write_lighting, write_matrices
 from glsandbox.gl.draw_steps import _DrawSetup, _DrawStep, _PreparedFrame, _Steps
 from glsandbox.gl.user_shaders import UserProgram, check_user_draw
-from glsandbox.passes.base import SHADOW_MAP_UNIT, Draw, Pass, ProgramVariant
+from glsandbox.passes.plan_parts import SHADOW_MAP_UNIT, Draw, Pass, ProgramVariant
 from glsandbox.plan import Plan, plan as make_plan
 from glsandbox.scene import Camera, Light, Material, Node, Scene, mesh_origin
 

@@ -92,7 +92,7 @@ class TextureCache:
         # two draws flushes the frame and waits for the rasterizer: 4-15 ms of wall time and
         # +30-50 us of main-thread CPU per frame, for as long as the texture lives (the
         # texture lesson's cube). Finishing the queued work first (once per upload) leaves it an
-        # ordinary texture; the sampler objects were not the cause, and the pixels are the same.
+        # ordinary texture, with the same pixels.
         self.ctx.finish()
         texture = self.ctx.texture((width, height), 4, np.ascontiguousarray(levels[0]).tobytes())
         # glGenerateMipmap allocates and fills every level (box-filtered halves);

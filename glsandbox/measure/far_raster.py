@@ -17,7 +17,7 @@ is the oracle for the others:
   shadow-mapped frame against the ray tracer's shadow rays on the same scene
   (:mod:`glsandbox.measure.shadow_state`), off the reference's edge band.
 
-Measured by tests/gl/test_far_raster.py and the ``far`` rows of
+Measured by tests/measure/test_far_raster.py and the ``far`` rows of
 docs/numerics.md.
 """
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from glsandbox.passes.base import Pass
+from glsandbox.passes.plan_parts import Pass
 from glsandbox.scene import Scene
 
 

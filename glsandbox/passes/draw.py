@@ -6,8 +6,8 @@ Opaque nodes first in scene order, then the blended ones farthest first
 
 from __future__ import annotations
 
-from glsandbox.passes.base import Draw, Pass, ProgramVariant, describe_draws
 from glsandbox.passes.order import farthest_first
+from glsandbox.passes.plan_parts import Draw, Pass, ProgramVariant, describe_draws
 from glsandbox.plan_variants import program_for
 from glsandbox.scene import Scene
 

@@ -4,7 +4,7 @@ stands in front of the glass keeps its pixels unmarked."""
 
 from __future__ import annotations
 
-from glsandbox.passes.base import Draw, Pass
+from glsandbox.passes.plan_parts import Draw, Pass
 from glsandbox.passes.planar_effects import MARK_MIRROR_STENCIL, describe_planar
 
 

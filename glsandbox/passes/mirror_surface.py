@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from glsandbox.passes.base import Draw, Pass
+from glsandbox.passes.plan_parts import Draw, Pass
 from glsandbox.passes.planar_effects import describe_planar
 
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from glsandbox.passes.base import Draw, Pass, ProgramVariant
+from glsandbox.passes.plan_parts import Draw, Pass, ProgramVariant
 from glsandbox.scene import Scene
 
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from glsandbox.passes.base import Pass, ProgramVariant, StencilState, describe_draws
+from glsandbox.passes.plan_parts import Pass, ProgramVariant, StencilState, describe_draws
 from glsandbox.scene import Color, Material, Node, Scene
 
 #: The stencil bit of the mirror's pixels, and the bit of pixels already shadowed.

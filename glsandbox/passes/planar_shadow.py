@@ -5,7 +5,7 @@ pixel is darkened once: test "shadow bit clear", then set it."""
 
 from __future__ import annotations
 
-from glsandbox.passes.base import Draw, Pass, ProgramVariant
+from glsandbox.passes.plan_parts import Draw, Pass, ProgramVariant
 from glsandbox.passes.planar_effects import (PLANAR_SHADOW_PROGRAM, PLANAR_SHADOW_STENCIL, caster_program,
                                              describe_planar)
 from glsandbox.scene import Node, Scene

@@ -6,8 +6,8 @@ Without the stencil the reflection has no stencil test and leaks outside the gla
 from __future__ import annotations
 
 from glsandbox.errors import SandboxError
-from glsandbox.passes.base import Draw, Pass, ProgramVariant
 from glsandbox.passes.order import farthest_first, mirrored_eye
+from glsandbox.passes.plan_parts import Draw, Pass, ProgramVariant
 from glsandbox.passes.planar_effects import REFLECTION_STENCIL, describe_planar
 from glsandbox.plan_variants import program_for
 from glsandbox.scene import Node, Scene

@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from glsandbox.passes.base import Draw, Pass, ProgramVariant, describe_draws
+from glsandbox.passes.plan_parts import Draw, Pass, ProgramVariant, describe_draws
 from glsandbox.passes.planar_effects import caster_program
 from glsandbox.scene import Scene
 from glsandbox.shadowmap import casters, casting_light, receivers

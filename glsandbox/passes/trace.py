@@ -10,7 +10,7 @@ from dataclasses import replace
 from typing import Any
 
 from glsandbox.overlay import Overlay
-from glsandbox.passes.base import Draw, Pass
+from glsandbox.passes.plan_parts import Draw, Pass
 from glsandbox.scene import Node, Scene
 
 

@@ -24,8 +24,8 @@ checks that these reproduce every worked example of the notes):
   :class:`BVH` (binned SAH, cached by content), the numpy engine's
   ``bvh=True`` traversal.
 
-The modules, each importing only those above it: ``errors``, ``vec``, ``ray``,
-``base``, then the shapes (``plane``, ``triangle``, ``sphere``, ``aabb``) and
+The modules, each importing only those above it: ``raytrace_error``, ``vec``, ``ray``,
+``shape_protocol``, then the shapes (``plane``, ``triangle``, ``sphere``, ``aabb``) and
 what uses them (``trace``, ``shading``); ``constants`` (the numbers both
 engines share); ``world`` (a Scene as the engines trace it, and the primary
 rays); the engines, ``numpy_engine`` and ``gpu`` (GLSL, ``shaders/raytrace.glsl``);
@@ -38,13 +38,13 @@ direction as given; misses are ``None`` (scalar) or ``inf`` (vectorized).
 from __future__ import annotations
 
 from glsandbox.raytrace.aabb import AABB
-from glsandbox.raytrace.base import Shape
 from glsandbox.raytrace.bvh import BVH, bvh_for_mesh
-from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.plane import Plane
 from glsandbox.raytrace.ray import Ray
+from glsandbox.raytrace.raytrace_error import RayTraceError
 from glsandbox.raytrace.render import ENGINES, RenderStats, render
 from glsandbox.raytrace.shading import diffuse_factor, phong, reflect, specular_factor
+from glsandbox.raytrace.shape_protocol import Shape
 from glsandbox.raytrace.sphere import SPHERE_METHODS, Sphere
 from glsandbox.raytrace.trace import (
     SHADOW_EPSILON,

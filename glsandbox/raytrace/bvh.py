@@ -104,7 +104,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from glsandbox import transforms
 from glsandbox.geometry import Mesh
-from glsandbox.raytrace.errors import RayTraceError
+from glsandbox.raytrace.raytrace_error import RayTraceError
 from glsandbox.raytrace.watertight import nondegenerate
 
 __all__ = [

@@ -51,9 +51,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from glsandbox.raytrace.base import broadcast_rays, shared_origin
 from glsandbox.raytrace.bvh import BVH
-from glsandbox.raytrace.errors import RayTraceError
+from glsandbox.raytrace.raytrace_error import RayTraceError
+from glsandbox.raytrace.shape_protocol import broadcast_rays, shared_origin
 from glsandbox.raytrace.watertight import RaySetup, nondegenerate, ray_setup, watertight_pairs
 
 #: An any-hit filter: ``(rays, triangles, t) -> which hits count`` (bool per hit).

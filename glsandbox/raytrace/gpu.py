@@ -141,8 +141,8 @@ from numpy.typing import NDArray
 from glsandbox.gl.shaders import compile_program
 from glsandbox.plan import ProgramVariant
 from glsandbox.raytrace.constants import NODE_BOX_PAD, OFFSETS, SIMPLE_OFFSET, glsl_defines
-from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.gpu_records import NODE, TRI, layout_defines
+from glsandbox.raytrace.raytrace_error import RayTraceError
 from glsandbox.raytrace.watertight import nondegenerate
 from glsandbox.raytrace.shapes import glsl_dispatch
 from glsandbox.raytrace.world import MODES, NodeKind, World, build_world, camera_basis, kind_defines

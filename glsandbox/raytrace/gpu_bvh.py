@@ -29,7 +29,7 @@ in all, silently. The GLSL traversal therefore bounds its one loop by
 ``max_steps`` (:data:`MAX_STEPS`: node visits plus triangle tests per ray)
 and flags every ray that did not finish within it (or would have overflowed
 its stack). :class:`GpuHits` carries the flags; with ``strict=True`` (the
-default) :meth:`GpuBVH.trace` raises :class:`~glsandbox.raytrace.errors.RayTraceError`
+default) :meth:`GpuBVH.trace` raises :class:`~glsandbox.raytrace.raytrace_error.RayTraceError`
 saying how many rays were cut off, rather than return hits that may be wrong.
 """
 
@@ -45,10 +45,10 @@ from numpy.typing import ArrayLike, NDArray
 
 from glsandbox.gl.shaders import compile_program
 from glsandbox.plan import ProgramVariant
-from glsandbox.raytrace.base import broadcast_rays
 from glsandbox.raytrace.bvh import BVH
 from glsandbox.raytrace.constants import glsl_defines
-from glsandbox.raytrace.errors import RayTraceError
+from glsandbox.raytrace.raytrace_error import RayTraceError
+from glsandbox.raytrace.shape_protocol import broadcast_rays
 from glsandbox.raytrace.world import camera_basis
 from glsandbox.scene import Camera
 

@@ -128,7 +128,7 @@ def _nearest(world: World, o: NDArray[np.float64], d: NDArray[np.float64], cull:
 
     ``o`` is ``(N, 3)``, or ``(3,)`` for rays that share one origin (the eye):
     the kernels then form the origin's terms once (see
-    :func:`~glsandbox.raytrace.base.shared_origin`). ``cull`` is the render's
+    :func:`~glsandbox.raytrace.shape_protocol.shared_origin`). ``cull`` is the render's
     ``cull_backfaces`` (None: each node's own), ``aabb`` whether boxes are
     tested first; ``bvh`` (the render's ``bvh=True``) traces mesh nodes through
     their BVHs instead of testing all their triangles.

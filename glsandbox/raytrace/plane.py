@@ -32,9 +32,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from glsandbox.raytrace.base import broadcast_rays, finite_positive_or_none
-from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.ray import Ray
+from glsandbox.raytrace.raytrace_error import RayTraceError
+from glsandbox.raytrace.shape_protocol import broadcast_rays, finite_positive_or_none
 from glsandbox.raytrace.vec import Vec3, as_vec3, dot, length
 
 __all__ = ["Plane"]

@@ -79,8 +79,8 @@ from numpy.typing import NDArray
 
 from glsandbox.raytrace import numpy_engine
 from glsandbox.raytrace.constants import OFFSETS
-from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.numpy_engine import RenderStats
+from glsandbox.raytrace.raytrace_error import RayTraceError
 from glsandbox.scene import Scene
 
 __all__ = ["ENGINES", "RenderStats", "render"]

@@ -31,7 +31,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from glsandbox.raytrace.errors import RayTraceError
+from glsandbox.raytrace.raytrace_error import RayTraceError
 from glsandbox.raytrace.vec import Vec3, as_vec3, dot, normalize
 
 __all__ = ["diffuse_factor", "phong", "reflect", "specular_factor"]

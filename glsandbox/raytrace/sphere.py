@@ -57,10 +57,10 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from glsandbox.raytrace.base import broadcast_rays, finite_positive_or_none, shared_origin
 from glsandbox.raytrace.constants import SPHERE_C_GAMMA, UNIT_F64, gamma
-from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.ray import Ray
+from glsandbox.raytrace.raytrace_error import RayTraceError
+from glsandbox.raytrace.shape_protocol import broadcast_rays, finite_positive_or_none, shared_origin
 from glsandbox.raytrace.vec import Vec3, as_vec3, dot, length, normalize
 
 __all__ = ["Sphere", "SPHERE_METHODS"]

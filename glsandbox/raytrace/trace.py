@@ -63,9 +63,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from glsandbox.raytrace.base import Shape, broadcast_rays
 from glsandbox.raytrace.constants import RAY_POINT_GAMMA, UNIT_F64, gamma
 from glsandbox.raytrace.ray import Ray
+from glsandbox.raytrace.shape_protocol import Shape, broadcast_rays
 from glsandbox.raytrace.vec import Vec3, as_vec3, dot, length, moved_off, normalize
 
 __all__ = [

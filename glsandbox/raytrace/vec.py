@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from glsandbox.raytrace.errors import RayTraceError
+from glsandbox.raytrace.raytrace_error import RayTraceError
 
 Vec3 = NDArray[np.float64]
 """A float64 array whose last axis has length 3 (one vector or a batch)."""

@@ -52,7 +52,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from glsandbox.raytrace.base import broadcast_rays
+from glsandbox.raytrace.shape_protocol import broadcast_rays
 from glsandbox.raytrace.triangle import DEGENERATE_SIN, watertight_t_bound
 
 __all__ = ["RaySetup", "aimed_rays", "nearest_by", "nearest_watertight", "nondegenerate", "ray_setup",

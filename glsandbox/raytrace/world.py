@@ -13,10 +13,11 @@ once per viewport by :func:`build_world` from the *same*
   and are not traced;
 - a node whose mesh says it tessellates the unit sphere
   (``Mesh.analytic == "sphere"``, as :func:`glsandbox.geometry.sphere` does,
-  and every vertex lies on it) is a :attr:`NodeKind.SPHERE` node, traced as the *exact* unit sphere under its model matrix (an ellipsoid in
-  general; the capped unit cylinder, :func:`glsandbox.geometry.cylinder`, likewise
-  a :attr:`NodeKind.CYLINDER` node): the ray is taken into the sphere's own space with ``M⁻¹`` and
-  tested against ``|p| = 1`` (course section "Işın-Küre kesim testi"). An
+  and every vertex lies on it) is a :attr:`NodeKind.SPHERE` node, traced as the
+  *exact* unit sphere under its model matrix (an ellipsoid in general; the capped
+  unit cylinder, :func:`glsandbox.geometry.cylinder`, likewise a
+  :attr:`NodeKind.CYLINDER` node): the ray is taken into the sphere's own space
+  with ``M⁻¹`` and tested against ``|p| = 1`` (course section "Işın-Küre kesim testi"). An
   affine map keeps ``t``: ``M⁻¹(O + t·d) = M⁻¹O + t·(M⁻¹d)``, so no
   renormalising is needed. The rasterizer draws the tessellation; the
   difference at the silhouette is one of the approximations the
@@ -75,7 +76,7 @@ from glsandbox.images import texture_levels
 from glsandbox.plan import traced_reflectivity
 from glsandbox.raytrace import shapes
 from glsandbox.raytrace.constants import LENGTH_TINY, SQUARES_UNDERFLOW
-from glsandbox.raytrace.errors import RayTraceError
+from glsandbox.raytrace.raytrace_error import RayTraceError
 from glsandbox.raytrace.shape_kind import ShapeKind
 from glsandbox.scene import MIN_SCALE, Camera, Node, Scene, Texture
 

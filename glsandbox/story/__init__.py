@@ -4,9 +4,11 @@
 F2 in the window) tells one pixel's story and returns a :class:`Story`: its text, its raw
 record (``--json``), and in a notebook an HTML view. A ray-traced pixel is traced through
 the numpy engine (numbered steps in the course's names); a rasterised one is told pass
-by pass from the frame's X-ray. The modules: ``ray`` (the ray record and its recorder,
+by pass from the frame's X-ray. The modules: ``ray_pixel`` (the ray record and its recorder,
 on the numpy engine's probe seam), ``text`` (the ray story's rendering), ``xray`` (each
-pass's colour, depth and stencil), ``raster`` (a rasterised pixel's story).
+pass's colour, depth and stencil), ``raster`` (a rasterised pixel's story), ``fragment``
+(what the shader saw there), ``divergence`` (a student's function traced beside the
+reference), ``coverage`` (the top-left rule on the CPU).
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ from typing import Any
 from glsandbox.errors import SandboxError
 from glsandbox.frame import FrameRenderer
 from glsandbox.scene import Scene
-from glsandbox.story.ray import explain_ray_pixel, locate_pixel
+from glsandbox.story.ray_pixel import explain_ray_pixel, locate_pixel
 from glsandbox.story.text import render_story
 
 __all__ = ["Story", "explain", "parse_pixel", "pixel_story"]
@@ -27,7 +29,7 @@ __all__ = ["Story", "explain", "parse_pixel", "pixel_story"]
 
 class Story:
     """One pixel's story: :attr:`text` (what the terminal prints), :attr:`record` (the raw
-    record: a ray-traced pixel's :class:`~glsandbox.story.ray.PixelTrace` or a rasterised
+    record: a ray-traced pixel's :class:`~glsandbox.story.ray_pixel.PixelTrace` or a rasterised
     one's :class:`~glsandbox.story.raster.RasterTrace`), :meth:`to_json`. Jupyter shows it
     as a block of text with a swatch of the colour (``_repr_html_``)."""
 

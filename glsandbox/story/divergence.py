@@ -1,7 +1,7 @@
 """A pixel's story with a student's function: their trace beside the reference's, and where they part.
 
 ``glsandbox explain LESSON --pixel X,Y --exercise NAME FILE.py`` traces the pixel
-twice through the numpy engine (:func:`glsandbox.story.ray.explain_ray_pixel`), once
+twice through the numpy engine (:func:`glsandbox.story.ray_pixel.explain_ray_pixel`), once
 with the exercise's reference and once with the student's function as the hit test of
 its kind of node (the engine's ``hit_tests`` seam, as the exercise's lesson picture
 uses it: ``intersect_sphere`` for the spheres, ``intersect_triangle`` for the meshes'
@@ -33,11 +33,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from glsandbox.errors import SandboxError
-from glsandbox.exercises.base import Exercise
 from glsandbox.exercises.compare import WrongType, describe, matches, normalize
+from glsandbox.exercises.definition import Exercise
 from glsandbox.exercises.lesson_view import _Calls
 from glsandbox.scene import Scene
-from glsandbox.story.ray import PixelTrace, ShapeTest, explain_ray_pixel
+from glsandbox.story.ray_pixel import PixelTrace, ShapeTest, explain_ray_pixel
 from glsandbox.story.text import num, render_story, vec
 
 __all__ = ["TRACED_KINDS", "Direct", "Divergence", "ExerciseStory", "compare_traces", "explain_with_function", "traced_kind"]

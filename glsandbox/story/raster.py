@@ -15,7 +15,7 @@ from typing import Any
 from glsandbox.frame import FrameRenderer
 from glsandbox.scene import Scene
 from glsandbox.story.fragment import blend_values, fragment_values
-from glsandbox.story.ray import locate_pixel
+from glsandbox.story.ray_pixel import locate_pixel
 from glsandbox.story.text import num, vec
 from glsandbox.story.xray import cleared_depth, pixel_passes, xray
 

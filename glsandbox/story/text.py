@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from glsandbox.story.ray import Bounce, LightStep, PixelTrace, ShapeTest
+from glsandbox.story.ray_pixel import Bounce, LightStep, PixelTrace, ShapeTest
 
 __all__ = ["num", "render_story", "vec"]
 

@@ -25,9 +25,9 @@ PROBE = 48
 
 
 def _plain(value):
-    from glsandbox.exercises import runner
+    from glsandbox.exercises import student_process
 
-    return runner._encode(value)
+    return student_process._encode(value)
 
 
 @pytest.mark.parametrize("name", NAMES)

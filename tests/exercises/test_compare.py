@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from glsandbox.exercises.base import Case
 from glsandbox.exercises.compare import WrongType, describe, judge, matches, normalize
+from glsandbox.exercises.definition import Case
 
 
 @pytest.mark.parametrize(("value", "returns", "expected"), [

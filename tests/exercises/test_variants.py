@@ -10,9 +10,9 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from glsandbox.exercises import get
-from glsandbox.exercises.base import Case
 from glsandbox.exercises.check import PASS, check_function
 from glsandbox.exercises.compare import judge
+from glsandbox.exercises.definition import Case
 
 
 def sub(a, b):

@@ -8,8 +8,8 @@ import numpy as np
 
 from glsandbox.gl.overlay_drawer import OverlayDrawer
 from glsandbox.overlay import Overlay
-from glsandbox.passes.base import Draw, Pass
 from glsandbox.passes.overlay import OVERLAY_PROGRAM
+from glsandbox.passes.plan_parts import Draw, Pass
 from glsandbox.scene import Scene
 
 SIZE = (16, 8)

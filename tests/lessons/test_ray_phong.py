@@ -88,7 +88,7 @@ def test_the_exam_scenes_draw_their_question_over_the_picture(gl, renderer, whic
 
 def test_a_pixel_story_says_when_the_exam_figure_lies_over_the_pixel():
     from glsandbox.overlay import project_segment
-    from glsandbox.story.ray import overlays_over
+    from glsandbox.story.ray_pixel import overlays_over
 
     scene = find_lesson("ray_phong")(scene="exam2013").scene()
     size = (320, 240)

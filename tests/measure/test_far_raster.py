@@ -73,7 +73,7 @@ def test_raster_triangle_ids_stay_put_far_from_the_origin(far, offset, scale) ->
 
 def test_the_shadow_maps_hold_float_depth_on_each_backend(far) -> None:
     # Mesa's EGL and OSMesa (llvmpipe, OpenGL 4.5 core) both give DEPTH_COMPONENT32F; a
-    # context without it would fall back to 24-bit fixed point (glsandbox/gl/shadowmap.py),
+    # context without it would fall back to 24-bit fixed point (glsandbox/gl/shadow_textures.py),
     # and this says so rather than the far-away rows below passing or failing unexplained.
     assert far["float_depth"] == {True}, f"{far['backend']}: 32-bit float shadow depth {far['float_depth']}"
 

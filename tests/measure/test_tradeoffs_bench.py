@@ -282,7 +282,7 @@ def test_tradeoffs_without_flip_says_so_in_one_line_and_measures_the_rest(tmp_pa
 
     monkeypatch.setitem(sys.modules, "flip_evaluator", None)
     # The columns are what is checked here: the cheap settings' extra rounds until their medians are
-    # stable (tests/measure/test_tradeoffs_timing.py) are left out, the five rounds kept.
+    # stable (tests/measure/test_tradeoffs.py) are left out, the five rounds kept.
     monkeypatch.setattr(tradeoffs, "MAX_RUNS", 5)
     out = tmp_path / "tradeoffs"
     assert main(["tradeoffs", "--quick", "--knob", "antialiasing", "--out", str(out)]) == 0

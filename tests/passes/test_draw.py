@@ -5,8 +5,8 @@ glass left to the mirror passes; a receiver's draw naming the shadow map it read
 from __future__ import annotations
 
 from glsandbox import geometry, transforms
-from glsandbox.passes.base import ProgramVariant
 from glsandbox.passes.draw import describe, draw_pass
+from glsandbox.passes.plan_parts import ProgramVariant
 from glsandbox.planar import Mirror
 from glsandbox.scene import Camera, Light, Material, Node, Scene, ShadowMap, Viewport
 

@@ -3,8 +3,8 @@ only, depth-tested (course "The stencil Test", ``MarkMirrorDSS``)."""
 
 from __future__ import annotations
 
-from glsandbox.passes.base import Draw
 from glsandbox.passes.mark_mirror import describe, mark_mirror_pass
+from glsandbox.passes.plan_parts import Draw
 from glsandbox.passes.planar_effects import MARK_MIRROR_STENCIL
 
 GLASS = Draw("glass", "basic", True)

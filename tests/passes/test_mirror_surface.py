@@ -3,8 +3,8 @@ reflection, depth-tested, with no stencil of its own (course "The stencil Test")
 
 from __future__ import annotations
 
-from glsandbox.passes.base import Draw
 from glsandbox.passes.mirror_surface import describe, mirror_surface_pass
+from glsandbox.passes.plan_parts import Draw
 
 GLASS = Draw("glass", "phong[NUM_LIGHTS=1]", True, blend=True)
 

@@ -5,7 +5,7 @@ the shadow asks for it (course "The stencil Test", ``XMMatrixShadow``)."""
 from __future__ import annotations
 
 from glsandbox import geometry, transforms
-from glsandbox.passes.base import ProgramVariant
+from glsandbox.passes.plan_parts import ProgramVariant
 from glsandbox.passes.planar_effects import PLANAR_SHADOW_PROGRAM, PLANAR_SHADOW_STENCIL
 from glsandbox.passes.planar_shadow import describe, planar_shadow_pass
 from glsandbox.planar import PlanarShadow

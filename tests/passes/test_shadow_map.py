@@ -5,7 +5,7 @@ program, a blended caster left out; the line names the light, the target and the
 from __future__ import annotations
 
 from glsandbox import geometry, transforms
-from glsandbox.passes.base import ProgramVariant
+from glsandbox.passes.plan_parts import ProgramVariant
 from glsandbox.passes.shadow_map import DEPTH_PROGRAM, describe, shadow_map_passes
 from glsandbox.scene import Light, Material, Node, Scene, ShadowMap
 

@@ -15,8 +15,8 @@ from glsandbox.gl.shaders import compile_program, shader_root
 from glsandbox.plan import ProgramVariant
 from glsandbox.raytrace.bvh import build_bvh, mesh_world_triangles
 from glsandbox.raytrace.bvh_traverse import any_hit, closest_hit
-from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.gpu_bvh import GpuBVH, pack_bvh, texture_from_chunks
+from glsandbox.raytrace.raytrace_error import RayTraceError
 from glsandbox.raytrace.world import camera_rays
 from glsandbox.scene import Camera
 

@@ -14,7 +14,7 @@ import pytest
 from glsandbox.lesson import find_lesson
 from glsandbox.raytrace import AABB, Sphere, TriangleBatch, moller_trumbore_many, render
 from glsandbox.raytrace import numpy_engine as render_module
-from glsandbox.raytrace.base import shared_origin
+from glsandbox.raytrace.shape_protocol import shared_origin
 from glsandbox.raytrace.world import build_world, camera_basis, camera_rays
 
 RNG = np.random.default_rng(7)

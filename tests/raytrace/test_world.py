@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from glsandbox import geometry, transforms
-from glsandbox.raytrace.errors import RayTraceError
+from glsandbox.raytrace.raytrace_error import RayTraceError
 from glsandbox.raytrace.world import (ALPHA_CODES, NodeKind, analytic_kind, build_world, camera_rays, coverage,
                                       course_image_plane)
 from glsandbox.scene import Camera, Material, Node, Scene, Viewport

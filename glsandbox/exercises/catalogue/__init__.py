@@ -1,6 +1,6 @@
 """The exercises, one module each, in the course's order.
 
-A module defines ``EXERCISE``, an :class:`~glsandbox.exercises.base.Exercise`.
+A module defines ``EXERCISE``, an :class:`~glsandbox.exercises.definition.Exercise`.
 To add one: write the module (``ray_sphere.py`` is the template: the
 reference wrapped from the engine, the notes' worked examples as visible
 cases, a generator of hard cases, the probe, at least three named mistakes),
@@ -13,7 +13,7 @@ from __future__ import annotations
 import importlib
 
 from glsandbox.errors import SandboxError
-from glsandbox.exercises.base import Exercise
+from glsandbox.exercises.definition import Exercise
 
 __all__ = ["MODULES", "all_exercises", "get", "markdown_table"]
 

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from glsandbox.exercises.base import Case, Exercise, Mistake, Probe
+from glsandbox.exercises.definition import Case, Exercise, Mistake, Probe
 from glsandbox.exercises.fields import grid
 
 COS15, SIN15 = math.cos(math.radians(15.0)), math.sin(math.radians(15.0))

@@ -7,8 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from glsandbox.exercises.base import Case, Exercise, Mistake, Probe
 from glsandbox.exercises.compare import WrongType, normalize
+from glsandbox.exercises.definition import Case, Exercise, Mistake, Probe
 from glsandbox.exercises.dxmath import camera
 
 DOC = """The cube's index buffer (küp: vertex + index buffer), course section "Küp: vertex + index buffer, 36 indices".

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from glsandbox.exercises.base import Case, Exercise, Mistake, Probe
+from glsandbox.exercises.definition import Case, Exercise, Mistake, Probe
 from glsandbox.exercises.fields import grid
 
 DOC = """Görüntü düzlemi (the image plane), course section "Bakış noktası, görüntü düzlemi GD(x,y)".

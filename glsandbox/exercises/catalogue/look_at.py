@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from glsandbox.exercises.base import Case, Exercise, Mistake, Probe
+from glsandbox.exercises.definition import Case, Exercise, Mistake, Probe
 from glsandbox.exercises.dxmath import cube_segments, edge_probe, look_at_lh, perspective_fov_lh, row
 
 CONVENTION = ("the course's DirectX row vectors (p_view = p·View, the translation in the last row), "

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from glsandbox.exercises.base import Case, Exercise, Mistake, Probe
+from glsandbox.exercises.definition import Case, Exercise, Mistake, Probe
 from glsandbox.exercises.dxmath import camera, cube_segments, edge_probe, look_at_lh, perspective_fov_lh, row
 
 CONVENTION = ("the course's DirectX row vectors (p_clip = p_view·Projection, w = z in the last column), "

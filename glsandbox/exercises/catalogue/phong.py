@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from glsandbox.exercises.base import Case, Exercise, Mistake, Probe
+from glsandbox.exercises.definition import Case, Exercise, Mistake, Probe
 from glsandbox.exercises.fields import hemisphere
 from glsandbox.exercises.plain import unit
 

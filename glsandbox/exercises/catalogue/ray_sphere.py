@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from glsandbox.exercises.base import Case, Exercise, LessonView, Mistake, Probe
+from glsandbox.exercises.definition import Case, Exercise, LessonView, Mistake, Probe
 from glsandbox.exercises.fields import grid
 
 DOC = """Işın-Küre kesim testi (ray-sphere intersection), course section "Işın-Küre kesim testi".

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from glsandbox.exercises.base import Case, Exercise, LessonView, Mistake, Probe
+from glsandbox.exercises.definition import Case, Exercise, LessonView, Mistake, Probe
 from glsandbox.exercises.fields import grid
 from glsandbox.exercises.plain import cross, dot, sub
 

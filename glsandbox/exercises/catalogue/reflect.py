@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from glsandbox.exercises.base import Case, Exercise, Mistake, Probe
+from glsandbox.exercises.definition import Case, Exercise, Mistake, Probe
 from glsandbox.exercises.fields import hemisphere
 
 DOC = """Yansıma vektörü (the reflection vector), course section "Yansıma vektörü".

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from glsandbox.exercises.base import Case, Exercise, Mistake, Probe
+from glsandbox.exercises.definition import Case, Exercise, Mistake, Probe
 from glsandbox.exercises.fields import grid
 from glsandbox.exercises.plain import cross, dot, sub
 

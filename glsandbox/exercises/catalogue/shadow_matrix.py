@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from glsandbox.exercises.base import Case, Exercise, Mistake, Probe
+from glsandbox.exercises.definition import Case, Exercise, Mistake, Probe
 from glsandbox.exercises.dxmath import CUBE_POINTS, camera, cube_segments, edge_probe, row
 
 CONVENTION = ("the course's DirectX row vectors (p' = p·Shadow, then the divide by w); "

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from glsandbox.exercises.base import Case, Exercise, Mistake, Probe
+from glsandbox.exercises.definition import Case, Exercise, Mistake, Probe
 from glsandbox.exercises.dxmath import camera, cube_segments, edge_probe, row
 
 CONVENTION = ("the course's DirectX row vectors: a point is a row, p' = p·World, and the product "

@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from glsandbox.exercises.states.tables import DepthStencil, StateTables, parse_tables
-from glsandbox.passes.base import Pass, StencilState
+from glsandbox.passes.plan_parts import Pass, StencilState
 
 __all__ = ["CLASSES", "MISTAKES", "REFERENCE_SOURCE", "LeakMap", "apply_tables", "leak_map", "reference_tables",
            "starter", "render_with"]

@@ -23,7 +23,7 @@ from glsandbox.errors import SandboxError
 from glsandbox.gl import rawgl
 from glsandbox.gl.target import FRAME_COLOR_MASK
 from glsandbox.passes import PASS_KINDS
-from glsandbox.passes.base import Pass
+from glsandbox.passes.plan_parts import Pass
 from glsandbox.scene import Light, Node, Scene
 
 

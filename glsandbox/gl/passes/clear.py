@@ -6,7 +6,7 @@ from typing import Any
 
 from glsandbox.gl.passes import FrameState, Runner, touches_nothing
 from glsandbox.gl.target import clear_opaque
-from glsandbox.passes.base import Pass
+from glsandbox.passes.plan_parts import Pass
 
 
 def run(executor: Any, frame: FrameState, step: Pass, camera: Any) -> None:

@@ -6,7 +6,7 @@ from __future__ import annotations
 from typing import Any
 
 from glsandbox.gl.passes import FrameState, Runner, touches_nothing
-from glsandbox.passes.base import Pass
+from glsandbox.passes.plan_parts import Pass
 
 
 def run(executor: Any, frame: FrameState, step: Pass, camera: Any) -> None:

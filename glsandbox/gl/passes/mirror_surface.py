@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from glsandbox.gl.passes import Runner
 from glsandbox.gl.planar_state import mirror_surface
-from glsandbox.passes.base import Pass
+from glsandbox.passes.plan_parts import Pass
 
 _BLEND = frozenset({"blend"})
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from glsandbox.gl.passes import Runner, stencil_set
 from glsandbox.gl.planar_state import planar_shadow
-from glsandbox.passes.base import Pass
+from glsandbox.passes.plan_parts import Pass
 
 
 def habits(step: Pass) -> tuple[frozenset[str], frozenset[str]]:

@@ -19,7 +19,7 @@ drawn first) is a z-fighting pixel.
 What the model leaves out: a GPU computes clip depth and interpolates
 ``z/w`` in float32 before it stores it, which moves the share of fighting
 pixels, and the onset where the gap is one buffer step. The rasterizer's two
-modes drawn on this scene at 96x72 (tests/measure/test_precision_knobs.py):
+modes drawn on this scene at 96x72 (tests/measure/knobs/test_depth_format.py):
 24-bit at near 0.01 loses all of the decal's inner pixels (the model: 79%);
 at 0.02 18% (57%) and at 0.05 55% (none), where the gap is about one 24-bit
 step and float32 decides the ties; at 1 none (none); reverse-Z float none

@@ -11,7 +11,7 @@ import numpy as np
 from glsandbox.exercises.states.mirror import (CLASSES, MISTAKES, REFERENCE_SOURCE, apply_tables, check_tables,
                                                reference_tables)
 from glsandbox.exercises.states.tables import parse_tables
-from glsandbox.passes.base import StencilState
+from glsandbox.passes.plan_parts import StencilState
 from glsandbox.plan import MARK_MIRROR_STENCIL, plan
 
 

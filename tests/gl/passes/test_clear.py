@@ -7,7 +7,7 @@ import numpy as np
 
 from glsandbox.gl.passes import FrameState, runner
 from glsandbox.gl.passes.clear import RUNNER, run
-from glsandbox.passes.base import Pass
+from glsandbox.passes.plan_parts import Pass
 from glsandbox.scene import Scene, Viewport
 
 SIZE = (8, 4)

@@ -9,7 +9,7 @@ import pytest
 from glsandbox import geometry
 from glsandbox.gl.passes import FrameState, runner
 from glsandbox.gl.passes.draw import RUNNER, run
-from glsandbox.passes.base import Draw, Pass
+from glsandbox.passes.plan_parts import Draw, Pass
 from glsandbox.scene import Node, Scene
 
 

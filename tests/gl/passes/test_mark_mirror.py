@@ -6,8 +6,8 @@ from __future__ import annotations
 from glsandbox.gl.passes import runner
 from glsandbox.gl.passes.mark_mirror import RUNNER
 from glsandbox.gl.planar_state import mark_mirror
-from glsandbox.passes.base import Draw, Pass
 from glsandbox.passes.mark_mirror import mark_mirror_pass
+from glsandbox.passes.plan_parts import Draw, Pass
 
 
 def test_the_runner_is_the_registrys_and_runs_the_stencil_marking() -> None:

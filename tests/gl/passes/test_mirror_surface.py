@@ -6,8 +6,8 @@ from __future__ import annotations
 from glsandbox.gl.passes import runner
 from glsandbox.gl.passes.mirror_surface import RUNNER
 from glsandbox.gl.planar_state import mirror_surface
-from glsandbox.passes.base import Draw
 from glsandbox.passes.mirror_surface import mirror_surface_pass
+from glsandbox.passes.plan_parts import Draw
 
 
 def test_the_runner_is_the_registrys_and_draws_the_glass() -> None:

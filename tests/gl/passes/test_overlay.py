@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from glsandbox.gl.passes import FrameState, runner
 from glsandbox.gl.passes.overlay import RUNNER, run
-from glsandbox.passes.base import Draw, Pass
+from glsandbox.passes.plan_parts import Draw, Pass
 from glsandbox.scene import Scene
 
 

@@ -9,7 +9,7 @@ from dataclasses import replace
 from glsandbox.gl.passes import runner
 from glsandbox.gl.passes.planar_shadow import RUNNER
 from glsandbox.gl.planar_state import planar_shadow
-from glsandbox.passes.base import Pass
+from glsandbox.passes.plan_parts import Pass
 from glsandbox.passes.planar_effects import PLANAR_SHADOW_STENCIL
 
 LEFT = frozenset({"stencil", "masks", "blend", "offset"})

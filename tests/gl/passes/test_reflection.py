@@ -9,7 +9,7 @@ from dataclasses import replace
 from glsandbox.gl.passes import runner
 from glsandbox.gl.passes.reflection import RUNNER
 from glsandbox.gl.planar_state import reflection
-from glsandbox.passes.base import Pass
+from glsandbox.passes.plan_parts import Pass
 from glsandbox.passes.planar_effects import REFLECTION_STENCIL
 
 

@@ -9,7 +9,7 @@ from glsandbox import geometry, transforms
 from glsandbox.gl.passes import runner
 from glsandbox.gl.passes.shadow_map import RUNNER
 from glsandbox.gl.shadow_textures import run_shadow_map_pass
-from glsandbox.passes.base import Pass
+from glsandbox.passes.plan_parts import Pass
 from glsandbox.plan import plan
 from glsandbox.scene import Light, Material, Node, Scene, ShadowMap
 

@@ -7,7 +7,7 @@ import pytest
 
 from glsandbox.gl.passes import FrameState, runner
 from glsandbox.gl.passes.trace import RUNNER, run
-from glsandbox.passes.base import Pass
+from glsandbox.passes.plan_parts import Pass
 from glsandbox.scene import Scene
 
 

@@ -141,7 +141,7 @@ def test_a_kind_with_no_gpu_case_fails_loudly(gl, monkeypatch, unroll: bool) -> 
     is refused with an error, never traced as another kind (as a sphere, before the registry)."""
     from glsandbox.raytrace import gpu as gpu_engine
     from glsandbox.raytrace import render
-    from glsandbox.raytrace.errors import RayTraceError
+    from glsandbox.raytrace.raytrace_error import RayTraceError
 
     tracer = gpu_engine.gpu_tracer(gl.host.ctx)
     tracer.forget_scenes()

@@ -14,7 +14,7 @@ from glsandbox.plan import TRACE_OPTIONS
 from glsandbox.raytrace.render import render
 from glsandbox.scene import Scene
 from glsandbox.story import explain, parse_pixel
-from glsandbox.story.ray import explain_ray_pixel, locate_pixel
+from glsandbox.story.ray_pixel import explain_ray_pixel, locate_pixel
 from support import EXAMPLES_DIR, course_ray
 
 #: Every ray lesson (its scenes), and raster lessons and a scene file traced by the numpy engine.

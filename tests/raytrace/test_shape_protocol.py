@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from glsandbox.raytrace import AABB, Plane, RayTraceError, Sphere, Triangle
-from glsandbox.raytrace.base import Shape, broadcast_rays, finite_positive_or_none, shared_origin
+from glsandbox.raytrace.shape_protocol import Shape, broadcast_rays, finite_positive_or_none, shared_origin
 
 
 def test_the_course_shapes_offer_the_shape_interface() -> None:

@@ -1,9 +1,10 @@
 """The student's process: load one file, call one function on the inputs it is sent.
 
 Run as a script by :mod:`glsandbox.exercises.isolation` (``python -I -S -B
-runner.py CONFIG``), never imported by glsandbox: it uses the standard
-library only, so nothing of glsandbox (least of all the reference
-implementations) is ever loaded here. Its import path is set from the
+student_process.py CONFIG``); it imports the standard library only, so
+nothing of glsandbox (least of all the reference implementations) is ever
+loaded here (glsandbox imports it for :func:`_encode` alone, so the grader
+reads values as the student's process writes them). Its import path is set from the
 config (the standard library and the third-party packages, without
 glsandbox); the parent has already put the process in its own session,
 under limits and, on Linux, under a Landlock rule set that cannot read

@@ -21,8 +21,8 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from glsandbox.raytrace.errors import RayTraceError
 from glsandbox.raytrace.ray import Ray
+from glsandbox.raytrace.raytrace_error import RayTraceError
 from glsandbox.raytrace.vec import Vec3, as_vec3_batch
 
 __all__ = ["Shape", "broadcast_rays", "finite_positive_or_none", "shared_origin"]

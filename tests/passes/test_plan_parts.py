@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from glsandbox.errors import SandboxError
-from glsandbox.passes.base import Draw, Pass, ProgramVariant, StencilState, describe_draws
+from glsandbox.passes.plan_parts import Draw, Pass, ProgramVariant, StencilState, describe_draws
 from glsandbox.passes.planar_effects import MARK_MIRROR_STENCIL, PLANAR_SHADOW_STENCIL, REFLECTION_STENCIL
 
 

@@ -1,4 +1,4 @@
-"""An exercise's parts (glsandbox/exercises/base.py): a case hidden unless visible, the signature
+"""An exercise's parts (glsandbox/exercises/definition.py): a case hidden unless visible, the signature
 as the student reads it, the cases a check runs, and expected vectors as plain floats. (Every
 exercise's parts against its cases: test_catalogue.py.)"""
 
@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from glsandbox.exercises import get
-from glsandbox.exercises.base import RESULT_KINDS, Case, vec
+from glsandbox.exercises.definition import RESULT_KINDS, Case, vec
 
 
 def test_a_case_is_hidden_unless_it_is_visible() -> None:
