@@ -38,6 +38,7 @@ from glsandbox.exercises.compare import WrongType, describe, matches, normalize
 from glsandbox.exercises.lesson_view import _Calls
 from glsandbox.scene import Scene
 from glsandbox.story.ray import PixelTrace, ShapeTest, explain_ray_pixel
+from glsandbox.story.seams import STEPS, seams_for
 from glsandbox.story.text import num, render_story, vec
 
 __all__ = ["TRACED_KINDS", "Direct", "Divergence", "ExerciseStory", "compare_traces", "explain_with_function", "traced_kind"]
@@ -46,18 +47,19 @@ __all__ = ["TRACED_KINDS", "Direct", "Divergence", "ExerciseStory", "compare_tra
 #: correct geometric sphere test and the engine's stable one differ by rounding only.
 REL, ABS = 1e-9, 1e-9
 
-#: The node kind (the engine's ``hit_tests`` name) each exercise's function is the test of.
+#: The node kind (the engine's ``hit_tests`` name) each hit-test exercise's function is the test of.
 TRACED_KINDS = {"sphere": "sphere", "triangles": "triangles"}
 
 
 def traced_kind(exercise: Exercise) -> str:
-    """The engine's node kind ``exercise``'s function traces, refusing one the tracer cannot plug in."""
+    """The step of a traced ray ``exercise``'s function is (a node kind's hit test, or one of
+    :mod:`glsandbox.story.seams`'), refusing one the tracer cannot plug in."""
+    if exercise.name in STEPS and exercise.name not in ("ray_sphere", "ray_triangle"):
+        return exercise.name
     if exercise.lesson is None or exercise.lesson.kind not in TRACED_KINDS:
-        from glsandbox.exercises.catalogue import all_exercises
-
-        known = ", ".join(e.name for e in all_exercises() if e.lesson is not None)
-        raise SandboxError(f"--exercise {exercise.name}: its function is not a hit test the ray tracer can use; "
-                           f"the exercises it traces: {known}")
+        known = ", ".join(STEPS)
+        raise SandboxError(f"--exercise {exercise.name}: {exercise.function} is not a step of a traced ray; "
+                           f"explain traces the exercises {known}")
     return TRACED_KINDS[exercise.lesson.kind]
 
 
@@ -69,11 +71,13 @@ class Direct:
         self.function = function
 
     def batch(self, inputs: list[tuple[Any, ...]]) -> tuple[list[Any], dict[int, str]]:
+        from glsandbox.exercises.runner import _encode  # the answers as the confined process sends them
+
         values: list[Any] = []
         errors: dict[int, str] = {}
         for i, args in enumerate(inputs):
             try:
-                values.append(self.function(*args))
+                values.append(_encode(self.function(*args)))
             except Exception as exc:  # noqa: BLE001 - the function's own
                 values.append(None)
                 errors[i] = f"{type(exc).__name__}: {exc}"[:300]
@@ -207,6 +211,13 @@ def _facts(events: list[tuple[str, dict[str, Any]]], trace: PixelTrace, nodes: l
         for call in pending:
             for i, (args, answer) in enumerate(zip(call["inputs"], call["answers"], strict=True)):
                 info = {"kind": call["kind"], "args": args, "answer": answer, "ray": where}
+                if "what" in call:  # one of glsandbox.story.seams' steps
+                    info["node"] = str(call.get("node_name") or "a mesh")
+                    what = f"{function} {call['what'][i].format(node=info['node'])}"
+                    if "light" in call:  # a light's Phong term: its light's, at the hit
+                        info["ray"] = f"light {call['light']} at the hit of depth {depth}"
+                    facts.append(Fact(str(info["ray"]), what, answer, info))
+                    continue
                 if call["kind"] == "sphere":
                     node = _node_of_sphere_call(nodes, args[0], world_o) if world_o is not None else None
                     info["node"] = node.name if node is not None else "a sphere"
@@ -281,10 +292,21 @@ def _say(value: Any) -> str:
     return describe(value)
 
 
+def _arg(a: Any) -> str:
+    if isinstance(a, list):  # in_shadow's triangles
+        return f"[{len(a)} triangles]"
+    return vec(a) if isinstance(a, tuple) else num(a)
+
+
 def _call_message(function: str, mine: Fact, ref: Fact) -> str:
     info, other = mine.call or {}, ref.call or {}
     got, want = info.get("answer"), other.get("answer")
-    args = ", ".join(vec(a) if isinstance(a, (tuple, list)) else num(a) for a in info.get("args", ()))
+    args = ", ".join(_arg(a) for a in info.get("args", ()))
+    if info.get("kind") not in ("sphere", "triangles"):  # glsandbox.story.seams' steps
+        def say(v: Any) -> str:
+            return describe(v) if isinstance(v, (bool, tuple)) else _say(v)
+        return (f"{function} returned {say(got)} where the reference has {say(want).removeprefix('t = ')} "
+                f"({mine.what.removeprefix(function).strip()}, {mine.where}); called as {function}({args})")
     text = (f"{function} returned {_say(got)} where the reference has {_say(want).removeprefix('t = ')} "
             f"({info.get('node')}, {mine.where})")
     scale = info.get("scale")
@@ -343,21 +365,29 @@ def explain_with_function(scene: Scene, size: tuple[int, int], pixel: tuple[int,
     """Pixel ``pixel`` of ``scene`` traced with ``exercise``'s reference and with ``caller``'s function
     (see the module docstring)."""
     kind = traced_kind(exercise)
+
+    def plugged(function: Any, events: list[tuple[str, dict[str, Any]]]) -> tuple[dict[str, Any], Any]:
+        other = seams_for(exercise, function, events)
+        if other is not None:
+            return other
+        hit = _Seam(exercise, function, events)
+        return {kind: getattr(hit, kind)}, hit
+
     ref_events: list[tuple[str, dict[str, Any]]] = []
-    ref_seam = _Seam(exercise, Direct(exercise.reference), ref_events)
-    reference = explain_ray_pixel(scene, size, pixel, title, hit_tests={kind: getattr(ref_seam, kind)}, simple=True,
-                                  events=ref_events, traced=True)
+    tests, _ = plugged(Direct(exercise.reference), ref_events)
+    reference = explain_ray_pixel(scene, size, pixel, title, hit_tests=tests, simple=True, events=ref_events,
+                                  traced=True)
     my_events: list[tuple[str, dict[str, Any]]] = []
-    seam = _Seam(exercise, caller, my_events)
-    yours = explain_ray_pixel(scene, size, pixel, title, hit_tests={kind: getattr(seam, kind)}, simple=True,
-                              events=my_events, traced=True)
+    tests, seam = plugged(caller, my_events)
+    yours = explain_ray_pixel(scene, size, pixel, title, hit_tests=tests, simple=True, events=my_events, traced=True)
     reference.renderer = yours.renderer = "ray_numpy"  # both traced by the numpy engine, as the lesson picture is
     world = _world(scene, reference.viewport)
     nodes = list(world.nodes)
     _name_meshes(world, ref_events, my_events)
     ref_facts = _facts(ref_events, reference, nodes, exercise.function)
     my_facts = _facts(my_events, yours, nodes, exercise.function)
-    _tested_by_function(yours, my_facts, kind, exercise.function)
+    if kind in TRACED_KINDS:
+        _tested_by_function(yours, my_facts, kind, exercise.function)
     divergence = compare_traces(my_facts, ref_facts, exercise.function)
     return ExerciseStory(exercise.name, exercise.function, reference, yours, divergence, len(my_facts), seam.error)
 
@@ -374,7 +404,7 @@ def _name_meshes(world: Any, *event_lists: list[tuple[str, dict[str, Any]]]) -> 
     """Each triangle call's node, by its first triangle's first vertex (the node's rows of the World)."""
     for events in event_lists:
         for step, v in events:
-            if step == "call" and v["kind"] == "triangles" and v["first"] is not None:
+            if step == "call" and v.get("first") is not None:
                 for node in world.nodes:
                     if node.kind.triangles and node.count and np.array_equal(world.v0[node.start], v["first"]):
                         v["node_name"] = node.name
