@@ -90,9 +90,11 @@ Probe = Callable[..., None]
 #: ``"aabb"``: ``(node, o, d) -> bool`` per ray, whether it enters the node's box;
 #: ``"backface"``: ``(world, node, o, d) -> (t, world triangle)`` of a one-sided mesh node;
 #: ``"reflect"``: ``(d, n) -> R``; ``"phong"``: ``(world, light, nodes, values) -> term`` (a
-#: light's per-hit colour, ``min(ka·C + lighting, 1)``); ``"shadow"``: ``(world, point, start, light, cull, aabb) -> bool``.
+#: light's per-hit colour, ``min(ka·C + lighting, 1)``); ``"shadow"``:
+#: ``(world, point, start, light, cull, aabb) -> bool``; ``"normal"``: ``(world, node, triangles) -> N`` (the face normal of a two-sided node's back-face
+#: test and of the secondary rays' offset).
 #: Renders hand none: only :mod:`glsandbox.story` builds a World with them.
-SEAMS = ("aabb", "backface", "reflect", "phong", "shadow")
+SEAMS = ("aabb", "backface", "reflect", "phong", "shadow", "normal")
 
 
 @dataclass
@@ -487,6 +489,9 @@ def _surface_triangles(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[n
     w = (1.0 - u - v)[:, None], u[:, None], v[:, None]  # weights of V0, V1, V2
     normal = _interpolate(world.normals[tri], w)
     face = np.cross(e1, e2) if node.two_sided or spawn is not None else None
+    normals = world.hit_tests.get("normal")  # the story's seam
+    if normals is not None and face is not None:
+        face = normals(world, node, tri)
     if node.two_sided:
         # A back face seen (the ray runs along the face normal: clockwise from the eye,
         # the rasterizer's !gl_FrontFacing) is lit as its other side: the normal reversed.

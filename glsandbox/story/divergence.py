@@ -51,6 +51,13 @@ REL, ABS = 1e-9, 1e-9
 TRACED_KINDS = {"sphere": "sphere", "triangles": "triangles"}
 
 
+#: Why an exercise near the ray tracer is not one of its traced steps (said when refused).
+NOT_TRACED = {"image_plane": "the tracer casts its rays through the pixel centres of the lesson's camera, "
+                             "not through the notes' GD(x, y) of an 800x450 picture",
+              "camera_turn": "the camera is placed before a ray is cast",
+              "cube_indices": "the tracer takes the mesh's triangles as built"}
+
+
 def traced_kind(exercise: Exercise) -> str:
     """The step of a traced ray ``exercise``'s function is (a node kind's hit test, or one of
     :mod:`glsandbox.story.seams`'), refusing one the tracer cannot plug in."""
@@ -58,8 +65,10 @@ def traced_kind(exercise: Exercise) -> str:
         return exercise.name
     if exercise.lesson is None or exercise.lesson.kind not in TRACED_KINDS:
         known = ", ".join(STEPS)
-        raise SandboxError(f"--exercise {exercise.name}: {exercise.function} is not a step of a traced ray; "
-                           f"explain traces the exercises {known}")
+        why = NOT_TRACED.get(exercise.name) or ("a matrix the rasterizer's passes use; the tracer takes the "
+                                                "scene's matrices as built" if exercise.returns == "matrix4" else "")
+        raise SandboxError(f"--exercise {exercise.name}: {exercise.function} is not a step of a traced ray"
+                           f"{' (' + why + ')' if why else ''}; explain traces the exercises {known}")
     return TRACED_KINDS[exercise.lesson.kind]
 
 
@@ -247,6 +256,8 @@ def _facts(events: list[tuple[str, dict[str, Any]]], trace: PixelTrace, nodes: l
             node = int(v["node"][0])
             hit = None if node < 0 else (nodes[node].name, float(v["t"][0]), int(v["tri"][0]))
             facts.append(Fact(where, "the nearest hit (min_indis)", hit))
+        elif step == "surface":  # what the hit's surface asked (a face normal)
+            label(f"the hit at depth {depth}", None, None)
         elif step == "light":
             index = int(v["index"])
             where = f"the shadow ray towards light {index} (depth {depth})"
@@ -303,9 +314,13 @@ def _call_message(function: str, mine: Fact, ref: Fact) -> str:
     got, want = info.get("answer"), other.get("answer")
     args = ", ".join(_arg(a) for a in info.get("args", ()))
     if info.get("kind") not in ("sphere", "triangles"):  # glsandbox.story.seams' steps
-        def say(v: Any) -> str:
+        def say(v: Any, fine: bool = False) -> str:
+            if fine and isinstance(v, (tuple, float)):  # they part beyond six digits
+                return "(" + ", ".join(f"{x:.12g}" for x in v) + ")" if isinstance(v, tuple) else f"t = {v:.12g}"
             return describe(v) if isinstance(v, (bool, tuple)) else _say(v)
-        return (f"{function} returned {say(got)} where the reference has {say(want).removeprefix('t = ')} "
+        fine = say(got) == say(want)
+        return (f"{function} returned {say(got, fine)} where the reference has "
+                f"{say(want, fine).removeprefix('t = ')} "
                 f"({mine.what.removeprefix(function).strip()}, {mine.where}); called as {function}({args})")
     text = (f"{function} returned {_say(got)} where the reference has {_say(want).removeprefix('t = ')} "
             f"({info.get('node')}, {mine.where})")

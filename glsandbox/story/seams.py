@@ -20,6 +20,10 @@ between the engine's own steps. The steps:
   (course "Phong boyama modeli"), with ``C`` in 0..255 as the exercise has it (the answer is
   divided by 255 and clamped as the engine's term is); a coloured light, a Blinn-Phong material
   and a point in shadow keep the engine's terms (in shadow only the ambient stays);
+- ``triangle_normal``: a hit triangle's face normal ``(V1 − V0) × (V2 − V0)``, normalized
+  (course "Vektörel işlemler"), where the tracer uses it: which side of a two-sided triangle
+  the ray sees (its back face is lit with the normal reversed) and which way a secondary ray
+  is moved off the surface (the shading normal stays the mesh's vertex normals);
 - ``shadow``: whether a hit is in shadow of a light (course "Gölge testi"): ``in_shadow`` over
   the triangles of the scene's meshes (the light's own lamp left out, as the engine does),
   from the hit point itself (the function moves off the surface); an analytic shape (a
@@ -46,7 +50,8 @@ __all__ = ["STEPS", "Logged", "seams_for"]
 #: Each exercise whose function a traced ray calls, and the step it is (see the module docstring).
 STEPS = {"ray_sphere": "the sphere's hit test", "ray_triangle": "the triangles' hit test",
          "ray_plane": "the triangles' plane", "aabb": "the nodes' boxes", "backface": "backface culling",
-         "reflect": "the reflected ray", "phong": "a white light's Phong term", "shadow": "the shadow test"}
+         "reflect": "the reflected ray", "phong": "a white light's Phong term", "shadow": "the shadow test",
+         "triangle_normal": "a hit triangle's face normal"}
 
 
 def _vec(a: Any) -> tuple[float, ...]:
@@ -227,10 +232,24 @@ class ShadowSeam(Logged):
         return mine | numpy_engine._occluded(analytic, start, light - start, index, cull, aabb)
 
 
+class NormalSeam(Logged):
+    """``triangle_normal`` as the face normal of the hit triangles (``"normal"``); no normal (a
+    None, a failed call) is the zero vector."""
+
+    kind = "normal"
+
+    def __call__(self, world: Any, node: Any, tri: NDArray[np.intp]) -> NDArray[np.float64]:
+        answers = self.ask([(_vec(world.v0[k]), _vec(world.v1[k]), _vec(world.v2[k])) for k in tri],
+                           [f"on {node.name}, triangle {int(k) - node.start}" for k in tri])
+        return np.array([a if isinstance(a, tuple) else (0.0, 0.0, 0.0) for a in answers], dtype=np.float64
+                        ).reshape(-1, 3)
+
+
 #: Each exercise's seam: the World's key it takes and its class.
 _SEAMS: dict[str, tuple[str, type[Logged]]] = {
     "ray_plane": ("triangles", PlaneSeam), "aabb": ("aabb", BoxSeam), "backface": ("backface", BackfaceSeam),
-    "reflect": ("reflect", ReflectSeam), "phong": ("phong", PhongSeam), "shadow": ("shadow", ShadowSeam)}
+    "reflect": ("reflect", ReflectSeam), "phong": ("phong", PhongSeam), "shadow": ("shadow", ShadowSeam),
+    "triangle_normal": ("normal", NormalSeam)}
 
 
 def seams_for(exercise: Exercise, caller: Any, events: list[tuple[str, dict[str, Any]]]) -> tuple[dict[str, Any],

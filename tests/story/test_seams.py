@@ -1,7 +1,7 @@
 """The other ray-tracer exercises plugged into one traced ray: the first divergence is their call.
 
 For every named mistake of the exercises whose function a traced ray calls besides the hit
-tests (ray_plane, aabb, backface, reflect, phong, shadow: their catalogue's ``MISTAKES``), a
+tests (ray_plane, aabb, backface, reflect, phong, shadow, triangle_normal: their catalogue's ``MISTAKES``), a
 pixel where the mistake shows (the traces part there) is traced with the mistake: the first
 divergence is a call of the mutated function, named with both values. A correct version of the
 function written apart from the engine (the catalogue's plain-Python helper with nothing
@@ -10,12 +10,16 @@ wrong) agrees there step for step. A mistake the tracer cannot meet is listed wi
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import pytest
+from support import assert_user_error, run_cli
 
 from glsandbox.app.notebook import scene_of
 from glsandbox.errors import SandboxError
-from glsandbox.exercises.catalogue import aabb, backface, get, phong, ray_plane, reflect, shadow
-from glsandbox.exercises.plain import dot
+from glsandbox.exercises.catalogue import aabb, backface, get, phong, ray_plane, reflect, shadow, triangle_normal
+from glsandbox.exercises.plain import cross, dot, sub
 from glsandbox.story.divergence import Direct, explain_with_function, traced_kind
 from glsandbox.story.seams import STEPS
 
@@ -40,6 +44,10 @@ WHERE = {
     ("phong", "specular_behind"): ("ray_phong", {"camera": "-3,0.5,-3,0,1,0"}, (22, 27)),  # against the light
     ("phong", "reflected_wrong_way"): ("ray_phong", {}, (27, 17)),
     ("phong", "light_not_normalized"): ("ray_spheres", {}, (27, 12)),
+    ("triangle_normal", "unnormalized"): ("ray_phong", {}, (47, 17)),
+    ("triangle_normal", "reversed_order"): ("ray_phong", {}, (47, 17)),
+    ("triangle_normal", "cross_y_sign"): ("ray_phong", {}, (47, 17)),
+    ("triangle_normal", "vertices_not_edges"): ("ray_phong", {}, (47, 17)),
     ("shadow", "the_notes_erratum"): ("ray_phong", {"scene": "exam2012"}, (2, 2)),
     ("shadow", "no_offset"): ("ray_phong", {}, (47, 17)),
     ("shadow", "towards_the_point"): ("ray_phong", {}, (27, 12)),
@@ -59,6 +67,7 @@ CORRECT = {
     "reflect": lambda d, n: reflect._reflect(d, n),
     "phong": lambda *args: phong._phong(*args),
     "shadow": lambda p, light, tris: shadow._shadow(p, light, tris),
+    "triangle_normal": lambda v0, v1, v2: triangle_normal._normalized(cross(sub(v1, v0), sub(v2, v0))),
 }
 
 CASES = [(e, m.name) for e in CORRECT for m in get(e).mistakes]
@@ -115,7 +124,7 @@ def test_a_failing_function_is_named_with_its_error() -> None:
     assert story.divergence.message.startswith("reflect returned error: ValueError: not yet where the reference has")
 
 
-@pytest.mark.parametrize("name", ["image_plane", "triangle_normal", "camera_turn", "world_matrix", "cube_indices"])
+@pytest.mark.parametrize("name", ["image_plane", "camera_turn", "world_matrix", "cube_indices"])
 def test_what_a_traced_ray_does_not_call_is_refused_in_one_line(name: str) -> None:
     with pytest.raises(SandboxError) as caught:
         traced_kind(get(name))
@@ -127,3 +136,29 @@ def test_what_a_traced_ray_does_not_call_is_refused_in_one_line(name: str) -> No
 def test_the_steps_are_every_traced_exercise() -> None:
     assert sorted(STEPS) == sorted(["ray_sphere", "ray_triangle", *CORRECT])
     assert all(traced_kind(get(name)) for name in STEPS)
+
+
+REFLECT = """import math
+def reflect(direction, normal):
+    size = math.sqrt(sum(x * x for x in normal))
+    n = [x / size for x in normal]
+    dn = sum(a * b for a, b in zip(direction, n))
+    return [a {sign} 2 * dn * b for a, b in zip(direction, n)]
+"""
+
+
+def test_the_command_runs_a_reflect_file_confined_and_exits_like_diff(tmp_path: Path) -> None:
+    wrong, right = tmp_path / "plus.py", tmp_path / "minus.py"
+    wrong.write_text(REFLECT.format(sign="+"))
+    right.write_text(REFLECT.format(sign="-"))
+    where = ("ray_phong", "--size", "64x48", "--pixel", "27,12")
+    differ = run_cli("explain", *where, "--exercise", "reflect", str(wrong))
+    assert differ.returncode == 1, differ.stderr
+    assert differ.stdout.startswith("first difference: reflect returned (-0.125664, -0.524427, -1.06241) where the "
+                                    "reference has (-0.0296657, 0.329944, -0.967306) (for the reflected ray, the "
+                                    "ray of depth 1)")
+    agree = run_cli("explain", *where, "--exercise", "reflect", str(right), "--json")
+    assert agree.returncode == 0, agree.stderr
+    assert json.loads(agree.stdout)["agree"] is True
+    assert_user_error(run_cli("explain", *where, "--exercise", "image_plane", str(right)),
+                      "--exercise image_plane: image_plane is not a step of a traced ray")
