@@ -36,11 +36,11 @@ from numpy.typing import NDArray
 
 from glsandbox.errors import SandboxError
 from glsandbox.exercises.base import Exercise
-from glsandbox.exercises.compare import WrongType, describe, matches, normalize
+from glsandbox.exercises.compare import describe, matches
 from glsandbox.exercises.lesson_view import _Calls
 from glsandbox.scene import Scene
 from glsandbox.story.ray import PixelTrace, ShapeTest, explain_ray_pixel
-from glsandbox.story.seams import STEPS, seams_for
+from glsandbox.story.seams import STEPS, answers_of, seams_for
 from glsandbox.story.text import num, render_story, vec
 
 __all__ = ["TRACED_KINDS", "Direct", "Divergence", "ExerciseStory", "compare_traces", "explain_with_function", "traced_kind"]
@@ -107,23 +107,7 @@ class _Seam(_Calls):
 
     def _answers(self, inputs: list[tuple[Any, ...]]) -> list[Any]:
         """Each input's answer, normalized: a value, or an ``error: ...`` string."""
-        if not inputs:
-            return []
-        batch = self.caller.batch(inputs) if not self.error else None
-        if batch is None or not isinstance(batch, tuple):
-            self.error = self.error or f"your function stopped answering ({getattr(batch, 'error', '')})"
-            return [f"error: {self.error}"] * len(inputs)
-        values, errors = batch
-        out: list[Any] = []
-        for i, value in enumerate(values):
-            if i in errors:
-                out.append(f"error: {errors[i]}")
-                continue
-            try:
-                out.append(normalize(value, self.exercise.returns))
-            except WrongType as exc:
-                out.append(f"error: {exc}")
-        return out
+        return answers_of(self, inputs)
 
     def values(self, inputs: list[tuple]) -> list[float]:
         """``t`` of each input (``inf`` for None, a failure or the wrong type), the call logged."""

@@ -45,7 +45,7 @@ from numpy.typing import NDArray
 from glsandbox.exercises.base import Exercise
 from glsandbox.exercises.compare import WrongType, normalize
 
-__all__ = ["STEPS", "Logged", "seams_for"]
+__all__ = ["STEPS", "Logged", "answers_of", "seams_for"]
 
 #: Each exercise whose function a traced ray calls, and the step it is (see the module docstring).
 STEPS = {"ray_sphere": "the sphere's hit test", "ray_triangle": "the triangles' hit test",
@@ -56,6 +56,28 @@ STEPS = {"ray_sphere": "the sphere's hit test", "ray_triangle": "the triangles' 
 
 def _vec(a: Any) -> tuple[float, ...]:
     return tuple(float(x) for x in np.asarray(a, dtype=np.float64).reshape(-1)[:3])
+
+
+def answers_of(asker: Any, inputs: list[tuple[Any, ...]]) -> list[Any]:
+    """Each input's answer from ``asker.caller``, normalized as ``asker.exercise`` returns: a
+    value, or an ``error: ...`` string. A caller that stops answering sets ``asker.error``."""
+    if not inputs:
+        return []
+    batch = asker.caller.batch(inputs) if not asker.error else None
+    if batch is None or not isinstance(batch, tuple):
+        asker.error = asker.error or f"your function stopped answering ({getattr(batch, 'error', '')})"
+        return [f"error: {asker.error}"] * len(inputs)
+    values, errors = batch
+    out: list[Any] = []
+    for i, value in enumerate(values):
+        if i in errors:
+            out.append(f"error: {errors[i]}")
+            continue
+        try:
+            out.append(normalize(value, asker.exercise.returns))
+        except WrongType as exc:
+            out.append(f"error: {exc}")
+    return out
 
 
 class Logged:
@@ -69,24 +91,7 @@ class Logged:
         self.error = ""
 
     def answers(self, inputs: list[tuple[Any, ...]]) -> list[Any]:
-        """Each input's answer, normalized: a value, or an ``error: ...`` string."""
-        if not inputs:
-            return []
-        batch = self.caller.batch(inputs) if not self.error else None
-        if batch is None or not isinstance(batch, tuple):
-            self.error = self.error or f"your function stopped answering ({getattr(batch, 'error', '')})"
-            return [f"error: {self.error}"] * len(inputs)
-        values, errors = batch
-        out: list[Any] = []
-        for i, value in enumerate(values):
-            if i in errors:
-                out.append(f"error: {errors[i]}")
-                continue
-            try:
-                out.append(normalize(value, self.exercise.returns))
-            except WrongType as exc:
-                out.append(f"error: {exc}")
-        return out
+        return answers_of(self, inputs)
 
     def ask(self, inputs: list[tuple[Any, ...]], what: list[str], **extra: Any) -> list[Any]:
         """The answers to ``inputs``, the call logged with ``what`` each input was about."""
