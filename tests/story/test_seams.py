@@ -96,6 +96,7 @@ def test_the_first_divergence_is_in_the_mutated_function(name: str, mistake: str
     assert story.divergence.message.startswith(f"{exercise.function} returned "), story.divergence.message
     assert "where the reference has" in story.divergence.message
     assert f"called as {exercise.function}(" in story.divergence.message
+    assert story.yours.replay() == story.yours.rgba8  # the story with their function is still the whole story
     right = explain_with_function(scene, SIZE, pixel, exercise, Direct(CORRECT[name]))
     assert right.agree, right.divergence
     assert right.yours.rgba8 == right.reference.rgba8
