@@ -116,6 +116,18 @@ def test_a_plugged_reference_renders_the_engines_pixel() -> None:
         assert story.yours.replay() == story.yours.rgba8, name
 
 
+def test_the_story_says_which_term_the_function_gave() -> None:
+    from glsandbox.story.text import render_story
+
+    wrong = next(m for m in get("phong").mistakes if m.name == "light_not_normalized").function
+    story = explain_with_function(_scene("ray_spheres", {}), SIZE, (27, 12), get("phong"), Direct(wrong))
+    yours, reference = story.yours.bounces[0].lights[0], story.reference.bounces[0].lights[0]
+    assert yours.given == yours.term == [1.0, 1.0, 1.0]  # 7e63 clamped to 1
+    assert reference.given is not None and reference.given != yours.given
+    text = render_story(story.yours)
+    assert "the function's phong(N, L, E, 255·colour, ka, kd, ks, n)/255, each channel at most 1: (1, 1, 1)" in text
+
+
 def test_a_failing_function_is_named_with_its_error() -> None:
     def raises(direction, normal):
         raise ValueError("not yet")
