@@ -91,8 +91,8 @@ Probe = Callable[..., None]
 #: ``"backface"``: ``(world, node, o, d) -> (t, world triangle)`` of a one-sided mesh node;
 #: ``"reflect"``: ``(d, n) -> R``; ``"phong"``: ``(world, light, nodes, values) -> term`` (a
 #: light's per-hit colour, ``min(ka·C + lighting, 1)``); ``"shadow"``:
-#: ``(world, point, start, light, cull, aabb) -> bool``; ``"normal"``: ``(world, node, triangles) -> N`` (the face normal of a two-sided node's back-face
-#: test and of the secondary rays' offset).
+#: ``(world, point, start, light, cull, aabb) -> bool``; ``"normal"``: ``(world, node, triangles)
+#: -> N`` (the face normal of a two-sided node's back-face test and of the secondary rays' offset).
 #: Renders hand none: only :mod:`glsandbox.story` builds a World with them.
 SEAMS = ("aabb", "backface", "reflect", "phong", "shadow", "normal")
 

@@ -7,9 +7,9 @@ its kind of node (the engine's ``hit_tests`` seam, as the exercise's lesson pict
 uses it: ``intersect_sphere`` for the spheres, ``intersect_triangle`` for the meshes'
 triangles), or, for the other exercises a ray calls, as its step of the traced ray
 (:mod:`glsandbox.story.seams`: the triangles' plane, the boxes, culling, the reflected
-ray, a light's Phong term, the shadow test, the face normal). Both use the course's simple offset for secondary rays, as the lesson
-picture does. Every call of the function is logged in the trace's order, between the
-engine's steps, so the two traces are two lists of facts:
+ray, a light's Phong term, the shadow test, the face normal). Both use the course's simple
+offset for secondary rays, as the lesson picture does. Every call of the function is
+logged in the trace's order, between the engine's steps, so the two traces are two lists of facts:
 
 - each call's answer (which node, which ray: the primary or a reflected ray at its
   depth, or a light's shadow ray, course "Gölge testi");

@@ -125,7 +125,8 @@ class PlaneSeam(Logged):
         open_ = np.flatnonzero(size > 0.0)  # a triangle of zero area has no plane
         unit = normal[open_] / size[open_, None]
         plane_d = -np.einsum("ij,ij->i", unit, v0[open_])  # N·V0 + d = 0
-        inputs = [(_vec(o[i]), _vec(d[i]), _vec(unit[k]), float(plane_d[k])) for i in range(n) for k in range(len(open_))]
+        inputs = [(_vec(o[i]), _vec(d[i]), _vec(unit[k]), float(plane_d[k])) for i in range(n)
+                  for k in range(len(open_))]
         what = [f"on {{node}}, triangle {int(j)}'s plane" for _ in range(n) for j in open_]
         answers = self.ask(inputs, what, first=_vec(v0[0]) if m else None)
         if open_.size:
