@@ -85,6 +85,17 @@ RAY_BLOCK: int = 1 << 14
 #: with or without one. Renders pass none.
 Probe = Callable[..., None]
 
+#: The story's seams besides the hit tests (:mod:`glsandbox.story.seams`, an exercise's
+#: function traced through one ray): each key of a World's ``hit_tests`` replaces one step.
+#: ``"aabb"``: ``(node, o, d) -> bool`` per ray, whether it enters the node's box;
+#: ``"backface"``: ``(world, node, o, d) -> (t, world triangle)`` of a one-sided mesh node;
+#: ``"reflect"``: ``(d, n) -> R``; ``"phong"``: ``(world, light, nodes, values) -> term`` (a
+#: light's per-hit colour, ``min(ka·C + lighting, 1)``); ``"shadow"``:
+#: ``(world, point, start, light, cull, aabb) -> bool``; ``"normal"``: ``(world, node, triangles)
+#: -> N`` (the face normal of a two-sided node's back-face test and of the secondary rays' offset).
+#: Renders hand none: only :mod:`glsandbox.story` builds a World with them.
+SEAMS = ("aabb", "backface", "reflect", "phong", "shadow", "normal")
+
 
 @dataclass
 class RenderStats:
@@ -193,6 +204,7 @@ def _top_level(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_m
     best_node = np.full(n, -1, dtype=np.intp)
     best_tri = np.full(n, -1, dtype=np.intp)
     inverse = reciprocals(d) if aabb or bvh is not None else None  # 1/d once for every node's slab test
+    boxes, backface = world.hit_tests.get("aabb"), world.hit_tests.get("backface")  # the story's seams
     for k, node in enumerate(world.nodes):
         if light >= 0 and node.lamp_of >> light & 1:
             continue
@@ -230,7 +242,9 @@ def _top_level(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_m
             best_tri[sel] = entry.start + hits.triangle[won]
             continue
         count = n if rays is None else rays.size
-        if rinv is not None and aabb:
+        if boxes is not None and aabb:
+            idx = np.flatnonzero(boxes(node, ro, d if rays is None else d[rays]))
+        elif rinv is not None and aabb:
             if stats is not None:
                 stats.box_tests += count
             near, far = AABB(node.box_min, node.box_max).slabs_reciprocal(ro, rinv)
@@ -242,7 +256,9 @@ def _top_level(world: World, o: NDArray[np.float64], d: NDArray[np.float64], t_m
             idx = rays[idx]
         if idx.size == 0:
             continue
-        if node.kind.triangles and (cut_out or one_sided) and "triangles" not in world.hit_tests:
+        if backface is not None and node.kind.triangles and one_sided:
+            t, j = backface(world, node, _rows(o, idx), d[idx])
+        elif node.kind.triangles and (cut_out or one_sided) and "triangles" not in world.hit_tests:
             # Every triangle (on a drawn texel, when cut out); with culling, the pairs facing
             # away are skipped after a dot product and only the tests run are counted.
             rows = slice(node.start, node.start + node.count)
@@ -473,6 +489,9 @@ def _surface_triangles(world: World, node: NodeInfo, hits: _Hits, sel: NDArray[n
     w = (1.0 - u - v)[:, None], u[:, None], v[:, None]  # weights of V0, V1, V2
     normal = _interpolate(world.normals[tri], w)
     face = np.cross(e1, e2) if node.two_sided or spawn is not None else None
+    normals = world.hit_tests.get("normal")  # the story's seam
+    if normals is not None and face is not None:
+        face = normals(world, node, tri)
     if node.two_sided:
         # A back face seen (the ray runs along the face normal: clockwise from the eye,
         # the rasterizer's !gl_FrontFacing) is lit as its other side: the normal reversed.
@@ -560,6 +579,7 @@ def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.floa
         dl = d[pick]
         to_eye = -dl / length(dl)[:, None]
         total = np.zeros_like(mesh)
+        shading, shadow_test = world.hit_tests.get("phong"), world.hit_tests.get("shadow")  # the story's seams
         for index, (light, light_color) in enumerate(zip(world.light_positions, world.light_colors)):
             to_light = light - p
             to_light /= np.maximum(length(to_light), LENGTH_TINY)[:, None]
@@ -581,13 +601,21 @@ def _shade(world: World, hits: _Hits, o: NDArray[np.float64], d: NDArray[np.floa
                 assert lit_spawn is not None
                 start = _offset(lit_spawn, nrm, light - p, simple)
                 stats.shadow += idx.size
-                blocked = _occluded(world, start, light - start, index, cull, aabb, stats, bvh)
+                blocked = shadow_test(world, p, start, index, cull, aabb) if shadow_test is not None else \
+                    _occluded(world, start, light - start, index, cull, aabb, stats, bvh)
                 lighting *= np.where(blocked, 0.0, 1.0)[:, None]  # in shadow only the ambient term stays
-            total += np.minimum(ka * mesh + lighting, 1.0)
+            term = np.minimum(ka * mesh + lighting, 1.0)
+            given = None
+            if shading is not None:
+                given = term = shading(world, index, nodes, {"normal": nrm, "to_light": light - p, "to_eye": -dl,
+                                                             "color": mesh, "ka": ka, "kd": kd, "ks": ks,
+                                                             "shininess": shin, "blinn": blinn,
+                                                             "blocked": blocked, "term": term})
+            total += term
             if probe is not None:
                 probe("light", index=index, ka=ka, kd=kd, ks=ks, shininess=shin, blinn=blinn, mesh=mesh,
                       to_light=to_light, to_eye=to_eye, n_dot_l=n_dot_l, cosine=cosine, diffuse=diffuse,
-                      specular=specular, start=start, blocked=blocked)
+                      specular=specular, start=start, blocked=blocked, given=given)
         color[pick] = total
     return color, normal, alpha, spawn
 
@@ -636,7 +664,9 @@ def _trace(world: World, o: NDArray[np.float64], d: NDArray[np.float64], max_dep
         dh = d[hit][bounce]
         nh = normal[bounce]
         on = through[bounce][:, None]
-        reflected = dh - 2.0 * np.einsum("ij,ij->i", dh, nh)[:, None] * nh  # Yansıma vektörü
+        mirror = world.hit_tests.get("reflect")  # the story's seam
+        reflected = mirror(dh, nh) if mirror is not None else \
+            dh - 2.0 * np.einsum("ij,ij->i", dh, nh)[:, None] * nh  # Yansıma vektörü
         assert spawn is not None  # not the last depth: _shade made it
         o = _offset(spawn.subset(bounce), nh, np.where(on, dh, -dh), simple)  # behind the surface, or back in front
         d = np.where(on, dh, reflected)

@@ -246,7 +246,9 @@ class World:
     background: NDArray[np.float64]  # rgb of the viewport's clear colour
     textures: list[tuple[NDArray[np.float64], int]]  # (image (H, W, 4) in 0..1, wrap code)
     #: Hit tests that replace the numpy engine's own for a node kind (``"sphere"``,
-    #: ``"triangles"``): see :func:`glsandbox.raytrace.numpy_engine.render_viewport`.
+    #: ``"triangles"``): see :func:`glsandbox.raytrace.numpy_engine.render_viewport`; and the
+    #: single-ray story's other seams (``"aabb"``, ``"backface"``, ``"reflect"``, ``"phong"``,
+    #: ``"shadow"``): see :data:`glsandbox.raytrace.numpy_engine.SEAMS`.
     hit_tests: dict[str, Any] = field(default_factory=dict)
 
     @property

@@ -5,9 +5,11 @@ twice through the numpy engine (:func:`glsandbox.story.ray_pixel.explain_ray_pix
 with the exercise's reference and once with the student's function as the hit test of
 its kind of node (the engine's ``hit_tests`` seam, as the exercise's lesson picture
 uses it: ``intersect_sphere`` for the spheres, ``intersect_triangle`` for the meshes'
-triangles). Both use the course's simple offset for secondary rays, as the lesson
-picture does. Every call of the function is logged in the trace's order, between the
-engine's steps, so the two traces are two lists of facts:
+triangles), or, for the other exercises a ray calls, as its step of the traced ray
+(:mod:`glsandbox.story.seams`: the triangles' plane, the boxes, culling, the reflected
+ray, a light's Phong term, the shadow test, the face normal). Both use the course's simple
+offset for secondary rays, as the lesson picture does. Every call of the function is
+logged in the trace's order, between the engine's steps, so the two traces are two lists of facts:
 
 - each call's answer (which node, which ray: the primary or a reflected ray at its
   depth, or a light's shadow ray, course "Gölge testi");
@@ -33,11 +35,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from glsandbox.errors import SandboxError
-from glsandbox.exercises.compare import WrongType, describe, matches, normalize
+from glsandbox.exercises.compare import describe, matches
 from glsandbox.exercises.definition import Exercise
 from glsandbox.exercises.lesson_view import _Calls
 from glsandbox.scene import Scene
 from glsandbox.story.ray_pixel import PixelTrace, ShapeTest, explain_ray_pixel
+from glsandbox.story.seams import STEPS, answers_of, seams_for
 from glsandbox.story.text import num, render_story, vec
 
 __all__ = ["TRACED_KINDS", "Direct", "Divergence", "ExerciseStory", "compare_traces", "explain_with_function", "traced_kind"]
@@ -46,18 +49,28 @@ __all__ = ["TRACED_KINDS", "Direct", "Divergence", "ExerciseStory", "compare_tra
 #: correct geometric sphere test and the engine's stable one differ by rounding only.
 REL, ABS = 1e-9, 1e-9
 
-#: The node kind (the engine's ``hit_tests`` name) each exercise's function is the test of.
+#: The node kind (the engine's ``hit_tests`` name) each hit-test exercise's function is the test of.
 TRACED_KINDS = {"sphere": "sphere", "triangles": "triangles"}
 
 
-def traced_kind(exercise: Exercise) -> str:
-    """The engine's node kind ``exercise``'s function traces, refusing one the tracer cannot plug in."""
-    if exercise.lesson is None or exercise.lesson.kind not in TRACED_KINDS:
-        from glsandbox.exercises.catalogue import all_exercises
+#: Why an exercise near the ray tracer is not one of its traced steps (said when refused).
+NOT_TRACED = {"image_plane": "the tracer casts its rays through the pixel centres of the lesson's camera, "
+                             "not through the notes' GD(x, y) of an 800x450 picture",
+              "camera_turn": "the camera is placed before a ray is cast",
+              "cube_indices": "the tracer takes the mesh's triangles as built"}
 
-        known = ", ".join(e.name for e in all_exercises() if e.lesson is not None)
-        raise SandboxError(f"--exercise {exercise.name}: its function is not a hit test the ray tracer can use; "
-                           f"the exercises it traces: {known}")
+
+def traced_kind(exercise: Exercise) -> str:
+    """The step of a traced ray ``exercise``'s function is (a node kind's hit test, or one of
+    :mod:`glsandbox.story.seams`'), refusing one the tracer cannot plug in."""
+    if exercise.name in STEPS and exercise.name not in ("ray_sphere", "ray_triangle"):
+        return exercise.name
+    if exercise.lesson is None or exercise.lesson.kind not in TRACED_KINDS:
+        known = ", ".join(STEPS)
+        why = NOT_TRACED.get(exercise.name) or ("a matrix the rasterizer's passes use; the tracer takes the "
+                                                "scene's matrices as built" if exercise.returns == "matrix4" else "")
+        raise SandboxError(f"--exercise {exercise.name}: {exercise.function} is not a step of a traced ray"
+                           f"{' (' + why + ')' if why else ''}; explain traces the exercises {known}")
     return TRACED_KINDS[exercise.lesson.kind]
 
 
@@ -69,11 +82,13 @@ class Direct:
         self.function = function
 
     def batch(self, inputs: list[tuple[Any, ...]]) -> tuple[list[Any], dict[int, str]]:
+        from glsandbox.exercises.student_process import _encode  # the answers as the confined process sends them
+
         values: list[Any] = []
         errors: dict[int, str] = {}
         for i, args in enumerate(inputs):
             try:
-                values.append(self.function(*args))
+                values.append(_encode(self.function(*args)))
             except Exception as exc:  # noqa: BLE001 - the function's own
                 values.append(None)
                 errors[i] = f"{type(exc).__name__}: {exc}"[:300]
@@ -92,23 +107,7 @@ class _Seam(_Calls):
 
     def _answers(self, inputs: list[tuple[Any, ...]]) -> list[Any]:
         """Each input's answer, normalized: a value, or an ``error: ...`` string."""
-        if not inputs:
-            return []
-        batch = self.caller.batch(inputs) if not self.error else None
-        if batch is None or not isinstance(batch, tuple):
-            self.error = self.error or f"your function stopped answering ({getattr(batch, 'error', '')})"
-            return [f"error: {self.error}"] * len(inputs)
-        values, errors = batch
-        out: list[Any] = []
-        for i, value in enumerate(values):
-            if i in errors:
-                out.append(f"error: {errors[i]}")
-                continue
-            try:
-                out.append(normalize(value, self.exercise.returns))
-            except WrongType as exc:
-                out.append(f"error: {exc}")
-        return out
+        return answers_of(self, inputs)
 
     def values(self, inputs: list[tuple]) -> list[float]:
         """``t`` of each input (``inf`` for None, a failure or the wrong type), the call logged."""
@@ -207,6 +206,13 @@ def _facts(events: list[tuple[str, dict[str, Any]]], trace: PixelTrace, nodes: l
         for call in pending:
             for i, (args, answer) in enumerate(zip(call["inputs"], call["answers"], strict=True)):
                 info = {"kind": call["kind"], "args": args, "answer": answer, "ray": where}
+                if "what" in call:  # one of glsandbox.story.seams' steps
+                    info["node"] = str(call.get("node_name") or "a mesh")
+                    what = f"{function} {call['what'][i].format(node=info['node'])}"
+                    if "light" in call:  # a light's Phong term: its light's, at the hit
+                        info["ray"] = f"light {call['light']} at the hit of depth {depth}"
+                    facts.append(Fact(str(info["ray"]), what, answer, info))
+                    continue
                 if call["kind"] == "sphere":
                     node = _node_of_sphere_call(nodes, args[0], world_o) if world_o is not None else None
                     info["node"] = node.name if node is not None else "a sphere"
@@ -236,6 +242,8 @@ def _facts(events: list[tuple[str, dict[str, Any]]], trace: PixelTrace, nodes: l
             node = int(v["node"][0])
             hit = None if node < 0 else (nodes[node].name, float(v["t"][0]), int(v["tri"][0]))
             facts.append(Fact(where, "the nearest hit (min_indis)", hit))
+        elif step == "surface":  # what the hit's surface asked (a face normal)
+            label(f"the hit at depth {depth}", None, None)
         elif step == "light":
             index = int(v["index"])
             where = f"the shadow ray towards light {index} (depth {depth})"
@@ -281,10 +289,25 @@ def _say(value: Any) -> str:
     return describe(value)
 
 
+def _arg(a: Any) -> str:
+    if isinstance(a, list):  # in_shadow's triangles
+        return f"[{len(a)} triangles]"
+    return vec(a) if isinstance(a, tuple) else num(a)
+
+
 def _call_message(function: str, mine: Fact, ref: Fact) -> str:
     info, other = mine.call or {}, ref.call or {}
     got, want = info.get("answer"), other.get("answer")
-    args = ", ".join(vec(a) if isinstance(a, (tuple, list)) else num(a) for a in info.get("args", ()))
+    args = ", ".join(_arg(a) for a in info.get("args", ()))
+    if info.get("kind") not in ("sphere", "triangles"):  # glsandbox.story.seams' steps
+        def say(v: Any, fine: bool = False) -> str:
+            if fine and isinstance(v, (tuple, float)):  # they part beyond six digits
+                return "(" + ", ".join(f"{x:.12g}" for x in v) + ")" if isinstance(v, tuple) else f"t = {v:.12g}"
+            return describe(v) if isinstance(v, (bool, tuple)) else _say(v)
+        fine = say(got) == say(want)
+        return (f"{function} returned {say(got, fine)} where the reference has "
+                f"{say(want, fine).removeprefix('t = ')} "
+                f"({mine.what.removeprefix(function).strip()}, {mine.where}); called as {function}({args})")
     text = (f"{function} returned {_say(got)} where the reference has {_say(want).removeprefix('t = ')} "
             f"({info.get('node')}, {mine.where})")
     scale = info.get("scale")
@@ -343,21 +366,29 @@ def explain_with_function(scene: Scene, size: tuple[int, int], pixel: tuple[int,
     """Pixel ``pixel`` of ``scene`` traced with ``exercise``'s reference and with ``caller``'s function
     (see the module docstring)."""
     kind = traced_kind(exercise)
+
+    def plugged(function: Any, events: list[tuple[str, dict[str, Any]]]) -> tuple[dict[str, Any], Any]:
+        other = seams_for(exercise, function, events)
+        if other is not None:
+            return other
+        hit = _Seam(exercise, function, events)
+        return {kind: getattr(hit, kind)}, hit
+
     ref_events: list[tuple[str, dict[str, Any]]] = []
-    ref_seam = _Seam(exercise, Direct(exercise.reference), ref_events)
-    reference = explain_ray_pixel(scene, size, pixel, title, hit_tests={kind: getattr(ref_seam, kind)}, simple=True,
-                                  events=ref_events, traced=True)
+    tests, _ = plugged(Direct(exercise.reference), ref_events)
+    reference = explain_ray_pixel(scene, size, pixel, title, hit_tests=tests, simple=True, events=ref_events,
+                                  traced=True)
     my_events: list[tuple[str, dict[str, Any]]] = []
-    seam = _Seam(exercise, caller, my_events)
-    yours = explain_ray_pixel(scene, size, pixel, title, hit_tests={kind: getattr(seam, kind)}, simple=True,
-                              events=my_events, traced=True)
+    tests, seam = plugged(caller, my_events)
+    yours = explain_ray_pixel(scene, size, pixel, title, hit_tests=tests, simple=True, events=my_events, traced=True)
     reference.renderer = yours.renderer = "ray_numpy"  # both traced by the numpy engine, as the lesson picture is
     world = _world(scene, reference.viewport)
     nodes = list(world.nodes)
     _name_meshes(world, ref_events, my_events)
     ref_facts = _facts(ref_events, reference, nodes, exercise.function)
     my_facts = _facts(my_events, yours, nodes, exercise.function)
-    _tested_by_function(yours, my_facts, kind, exercise.function)
+    if kind in TRACED_KINDS:
+        _tested_by_function(yours, my_facts, kind, exercise.function)
     divergence = compare_traces(my_facts, ref_facts, exercise.function)
     return ExerciseStory(exercise.name, exercise.function, reference, yours, divergence, len(my_facts), seam.error)
 
@@ -374,7 +405,7 @@ def _name_meshes(world: Any, *event_lists: list[tuple[str, dict[str, Any]]]) -> 
     """Each triangle call's node, by its first triangle's first vertex (the node's rows of the World)."""
     for events in event_lists:
         for step, v in events:
-            if step == "call" and v["kind"] == "triangles" and v["first"] is not None:
+            if step == "call" and v.get("first") is not None:
                 for node in world.nodes:
                     if node.kind.triangles and node.count and np.array_equal(world.v0[node.start], v["first"]):
                         v["node_name"] = node.name

@@ -94,6 +94,10 @@ def _light_lines(light: LightStep, base: Sequence[float]) -> list[str]:
                      f"{num(max(light.cosine, 0.0), 4)}^{num(light.shininess)}·{vec(light.color, 3)} = "
                      f"{vec(ks_specular, 4)}")
     shadowed = "  (in shadow: the ambient term alone)" if light.blocked else ""
+    if light.given is not None:  # an exercise's phong gave the term (glsandbox.story.seams)
+        lines.append(f"   the function's phong(N, L, E, 255·colour, ka, kd, ks, n)/255, each channel at most 1: "
+                     f"{vec(light.term, 4)}")
+        return lines
     lines.append(f"   ka·ambient + kd·diffuse + ks·specular, each channel at most 1: {vec(light.term, 4)}{shadowed}")
     return lines
 

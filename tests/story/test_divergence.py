@@ -63,8 +63,8 @@ def _where_it_shows(exercise, mistake):
 
 def test_the_traced_exercises_are_the_hit_tests() -> None:
     assert sorted(e.name for e in TRACED) == ["ray_sphere", "ray_triangle"]
-    with pytest.raises(SandboxError, match="not a hit test the ray tracer can use"):
-        traced_kind(get("phong"))
+    with pytest.raises(SandboxError, match="is not a step of a traced ray"):
+        traced_kind(get("camera_turn"))
 
 
 @pytest.mark.parametrize(("name", "mistake"), CASES)
@@ -126,7 +126,7 @@ def test_the_command_runs_the_file_confined_and_exits_like_diff(tmp_path: Path) 
     assert agree.returncode == 0, agree.stderr
     record = json.loads(agree.stdout)
     assert record["agree"] is True and record["yours"]["rgba8"] == record["reference"]["rgba8"]
-    assert_user_error(run_cli("explain", *where, "--exercise", "phong", str(good)), "--exercise phong")
+    assert_user_error(run_cli("explain", *where, "--exercise", "camera_turn", str(good)), "--exercise camera_turn")
     assert_user_error(run_cli("explain", *where, "--exercise", "ray_sphere", str(tmp_path / "none.py")), "none.py")
     broken = tmp_path / "broken.py"
     broken.write_text("raise RuntimeError('at import')\ndef intersect_sphere(origin, direction, center, radius):\n"
