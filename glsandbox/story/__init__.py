@@ -8,7 +8,8 @@ by pass from the frame's X-ray. The modules: ``ray_pixel`` (the ray record and i
 on the numpy engine's probe seam), ``text`` (the ray story's rendering), ``xray`` (each
 pass's colour, depth and stencil), ``raster`` (a rasterised pixel's story), ``fragment``
 (what the shader saw there), ``divergence`` (a student's function traced beside the
-reference), ``coverage`` (the top-left rule on the CPU).
+reference), ``seams`` (an exercise's function plugged into the engine's step), ``coverage``
+(the top-left rule on the CPU).
 """
 
 from __future__ import annotations
