@@ -287,6 +287,7 @@ class Isolated:
 
     def _start(self) -> None:
         requests_read, self.requests = os.pipe()
+        os.set_blocking(self.requests, False)  # our end only: the child's end is another open file
         self.answers, answers_write = os.pipe()
         config = {"file": str(self.copy), "function": self.function, "folder": str(self.copy.parent),
                   "path": self.path_list, "denied": self.denied, "work": self.work,
@@ -362,7 +363,7 @@ class Isolated:
 
     def _read(self, seconds: float) -> dict | None:
         """The next answer line within ``seconds`` (None: none came, or the process ended)."""
-        deadline = time.monotonic() + seconds
+        deadline = time.monotonic() + max(seconds, 0.0)
         while b"\n" not in self.buffer:
             left = deadline - time.monotonic()
             if left <= 0:
@@ -383,7 +384,29 @@ class Isolated:
             return {"garbled": True}
         return message if isinstance(message, dict) else {"garbled": True}
 
-    def _request(self, payload: dict, seconds: float) -> dict | Answer:
+    def _write(self, data: bytes, deadline: float) -> bool:
+        """Write a request by the answer's deadline (False: not all of it went in time). The pipe is
+        non-blocking on this side: a process that stops reading (it stopped itself) cannot hang
+        the grader in a write of a big batch."""
+        view = memoryview(data)
+        while view:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                return False
+            _, ready, _ = select.select([], [self.requests], [], left)
+            if not ready:
+                return False
+            try:
+                view = view[os.write(self.requests, view[:1 << 16]):]
+            except BlockingIOError:
+                continue
+            except OSError:
+                return True  # the process has gone: its reading end says why
+        return True
+
+    def _send(self, payload: dict, seconds: float) -> float | Answer:
+        """Send one request; its answer's deadline (``seconds`` from now), or the :class:`Answer`
+        when it could not be asked (the file did not load, too many endings, the write timed out)."""
         if self.load_error:
             return Answer(ERROR, error=self.load_error)
         if self.endings >= self.limits.restarts:
@@ -393,16 +416,22 @@ class Isolated:
             if self.load_error:
                 return Answer(ERROR, error=self.load_error)
         self.next_id += 1
-        payload = {"id": self.next_id, **payload}
-        try:
-            os.write(self.requests, (json.dumps(payload) + "\n").encode())  # small requests fit the pipe
-        except OSError:
-            pass
-        message = self._read(seconds)
+        deadline = time.monotonic() + seconds
+        if not self._write((json.dumps({"id": self.next_id, **payload}) + "\n").encode(), deadline):
+            return self._ended(None, seconds)
+        return deadline
+
+    def _receive(self, deadline: float, seconds: float) -> dict | Answer:
+        """The answer to the request last sent, by ``deadline``."""
+        message = self._read(deadline - time.monotonic())
         while message is not None and message.get("id") != self.next_id and not _broken(message):
-            message = self._read(seconds)  # something the function wrote itself on the answers pipe
+            message = self._read(deadline - time.monotonic())  # something the function wrote on the answers pipe
         if message is not None and not _broken(message):
             return message
+        return self._ended(message, seconds)
+
+    def _ended(self, message: dict | None, seconds: float) -> Answer:
+        """A request with no answer: the process is stopped and the ending counted."""
         reason = self._ending() if message is not None and message.get("closed") else ""
         self._stop()
         self.endings += 1
@@ -411,6 +440,10 @@ class Isolated:
         if message.get("garbled"):
             return Answer(CRASHED, error="the function's process sent something that is not an answer")
         return Answer(CRASHED, error=reason)
+
+    def _request(self, payload: dict, seconds: float) -> dict | Answer:
+        deadline = self._send(payload, seconds)
+        return deadline if isinstance(deadline, Answer) else self._receive(deadline, seconds)
 
     # --- calls -------------------------------------------------------------------------
 
@@ -426,19 +459,40 @@ class Isolated:
     def batch(self, inputs: Sequence[Sequence[Any]]) -> tuple[list[Any], dict[int, str]] | Answer:
         """Many calls at once (a probe picture's field): the values, and the errors by index;
         an :class:`Answer` when the whole batch failed (timed out, crashed)."""
-        message = self._request(_batch_request(inputs), self.limits.batch_seconds)
-        if isinstance(message, Answer):
-            return message
-        values = message.get("values")
-        stopped = message.get("stopped")
-        if isinstance(stopped, int) and isinstance(values, list) and len(values) == stopped < len(inputs):
-            first = str((message.get("errors") or {}).get("0", "it raised"))
-            message["errors"].update({str(i): first for i in range(stopped, len(inputs))})
-            values = values + [None] * (len(inputs) - stopped)
-        if not isinstance(values, list) or len(values) != len(inputs):
-            return Answer(CRASHED, error="the function's process sent a batch of the wrong length")
-        errors = {int(k): str(v) for k, v in (message.get("errors") or {}).items()}
-        return values, errors
+        return self.begin_batch(inputs)()
+
+    def begin_batch(self, inputs: Sequence[Sequence[Any]]
+                    ) -> Callable[[], tuple[list[Any], dict[int, str]] | Answer]:
+        """:meth:`batch` in two halves: the inputs are sent now; the returned function waits for
+        the answers (what :meth:`batch` returns). Between the two the grader works on (the
+        reference's values) while the student's process runs the calls; no other call may be
+        made before the answers are taken. The batch's time runs from now."""
+        seconds = self.limits.batch_seconds
+        deadline = self._send(_batch_request(inputs), seconds)
+
+        def answers() -> tuple[list[Any], dict[int, str]] | Answer:
+            message = deadline if isinstance(deadline, Answer) else self._receive(deadline, seconds)
+            return _batch_answers(message, len(inputs))
+
+        return answers
+
+
+def _batch_answers(message: dict | Answer, count: int) -> tuple[list[Any], dict[int, str]] | Answer:
+    """A batch's answer message as the values and the errors by index (or the failure)."""
+    if isinstance(message, Answer):
+        return message
+    values, stopped = message.get("values"), message.get("stopped")
+    errors = message.get("errors") if isinstance(message.get("errors"), dict) else {}
+    if isinstance(stopped, int) and isinstance(values, list) and len(values) == stopped < count:
+        first = str(errors.get("0", "it raised"))
+        errors.update({str(i): first for i in range(stopped, count)})
+        values = values + [None] * (count - stopped)
+    if not isinstance(values, list) or len(values) != count:
+        return Answer(CRASHED, error="the function's process sent a batch of the wrong length")
+    try:
+        return values, {int(k): str(v) for k, v in errors.items()}
+    except ValueError:
+        return Answer(CRASHED, error="the function's process sent something that is not an answer")
 
 
 def _batch_request(inputs: Sequence[Sequence[Any]]) -> dict:
@@ -477,6 +531,11 @@ class InProcess:
             return Answer(VALUE, value=runner._encode(self.function(*args)))
         except Exception as exc:  # noqa: BLE001 - the student's
             return Answer(ERROR, error=f"{type(exc).__name__}: {exc}"[:300])
+
+    def begin_batch(self, inputs: Sequence[Sequence[Any]]) -> Callable[[], tuple[list[Any], dict[int, str]]]:
+        """:meth:`batch` run now, its answers given by the returned function (as Isolated's)."""
+        answers = self.batch(inputs)
+        return lambda: answers
 
     def batch(self, inputs: Sequence[Sequence[Any]]) -> tuple[list[Any], dict[int, str]]:
         values, errors = [], {}
