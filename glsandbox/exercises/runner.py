@@ -191,7 +191,7 @@ def main():
         config = json.load(handle)
     os.unlink(sys.argv[1])
     sys.path[:] = [config["folder"], *config["path"]]
-    requests = os.fdopen(config["requests"], "r", encoding="utf-8")
+    requests = os.fdopen(config["requests"], "r", encoding="utf-8", buffering=1 << 20)
     answers = os.fdopen(config["answers"], "w", encoding="utf-8")
     signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a file grown past its limit: an error, not a kill
     limit = int(config["output_limit"])
@@ -199,7 +199,7 @@ def main():
     _audit([os.path.realpath(p) for p in config["denied"]], [os.path.realpath(config["work"])], os.getpid())
 
     def answer(message):
-        answers.write(json.dumps(message) + "\n")
+        answers.write(json.dumps(message, separators=(",", ":")) + "\n")
         answers.flush()
 
     namespace = {"__name__": "submission", "__file__": _PATH[0]}
