@@ -31,7 +31,7 @@ from glsandbox.exercises import runner
 from glsandbox.exercises.base import Case, Exercise, Mistake
 from glsandbox.exercises.compare import WrongType, describe, judge, matches, normalize
 from glsandbox.exercises.isolation import CRASHED, ERROR, TIMEOUT, VALUE, Answer, InProcess, Isolated, Limits
-from glsandbox.exercises.probe import ProbeResult, start_probe
+from glsandbox.exercises.probe import ProbeResult, probe_field, start_probe
 
 __all__ = ["PASS", "FAIL", "BROKEN", "TIMEOUT_STATUS", "CaseResult", "CheckResult", "check", "check_file",
            "check_function", "static_check"]
@@ -246,7 +246,12 @@ def _check(exercise: Exercise, caller: Isolated | InProcess, hidden: bool, probe
            lesson: bool) -> CheckResult:
     results: list[CaseResult] = []
     evidence: list[Evidence] = []
-    for case in exercise.cases(hidden):
+    start = getattr(caller, "start", None)
+    if start is not None:
+        start()  # the student's interpreter starts while this process makes the cases and the probe's field
+    cases = exercise.cases(hidden)
+    field = probe_field(exercise, probe_size) if probe else None
+    for case in cases:
         answer = caller.call(case.args)
         status, note = _outcome(case, answer, exercise)
         got = describe(answer.value) if answer.status == VALUE else _GOT[answer.status]
@@ -260,7 +265,7 @@ def _check(exercise: Exercise, caller: Isolated | InProcess, hidden: bool, probe
     lesson = lesson and exercise.lesson is not None and not caller.load_error
     prepared = None
     if probe and not caller.load_error:
-        finish = start_probe(exercise, caller, probe_size)  # the student's process works on the field...
+        finish = start_probe(exercise, caller, probe_size, field)  # the student's process works on the field...
         if lesson:  # ...while this one renders the lesson's reference picture and the probe's reference
             from glsandbox.exercises.lesson_view import lesson_reference
 

@@ -296,6 +296,7 @@ class Isolated:
         self.endings = 0
         self.load_error = ""
         self.next_id = 0
+        self.ready_by: float | None = None  # started, its ready line not read yet: by when it must come
         self.denied = denied_paths()
         folder = Path(self.work) / "submission"
         folder.mkdir()
@@ -314,7 +315,17 @@ class Isolated:
 
     # --- the process ---------------------------------------------------------------------
 
+    def start(self) -> None:
+        """Start the student's process now and go on (the first call waits for it to be ready):
+        a checker with work of its own first (the probe's field) overlaps the interpreter's start."""
+        if self.process is None and not self.load_error and self.endings < self.limits.restarts:
+            self._spawn()
+
     def _start(self) -> None:
+        self._spawn()
+        self._await_ready()
+
+    def _spawn(self) -> None:
         requests_read, self.requests = os.pipe()
         os.set_blocking(self.requests, False)  # our end only: the child's end is another open file
         self.answers, answers_write = os.pipe()
@@ -352,7 +363,12 @@ class Isolated:
             os.close(requests_read)
             os.close(answers_write)
         self.buffer = b""
-        message = self._read(self.limits.start_seconds)
+        self.ready_by = time.monotonic() + self.limits.start_seconds
+
+    def _await_ready(self) -> None:
+        """The started process's first line: ready, or why its file did not load."""
+        message = self._read(self.ready_by - time.monotonic())
+        self.ready_by = None
         if message is None or "ready" not in message:
             message = None if message is None or _broken(message) else message
             reason = (message or {}).get("load_error") or self._ending()
@@ -368,6 +384,7 @@ class Isolated:
             except subprocess.TimeoutExpired:
                 pass
             self.process = None
+        self.ready_by = None
         for fd in (self.requests, self.answers):
             if fd >= 0:
                 os.close(fd)
@@ -394,12 +411,14 @@ class Isolated:
 
     def _read(self, seconds: float) -> dict | None:
         """The next answer line within ``seconds`` (None: none came, or the process ended)."""
-        deadline = time.monotonic() + max(seconds, 0.0)
+        deadline = time.monotonic() + seconds
+        first = True
         while b"\n" not in self.buffer:
             left = deadline - time.monotonic()
-            if left <= 0:
+            if left <= 0 and not first:  # a line already waiting is read even past the time (one look)
                 return None
-            ready, _, _ = select.select([self.answers], [], [], left)
+            first = False
+            ready, _, _ = select.select([self.answers], [], [], max(left, 0.0))
             if not ready:
                 return None
             chunk = os.read(self.answers, 1 << 20)
@@ -443,7 +462,9 @@ class Isolated:
         if self.endings >= self.limits.restarts:
             return Answer(TIMEOUT, error=f"not run: the function's process ended {self.endings} times already")
         if self.process is None:
-            self._start()
+            self._spawn()
+        if self.ready_by is not None:
+            self._await_ready()
             if self.load_error:
                 return Answer(ERROR, error=self.load_error)
         self.next_id += 1

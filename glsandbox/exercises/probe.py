@@ -31,8 +31,8 @@ from glsandbox.exercises import runner
 from glsandbox.exercises.base import Exercise
 from glsandbox.exercises.compare import WrongType, matches, normalize
 
-__all__ = ["CLASSES", "COLOURS", "ProbeResult", "classify", "picture", "probe_picture", "reference_values",
-           "start_probe"]
+__all__ = ["CLASSES", "COLOURS", "ProbeResult", "classify", "picture", "probe_field", "probe_picture",
+           "reference_values", "start_probe"]
 
 #: The classes of a probe pixel, in the order of :data:`COLOURS`.
 CLASSES = ("both none", "agree", "student only", "reference only", "value differs", "broken")
@@ -227,13 +227,22 @@ def probe_picture(exercise: Exercise, caller: Any, n: int = 256) -> ProbeResult:
     return start_probe(exercise, caller, n)()
 
 
-def start_probe(exercise: Exercise, caller: Any, n: int = 256) -> Callable[[], ProbeResult]:
-    """:func:`probe_picture` in two halves: the field is sent to ``caller`` now; the returned
-    function computes the reference's values (while the student's process is still answering)
-    and then draws the picture. What the grader does in between overlaps the student's calls."""
+def probe_field(exercise: Exercise, n: int = 256) -> list[tuple[Any, ...]]:
+    """The inputs of the probe drawn ``n x n``: one a pixel, or a coarser field's
+    (``resolution``), or a drawn probe's few."""
+    m = n if exercise.probe.draw is not None else min(n, exercise.probe.resolution or n)
+    return exercise.probe.inputs(m)
+
+
+def start_probe(exercise: Exercise, caller: Any, n: int = 256,
+                inputs: list[tuple[Any, ...]] | None = None) -> Callable[[], ProbeResult]:
+    """:func:`probe_picture` in two halves: the field (``inputs``: :func:`probe_field`'s, made
+    already) is sent to ``caller`` now; the returned function computes the reference's values
+    (while the student's process is still answering) and then draws the picture. What the
+    grader does in between overlaps the student's calls."""
     draw = exercise.probe.draw
     m = n if draw is not None else min(n, exercise.probe.resolution or n)
-    inputs = exercise.probe.inputs(m)
+    inputs = probe_field(exercise, n) if inputs is None else inputs
     begin = getattr(caller, "begin_batch", None)
     if begin is not None:
         answers = begin(inputs)

@@ -278,3 +278,19 @@ def test_a_batch_begun_comes_back_whole_while_the_grader_works_meanwhile(tmp_pat
         assert caller.call([1.0, 3.0]).value == 3.0  # the next request after it is answered as usual
     assert values == [0.0, 2.0, 4.0, None, 8.0]
     assert list(errors) == [3] and errors[3].startswith("ValueError: three")
+
+
+def test_a_process_started_ahead_answers_its_first_call_or_says_why_it_did_not_load(tmp_path) -> None:
+    good, bad = tmp_path / "good.py", tmp_path / "bad.py"
+    good.write_text("def f(x):\n    return 2 * x\n")
+    bad.write_text("raise RuntimeError('not today')\ndef f(x):\n    return x\n")
+    with Isolated(good, "f") as caller:
+        caller.start()
+        assert caller.process is not None
+        time.sleep(0.3)  # the checker's own work meanwhile
+        assert caller.call([2.5]).value == 5.0
+    with Isolated(bad, "f") as caller:
+        caller.start()
+        answer = caller.call([1.0])
+        assert answer.status == ERROR and "RuntimeError: not today" in answer.error
+        assert caller.load_error and caller.call([1.0]).status == ERROR
