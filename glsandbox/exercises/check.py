@@ -18,8 +18,10 @@ wrong, the mistake that gives the same wrong answers is the one named
 from __future__ import annotations
 
 import ast
+import gc
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -29,7 +31,7 @@ from glsandbox.exercises import student_process
 from glsandbox.exercises.compare import WrongType, describe, judge, matches, normalize
 from glsandbox.exercises.definition import Case, Exercise, Mistake
 from glsandbox.exercises.isolation import CRASHED, ERROR, TIMEOUT, VALUE, Answer, InProcess, Isolated, Limits
-from glsandbox.exercises.probe import ProbeResult, probe_picture
+from glsandbox.exercises.probe import ProbeResult, probe_field, start_probe
 
 __all__ = ["PASS", "FAIL", "BROKEN", "TIMEOUT_STATUS", "CaseResult", "CheckResult", "check", "check_file",
            "check_function", "static_check"]
@@ -217,14 +219,39 @@ def match_mistakes(exercise: Exercise, evidence: list[Evidence]) -> list[Mistake
     return named
 
 
+@contextmanager
+def _collector_paused() -> Iterator[None]:
+    """Python's cycle collector held off while a check runs, put back as it was after: the probe
+    makes some 65,536 tuples of arguments and as many answers at once, none of them in a cycle,
+    and each of the collector's passes would walk them all again (a quarter of its time)."""
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if enabled:
+            gc.enable()
+
+
 def check(exercise: Exercise, caller: Isolated | InProcess, *, hidden: bool = False, probe: bool = True,
           probe_size: int = 256, lesson: bool = False) -> CheckResult:
     """Run ``exercise``'s cases (the hidden ones too with ``hidden``) through ``caller`` and
     judge them; draw the probe picture (``probe``) and, where the exercise has one and
     ``lesson`` is asked, the lesson rendered with the student's function."""
+    with _collector_paused():
+        return _check(exercise, caller, hidden, probe, probe_size, lesson)
+
+
+def _check(exercise: Exercise, caller: Isolated | InProcess, hidden: bool, probe: bool, probe_size: int,
+           lesson: bool) -> CheckResult:
     results: list[CaseResult] = []
     evidence: list[Evidence] = []
-    for case in exercise.cases(hidden):
+    start = getattr(caller, "start", None)
+    if start is not None:
+        start()  # the student's interpreter starts while this process makes the cases and the probe's field
+    cases = exercise.cases(hidden)
+    field = probe_field(exercise, probe_size) if probe else None
+    for case in cases:
         answer = caller.call(case.args)
         status, note = _outcome(case, answer, exercise)
         got = describe(answer.value) if answer.status == VALUE else _GOT[answer.status]
@@ -235,17 +262,24 @@ def check(exercise: Exercise, caller: Isolated | InProcess, *, hidden: bool = Fa
                                      lambda value, case=case: judge(case, value, exercise.returns)[0]))
     result = CheckResult(exercise.name, exercise.function, exercise.signature, results,
                          load_error=caller.load_error)
+    lesson = lesson and exercise.lesson is not None and not caller.load_error
+    prepared = None
     if probe and not caller.load_error:
-        result.probe = probe_picture(exercise, caller, probe_size)
+        finish = start_probe(exercise, caller, probe_size, field)  # the student's process works on the field...
+        if lesson:  # ...while this one renders the lesson's reference picture and the probe's reference
+            from glsandbox.exercises.lesson_view import lesson_reference
+
+            prepared = lesson_reference(exercise)
+        result.probe = finish()
         evidence += [Evidence(args, answer, wrong, lambda value, ref=ref: _same(value, ref, exercise.returns))
                      for args, answer, ref, wrong in result.probe.sample(HINT_STRIDE)]
     for mistake in match_mistakes(exercise, evidence):
         result.mistakes.append(mistake.name)
         result.hints.append(mistake.hint)
-    if lesson and exercise.lesson is not None and not caller.load_error:
+    if lesson and not caller.load_error:
         from glsandbox.exercises.lesson_view import render_lesson
 
-        result.lesson = render_lesson(exercise, caller)
+        result.lesson = render_lesson(exercise, caller, prepared)
     return result
 
 

@@ -137,20 +137,24 @@ def import_path(denied: Sequence[str], site: str | os.PathLike[str]) -> list[str
     on the path before it finds anything in it."""
     site = Path(site)
     site.mkdir(exist_ok=True)
+    folder = str(site)
+    linked = set(os.listdir(folder))
     path: list[str] = []
     package_root = str(_package_dir().parent)
+    exact, below = set(denied), tuple(d.rstrip("/") + "/" for d in denied)  # _inside of any, in C
     for entry in sys.path:
         real = os.path.realpath(entry) if entry else ""
-        if not real or not os.path.isdir(real) or real == package_root or any(_inside(real, d) for d in denied):
+        if not real or not os.path.isdir(real) or real == package_root or real in exact or real.startswith(below):
             continue
         if real.endswith(("site-packages", "dist-packages")):
             for name in os.listdir(real):
                 target = os.path.join(real, name)
-                if not name.endswith(".pth") and not any(_inside(target, d) for d in denied):
-                    if not (site / name).exists():
-                        os.symlink(target, site / name)
-            if str(site) not in path:
-                path.append(str(site))
+                if not name.endswith(".pth") and name not in linked and target not in exact \
+                        and not target.startswith(below):
+                    os.symlink(target, os.path.join(folder, name))
+                    linked.add(name)
+            if folder not in path:
+                path.append(folder)
         else:
             path.append(real)
     return path
@@ -245,6 +249,31 @@ def _restrict(reads: list[str], writes: list[str], limits: Limits, ids: tuple[in
     return setup
 
 
+#: The pipes' size asked for (Linux; 64 KiB otherwise): a probe's batch of 1-2 MB then goes
+#: in a few writes, not thirty turns of each process waiting for the other.
+PIPE_BYTES = 1 << 20
+
+
+def _widen(fd: int) -> None:
+    """Ask for a pipe of :data:`PIPE_BYTES` (as much as the system allows unprivileged; no error)."""
+    try:
+        import fcntl
+    except ImportError:  # not a Unix
+        return
+    size = getattr(fcntl, "F_SETPIPE_SZ", None)
+    if size is None:
+        return
+    try:
+        with open("/proc/sys/fs/pipe-max-size", encoding="ascii") as handle:
+            most = int(handle.read())
+    except (OSError, ValueError):
+        most = PIPE_BYTES
+    try:
+        fcntl.fcntl(fd, size, min(PIPE_BYTES, most))
+    except OSError:
+        pass
+
+
 def _broken(message: dict) -> bool:
     """Whether an answers-pipe reading is the pipe's end or garbage rather than an answer."""
     return bool(message.get("closed") or message.get("garbled"))
@@ -267,6 +296,7 @@ class Isolated:
         self.endings = 0
         self.load_error = ""
         self.next_id = 0
+        self.ready_by: float | None = None  # started, its ready line not read yet: by when it must come
         self.denied = denied_paths()
         folder = Path(self.work) / "submission"
         folder.mkdir()
@@ -285,9 +315,22 @@ class Isolated:
 
     # --- the process ---------------------------------------------------------------------
 
+    def start(self) -> None:
+        """Start the student's process now and go on (the first call waits for it to be ready):
+        a checker with work of its own first (the probe's field) overlaps the interpreter's start."""
+        if self.process is None and not self.load_error and self.endings < self.limits.restarts:
+            self._spawn()
+
     def _start(self) -> None:
+        self._spawn()
+        self._await_ready()
+
+    def _spawn(self) -> None:
         requests_read, self.requests = os.pipe()
+        os.set_blocking(self.requests, False)  # our end only: the child's end is another open file
         self.answers, answers_write = os.pipe()
+        _widen(self.requests)
+        _widen(self.answers)
         config = {"file": str(self.copy), "function": self.function, "folder": str(self.copy.parent),
                   "path": self.path_list, "denied": self.denied, "work": self.work,
                   "requests": requests_read, "answers": answers_write, "output_limit": self.limits.output_limit}
@@ -320,7 +363,12 @@ class Isolated:
             os.close(requests_read)
             os.close(answers_write)
         self.buffer = b""
-        message = self._read(self.limits.start_seconds)
+        self.ready_by = time.monotonic() + self.limits.start_seconds
+
+    def _await_ready(self) -> None:
+        """The started process's first line: ready, or why its file did not load."""
+        message = self._read(self.ready_by - time.monotonic())
+        self.ready_by = None
         if message is None or "ready" not in message:
             message = None if message is None or _broken(message) else message
             reason = (message or {}).get("load_error") or self._ending()
@@ -336,6 +384,7 @@ class Isolated:
             except subprocess.TimeoutExpired:
                 pass
             self.process = None
+        self.ready_by = None
         for fd in (self.requests, self.answers):
             if fd >= 0:
                 os.close(fd)
@@ -363,11 +412,13 @@ class Isolated:
     def _read(self, seconds: float) -> dict | None:
         """The next answer line within ``seconds`` (None: none came, or the process ended)."""
         deadline = time.monotonic() + seconds
+        first = True
         while b"\n" not in self.buffer:
             left = deadline - time.monotonic()
-            if left <= 0:
+            if left <= 0 and not first:  # a line already waiting is read even past the time (one look)
                 return None
-            ready, _, _ = select.select([self.answers], [], [], left)
+            first = False
+            ready, _, _ = select.select([self.answers], [], [], max(left, 0.0))
             if not ready:
                 return None
             chunk = os.read(self.answers, 1 << 20)
@@ -383,26 +434,56 @@ class Isolated:
             return {"garbled": True}
         return message if isinstance(message, dict) else {"garbled": True}
 
-    def _request(self, payload: dict, seconds: float) -> dict | Answer:
+    def _write(self, data: bytes, deadline: float) -> bool:
+        """Write a request by the answer's deadline (False: not all of it went in time). The pipe is
+        non-blocking on this side: a process that stops reading (it stopped itself) cannot hang
+        the grader in a write of a big batch."""
+        view = memoryview(data)
+        while view:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                return False
+            _, ready, _ = select.select([], [self.requests], [], left)
+            if not ready:
+                return False
+            try:
+                view = view[os.write(self.requests, view[:PIPE_BYTES]):]
+            except BlockingIOError:
+                continue
+            except OSError:
+                return True  # the process has gone: its reading end says why
+        return True
+
+    def _send(self, payload: dict, seconds: float) -> float | Answer:
+        """Send one request; its answer's deadline (``seconds`` from now), or the :class:`Answer`
+        when it could not be asked (the file did not load, too many endings, the write timed out)."""
         if self.load_error:
             return Answer(ERROR, error=self.load_error)
         if self.endings >= self.limits.restarts:
             return Answer(TIMEOUT, error=f"not run: the function's process ended {self.endings} times already")
         if self.process is None:
-            self._start()
+            self._spawn()
+        if self.ready_by is not None:
+            self._await_ready()
             if self.load_error:
                 return Answer(ERROR, error=self.load_error)
         self.next_id += 1
-        payload = {"id": self.next_id, **payload}
-        try:
-            os.write(self.requests, (json.dumps(payload) + "\n").encode())  # small requests fit the pipe
-        except OSError:
-            pass
-        message = self._read(seconds)
+        deadline = time.monotonic() + seconds
+        if not self._write(_line({"id": self.next_id, **payload}), deadline):
+            return self._ended(None, seconds)
+        return deadline
+
+    def _receive(self, deadline: float, seconds: float) -> dict | Answer:
+        """The answer to the request last sent, by ``deadline``."""
+        message = self._read(deadline - time.monotonic())
         while message is not None and message.get("id") != self.next_id and not _broken(message):
-            message = self._read(seconds)  # something the function wrote itself on the answers pipe
+            message = self._read(deadline - time.monotonic())  # something the function wrote on the answers pipe
         if message is not None and not _broken(message):
             return message
+        return self._ended(message, seconds)
+
+    def _ended(self, message: dict | None, seconds: float) -> Answer:
+        """A request with no answer: the process is stopped and the ending counted."""
         reason = self._ending() if message is not None and message.get("closed") else ""
         self._stop()
         self.endings += 1
@@ -411,6 +492,10 @@ class Isolated:
         if message.get("garbled"):
             return Answer(CRASHED, error="the function's process sent something that is not an answer")
         return Answer(CRASHED, error=reason)
+
+    def _request(self, payload: dict, seconds: float) -> dict | Answer:
+        deadline = self._send(payload, seconds)
+        return deadline if isinstance(deadline, Answer) else self._receive(deadline, seconds)
 
     # --- calls -------------------------------------------------------------------------
 
@@ -426,19 +511,46 @@ class Isolated:
     def batch(self, inputs: Sequence[Sequence[Any]]) -> tuple[list[Any], dict[int, str]] | Answer:
         """Many calls at once (a probe picture's field): the values, and the errors by index;
         an :class:`Answer` when the whole batch failed (timed out, crashed)."""
-        message = self._request(_batch_request(inputs), self.limits.batch_seconds)
-        if isinstance(message, Answer):
-            return message
-        values = message.get("values")
-        stopped = message.get("stopped")
-        if isinstance(stopped, int) and isinstance(values, list) and len(values) == stopped < len(inputs):
-            first = str((message.get("errors") or {}).get("0", "it raised"))
-            message["errors"].update({str(i): first for i in range(stopped, len(inputs))})
-            values = values + [None] * (len(inputs) - stopped)
-        if not isinstance(values, list) or len(values) != len(inputs):
-            return Answer(CRASHED, error="the function's process sent a batch of the wrong length")
-        errors = {int(k): str(v) for k, v in (message.get("errors") or {}).items()}
-        return values, errors
+        return self.begin_batch(inputs)()
+
+    def begin_batch(self, inputs: Sequence[Sequence[Any]]
+                    ) -> Callable[[], tuple[list[Any], dict[int, str]] | Answer]:
+        """:meth:`batch` in two halves: the inputs are sent now; the returned function waits for
+        the answers (what :meth:`batch` returns). Between the two the grader works on (the
+        reference's values) while the student's process runs the calls; no other call may be
+        made before the answers are taken. The batch's time runs from now."""
+        seconds = self.limits.batch_seconds
+        deadline = self._send(_batch_request(inputs), seconds)
+
+        def answers() -> tuple[list[Any], dict[int, str]] | Answer:
+            message = deadline if isinstance(deadline, Answer) else self._receive(deadline, seconds)
+            return _batch_answers(message, len(inputs))
+
+        return answers
+
+
+def _batch_answers(message: dict | Answer, count: int) -> tuple[list[Any], dict[int, str]] | Answer:
+    """A batch's answer message as the values and the errors by index (or the failure)."""
+    if isinstance(message, Answer):
+        return message
+    values, stopped = message.get("values"), message.get("stopped")
+    errors = message.get("errors") if isinstance(message.get("errors"), dict) else {}
+    if isinstance(stopped, int) and isinstance(values, list) and len(values) == stopped < count:
+        first = str(errors.get("0", "it raised"))
+        errors.update({str(i): first for i in range(stopped, count)})
+        values = values + [None] * (count - stopped)
+    if not isinstance(values, list) or len(values) != count:
+        return Answer(CRASHED, error="the function's process sent a batch of the wrong length")
+    try:
+        return values, {int(k): str(v) for k, v in errors.items()}
+    except ValueError:
+        return Answer(CRASHED, error="the function's process sent something that is not an answer")
+
+
+def _line(message: dict) -> bytes:
+    """A request as its JSON line, without the spaces after separators (a probe's batch is
+    megabytes of numbers: a fifth less to write and for the student's process to read)."""
+    return (json.dumps(message, separators=(",", ":")) + "\n").encode()
 
 
 def _batch_request(inputs: Sequence[Sequence[Any]]) -> dict:
@@ -477,6 +589,11 @@ class InProcess:
             return Answer(VALUE, value=student_process._encode(self.function(*args)))
         except Exception as exc:  # noqa: BLE001 - the student's
             return Answer(ERROR, error=f"{type(exc).__name__}: {exc}"[:300])
+
+    def begin_batch(self, inputs: Sequence[Sequence[Any]]) -> Callable[[], tuple[list[Any], dict[int, str]]]:
+        """:meth:`batch` run now, its answers given by the returned function (as Isolated's)."""
+        answers = self.batch(inputs)
+        return lambda: answers
 
     def batch(self, inputs: Sequence[Sequence[Any]]) -> tuple[list[Any], dict[int, str]]:
         values, errors = [], {}

@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 from glsandbox.exercises.compare import WrongType, normalize
 from glsandbox.exercises.definition import Exercise
 
-__all__ = ["LessonResult", "render_lesson", "sphere_scene", "triangle_scene"]
+__all__ = ["LessonResult", "lesson_reference", "render_lesson", "sphere_scene", "triangle_scene"]
 
 #: Pixels whose largest channel differs by more than this count as different.
 THRESHOLD = 2
@@ -123,8 +123,10 @@ def _difference(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, int]:
     return picture, int(bad.sum())
 
 
-def render_lesson(exercise: Exercise, caller: Any) -> LessonResult:
-    """Render ``exercise.lesson`` with ``caller``'s function and with the engine's own."""
+def lesson_reference(exercise: Exercise) -> tuple[Any, np.ndarray]:
+    """The lesson's scene and the engine's own picture of it: what :func:`render_lesson` compares
+    the student's picture with, made on its own so that it can be made while the student's
+    process is busy (the probe's calls)."""
     from glsandbox.raytrace.numpy_engine import render_viewport
 
     view = exercise.lesson
@@ -133,7 +135,17 @@ def render_lesson(exercise: Exercise, caller: Any) -> LessonResult:
     # Secondary rays leave the surface by the course's simple offset: the engine's own
     # (the hit point's rounding-error bound) is tight for its stable tests, too tight for a
     # correct geometric one, which would then see its own surface and draw acne.
-    reference = render_viewport(scene, view.size, offset="simple")
+    return scene, render_viewport(scene, view.size, offset="simple")
+
+
+def render_lesson(exercise: Exercise, caller: Any, prepared: tuple[Any, np.ndarray] | None = None) -> LessonResult:
+    """Render ``exercise.lesson`` with ``caller``'s function and with the engine's own
+    (``prepared``: :func:`lesson_reference`'s scene and picture, made already)."""
+    from glsandbox.raytrace.numpy_engine import render_viewport
+
+    view = exercise.lesson
+    assert view is not None
+    scene, reference = prepared if prepared is not None else lesson_reference(exercise)
     calls = _Calls(exercise, caller)
     test = calls.sphere if view.kind == "sphere" else calls.triangles
     yours = render_viewport(scene, view.size, offset="simple", hit_tests={view.kind: test})

@@ -21,6 +21,7 @@ own pattern of colours (the tests check that no two are alike).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -30,7 +31,8 @@ from glsandbox.exercises import student_process
 from glsandbox.exercises.compare import WrongType, matches, normalize
 from glsandbox.exercises.definition import Exercise
 
-__all__ = ["CLASSES", "COLOURS", "ProbeResult", "classify", "picture", "probe_picture", "reference_values"]
+__all__ = ["CLASSES", "COLOURS", "ProbeResult", "classify", "picture", "probe_field", "probe_picture",
+           "reference_values", "start_probe"]
 
 #: The classes of a probe pixel, in the order of :data:`COLOURS`.
 CLASSES = ("both none", "agree", "student only", "reference only", "value differs", "broken")
@@ -103,8 +105,15 @@ class ProbeResult:
 def reference_values(exercise: Exercise, inputs: list[tuple[Any, ...]]) -> list[Any]:
     """The reference's answers on the field, as plain data (vectorized where the exercise can)."""
     if exercise.probe.reference_many is not None:
-        return [student_process._encode(v) for v in exercise.probe.reference_many(inputs)]
+        values = exercise.probe.reference_many(inputs)
+        if set(map(type, values)) <= _PLAIN:  # already what encoding gives (a field of distances)
+            return list(values)
+        return [student_process._encode(v) for v in values]
     return [student_process._encode(exercise.reference(*args)) for args in inputs]
+
+
+#: The types an answer has as plain data already (:func:`student_process._encode` leaves them alone).
+_PLAIN = {float, int, bool, type(None)}
 
 
 def _present(value: Any) -> bool:
@@ -171,15 +180,30 @@ def _brightness(exercise: Exercise, value: Any) -> float:
     return min(1.0, max(0.0, level)) if level == level else 0.75
 
 
+def _levels(exercise: Exercise, values: list[Any]) -> np.ndarray:
+    """:func:`_brightness` of each value; for distances (``t``, every one a number) the shade
+    is taken of them all at once, as one array."""
+    shade = exercise.probe.shade
+    t = _as_t(values) if exercise.returns == "t" and shade is not None and values else None
+    if t is not None and not np.isnan(t).any():
+        try:
+            with np.errstate(all="ignore"):
+                level = np.asarray(shade(t), dtype=np.float64)
+        except (TypeError, ValueError, ZeroDivisionError):
+            level = None
+        if level is not None and level.shape == t.shape:
+            return np.where(np.isnan(level), 0.75, np.clip(level, 0.0, 1.0))
+    return np.array([_brightness(exercise, v) for v in values], dtype=np.float64)
+
+
 def _draw(exercise: Exercise, classes: np.ndarray, reference: list[Any], student: list[Any], n: int) -> np.ndarray:
     """The picture: each class's colour; where both agree, grey shaded by the value; where the
     values differ, amber shaded by the student's value (so two wrong versions that differ
     everywhere still draw different pictures)."""
     flat = COLOURS[classes].astype(np.float64)
-    for i in np.flatnonzero(classes == 1):
-        flat[i] = 80.0 + 160.0 * _brightness(exercise, reference[i])
-    for i in np.flatnonzero(classes == 4):
-        flat[i] = COLOURS[4] * (0.45 + 0.55 * _brightness(exercise, student[i]))
+    agree, differ = np.flatnonzero(classes == 1), np.flatnonzero(classes == 4)
+    flat[agree] = (80.0 + 160.0 * _levels(exercise, [reference[i] for i in agree]))[:, None]
+    flat[differ] = COLOURS[4] * (0.45 + 0.55 * _levels(exercise, [student[i] for i in differ]))[:, None]
     rgba = np.full((n * n, 4), 255, dtype=np.uint8)
     rgba[:, :3] = np.round(flat).astype(np.uint8)
     return rgba.reshape(n, n, 4)
@@ -200,23 +224,49 @@ def _shaded(classes: np.ndarray, shade: np.ndarray) -> np.ndarray:
 def probe_picture(exercise: Exercise, caller: Any, n: int = 256) -> ProbeResult:
     """The probe of ``caller``'s function (``Isolated`` or ``InProcess``) against the reference,
     drawn ``n x n`` (from a coarser field where the exercise's probe has a ``resolution``)."""
+    return start_probe(exercise, caller, n)()
+
+
+def probe_field(exercise: Exercise, n: int = 256) -> list[tuple[Any, ...]]:
+    """The inputs of the probe drawn ``n x n``: one a pixel, or a coarser field's
+    (``resolution``), or a drawn probe's few."""
+    m = n if exercise.probe.draw is not None else min(n, exercise.probe.resolution or n)
+    return exercise.probe.inputs(m)
+
+
+def start_probe(exercise: Exercise, caller: Any, n: int = 256,
+                inputs: list[tuple[Any, ...]] | None = None) -> Callable[[], ProbeResult]:
+    """:func:`probe_picture` in two halves: the field (``inputs``: :func:`probe_field`'s, made
+    already) is sent to ``caller`` now; the returned function computes the reference's values
+    (while the student's process is still answering) and then draws the picture. What the
+    grader does in between overlaps the student's calls."""
     draw = exercise.probe.draw
     m = n if draw is not None else min(n, exercise.probe.resolution or n)
-    inputs = exercise.probe.inputs(m)
-    batch = caller.batch(inputs)
-    if not isinstance(batch, tuple):
-        return ProbeResult(exercise.probe.what, None, None, inputs, [], error=batch.error)
-    student, errors = batch
-    reference = reference_values(exercise, inputs)
-    if draw is not None:
-        classes, shade, own = draw(reference, student, errors, n)
-        classes = np.asarray(classes, dtype=np.uint8)
-        return ProbeResult(exercise.probe.what, _shaded(classes, np.asarray(shade, dtype=np.float64)), classes,
-                           inputs, student, reference, input_classes=np.asarray(own, dtype=np.uint8))
-    classes, image = picture(exercise, reference, student, errors, m)
-    if m < n:
-        image = np.repeat(np.repeat(image, -(-n // m), axis=0), -(-n // m), axis=1)[:n, :n]
-    return ProbeResult(exercise.probe.what, image, classes, inputs, student, reference)
+    inputs = probe_field(exercise, n) if inputs is None else inputs
+    begin = getattr(caller, "begin_batch", None)
+    if begin is not None:
+        answers = begin(inputs)
+    else:  # a caller with batch alone
+        batch = caller.batch(inputs)
+        answers = lambda: batch  # noqa: E731
+
+    def finish() -> ProbeResult:
+        reference = reference_values(exercise, inputs)
+        batch = answers()
+        if not isinstance(batch, tuple):
+            return ProbeResult(exercise.probe.what, None, None, inputs, [], error=batch.error)
+        student, errors = batch
+        if draw is not None:
+            classes, shade, own = draw(reference, student, errors, n)
+            classes = np.asarray(classes, dtype=np.uint8)
+            return ProbeResult(exercise.probe.what, _shaded(classes, np.asarray(shade, dtype=np.float64)), classes,
+                               inputs, student, reference, input_classes=np.asarray(own, dtype=np.uint8))
+        classes, image = picture(exercise, reference, student, errors, m)
+        if m < n:
+            image = np.repeat(np.repeat(image, -(-n // m), axis=0), -(-n // m), axis=1)[:n, :n]
+        return ProbeResult(exercise.probe.what, image, classes, inputs, student, reference)
+
+    return finish
 
 
 def picture(exercise: Exercise, reference: list[Any], student: list[Any], errors: dict[int, str],

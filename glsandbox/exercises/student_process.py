@@ -83,7 +83,7 @@ class _Bounded(io.TextIOBase):
     """What the function prints: kept up to ``limit`` characters; past that, the case fails."""
 
     def __init__(self, limit):
-        self.limit, self.size, self.kept = limit, 0, []
+        self.limit, self.size = limit, 0
 
     def writable(self):
         return True
@@ -93,7 +93,6 @@ class _Bounded(io.TextIOBase):
         self.size += len(text)
         if self.size > self.limit:
             raise _TooMuchOutput(f"printed more than {self.limit // 1024} KiB")
-        self.kept.append(text)
         return len(text)
 
 
@@ -151,12 +150,49 @@ _PATH = [""]
 _STOP_AFTER = 256
 
 
+def _batch(function, request, limit):
+    """A batch's calls, each as :func:`_call` makes it (its printing bounded on its own, its
+    error its own) at less cost a call: one output guard reused, the arguments every input
+    shares (``shared``, by position) put in one template that each input's own fill."""
+    shared = {int(k): v for k, v in request.get("shared", {}).items()}
+    arity = int(request.get("arity", 0))
+    template = [shared.get(k) for k in range(arity)]
+    slots = [k for k in range(arity) if k not in shared]  # where each input's own arguments go
+    printed = _Bounded(limit)
+    values, errors, stopped = [], {}, None
+    try:
+        for i, varying in enumerate(request["batch"]):
+            if shared:
+                args = template.copy()
+                for k, v in zip(slots, varying):
+                    args[k] = v
+            else:
+                args = varying
+            printed.size = 0
+            sys.stdout = sys.stderr = printed  # again each call: the function may have replaced them
+            try:
+                values.append(_encode(function(*args)))
+                continue
+            except _TooMuchOutput as exc:
+                error = str(exc)
+            except BaseException as exc:  # noqa: BLE001 - SystemExit, KeyboardInterrupt: the case's
+                error = _error_line(exc, _PATH[0])
+            values.append(None)
+            errors[str(i)] = error if len(errors) < 20 else ""
+            if i == _STOP_AFTER - 1 and len(errors) == _STOP_AFTER:
+                stopped = i + 1  # every call so far raised: the rest would too (a starter)
+                break
+    finally:
+        sys.stdout, sys.stderr = sys.__stdout__, sys.__stderr__
+    return {"values": values, "errors": errors, "stopped": stopped}
+
+
 def main():
     with open(sys.argv[1], encoding="utf-8") as handle:
         config = json.load(handle)
     os.unlink(sys.argv[1])
     sys.path[:] = [config["folder"], *config["path"]]
-    requests = os.fdopen(config["requests"], "r", encoding="utf-8")
+    requests = os.fdopen(config["requests"], "r", encoding="utf-8", buffering=1 << 20)
     answers = os.fdopen(config["answers"], "w", encoding="utf-8")
     signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a file grown past its limit: an error, not a kill
     limit = int(config["output_limit"])
@@ -164,7 +200,7 @@ def main():
     _audit([os.path.realpath(p) for p in config["denied"]], [os.path.realpath(config["work"])], os.getpid())
 
     def answer(message):
-        answers.write(json.dumps(message) + "\n")
+        answers.write(json.dumps(message, separators=(",", ":")) + "\n")
         answers.flush()
 
     namespace = {"__name__": "submission", "__file__": _PATH[0]}
@@ -188,23 +224,7 @@ def main():
     for line in requests:
         request = json.loads(line)
         if "batch" in request:
-            values, errors, stopped = [], {}, None
-            shared = {int(k): v for k, v in request.get("shared", {}).items()}
-            arity = int(request.get("arity", 0))
-            for i, varying in enumerate(request["batch"]):
-                if shared:  # the arguments every input shares, put back in their places
-                    rest = iter(varying)
-                    args = [shared[k] if k in shared else next(rest) for k in range(arity)]
-                else:
-                    args = varying
-                result = _call(function, args, limit)
-                values.append(result.get("value"))
-                if "error" in result:
-                    errors[str(i)] = result["error"] if len(errors) < 20 else ""
-                if i == _STOP_AFTER - 1 and len(errors) == _STOP_AFTER:
-                    stopped = i + 1  # every call so far raised: the rest would too (a starter)
-                    break
-            answer({"id": request["id"], "values": values, "errors": errors, "stopped": stopped})
+            answer({"id": request["id"], **_batch(function, request, limit)})
         else:
             answer({"id": request["id"], **_call(function, request["args"], limit)})
 

@@ -83,3 +83,20 @@ def test_the_notebook_shows_the_table_and_pictures_inline_without_hidden_cases()
     assert "✗" in repr(report)
     with pytest.raises(SandboxError, match="expected a function"):
         glsandbox.exercise("ray_sphere", 3)
+
+
+def test_a_check_pauses_the_cycle_collector_and_puts_it_back_as_it_was() -> None:
+    import gc
+
+    exercise = get("reflect")
+    seen = []
+    function = lambda d, n: seen.append(gc.isenabled()) or exercise.reference(d, n)  # noqa: E731
+    assert gc.isenabled()
+    check_function(exercise, function, probe=False)
+    assert seen and not any(seen) and gc.isenabled()
+    gc.disable()
+    try:
+        check_function(exercise, function, probe=False)
+        assert not gc.isenabled()
+    finally:
+        gc.enable()

@@ -248,3 +248,49 @@ def test_under_a_root_grader_the_function_runs_as_a_user_with_no_account(tmp_pat
     if shadow is not None and not os.stat("/etc/shadow").st_mode & 0o004:
         assert shadow.status == VALUE and shadow.value[4] < 0, shadow
     assert second.status == VALUE and second.value[0] not in (0, uid)  # two processes: two users
+
+
+def test_a_process_that_stops_itself_cannot_hang_the_grader_in_a_big_batch(tmp_path) -> None:
+    # The submission stops its own process (SIGSTOP, the one signal it may send) soon after it
+    # loads: a batch of some megabytes then no longer fits the pipe, and its write must end by
+    # the batch's deadline, as a TIMEOUT, rather than block the grader for ever.
+    path = tmp_path / "stops.py"
+    path.write_text("import os, signal, threading\n"
+                    "threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGSTOP)).start()\n"
+                    "def f(x):\n    return 1.0\n")
+    with Isolated(path, "f", Limits(batch_seconds=1.5, restarts=1)) as caller:
+        assert caller.call([0.0]).status == VALUE
+        time.sleep(0.8)
+        started = time.monotonic()
+        answer = caller.batch([[float(i) * 1.000001] for i in range(300_000)])
+        assert time.monotonic() - started < 6.0
+    assert answer.status == TIMEOUT
+
+
+def test_a_batch_begun_comes_back_whole_while_the_grader_works_meanwhile(tmp_path) -> None:
+    path = tmp_path / "double.py"
+    path.write_text("def f(x, k):\n    if x == 3:\n        raise ValueError('three')\n    return k * x\n")
+    inputs = [(float(i), 2.0) for i in range(5)]
+    with Isolated(path, "f") as caller:
+        answers = caller.begin_batch(inputs)
+        time.sleep(0.2)  # the grader's own work, while the process answers
+        values, errors = answers()
+        assert caller.call([1.0, 3.0]).value == 3.0  # the next request after it is answered as usual
+    assert values == [0.0, 2.0, 4.0, None, 8.0]
+    assert list(errors) == [3] and errors[3].startswith("ValueError: three")
+
+
+def test_a_process_started_ahead_answers_its_first_call_or_says_why_it_did_not_load(tmp_path) -> None:
+    good, bad = tmp_path / "good.py", tmp_path / "bad.py"
+    good.write_text("def f(x):\n    return 2 * x\n")
+    bad.write_text("raise RuntimeError('not today')\ndef f(x):\n    return x\n")
+    with Isolated(good, "f") as caller:
+        caller.start()
+        assert caller.process is not None
+        time.sleep(0.3)  # the checker's own work meanwhile
+        assert caller.call([2.5]).value == 5.0
+    with Isolated(bad, "f") as caller:
+        caller.start()
+        answer = caller.call([1.0])
+        assert answer.status == ERROR and "RuntimeError: not today" in answer.error
+        assert caller.load_error and caller.call([1.0]).status == ERROR

@@ -60,3 +60,25 @@ def test_a_coarse_field_is_drawn_at_full_size() -> None:
     assert exercise.probe.resolution == 64 and probe.classes.shape == (64, 64)
     assert probe.image.shape == (256, 256, 4)
     np.testing.assert_array_equal(probe.image[::4, ::4], probe.image[3::4, 3::4])
+
+
+def test_distances_are_shaded_all_at_once_as_each_would_be_alone() -> None:
+    from glsandbox.exercises.probe import _brightness, _levels
+
+    exercise = get("ray_sphere")  # shade: 1 - t / 4
+    values = [0.5, 3.0, 9.0, -2.0, 4, 1e300]
+    assert np.array_equal(_levels(exercise, values), [_brightness(exercise, v) for v in values])
+    odd = [0.5, [1.0], None]  # not all distances: each judged alone, a wrong type mid-grey
+    assert np.array_equal(_levels(exercise, odd), [_brightness(exercise, v) for v in odd])
+    assert _levels(exercise, [0.5, float("nan")])[1] == 0.75
+
+
+def test_a_probe_begun_and_finished_later_is_the_probe_drawn_at_once() -> None:
+    from glsandbox.exercises.probe import start_probe
+
+    exercise = get("ray_sphere")
+    mistake = next(m for m in exercise.mistakes if m.name == "far_root")
+    finish = start_probe(exercise, InProcess(mistake.function), 64)
+    later, now = finish(), probe_picture(exercise, InProcess(mistake.function), 64)
+    assert np.array_equal(later.image, now.image) and later.counts() == now.counts()
+    assert later.counts()["value differs"] > 0

@@ -53,3 +53,26 @@ def test_a_call_keeps_its_printing_bounded_and_its_exit_to_itself(monkeypatch) -
             return 1.0
 
     assert student_process._call(swallows, (), 1024)["kind"] == "output"
+
+
+def test_a_batch_puts_the_shared_arguments_back_and_bounds_each_call_alone(monkeypatch) -> None:
+    monkeypatch.setattr(sys, "stdout", sys.stdout)
+    monkeypatch.setattr(sys, "stderr", sys.stderr)
+
+    def f(a, b, c):
+        print("z" * int(a))  # 600 characters a call: within 1 KiB each, past it together
+        if a == 700.0:
+            raise ValueError("seven hundred")
+        return a + 10 * b + 100 * c
+
+    request = {"batch": [[600.0, 1.0], [600.0, 2.0], [700.0, 0.0], [2000.0, 0.0]], "shared": {"1": 3.0}, "arity": 3}
+    answer = student_process._batch(f, request, 1024)
+    assert answer["values"] == [600.0 + 30.0 + 100.0, 600.0 + 30.0 + 200.0, None, None]
+    assert answer["errors"] == {"2": "ValueError: seven hundred", "3": "printed more than 1 KiB"}
+    assert answer["stopped"] is None and sys.stdout is sys.__stdout__
+
+
+def test_a_batch_that_raises_on_every_call_is_stopped_early() -> None:
+    answer = student_process._batch(lambda x: 1 / 0, {"batch": [[i] for i in range(1000)], "shared": {}, "arity": 1}, 1024)
+    assert answer["stopped"] == student_process._STOP_AFTER == len(answer["values"])
+    assert len(answer["errors"]) == student_process._STOP_AFTER and answer["errors"]["0"].startswith("ZeroDivisionError")

@@ -146,7 +146,7 @@ def hidden() -> list[Case]:
 def _probe_inputs(n: int) -> list[tuple]:
     """Rays along (-1, -0.4, 0.05) from each point of the plane z = 0 around the box [-1, 1]³."""
     direction, lo, hi = (-1.0, -0.4, 0.05), (-1.0, -1.0, -1.0), (1.0, 1.0, 1.0)
-    return [((float(u), float(v), 0.0), direction, lo, hi) for u, v in grid(n, -3.0, 3.0)]
+    return [((float(u), float(v), 0.0), direction, lo, hi) for u, v in grid(n, -3.0, 3.0).tolist()]
 
 
 EXERCISE = Exercise(

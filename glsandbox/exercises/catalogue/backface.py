@@ -104,7 +104,7 @@ def hidden() -> list[Case]:
 def _probe_inputs(n: int) -> list[tuple]:
     """The notes' triangle turned about the y axis by 180°·u, seen along (v, 0, 1)."""
     out = []
-    for u, v in grid(n, -1.0, 1.0):
+    for u, v in grid(n, -1.0, 1.0).tolist():
         c, s = math.cos(math.pi * u), math.sin(math.pi * u)
         turned = [(c * x + s * z, y, -s * x + c * z) for x, y, z in (V0, V1, V2)]
         out.append((*turned, (float(v), 0.0, 1.0)))

@@ -121,7 +121,8 @@ def _probe_inputs(n: int) -> list[tuple]:
     """Points of the floor [-10, 10]² about a camera at (1, 0, 2): the top half one left press,
     the bottom half one right press."""
     camera = (1.0, 0.0, 2.0)
-    return [((10.0 * float(u), 0.0, 10.0 * float(v)), camera, 1 if v > 0 else -1) for u, v in grid(n, -1.0, 1.0)]
+    return [((10.0 * float(u), 0.0, 10.0 * float(v)), camera, 1 if v > 0 else -1)
+            for u, v in grid(n, -1.0, 1.0).tolist()]
 
 
 EXERCISE = Exercise(

@@ -83,7 +83,7 @@ def hidden() -> list[Case]:
 
 
 def _probe_inputs(n: int) -> list[tuple]:
-    return [(float(u), float(449.0 - v)) for u, v in grid(n, 0.0, 799.0) * [1.0, 449.0 / 799.0]]
+    return [(float(u), float(449.0 - v)) for u, v in (grid(n, 0.0, 799.0) * [1.0, 449.0 / 799.0]).tolist()]
 
 
 EXERCISE = Exercise(

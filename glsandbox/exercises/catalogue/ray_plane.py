@@ -115,7 +115,7 @@ def hidden() -> list[Case]:
 
 def _probe_inputs(n: int) -> list[tuple]:
     """Rays along (0, 0.6, 0.8) from each point (0, y, z) of a 400 x 400 square around the plane."""
-    return [((0.0, float(y), float(z)), (0.0, 0.6, 0.8), N, D) for z, y in grid(n, -200.0, 200.0)]
+    return [((0.0, float(y), float(z)), (0.0, 0.6, 0.8), N, D) for z, y in grid(n, -200.0, 200.0).tolist()]
 
 
 EXERCISE = Exercise(

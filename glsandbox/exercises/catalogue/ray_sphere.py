@@ -176,7 +176,7 @@ def hidden() -> list[Case]:
 
 def _probe_inputs(n: int) -> list[tuple]:
     """Rays to the right (+x) from every point of the plane z = 0 around the unit sphere."""
-    return [((float(u), float(v), 0.0), (1.0, 0.0, 0.0), ORIGIN, 1.0) for u, v in grid(n, -2.0, 2.0)]
+    return [((float(u), float(v), 0.0), (1.0, 0.0, 0.0), ORIGIN, 1.0) for u, v in grid(n, -2.0, 2.0).tolist()]
 
 
 def _lesson_scene():  # noqa: ANN202

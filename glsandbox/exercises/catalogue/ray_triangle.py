@@ -161,7 +161,7 @@ PROBE_TRIANGLE = ((-1.5, -1.23, -0.75), (1.5, -1.23, 0.75), (0.13, 1.47, 0.065))
 
 
 def _probe_inputs(n: int) -> list[tuple]:
-    return [((float(u), float(v), 0.0), (0.0, 0.0, 1.0), *PROBE_TRIANGLE) for u, v in grid(n, -2.0, 2.0)]
+    return [((float(u), float(v), 0.0), (0.0, 0.0, 1.0), *PROBE_TRIANGLE) for u, v in grid(n, -2.0, 2.0).tolist()]
 
 
 def _lesson_scene():  # noqa: ANN202

@@ -165,7 +165,7 @@ PROBE_LIGHT = (0.0, 3.0, 0.0)
 
 def _probe_inputs(n: int) -> list[tuple]:
     """Points of the floor y = 0, seen from above."""
-    return [((float(u), 0.0, float(-v)), PROBE_LIGHT, PROBE_TRIANGLES) for u, v in grid(n, -2.4, 2.4)]
+    return [((float(u), 0.0, float(-v)), PROBE_LIGHT, PROBE_TRIANGLES) for u, v in grid(n, -2.4, 2.4).tolist()]
 
 
 EXERCISE = Exercise(

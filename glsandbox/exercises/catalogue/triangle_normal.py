@@ -106,7 +106,8 @@ def hidden() -> list[Case]:
 
 def _probe_inputs(n: int) -> list[tuple]:
     """V0 = (0.3, 0.2, 0.5), V1 = V0 + (1, u, 0), V2 = V0 + (0, 1, v)."""
-    return [((0.3, 0.2, 0.5), (1.3, 0.2 + float(u), 0.5), (0.3, 1.2, 0.5 + float(v))) for u, v in grid(n, -2.0, 2.0)]
+    return [((0.3, 0.2, 0.5), (1.3, 0.2 + float(u), 0.5), (0.3, 1.2, 0.5 + float(v)))
+            for u, v in grid(n, -2.0, 2.0).tolist()]
 
 
 EXERCISE = Exercise(
