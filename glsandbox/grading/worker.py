@@ -380,14 +380,20 @@ def zygote_main(channel_fd: int) -> None:
         except ImportError:  # e.g. no lessons package beside an installed glsandbox
             pass
     preload_gl_libraries()
+    prepare_confinement()
+    zygote(channel_fd)
+
+
+def prepare_confinement() -> None:
+    """Work out once, before any fork, what every renderer's :func:`~glsandbox.grading.sandbox.confine`
+    reads of the file system, so each inherits the answers: the folders a submission may read, and
+    where the grader is root and a renderer keeps reading as root does, the parts of ``/etc`` a user
+    with no account may read (a walk of ``/etc``: 30 to 40 ms that each renderer paid before)."""
     from glsandbox.grading.sandbox import landlock_abi, others_may_read, read_roots
 
-    read_roots()  # worked out once, for every renderer
+    read_roots()
     if layers.submission_ids(os.getpid()) is not None and not _python_readable() and landlock_abi() >= 1:
-        # what of /etc a user with no account may read (a walk of /etc: 30 to 40 ms), worked out
-        # once here and inherited by every renderer that keeps reading as root does
         others_may_read("/etc")
-    zygote(channel_fd)
 
 
 def zygote(channel_fd: int) -> None:
