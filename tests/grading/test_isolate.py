@@ -6,6 +6,7 @@ private folder's path said as the submission's own), and a job with no GL retrie
 from __future__ import annotations
 
 import os
+import sys
 from collections import deque
 from pathlib import Path
 
@@ -13,7 +14,7 @@ import numpy as np
 import pytest
 
 from glsandbox.grading.isolate import (CRASHED, STORY_LIMIT, Job, JobResult, Picture, Reader, Render, _job_data,
-                                       _result, job_from, send, settle, story_of)
+                                       _result, job_from, send, settle, story_of, wide_pipe)
 
 JOB = Job(3, "/subs/ann/spin.py", "spin.py", (Render(("time=1",), (4, 2)), Render((), (2, 2), 4, explain=(1, 0))),
           timeout=5.0, describe=True)
@@ -102,3 +103,21 @@ def test_no_gl_is_retried_once_then_stops_the_run() -> None:
     assert results == {3: no_gl} and done == []
     fine = JobResult(Job(4, None, "phong", ()), [Picture()])
     assert settle(fine.job, fine, pending, retried, results, done.append) is False and done == [fine]
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="F_SETPIPE_SZ is Linux's")
+def test_a_wide_pipe_takes_a_whole_picture_in_one_write() -> None:
+    """A 320x240 picture and its header go in one write that does not wait for the reader
+    (a pipe of 64 KiB takes five)."""
+    import fcntl
+
+    read_end, write_end = os.pipe()
+    try:
+        os.set_blocking(write_end, False)
+        wide_pipe(write_end)
+        assert fcntl.fcntl(write_end, fcntl.F_GETPIPE_SZ) >= 1 << 20
+        message = bytes(320 * 240 * 4 + 4096)
+        assert os.write(write_end, message) == len(message)
+    finally:
+        os.close(read_end)
+        os.close(write_end)

@@ -115,3 +115,14 @@ def test_the_zygote_works_out_the_readable_etc_once_where_renderers_need_it(
         sandbox.others_may_read("/etc")
         assert sandbox.others_may_read.cache_info().hits == walked.hits + 1
         assert sandbox.others_may_read.cache_info().currsize == walked.currsize
+
+
+def test_the_zygote_freezes_its_heap_before_it_serves() -> None:
+    """Every object the zygote made while preloading is in the permanent generation by the time it
+    forks: a renderer's collector never walks them (and copies their pages)."""
+    code = ("import gc, os, sys; from glsandbox.grading import worker; "
+            "worker.zygote = lambda fd: (print(gc.get_freeze_count(), len(gc.get_objects()), flush=True), os._exit(0)); "
+            "worker.zygote_main(-1)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=True).stdout
+    frozen, tracked = map(int, out.split())
+    assert frozen > 10_000 and tracked < frozen // 10
