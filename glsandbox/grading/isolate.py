@@ -290,6 +290,9 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
     running: dict[int, _Running] = {}
     results: dict[int, JobResult] = {}
     retried: set[int] = set()
+    # Supervisors that sent their result and are cleaning up (killing their renderer's tree,
+    # removing their private folder): their pipes close when they end; the run waits for that.
+    closing: dict[int, _Running] = {}
     zygote_process = _Zygote()
     try:
         while pending or running:
@@ -303,7 +306,8 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
                     fd = zygote_process.start(job)
                 # a supervisor that hangs (it should not) is given up after every picture's time and a margin
                 running[fd] = _Running(job, Reader(fd), time.monotonic() + job.timeout * len(job.renders) + 60)
-            ready, _, _ = select.select(list(running), [], [], 1.0)
+            ready, _, _ = select.select([*running, *closing], [], [], 1.0)
+            _drain(closing, ready)
             for fd in list(running):
                 entry = running[fd]
                 if fd in ready:
@@ -324,7 +328,10 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
                     kill_tree(entry.pid)
                     killpg(entry.pid)
                 del running[fd]
-                os.close(fd)
+                if message is not None and not entry.reader.closed:
+                    closing[fd] = _Running(entry.job, entry.reader, time.monotonic() + 10, entry.pid)
+                else:
+                    os.close(fd)
                 if settle(entry.job, _result(entry.job, message), pending, retried, results, done):
                     return [results[j.index] for j in jobs if j.index in results]
     finally:
@@ -332,10 +339,29 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
             if entry.pid:
                 killpg(entry.pid)
             os.close(fd)
+        while closing:
+            ready, _, _ = select.select(list(closing), [], [], 0.5)
+            _drain(closing, ready)
         zygote_process.close()
         kill_tree(os.getpid(), keep=sorted(before))
         set_subreaper(False)
     return [results[j.index] for j in jobs]
+
+
+def _drain(closing: dict[int, _Running], ready: Sequence[int]) -> None:
+    """Read the pipes of the supervisors cleaning up; forget each that closed (its supervisor
+    ended) and kill the tree of one that is still at it past its deadline."""
+    for fd in [fd for fd in closing if fd in ready or time.monotonic() > closing[fd].deadline]:
+        entry = closing[fd]
+        if fd in ready:
+            entry.reader.pump(0.0)
+            entry.reader.buffer.clear()  # nothing more is expected: whatever came is dropped
+        if entry.reader.closed or time.monotonic() > entry.deadline:
+            if not entry.reader.closed and entry.pid:
+                kill_tree(entry.pid)
+                killpg(entry.pid)
+            del closing[fd]
+            os.close(fd)
 
 
 def _result(job: Job, message: tuple[dict, bytes] | None) -> JobResult:

@@ -121,3 +121,46 @@ def test_a_wide_pipe_takes_a_whole_picture_in_one_write() -> None:
     finally:
         os.close(read_end)
         os.close(write_end)
+
+
+PRINTING_LESSON = """from glsandbox.geometry import builtin_mesh
+from glsandbox.lesson import Lesson
+from glsandbox.scene import Node, Scene
+
+
+class Printer(Lesson):
+    def build(self):
+        print("built by {name}")
+        return Scene("printer", nodes=[Node("cube", mesh=builtin_mesh("cube24"))])
+"""
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="the tree's processes are found through /proc")
+def test_the_run_ends_with_every_supervisor_cleaned_up_and_every_output_kept(gl_renderer, tmp_path: Path) -> None:
+    """Each supervisor sends its result before it cleans up (the grader starts the next
+    submission meanwhile); the output printed before the picture still comes back, and when
+    ``run_jobs`` returns no process it started and no private folder is left."""
+    import tempfile
+
+    from glsandbox.grading.isolate import run_jobs
+    from glsandbox.grading.processes import descendants
+
+    jobs = []
+    for n in range(4):
+        (tmp_path / f"s{n}.py").write_text(PRINTING_LESSON.format(name=f"student {n}"))
+        jobs.append(Job(n, str(tmp_path / f"s{n}.py"), f"s{n}.py", (Render((), (32, 24)),), timeout=20.0))
+    before = set(Path(tempfile.gettempdir()).glob("glsandbox-grade-*"))
+    results = run_jobs(jobs, 2, lambda result: None)
+    assert [r.pictures[0].image.shape for r in results] == [(24, 32, 4)] * 4
+    assert [r.output for r in results] == [[f"built by student {n}"] for n in range(4)]
+    assert descendants(os.getpid()) == []
+    # the temp folder is the machine's: other runs' folders may come and go; none may hold ours
+    for folder in set(Path(tempfile.gettempdir()).glob("glsandbox-grade-*")) - before:
+        assert not any(f"student {n}" in _text_or_empty(folder / "submission" / f"s{n}.py") for n in range(4))
+
+
+def _text_or_empty(path: Path) -> str:
+    try:
+        return path.read_text()
+    except OSError:  # not there (another run's folder, or gone while looked at)
+        return ""
