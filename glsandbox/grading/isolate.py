@@ -49,7 +49,7 @@ import numpy as np
 
 from glsandbox.grading.processes import descendants, kill_tree, killpg, set_subreaper
 
-__all__ = ["Render", "Job", "Picture", "JobResult", "run_jobs"]
+__all__ = ["Render", "Job", "Picture", "JobResult", "run_jobs", "wide_pipe"]
 
 #: Outcomes of one picture, besides the grader's PASS and FAIL.
 BROKEN, TIMEOUT, CRASHED, OOM = "BROKEN", "TIMEOUT", "CRASHED", "OUT OF MEMORY"
@@ -126,6 +126,18 @@ class JobResult:
 
 
 # --- the framed messages of a pipe: a JSON header and raw bytes ---------------------------------
+
+
+def wide_pipe(fd: int) -> None:
+    """Let the pipe at ``fd`` hold a whole 320x240 picture and more (Linux: 1 MiB, the most an
+    unprivileged process may ask by default, against 64 KiB): the sender writes a picture in one
+    call instead of waking the reader for each 64 KiB. Where refused, the pipe stays as it was."""
+    import fcntl
+
+    try:
+        fcntl.fcntl(fd, getattr(fcntl, "F_SETPIPE_SZ"), 1 << 20)
+    except (AttributeError, OSError):
+        pass
 
 
 def send(fd: int, header: dict, payload: bytes = b"") -> None:
@@ -218,6 +230,7 @@ class _Zygote:
         import socket
 
         read_end, write_end = os.pipe()
+        wide_pipe(write_end)
         data = json.dumps(_job_data(job)).encode()
         try:
             self.channel.sendall(struct.pack("!I", len(data)))
@@ -277,6 +290,9 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
     running: dict[int, _Running] = {}
     results: dict[int, JobResult] = {}
     retried: set[int] = set()
+    # Supervisors that sent their result and are cleaning up (killing their renderer's tree,
+    # removing their private folder): their pipes close when they end; the run waits for that.
+    closing: dict[int, _Running] = {}
     zygote_process = _Zygote()
     try:
         while pending or running:
@@ -290,7 +306,8 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
                     fd = zygote_process.start(job)
                 # a supervisor that hangs (it should not) is given up after every picture's time and a margin
                 running[fd] = _Running(job, Reader(fd), time.monotonic() + job.timeout * len(job.renders) + 60)
-            ready, _, _ = select.select(list(running), [], [], 1.0)
+            ready, _, _ = select.select([*running, *closing], [], [], 1.0)
+            _drain(closing, ready)
             for fd in list(running):
                 entry = running[fd]
                 if fd in ready:
@@ -311,7 +328,10 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
                     kill_tree(entry.pid)
                     killpg(entry.pid)
                 del running[fd]
-                os.close(fd)
+                if message is not None and not entry.reader.closed:
+                    closing[fd] = _Running(entry.job, entry.reader, time.monotonic() + 10, entry.pid)
+                else:
+                    os.close(fd)
                 if settle(entry.job, _result(entry.job, message), pending, retried, results, done):
                     return [results[j.index] for j in jobs if j.index in results]
     finally:
@@ -319,10 +339,29 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
             if entry.pid:
                 killpg(entry.pid)
             os.close(fd)
+        while closing:
+            ready, _, _ = select.select(list(closing), [], [], 0.5)
+            _drain(closing, ready)
         zygote_process.close()
         kill_tree(os.getpid(), keep=sorted(before))
         set_subreaper(False)
     return [results[j.index] for j in jobs]
+
+
+def _drain(closing: dict[int, _Running], ready: Sequence[int]) -> None:
+    """Read the pipes of the supervisors cleaning up; forget each that closed (its supervisor
+    ended) and kill the tree of one that is still at it past its deadline."""
+    for fd in [fd for fd in closing if fd in ready or time.monotonic() > closing[fd].deadline]:
+        entry = closing[fd]
+        if fd in ready:
+            entry.reader.pump(0.0)
+            entry.reader.buffer.clear()  # nothing more is expected: whatever came is dropped
+        if entry.reader.closed or time.monotonic() > entry.deadline:
+            if not entry.reader.closed and entry.pid:
+                kill_tree(entry.pid)
+                killpg(entry.pid)
+            del closing[fd]
+            os.close(fd)
 
 
 def _result(job: Job, message: tuple[dict, bytes] | None) -> JobResult:

@@ -6,6 +6,7 @@ private folder's path said as the submission's own), and a job with no GL retrie
 from __future__ import annotations
 
 import os
+import sys
 from collections import deque
 from pathlib import Path
 
@@ -13,7 +14,7 @@ import numpy as np
 import pytest
 
 from glsandbox.grading.isolate import (CRASHED, STORY_LIMIT, Job, JobResult, Picture, Reader, Render, _job_data,
-                                       _result, job_from, send, settle, story_of)
+                                       _result, job_from, send, settle, story_of, wide_pipe)
 
 JOB = Job(3, "/subs/ann/spin.py", "spin.py", (Render(("time=1",), (4, 2)), Render((), (2, 2), 4, explain=(1, 0))),
           timeout=5.0, describe=True)
@@ -102,3 +103,64 @@ def test_no_gl_is_retried_once_then_stops_the_run() -> None:
     assert results == {3: no_gl} and done == []
     fine = JobResult(Job(4, None, "phong", ()), [Picture()])
     assert settle(fine.job, fine, pending, retried, results, done.append) is False and done == [fine]
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="F_SETPIPE_SZ is Linux's")
+def test_a_wide_pipe_takes_a_whole_picture_in_one_write() -> None:
+    """A 320x240 picture and its header go in one write that does not wait for the reader
+    (a pipe of 64 KiB takes five)."""
+    import fcntl
+
+    read_end, write_end = os.pipe()
+    try:
+        os.set_blocking(write_end, False)
+        wide_pipe(write_end)
+        assert fcntl.fcntl(write_end, fcntl.F_GETPIPE_SZ) >= 1 << 20
+        message = bytes(320 * 240 * 4 + 4096)
+        assert os.write(write_end, message) == len(message)
+    finally:
+        os.close(read_end)
+        os.close(write_end)
+
+
+PRINTING_LESSON = """from glsandbox.geometry import builtin_mesh
+from glsandbox.lesson import Lesson
+from glsandbox.scene import Node, Scene
+
+
+class Printer(Lesson):
+    def build(self):
+        print("built by {name}")
+        return Scene("printer", nodes=[Node("cube", mesh=builtin_mesh("cube24"))])
+"""
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="the tree's processes are found through /proc")
+def test_the_run_ends_with_every_supervisor_cleaned_up_and_every_output_kept(gl_renderer, tmp_path: Path) -> None:
+    """Each supervisor sends its result before it cleans up (the grader starts the next
+    submission meanwhile); the output printed before the picture still comes back, and when
+    ``run_jobs`` returns no process it started and no private folder is left."""
+    import tempfile
+
+    from glsandbox.grading.isolate import run_jobs
+    from glsandbox.grading.processes import descendants
+
+    jobs = []
+    for n in range(4):
+        (tmp_path / f"s{n}.py").write_text(PRINTING_LESSON.format(name=f"student {n}"))
+        jobs.append(Job(n, str(tmp_path / f"s{n}.py"), f"s{n}.py", (Render((), (32, 24)),), timeout=20.0))
+    before = set(Path(tempfile.gettempdir()).glob("glsandbox-grade-*"))
+    results = run_jobs(jobs, 2, lambda result: None)
+    assert [r.pictures[0].image.shape for r in results] == [(24, 32, 4)] * 4
+    assert [r.output for r in results] == [[f"built by student {n}"] for n in range(4)]
+    assert descendants(os.getpid()) == []
+    # the temp folder is the machine's: other runs' folders may come and go; none may hold ours
+    for folder in set(Path(tempfile.gettempdir()).glob("glsandbox-grade-*")) - before:
+        assert not any(f"student {n}" in _text_or_empty(folder / "submission" / f"s{n}.py") for n in range(4))
+
+
+def _text_or_empty(path: Path) -> str:
+    try:
+        return path.read_text()
+    except OSError:  # not there (another run's folder, or gone while looked at)
+        return ""

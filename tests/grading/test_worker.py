@@ -97,3 +97,34 @@ def test_the_output_tail_is_its_last_lines_each_cut(tmp_path: Path) -> None:
     tail = worker._tail(str(log))
     assert len(tail) == TAIL_LINES and tail[-1] == "last \\xff" and tail[-2] == "y" * TAIL_WIDTH
     assert worker._tail(str(tmp_path / "missing.log")) == []
+
+
+@pytest.mark.parametrize("root, python_readable, expected", [(True, False, 1), (True, True, 0), (False, False, 0)])
+def test_the_zygote_works_out_the_readable_etc_once_where_renderers_need_it(
+        monkeypatch: pytest.MonkeyPatch, root: bool, python_readable: bool, expected: int) -> None:
+    """A renderer that keeps reading as root does is granted only what of /etc a user with no
+    account may read: the zygote walks /etc before any fork, so no renderer walks it again."""
+    from glsandbox.grading import layers, sandbox
+
+    monkeypatch.setattr(layers, "submission_ids", lambda seed: (1_870_000_001, 1_870_000_001) if root else None)
+    monkeypatch.setattr(worker, "_python_readable", lambda: python_readable)
+    monkeypatch.setattr(sandbox, "landlock_abi", lambda: 1)
+    sandbox.others_may_read.cache_clear()
+    worker.prepare_confinement()
+    walked = sandbox.others_may_read.cache_info()
+    assert (walked.currsize > 0) == bool(expected)
+    if expected:  # what confine asks for next is already there: a hit, no walk
+        sandbox.others_may_read("/etc")
+        assert sandbox.others_may_read.cache_info().hits == walked.hits + 1
+        assert sandbox.others_may_read.cache_info().currsize == walked.currsize
+
+
+def test_the_zygote_freezes_its_heap_before_it_serves() -> None:
+    """Every object the zygote made while preloading is in the permanent generation by the time it
+    forks: a renderer's collector never walks them (and copies their pages)."""
+    code = ("import gc, os, sys; from glsandbox.grading import worker; "
+            "worker.zygote = lambda fd: (print(gc.get_freeze_count(), len(gc.get_objects()), flush=True), os._exit(0)); "
+            "worker.zygote_main(-1)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=True).stdout
+    frozen, tracked = map(int, out.split())
+    assert frozen > 10_000 and tracked < frozen // 10
