@@ -212,4 +212,17 @@ def material_constants(material: Material, lit: bool) -> tuple[tuple[str, bytes]
     constants.append(("u_alpha_cutoff", _float_bytes(material.alpha_cutoff)))
     if material.texture is not None:
         constants.append(("u_texture", _UNIT_0))
-    return tuple(constants)
+    found = tuple(constants)
+    kept = _KEPT_CONSTANTS.get(found)
+    if kept is None:
+        if len(_KEPT_CONSTANTS) >= _MATRICES_KEPT:
+            _KEPT_CONSTANTS.clear()
+        kept = _KEPT_CONSTANTS[found] = found
+    return kept
+
+
+#: Each set of material constants once (by value): draws whose materials write the same bytes (a
+#: scene's white textured ground and cube, one program's two quads) share one tuple, so the
+#: executor sees that the program holds them already (``written[_CONSTANTS] is`` the draw's:
+#: :meth:`~glsandbox.gl.executor.Executor.draw_node`) and compares nothing.
+_KEPT_CONSTANTS: dict[tuple[tuple[str, bytes], ...], tuple[tuple[str, bytes], ...]] = {}
