@@ -345,7 +345,9 @@ class Executor(GpuMeshes):
         """
         if material is None:
             material = node.material
-        step = self._prepared_draw(node, draw, material, front_face)
+        step = self._steps[(id(draw), front_face)]  # (_prepared_draw's kept step, inline: every draw)
+        if step is None or step.draw is not draw or step.material is not material or step.mesh is not node.mesh:
+            step = self._prepared_draw(node, draw, material, front_face)
         setup = step.setup
         own: dict[str, object] = {}
         if step.user is not None:  # a node's own shader: checked before anything is drawn with it

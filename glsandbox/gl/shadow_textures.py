@@ -39,8 +39,10 @@ class ShadowMaps:
         self.float_depth: dict[tuple[int, int], bool] = {}
         self._maps: dict[tuple[int, int], tuple[moderngl.Texture, moderngl.Framebuffer]] = {}
         #: light -> (its map's texture, light projection @ view (float64), its ShadowMap, the
-        #: matrix's uniform bytes by the receiving pass's origin, a texel's width at unit distance)
-        self._current: dict[int, tuple[moderngl.Texture, np.ndarray, ShadowMap, dict[bytes, bytes], float]] = {}
+        #: receivers' uniforms (:meth:`use`'s answer) by the receiving pass's origin and the unit, a
+        #: texel's width at unit distance)
+        self._current: dict[int, tuple[moderngl.Texture, np.ndarray, ShadowMap,
+                                       dict[tuple[bytes, int], tuple[tuple[str, bytes], ...]], float]] = {}
 
     def target(self, light: int, size: int) -> tuple[moderngl.Texture, moderngl.Framebuffer]:
         key = (light, size)
@@ -73,14 +75,15 @@ class ShadowMaps:
         texture, matrix, settings, relative, footprint = self._current[light]
         texture.use(unit)
         key = b"" if origin is None else np.asarray(origin, dtype=np.float64).tobytes()
-        data = relative.get(key)
-        if data is None:
+        found = relative.get((key, unit))  # (every receiver of a pass asks with the same origin)
+        if found is None:
             moved = matrix.copy()
             if origin is not None:
                 moved[:, 3] += matrix[:, :3] @ np.asarray(origin, dtype=np.float64)  # M @ T(o)
-            data = relative[key] = transforms.gl_bytes(moved)
-        return (*_settings_bytes(unit, settings), ("u_shadow_footprint", struct.pack("f", footprint)),
-                ("u_shadow_matrix", data))
+            found = relative[key, unit] = (*_settings_bytes(unit, settings), ("u_shadow_footprint",
+                                                                             struct.pack("f", footprint)),
+                                           ("u_shadow_matrix", transforms.gl_bytes(moved)))
+        return found
 
     def bind(self, light: int, unit: int, program: moderngl.Program, members: Collection[str],
              origin: np.ndarray | None = None) -> None:

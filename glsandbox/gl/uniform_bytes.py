@@ -115,9 +115,16 @@ class _MatrixBytes(dict):
 
 def _relative_model_bytes(key: bytes) -> bytes:
     """``m_model``'s bytes for ``key``: a float64 model matrix's 128 bytes, then the pass origin's
-    24 (:class:`PassCamera`): ``T(-origin) @ model`` formed in float64, rounded to float32 once."""
+    24 (:class:`PassCamera`; none: the origin at 0): ``T(-origin) @ model`` formed in float64,
+    rounded to float32 once."""
     matrix = np.frombuffer(key[:128]).reshape(4, 4)
-    relative = matrix - np.outer(np.append(np.frombuffer(key[128:]), 0.0), matrix[3])  # row i − o_i·row 3
+    if len(key) == 128:
+        return transforms.gl_bytes(matrix)
+    relative = matrix.copy()
+    # Row i − o_i·row 3 for the first three rows (T(-o)'s rows), row 3 kept: the same products and
+    # differences as ``matrix - outer((o, 0), row 3)``, without numpy's Python-level wrappers
+    # (outer, append), which cost more than the arithmetic on a 4x4 (a moving node, every frame).
+    relative[:3] -= np.frombuffer(key[128:])[:, None] * matrix[3]
     return transforms.gl_bytes(relative)
 
 
@@ -205,4 +212,17 @@ def material_constants(material: Material, lit: bool) -> tuple[tuple[str, bytes]
     constants.append(("u_alpha_cutoff", _float_bytes(material.alpha_cutoff)))
     if material.texture is not None:
         constants.append(("u_texture", _UNIT_0))
-    return tuple(constants)
+    found = tuple(constants)
+    kept = _KEPT_CONSTANTS.get(found)
+    if kept is None:
+        if len(_KEPT_CONSTANTS) >= _MATRICES_KEPT:
+            _KEPT_CONSTANTS.clear()
+        kept = _KEPT_CONSTANTS[found] = found
+    return kept
+
+
+#: Each set of material constants once (by value): draws whose materials write the same bytes (a
+#: scene's white textured ground and cube, one program's two quads) share one tuple, so the
+#: executor sees that the program holds them already (``written[_CONSTANTS] is`` the draw's:
+#: :meth:`~glsandbox.gl.executor.Executor.draw_node`) and compares nothing.
+_KEPT_CONSTANTS: dict[tuple[tuple[str, bytes], ...], tuple[tuple[str, bytes], ...]] = {}

@@ -109,6 +109,7 @@ class LightBytes:
     def __init__(self) -> None:
         # by id of the lights tuple and the pass origin (the tuple kept to check)
         self._cache: dict[tuple[int, bytes], tuple[tuple[Light, ...], bytes, bytes]] = {}
+        self._colors: dict[tuple, bytes] = {}  # u_light_color's bytes by the lights' colours
 
     def __call__(self, lights: tuple[Light, ...], camera: PassCamera) -> tuple[bytes, bytes]:
         key = (id(lights), camera.origin_bytes)
@@ -117,6 +118,11 @@ class LightBytes:
             if len(self._cache) >= self.KEPT:
                 self._cache.clear()
             positions = np.array([l.position for l in lights], dtype=np.float64) - camera.origin
-            cached = self._cache[key] = (
-                lights, positions.astype("f4").tobytes(), np.array([l.color for l in lights], dtype="f4").tobytes())
+            colors = tuple(l.color for l in lights)
+            color_bytes = self._colors.get(colors)  # (moving lights keep their colours: made once)
+            if color_bytes is None:
+                if len(self._colors) >= self.KEPT:
+                    self._colors.clear()
+                color_bytes = self._colors[colors] = np.array(colors, dtype="f4").tobytes()
+            cached = self._cache[key] = (lights, positions.astype("f4").tobytes(), color_bytes)
         return cached[1], cached[2]
