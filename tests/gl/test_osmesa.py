@@ -40,6 +40,7 @@ def test_a_path_that_is_not_a_library_file_is_refused_before_loading(monkeypatch
 def test_a_library_without_the_osmesa_entry_points_is_named(monkeypatch) -> None:
     libc = ctypes.util.find_library("c")
     if not libc:
+        assert not (sys.platform == "linux" and os.environ.get("CI")), "CI's Linux has a C library ctypes finds"
         pytest.skip("no C library found by name here")
     assert osmesa._missing_symbol(ctypes.CDLL(libc)) == "OSMesaCreateContextAttribs"
     assert _refused(monkeypatch, libc).endswith(
