@@ -15,6 +15,7 @@ Grading submissions is :mod:`glsandbox.grading`, which uses this wing.
   type and registry), :mod:`~glsandbox.measure.knobs` (the built-in knobs, one module each),
   :mod:`~glsandbox.measure.render_context` (rendering a setting, supersampling),
   :mod:`~glsandbox.measure.tradeoffs` (timing and comparing, :func:`~glsandbox.measure.tradeoffs.run`),
+  :mod:`~glsandbox.measure.timing_pass` (a timing pass in a process of its own),
   :mod:`~glsandbox.measure.tradeoffs_report` (CSV, Markdown, plot) and
   :mod:`~glsandbox.measure.extra` (its optional dependencies, the ``measure`` extra).
 

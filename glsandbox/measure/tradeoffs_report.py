@@ -68,15 +68,15 @@ def write_report(results: Sequence[KnobResult], info: Mapping[str, str], path: P
     """``report.md``: a table per knob, then the ``skipped`` knobs (name: why) under "Not measured yet"."""
     lines = ["# Accuracy against time: the tradeoffs report", "",
              f"Renderer: {info['renderer']} ({info['backend']}); frame {info['size']}; "
-             f"{info.get('passes', '1')} independent passes of {info['runs']} timed rounds, each round every "
-             f"setting of every knob once, the knobs in turn; "
+             f"{info.get('passes', '1')} independent passes of {info['runs']} timed rounds, each pass in a "
+             f"process of its own and each round every setting of every knob once, the knobs in turn; "
              f"{'quick set' if info['quick'] == 'yes' else 'full set'}.", ""]
     if "load" in info:
         lines += [f"Load average (1, 5, 15 min) on {info.get('cpus', '?')} CPUs: {info['load']}. A machine "
                   "busier than its CPUs moves every time; compare runs made at the same load.", ""]
     lines += ["Time is the whole frame as a user gets it: render, read back, and for supersampling the "
               "downsample: the median of all runs ± half the spread of the passes' medians (the run-to-run "
-              f"spread); where the passes differ by more than {WIDE_SPREAD:.0%}, or the load average passed "
+              "spread: another run at the same load should give a figure whose range overlaps); where the passes differ by more than {WIDE_SPREAD:.0%}, or the load average passed "
               f"{BUSY_LOAD_PER_CPU:g} runnable threads a CPU while the passes ran, the time is noise and "
               "the table says \"too noisy\" instead of a figure. Errors are against the knob's reference: "
               "RMSE (0..1 scale), PSNR (dB, higher is better), FLIP (mean perceptual error, 0..1, lower is "

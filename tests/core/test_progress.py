@@ -116,8 +116,8 @@ def test_tradeoffs_counts_every_render_of_a_knob(tmp_path) -> None:
         (tmp_path / folder).mkdir()
     steps: list[int] = []
     tradeoffs.measure_knob(knob, context=None, out=tmp_path, quick=False, runs=5, advance=steps.append)
-    # the bar counts the planned renders (each setting and the reference, once and 5 times in each of 2 passes) ...
-    assert steps == [1] * tradeoffs.knob_renders(knob, quick=False, runs=5) == [1] * (3 * 11)
+    # the bar counts the planned renders (each setting and the reference, once and 5 times in each of 3 passes) ...
+    assert steps == [1] * tradeoffs.knob_renders(knob, quick=False, runs=5) == [1] * (3 * (1 + 5 * tradeoffs.PASSES))
     # ... and cheap settings whose median is not yet stable are timed again beyond them,
     # which no total can know in advance: only re-timings of the settings, never a new picture
     assert len(renders) >= len(steps) and set(renders[len(steps):]) <= {"a", "b", "ref"}

@@ -94,7 +94,7 @@ def test_effects_is_a_parameter_of_every_lesson() -> None:
 @pytest.fixture(scope="module")
 def quick_report(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("tradeoffs")
-    proc = _run("tradeoffs", "--quick", "--out", str(out))
+    proc = _run("tradeoffs", "--quick", "--passes", "2", "--out", str(out))  # two: the least, to keep it short
     assert proc.returncode == 0, proc.stderr
     assert "[1/" in proc.stderr and "timing pass 2/2" in proc.stderr and "load average" in proc.stderr
     return out
@@ -304,6 +304,13 @@ def test_the_measure_extra_is_imported_only_by_tradeoffs_at_work() -> None:
     proc = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip() == "[]"
+
+
+def test_the_commands_passes_default_is_the_measuring_wings() -> None:
+    from glsandbox.cli import build_parser
+    from glsandbox.measure.tradeoffs import PASSES
+
+    assert build_parser("tradeoffs").parse_args(["tradeoffs"]).passes == PASSES >= 3
 
 
 def test_tradeoffs_bad_passes_is_one_line() -> None:
