@@ -76,7 +76,8 @@ def write_report(results: Sequence[KnobResult], info: Mapping[str, str], path: P
                   "busier than its CPUs moves every time; compare runs made at the same load.", ""]
     lines += ["Time is the whole frame as a user gets it: render, read back, and for supersampling the "
               "downsample: the median of all runs ± half the spread of the passes' medians (the run-to-run "
-              "spread: another run at the same load should give a figure whose range overlaps); where the passes differ by more than {WIDE_SPREAD:.0%}, or the load average passed "
+              "spread: another run at the same load should give a figure whose range overlaps); "
+              f"where the passes differ by more than {WIDE_SPREAD:.0%}, or the load average passed "
               f"{BUSY_LOAD_PER_CPU:g} runnable threads a CPU while the passes ran, the time is noise and "
               "the table says \"too noisy\" instead of a figure. Errors are against the knob's reference: "
               "RMSE (0..1 scale), PSNR (dB, higher is better), FLIP (mean perceptual error, 0..1, lower is "

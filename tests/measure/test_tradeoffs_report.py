@@ -32,6 +32,14 @@ def test_the_report_says_whether_errors_fall_along_the_knobs_order(tmp_path) -> 
     assert "Not measured yet" not in falls_text
 
 
+def test_the_report_says_how_its_times_were_taken_with_every_figure_filled_in(tmp_path) -> None:
+    write_report([KnobResult(KNOB, [row("low", 0.1), row("ref", 0.0, True)])], INFO, tmp_path / "r.md")
+    text = (tmp_path / "r.md").read_text(encoding="utf-8")
+    assert "2 independent passes of 5 timed rounds, each pass in a process of its own" in text
+    assert "where the passes differ by more than 20%, or the load average passed 2 runnable threads" in text
+    assert "{" not in text and "}" not in text  # no placeholder left unformatted
+
+
 def test_the_csv_has_a_row_per_setting_in_its_columns(tmp_path) -> None:
     knob = Knob("k", "A knob", "phong", (Setting("MSAA 4x", lambda c: None),), Setting("ref", lambda c: None), "r")
     reference = Row("k", "ref", True, [2.0, 2.0, 2.0], 0.0, float("inf"), None, pass_medians=[2.0, 2.0])
