@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import ast
 import doctest
+import json
 import re
 import shlex
 import subprocess
@@ -123,19 +124,44 @@ def runnable(words: list[str]) -> bool:
     return not any(re.search(r"=\S*\.(obj|ply|stl|glb|gltf|png|off)$", w) for w in words if "=" in w)
 
 
+#: Runs each command of a JSON list through ``glsandbox.cli.main``, as the ``glsandbox`` entry
+#: point does, one after another in one process (a process each spent most of its time starting
+#: Python and importing glsandbox): the exit status and the end of stderr of each.
+RESULTS = "commands' results: "
+COMMANDS_DRIVER = f"""
+RESULTS = {RESULTS!r}
+import contextlib, io, json, sys
+from glsandbox.cli import main
+results = []
+for words in json.loads(sys.stdin.read()):
+    errors = io.StringIO()
+    with contextlib.redirect_stderr(errors):
+        try:
+            status = main(words)
+        except SystemExit as exc:
+            status = exc.code
+    results.append([status, errors.getvalue()[-2000:]])
+print("\\n" + RESULTS + json.dumps(results))
+"""
+
+
 @pytest.mark.slow
 def test_the_headless_commands_in_the_docs_run(tmp_path: Path, gl) -> None:
     """Each render, plan, compare and list line, as written (small pictures where it names no size)."""
-    seen = set()
+    seen: dict[tuple[str, ...], str] = {}
     for page, words in glsandbox_commands():
-        if not runnable(words) or tuple(words) in seen:
-            continue
-        seen.add(tuple(words))
-        extra = ["--size", "64x48"] if words[0] in ("render", "compare") and "--size" not in words else []
-        proc = subprocess.run([sys.executable, "-m", "glsandbox.cli", *words, *extra], cwd=tmp_path,
-                              capture_output=True, text=True, timeout=300)
-        assert proc.returncode == 0, f"{page}: glsandbox {shlex.join(words)}\n{proc.stderr}"
-    assert len(seen) > 30
+        if runnable(words) and tuple(words) not in seen:
+            seen[tuple(words)] = page
+    commands = [[*words, *(["--size", "64x48"] if words[0] in ("render", "compare") and "--size" not in words
+                           else [])] for words in seen]
+    proc = subprocess.run([sys.executable, "-c", COMMANDS_DRIVER], input=json.dumps(commands), cwd=tmp_path,
+                          capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    [line] = [line for line in proc.stdout.splitlines() if line.startswith(RESULTS)]
+    results = json.loads(line[len(RESULTS):])
+    failed = [f"{page}: glsandbox {shlex.join(words)} (exit {status})\n{errors}"
+              for (words, page), (status, errors) in zip(seen.items(), results) if status != 0]
+    assert len(results) == len(seen) > 30 and not failed, failed
     assert (tmp_path / "phong.png").is_file()  # the phong page's render line wrote its picture
 
 
