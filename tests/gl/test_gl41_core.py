@@ -21,6 +21,7 @@ MACOS_GL = {"MESA_GL_VERSION_OVERRIDE": "4.1", "MESA_GLSL_VERSION_OVERRIDE": "41
 #: Run pytest on exactly the tests that compare with a golden image (wherever they live).
 GOLDENS_ONLY = """
 import sys, pytest
+from pathlib import Path
 
 class GoldensOnly:
     def pytest_collection_modifyitems(self, config, items):
@@ -29,9 +30,11 @@ class GoldensOnly:
         items[:] = kept
         print(f"golden tests: {len(kept)}", flush=True)
 
-# -n 0: in this process, where the plugin is (pyproject's -n auto would start workers without it,
-# each running the whole suite, this test again included).
-sys.exit(pytest.main(["tests", "-n", "0", "-q", "-p", "no:cacheprovider", "-x"], plugins=[GoldensOnly()]))
+# Only the files that name the fixture are collected (collecting all of them took longer than
+# running their goldens). -n 0: in this process, where the plugin is (pyproject's -n auto would
+# start workers without it, each running the whole suite, this test again included).
+files = sorted(str(p) for p in Path("tests").rglob("test_*.py") if "golden" in p.read_text(encoding="utf-8"))
+sys.exit(pytest.main([*files, "-n", "0", "-q", "-p", "no:cacheprovider", "-x"], plugins=[GoldensOnly()]))
 """
 
 
