@@ -278,14 +278,9 @@ def test_tradeoffs_without_flip_says_so_in_one_line_and_measures_the_rest(tmp_pa
     from glsandbox.cli import main
     from glsandbox.measure.extra import FLIP_MISSING
 
-    from glsandbox.measure import tradeoffs
-
-    monkeypatch.setitem(sys.modules, "flip_evaluator", None)
-    # The columns are what is checked here: the cheap settings' extra rounds until their medians are
-    # stable (tests/measure/test_tradeoffs.py) are left out, the five rounds kept.
-    monkeypatch.setattr(tradeoffs, "MAX_RUNS", 5)
+    monkeypatch.setitem(sys.modules, "flip_evaluator", None)  # here, where the pictures are compared
     out = tmp_path / "tradeoffs"
-    assert main(["tradeoffs", "--quick", "--knob", "antialiasing", "--out", str(out)]) == 0
+    assert main(["tradeoffs", "--quick", "--knob", "antialiasing", "--passes", "2", "--out", str(out)]) == 0
     err = capsys.readouterr().err
     assert err.count(FLIP_MISSING) == 1 and "FLIP column" in FLIP_MISSING
     rows = list(csv.DictReader((out / "tradeoffs.csv").open(encoding="utf-8")))
