@@ -17,7 +17,9 @@
 // Integers are stored as floats: exact up to 2^24 (the host checks).
 //
 // Defines (with defaults): BVH_TEX_WIDTH (4096), BVH_STACK (64: at least
-// the tree's depth; the host sets it), BVH_MAX_STEPS (8192), BVH_PAD (2^-18).
+// the tree's depth; the host sets it), BVH_MAX_STEPS (8192), BVH_PAD (2^-18),
+// BVH_WIDE (0; 1: the 4-wide tree of common/bvh_wide.glsl, its own record
+// layout, traversed by the same two functions).
 //
 // The loop budget. llvmpipe ends a shader invocation's loops after 65,535
 // iterations IN TOTAL, silently: sequential loops and nested loops share one
@@ -47,6 +49,9 @@
 #endif
 #ifndef BVH_MAX_STEPS
 #define BVH_MAX_STEPS 8192
+#endif
+#ifndef BVH_WIDE
+#define BVH_WIDE 0
 #endif
 #ifndef BVH_PAD
 #define BVH_PAD 3.814697265625e-06
@@ -132,6 +137,9 @@ float bvh_triangle(BvhRay r, int k, bool cull, out int index, out vec2 uv) {
                        cull, uv);
 }
 
+#if BVH_WIDE
+#include "common/bvh_wide.glsl"
+#else
 // The nearest hit with 0 < t < t_max: an ordered, stackful traversal (the
 // nearer child first, the other pushed with its entry distance so it can be
 // skipped once a nearer hit is known). On 8-wide SIMD every loop iteration
@@ -257,6 +265,8 @@ bool bvh_any_at(int root, vec3 o, vec3 d, float t_max, bool cull, out bool overf
     if (!finished) overflow = true;
     return found;
 }
+
+#endif
 
 BvhHit bvh_closest(vec3 o, vec3 d, float t_max, bool cull) { return bvh_closest_at(0, o, d, t_max, cull); }
 bool bvh_any(vec3 o, vec3 d, float t_max, bool cull, out bool overflow) {
