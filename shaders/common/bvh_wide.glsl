@@ -14,7 +14,10 @@
 // The loop is the binary one's (one unit of work an iteration: a triangle of
 // the current leaf, and one node further), so the loop budget, the leaf that
 // waits and the tie rule are as bvh.glsl describes; a visit pushes up to
-// three children (the stack: 3 entries a wide level, the host sets it).
+// three children (the stack: 3 entries a wide level, the host sets it). The
+// walk starts at the root record itself: its four boxes are the first visit
+// (the binary walk tests the root's own box first; here that would be a
+// visit more for every ray that enters it, measured slower on shadow rays).
 
 // The slab test of the four children of record `rec`; `near` their entries
 // (+inf where missed, so that they sort last), `entry` what the traversal
@@ -33,11 +36,14 @@ void bvh4_visit(BvhRay r, int rec, float limit, out vec4 near, out ivec4 entry) 
     ivec4 count = ivec4(texelFetch(u_bvh_nodes, at + ivec2(7, 0), 0));
     vec4 n = max(max(min(ax, bx), min(ay, by)), min(az, bz));
     vec4 f = min(min(max(ax, bx), max(ay, by)), max(az, bz));
-    for (int i = 0; i < 4; ++i) {  // unrolled: constant indices
-        bool hit = n[i] <= f[i] && f[i] >= 0.0 && n[i] <= limit && count[i] >= 0;
-        near[i] = hit ? n[i] : 1.0 / 0.0;
-        entry[i] = !hit ? -1 : (count[i] > 0 ? -2 - (ref[i] * 64 + count[i] - 1) : ref[i]);
-    }
+    // The four tests as vectors (no loop: a loop, even of constant bounds, may count towards
+    // llvmpipe's 65,535 iterations). GLSL 3.30 has no integer mix: selects by arithmetic.
+    uvec4 hit = uvec4(lessThanEqual(n, f)) & uvec4(greaterThanEqual(f, vec4(0.0)))
+              & uvec4(lessThanEqual(n, vec4(limit))) & uvec4(greaterThanEqual(count, ivec4(0)));
+    near = mix(vec4(1.0 / 0.0), n, bvec4(hit));
+    ivec4 leaf = -2 - (ref * 64 + count - 1);
+    ivec4 code = ref + (leaf - ref) * ivec4(greaterThan(count, ivec4(0)));
+    entry = (code + 1) * ivec4(hit) - 1;
 }
 
 // Sorts the children nearest first (a 5-comparator network), misses last.
@@ -57,12 +63,11 @@ BvhHit bvh_closest_at(int root, vec3 o, vec3 d, float t_max, bool cull) {
     int sp = 0;
     vec4 near;
     ivec4 entry;
-    bvh4_visit(r, root, t_max, near, entry);  // a ray that misses all of the root's boxes never loops
-    int node = any(greaterThan(entry, ivec4(-1))) || any(lessThan(entry, ivec4(-1))) ? root : -1;
+    int node = root;  // the root's four boxes: the first iteration's visit
     int waiting = -1;
     int tri = 0;
     int tri_end = 0;
-    bool finished = node == -1;
+    bool finished = false;
     for (int step = 0; step < BVH_MAX_STEPS && !finished; ++step) {
         hit.steps = step + 1;
         if (tri < tri_end) {  // one triangle of the current leaf
@@ -85,13 +90,9 @@ BvhHit bvh_closest_at(int root, vec3 o, vec3 d, float t_max, bool cull) {
                 bvh4_visit(r, node, hit.t, near, entry);
                 bvh4_sort(near, entry);
                 if (sp + 3 > BVH_STACK) { hit.overflow = true; break; }  // never drop a subtree silently
-                for (int i = 3; i > 0; --i) {  // far to near: the nearest pushed is popped first
-                    if (entry[i] != -1) {
-                        stack[sp] = entry[i];
-                        stack_near[sp] = near[i];
-                        ++sp;
-                    }
-                }
+#define BVH4_PUSH(c) if (entry.c != -1) { stack[sp] = entry.c; stack_near[sp] = near.c; ++sp; }
+                BVH4_PUSH(w) BVH4_PUSH(z) BVH4_PUSH(y)  // far to near: the nearest pushed is popped first
+#undef BVH4_PUSH
                 node = entry[0];  // a child hit has a finite near (some axis of d is not 0): never after a miss
             }
             if (node < -1) {
@@ -116,12 +117,11 @@ bool bvh_any_at(int root, vec3 o, vec3 d, float t_max, bool cull, out bool overf
     int sp = 0;
     vec4 near;
     ivec4 entry;
-    bvh4_visit(r, root, t_max, near, entry);
-    int node = any(greaterThan(entry, ivec4(-1))) || any(lessThan(entry, ivec4(-1))) ? root : -1;
+    int node = root;  // the root's four boxes: the first iteration's visit
     int waiting = -1;
     int tri = 0;
     int tri_end = 0;
-    bool finished = node == -1;
+    bool finished = false;
     bool found = false;
     overflow = false;
     for (int step = 0; step < BVH_MAX_STEPS && !finished; ++step) {
@@ -138,15 +138,9 @@ bool bvh_any_at(int root, vec3 o, vec3 d, float t_max, bool cull, out bool overf
                 bvh4_visit(r, node, t_max, near, entry);
                 if (sp + 3 > BVH_STACK) { overflow = true; break; }
                 node = -1;
-                for (int i = 0; i < 4; ++i) {  // the first child hit taken, the others pushed
-                    if (entry[i] != -1) {
-                        if (node == -1) {
-                            node = entry[i];
-                        } else {
-                            stack[sp++] = entry[i];
-                        }
-                    }
-                }
+#define BVH4_TAKE(c) if (entry.c != -1) { if (node == -1) node = entry.c; else stack[sp++] = entry.c; }
+                BVH4_TAKE(x) BVH4_TAKE(y) BVH4_TAKE(z) BVH4_TAKE(w)  // the first child hit taken, the others pushed
+#undef BVH4_TAKE
             }
             if (node < -1) {
                 waiting = node;
