@@ -28,6 +28,12 @@ answer when the ray turns by a few float32 steps (:data:`EDGE_TURN`): there,
 float32 and float64 may rightly disagree. Any other differing pixel is a
 wrong hit or a hole.
 
+Beside the gpu engine's rows, a ``gpu wide BVH`` row per model and mode times the gpu
+engine's two BVH shapes against each other on the same frames: its binary tree
+(baseline) and the same tree collapsed to 4 children a node
+(:mod:`glsandbox.raytrace.bvh_wide`, subject; ``GpuTracer(ctx, wide_bvh=True)``), one
+tracer each; its last column compares their pictures pixel for pixel (any channel).
+
 Beside the gpu engine's rows, when Mitsuba 3 is installed and its LLVM variant
 runs (the ``mitsuba`` group, which needs libLLVM: :mod:`benchmarks._mitsuba`), a
 ``mitsuba`` row per model and mode: Mitsuba's ``llvm_ad_rgb`` casting exactly

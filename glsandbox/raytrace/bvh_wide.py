@@ -136,6 +136,27 @@ def _padded(wide: WideBVH) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     return lo, hi
 
 
+def _keep_nearest(rr: NDArray[np.intp], tris: NDArray[np.intp], t: NDArray[np.float64], limit: NDArray[np.float64],
+                  best_t: NDArray[np.float64], best_tri: NDArray[np.int64], best_slot: NDArray[np.int64],
+                  tri_index: NDArray[np.int64]) -> None:
+    """Fold (ray, stored triangle, t) hits into each ray's best so far (in place), by the course's
+    ``min_indis``: the smallest ``t < t_max`` wins, an equal ``t`` goes to the lower caller's index."""
+    ok = np.flatnonzero((t < limit[rr]) & (t <= best_t[rr]))
+    if not ok.size:
+        return
+    rr, tris, t = rr[ok], tris[ok], t[ok]
+    before = best_t[rr]
+    np.minimum.at(best_t, rr, t)
+    after = best_t[rr]
+    best_tri[rr[after < before]] = np.iinfo(np.int64).max  # a nearer t: the old winner is out
+    at_best = t == after
+    rr, tris = rr[at_best], tris[at_best]
+    index = tri_index[tris]
+    np.minimum.at(best_tri, rr, index)
+    won = index == best_tri[rr]
+    best_slot[rr[won]] = tris[won]
+
+
 def closest_hit_wide(wide: WideBVH, origins: ArrayLike, directions: ArrayLike, t_max: ArrayLike = np.inf, *,
                      cull_backfaces: bool = False) -> Hits:
     """The nearest hit of each ray through the wide tree (float64): a frontier of (ray, record)
@@ -153,7 +174,7 @@ def closest_hit_wide(wide: WideBVH, origins: ArrayLike, directions: ArrayLike, t
     o_pad = BOX_PAD * np.abs(o).max(axis=1)
     with np.errstate(divide="ignore"):
         inv = 1.0 / d
-    best_t, best_tri, best_slot = limit.copy(), np.full(n, np.iinfo(np.int64).max), np.full(n, -1)
+    best_t, best_tri, best_slot = limit.copy(), np.full(n, np.iinfo(np.int64).max), np.full(n, -1, dtype=np.int64)
     rays, recs = np.arange(n), np.zeros(n, dtype=np.int64)
     with np.errstate(invalid="ignore"):
         while rays.size:
@@ -171,10 +192,7 @@ def closest_hit_wide(wide: WideBVH, origins: ArrayLike, directions: ArrayLike, t
                 tris = np.repeat(first - np.cumsum(many) + many, many) + np.arange(int(many.sum()))
                 t, _, _ = watertight_pairs(setup, rr, bvh.v0, bvh.v1, bvh.v2, tris, cull_backfaces,
                                            barycentrics=False)
-                for k in np.flatnonzero(t < limit[rr]):  # few: the tests' rays (min_indis, one at a time)
-                    ray, index = rr[k], bvh.tri_index[tris[k]]
-                    if t[k] < best_t[ray] or (t[k] == best_t[ray] and index < best_tri[ray]):
-                        best_t[ray], best_tri[ray], best_slot[ray] = t[k], index, tris[k]
+                _keep_nearest(rr, tris, t, limit, best_t, best_tri, best_slot, bvh.tri_index)
             pair, slot = np.nonzero(keep & (count[recs] == 0) & (wide.child[recs] >= 0))
             rays, recs = rays[pair], ref[recs[pair], slot]
     hit = np.flatnonzero(best_slot >= 0)
