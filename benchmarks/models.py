@@ -28,6 +28,12 @@ answer when the ray turns by a few float32 steps (:data:`EDGE_TURN`): there,
 float32 and float64 may rightly disagree. Any other differing pixel is a
 wrong hit or a hole.
 
+Beside the gpu engine's rows, a ``gpu wide BVH`` row per model and mode times the gpu
+engine's two BVH shapes against each other on the same frames: its binary tree
+(baseline) and the same tree collapsed to 4 children a node
+(:mod:`glsandbox.raytrace.bvh_wide`, subject; ``GpuTracer(ctx, wide_bvh=True)``), one
+tracer each; its last column compares their pictures pixel for pixel (any channel).
+
 Beside the gpu engine's rows, when Mitsuba 3 is installed and its LLVM variant
 runs (the ``mitsuba`` group, which needs libLLVM: :mod:`benchmarks._mitsuba`), a
 ``mitsuba`` row per model and mode: Mitsuba's ``llvm_ad_rgb`` casting exactly
@@ -70,6 +76,8 @@ SIZES = (1_000, 10_000, 100_000, 1_000_000)
 #: The goals as time ratios against Embree.
 GOALS = {"gpu": 1.0, "numpy": 5.0}
 ENGINE_LABELS = {"gpu": "gpu engine (GLSL float32)", "numpy": "numpy engine (float64)"}
+#: The gpu engine's two BVH shapes, timed against each other (``gpu.BVH_WIDE``).
+WIDE_LABELS = {False: "gpu engine, binary BVH", True: "gpu engine, 4-wide BVH"}
 MITSUBA_NOTE = ("ratio = Mitsuba time / Embree time for the same rays; kernel compiled at the warm-up, "
                 "not timed; Dr.Jit on all cores, the CPU column counts its main thread only")
 BACKGROUND = (1.0, 0.0, 1.0, 1.0)  # magenta: no shade of the grey model
@@ -154,6 +162,13 @@ class HitMiss:
         return f"hit/miss: {differ.size:,} of {engine_hit.size:,} px differ from Embree, {share} at an edge"
 
 
+def same_pixels(binary: np.ndarray, wide: np.ndarray) -> str:
+    """``pixels: identical`` or how many of the two BVHs' pictures differ (any channel)."""
+    differ = int(np.count_nonzero(np.any(np.asarray(binary) != np.asarray(wide), axis=-1)))
+    total = int(np.asarray(binary).shape[0] * np.asarray(binary).shape[1])
+    return "pixels: identical to the binary BVH's" if differ == 0 else f"pixels: {differ:,} of {total:,} differ"
+
+
 def cases(env: Any) -> list:
     """``glsandbox bench`` cases: per model, mode and engine, the engine against Embree.
 
@@ -179,22 +194,24 @@ def cases(env: Any) -> list:
             references[label] = HitMiss(label, size)
         return references[label]
 
-    tracers: dict[str, Any] = {}
+    tracers: dict[tuple[str, bool | None], Any] = {}
 
-    def engine(label: str, mode: str, kind: str) -> Side:
+    def engine(label: str, mode: str, kind: str, wide: bool | None = None) -> Side:
         def run(_: int) -> np.ndarray:
             scene = model_scene(label)
             if kind == "numpy":
                 return render(scene, size, **MODES[mode])
             # One tracer per model, as Embree keeps one scene per case: the context's own
             # tracer keeps only its last few uploads, and five models would evict each other.
-            if label not in tracers:
+            # ``wide``: the BVH's shape (None: the engine's default, gpu.BVH_WIDE).
+            if (label, wide) not in tracers:
                 from glsandbox.raytrace.gpu import GpuTracer
 
-                tracers[label] = GpuTracer(env.renderer.host.ctx)
-            return tracers[label].render_viewport(scene, size, **MODES[mode])
+                tracers[label, wide] = GpuTracer(env.renderer.host.ctx, wide_bvh=wide)
+            return tracers[label, wide].render_viewport(scene, size, **MODES[mode])
 
-        return Side(ENGINE_LABELS[kind], run)
+        label_of = ENGINE_LABELS[kind] if wide is None else WIDE_LABELS[wide]
+        return Side(label_of, run)
 
     def embree(label: str, mode: str) -> Side:
         return embree_side(lambda: model_scene(label), size, mode)
@@ -236,6 +253,9 @@ def cases(env: Any) -> list:
                 found.append(Case(GROUP, f"{name}, {mode}, {kind}", embree(label, mode), engine(label, mode, kind),
                                   repeat=1, unit="s", goal=GOALS[kind], compare=hit_miss(label),
                                   note="ratio = engine time / Embree time for the same rays"))
+            found.append(Case(GROUP, f"{name}, {mode}, gpu wide BVH", engine(label, mode, "gpu", False),
+                              engine(label, mode, "gpu", True), repeat=1, unit="s", compare=same_pixels,
+                              note="ratio = 4-wide BVH time / binary BVH time, the gpu engine, the same frames"))
             if mitsuba_why is None:
                 found.append(Case(GROUP, f"{name}, {mode}, mitsuba", embree(label, mode),
                                   mitsuba_side(lambda label=label: model_scene(label), size, mode, BACKGROUND),

@@ -686,6 +686,16 @@ def random_rays(seed: int, count: int, spread: float = 6.0) -> tuple[np.ndarray,
     return rng.uniform(-spread, spread, (count, 3)), rng.normal(size=(count, 3))
 
 
+def soup_and_rays(seed: int, count: int, limited: bool, rays: int = 300) -> tuple[np.ndarray, ...]:
+    """``(a, b, c, o, d, t_max)``: :func:`triangle_soup` and :func:`random_rays`, the first 50 rays
+    aimed straight at vertices, ``t_max`` random per ray (``limited``) or infinite."""
+    a, b, c = triangle_soup(seed, count)
+    o, d = random_rays(seed, rays)
+    d[:50] = a[np.arange(50) % count] - o[:50]
+    t_max = np.random.default_rng(seed).uniform(0.2, 3.0, len(o)) if limited else np.full(len(o), np.inf)
+    return a, b, c, o, d, t_max
+
+
 def assert_same_hits(got, want) -> None:
     np.testing.assert_array_equal(got.triangle, want.triangle)
     np.testing.assert_array_equal(got.t, want.t)

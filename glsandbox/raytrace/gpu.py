@@ -133,6 +133,7 @@ import ctypes
 import hashlib
 import sys
 from collections.abc import Iterable, Iterator
+from typing import TYPE_CHECKING
 
 import moderngl
 import numpy as np
@@ -147,6 +148,9 @@ from glsandbox.raytrace.watertight import nondegenerate
 from glsandbox.raytrace.shapes import glsl_dispatch
 from glsandbox.raytrace.world import MODES, NodeKind, World, build_world, camera_basis, kind_defines
 from glsandbox.scene import Scene
+
+if TYPE_CHECKING:
+    from glsandbox.raytrace.bvh import BVH
 
 __all__ = ["LOOP_LIMIT", "GpuTracer", "MAX_TEXTURES", "check_loop_budget", "gpu_tracer"]
 
@@ -198,6 +202,11 @@ BVH_TRIANGLES = 64
 #: against 4): 2 took 0.96/0.94x on the 1k terrain, 0.99/1.00x on the bunny,
 #: 0.97/0.97x on 100k; 1 took 1.04-1.09x of 2's, 3 0.98-1.03x, 8 1.07-1.15x of 4's.
 BVH_LEAF_SIZE = 2
+#: Whether a :class:`GpuTracer` traces its meshes through the 4-wide tree
+#: (:mod:`glsandbox.raytrace.bvh_wide`, ``BVH_WIDE`` in ``shaders/common/bvh.glsl``)
+#: rather than the binary one; the same pictures either way. ``GpuTracer(ctx, wide_bvh=...)``
+#: chooses per tracer (what benchmarks/models.py compares side by side).
+BVH_WIDE = False
 #: A BVH render is refused when the budget leaves a ray fewer steps than this.
 BVH_MIN_STEPS = 256
 
@@ -471,6 +480,29 @@ def _return_freed_memory() -> None:
         pass
 
 
+def _packed_bvh(bvh: BVH, wide: bool, tri_offset: int, record_offset: int
+                ) -> tuple[NDArray[np.float32], NDArray[np.float32], int, int]:
+    """``(nodes, tris, texels a record, stack)`` of one mesh node's BVH, packed for
+    ``shaders/common/bvh.glsl`` (:func:`~glsandbox.raytrace.gpu_bvh.pack_bvh`, or
+    :func:`~glsandbox.raytrace.gpu_bvh.pack_wide` of its 4-wide collapse), its refs moved
+    to where its records and triangles start in the shared textures."""
+    from glsandbox.raytrace.bvh_wide import collapse
+    from glsandbox.raytrace.gpu_bvh import RECORD_TEXELS, WIDE_RECORD_TEXELS, pack_bvh, pack_wide, wide_stack
+
+    if wide:
+        tree = collapse(bvh)
+        nodes, tris = pack_wide(tree)
+        records = nodes.reshape(-1, WIDE_RECORD_TEXELS, 4)  # a view: texel 6 the refs, 7 the counts
+        count = records[:, 7]
+        records[:, 6] += np.where(count > 0, tri_offset, np.where(count == 0, record_offset, 0)).astype(np.float32)
+        return nodes, tris, WIDE_RECORD_TEXELS, wide_stack(tree.depth)
+    nodes, tris = pack_bvh(bvh)
+    children = nodes.reshape(-1, 2, 4)  # (box min, ref), (box max, count) per child: a view
+    leaf = children[:, 1, 3] > 0
+    children[:, 0, 3] += np.where(leaf, tri_offset, record_offset).astype(np.float32)
+    return nodes, tris, RECORD_TEXELS, max(2, bvh.depth + 1)
+
+
 class _Uploaded:
     """One scene's World on the context: its records and images, kept between renders.
 
@@ -482,9 +514,11 @@ class _Uploaded:
     """
 
     def __init__(self, ctx: moderngl.Context, world: World, key: tuple[object, ...], block_records: int,
-                 relative: bool = True) -> None:
+                 relative: bool = True, wide: bool = False) -> None:
         self.key = key
         self.world = world
+        #: The BVHs uploaded as 4-wide trees (:data:`BVH_WIDE`).
+        self.wide = wide
         #: Every uploaded position is relative to this point (:func:`world_anchor`; the
         #: origin for ``relative=False``, world-space float32, what the tradeoffs knob shows).
         self.anchor = world_anchor(world) if relative else np.zeros(3)
@@ -576,15 +610,15 @@ class _Uploaded:
         if self.bvh_stack:
             return self.bvh_stack
         from glsandbox.raytrace.bvh import build_bvh
-        from glsandbox.raytrace.gpu_bvh import RECORD_TEXELS, TEX_WIDTH as BVH_TEX_WIDTH, _texture, pack_bvh
-        from glsandbox.raytrace.gpu_bvh import texture_from_chunks
+        from glsandbox.raytrace.gpu_bvh import TEX_WIDTH as BVH_TEX_WIDTH, _texture, texture_from_chunks
 
         world = self.world
         node_parts: list[NDArray[np.float32]] = []
         tri_parts: list[NDArray[np.float32]] = []
         roots: list[int] = []
         record_offset = tri_offset = 0
-        depth = 1
+        stack = 2  # the deepest of the BVHs' stacks
+        record_texels = 4
         for k in node_order(world)[: self.mesh_count]:
             node = world.nodes[k]
             stop = node.start + node.count
@@ -597,21 +631,18 @@ class _Uploaded:
                 corners = tuple(v[rows] - self.anchor for v in (world.v0, world.v1, world.v2))
             bvh = build_bvh(*corners, leaf_size=BVH_LEAF_SIZE)
             del corners
-            nodes, tris = pack_bvh(bvh)
-            depth = max(depth, bvh.depth)
+            nodes, tris, record_texels, needs = _packed_bvh(bvh, self.wide, tri_offset, record_offset)
+            stack = max(stack, needs)
             del bvh  # its float64 arrays: the records hold what the shader reads
-            children = nodes.reshape(-1, 2, 4)  # (box min, ref), (box max, count) per child: a view
             tris = tris.reshape(-1, 3, 4)
-            leaf = children[:, 1, 3] > 0
-            children[:, 0, 3] += np.where(leaf, tri_offset, record_offset).astype(np.float32)
             tris[:, 0, 3] += node.start
             roots.append(record_offset)
-            record_offset += nodes.shape[0] // RECORD_TEXELS
+            record_offset += nodes.shape[0] // record_texels
             tri_offset += tris.shape[0]
             node_parts.append(nodes)
             tri_parts.append(tris.reshape(-1, 4))
             del nodes, tris
-        if RECORD_TEXELS * record_offset > (1 << 24) or 3 * tri_offset > (1 << 24):
+        if record_texels * record_offset > (1 << 24) or 3 * tri_offset > (1 << 24):
             raise RayTraceError(f"the gpu BVH holds at most {(1 << 24) // 3:,} triangles, this scene has {tri_offset:,}")
         # The parts written one after the other (no concatenated copy), each freed once written.
         for name, parts in (("u_bvh_nodes", node_parts), ("u_bvh_tris", tri_parts)):
@@ -620,7 +651,7 @@ class _Uploaded:
         root_rows = np.zeros((max(1, len(roots)), 4), dtype=np.float32)
         root_rows[: len(roots), 0] = roots
         self.textures["u_bvh_roots"] = _texture(ctx, root_rows, root_rows.shape[0])
-        self.bvh_stack = max(2, depth + 1)
+        self.bvh_stack = stack
         return self.bvh_stack
 
     def defines(self, cull: bool | None) -> tuple[tuple[str, str], ...]:
@@ -727,8 +758,10 @@ class GpuTracer:
     #: Program variants kept (compiled again when needed after that).
     KEEP_PROGRAMS = 32
 
-    def __init__(self, ctx: moderngl.Context) -> None:
+    def __init__(self, ctx: moderngl.Context, wide_bvh: bool | None = None) -> None:
         self.ctx = ctx
+        #: This tracer's meshes go through 4-wide BVHs (None: :data:`BVH_WIDE`, read now).
+        self.wide_bvh = BVH_WIDE if wide_bvh is None else bool(wide_bvh)
         self._programs: dict[tuple[tuple[str, str], ...], moderngl.Program] = {}
         self._vaos: dict[tuple[tuple[str, str], ...], moderngl.VertexArray] = {}
         self._targets: dict[tuple[int, int], tuple[moderngl.Texture, moderngl.Framebuffer]] = {}
@@ -787,7 +820,7 @@ class GpuTracer:
                 self._scenes.insert(0, self._scenes.pop(i))
                 self.reuses += 1
                 return entry
-        entry = _Uploaded(self.ctx, world, key, self.block_records, relative)
+        entry = _Uploaded(self.ctx, world, key, self.block_records, relative, self.wide_bvh)
         self.uploads += 1
         self._scenes.insert(0, entry)
         while len(self._scenes) > self.KEEP_SCENES:
@@ -829,7 +862,8 @@ class GpuTracer:
             use_bvh = True
             cap = bvh_step_cap(world, lights, bool(shadows), reflect, int(max_depth))
             stack = uploaded.bvh_textures(self.ctx)
-            scene_defines += (("BVH", "1"), ("BVH_STACK", str(stack)), ("BVH_MAX_STEPS", str(cap)))
+            scene_defines += (("BVH", "1"), ("BVH_STACK", str(stack)), ("BVH_MAX_STEPS", str(cap)),
+                              ("BVH_WIDE", str(int(uploaded.wide))))
         program, vao = self._program(lights, len(world.textures), shadows=bool(shadows), reflect=reflect,
                                      kinds=uploaded.kinds,
                                      scene=scene_defines)

@@ -46,13 +46,15 @@ from numpy.typing import ArrayLike, NDArray
 from glsandbox.gl.shaders import compile_program
 from glsandbox.plan import ProgramVariant
 from glsandbox.raytrace.bvh import BVH
+from glsandbox.raytrace.bvh_wide import WIDTH, WideBVH, collapse
 from glsandbox.raytrace.constants import glsl_defines
 from glsandbox.raytrace.raytrace_error import RayTraceError
 from glsandbox.raytrace.shape_protocol import broadcast_rays
 from glsandbox.raytrace.world import camera_basis
 from glsandbox.scene import Camera
 
-__all__ = ["EXACT_INTEGERS", "LOOP_LIMIT", "MAX_STEPS", "RECORD_TEXELS", "TEX_WIDTH", "GpuBVH", "GpuHits", "pack_bvh"]
+__all__ = ["EXACT_INTEGERS", "LOOP_LIMIT", "MAX_STEPS", "RECORD_TEXELS", "TEX_WIDTH", "WIDE_RECORD_TEXELS", "GpuBVH",
+           "GpuHits", "pack_bvh", "pack_wide", "wide_stack"]
 
 #: Texels per row of the node and triangle textures (``BVH_TEX_WIDTH`` in the shader): a power of
 #: two (the shader takes a texel's row and column with a shift and a mask, and a node record's
@@ -78,6 +80,12 @@ def _outward(values: NDArray[np.float64], down: bool) -> NDArray[np.float32]:
 
 #: Texels per node record (``BVH_RECORD`` in ``bvh.glsl``): two children, two texels each.
 RECORD_TEXELS: int = 4
+
+
+def wide_stack(depth: int) -> int:
+    """The stack a 4-wide tree of ``depth`` levels needs: a visit keeps one child and pushes
+    the other three at most, so a walk down ``depth`` levels holds ``3·depth`` entries at most."""
+    return max(2, (WIDTH - 1) * depth + 1)
 
 
 def pack_bvh(bvh: BVH) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
@@ -111,10 +119,49 @@ def pack_bvh(bvh: BVH) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
     child(0, 0, 0)
     child(record_of[inner], bvh.node_first[inner], 0)
     child(record_of[inner], bvh.node_first[inner] + 1, 1)
+    _pack_triangles(bvh, tris)
+    return records.reshape(-1, 4), tris.reshape(-1, 4)
+
+
+def _pack_triangles(bvh: BVH, tris: NDArray[np.float32]) -> None:
+    """The stored triangles into ``tris`` ``(M, 3, 4)``: ``(v0, caller's index), (v1, 0), (v2, 0)``."""
     if bvh.triangle_count:
         tris[:, 0, :3], tris[:, 1, :3], tris[:, 2, :3] = bvh.v0, bvh.v1, bvh.v2
         tris[:, 0, 3] = bvh.tri_index
-    return records.reshape(-1, 4), tris.reshape(-1, 4)
+
+
+#: Texels per record of the 4-wide tree (``shaders/common/bvh_wide.glsl``): six planes of the
+#: four child boxes, their refs, their counts.
+WIDE_RECORD_TEXELS: int = 8
+
+
+def pack_wide(wide: WideBVH) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
+    """The node and triangle records of a 4-wide tree (``bvh_wide.glsl``'s layout): record ``r``
+    is texels ``8r .. 8r+7``, one plane (min x, y, z, max x, y, z) of its four child boxes per
+    texel, then the children's refs and counts (``-1``: an empty slot). The triangles as
+    :func:`pack_bvh`'s; the boxes rounded outwards as there."""
+    bvh = wide.bvh
+    records = wide.record_count
+    if records * WIDE_RECORD_TEXELS > EXACT_INTEGERS or bvh.triangle_count * 3 > EXACT_INTEGERS or \
+            bvh.input_count > EXACT_INTEGERS:
+        raise RayTraceError(f"the gpu BVH holds at most {EXACT_INTEGERS // 3:,} triangles and "
+                            f"{EXACT_INTEGERS // WIDE_RECORD_TEXELS:,} wide nodes; this one has "
+                            f"{bvh.triangle_count:,} and {records:,}")
+    packed = np.zeros((records, WIDE_RECORD_TEXELS, WIDTH), dtype=np.float32)  # record, texel, child
+    tris = np.zeros((max(1, bvh.triangle_count), 3, 4), dtype=np.float32)
+    ref, count, used = wide.slots()
+    if bvh.empty:
+        # As pack_bvh's: one leaf of one zero-area triangle, which is never hit.
+        count, used = np.array([[1, 0, 0, 0]]), np.array([[True, False, False, False]])
+    node = np.where(used, wide.child, 0)
+    packed[:, 0:3] = np.moveaxis(_outward(bvh.node_min[node], down=True), 2, 1)
+    packed[:, 3:6] = np.moveaxis(_outward(bvh.node_max[node], down=False), 2, 1)
+    if bvh.empty:
+        packed[:, 0:6] = 0.0
+    packed[:, 6] = ref
+    packed[:, 7] = np.where(used, count, -1)
+    _pack_triangles(bvh, tris)
+    return packed.reshape(-1, 4), tris.reshape(-1, 4)
 
 
 @dataclass
@@ -190,17 +237,24 @@ def texture_from_chunks(ctx: moderngl.Context, chunks: Iterable[NDArray[np.float
 class GpuBVH:
     """A BVH uploaded to ``ctx``, with the probe programs that trace rays through it."""
 
-    def __init__(self, ctx: moderngl.Context, bvh: BVH, *, max_steps: int = MAX_STEPS) -> None:
+    def __init__(self, ctx: moderngl.Context, bvh: BVH, *, max_steps: int = MAX_STEPS, wide: bool = False) -> None:
         if int(max_steps) != max_steps or not 1 <= max_steps <= LOOP_LIMIT - 16:
             raise RayTraceError(f"max_steps must be an integer in 1..{LOOP_LIMIT - 16}, got {max_steps!r}")
         self.ctx = ctx
         self.bvh = bvh
         self.max_steps = int(max_steps)
-        nodes, tris = pack_bvh(bvh)
+        #: Traced as the 4-wide tree (:mod:`glsandbox.raytrace.bvh_wide`, ``BVH_WIDE``) or the binary one.
+        self.wide = bool(wide)
+        if self.wide:
+            tree = collapse(bvh)
+            nodes, tris = pack_wide(tree)
+            #: The shader's stack (:func:`wide_stack`; binary: one entry a level at most).
+            self.stack = wide_stack(tree.depth)
+        else:
+            nodes, tris = pack_bvh(bvh)
+            self.stack = max(2, bvh.depth + 1)
         self._nodes = _texture(ctx, nodes, TEX_WIDTH)
         self._tris = _texture(ctx, tris, TEX_WIDTH)
-        #: The shader's stack: the ordered traversal pushes at most one entry per level.
-        self.stack = max(2, bvh.depth + 1)
         self._programs: dict[tuple[bool, bool], tuple[moderngl.Program, moderngl.VertexArray]] = {}
         #: The two float result targets, their framebuffer and the host arrays they are read
         #: back into, kept for the last grid size (a 800x600 grid's are 15 MB).
@@ -216,7 +270,7 @@ class GpuBVH:
         """The ``#define`` lines of the probe program (what an including shader sets too)."""
         return (("BVH_TEX_WIDTH", str(TEX_WIDTH)), ("BVH_STACK", str(self.stack)),
                 ("BVH_MAX_STEPS", str(self.max_steps)), ("BVH_ANY", str(int(any_hit))),
-                ("BVH_CAMERA", str(int(camera))), *glsl_defines())
+                ("BVH_CAMERA", str(int(camera))), ("BVH_WIDE", str(int(self.wide))), *glsl_defines())
 
     def _program(self, any_hit: bool, camera: bool = False) -> tuple[moderngl.Program, moderngl.VertexArray]:
         key = (any_hit, camera)

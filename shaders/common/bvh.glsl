@@ -12,12 +12,15 @@
 //                inner node reads both children's boxes (4 fetches) and a leaf
 //                is never visited on its own: its range comes with its box.
 //                Boxes are rounded outwards to float32.
+//                (BVH_WIDE 1: 8 texels a record of four children, common/bvh_wide.glsl.)
 //   u_bvh_tris   3 texels per stored triangle k: 3k = (v0 xyz, caller's index),
 //                3k+1 = (v1 xyz, 0), 3k+2 = (v2 xyz, 0).
 // Integers are stored as floats: exact up to 2^24 (the host checks).
 //
 // Defines (with defaults): BVH_TEX_WIDTH (4096), BVH_STACK (64: at least
-// the tree's depth; the host sets it), BVH_MAX_STEPS (8192), BVH_PAD (2^-18).
+// the tree's depth; the host sets it), BVH_MAX_STEPS (8192), BVH_PAD (2^-18),
+// BVH_WIDE (0; 1: the 4-wide tree of common/bvh_wide.glsl, its own record
+// layout, traversed by the same two functions).
 //
 // The loop budget. llvmpipe ends a shader invocation's loops after 65,535
 // iterations IN TOTAL, silently: sequential loops and nested loops share one
@@ -47,6 +50,9 @@
 #endif
 #ifndef BVH_MAX_STEPS
 #define BVH_MAX_STEPS 8192
+#endif
+#ifndef BVH_WIDE
+#define BVH_WIDE 0
 #endif
 #ifndef BVH_PAD
 #define BVH_PAD 3.814697265625e-06
@@ -132,6 +138,56 @@ float bvh_triangle(BvhRay r, int k, bool cull, out int index, out vec2 uv) {
                        cull, uv);
 }
 
+// The steps of the loop below (both tree shapes). One triangle of the current leaf, if any is left, folded into the
+// nearest hit by the tie rule.
+void bvh_closest_triangle(BvhRay r, bool cull, float t_max, inout int tri, int tri_end, inout BvhHit hit) {
+    if (tri < tri_end) {
+        int index;
+        vec2 uv;
+        float t = bvh_triangle(r, tri, cull, index, uv);
+        if (t > 0.0 && t < t_max && (t < hit.t || (t == hit.t && index < hit.index))) {
+            hit.t = t;
+            hit.index = index;
+            hit.uv = uv;
+        }
+        ++tri;
+    }
+}
+
+// One triangle of the current leaf for an any-hit ray: whether it counts
+// (`o`, `d`: the ray, by the names BVH_ANY_ACCEPT reads).
+bool bvh_any_triangle(BvhRay r, vec3 o, vec3 d, bool cull, float t_max, inout int tri, int tri_end) {
+    bool found = false;
+    if (tri < tri_end) {
+        int index;
+        vec2 uv;
+        float t = bvh_triangle(r, tri, cull, index, uv);
+        found = t > 0.0 && t < t_max && BVH_ANY_ACCEPT(index, t, uv);
+        ++tri;
+    }
+    return found;
+}
+
+// The walk came to a leaf (`node` < -1): it waits for the current leaf to be done.
+void bvh_wait(inout int node, inout int waiting) {
+    if (node < -1) {
+        waiting = node;
+        node = -1;
+    }
+}
+
+// The waiting leaf's triangles from the next iteration, once the current leaf is done.
+void bvh_next_leaf(inout int waiting, inout int tri, inout int tri_end) {
+    if (waiting != -1 && tri >= tri_end) {
+        bvh_leaf(waiting, tri, tri_end);
+        waiting = -1;
+    }
+}
+
+#if BVH_WIDE
+#include "common/bvh_wide.glsl"
+#endif
+
 // The nearest hit with 0 < t < t_max: an ordered, stackful traversal (the
 // nearer child first, the other pushed with its entry distance so it can be
 // skipped once a nearer hit is known). On 8-wide SIMD every loop iteration
@@ -149,31 +205,38 @@ BvhHit bvh_closest_at(int root, vec3 o, vec3 d, float t_max, bool cull) {
     int stack[BVH_STACK];
     float stack_near[BVH_STACK];
     int sp = 0;
+#if BVH_WIDE
+    vec4 near;
+    ivec4 entry;
+    int node = root;  // the root record's four boxes: the first iteration's visit
+#else
     float near;
     int node;
     if (!bvh_child(r, root, 0, t_max, near, node)) node = -1;
+#endif
     int waiting = -1;  // a leaf entry waiting for the current leaf to be done
     int tri = 0;
     int tri_end = 0;
     bool finished = node == -1;
     for (int step = 0; step < BVH_MAX_STEPS && !finished; ++step) {
         hit.steps = step + 1;
-        if (tri < tri_end) {  // one triangle of the current leaf
-            int index;
-            vec2 uv;
-            float t = bvh_triangle(r, tri, cull, index, uv);
-            if (t > 0.0 && t < t_max && (t < hit.t || (t == hit.t && index < hit.index))) {
-                hit.t = t;
-                hit.index = index;
-                hit.uv = uv;
-            }
-            ++tri;
-        }
+        bvh_closest_triangle(r, cull, t_max, tri, tri_end, hit);  // one triangle of the current leaf
         if (waiting == -1) {  // the walk: one node further
             if (node == -1 && sp > 0) {  // pop the next subtree, skipped if it starts beyond the best hit
                 --sp;
                 node = stack_near[sp] <= hit.t ? stack[sp] : -1;
             }
+#if BVH_WIDE
+            if (node >= 0) {  // an inner node: its four children's boxes, the nearest taken, the rest pushed
+                bvh4_visit(r, node, hit.t, near, entry);
+                bvh4_sort(near, entry);
+                if (sp + 3 > BVH_STACK) { hit.overflow = true; break; }  // never drop a subtree silently
+#define BVH4_PUSH(c) if (entry.c != -1) { stack[sp] = entry.c; stack_near[sp] = near.c; ++sp; }
+                BVH4_PUSH(w) BVH4_PUSH(z) BVH4_PUSH(y)  // far to near: the nearest pushed is popped first
+#undef BVH4_PUSH
+                node = entry.x;  // a child hit has a finite near (some axis of d is not 0): never after a miss
+            }
+#else
             if (node >= 0) {  // an inner node: both children's boxes
                 float near_l, near_r;
                 int left, right;
@@ -190,15 +253,10 @@ BvhHit bvh_closest_at(int root, vec3 o, vec3 d, float t_max, bool cull) {
                     node = hit_l ? left : (hit_r ? right : -1);
                 }
             }
-            if (node < -1) {
-                waiting = node;
-                node = -1;
-            }
+#endif
+            bvh_wait(node, waiting);
         }
-        if (waiting != -1 && tri >= tri_end) {  // the waiting leaf's triangles from the next iteration
-            bvh_leaf(waiting, tri, tri_end);
-            waiting = -1;
-        }
+        bvh_next_leaf(waiting, tri, tri_end);
         finished = tri >= tri_end && waiting == -1 && node == -1 && sp == 0;
     }
     if (!finished) hit.overflow = true;
@@ -211,9 +269,15 @@ bool bvh_any_at(int root, vec3 o, vec3 d, float t_max, bool cull, out bool overf
     BvhRay r = bvh_ray(o, d);
     int stack[BVH_STACK];
     int sp = 0;
+#if BVH_WIDE
+    vec4 near;
+    ivec4 entry;
+    int node = root;
+#else
     float near;
     int node;
     if (!bvh_child(r, root, 0, t_max, near, node)) node = -1;
+#endif
     int waiting = -1;
     int tri = 0;
     int tri_end = 0;
@@ -221,15 +285,19 @@ bool bvh_any_at(int root, vec3 o, vec3 d, float t_max, bool cull, out bool overf
     bool found = false;
     overflow = false;
     for (int step = 0; step < BVH_MAX_STEPS && !finished; ++step) {
-        if (tri < tri_end) {
-            int index;
-            vec2 uv;
-            float t = bvh_triangle(r, tri, cull, index, uv);
-            found = t > 0.0 && t < t_max && BVH_ANY_ACCEPT(index, t, uv);
-            ++tri;
-        }
+        found = bvh_any_triangle(r, o, d, cull, t_max, tri, tri_end);
         if (waiting == -1) {
             if (node == -1 && sp > 0) node = stack[--sp];
+#if BVH_WIDE
+            if (node >= 0) {
+                bvh4_visit(r, node, t_max, near, entry);
+                if (sp + 3 > BVH_STACK) { overflow = true; break; }
+                node = -1;
+#define BVH4_TAKE(c) if (entry.c != -1) { if (node == -1) node = entry.c; else stack[sp++] = entry.c; }
+                BVH4_TAKE(x) BVH4_TAKE(y) BVH4_TAKE(z) BVH4_TAKE(w)  // the first child hit taken, the others pushed
+#undef BVH4_TAKE
+            }
+#else
             if (node >= 0) {
                 float near_l, near_r;
                 int left, right;
@@ -243,15 +311,10 @@ bool bvh_any_at(int root, vec3 o, vec3 d, float t_max, bool cull, out bool overf
                     node = hit_l ? left : (hit_r ? right : -1);
                 }
             }
-            if (node < -1) {
-                waiting = node;
-                node = -1;
-            }
+#endif
+            bvh_wait(node, waiting);
         }
-        if (waiting != -1 && tri >= tri_end) {
-            bvh_leaf(waiting, tri, tri_end);
-            waiting = -1;
-        }
+        bvh_next_leaf(waiting, tri, tri_end);
         finished = found || (tri >= tri_end && waiting == -1 && node == -1 && sp == 0);
     }
     if (!finished) overflow = true;

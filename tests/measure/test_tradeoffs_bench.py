@@ -471,10 +471,20 @@ def test_model_cases_cover_every_size_mode_and_engine(monkeypatch) -> None:
     monkeypatch.setattr(module, "mitsuba_missing", lambda: "mitsuba not installed")
     found = module.cases(BenchEnv())  # nothing is built until a case runs
     assert found[0].name == "BVH build, 1,000,000 tris"
-    assert [c.name for c in found[1:5]] == ["1,000 tris, primary, numpy", "1,000 tris, primary, gpu",
-                                           "1,000 tris, shadow+bounce, numpy", "1,000 tris, shadow+bounce, gpu"]
-    assert len(found) == 1 + 4 * len(module.SIZES)
-    assert {c.goal for c in found[1:]} == {1.0, 5.0}  # the start-up and frame-time goals
+    assert [c.name for c in found[1:7]] == ["1,000 tris, primary, numpy", "1,000 tris, primary, gpu",
+                                           "1,000 tris, primary, gpu wide BVH", "1,000 tris, shadow+bounce, numpy",
+                                           "1,000 tris, shadow+bounce, gpu", "1,000 tris, shadow+bounce, gpu wide BVH"]
+    assert len(found) == 1 + 6 * len(module.SIZES)
+    assert {c.goal for c in found[1:] if "wide" not in c.name} == {1.0, 5.0}  # the start-up and frame-time goals
+    # The gpu engine's two BVH shapes timed against each other, their pictures compared.
+    wide = [c for c in found if c.name.endswith("gpu wide BVH")]
+    assert len(wide) == 2 * len(module.SIZES) and {c.goal for c in wide} == {None}
+    assert {(c.baseline.label, c.subject.label) for c in wide} == {("gpu engine, binary BVH", "gpu engine, 4-wide BVH")}
+    image = np.zeros((3, 4, 4), dtype=np.uint8)
+    assert wide[0].compare(image, image.copy()) == "pixels: identical to the binary BVH's"
+    other = image.copy()
+    other[1, 2, 0] = 9
+    assert wide[0].compare(image, other) == "pixels: 1 of 12 differ"
 
 
 def test_model_cases_without_mitsuba_leave_its_rows_out_and_say_why(monkeypatch) -> None:
@@ -501,9 +511,10 @@ def test_model_cases_with_mitsuba_add_a_row_beside_each_gpu_row(monkeypatch) -> 
     monkeypatch.setattr(module, "bunny_path", lambda: None)
     monkeypatch.setattr(module, "mitsuba_missing", lambda: None)
     found = module.cases(BenchEnv())  # nothing is built (nor mitsuba imported) until a case runs
-    assert [c.name for c in found[1:7]] == [
-        "1,000 tris, primary, numpy", "1,000 tris, primary, gpu", "1,000 tris, primary, mitsuba",
-        "1,000 tris, shadow+bounce, numpy", "1,000 tris, shadow+bounce, gpu", "1,000 tris, shadow+bounce, mitsuba"]
+    assert [c.name for c in found[1:9]] == [
+        "1,000 tris, primary, numpy", "1,000 tris, primary, gpu", "1,000 tris, primary, gpu wide BVH",
+        "1,000 tris, primary, mitsuba", "1,000 tris, shadow+bounce, numpy", "1,000 tris, shadow+bounce, gpu",
+        "1,000 tris, shadow+bounce, gpu wide BVH", "1,000 tris, shadow+bounce, mitsuba"]
     mitsuba = [c for c in found if c.name.endswith("mitsuba")]
     assert len(mitsuba) == 2 * len(module.SIZES)
     assert {c.baseline.label for c in mitsuba} == {"Embree (embreex)"}

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from support import assert_same_hits, random_rays, triangle_soup
+from support import assert_same_hits, random_rays, soup_and_rays, triangle_soup
 
 from glsandbox import geometry, meshgen
 from glsandbox.raytrace.bvh import BVH, build_bvh, mesh_world_triangles
@@ -25,10 +25,7 @@ from glsandbox.raytrace.watertight import ray_setup, watertight_pairs
 @settings(max_examples=30, deadline=None)
 @given(seed=st.integers(0, 10**6), count=st.integers(1, 300), cull=st.booleans(), limited=st.booleans())
 def test_closest_hit_equals_brute_force(seed: int, count: int, cull: bool, limited: bool) -> None:
-    a, b, c = triangle_soup(seed, count)
-    o, d = random_rays(seed, 300)
-    d[:50] = a[np.arange(50) % count] - o[:50]  # some rays straight at vertices
-    t_max = np.random.default_rng(seed).uniform(0.2, 3.0, len(o)) if limited else np.inf
+    a, b, c, o, d, t_max = soup_and_rays(seed, count, limited)  # some rays straight at vertices
     bvh = build_bvh(a, b, c)
     want = closest_hit_brute_force(a, b, c, o, d, t_max, cull_backfaces=cull)
     assert_same_hits(closest_hit(bvh, o, d, t_max, cull_backfaces=cull), want)

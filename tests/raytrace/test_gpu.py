@@ -128,6 +128,34 @@ def test_the_unrolled_scan_draws_what_the_node_loops_draw(gl, monkeypatch) -> No
     assert np.array_equal(unrolled, looped)
 
 
+def test_the_wide_bvh_draws_exactly_what_the_binary_one_draws(gl, monkeypatch) -> None:
+    """Two mesh nodes (their trees side by side in one texture pair, refs offset), one shiny
+    (bounces), shadows between them: the 4-wide trees draw the same pixels, byte for byte, and a
+    ray out of its steps still raises. ``gpu.BVH_WIDE`` is the default a tracer takes."""
+    rock = meshgen.rock(4, seed=4, roughness=0.3)
+    shiny = Material(color=(0.6, 0.7, 0.8, 1.0), shading="phong", reflectivity=0.4)
+    scene = Scene("rocks", nodes=(Node("a", rock, np.eye(4), shiny),
+                                  Node("b", meshgen.terrain(20), np.diag([3.0, 0.5, 3.0, 1.0]) @ np.eye(4))),
+                  camera=Camera(eye=(0.0, 1.5, 3.0), target=(0.0, 0.0, 0.0)), lights=(Light((3.0, 3.0, 1.0)),),
+                  clear_color=(0.0, 0.0, 0.0, 1.0))
+    size = (160, 120)
+    binary, wide = gpu_engine.GpuTracer(gl.host.ctx, wide_bvh=False), gpu_engine.GpuTracer(gl.host.ctx, wide_bvh=True)
+    try:
+        for options in (dict(shadows=False, max_depth=0), dict(shadows=True, max_depth=2)):
+            want = binary.render_viewport(scene, size, **options).copy()
+            assert 0.3 < want[..., :3].any(axis=-1).mean() < 0.99
+            np.testing.assert_array_equal(wide.render_viewport(scene, size, **options), want)
+        assert wide._scenes[0].wide and not binary._scenes[0].wide
+        monkeypatch.setattr(gpu_engine, "BVH_STEP_CAP", 4)
+        with pytest.raises(RayTraceError, match="4 steps"):
+            wide.render_viewport(rock_scene(), (40, 30))
+    finally:
+        binary.release()
+        wide.release()
+    monkeypatch.setattr(gpu_engine, "BVH_WIDE", True)
+    assert gpu_engine.GpuTracer(gl.host.ctx).wide_bvh
+
+
 def test_a_model_packed_in_chunks_draws_what_one_pack_draws_and_is_recognised_again(gl, monkeypatch) -> None:
     """A model's triangle records are packed and written to their texture a chunk at a time
     (never whole on the host). Chunks of 1,000 triangles (9,000 texels: rows of 1,024 split

@@ -15,7 +15,8 @@ from glsandbox.gl.shaders import compile_program, shader_root
 from glsandbox.plan import ProgramVariant
 from glsandbox.raytrace.bvh import build_bvh, mesh_world_triangles
 from glsandbox.raytrace.bvh_traverse import any_hit, closest_hit
-from glsandbox.raytrace.gpu_bvh import GpuBVH, pack_bvh, texture_from_chunks
+from glsandbox.raytrace.bvh_wide import collapse
+from glsandbox.raytrace.gpu_bvh import WIDE_RECORD_TEXELS, GpuBVH, pack_bvh, pack_wide, texture_from_chunks, wide_stack
 from glsandbox.raytrace.raytrace_error import RayTraceError
 from glsandbox.raytrace.world import camera_rays
 from glsandbox.scene import Camera
@@ -209,6 +210,7 @@ def test_bvh_glsl_also_compiles_into_a_glsl_330_shader(ctx, tmp_path: Path) -> N
     # watertight test it includes) must still compile there.
     (tmp_path / "common").mkdir()
     shutil.copy(shader_root() / "common" / "bvh.glsl", tmp_path / "common" / "bvh.glsl")
+    shutil.copy(shader_root() / "common" / "bvh_wide.glsl", tmp_path / "common" / "bvh_wide.glsl")
     shutil.copy(shader_root() / "common" / "watertight.glsl", tmp_path / "common" / "watertight.glsl")
     shutil.copy(shader_root() / "common" / "fullscreen_vertex.glsl", tmp_path / "common" / "fullscreen_vertex.glsl")
     (tmp_path / "probe330.glsl").write_text(
@@ -217,8 +219,10 @@ def test_bvh_glsl_also_compiles_into_a_glsl_330_shader(ctx, tmp_path: Path) -> N
         "void main() { BvhHit h = bvh_closest(vec3(0.0), vec3(0.0, 0.0, -1.0), 1e30, false);\n"
         "bool overflow; bool any = bvh_any(vec3(0.0), vec3(1.0), 1.0, true, overflow);\n"
         "frag_color = vec4(h.t, float(h.index), any ? 1.0 : 0.0, overflow ? 1.0 : 0.0); }\n#endif\n")
-    program = compile_program(ctx, ProgramVariant("probe330", (("BVH_STACK", "24"),)), root=tmp_path)
-    program.release()
+    for wide in ("0", "1"):  # the binary traversal and the 4-wide one
+        program = compile_program(ctx, ProgramVariant("probe330", (("BVH_STACK", "24"), ("BVH_WIDE", wide))),
+                                  root=tmp_path)
+        program.release()
 
 
 def test_bad_bounds_are_refused(ctx) -> None:
@@ -262,3 +266,84 @@ def test_records_written_in_uneven_chunks_fill_the_texture_in_order(ctx) -> None
     assert np.array_equal(texels[:23], records)
     with pytest.raises(ValueError):
         texture_from_chunks(ctx, (records,), 24, 5)
+
+
+# --- the 4-wide tree (glsandbox/raytrace/bvh_wide.py, shaders/common/bvh_wide.glsl) ---------
+
+
+def test_the_wide_tree_finds_exactly_the_binary_trees_hits(ctx) -> None:
+    """Nearest hits, shadow queries, ties and culling: bit for bit what the binary traversal finds
+    (the same triangle test on the same float32 corners; the boxes only decide what is tested)."""
+    a, b, c = mesh_world_triangles(meshgen.rock(4, seed=2))
+    bvh = build_bvh(a, b, c, leaf_size=2)
+    eye, dirs = camera_rays(Camera(eye=(0.4, 1.1, 3.2)), 160, 120)
+    rng = np.random.default_rng(4)
+    o, d = rng.uniform(-2, 2, (3000, 3)), rng.normal(size=(3000, 3))
+    binary, wide = GpuBVH(ctx, bvh), GpuBVH(ctx, bvh, wide=True)
+    try:
+        want, got = binary.trace(eye, dirs), wide.trace(eye, dirs)
+        for field in ("t", "triangle", "u", "v"):
+            np.testing.assert_array_equal(getattr(got, field), getattr(want, field))
+        assert 0.2 < got.hit.mean() < 0.9
+        # About half the loop iterations a ray (half the levels to walk down).
+        assert got.steps.mean() < 0.75 * want.steps.mean()
+        for cull in (False, True):
+            np.testing.assert_array_equal(wide.trace(o, d, 1.5, cull_backfaces=cull).triangle,
+                                          binary.trace(o, d, 1.5, cull_backfaces=cull).triangle)
+            blocked, overflow = wide.any_hit(o, d, 1.5, cull_backfaces=cull)
+            np.testing.assert_array_equal(blocked, binary.any_hit(o, d, 1.5, cull_backfaces=cull)[0])
+            assert not overflow.any() and 0.03 < blocked.mean() < 0.9
+        camera = Camera(eye=(0.3, 1.0, 2.0))
+        np.testing.assert_array_equal(wide.trace_camera(camera, 64, 48).triangle,
+                                      binary.trace_camera(camera, 64, 48).triangle)
+    finally:
+        binary.release()
+        wide.release()
+
+
+def test_the_wide_tree_keeps_the_tie_rule_and_reports_cut_off_rays(ctx) -> None:
+    tri = np.array([[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, 0.0]])
+    count = 300  # copies of one triangle: all tie, the lowest index wins
+    a, b, c = (np.repeat(tri[i][None], count, axis=0) for i in range(3))
+    bvh = build_bvh(a, b, c)
+    o = np.array([[0.0, 0.0, 2.0], [5.0, 5.0, 2.0]])
+    d = np.array([[0.0, 0.0, -1.0], [0.0, 0.0, -1.0]])
+    wide = GpuBVH(ctx, bvh, wide=True)
+    tight = GpuBVH(ctx, bvh, wide=True, max_steps=40)
+    try:
+        hits = wide.trace(o, d)
+        assert hits.triangle.tolist() == [0, -1] and hits.t[0] == 2.0 and hits.steps[0] >= count
+        cut = tight.trace(o, d, strict=False)
+        assert cut.overflow.tolist() == [True, False] and cut.steps[0] == 40
+        with pytest.raises(RayTraceError, match="cut off 1 of 2 rays at its bound of 40"):
+            tight.trace(o, d)
+    finally:
+        wide.release()
+        tight.release()
+    empty = GpuBVH(ctx, build_bvh(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3))), wide=True)
+    try:
+        assert not empty.trace(np.zeros(3), np.array([[0.0, 0.0, 1.0]])).hit.any()
+        assert not empty.any_hit(np.zeros(3), np.array([[0.0, 0.0, 1.0]]))[0].any()
+    finally:
+        empty.release()
+
+
+def test_wide_records_hold_four_boxes_a_plane_a_texel(ctx) -> None:
+    a, b, c = mesh_world_triangles(meshgen.rock(3), np.diag([3.3, 1.7, 0.9, 1.0]))
+    bvh = build_bvh(a, b, c, leaf_size=2)
+    tree = collapse(bvh)
+    nodes, tris = pack_wide(tree)
+    records = nodes.reshape(-1, WIDE_RECORD_TEXELS, 4)  # record, texel, child slot
+    assert records.shape[0] == tree.record_count
+    used = tree.child >= 0
+    node = np.where(used, tree.child, 0)
+    lo = np.moveaxis(records[:, 0:3], 1, 2).astype(np.float64)  # (record, slot, xyz)
+    hi = np.moveaxis(records[:, 3:6], 1, 2).astype(np.float64)
+    assert np.all((lo <= bvh.node_min[node]) | ~used[..., None])  # rounded outwards
+    assert np.all((hi >= bvh.node_max[node]) | ~used[..., None])
+    assert np.all((bvh.node_min[node] - lo < 1e-6) | ~used[..., None])
+    ref, count, _ = tree.slots()
+    np.testing.assert_array_equal(records[:, 7], np.where(used, count, -1))
+    np.testing.assert_array_equal(records[:, 6][used], ref[used])
+    np.testing.assert_array_equal(tris, pack_bvh(bvh)[1])
+    assert wide_stack(tree.depth) == 3 * tree.depth + 1
