@@ -517,6 +517,11 @@ def cmd_check(args: argparse.Namespace) -> int:
         from glsandbox.grading import portable
         from glsandbox.grading.layers import describe
 
+        if not portable.wanted():  # the zygote starts while the references are read and the folder listed
+            from glsandbox.grading.isolate import prestart
+
+            prestart()
+
         # which layers confine a submission on this machine
         layers_line = portable.describe() if portable.wanted() else describe()
         bars = []  # the progress bar, made when the first submission reports (the total known then)

@@ -227,17 +227,21 @@ class _Zygote:
 
     def start(self, job: Job) -> int:
         """Ask for a supervisor for ``job``; the read end of its result pipe."""
-        import socket
-
         read_end, write_end = os.pipe()
         wide_pipe(write_end)
-        data = json.dumps(_job_data(job)).encode()
         try:
-            self.channel.sendall(struct.pack("!I", len(data)))
-            socket.send_fds(self.channel, [data], [write_end])
+            self.request(_job_data(job), [write_end])
         finally:
             os.close(write_end)
         return read_end
+
+    def request(self, data: dict, fds: list[int]) -> None:
+        """Send the zygote ``data`` (a job, or a slot's request) and ``fds`` (the caller keeps its copies)."""
+        import socket
+
+        encoded = json.dumps(data).encode()
+        self.channel.sendall(struct.pack("!I", len(encoded)))
+        socket.send_fds(self.channel, [encoded], fds)
 
     def close(self) -> None:
         self.channel.close()
@@ -245,6 +249,30 @@ class _Zygote:
             self.process.wait(timeout=10)
         except Exception:  # noqa: BLE001 - it is killed with the rest of the run
             pass
+
+
+#: A zygote started ahead of its run (:func:`prestart`), taken by the next :func:`run_jobs`.
+_prestarted: _Zygote | None = None
+
+
+def prestart() -> None:
+    """Start the zygote now, so that its start (a fresh Python importing glsandbox, numpy and
+    moderngl: about half a second) overlaps the grader's own preparation (the references read,
+    the submissions listed); the next :func:`run_jobs` uses it. Nothing where the system cannot fork."""
+    global _prestarted
+    if _prestarted is None and hasattr(os, "fork"):
+        _prestarted = _Zygote()
+
+
+def _zygote() -> _Zygote:
+    """The prestarted zygote if there is one (and it lives), else a fresh one."""
+    global _prestarted
+    found, _prestarted = _prestarted, None
+    if found is not None and found.process.poll() is None:
+        return found
+    if found is not None:
+        found.close()
+    return _Zygote()
 
 
 @dataclass
@@ -284,7 +312,8 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
 
         raise SandboxError("glsandbox check runs each submission in a process of its own, which needs a POSIX "
                            "system (Linux, macOS); on Windows run it in WSL or a container")
-    before = set(descendants(os.getpid()))
+    ahead = _prestarted.process.pid if _prestarted is not None else None
+    before = set(descendants(os.getpid())) - {ahead}
     set_subreaper()
     pending = deque(jobs)
     running: dict[int, _Running] = {}
@@ -293,11 +322,17 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
     # Supervisors that sent their result and are cleaning up (killing their renderer's tree,
     # removing their private folder): their pipes close when they end; the run waits for that.
     closing: dict[int, _Running] = {}
-    zygote_process = _Zygote()
+    zygote_process = _zygote()
+    # Scene files go to job slots, each a supervisor with a renderer kept for many (glsandbox.grading.slots).
+    from glsandbox.grading.slots import Slots, wait_closed
+
+    slots = Slots(workers, lambda data, fds: zygote_process.request(data, fds))
     try:
-        while pending or running:
-            while pending and len(running) < max(1, workers):
+        while pending or running or slots.busy():
+            while pending and len(running) + slots.busy() < max(1, workers):
                 job = pending.popleft()
+                if slots.take(job):
+                    continue
                 try:
                     fd = zygote_process.start(job)
                 except OSError:  # the zygote is gone (it should not be): a fresh one, once
@@ -306,8 +341,10 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
                     fd = zygote_process.start(job)
                 # a supervisor that hangs (it should not) is given up after every picture's time and a margin
                 running[fd] = _Running(job, Reader(fd), time.monotonic() + job.timeout * len(job.renders) + 60)
-            ready, _, _ = select.select([*running, *closing], [], [], 1.0)
+            ready, _, _ = select.select([*running, *closing, *slots.fds()], [], [], 1.0)
             _drain(closing, ready)
+            if slots.collect(ready, pending, retried, results, done):
+                return [results[j.index] for j in jobs if j.index in results]
             for fd in list(running):
                 entry = running[fd]
                 if fd in ready:
@@ -339,6 +376,7 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
             if entry.pid:
                 killpg(entry.pid)
             os.close(fd)
+        wait_closed(slots.close())
         while closing:
             ready, _, _ = select.select(list(closing), [], [], 0.5)
             _drain(closing, ready)

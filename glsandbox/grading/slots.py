@@ -1,0 +1,175 @@
+"""The grader's job slots for data-only submissions: each a slot supervisor and its resident renderer.
+
+:func:`glsandbox.grading.isolate.run_jobs` hands a scene-file submission
+(:func:`data_only`) to an idle slot, or opens one while fewer than
+``--jobs`` are open; every other submission gets a supervisor of its own,
+as before. A slot is two pipes to a supervisor the zygote forked
+(:mod:`glsandbox.grading.resident`): jobs go down one, one at a time, and
+each job's result (the same message a one-shot supervisor sends) comes back
+on the other. A slot whose supervisor hangs past the job's time and a
+margin, or whose pipe closes without a result, is killed: its job is
+CRASHED, as a one-shot supervisor's would be, and the next scene file
+opens a fresh slot. A job the slot answers ``own_process`` (a scene file
+with a shader of its own) goes back to the queue for a supervisor of its own.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections import deque
+from collections.abc import Callable, Sequence
+
+from glsandbox.grading.isolate import Job, JobResult, Reader, _job_data, _result, send, settle, wide_pipe
+from glsandbox.grading.processes import kill_tree, killpg
+
+__all__ = ["data_only", "Slot", "Slots"]
+
+#: Seconds a slot supervisor may take past its job's time limits before it is given up.
+MARGIN = 60.0
+
+
+def data_only(job: Job) -> bool:
+    """Whether ``job`` is a copied submission whose lesson file is a scene file (data, no code),
+    and not the model answer (whose renderer fills Mesa's shader cache)."""
+    return job.copy and job.source is not None and job.target.endswith(".toml") and not job.writes_cache
+
+
+class Slot:
+    """One slot: the pipes to its supervisor, the supervisor's pid, and the job it is drawing."""
+
+    def __init__(self, request: Callable[[dict, list[int]], None]) -> None:
+        jobs_read, self.jobs = os.pipe()
+        results, results_write = os.pipe()
+        wide_pipe(results_write)
+        try:
+            request({"slot": True}, [jobs_read, results_write])
+        finally:
+            os.close(jobs_read)
+            os.close(results_write)
+        self.reader = Reader(results)
+        self.pid = 0
+        self.job: Job | None = None
+        self.deadline = 0.0
+
+    def give(self, job: Job) -> None:
+        send(self.jobs, _job_data(job))
+        self.job = job
+        self.deadline = time.monotonic() + job.timeout * len(job.renders) + MARGIN
+
+    def finished(self) -> tuple[dict, bytes] | None | bool:
+        """Its job's result message if it came; False while it is still drawing; None when the
+        slot is lost (its pipe closed or a bad message, or past its deadline)."""
+        try:
+            for header, payload in self.reader.messages(1 << 34):
+                if header.get("kind") == "pid":
+                    self.pid = int(header["pid"])
+                elif header.get("kind") == "result":
+                    return header, payload
+        except (ValueError, KeyError, TypeError):
+            return None
+        if self.reader.closed or time.monotonic() > self.deadline:
+            return None
+        return False
+
+    def kill(self) -> None:
+        """End the supervisor's whole tree (its renderer's too) and close the pipes."""
+        if self.pid:
+            kill_tree(self.pid)
+            killpg(self.pid)
+        os.close(self.jobs)
+        os.close(self.reader.fd)
+
+
+class Slots:
+    """The run's slots, at most ``workers`` of them."""
+
+    def __init__(self, workers: int, request: Callable[[dict, list[int]], None]) -> None:
+        self.workers, self.request = max(1, workers), request
+        self.open: list[Slot] = []
+        #: Jobs a slot handed back (a scene file with a shader of its own): a supervisor each.
+        self.own: set[int] = set()
+
+    def busy(self) -> int:
+        return sum(1 for slot in self.open if slot.job is not None)
+
+    def fds(self) -> list[int]:
+        return [slot.reader.fd for slot in self.open]
+
+    def take(self, job: Job) -> bool:
+        """Give ``job`` to an idle slot (opened if need be); False: not a slot's job."""
+        if not data_only(job) or job.index in self.own:
+            return False
+        slot = next((s for s in self.open if s.job is None), None)
+        if slot is None:
+            if len(self.open) >= self.workers:
+                return False
+            slot = Slot(self.request)
+            self.open.append(slot)
+        try:
+            slot.give(job)
+        except OSError:  # its supervisor is gone: a fresh slot, once
+            self.open.remove(slot)
+            slot.kill()
+            slot = Slot(self.request)
+            self.open.append(slot)
+            slot.give(job)
+        return True
+
+    def collect(self, ready: Sequence[int], pending: deque[Job], retried: set[int], results: dict[int, JobResult],
+                done: Callable[[JobResult], object]) -> bool:
+        """Read the slots that are ``ready`` and settle each job that finished (:func:`settle`);
+        True when the run must stop (no GL)."""
+        for slot in list(self.open):
+            if slot.reader.fd in ready:
+                slot.reader.pump(0.0)
+            if slot.job is None:
+                if slot.reader.closed:  # an idle supervisor that ended (it should not): forgotten
+                    self.open.remove(slot)
+                    slot.kill()
+                continue
+            message = slot.finished()
+            if message is False:
+                continue
+            job, slot.job = slot.job, None
+            if message is None:
+                self.open.remove(slot)
+                slot.kill()
+            elif message[0].get("own_process"):
+                self.own.add(job.index)
+                pending.appendleft(job)
+                continue
+            if settle(job, _result(job, message if message else None), pending, retried, results, done):
+                return True
+        return False
+
+    def close(self) -> list[tuple[Slot, float]]:
+        """Tell every slot the run is over (its jobs' pipe closed: the supervisor cleans up and
+        ends); a slot still drawing is killed. The slots to wait for, each with a deadline."""
+        waiting = []
+        for slot in self.open:
+            if slot.job is not None:
+                slot.kill()
+                continue
+            os.close(slot.jobs)
+            waiting.append((slot, time.monotonic() + 10))
+        self.open = []
+        return waiting
+
+
+def wait_closed(waiting: list[tuple[Slot, float]]) -> None:
+    """Wait until each slot's supervisor ended (its result pipe closed), killing one past its deadline."""
+    import select
+
+    while waiting:
+        ready, _, _ = select.select([s.reader.fd for s, _ in waiting], [], [], 0.5)
+        for slot, deadline in list(waiting):
+            if slot.reader.fd in ready:
+                slot.reader.pump(0.0)
+                slot.reader.buffer.clear()
+            if slot.reader.closed or time.monotonic() > deadline:
+                if not slot.reader.closed and slot.pid:
+                    kill_tree(slot.pid)
+                    killpg(slot.pid)
+                os.close(slot.reader.fd)
+                waiting.remove((slot, deadline))
