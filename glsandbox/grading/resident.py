@@ -59,12 +59,17 @@ SERVED_WAIT = 5.0
 def names_own_shader(path: Path) -> bool:
     """Whether the scene file at ``path`` gives a node a shader file of its own (``shader =``):
     GLSL, code the driver compiles and runs, rendered in a process of its own. A file that
-    cannot be read or parsed says no: loading it reports the error, as it would anywhere."""
+    cannot be read or parsed (or is too big to be) says no: loading it reports that, as it
+    would in a process of its own. Only a file holding the word, or an escape that could spell
+    it in a quoted key, is parsed here."""
     import tomllib
 
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+        raw = path.read_bytes()
+        if b"shader" not in raw and b"\\u" not in raw and b"\\U" not in raw:
+            return False
+        data = tomllib.loads(raw.decode("utf-8"))
+    except Exception:  # noqa: BLE001 - unreadable, not UTF-8, not TOML, out of memory: its load tells
         return False
     nodes = data.get("nodes")
     return isinstance(nodes, list) and any(isinstance(n, dict) and "shader" in n for n in nodes)
@@ -96,6 +101,11 @@ def _resident(job: Job, work: str, inbox: str, cwd: str, out: int, commands: int
 
     code = 0
     try:
+        # The warm template's drawing (glsandbox.grading.warm): no rasterizer threads and no
+        # on-disk shader cache, so a resident renderer's address space (what --memory bounds) is
+        # that of the renderers forked from the template, and an OUT OF MEMORY the same verdict.
+        os.environ["LP_NUM_THREADS"] = "0"
+        os.environ["MESA_SHADER_CACHE_DISABLE"] = "true"
         budget = cpu_budget(job)
         renderer = enter_renderer(job, inbox, cwd, [cwd], work, out, ids, keep=commands,
                                   cpu=(budget, budget * (RETIRE_AFTER + 1)))
