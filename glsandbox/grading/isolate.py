@@ -37,6 +37,7 @@ from __future__ import annotations
 import json
 import os
 import select
+import shutil
 import struct
 import sys
 import time
@@ -212,15 +213,24 @@ class _Zygote:
     def __init__(self) -> None:
         import socket
         import subprocess
+        import tempfile
 
+        # Every private folder of the run is made in this one (the zygote's temporary folder),
+        # removed by the grader when the run ends: none is left by a supervisor killed before
+        # its own clean-up (past its deadline, or the run stopped). Others may pass through it
+        # to the folders a submission's user owns, not list it.
+        self.folder = tempfile.mkdtemp(prefix="glsandbox-grade-run-")
+        os.chmod(self.folder, 0o711)
         self.channel, theirs = socket.socketpair()
-        code = "import sys; from glsandbox.grading.worker import zygote_main; zygote_main(int(sys.argv[1]))"
+        code = ("import sys; from glsandbox.grading.worker import zygote_main; "
+                "zygote_main(int(sys.argv[1]), sys.argv[2])")
         # a fresh program with only what rendering reads: every fork's /proc/self/environ is this one
         from glsandbox.grading.layers import minimal_environment
 
         package_parent = str(Path(__file__).resolve().parents[2])
         code = f"import sys; sys.path.insert(0, {package_parent!r}); " + code
-        self.process = subprocess.Popen([sys.executable, "-c", code, str(theirs.fileno())], pass_fds=[theirs.fileno()],
+        self.process = subprocess.Popen([sys.executable, "-c", code, str(theirs.fileno()), self.folder],
+                                        pass_fds=[theirs.fileno()],
                                         stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,  # never the grader's stdout
                                         env=minimal_environment())
         theirs.close()
@@ -323,6 +333,7 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
     # removing their private folder): their pipes close when they end; the run waits for that.
     closing: dict[int, _Running] = {}
     zygote_process = _zygote()
+    folders = [zygote_process.folder]
     # Scene files go to job slots, each a supervisor with a renderer kept for many (glsandbox.grading.slots).
     from glsandbox.grading.slots import Slots, wait_closed
 
@@ -338,6 +349,7 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
                 except OSError:  # the zygote is gone (it should not be): a fresh one, once
                     zygote_process.close()
                     zygote_process = _Zygote()
+                    folders.append(zygote_process.folder)
                     fd = zygote_process.start(job)
                 # a supervisor that hangs (it should not) is given up after every picture's time and a margin
                 running[fd] = _Running(job, Reader(fd), time.monotonic() + job.timeout * len(job.renders) + 60)
@@ -383,6 +395,8 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
         zygote_process.close()
         kill_tree(os.getpid(), keep=sorted(before))
         set_subreaper(False)
+        for folder in folders:  # every process of the run is gone: what they left goes too
+            shutil.rmtree(folder, ignore_errors=True)
     return [results[j.index] for j in jobs]
 
 

@@ -435,9 +435,13 @@ def preload_gl_libraries() -> None:
             pass
 
 
-def zygote_main(channel_fd: int) -> None:
-    """The zygote process: import :data:`PRELOAD` and the GL libraries once, then :func:`zygote`."""
+def zygote_main(channel_fd: int, folder: str | None = None) -> None:
+    """The zygote process: import :data:`PRELOAD` and the GL libraries once, then :func:`zygote`.
+    ``folder``: where every supervisor makes its private folder (the grader removes it at the end)."""
     import importlib
+
+    if folder is not None:
+        tempfile.tempdir = folder
 
     for module in PRELOAD:
         try:
