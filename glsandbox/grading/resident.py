@@ -81,13 +81,15 @@ def start_afresh(renderer) -> None:  # noqa: ANN001 - a HeadlessRenderer
     caches of what files held (models, BVHs) and the warnings printed once are emptied. The
     caches left are pure functions of numbers and names (built-in meshes, matrices), whose
     answers are read-only: they cannot carry one submission's picture into another's."""
-    from glsandbox.mesh import load
-    from glsandbox.raytrace import bvh, gpu
+    import sys
 
     renderer.forget()
-    load.clear_cache()
-    bvh.clear_cache()
-    gpu.clear_warnings()
+    # A module not imported yet holds nothing (and importing it here, under the audit hook, costs)
+    for name, clear in (("glsandbox.mesh.load", "clear_cache"), ("glsandbox.raytrace.bvh", "clear_cache"),
+                        ("glsandbox.raytrace.gpu", "clear_warnings")):
+        module = sys.modules.get(name)
+        if module is not None:
+            getattr(module, clear)()
 
 
 # --- the resident renderer (grandchild) --------------------------------------------------------
