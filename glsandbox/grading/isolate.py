@@ -30,6 +30,9 @@ worst it can do is lose its own pictures.
 This module is the grader's side and what both sides share (the jobs, the
 framed messages); :mod:`glsandbox.grading.worker` is the zygote, supervisor
 and renderer; :mod:`glsandbox.grading.processes` finds and kills a tree.
+A scene file (data, no code) goes instead to a job slot: a supervisor and a
+renderer kept for many scene files, confined as these are
+(:mod:`glsandbox.grading.slots`, :mod:`glsandbox.grading.resident`).
 """
 
 from __future__ import annotations
@@ -231,7 +234,8 @@ class _Zygote:
         code = f"import sys; sys.path.insert(0, {package_parent!r}); " + code
         self.process = subprocess.Popen([sys.executable, "-c", code, str(theirs.fileno()), self.folder],
                                         pass_fds=[theirs.fileno()],
-                                        stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,  # never the grader's stdout
+                                        # never the grader's stdout
+                                        stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                                         env=minimal_environment())
         theirs.close()
 
@@ -271,7 +275,20 @@ def prestart() -> None:
     the submissions listed); the next :func:`run_jobs` uses it. Nothing where the system cannot fork."""
     global _prestarted
     if _prestarted is None and hasattr(os, "fork"):
+        import atexit
+
         _prestarted = _Zygote()
+        atexit.register(_discard_prestarted)
+
+
+def _discard_prestarted() -> None:
+    """At exit: a prestarted zygote no run took (the command stopped first: a missing reference,
+    a rubric of exercises only) is closed and its folder removed."""
+    global _prestarted
+    found, _prestarted = _prestarted, None
+    if found is not None:
+        found.close()
+        shutil.rmtree(found.folder, ignore_errors=True)
 
 
 def _zygote() -> _Zygote:

@@ -34,9 +34,9 @@ __all__ = ["PRELOAD", "zygote_main"]
 
 #: What the zygote imports once, so each submission starts warm (and no module
 #: opens a GL context at import).
-PRELOAD = ["glsandbox.grading.worker", "glsandbox.grading.resident", "glsandbox.frame", "glsandbox.lesson", "glsandbox.scene_file",
-           "glsandbox.grading.sandbox", "glsandbox.gl.context", "glsandbox.gl.shaders", "numpy", "moderngl",
-           "glcontext", "glcontext.egl", "PIL.Image", "glsandbox.lessons"]
+PRELOAD = ["glsandbox.grading.worker", "glsandbox.grading.resident", "glsandbox.frame", "glsandbox.lesson",
+           "glsandbox.scene_file", "glsandbox.grading.sandbox", "glsandbox.gl.context", "glsandbox.gl.shaders",
+           "numpy", "moderngl", "glcontext", "glcontext.egl", "PIL.Image", "glsandbox.lessons"]
 
 
 
