@@ -225,7 +225,7 @@ class _Zygote:
         self.folder = tempfile.mkdtemp(prefix="glsandbox-grade-run-")
         os.chmod(self.folder, 0o711)
         self.channel, theirs = socket.socketpair()
-        code = ("import sys; from glsandbox.grading.worker import zygote_main; "
+        code = ("import sys; from glsandbox.grading.resident import zygote_main; "
                 "zygote_main(int(sys.argv[1]), sys.argv[2])")
         # a fresh program with only what rendering reads: every fork's /proc/self/environ is this one
         from glsandbox.grading.layers import minimal_environment
@@ -326,8 +326,30 @@ def settle(job: Job, result: JobResult, pending: deque[Job], retried: set[int], 
     return False
 
 
-def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None]) -> list[JobResult]:
+class _NoSlots:
+    """No job slots: every job gets a supervisor of its own (:func:`run_jobs` without ``slots``)."""
+
+    def take(self, job: Job) -> bool:
+        return False
+
+    def busy(self) -> int:
+        return 0
+
+    def fds(self) -> list[int]:
+        return []
+
+    def collect(self, *_: object) -> bool:
+        return False
+
+    def close(self) -> None:
+        pass
+
+
+def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None],
+             slots: Callable[[int, Callable[[dict, list[int]], None]], object] | None = None) -> list[JobResult]:
     """Run every job, ``workers`` at once; ``done`` is called as each finishes; results in job order.
+    ``slots(workers, request)``: the job slots that take the jobs they can (scene files,
+    :class:`glsandbox.grading.slots.Slots`, given a way to ask the zygote); else none.
 
     The grader becomes a subreaper for the run, so a process a submission
     leaves behind whose supervisor was killed still comes back here, and is
@@ -352,9 +374,7 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
     zygote_process = _zygote()
     folders = [zygote_process.folder]
     # Scene files go to job slots, each a supervisor with a renderer kept for many (glsandbox.grading.slots).
-    from glsandbox.grading.slots import Slots, wait_closed
-
-    slots = Slots(workers, lambda data, fds: zygote_process.request(data, fds))
+    slots = _NoSlots() if slots is None else slots(workers, lambda data, fds: zygote_process.request(data, fds))
     try:
         while pending or running or slots.busy():
             while pending and len(running) + slots.busy() < max(1, workers):
@@ -405,7 +425,7 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
             if entry.pid:
                 killpg(entry.pid)
             os.close(fd)
-        wait_closed(slots.close())
+        slots.close()
         while closing:
             ready, _, _ = select.select(list(closing), [], [], 0.5)
             _drain(closing, ready)

@@ -48,7 +48,7 @@ from glsandbox.grading.processes import kill_tree, killpg, set_subreaper
 from glsandbox.grading.worker import (OwnProcess, _collect, _copy_submission, _NoGL, _send_result, _tail,
                                       cpu_budget, enter_renderer, flush_output, render_job, wide_pipe)
 
-__all__ = ["serve_slot", "start_afresh", "names_own_shader", "RETIRE_AFTER"]
+__all__ = ["zygote_main", "serve_slot", "start_afresh", "names_own_shader", "RETIRE_AFTER"]
 
 #: Submissions one resident renderer draws before a fresh one replaces it (its CPU limit's horizon).
 RETIRE_AFTER = 200
@@ -90,6 +90,14 @@ def start_afresh(renderer) -> None:  # noqa: ANN001 - a HeadlessRenderer
         module = sys.modules.get(name)
         if module is not None:
             getattr(module, clear)()
+
+
+def zygote_main(channel_fd: int, folder: str) -> None:
+    """The zygote's program (:func:`glsandbox.grading.worker.zygote_main`), which forks a slot
+    supervisor (:func:`serve_slot`) for each slot the grader asks for."""
+    from glsandbox.grading import worker
+
+    worker.zygote_main(channel_fd, folder, serve_slot)
 
 
 # --- the resident renderer (grandchild) --------------------------------------------------------
@@ -196,10 +204,8 @@ def serve_slot(jobs: int, out: int) -> None:
         reader = Reader(jobs)
         number = 0
         while (command := _next(reader)) is not None:
-            job = job_from(command)
             number += 1
-            result, pictures, renderer = _serve(job, number, work, renderer, ids)
-            _send_result(out, result, pictures)
+            renderer = _serve(job_from(command), number, work, renderer, ids, out)
     finally:
         if renderer is not None:
             renderer.stop()
@@ -208,10 +214,10 @@ def serve_slot(jobs: int, out: int) -> None:
 
 
 def _serve(job: Job, number: int, work: str, renderer: _Renderer | None, ids: tuple[int, int] | None,
-           ) -> tuple[dict, list[Picture] | None, _Renderer | None]:
+           out: int) -> _Renderer | None:
     """One submission through the resident renderer (started first where there is none, or a
-    fresh one where it served its share or has other limits): the result message, the pictures,
-    and the renderer the next submission gets (None: a fresh one)."""
+    fresh one where it served its share or has other limits), its result sent on ``out`` as soon
+    as its pictures are in; the renderer the next submission gets (None: a fresh one)."""
     result: dict = {"kind": "result", "pictures": None, "output": [], "no_gl": "", "root": "", "meta": {}}
     root = os.path.join(work, "in", str(number))
     try:
@@ -219,8 +225,9 @@ def _serve(job: Job, number: int, work: str, renderer: _Renderer | None, ids: tu
     except (OSError, shutil.Error) as exc:
         shutil.rmtree(root, ignore_errors=True)
         reason = getattr(exc, "strerror", None) or str(exc).splitlines()[0][:200]
-        return result, [Picture(status=BROKEN, error=f"{job.source}: cannot be copied for grading ({reason})")
-                        for _ in job.renders], renderer
+        _send_result(out, result, [Picture(status=BROKEN, error=f"{job.source}: cannot be copied for grading "
+                                                                f"({reason})") for _ in job.renders])
+        return renderer
     result["root"] = root
     key = (job.backend, job.memory_mb, job.timeout, len(job.renders))
     try:
@@ -232,13 +239,18 @@ def _serve(job: Job, number: int, work: str, renderer: _Renderer | None, ids: tu
         renderer = renderer or _start(job, work, ids, key)
         output = os.path.join(work, "output.txt")
         os.truncate(output, 0)  # the renderer appends: this submission's lines only
-        pictures, clean = _draw(job, number, renderer, result)
+        pictures = _draw(job, number, renderer, result)
         renderer.served += 1
-        result["output"] = _tail(output)
-        if not clean or pictures is None or any(p.status in (TIMEOUT, CRASHED, OOM) for p in pictures):
+        result["output"] = _tail(output)  # (flushed before its last picture was sent)
+        failed = bool(result["no_gl"]) or any(p.status in (TIMEOUT, CRASHED, OOM) for p in pictures or ())
+        if not failed:  # the grader hears now; the renderer's "served" line and the clean-up follow
+            _send_result(out, result, pictures)
+        if failed or not _served(renderer):
             renderer.stop()
             renderer = None
-        return result, pictures, renderer
+        if failed:
+            _send_result(out, result, pictures)
+        return renderer
     finally:
         shutil.rmtree(root, ignore_errors=True)
         _empty(os.path.join(work, "cwd"))
@@ -254,22 +266,20 @@ def _empty(folder: str) -> None:
             pass
 
 
-def _draw(job: Job, number: int, renderer: _Renderer, result: dict) -> tuple[list[Picture] | None, bool]:
-    """Tell the renderer of the job and collect its pictures, then its ``served`` line: (the
-    pictures or None, whether the renderer is fit for another submission)."""
+def _draw(job: Job, number: int, renderer: _Renderer, result: dict) -> list[Picture] | None:
+    """Tell the renderer of the job and collect its pictures (None: no GL, or the job is handed
+    back for a process of its own, said in ``result``)."""
     try:
         send(renderer.commands, {"job": _job_data(job), "folder": number})
     except OSError:  # it ended while idle: the clock and its exit status tell below
         pass
     try:
-        pictures = _collect(job, renderer.pid, renderer.results, result["meta"], renderer.reader)
+        return _collect(job, renderer.pid, renderer.results, result["meta"], renderer.reader)
     except _NoGL as exc:
         result["no_gl"] = str(exc)
-        return None, False
     except OwnProcess:
         result["own_process"] = True
-        return None, _served(renderer)
-    return pictures, _served(renderer)
+    return None
 
 
 def _served(renderer: _Renderer) -> bool:

@@ -1,6 +1,7 @@
 """The grader's job slots for data-only submissions: each a slot supervisor and its resident renderer.
 
-:func:`glsandbox.grading.isolate.run_jobs` hands a scene-file submission
+:func:`glsandbox.grading.isolate.run_jobs`, given these slots by
+:func:`glsandbox.grading.runner.run_jobs`, hands a scene-file submission
 (:func:`data_only`) to an idle slot, or opens one while fewer than
 ``--jobs`` are open; every other submission gets a supervisor of its own,
 as before. A slot is two pipes to a supervisor the zygote forked
@@ -143,9 +144,9 @@ class Slots:
                 return True
         return False
 
-    def close(self) -> list[tuple[Slot, float]]:
+    def close(self) -> None:
         """Tell every slot the run is over (its jobs' pipe closed: the supervisor cleans up and
-        ends); a slot still drawing is killed. The slots to wait for, each with a deadline."""
+        ends) and wait until each has ended; a slot still drawing is killed."""
         waiting = []
         for slot in self.open:
             if slot.job is not None:
@@ -154,10 +155,10 @@ class Slots:
             os.close(slot.jobs)
             waiting.append((slot, time.monotonic() + 10))
         self.open = []
-        return waiting
+        _wait_closed(waiting)
 
 
-def wait_closed(waiting: list[tuple[Slot, float]]) -> None:
+def _wait_closed(waiting: list[tuple[Slot, float]]) -> None:
     """Wait until each slot's supervisor ended (its result pipe closed), killing one past its deadline."""
     import select
 

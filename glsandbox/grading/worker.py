@@ -34,7 +34,7 @@ __all__ = ["PRELOAD", "zygote_main"]
 
 #: What the zygote imports once, so each submission starts warm (and no module
 #: opens a GL context at import).
-PRELOAD = ["glsandbox.grading.worker", "glsandbox.grading.resident", "glsandbox.frame", "glsandbox.lesson",
+PRELOAD = ["glsandbox.grading.worker", "glsandbox.frame", "glsandbox.lesson",
            "glsandbox.scene_file", "glsandbox.grading.sandbox", "glsandbox.gl.context", "glsandbox.gl.shaders",
            "numpy", "moderngl", "glcontext", "glcontext.egl", "PIL.Image", "glsandbox.lessons"]
 
@@ -435,9 +435,11 @@ def preload_gl_libraries() -> None:
             pass
 
 
-def zygote_main(channel_fd: int, folder: str | None = None) -> None:
+def zygote_main(channel_fd: int, folder: str | None = None,
+                serve_slot: Callable[[int, int], None] | None = None) -> None:
     """The zygote process: import :data:`PRELOAD` and the GL libraries once, then :func:`zygote`.
-    ``folder``: where every supervisor makes its private folder (the grader removes it at the end)."""
+    ``folder``: where every supervisor makes its private folder (the grader removes it at the end);
+    ``serve_slot``: a job slot's supervisor (:func:`glsandbox.grading.resident.serve_slot`)."""
     import importlib
 
     if folder is not None:
@@ -454,7 +456,7 @@ def zygote_main(channel_fd: int, folder: str | None = None) -> None:
     # never writes their headers and copies their pages (a collection in a renderer touched the
     # whole inherited heap: about 10 ms of one renderer's 60 in one profile here).
     gc.freeze()
-    zygote(channel_fd)
+    zygote(channel_fd, serve_slot)
 
 
 def prepare_confinement() -> None:
@@ -469,7 +471,7 @@ def prepare_confinement() -> None:
         others_may_read("/etc")
 
 
-def zygote(channel_fd: int) -> None:
+def zygote(channel_fd: int, serve_slot: Callable[[int, int], None] | None = None) -> None:
     """Serve the grader on ``channel_fd`` (one end of a socket pair): each message is a job and
     the pipe its result goes to; fork a supervisor for it, or hand the job to the warm template
     of its backend (:func:`_template_for`), which forks it from a context already drawn with.
@@ -495,7 +497,7 @@ def zygote(channel_fd: int) -> None:
             continue
         request = json.loads(data)
         if request.get("slot"):  # a job slot for data-only submissions (glsandbox.grading.resident)
-            _fork_slot(channel, templates, fds)
+            _fork_slot(channel, templates, fds, serve_slot)
             continue
         job = job_from(request)
         if _template is None and not job.writes_cache:  # the model answer's renderer fills Mesa's cache: cold
@@ -527,11 +529,13 @@ def zygote(channel_fd: int) -> None:
     os._exit(0)
 
 
-def _fork_slot(channel, templates: dict, fds: list[int]) -> None:  # noqa: ANN001 - the grader's socket
-    """Fork a slot supervisor (:func:`glsandbox.grading.resident.serve_slot`) on ``fds``: the
-    read end of its jobs' pipe and the write end of its results'. Cold: a resident renderer opens
-    a context of its own, kept for all its submissions."""
-    if len(fds) != 2:
+def _fork_slot(channel, templates: dict, fds: list[int],  # noqa: ANN001 - the grader's socket
+               serve_slot: Callable[[int, int], None] | None) -> None:
+    """Fork a slot supervisor (``serve_slot``: :func:`glsandbox.grading.resident.serve_slot`) on
+    ``fds``: the read end of its jobs' pipe and the write end of its results'. Cold: a resident
+    renderer opens a context of its own, kept for all its submissions. None (a template's
+    zygote, which is never asked): the request is dropped, the grader sees its pipe close."""
+    if len(fds) != 2 or serve_slot is None:
         for fd in fds:
             os.close(fd)
         return
@@ -543,8 +547,6 @@ def _fork_slot(channel, templates: dict, fds: list[int]) -> None:  # noqa: ANN00
                 other.close()
         code = 0
         try:
-            from glsandbox.grading.resident import serve_slot
-
             serve_slot(fds[0], fds[1])
         except BaseException:  # noqa: BLE001 - the grader sees the pipe close without a result
             code = 1

@@ -16,8 +16,9 @@ import numpy as np
 import pytest
 
 from glsandbox.grading import slots
-from glsandbox.grading.isolate import BROKEN, CRASHED, TIMEOUT, Job, Render, run_jobs
+from glsandbox.grading.isolate import BROKEN, CRASHED, TIMEOUT, Job, Render
 from glsandbox.grading.resident import names_own_shader, start_afresh
+from glsandbox.grading.runner import run_jobs  # the slots' way: scene files to a renderer kept per slot
 from glsandbox.lesson import find_lesson
 
 pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="the slots' process tree is Linux's (fork, /proc)")
