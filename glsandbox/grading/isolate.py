@@ -332,6 +332,9 @@ class _NoSlots:
     def take(self, job: Job) -> bool:
         return False
 
+    def queue(self, job: Job) -> bool:
+        return False
+
     def busy(self) -> int:
         return 0
 
@@ -377,10 +380,10 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
     slots = _NoSlots() if slots is None else slots(workers, lambda data, fds: zygote_process.request(data, fds))
     try:
         while pending or running or slots.busy():
-            while pending and len(running) + slots.busy() < max(1, workers):
+            while pending and (len(running) + slots.busy() < max(1, workers) or slots.queue(pending[0])):
                 job = pending.popleft()
-                if slots.take(job):
-                    continue
+                if len(running) + slots.busy() >= max(1, workers) or slots.take(job):
+                    continue  # (queued behind a slot's job, or taken by an idle slot)
                 try:
                     fd = zygote_process.start(job)
                 except OSError:  # the zygote is gone (it should not be): a fresh one, once

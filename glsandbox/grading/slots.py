@@ -37,7 +37,9 @@ def data_only(job: Job) -> bool:
 
 
 class Slot:
-    """One slot: the pipes to its supervisor, the supervisor's pid, and the job it is drawing."""
+    """One slot: the pipes to its supervisor, the supervisor's pid, and its jobs: the one it is
+    drawing and at most one more, already sent (it starts on it as soon as it sent the first's
+    result, without waiting for the grader to read that result)."""
 
     def __init__(self, request: Callable[[dict, list[int]], None]) -> None:
         jobs_read, self.jobs = os.pipe()
@@ -50,17 +52,21 @@ class Slot:
             os.close(results_write)
         self.reader = Reader(results)
         self.pid = 0
-        self.job: Job | None = None
+        self.queue: list[Job] = []
         self.deadline = 0.0
 
     def give(self, job: Job) -> None:
         send(self.jobs, _job_data(job))
-        self.job = job
-        self.deadline = time.monotonic() + job.timeout * len(job.renders) + MARGIN
+        self.queue.append(job)
+        self._set_deadline()
+
+    def _set_deadline(self) -> None:
+        """Every job it holds may take its pictures' time limits; past them and a margin it is lost."""
+        self.deadline = time.monotonic() + sum(j.timeout * len(j.renders) for j in self.queue) + MARGIN
 
     def finished(self) -> tuple[dict, bytes] | None | bool:
-        """Its job's result message if it came; False while it is still drawing; None when the
-        slot is lost (its pipe closed or a bad message, or past its deadline)."""
+        """Its first job's result message if it came; False while it is still drawing; None when
+        the slot is lost (its pipe closed or a bad message, or past its deadline)."""
         try:
             for header, payload in self.reader.messages(1 << 34):
                 if header.get("kind") == "pid":
@@ -92,16 +98,20 @@ class Slots:
         self.own: set[int] = set()
 
     def busy(self) -> int:
-        return sum(1 for slot in self.open if slot.job is not None)
+        """The slots drawing (each counts as one of the run's ``workers``)."""
+        return sum(1 for slot in self.open if slot.queue)
 
     def fds(self) -> list[int]:
         return [slot.reader.fd for slot in self.open]
 
+    def _theirs(self, job: Job) -> bool:
+        return data_only(job) and job.index not in self.own
+
     def take(self, job: Job) -> bool:
-        """Give ``job`` to an idle slot (opened if need be); False: not a slot's job."""
-        if not data_only(job) or job.index in self.own:
+        """Give ``job`` to an idle slot (opened if need be); False: not a slot's job, or every slot busy."""
+        if not self._theirs(job):
             return False
-        slot = next((s for s in self.open if s.job is None), None)
+        slot = next((s for s in self.open if not s.queue), None)
         if slot is None:
             if len(self.open) >= self.workers:
                 return False
@@ -117,6 +127,18 @@ class Slots:
             slot.give(job)
         return True
 
+    def queue(self, job: Job) -> bool:
+        """Send ``job`` to a slot drawing one job, to start when that one is done (no slot more
+        is opened: the run is at ``workers``); False where none can take it."""
+        slot = next((s for s in self.open if len(s.queue) == 1), None) if self._theirs(job) else None
+        if slot is None:
+            return False
+        try:
+            slot.give(job)
+        except OSError:  # its supervisor is gone: collect() finds the pipe closed
+            return False
+        return True
+
     def collect(self, ready: Sequence[int], pending: deque[Job], retried: set[int], results: dict[int, JobResult],
                 done: Callable[[JobResult], object]) -> bool:
         """Read the slots that are ``ready`` and settle each job that finished (:func:`settle`);
@@ -124,32 +146,43 @@ class Slots:
         for slot in list(self.open):
             if slot.reader.fd in ready:
                 slot.reader.pump(0.0)
-            if slot.job is None:
-                if slot.reader.closed:  # an idle supervisor that ended (it should not): forgotten
-                    self.open.remove(slot)
-                    slot.kill()
-                continue
-            message = slot.finished()
-            if message is False:
-                continue
-            job, slot.job = slot.job, None
-            if message is None:
+            while slot in self.open and (settled := self._settled(slot, pending, retried, results, done)) is not None:
+                if settled:
+                    return True
+        return False
+
+    def _settled(self, slot: Slot, pending: deque[Job], retried: set[int], results: dict[int, JobResult],
+                 done: Callable[[JobResult], object]) -> bool | None:
+        """The first job of ``slot`` settled if its result came (True: the run must stop); None
+        (and ``slot`` kept) when there is nothing more to settle now."""
+        if not slot.queue:
+            if slot.reader.closed:  # an idle supervisor that ended (it should not): forgotten
                 self.open.remove(slot)
                 slot.kill()
-            elif message[0].get("own_process"):
-                self.own.add(job.index)
-                pending.appendleft(job)
-                continue
-            if settle(job, _result(job, message if message else None), pending, retried, results, done):
-                return True
-        return False
+            return None
+        message = slot.finished()
+        if message is False:
+            return None
+        job = slot.queue.pop(0)
+        slot._set_deadline()
+        if message is None:  # lost: its job crashed; the one behind it never started, it goes back
+            self.open.remove(slot)
+            slot.kill()
+            pending.extendleft(reversed(slot.queue))
+            slot.queue = []
+            return settle(job, _result(job, None), pending, retried, results, done)
+        if message[0].get("own_process"):
+            self.own.add(job.index)
+            pending.appendleft(job)
+            return False
+        return settle(job, _result(job, message), pending, retried, results, done)
 
     def close(self) -> None:
         """Tell every slot the run is over (its jobs' pipe closed: the supervisor cleans up and
         ends) and wait until each has ended; a slot still drawing is killed."""
         waiting = []
         for slot in self.open:
-            if slot.job is not None:
+            if slot.queue:
                 slot.kill()
                 continue
             os.close(slot.jobs)

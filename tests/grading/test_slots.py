@@ -72,6 +72,32 @@ def test_at_most_jobs_slots_and_each_draws_one_job_at_a_time(zygote: FakeZygote)
     slots.close()
 
 
+def test_a_busy_slot_holds_one_job_more_and_no_slot_more_is_opened(zygote: FakeZygote) -> None:
+    """At ``--jobs`` the next scene file waits in a drawing slot's pipe (it starts there as soon
+    as the first's result is sent), one per slot."""
+    slots = Slots(2, zygote.request)
+    assert [slots.take(_job(n)) for n in range(2)] == [True, True]
+    assert [slots.queue(_job(n)) for n in range(2, 5)] == [True, True, False]
+    assert [len(slot.queue) for slot in slots.open] == [2, 2] and len(zygote.slots) == 2
+    assert not slots.queue(_job(5, "lesson.py"))
+    slots.close()
+
+
+def test_a_lost_slot_crashes_the_job_it_draws_and_gives_back_the_one_waiting(zygote: FakeZygote) -> None:
+    slots = Slots(1, zygote.request)
+    assert slots.take(_job(0)) and slots.queue(_job(1))
+    jobs_end, results_end = zygote.slots[0]
+    os.close(results_end)
+    os.close(jobs_end)
+    zygote.slots[0] = (-1, -1)
+    pending, results, done = deque(), {}, []
+    while not done:
+        _collect(slots, pending, results, done)
+    assert [p.status for p in done[0].pictures] == [CRASHED] and done[0].job.index == 0
+    assert [job.index for job in pending] == [1]  # never started: graded again, not crashed
+    slots.close()
+
+
 def test_a_result_is_settled_and_the_slot_is_free_again(zygote: FakeZygote) -> None:
     slots = Slots(1, zygote.request)
     assert slots.take(_job(0))
