@@ -38,7 +38,6 @@ from __future__ import annotations
 
 import os
 import shutil
-import signal
 import tempfile
 from pathlib import Path
 
@@ -189,7 +188,6 @@ def serve_slot(jobs: int, out: int) -> None:
     drawn by the resident renderer, its result framed on ``out``, until ``jobs`` closes."""
     os.setsid()
     set_subreaper()
-    signal.signal(signal.SIGCHLD, signal.SIG_DFL)  # it waits for its renderers
     send(out, {"kind": "pid", "pid": os.getpid()})
     work = tempfile.mkdtemp(prefix="glsandbox-grade-")
     inbox, cwd = os.path.join(work, "in"), os.path.join(work, "cwd")

@@ -512,21 +512,28 @@ def zygote(channel_fd: int, serve_slot: Callable[[int, int], None] | None = None
                     templates[job.backend] = None
         if _template is not None:
             quiet()  # Mesa's cache thread holds no lock the copy could need
-        pid = os.fork()
-        if pid == 0:
-            signal.signal(signal.SIGCHLD, signal.SIG_DFL)  # the supervisor waits for its renderer
-            channel.close()
-            for other in templates.values():
-                if other is not None:
-                    other.close()
-            code = 0
-            try:
-                _supervise(job, fds[0])
-            except BaseException:  # noqa: BLE001 - the grader sees the pipe close without a result
-                code = 1
-            os._exit(code)
-        os.close(fds[0])
+        _fork_serving(channel, templates, fds, lambda: _supervise(job, fds[0]))
     os._exit(0)
+
+
+def _fork_serving(channel, templates: dict, fds: list[int], serve: Callable[[], None]) -> None:  # noqa: ANN001
+    """Fork a supervisor that runs ``serve`` and ends (its child reaped by itself, none of the
+    zygote's sockets kept); here, ``fds`` (now the supervisor's) are closed."""
+    pid = os.fork()
+    if pid == 0:
+        signal.signal(signal.SIGCHLD, signal.SIG_DFL)  # the supervisor waits for its renderer
+        channel.close()
+        for other in templates.values():
+            if other is not None:
+                other.close()
+        code = 0
+        try:
+            serve()
+        except BaseException:  # noqa: BLE001 - the grader sees the pipe close without a result
+            code = 1
+        os._exit(code)
+    for fd in fds:
+        os.close(fd)
 
 
 def _fork_slot(channel, templates: dict, fds: list[int],  # noqa: ANN001 - the grader's socket
@@ -539,20 +546,7 @@ def _fork_slot(channel, templates: dict, fds: list[int],  # noqa: ANN001 - the g
         for fd in fds:
             os.close(fd)
         return
-    pid = os.fork()
-    if pid == 0:
-        channel.close()
-        for other in templates.values():
-            if other is not None:
-                other.close()
-        code = 0
-        try:
-            serve_slot(fds[0], fds[1])
-        except BaseException:  # noqa: BLE001 - the grader sees the pipe close without a result
-            code = 1
-        os._exit(code)
-    for fd in fds:
-        os.close(fd)
+    _fork_serving(channel, templates, fds, lambda: serve_slot(fds[0], fds[1]))
 
 
 def _template_for(job: Job, templates: dict, channel, fds: list[int]) -> object | None:

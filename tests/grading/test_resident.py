@@ -19,21 +19,14 @@ from glsandbox.grading import slots
 from glsandbox.grading.isolate import BROKEN, CRASHED, TIMEOUT, Job, Render
 from glsandbox.grading.resident import names_own_shader, start_afresh
 from glsandbox.grading.runner import run_jobs  # the slots' way: scene files to a renderer kept per slot
+from glsandbox.grading.warm import _WARM_SCENE
 from glsandbox.lesson import find_lesson
 
 pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="the slots' process tree is Linux's (fork, /proc)")
 
 SIZE = (64, 48)
-SCENE = """name = "s"
-[camera]
-eye = [2.5, 2.0, 3.5]
-[[lights]]
-position = [2, 3, 4]
-[[nodes]]
-mesh = "{mesh}"
-shading = "{shading}"
-color = [0.8, 0.4, 0.2]
-"""
+#: The warm template's scene (a camera and a light) with one node.
+SCENE = _WARM_SCENE + '[[nodes]]\nmesh = "{mesh}"\nshading = "{shading}"\ncolor = [0.8, 0.4, 0.2]\n'
 #: A triangle in an OBJ file; two of them, the same length, differ only in where the corners lie.
 TRIANGLE = "v {a} 0.000 0.000\nv 0.000 {a} 0.000\nv 0.000 0.000 {a}\nf 1 2 3\n"
 
@@ -54,7 +47,7 @@ def _slow_scene(count: int = 1500) -> str:
     """A scene file that takes seconds to load and draw (many spheres): past a short time limit."""
     nodes = "".join(f'[[nodes]]\nname = "n{i}"\nmesh = "sphere"\ntranslate = [{i % 20 * 0.1:.1f}, 0, 0]\n'
                     for i in range(count))
-    return 'name = "slow"\n[camera]\neye = [2.5, 2.0, 3.5]\n[[lights]]\nposition = [2, 3, 4]\n' + nodes
+    return _WARM_SCENE + nodes
 
 
 def _one_process_each(monkeypatch: pytest.MonkeyPatch, jobs: list[Job], workers: int = 2) -> list:
