@@ -17,6 +17,7 @@ with a shader of its own) goes back to the queue for a supervisor of its own.
 from __future__ import annotations
 
 import os
+from pathlib import Path
 import time
 from collections import deque
 from collections.abc import Callable, Sequence
@@ -24,16 +25,37 @@ from collections.abc import Callable, Sequence
 from glsandbox.grading.isolate import Job, JobResult, Reader, _job_data, _result, send, settle, wide_pipe
 from glsandbox.grading.processes import kill_tree, killpg
 
-__all__ = ["data_only", "Slot", "Slots"]
+__all__ = ["data_only", "lone_file", "Slot", "Slots"]
 
 #: Seconds a slot supervisor may take past its job's time limits before it is given up.
 MARGIN = 60.0
 
 
 def data_only(job: Job) -> bool:
-    """Whether ``job`` is a copied submission whose lesson file is a scene file (data, no code),
-    and not the model answer (whose renderer fills Mesa's shader cache)."""
-    return job.copy and job.source is not None and job.target.endswith(".toml") and not job.writes_cache
+    """Whether ``job`` is a copied submission that is a scene file and nothing else (data, no code),
+    and not the model answer (whose renderer fills Mesa's shader cache).
+
+    Nothing else: a model file, a texture or a shader beside the scene file would be decoded by C
+    code (trimesh's and PIL's readers, the driver's GLSL compiler) in a renderer that goes on to draw
+    other students' submissions, where a crafted file that took that process over could change
+    their pictures. Such a submission gets a process of its own, as a lesson does."""
+    if not (job.copy and job.source is not None and job.target.endswith(".toml") and not job.writes_cache):
+        return False
+    return lone_file(Path(job.source), job.target)
+
+
+def lone_file(source: Path, name: str) -> bool:
+    """Whether ``source`` is a plain file, or a folder holding the plain file ``name`` and nothing else."""
+    try:
+        if source.is_symlink():
+            return False
+        if source.is_file():
+            return True
+        with os.scandir(source) as entries:
+            found = [(entry.name, entry.is_file(follow_symlinks=False)) for entry in entries]
+    except OSError:  # gone, unreadable: the one-shot path says what is wrong with it
+        return False
+    return found == [(name, True)]
 
 
 class Slot:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 from collections import deque
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -16,17 +17,56 @@ from glsandbox.grading.slots import Slots, data_only
 RENDERS = (Render((), (2, 1)),)
 
 
+#: Where :func:`_job` writes its submissions (a fresh folder per test, :func:`subs`).
+SUBS: list[Path] = []
+
+
+@pytest.fixture(autouse=True)
+def subs(tmp_path):
+    SUBS[:] = [tmp_path]
+    yield tmp_path
+    SUBS.clear()
+
+
 def _job(index: int, target: str = "scene.toml", **changes) -> Job:
-    return Job(index, f"/subs/s{index}", target, RENDERS, **changes)
+    """Submission ``index``: a folder holding its one file ``target``, as a student hands it in."""
+    folder = SUBS[0] / f"s{index}"
+    folder.mkdir(exist_ok=True)
+    if target:
+        (folder / target).write_text('name = "x"\n')
+    return Job(index, str(folder), target, RENDERS, **changes)
 
 
-def test_only_a_copied_scene_file_that_is_not_the_model_answer_is_data_only() -> None:
-    assert data_only(_job(0))
-    assert not data_only(_job(0, "lesson.py"))
-    assert not data_only(_job(0, ""))  # a folder whose lesson the renderer finds
-    assert not data_only(_job(0, copy=False))  # a lesson checked by its author, where it is
-    assert not data_only(_job(0, writes_cache=True))  # the model answer fills Mesa's cache
+def test_only_a_copied_scene_file_that_is_not_the_model_answer_is_data_only(tmp_path) -> None:
+    alone = tmp_path / "s0"
+    alone.mkdir()
+    (alone / "scene.toml").write_text('name = "x"\n')
+
+    def job(target: str = "scene.toml", source=alone, **changes) -> Job:
+        return Job(0, str(source), target, RENDERS, **changes)
+
+    assert data_only(job()) and data_only(job(source=alone / "scene.toml"))  # a folder of one, or the file
+    assert not data_only(job("lesson.py"))
+    assert not data_only(job(""))  # a folder whose lesson the renderer finds
+    assert not data_only(job(copy=False))  # a lesson checked by its author, where it is
+    assert not data_only(job(writes_cache=True))  # the model answer fills Mesa's cache
     assert not data_only(Job(0, None, "scene.toml", RENDERS))  # a built-in lesson's name
+    assert not data_only(job(source=tmp_path / "gone"))
+
+
+@pytest.mark.parametrize("beside", ["rock.obj", "wood.png", "glow.frag", "models/"])
+def test_a_scene_file_with_files_beside_it_gets_a_process_of_its_own(tmp_path, beside: str) -> None:
+    """A model, a texture or a shader is decoded by C code: never in a renderer kept for others."""
+    folder = tmp_path / "s1"
+    folder.mkdir()
+    (folder / "scene.toml").write_text('name = "x"\n')
+    if beside.endswith("/"):
+        (folder / beside).mkdir()
+    else:
+        (folder / beside).write_bytes(b"data")
+    assert not data_only(Job(1, str(folder), "scene.toml", RENDERS))
+    (folder / "link.toml").symlink_to(folder / "scene.toml")
+    assert not data_only(Job(1, str(folder / "link.toml"), "link.toml", RENDERS))  # a link is never lone
 
 
 class FakeZygote:
