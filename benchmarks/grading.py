@@ -18,11 +18,14 @@ submissions right so every run exits 0):
   without the zygote's warm template, so a ratio against it flatters the
   isolation (shown, not a goal).
 
-Subject: ``glsandbox check DIR`` as it is, each submission in a process of
-its own (a zygote that imported glsandbox once forks a supervisor and a
-renderer per submission), with ``--jobs 1`` and ``--jobs 2``. Goal on a
-2-core machine: isolated ``--jobs 2`` within 1.5x of the shared-context
-anchor.
+Subject: ``glsandbox check DIR`` as it is, with ``--jobs 1`` and ``--jobs 2``:
+scene files, which run no code, are drawn by one confined renderer kept
+per job slot (its supervisor copies each submission into a fresh folder
+and replaces the renderer after any TIMEOUT, crash or OUT OF MEMORY:
+:mod:`glsandbox.grading.resident`); a lesson file gets a supervisor and a
+renderer of its own, forked by the zygote that imported glsandbox once.
+Goal on a 2-core machine: isolated ``--jobs 2`` within 1.5x of the
+shared-context anchor.
 
 The class row (:func:`class_case`) grades generated submissions, one in 20
 hostile (an endless loop, ``os._exit``, a memory hog, a reader of secrets

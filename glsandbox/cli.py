@@ -481,6 +481,13 @@ def cmd_check_merge(argv: list[str]) -> int:
 
 def cmd_check(args: argparse.Namespace) -> int:
     """``glsandbox check``: render, compare with reference PNGs by the golden rule; 0 all pass, 1 not."""
+    if Path(args.lesson).is_dir() and not args.update:  # a class: its zygote starts while the rest gets ready
+        from glsandbox.grading import portable
+
+        if not portable.wanted():
+            from glsandbox.grading.isolate import prestart
+
+            prestart()
     from glsandbox.grading.check import Limits, check_folder, check_one, default_jobs, summary_table
     from glsandbox.grading.reports import REPORTS, write_reports
 
@@ -516,6 +523,7 @@ def cmd_check(args: argparse.Namespace) -> int:
 
         from glsandbox.grading import portable
         from glsandbox.grading.layers import describe
+
 
         # which layers confine a submission on this machine
         layers_line = portable.describe() if portable.wanted() else describe()

@@ -294,6 +294,17 @@ class FrameRenderer:
         image = target.read()
         return Frame(image, frame_plan, time.perf_counter() - start)
 
+    def forget(self) -> None:
+        """Start afresh on the same context, keeping only the compiled built-in programs
+        (:meth:`~glsandbox.gl.executor.Executor.hand_over_programs`): every target, mesh, texture,
+        plan and cache keyed by an object's ``id`` is released, and the notes already printed
+        are printed again. A renderer kept for many graded submissions calls it before each, so
+        that nothing drawn for one (an ``id`` reused by another's object) reaches the next."""
+        programs = self.executor.hand_over_programs()
+        FrameRenderer.close(self)  # (a HeadlessRenderer's close would release the context too)
+        FrameRenderer.__init__(self, self.host, self.primitive_ids)
+        self.executor.adopt(programs)
+
     def close(self) -> None:
         self.host.make_current()  # deletes must reach this context's objects
         for target in self._targets.values():

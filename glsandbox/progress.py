@@ -40,5 +40,9 @@ def say(text: str, file: TextIO | None = None) -> None:
     """One line on ``file`` (stderr), above any bar there (which is drawn again below it)."""
     from tqdm import tqdm
 
-    tqdm.write(text, file=file or sys.stderr)
-    (file or sys.stderr).flush()
+    stream = file or sys.stderr
+    if getattr(tqdm, "_instances", None):  # a bar drawn: the line goes above it
+        tqdm.write(text, file=stream)
+    else:  # no bar (not a terminal, or none made): the plain line, without tqdm's locks
+        stream.write(text + "\n")
+    stream.flush()

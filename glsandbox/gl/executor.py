@@ -132,6 +132,21 @@ class Executor(GpuMeshes):
         self._member_names.clear()
         self._written.clear()  # new programs hold no values yet
 
+    def hand_over_programs(self) -> dict[str, tuple[ProgramVariant, moderngl.Program]]:
+        """Take the built-in programs out of this executor (its :meth:`release` then leaves them),
+        for a fresh executor on the same context to :meth:`adopt`. A built-in program is a pure
+        function of glsandbox's own shader files and its defines, named by its key, so it holds
+        nothing of the scenes drawn with it but uniform values, which a fresh executor writes
+        again (it has no record of them); a node's own program stays here, to be released."""
+        kept = {key: entry for key, entry in self._programs.items() if not entry[0].user}
+        for key in kept:
+            del self._programs[key]
+        return kept
+
+    def adopt(self, programs: dict[str, tuple[ProgramVariant, moderngl.Program]]) -> None:
+        """Use ``programs`` (another executor's :meth:`hand_over_programs`, on this context) as compiled here."""
+        self._programs.update(programs)
+
     def shader_files(self) -> frozenset[Path]:
         """The files the nodes' own shader programs were built from (with their includes)."""
         return frozenset(path for user in self._user.values() for path in user.files)

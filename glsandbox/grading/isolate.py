@@ -30,6 +30,9 @@ worst it can do is lose its own pictures.
 This module is the grader's side and what both sides share (the jobs, the
 framed messages); :mod:`glsandbox.grading.worker` is the zygote, supervisor
 and renderer; :mod:`glsandbox.grading.processes` finds and kills a tree.
+A scene file (data, no code) goes instead to a job slot: a supervisor and a
+renderer kept for many scene files, confined as these are
+(:mod:`glsandbox.grading.slots`, :mod:`glsandbox.grading.resident`).
 """
 
 from __future__ import annotations
@@ -37,6 +40,7 @@ from __future__ import annotations
 import json
 import os
 import select
+import shutil
 import struct
 import sys
 import time
@@ -212,32 +216,46 @@ class _Zygote:
     def __init__(self) -> None:
         import socket
         import subprocess
+        import tempfile
 
+        # Every private folder of the run is made in this one (the zygote's temporary folder),
+        # removed by the grader when the run ends: none is left by a supervisor killed before
+        # its own clean-up (past its deadline, or the run stopped). Others may pass through it
+        # to the folders a submission's user owns, not list it.
+        self.folder = tempfile.mkdtemp(prefix="glsandbox-grade-run-")
+        os.chmod(self.folder, 0o711)
         self.channel, theirs = socket.socketpair()
-        code = "import sys; from glsandbox.grading.worker import zygote_main; zygote_main(int(sys.argv[1]))"
+        code = ("import sys; from glsandbox.grading.resident import zygote_main; "
+                "zygote_main(int(sys.argv[1]), sys.argv[2])")
         # a fresh program with only what rendering reads: every fork's /proc/self/environ is this one
         from glsandbox.grading.layers import minimal_environment
 
         package_parent = str(Path(__file__).resolve().parents[2])
         code = f"import sys; sys.path.insert(0, {package_parent!r}); " + code
-        self.process = subprocess.Popen([sys.executable, "-c", code, str(theirs.fileno())], pass_fds=[theirs.fileno()],
-                                        stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,  # never the grader's stdout
+        self.process = subprocess.Popen([sys.executable, "-c", code, str(theirs.fileno()), self.folder],
+                                        pass_fds=[theirs.fileno()],
+                                        # never the grader's stdout
+                                        stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                                         env=minimal_environment())
         theirs.close()
 
     def start(self, job: Job) -> int:
         """Ask for a supervisor for ``job``; the read end of its result pipe."""
-        import socket
-
         read_end, write_end = os.pipe()
         wide_pipe(write_end)
-        data = json.dumps(_job_data(job)).encode()
         try:
-            self.channel.sendall(struct.pack("!I", len(data)))
-            socket.send_fds(self.channel, [data], [write_end])
+            self.request(_job_data(job), [write_end])
         finally:
             os.close(write_end)
         return read_end
+
+    def request(self, data: dict, fds: list[int]) -> None:
+        """Send the zygote ``data`` (a job, or a slot's request) and ``fds`` (the caller keeps its copies)."""
+        import socket
+
+        encoded = json.dumps(data).encode()
+        self.channel.sendall(struct.pack("!I", len(encoded)))
+        socket.send_fds(self.channel, [encoded], fds)
 
     def close(self) -> None:
         self.channel.close()
@@ -245,6 +263,43 @@ class _Zygote:
             self.process.wait(timeout=10)
         except Exception:  # noqa: BLE001 - it is killed with the rest of the run
             pass
+
+
+#: A zygote started ahead of its run (:func:`prestart`), taken by the next :func:`run_jobs`.
+_prestarted: _Zygote | None = None
+
+
+def prestart() -> None:
+    """Start the zygote now, so that its start (a fresh Python importing glsandbox, numpy and
+    moderngl: about half a second) overlaps the grader's own preparation (the references read,
+    the submissions listed); the next :func:`run_jobs` uses it. Nothing where the system cannot fork."""
+    global _prestarted
+    if _prestarted is None and hasattr(os, "fork"):
+        import atexit
+
+        _prestarted = _Zygote()
+        atexit.register(_discard_prestarted)
+
+
+def _discard_prestarted() -> None:
+    """At exit: a prestarted zygote no run took (the command stopped first: a missing reference,
+    a rubric of exercises only) is closed and its folder removed."""
+    global _prestarted
+    found, _prestarted = _prestarted, None
+    if found is not None:
+        found.close()
+        shutil.rmtree(found.folder, ignore_errors=True)
+
+
+def _zygote() -> _Zygote:
+    """The prestarted zygote if there is one (and it lives), else a fresh one."""
+    global _prestarted
+    found, _prestarted = _prestarted, None
+    if found is not None and found.process.poll() is None:
+        return found
+    if found is not None:
+        found.close()
+    return _Zygote()
 
 
 @dataclass
@@ -271,8 +326,33 @@ def settle(job: Job, result: JobResult, pending: deque[Job], retried: set[int], 
     return False
 
 
-def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None]) -> list[JobResult]:
+class _NoSlots:
+    """No job slots: every job gets a supervisor of its own (:func:`run_jobs` without ``slots``)."""
+
+    def take(self, job: Job) -> bool:
+        return False
+
+    def queue(self, job: Job) -> bool:
+        return False
+
+    def busy(self) -> int:
+        return 0
+
+    def fds(self) -> list[int]:
+        return []
+
+    def collect(self, *_: object) -> bool:
+        return False
+
+    def close(self) -> None:
+        pass
+
+
+def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None],
+             slots: Callable[[int, Callable[[dict, list[int]], None]], object] | None = None) -> list[JobResult]:
     """Run every job, ``workers`` at once; ``done`` is called as each finishes; results in job order.
+    ``slots(workers, request)``: the job slots that take the jobs they can (scene files,
+    :class:`glsandbox.grading.slots.Slots`, given a way to ask the zygote); else none.
 
     The grader becomes a subreaper for the run, so a process a submission
     leaves behind whose supervisor was killed still comes back here, and is
@@ -284,7 +364,8 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
 
         raise SandboxError("glsandbox check runs each submission in a process of its own, which needs a POSIX "
                            "system (Linux, macOS); on Windows run it in WSL or a container")
-    before = set(descendants(os.getpid()))
+    ahead = _prestarted.process.pid if _prestarted is not None else None
+    before = set(descendants(os.getpid())) - {ahead}
     set_subreaper()
     pending = deque(jobs)
     running: dict[int, _Running] = {}
@@ -293,21 +374,29 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
     # Supervisors that sent their result and are cleaning up (killing their renderer's tree,
     # removing their private folder): their pipes close when they end; the run waits for that.
     closing: dict[int, _Running] = {}
-    zygote_process = _Zygote()
+    zygote_process = _zygote()
+    folders = [zygote_process.folder]
+    # Scene files go to job slots, each a supervisor with a renderer kept for many (glsandbox.grading.slots).
+    slots = _NoSlots() if slots is None else slots(workers, lambda data, fds: zygote_process.request(data, fds))
     try:
-        while pending or running:
-            while pending and len(running) < max(1, workers):
+        while pending or running or slots.busy():
+            while pending and (len(running) + slots.busy() < max(1, workers) or slots.queue(pending[0])):
                 job = pending.popleft()
+                if len(running) + slots.busy() >= max(1, workers) or slots.take(job):
+                    continue  # (queued behind a slot's job, or taken by an idle slot)
                 try:
                     fd = zygote_process.start(job)
                 except OSError:  # the zygote is gone (it should not be): a fresh one, once
                     zygote_process.close()
                     zygote_process = _Zygote()
+                    folders.append(zygote_process.folder)
                     fd = zygote_process.start(job)
                 # a supervisor that hangs (it should not) is given up after every picture's time and a margin
                 running[fd] = _Running(job, Reader(fd), time.monotonic() + job.timeout * len(job.renders) + 60)
-            ready, _, _ = select.select([*running, *closing], [], [], 1.0)
+            ready, _, _ = select.select([*running, *closing, *slots.fds()], [], [], 1.0)
             _drain(closing, ready)
+            if slots.collect(ready, pending, retried, results, done):
+                return [results[j.index] for j in jobs if j.index in results]
             for fd in list(running):
                 entry = running[fd]
                 if fd in ready:
@@ -339,12 +428,15 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
             if entry.pid:
                 killpg(entry.pid)
             os.close(fd)
+        slots.close()
         while closing:
             ready, _, _ = select.select(list(closing), [], [], 0.5)
             _drain(closing, ready)
         zygote_process.close()
         kill_tree(os.getpid(), keep=sorted(before))
         set_subreaper(False)
+        for folder in folders:  # every process of the run is gone: what they left goes too
+            shutil.rmtree(folder, ignore_errors=True)
     return [results[j.index] for j in jobs]
 
 

@@ -12,6 +12,7 @@ from collections.abc import Callable, Sequence
 
 from glsandbox.grading import isolate, portable
 from glsandbox.grading.isolate import Job, JobResult
+from glsandbox.grading.slots import Slots
 
 __all__ = ["run_jobs"]
 
@@ -21,4 +22,4 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
     finishes; the results come back in job order."""
     if portable.wanted():
         return portable.run_jobs_portable(jobs, workers, done)
-    return isolate.run_jobs(jobs, workers, done)
+    return isolate.run_jobs(jobs, workers, done, slots=Slots)  # scene files: a renderer kept per slot

@@ -19,6 +19,7 @@ import struct
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -33,36 +34,63 @@ __all__ = ["PRELOAD", "zygote_main"]
 
 #: What the zygote imports once, so each submission starts warm (and no module
 #: opens a GL context at import).
-PRELOAD = ["glsandbox.grading.worker", "glsandbox.frame", "glsandbox.lesson", "glsandbox.scene_file",
-           "glsandbox.grading.sandbox", "glsandbox.gl.context", "glsandbox.gl.shaders", "numpy", "moderngl",
-           "glcontext", "glcontext.egl", "PIL.Image", "glsandbox.lessons"]
+PRELOAD = ["glsandbox.grading.worker", "glsandbox.frame", "glsandbox.lesson",
+           "glsandbox.scene_file", "glsandbox.grading.sandbox", "glsandbox.gl.context", "glsandbox.gl.shaders",
+           "numpy", "moderngl", "glcontext", "glcontext.egl", "PIL.Image", "glsandbox.lessons"]
 
 
 
 # --- the renderer (grandchild) ---------------------------------------------------------------
 
 
-def _limit(job: Job) -> None:
-    """Address space (--memory), CPU seconds (--timeout for each picture, plus start-up), no core
-    files, and files no larger than 256 MB."""
+def _limit(job: Job, cpu: tuple[int, int] | None = None) -> None:
+    """Address space (--memory), CPU seconds (--timeout for each picture, plus start-up; or
+    ``cpu``, soft and hard), no core files, and files no larger than 256 MB."""
     import resource  # POSIX only, as the whole of this module's running side
 
     memory = job.memory_mb * 1024 * 1024
-    cpu = int(job.timeout * len(job.renders)) + 10
-    for limit, value in ((resource.RLIMIT_AS, memory), (resource.RLIMIT_CPU, cpu), (resource.RLIMIT_CORE, 0),
-                         (resource.RLIMIT_FSIZE, 256 * 1024 * 1024)):
+    soft, hard = cpu if cpu is not None else (cpu_budget(job), cpu_budget(job) + 1)
+    for limit, value, top in ((resource.RLIMIT_AS, memory, memory), (resource.RLIMIT_CPU, soft, hard),
+                              (resource.RLIMIT_CORE, 0, 0), (resource.RLIMIT_FSIZE, 256 << 20, 256 << 20)):
         try:
-            resource.setrlimit(limit, (value, value + 1 if limit == resource.RLIMIT_CPU else value))
+            resource.setrlimit(limit, (value, top))
         except (ValueError, OSError):
             pass
+
+
+def cpu_budget(job: Job) -> int:
+    """The CPU seconds one job may use: its pictures' time limits and 10 s of start-up."""
+    return int(job.timeout * len(job.renders)) + 10
 
 
 def _renderer(job: Job, root: str, target: str, work: str, out: int, ids: tuple[int, int] | None) -> None:
     """The renderer's whole life; it never returns (``os._exit``). ``ids``: the user it becomes
     before the submission's code runs (the grader is root)."""
+    code = 0
+    try:
+        cwd = os.path.join(work, "cwd")
+        renderer = enter_renderer(job, root, root if job.copy else cwd, [root if job.copy else cwd, cwd], work, out,
+                                  ids)
+        if renderer is not None:
+            render_job(job, renderer, root, target, 3)
+    except BaseException:  # noqa: BLE001 - the pipe closed, or worse: the supervisor reports it
+        code = 3
+    finally:
+        flush_output()
+        os._exit(code)  # no atexit handler, no thread, no finaliser of the submission runs
+
+
+def enter_renderer(job: Job, root: str, here: str, writable: list[str], work: str, out: int,
+                   ids: tuple[int, int] | None, keep: int | None = None, cpu: tuple[int, int] | None = None):
+    """A renderer's start, before any submission is read: its own session, stdin /dev/null,
+    stdout and stderr into ``work``'s ``output.txt``, the result pipe ``out`` as descriptor 3
+    (``keep``, a pipe of commands, as 4; every other one closed), its own network, working in
+    ``here``, limited (``cpu``: soft and hard CPU seconds, else :func:`cpu_budget`'s), its GL
+    context (or the warm template's copy), then the user ``ids``, confined to reading ``root``
+    and writing ``writable`` (:func:`~glsandbox.grading.sandbox.confine`), and seccomp's filter.
+    The renderer, or None when no GL context opened (the supervisor was told)."""
     from glsandbox.errors import SandboxError
     from glsandbox.frame import HeadlessRenderer
-    from glsandbox.grading import layers
     from glsandbox.grading.sandbox import confine, landlock_abi
 
     os.setsid()
@@ -74,35 +102,27 @@ def _renderer(job: Job, root: str, target: str, work: str, out: int, ids: tuple[
     os.close(null)
     os.close(log)
     os.dup2(out, 3)  # the result pipe; every other descriptor (the supervisor's, the zygote's) is closed
-    out = 3
-    os.closerange(4, os.sysconf("SC_OPEN_MAX"))
+    if keep is not None:
+        os.dup2(keep, 4)
+    os.closerange(5 if keep is not None else 4, os.sysconf("SC_OPEN_MAX"))
     sys.stdin = open(os.devnull)  # noqa: SIM115 - the submission's, for its life
     sys.argv = ["submission"]
     layers.close_network()  # before a context starts threads: a user namespace needs a single thread
-    cwd = os.path.join(work, "cwd")
-    os.chdir(root if job.copy else cwd)
-    _limit(job)
-    code = 0
-    try:
-        try:  # forked from a warm template: its context, copied (see glsandbox.grading.warm)
-            renderer = _template if _template is not None else HeadlessRenderer(job.backend)
-        except SandboxError as exc:
-            send(out, {"kind": "nogl", "error": str(exc)})
-            return
-        kept_reading = False
-        if ids is not None:  # Python only root may read: reading kept, bounded by Landlock below
-            kept_reading = not _python_readable() and landlock_abi() >= 1
-            layers.drop_privileges(ids, keep_reading=kept_reading)
-        if not confine(root, [root if job.copy else cwd, cwd], cache_writable=job.writes_cache,
-                       others_only=kept_reading) and kept_reading:
-            layers.drop_reading()
-        layers.install_seccomp()
-        render_job(job, renderer, root, target, out)
-    except BaseException:  # noqa: BLE001 - the pipe closed, or worse: the supervisor reports it
-        code = 3
-    finally:
-        flush_output()
-        os._exit(code)  # no atexit handler, no thread, no finaliser of the submission runs
+    os.chdir(here)
+    _limit(job, cpu)
+    try:  # forked from a warm template: its context, copied (see glsandbox.grading.warm)
+        renderer = _template if _template is not None else HeadlessRenderer(job.backend)
+    except SandboxError as exc:
+        send(3, {"kind": "nogl", "error": str(exc)})
+        return None
+    kept_reading = False
+    if ids is not None:  # Python only root may read: reading kept, bounded by Landlock below
+        kept_reading = not _python_readable() and landlock_abi() >= 1
+        layers.drop_privileges(ids, keep_reading=kept_reading)
+    if not confine(root, writable, cache_writable=job.writes_cache, others_only=kept_reading) and kept_reading:
+        layers.drop_reading()
+    layers.install_seccomp()
+    return renderer
 
 
 def flush_output() -> None:
@@ -115,24 +135,31 @@ def flush_output() -> None:
             pass  # no atexit handler, no thread, no finaliser of the submission runs
 
 
-def render_job(job: Job, renderer, root: str, target: str, out: int) -> None:
+def render_job(job: Job, renderer, root: str, target: str, out: int,
+               own_process: Callable[[Path], bool] | None = None) -> bool:
     """Load the submission's lesson (``target`` in ``root``, or a built-in lesson's name) and send
     each of the job's pictures on ``out`` as it is drawn, or the error that stopped it: the
-    renderer's work once confined, on either path (this one and :mod:`glsandbox.grading.portable`)."""
+    renderer's work once confined, on either path (this one and :mod:`glsandbox.grading.portable`).
+    ``own_process``: whether the lesson file must be rendered in a process of its own (a resident
+    renderer's question, :mod:`glsandbox.grading.resident`); then only ``own`` is sent. False
+    when drawing a picture raised (the renderer may hold a half-made frame), else True."""
     from glsandbox.errors import SandboxError
     from glsandbox.lesson import find_lesson, submission_lesson, user_code_error
 
+    if own_process is not None and own_process(Path(root) / target):
+        send(out, {"kind": "own"})
+        return True
     try:
         cls = find_lesson(target) if job.source is None else submission_lesson(Path(root) / target, job.entry)
     except MemoryError as exc:
         send(out, {"kind": "oom", "index": 0, "error": str(user_code_error(exc)), "all": True})
-        return
+        return True
     except SandboxError as exc:
         send(out, {"kind": "broken", "index": 0, "error": str(exc), "all": True})
-        return
+        return True
     except BaseException as exc:  # noqa: BLE001 - anything the submission raised while loading
         send(out, {"kind": "broken", "index": 0, "error": str(user_code_error(exc)), "all": True})
-        return
+        return True
     if job.describe:  # the tour's card: read from the class now, sent as text
         try:
             from glsandbox.lesson import lesson_description
@@ -141,6 +168,7 @@ def render_job(job: Job, renderer, root: str, target: str, out: int) -> None:
                        "description": str(lesson_description(cls))[:2000]})
         except BaseException:  # noqa: BLE001 - a class whose attributes raise: its card says less
             pass
+    clean = True
     for index, render in enumerate(job.renders):
         started = time.perf_counter()
         try:
@@ -163,11 +191,15 @@ def render_job(job: Job, renderer, root: str, target: str, out: int) -> None:
             flush_output()
             send(out, header, image.tobytes())
         except MemoryError as exc:
+            clean = False
             send(out, {"kind": "oom", "index": index, "error": str(user_code_error(exc))})
         except SandboxError as exc:
+            clean = False
             send(out, {"kind": "broken", "index": index, "error": str(exc)})
         except BaseException as exc:  # noqa: BLE001 - KeyboardInterrupt, SystemExit, its own kinds
+            clean = False
             send(out, {"kind": "broken", "index": index, "error": str(user_code_error(exc))})
+    return clean
 
 
 def _story(cls, render, renderer) -> str:  # noqa: ANN001 - the submission's class, a Render, its renderer
@@ -209,17 +241,18 @@ def _exit_reason(status: int, job: Job) -> tuple[str, str]:
     if os.WIFSIGNALED(status):
         number = os.WTERMSIG(status)
         if number == signal.SIGXCPU:
-            return TIMEOUT, f"timed out: the CPU time limit ({int(job.timeout * len(job.renders)) + 10} s) reached"
+            return TIMEOUT, f"timed out: the CPU time limit ({cpu_budget(job)} s) reached"
         name = signal.Signals(number).name if number in signal.Signals._value2member_map_ else str(number)
         return CRASHED, f"killed by signal {name}"
     return CRASHED, f"exited with code {os.WEXITSTATUS(status)} before its picture was sent"
 
 
-def _collect(job: Job, pid: int, fd: int, meta: dict | None = None) -> list[Picture]:
-    """Each picture as it arrives, against the clock: ``job.timeout`` seconds for each."""
+def _collect(job: Job, pid: int, fd: int, meta: dict | None = None, reader: Reader | None = None) -> list[Picture]:
+    """Each picture as it arrives, against the clock: ``job.timeout`` seconds for each. ``reader``:
+    the pipe's, kept by a caller that reads on after the last picture (a resident renderer's)."""
     pictures: list[Picture] = [Picture() for _ in job.renders]
     limit = max(w * h * 4 for w, h in (r.size for r in job.renders))
-    reader = Reader(fd)
+    reader = reader if reader is not None else Reader(fd)
     status: int | None = None
     current, started = 0, time.monotonic()
 
@@ -246,6 +279,8 @@ def _collect(job: Job, pid: int, fd: int, meta: dict | None = None) -> list[Pict
                 kind = header.get("kind")
                 if kind == "nogl":
                     raise _NoGL(str(header.get("error", "")))
+                if kind == "own":
+                    raise OwnProcess()
                 if kind == "meta" and meta is not None and not meta:
                     meta.update({k: str(header.get(k, ""))[:2000] for k in ("title", "course_section", "description")})
                     continue
@@ -269,6 +304,8 @@ def _collect(job: Job, pid: int, fd: int, meta: dict | None = None) -> list[Pict
                     if header.get("all"):  # the lesson did not load: no picture of it can be made
                         return finish(picture.status, picture.error)
                 current, started = current + 1, time.monotonic()
+                if current == len(pictures):  # what follows is the caller's (a resident renderer's "served")
+                    break
         except (ValueError, KeyError, TypeError) as exc:
             return finish(CRASHED, f"sent {exc}")
         if status is not None and (reader.closed or not select.select([fd], [], [], 0)[0]) and current < len(pictures):
@@ -278,6 +315,10 @@ def _collect(job: Job, pid: int, fd: int, meta: dict | None = None) -> list[Pict
 
 class _NoGL(Exception):
     """The renderer could not open a GL context: the machine's problem, not the submission's."""
+
+
+class OwnProcess(Exception):
+    """A resident renderer's answer: this submission is rendered in a process of its own."""
 
 
 def _tail(path: str) -> list[str]:
@@ -394,9 +435,15 @@ def preload_gl_libraries() -> None:
             pass
 
 
-def zygote_main(channel_fd: int) -> None:
-    """The zygote process: import :data:`PRELOAD` and the GL libraries once, then :func:`zygote`."""
+def zygote_main(channel_fd: int, folder: str | None = None,
+                serve_slot: Callable[[int, int], None] | None = None) -> None:
+    """The zygote process: import :data:`PRELOAD` and the GL libraries once, then :func:`zygote`.
+    ``folder``: where every supervisor makes its private folder (the grader removes it at the end);
+    ``serve_slot``: a job slot's supervisor (:func:`glsandbox.grading.resident.serve_slot`)."""
     import importlib
+
+    if folder is not None:
+        tempfile.tempdir = folder
 
     for module in PRELOAD:
         try:
@@ -409,7 +456,7 @@ def zygote_main(channel_fd: int) -> None:
     # never writes their headers and copies their pages (a collection in a renderer touched the
     # whole inherited heap: about 10 ms of one renderer's 60 in one profile here).
     gc.freeze()
-    zygote(channel_fd)
+    zygote(channel_fd, serve_slot)
 
 
 def prepare_confinement() -> None:
@@ -424,7 +471,7 @@ def prepare_confinement() -> None:
         others_may_read("/etc")
 
 
-def zygote(channel_fd: int) -> None:
+def zygote(channel_fd: int, serve_slot: Callable[[int, int], None] | None = None) -> None:
     """Serve the grader on ``channel_fd`` (one end of a socket pair): each message is a job and
     the pipe its result goes to; fork a supervisor for it, or hand the job to the warm template
     of its backend (:func:`_template_for`), which forks it from a context already drawn with.
@@ -444,11 +491,15 @@ def zygote(channel_fd: int) -> None:
         if size_bytes is None:
             break
         (size,) = struct.unpack("!I", size_bytes)
-        first, fds, _, _ = socket.recv_fds(channel, min(size, 1 << 16), 1)
+        first, fds, _, _ = socket.recv_fds(channel, min(size, 1 << 16), 2)
         data = first + (_recv_exact(channel, size - len(first)) or b"")
         if not fds:
             continue
-        job = job_from(json.loads(data))
+        request = json.loads(data)
+        if request.get("slot"):  # a job slot for data-only submissions (glsandbox.grading.resident)
+            _fork_slot(channel, templates, fds, serve_slot)
+            continue
+        job = job_from(request)
         if _template is None and not job.writes_cache:  # the model answer's renderer fills Mesa's cache: cold
             warm = _template_for(job, templates, channel, fds)
             if warm is not None:
@@ -461,21 +512,41 @@ def zygote(channel_fd: int) -> None:
                     templates[job.backend] = None
         if _template is not None:
             quiet()  # Mesa's cache thread holds no lock the copy could need
-        pid = os.fork()
-        if pid == 0:
-            signal.signal(signal.SIGCHLD, signal.SIG_DFL)  # the supervisor waits for its renderer
-            channel.close()
-            for other in templates.values():
-                if other is not None:
-                    other.close()
-            code = 0
-            try:
-                _supervise(job, fds[0])
-            except BaseException:  # noqa: BLE001 - the grader sees the pipe close without a result
-                code = 1
-            os._exit(code)
-        os.close(fds[0])
+        _fork_serving(channel, templates, fds, lambda: _supervise(job, fds[0]))
     os._exit(0)
+
+
+def _fork_serving(channel, templates: dict, fds: list[int], serve: Callable[[], None]) -> None:  # noqa: ANN001
+    """Fork a supervisor that runs ``serve`` and ends (its child reaped by itself, none of the
+    zygote's sockets kept); here, ``fds`` (now the supervisor's) are closed."""
+    pid = os.fork()
+    if pid == 0:
+        signal.signal(signal.SIGCHLD, signal.SIG_DFL)  # the supervisor waits for its renderer
+        channel.close()
+        for other in templates.values():
+            if other is not None:
+                other.close()
+        code = 0
+        try:
+            serve()
+        except BaseException:  # noqa: BLE001 - the grader sees the pipe close without a result
+            code = 1
+        os._exit(code)
+    for fd in fds:
+        os.close(fd)
+
+
+def _fork_slot(channel, templates: dict, fds: list[int],  # noqa: ANN001 - the grader's socket
+               serve_slot: Callable[[int, int], None] | None) -> None:
+    """Fork a slot supervisor (``serve_slot``: :func:`glsandbox.grading.resident.serve_slot`) on
+    ``fds``: the read end of its jobs' pipe and the write end of its results'. Cold: a resident
+    renderer opens a context of its own, kept for all its submissions. None (a template's
+    zygote, which is never asked): the request is dropped, the grader sees its pipe close."""
+    if len(fds) != 2 or serve_slot is None:
+        for fd in fds:
+            os.close(fd)
+        return
+    _fork_serving(channel, templates, fds, lambda: serve_slot(fds[0], fds[1]))
 
 
 def _template_for(job: Job, templates: dict, channel, fds: list[int]) -> object | None:

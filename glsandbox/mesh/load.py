@@ -281,6 +281,11 @@ def _load_model(path: str | os.PathLike[str], *, fit: bool, normals: str, crease
     return model
 
 
+def clear_cache() -> None:
+    """Forget every model loaded (a renderer kept for many graded submissions, before each)."""
+    _CACHE.clear()
+
+
 def fit_mesh(mesh: Mesh) -> Mesh:
     """``mesh`` centred on the origin and scaled uniformly so its bounding box's
     longest side spans -1..1 (normals unchanged: a uniform scale keeps their directions)."""

@@ -170,3 +170,44 @@ def _text_or_empty(path: Path) -> str:
         return path.read_text()
     except OSError:  # not there (another run's folder, or gone while looked at)
         return ""
+
+
+SLOW_LESSON = """import time
+from glsandbox.geometry import builtin_mesh
+from glsandbox.lesson import Lesson
+from glsandbox.scene import Node, Scene
+
+
+class Slow(Lesson):
+    def build(self):
+        time.sleep({seconds})
+        return Scene("slow", nodes=[Node("cube", mesh=builtin_mesh("cube24"))])
+"""
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="the tree's processes are found through /proc")
+def test_a_run_stopped_midway_leaves_no_private_folder(gl_renderer, tmp_path: Path) -> None:
+    """The run stops while a supervisor is still at work (here the grader's own callback raises
+    on the first result; Ctrl-C does the same): that supervisor is killed before its clean-up,
+    and still no private folder of the run is left in the temp folder (they are all made in one
+    folder of the run's, which the grader removes once every process of the run is gone)."""
+    import tempfile
+
+    from glsandbox.grading.isolate import run_jobs
+
+    (tmp_path / "quick.py").write_text(SLOW_LESSON.format(seconds=0))
+    (tmp_path / "slow.py").write_text(SLOW_LESSON.format(seconds=30))
+    jobs = [Job(0, str(tmp_path / "quick.py"), "quick.py", (Render((), (16, 12)),), timeout=60.0),
+            Job(1, str(tmp_path / "slow.py"), "slow.py", (Render((), (16, 12)),), timeout=60.0)]
+    temp = Path(tempfile.gettempdir())
+    before = set(temp.glob("glsandbox-grade-*"))
+
+    def stop(result: JobResult) -> None:
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_jobs(jobs, 2, stop)
+    # the temp folder is the machine's: other runs' folders may come and go; none may hold ours
+    ours = [folder for folder in set(temp.glob("glsandbox-grade-*")) - before
+            if any("time.sleep(30)" in _text_or_empty(p) for p in folder.rglob("slow.py"))]
+    assert ours == []

@@ -7,12 +7,14 @@ from __future__ import annotations
 import pytest
 
 from glsandbox.grading import isolate, portable, runner
+from glsandbox.grading.slots import Slots
 
 
 @pytest.fixture
 def calls(monkeypatch) -> list[tuple]:
     found: list[tuple] = []
-    monkeypatch.setattr(isolate, "run_jobs", lambda jobs, workers, done: found.append(("tree", jobs, workers)) or ["t"])
+    monkeypatch.setattr(isolate, "run_jobs",
+                        lambda jobs, workers, done, slots=None: found.append(("tree", jobs, workers, slots)) or ["t"])
     monkeypatch.setattr(portable, "run_jobs_portable",
                         lambda jobs, workers, done: found.append(("portable", jobs, workers)) or ["p"])
     return found
@@ -24,7 +26,8 @@ def test_the_environment_chooses_the_way(monkeypatch, calls, value: str, way: st
     monkeypatch.setenv("GLSANDBOX_ISOLATION", value)
     jobs = ["a job"]
     assert runner.run_jobs(jobs, 3, print) == (["p"] if way == "portable" else ["t"])
-    assert calls == [(way, jobs, 3)]
+    # the tree's way gives scene files their job slots (glsandbox.grading.slots)
+    assert calls == [(way, jobs, 3, *((Slots,) if way == "tree" else ()))]
 
 
 def test_a_system_that_cannot_fork_grades_the_portable_way(monkeypatch, calls) -> None:

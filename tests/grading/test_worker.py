@@ -123,7 +123,8 @@ def test_the_zygote_freezes_its_heap_before_it_serves() -> None:
     """Every object the zygote made while preloading is in the permanent generation by the time it
     forks: a renderer's collector never walks them (and copies their pages)."""
     code = ("import gc, os, sys; from glsandbox.grading import worker; "
-            "worker.zygote = lambda fd: (print(gc.get_freeze_count(), len(gc.get_objects()), flush=True), os._exit(0)); "
+            "worker.zygote = lambda fd, slots: (print(gc.get_freeze_count(), len(gc.get_objects()), flush=True), "
+            "os._exit(0)); "
             "worker.zygote_main(-1)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=True).stdout
     frozen, tracked = map(int, out.split())
