@@ -28,7 +28,7 @@ import numpy as np
 from glsandbox.gl.draw_steps import _DrawStep
 from glsandbox.gl.passes import FrameState, RunPass
 from glsandbox.gl.uniform_bytes import _CAMERA, _CONSTANTS, _EYE, _FLOAT64, _MODEL_BYTES, _NORMAL_BYTES
-from glsandbox.gl.uniform_writes import write_constants, write_lighting
+from glsandbox.gl.uniform_writes import write_camera, write_constants, write_lighting, write_lights
 from glsandbox.passes.plan_parts import Pass
 from glsandbox.scene import Node
 
@@ -106,23 +106,11 @@ def draw_prepared(ex: Any, draws: tuple[PreparedDraw, ...], camera: Any, models:
             written["m_normal"] = normal_bytes
             uniforms["m_normal"].write(normal_bytes)
         if written[_CAMERA] is not camera:  # (as write_matrices: a pass's draws share its camera)
-            if camera.view_bytes != written["m_view"]:
-                written["m_view"] = camera.view_bytes
-                uniforms["m_view"].write(camera.view_bytes)
-            if camera.proj_bytes != written["m_proj"]:
-                written["m_proj"] = camera.proj_bytes
-                uniforms["m_proj"].write(camera.proj_bytes)
-            written[_CAMERA] = camera
+            write_camera(written, uniforms, camera)
         if step.lit:
-            if written[_EYE] is camera and lights and step.lights[0] is lights and step.lights[3] is camera:
-                # (write_lighting's writes where the eye is written and this draw's light bytes made)
-                light_pos, light_color = step.lights[1], step.lights[2]
-                if written["u_light_pos"] != light_pos:
-                    written["u_light_pos"] = light_pos
-                    uniforms["u_light_pos"].write(light_pos)
-                if written["u_light_color"] != light_color:
-                    written["u_light_color"] = light_color
-                    uniforms["u_light_color"].write(light_color)
+            kept = step.lights
+            if written[_EYE] is camera and lights and kept[0] is lights and kept[3] is camera:
+                write_lights(written, uniforms, kept[1], kept[2])  # (the eye written, these lights' bytes made)
             else:
                 write_lighting(step, written, uniforms, camera, lights, light_bytes)
         constants = step.constants
