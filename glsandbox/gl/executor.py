@@ -423,7 +423,9 @@ class Executor(GpuMeshes):
             check_user_draw(self._overrides, user, self._programs[draw.program][1], self._members(draw.program), node)
         mesh = node.mesh
         setup = self._draw_setup(draw.program, mesh)
-        lit = material.lit or user is not None  # a node's own shader may light itself whatever the shading
+        # A node's own shader may light itself whatever the shading; a program without any lighting
+        # uniform (a shadow map's depth program drawing a lit node) is given none of them.
+        lit = (material.lit or user is not None) and not setup.members.isdisjoint(_LIGHTING_UNIFORMS)
         origin = setup.source if setup.source is not mesh else None  # a moved mesh's set-up is its origin's
         if len(self._steps) >= self.SETUPS_KEPT:  # new draws every frame (plans not kept): start again
             self._steps.clear()
@@ -518,5 +520,9 @@ class Executor(GpuMeshes):
 
 #: A frame's models where nothing is moved by a motion handed over (see :class:`FrameState`).
 _NO_MODELS: Mapping[str, np.ndarray] = MappingProxyType({})
+#: The uniforms a lit draw writes besides the matrices and colour (write_lighting, the material's
+#: coefficients): a program with none of them is drawn as unlit, writing the same into GL.
+_LIGHTING_UNIFORMS = frozenset({"u_eye", "u_light_pos", "u_light_color", "u_ambient", "u_diffuse", "u_specular",
+                                "u_shininess"})
 #: What restore_state leaves of culling (off, counter-clockwise fronts).
 _NO_CULLING = (False, "ccw")
