@@ -246,9 +246,9 @@ class FrameRenderer:
         ``scene`` while its :func:`~glsandbox.plan.motion_decisions` agree, and the executor
         writes the moved uniforms into its prepared steps. None, with nothing drawn, where this
         does not apply: a motion that moves meshes, overlays or the camera, a ray-traced
-        viewport, a plan with a pass that reads the scene's nodes where they are (a shadow map
-        fits its light to them: known from the scene's first frame on); the caller then draws
-        the moved scene."""
+        viewport, a plan with a pass that reads the scene's nodes where they are
+        (:attr:`glsandbox.gl.passes.Runner.moved`: known from the scene's first frame on); the
+        caller then draws the moved scene."""
         if motion.positions or motion.overlays or motion.camera is not None:
             return None
         for vp in scene.viewports:

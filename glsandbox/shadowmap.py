@@ -22,7 +22,10 @@ from __future__ import annotations
 
 import math
 import weakref
+from collections.abc import Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
+from typing import Any
 
 import numpy as np
 
@@ -72,6 +75,9 @@ def _corners(mesh: Mesh) -> np.ndarray:
     return corners
 
 
+#: No node moved (:func:`light_frame` without models).
+_NO_MODELS: Mapping[str, Any] = MappingProxyType({})
+
 #: Each node's world corners by (its model's bytes, id of its mesh), with the mesh kept to
 #: check: a node that does not move is transformed once, not every frame.
 _WORLD_CORNERS: dict[tuple[bytes, int], tuple[Mesh, np.ndarray]] = {}
@@ -79,9 +85,10 @@ _WORLD_CORNERS: dict[tuple[bytes, int], tuple[Mesh, np.ndarray]] = {}
 _WORLD_CORNERS_KEPT = 256
 
 
-def _node_corners(node: Node) -> np.ndarray:
-    """The corners of ``node``'s mesh bounds in world space (8 rows, read-only)."""
-    model = np.asarray(node.model, dtype=np.float64)
+def _node_corners(node: Node, model: object = None) -> np.ndarray:
+    """The corners of ``node``'s mesh bounds in world space (8 rows, read-only), placed by
+    ``model`` (None: the node's own)."""
+    model = np.asarray(node.model if model is None else model, dtype=np.float64)
     key = (model.tobytes(), id(node.mesh))
     kept = _WORLD_CORNERS.get(key)
     if kept is None or kept[0] is not node.mesh:
@@ -93,21 +100,21 @@ def _node_corners(node: Node) -> np.ndarray:
     return kept[1]
 
 
-def _world_corners(nodes: list[Node]) -> np.ndarray:
-    """The corners of each node's mesh bounds in world space (8 per node)."""
+def _world_corners(nodes: list[Node], models: Mapping[str, Any]) -> np.ndarray:
+    """The corners of each node's mesh bounds in world space (8 per node), each node placed
+    by ``models[node.name]`` where it names one."""
     if not nodes:
         return np.zeros((0, 3))
-    return np.concatenate([_node_corners(node) for node in nodes])
+    return np.concatenate([_node_corners(node, models.get(node.name)) for node in nodes])
 
 
 def _casters_and_receivers(scene: Scene) -> tuple[list[Node], list[Node]]:
     """:func:`casters` and :func:`receivers` of ``scene``. Which nodes they are depends on nothing
     a lesson's motion changes (:func:`glsandbox.scene.moved_scene` keeps every node's flags and
     material, and the viewports): for a moved scene they are found once, by index, on the scene
-    it was moved from."""
-    origin = scene_origin(scene)
-    if origin is None:
-        return casters(scene), receivers(scene)
+    it was moved from, and for any other scene on the scene itself (a frame moved only by time
+    hands the executor the scene it is moved from and the models apart)."""
+    origin = scene_origin(scene) or scene
     kept = origin.__dict__.get("_shadow_map_nodes")
     if kept is None:
         index = {id(node): i for i, node in enumerate(origin.nodes)}
@@ -149,8 +156,10 @@ def _extent(view: np.ndarray, points: np.ndarray) -> float:
     return float((np.abs(local[:, :2]).max(axis=1) / depth).max())
 
 
-def light_frame(scene: Scene, light: Light) -> LightFrame:
-    """The shadow map's camera for ``light`` (which has a ShadowMap), fitted to the scene.
+def light_frame(scene: Scene, light: Light, models: Mapping[str, Any] | None = None) -> LightFrame:
+    """The shadow map's camera for ``light`` (which has a ShadowMap), fitted to the scene, its
+    nodes placed by ``models`` (model matrices by node name, :func:`glsandbox.scene.motion_parts`:
+    the scene moved there; None or a name left out: a node's own model).
 
     The view looks from the light at the centre of the casters' bounds. The field of
     view is the narrowest that holds every caster's bounds or every receiver's,
@@ -163,7 +172,8 @@ def light_frame(scene: Scene, light: Light) -> LightFrame:
     assert light.shadow is not None
     eye = np.asarray(light.position, dtype=np.float64)
     casting, receiving = _casters_and_receivers(scene)
-    cast, received = _world_corners(casting), _world_corners(receiving)
+    models = models or _NO_MODELS
+    cast, received = _world_corners(casting, models), _world_corners(receiving, models)
     target = cast.mean(axis=0) if len(cast) else eye - np.array([0.0, 1.0, 0.0])
     forward = target - eye
     reach = max(float(np.abs(eye).max()), 1.0)

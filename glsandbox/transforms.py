@@ -75,28 +75,45 @@ def identity() -> Matrix:
     return np.eye(4)
 
 
+#: The 4x4 identity the model transforms below start from (copied: a fresh array each).
+_IDENTITY = np.eye(4)
+_IDENTITY.flags.writeable = False
+
+
 def translate(x: float, y: float, z: float) -> Matrix:
     """Translation by (x, y, z): the last column carries the offset."""
-    return np.array([[1.0, 0.0, 0.0, x], [0.0, 1.0, 0.0, y], [0.0, 0.0, 1.0, z], [0.0, 0.0, 0.0, 1.0]],
-                    dtype=np.float64)
+    # The identity copied and three entries set: half the cost of np.array on nested lists
+    # (lessons move nodes every frame).
+    m = _IDENTITY.copy()
+    m[0, 3] = x
+    m[1, 3] = y
+    m[2, 3] = z
+    return m
 
 
 def scale(x: float, y: float, z: float) -> Matrix:
     """Non-uniform scale along the axes."""
-    # One np.array call (np.diag is Python around several numpy calls; lessons scale every frame).
-    return np.array([[float(x), 0, 0, 0], [0, float(y), 0, 0], [0, 0, float(z), 0], [0, 0, 0, 1]], dtype=np.float64)
+    m = _IDENTITY.copy()  # (as translate; np.diag is Python around several numpy calls)
+    m[0, 0] = x
+    m[1, 1] = y
+    m[2, 2] = z
+    return m
 
 
 def rotate_x(angle: float) -> Matrix:
     """Right-handed rotation about +x by ``angle`` radians (y turns towards z)."""
     c, s = math.cos(angle), math.sin(angle)
-    return np.array([[1, 0, 0, 0], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1]], dtype=np.float64)
+    m = _IDENTITY.copy()
+    m[1, 1], m[1, 2], m[2, 1], m[2, 2] = c, -s, s, c
+    return m
 
 
 def rotate_y(angle: float) -> Matrix:
     """Right-handed rotation about +y by ``angle`` radians (z turns towards x)."""
     c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, 0, s, 0], [0, 1, 0, 0], [-s, 0, c, 0], [0, 0, 0, 1]], dtype=np.float64)
+    m = _IDENTITY.copy()
+    m[0, 0], m[0, 2], m[2, 0], m[2, 2] = c, s, -s, c
+    return m
 
 
 def rotate_y_stack(angles: np.ndarray) -> np.ndarray:
@@ -113,7 +130,9 @@ def rotate_y_stack(angles: np.ndarray) -> np.ndarray:
 def rotate_z(angle: float) -> Matrix:
     """Right-handed rotation about +z by ``angle`` radians (x turns towards y)."""
     c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], dtype=np.float64)
+    m = _IDENTITY.copy()
+    m[0, 0], m[0, 1], m[1, 0], m[1, 1] = c, -s, s, c
+    return m
 
 
 def parse_order(order: str) -> str:

@@ -36,10 +36,18 @@ class _DrawSetup:
 
 
 class _Steps(dict):
-    """The prepared draws by key (:attr:`Executor._steps`); a key not there gives None (a subscript per draw)."""
+    """The prepared draws by key (:attr:`Executor._steps`); a key not there gives None (a subscript per draw).
+    ``made`` counts the times they were all dropped: a prepared pass made before the last
+    (:mod:`glsandbox.gl.prepared_frame`) holds draws that may be gone."""
+
+    made = 0
 
     def __missing__(self, key: tuple[int, str]) -> None:
         return None
+
+    def clear(self) -> None:
+        super().clear()
+        self.made += 1
 
 
 class _DrawStep:

@@ -27,6 +27,7 @@ from glsandbox.gl.gpu_meshes import GpuMeshes, _mesh_key, _moved_key
 from glsandbox.gl.uniform_bytes import _CONSTANTS, PassCamera, material_constants, _Uniforms, _Written
 from glsandbox.gl.uniform_writes import LightBytes, uniform_writer, write_constants, write_lighting, write_matrices
 from glsandbox.gl.draw_steps import _DrawSetup, _DrawStep, _PreparedFrame, _Steps
+from glsandbox.gl.prepared_frame import prepare_draw_pass
 from glsandbox.gl.user_shaders import UserProgram, check_user_draw
 from glsandbox.passes.plan_parts import SHADOW_MAP_UNIT, Draw, Pass, ProgramVariant
 from glsandbox.plan import Plan, plan as make_plan
@@ -263,6 +264,8 @@ class Executor(GpuMeshes):
             if not any(name in user.declared for user in users):
                 raise SandboxError(f"--set u.{name}: no shader of the scene declares uniform {name} "
                                    f"({', '.join(sorted(str(user.path) for user in users))})")
+        nodes = {node.name: node for node in scene.nodes}
+        moves = gl_passes.all_moved(frame_plan.passes)
         passes = []
         for step in frame_plan.passes:
             runner = gl_passes.runner(step.kind)
@@ -271,11 +274,13 @@ class Executor(GpuMeshes):
             if step.target == "frame" and step.camera == "viewport":
                 viewport = scene.viewports[step.viewport]
             sets, changes = runner.state(step)
-            passes.append((runner.run, step, viewport, rect, sets, changes))
+            run = runner.run
+            if moves and step.kind == "draw":  # frames moved only by time: its draws found once
+                run = prepare_draw_pass(self, step, nodes, runner.run) or run
+            passes.append((run, step, viewport, rect, sets, changes))
         prepared = _PreparedFrame(frame_plan, scene.viewports, size, scene.uniform_overrides, self._programs,
                                   scene.depth_mode, gl_depth.clear_depth_value(scene), scene.depth_mode == "reverse_z",
-                                  tuple(passes), scene, {node.name: node for node in scene.nodes},
-                                  gl_passes.all_moved(frame_plan.passes))
+                                  tuple(passes), scene, nodes, moves)
         if len(self._prepared_frames) >= 16:  # a live compare draws a few plans by turns; more: start again
             self._prepared_frames.clear()
         self._prepared_frames[id(frame_plan)] = prepared
@@ -433,7 +438,9 @@ class Executor(GpuMeshes):
             check_user_draw(self._overrides, user, self._programs[draw.program][1], self._members(draw.program), node)
         mesh = node.mesh
         setup = self._draw_setup(draw.program, mesh)
-        lit = material.lit or user is not None  # a node's own shader may light itself whatever the shading
+        # A node's own shader may light itself whatever the shading; a program without any lighting
+        # uniform (a shadow map's depth program drawing a lit node) is given none of them.
+        lit = (material.lit or user is not None) and not setup.members.isdisjoint(_LIGHTING_UNIFORMS)
         origin = setup.source if setup.source is not mesh else None  # a moved mesh's set-up is its origin's
         if len(self._steps) >= self.SETUPS_KEPT:  # new draws every frame (plans not kept): start again
             self._steps.clear()
@@ -528,5 +535,9 @@ class Executor(GpuMeshes):
 
 #: A frame's models where nothing is moved by a motion handed over (see :class:`FrameState`).
 _NO_MODELS: Mapping[str, np.ndarray] = MappingProxyType({})
+#: The uniforms a lit draw writes besides the matrices and colour (write_lighting, the material's
+#: coefficients): a program with none of them is drawn as unlit, writing the same into GL.
+_LIGHTING_UNIFORMS = frozenset({"u_eye", "u_light_pos", "u_light_color", "u_ambient", "u_diffuse", "u_specular",
+                                "u_shininess"})
 #: What restore_state leaves of culling (off, counter-clockwise fronts).
 _NO_CULLING = (False, "ccw")

@@ -118,12 +118,12 @@ def run_shadow_map_pass(executor: Any, frame: FrameState, step: Pass, camera: An
     same light matrix in the phong shader.
     """
     assert step.camera is not None and step.camera.startswith("light ")
-    scene, ctx = frame.scene, executor.ctx
+    scene, ctx, models = frame.scene, executor.ctx, frame.models
     light_index = int(step.camera.split()[1])
-    light = scene.lights[light_index]
+    light = frame.lights[light_index]  # (where the frame's motion put it)
     assert light.shadow is not None
     texture, framebuffer = executor.shadow_maps.target(light_index, light.shadow.size)
-    fitted = light_frame(scene, light)
+    fitted = light_frame(scene, light, models)  # fitted to the casters where the frame has them
     view, proj = fitted.view, fitted.proj
     gl_depth.end_depth_mode(ctx, executor.raw, scene)
     try:
@@ -134,11 +134,12 @@ def run_shadow_map_pass(executor: Any, frame: FrameState, step: Pass, camera: An
         pass_camera = executor.pass_camera(view, proj, np.asarray(light.position, dtype=np.float64))
         for draw in step.draws:
             node = frame.nodes[draw.node]
+            model = models.get(draw.node)
             if draw.program == CUTOUT_SHADOW_PROGRAM.key:  # a cut-out: depth only where its texels are drawn
-                executor.draw_node(node, draw, pass_camera, material=cutout_caster_material(node.material,
-                                                                                               node.material.color))
+                executor.draw_node(node, draw, pass_camera, model=model,
+                                   material=cutout_caster_material(node.material, node.material.color))
             else:
-                executor.draw_node(node, draw, pass_camera)
+                executor.draw_node(node, draw, pass_camera, model=model)
     finally:
         gl_depth.begin_depth_mode(ctx, executor.raw, scene)
         frame.framebuffer.use()

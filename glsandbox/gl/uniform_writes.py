@@ -30,18 +30,24 @@ def write_matrices(setup: _DrawSetup, written: _Written, uniforms: _Uniforms, ma
         written["m_model"] = data
         uniforms["m_model"].write(data)
     if written[_CAMERA] is not camera:  # (a pass's draws share its camera)
-        if camera.view_bytes != written["m_view"]:
-            written["m_view"] = camera.view_bytes
-            uniforms["m_view"].write(camera.view_bytes)
-        if camera.proj_bytes != written["m_proj"]:
-            written["m_proj"] = camera.proj_bytes
-            uniforms["m_proj"].write(camera.proj_bytes)
-        written[_CAMERA] = camera
+        write_camera(written, uniforms, camera)
     if setup.normal:
         data = _NORMAL_BYTES[content]
         if written["m_normal"] != data:
             written["m_normal"] = data
             uniforms["m_normal"].write(data)
+
+
+def write_camera(written: _Written, uniforms: _Uniforms, camera: PassCamera) -> None:
+    """The pass camera's ``m_view`` and ``m_proj``, each where the program holds other bytes;
+    the program then holds ``camera``'s (its ``written[_CAMERA]``)."""
+    if camera.view_bytes != written["m_view"]:
+        written["m_view"] = camera.view_bytes
+        uniforms["m_view"].write(camera.view_bytes)
+    if camera.proj_bytes != written["m_proj"]:
+        written["m_proj"] = camera.proj_bytes
+        uniforms["m_proj"].write(camera.proj_bytes)
+    written[_CAMERA] = camera
 
 
 def write_lighting(step: _DrawStep, written: _Written, uniforms: _Uniforms, camera: PassCamera,
@@ -57,13 +63,17 @@ def write_lighting(step: _DrawStep, written: _Written, uniforms: _Uniforms, came
         if step.lights[0] is not frame_lights or step.lights[3] is not camera:
             # (lights that do not move, seen from an eye that does not: the same bytes every frame)
             step.lights = (frame_lights, *light_bytes(frame_lights, camera), camera)
-        _, light_pos, light_color, _ = step.lights
-        if written["u_light_pos"] != light_pos:
-            written["u_light_pos"] = light_pos
-            uniforms["u_light_pos"].write(light_pos)
-        if written["u_light_color"] != light_color:
-            written["u_light_color"] = light_color
-            uniforms["u_light_color"].write(light_color)
+        write_lights(written, uniforms, step.lights[1], step.lights[2])
+
+
+def write_lights(written: _Written, uniforms: _Uniforms, light_pos: bytes, light_color: bytes) -> None:
+    """``u_light_pos`` and ``u_light_color``, each where the program holds other bytes."""
+    if written["u_light_pos"] != light_pos:
+        written["u_light_pos"] = light_pos
+        uniforms["u_light_pos"].write(light_pos)
+    if written["u_light_color"] != light_color:
+        written["u_light_color"] = light_color
+        uniforms["u_light_color"].write(light_color)
 
 
 def write_constants(step: _DrawStep, written: _Written, uniforms: _Uniforms) -> None:

@@ -344,7 +344,7 @@ def _counting_moved_scenes(monkeypatch) -> list:
 @pytest.mark.parametrize(("name", "settings", "handed_over"), [
     ("indexed_cube", {}, True), ("phong", {}, True), ("texture", {}, True), ("mirror", {}, True),
     ("mirror", {"light": "directional", "shadow": "double_blend"}, True),
-    ("shadow_map", {"show": "map"}, False),  # its light's frustum is fitted to the nodes where they are
+    ("shadow_map", {"show": "map"}, True),  # its light's frustum fitted to the models handed over
     ("transform_order", {}, False),  # its trail's points and its panel move: meshes and overlays
 ])
 def test_a_headless_frame_moved_by_time_makes_no_moved_scene(gl, monkeypatch, name, settings, handed_over):
@@ -396,14 +396,19 @@ def test_a_frame_after_a_changed_value_is_drawn_from_its_new_scene(gl):
     assert after.plan == fresh.plan and np.array_equal(after.image, fresh.image)
 
 
-def test_a_moved_frame_refuses_a_plan_that_reads_the_nodes_where_they_are(gl):
+def test_a_moved_shadow_map_frame_fits_its_light_to_the_models_handed_over(gl):
+    """The shadow map's light frustum follows the turning cube: drawn from the motion handed over
+    (no moved scene), the frame is the moved scene's, pixel for pixel, and the map moves with it."""
     lesson = find_lesson("shadow_map")(show="map")
-    scene, motion = lesson.at(0.5).moving()
-    assert gl.render_motion(scene, motion, SIZE) is None  # the caller draws the moved scene
-    frame_plan = gl.plan(moved_scene(scene, motion))
-    target = gl.target(SIZE, frame_plan.buffers)
-    with pytest.raises(ValueError, match="draw the moved scene"):
-        gl.executor.render(scene, target.framebuffer, SIZE, frame_plan, motion_parts(scene, motion))
+    images = []
+    for t in (0.5, 3.0):
+        scene, motion = lesson.at(t).moving()
+        handed = gl.render_motion(scene, motion, SIZE)
+        assert handed is not None
+        fresh = gl.render_scene(moved_scene(scene, motion), SIZE)
+        assert handed.plan == fresh.plan and np.array_equal(handed.image, fresh.image), f"t={t}"
+        images.append(handed.image.copy())
+    assert not np.array_equal(*images)  # the cube and its shadow turned
 
 
 def test_the_last_frames_scene_is_found_again_only_for_the_same_values():
