@@ -234,5 +234,7 @@ def test_starting_afresh_keeps_the_built_in_programs_and_forgets_the_rest(gl, tm
     assert programs and load._CACHE and gl._targets
     start_afresh(gl)
     assert not load._CACHE and not gl._targets and not gl.executor._meshes and not gl._noted
-    assert {k: p for k, (_, p) in gl.executor._programs.items()} == {k: p for k, (_, p) in programs.items()}
+    # The shared context may hold other tests' own-shader programs (keyed by their file's path): gone.
+    built_in = {k: p for k, (_, p) in programs.items() if not Path(k.split("[")[0]).is_absolute()}
+    assert built_in and {k: p for k, (_, p) in gl.executor._programs.items()} == built_in
     assert np.array_equal(gl.render(lesson, SIZE).image, before)
