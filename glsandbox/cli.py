@@ -945,6 +945,10 @@ def main(argv: list[str] | None = None) -> int:
             return supervise.supervised(words, source)
     named = words[0] if words and words[0] in COMMANDS else None  # else: the whole parser (--help, a mistake)
     args = build_parser(named).parse_args(argv)
+    if argv is None:  # the process's own command line: Ctrl-C ends it within a bound, stuck or not
+        from glsandbox.interrupt_watch import watch_interrupts
+
+        watch_interrupts()
     status = run_guarded(lambda: args.func(args))
     supervise.finished()
     if status == EXIT_INTERRUPTED and argv is None:  # the process's own command line: end it now

@@ -36,7 +36,8 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
                            "glsandbox.exercises.lesson_view", "glsandbox.exercises.student_process",
                            "glsandbox.exercises.dxmath", "glsandbox.story")),
     ("grading", ("glsandbox.grading", "glsandbox.exercises")),
-    ("command line", ("glsandbox.cli", "glsandbox.supervise", "glsandbox.pytest_plugin", "glsandbox.__main__")),
+    ("command line", ("glsandbox.cli", "glsandbox.supervise", "glsandbox.interrupt_watch", "glsandbox.pytest_plugin",
+                      "glsandbox.__main__")),
 ]
 
 #: The two doors up, each opened only when called: lesson discovery
