@@ -902,9 +902,9 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         p.add_argument("--out", type=Path, default=Path("out/tradeoffs"), help="output folder (default out/tradeoffs)")
         p.add_argument("--quick", action="store_true", help="a reduced set at a small size (for CI)")
         p.add_argument("--runs", type=int, default=5, help="timed rounds per pass (at least 5, default 5)")
-        p.add_argument("--passes", type=int, default=3,  # tradeoffs.PASSES (the measuring wing loads late)
+        p.add_argument("--passes", type=int, default=4,  # tradeoffs.PASSES (the measuring wing loads late)
                        help="independent passes of the rounds, each in a process of its own, whose medians give "
-                            "each time's spread (at least 2, default 3)")
+                            "each time's spread (at least 2, default 4)")
         p.add_argument("--knob", action="append", default=[], metavar="NAME", help="only this knob (repeatable)")
         p.add_argument("--backend", default=None, help="GL backend (default: GLSANDBOX_BACKEND or auto)")
         p.set_defaults(func=cmd_tradeoffs)

@@ -70,10 +70,11 @@ __all__ = ["CHEAP_MS", "MAX_RUNS", "STABLE_SPREAD", "FULL_SIZE", "median_spread"
 RUNS = 5
 #: Independent passes of the timing rounds, each in a process of its own: each figure's
 #: run-to-run spread is how far apart the passes' medians lie
-#: (:attr:`~glsandbox.measure.knob.Row.run_spread`). With two, a third run's median falls
-#: outside their range one time in three; with three, the ranges of two runs overlap
-#: nine times in ten (for medians that scatter alike from run to run).
-PASSES = 3
+#: (:attr:`~glsandbox.measure.knob.Row.run_spread`), and the report gives the median ± that
+#: whole range (never less than :data:`~glsandbox.measure.knob.RUN_DRIFT`). For medians that
+#: scatter alike from run to run, two runs' ranges so stated overlap 98.6% of the time with
+#: three passes and 99.9% with four (± half the range: 88% and 97%).
+PASSES = 4
 #: Frame size of the full report, and of ``--quick``.
 FULL_SIZE = (320, 240)
 QUICK_SIZE = (128, 96)

@@ -19,14 +19,15 @@ from pathlib import Path
 
 from glsandbox.files import atomic_write, write_text
 from glsandbox.measure import extra
-from glsandbox.measure.knob import BUSY_LOAD_PER_CPU, WIDE_SPREAD, KnobResult, Row
+from glsandbox.measure.knob import BUSY_LOAD_PER_CPU, FRAME_NOISE_MS, RUN_DRIFT, WIDE_SPREAD, KnobResult, Row
 
 
 __all__ = ["CSV_COLUMNS", "write_csv", "write_plot", "write_report"]
 
 CSV_COLUMNS = ("knob", "setting", "reference", "width", "height", "runs", "time_median_ms", "time_min_ms",
                "time_max_ms", "rmse", "psnr_db", "flip", "count_px", "count_of_px", "count_share", "image",
-               "error_map", "median_spread", "passes", "pass_medians_ms", "run_spread", "trusted", "busy")
+               "error_map", "median_spread", "passes", "pass_medians_ms", "run_spread", "trusted", "busy",
+               "stated_spread")
 
 
 def _fmt_psnr(value: float) -> str:
@@ -48,19 +49,26 @@ def write_csv(results: Sequence[KnobResult], size: tuple[int, int], path: Path) 
                                (r.count.pixels, r.count.of, f"{r.count.share:.6f}")),
                              r.image, r.error_map, f"{r.median_spread:.4f}", len(r.pass_medians),
                              " ".join(f"{m:.3f}" for m in r.pass_medians), f"{r.run_spread:.4f}", int(r.trusted),
-                             r.busy or ""])
+                             r.busy or "", f"{r.stated_spread:.4f}"])
     write_text(path, buffer.getvalue())
 
 
 def time_cell(r: Row) -> str:
-    """A setting's time for the report: the median with its run-to-run spread, or, where the
+    """A setting's time for the report: the median ± its stated spread
+    (:attr:`~glsandbox.measure.knob.Row.stated_spread`: the passes' whole range, at least the
+    drift of whole runs and a frame's noise), or, where the
     passes disagree by more than :data:`~glsandbox.measure.knob.WIDE_SPREAD` or the machine
     was too busy (:func:`~glsandbox.measure.knob.machine_busy`), no figure."""
     passes = ", ".join(f"{m:.2f}" for m in r.pass_medians)
     if not r.trusted:
         why = f"{r.busy}; " if r.busy else ""
-        return f"too noisy ({why}passes {passes} ms: ±{r.run_spread / 2:.0%})"
-    return f"{r.median_ms:.2f} ±{r.run_spread / 2:.0%}"
+        return f"too noisy ({why}passes {passes} ms: ±{_percent_up(r.run_spread)}%)"
+    return f"{r.median_ms:.2f} ±{_percent_up(r.stated_spread)}%"
+
+
+def _percent_up(share: float) -> int:
+    """``share`` in whole percent, rounded up: the range stated holds every pass's median."""
+    return math.ceil(round(share * 100, 6))
 
 
 def write_report(results: Sequence[KnobResult], info: Mapping[str, str], path: Path,
@@ -75,8 +83,9 @@ def write_report(results: Sequence[KnobResult], info: Mapping[str, str], path: P
         lines += [f"Load average (1, 5, 15 min) on {info.get('cpus', '?')} CPUs: {info['load']}. A machine "
                   "busier than its CPUs moves every time; compare runs made at the same load.", ""]
     lines += ["Time is the whole frame as a user gets it: render, read back, and for supersampling the "
-              "downsample: the median of all runs ± half the spread of the passes' medians (the run-to-run "
-              "spread: another run at the same load should give a figure whose range overlaps); "
+              "downsample: the median of all runs ± the whole spread of the passes' medians, but never less "
+              f"than {RUN_DRIFT:.0%} (what whole runs move together on a shared machine) nor {FRAME_NOISE_MS:g} ms "
+              "(a frame's noise): another run at the same load gives a figure whose range overlaps this one; "
               f"where the passes differ by more than {WIDE_SPREAD:.0%}, or the load average passed "
               f"{BUSY_LOAD_PER_CPU:g} runnable threads a CPU while the passes ran, the time is noise and "
               "the table says \"too noisy\" instead of a figure. Errors are against the knob's reference: "

@@ -8,6 +8,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from hypothesis import given
+from hypothesis import strategies as st
 
 from glsandbox.measure import tradeoffs
 from glsandbox.measure.knob import Knob, Row, Setting, machine_busy, run_spread
@@ -84,7 +86,7 @@ def test_the_machine_is_busy_above_two_runnable_threads_a_cpu() -> None:
 def test_passes_that_agree_on_a_busy_machine_give_no_figure(tmp_path) -> None:
     busy = row([36.6, 36.8], "machine busy: load 12.1 on 2 CPUs")
     assert row([36.6, 36.8]).trusted and not busy.trusted
-    assert time_cell(busy) == "too noisy (machine busy: load 12.1 on 2 CPUs; passes 36.60, 36.80 ms: ±0%)"
+    assert time_cell(busy) == "too noisy (machine busy: load 12.1 on 2 CPUs; passes 36.60, 36.80 ms: ±1%)"
     knob = Knob("k", "A knob", "phong", (Setting("MSAA 4x", lambda c: None),), Setting("ref", lambda c: None), "r")
     from glsandbox.measure.knob import KnobResult
 
@@ -108,9 +110,33 @@ def test_measure_knobs_reads_the_load_at_each_pass_and_marks_a_busy_run(tmp_path
     assert not any(r.trusted for r in result.rows)
 
 
+@given(st.lists(st.floats(0.05, 500.0), min_size=2, max_size=6))
+def test_the_stated_range_holds_every_pass_median(medians) -> None:
+    """A figure is the median ± the whole spread of the passes' medians: each pass, a run of its own,
+    lands inside the range the report states (± half the spread would leave the extreme passes out)."""
+    r = row(medians)
+    if not r.trusted:
+        return
+    figure, stated = time_cell(r).split(" ±")
+    assert figure == f"{r.median_ms:.2f}"
+    percent = int(stated.removesuffix("%"))
+    assert all(abs(m - r.median_ms) <= percent / 100 * r.median_ms * (1 + 1e-9) for m in medians), (medians, percent)
+
+
+def test_the_stated_spread_is_never_narrower_than_whole_runs_move() -> None:
+    """Passes that agree closely still get ± the drift of whole runs (RUN_DRIFT), and a sub-millisecond
+    frame ± its noise (FRAME_NOISE_MS); passes further apart than that get their own range."""
+    from glsandbox.measure.knob import FRAME_NOISE_MS, RUN_DRIFT
+
+    assert row([18.9, 18.95, 19.0]).stated_spread == RUN_DRIFT
+    assert row([0.20, 0.201]).stated_spread == FRAME_NOISE_MS / row([0.20, 0.201]).median_ms
+    assert row([10.0, 11.5]).stated_spread == row([10.0, 11.5]).run_spread > RUN_DRIFT
+    assert time_cell(row([0.20, 0.201])) == "0.20 ±25%"
+
+
 def test_a_time_whose_passes_disagree_gets_no_figure(tmp_path) -> None:
-    assert time_cell(row([1.66, 1.70])) == "1.68 ±1%"
-    assert time_cell(row([1.66, 8.37])) == "too noisy (passes 1.66, 8.37 ms: ±67%)"
+    assert time_cell(row([1.66, 1.70])) == "1.68 ±10%"  # passes within 3%: the runs' drift
+    assert time_cell(row([1.66, 8.37])) == "too noisy (passes 1.66, 8.37 ms: ±134%)"
     knob = Knob("k", "A knob", "phong", (Setting("MSAA 4x", lambda c: None),), Setting("ref", lambda c: None), "r")
     from glsandbox.measure.knob import KnobResult
 
@@ -118,6 +144,6 @@ def test_a_time_whose_passes_disagree_gets_no_figure(tmp_path) -> None:
             "load": "3.10, 2.50, 2.00 before, 3.20, 2.60, 2.00 after", "cpus": "2"}
     write_report([KnobResult(knob, [row([1.66, 8.37])])], info, tmp_path / "report.md")
     report = (tmp_path / "report.md").read_text(encoding="utf-8")
-    assert "| MSAA 4x | too noisy (passes 1.66, 8.37 ms: ±67%) |" in report
+    assert "| MSAA 4x | too noisy (passes 1.66, 8.37 ms: ±134%) |" in report
     assert "Too noisy to give a time (1 of 1 settings)" in report
     assert "Load average (1, 5, 15 min) on 2 CPUs: 3.10, 2.50, 2.00 before, 3.20, 2.60, 2.00 after." in report
