@@ -135,6 +135,13 @@ def flush_output() -> None:
             pass  # no atexit handler, no thread, no finaliser of the submission runs
 
 
+def _flushed_send(out: int, header: dict, payload: bytes = b"") -> None:
+    """:func:`send` once what the submission printed is written out: the supervisor reads the
+    output file as soon as the last picture's message (an image, or why there is none) arrives."""
+    flush_output()
+    send(out, header, payload)
+
+
 def render_job(job: Job, renderer, root: str, target: str, out: int,
                own_process: Callable[[Path], bool] | None = None) -> bool:
     """Load the submission's lesson (``target`` in ``root``, or a built-in lesson's name) and send
@@ -147,24 +154,24 @@ def render_job(job: Job, renderer, root: str, target: str, out: int,
     from glsandbox.lesson import find_lesson, submission_lesson, user_code_error
 
     if own_process is not None and own_process(Path(root) / target):
-        send(out, {"kind": "own"})
+        _flushed_send(out, {"kind": "own"})
         return True
     try:
         cls = find_lesson(target) if job.source is None else submission_lesson(Path(root) / target, job.entry)
     except MemoryError as exc:
-        send(out, {"kind": "oom", "index": 0, "error": str(user_code_error(exc)), "all": True})
+        _flushed_send(out, {"kind": "oom", "index": 0, "error": str(user_code_error(exc)), "all": True})
         return True
     except SandboxError as exc:
-        send(out, {"kind": "broken", "index": 0, "error": str(exc), "all": True})
+        _flushed_send(out, {"kind": "broken", "index": 0, "error": str(exc), "all": True})
         return True
     except BaseException as exc:  # noqa: BLE001 - anything the submission raised while loading
-        send(out, {"kind": "broken", "index": 0, "error": str(user_code_error(exc)), "all": True})
+        _flushed_send(out, {"kind": "broken", "index": 0, "error": str(user_code_error(exc)), "all": True})
         return True
     if job.describe:  # the tour's card: read from the class now, sent as text
         try:
             from glsandbox.lesson import lesson_description
 
-            send(out, {"kind": "meta", "title": str(cls.title)[:500], "course_section": str(cls.course_section)[:500],
+            _flushed_send(out, {"kind": "meta", "title": str(cls.title)[:500], "course_section": str(cls.course_section)[:500],
                        "description": str(lesson_description(cls))[:2000]})
         except BaseException:  # noqa: BLE001 - a class whose attributes raise: its card says less
             pass
@@ -188,17 +195,16 @@ def render_job(job: Job, renderer, root: str, target: str, out: int,
                 header["info"] = {"plan": frame.plan.to_dict(), "plan_text": frame.plan.describe()}
             if render.explain is not None:
                 header["story"] = _story(cls, render, renderer)
-            flush_output()
-            send(out, header, image.tobytes())
+            _flushed_send(out, header, image.tobytes())
         except MemoryError as exc:
             clean = False
-            send(out, {"kind": "oom", "index": index, "error": str(user_code_error(exc))})
+            _flushed_send(out, {"kind": "oom", "index": index, "error": str(user_code_error(exc))})
         except SandboxError as exc:
             clean = False
-            send(out, {"kind": "broken", "index": index, "error": str(exc)})
+            _flushed_send(out, {"kind": "broken", "index": index, "error": str(exc)})
         except BaseException as exc:  # noqa: BLE001 - KeyboardInterrupt, SystemExit, its own kinds
             clean = False
-            send(out, {"kind": "broken", "index": index, "error": str(user_code_error(exc))})
+            _flushed_send(out, {"kind": "broken", "index": index, "error": str(user_code_error(exc))})
     return clean
 
 

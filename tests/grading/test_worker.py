@@ -129,3 +129,38 @@ def test_the_zygote_freezes_its_heap_before_it_serves() -> None:
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=True).stdout
     frozen, tracked = map(int, out.split())
     assert frozen > 10_000 and tracked < frozen // 10
+
+
+#: A renderer's process: the submission prints, then its build raises; ``render_job`` sends why
+#: there is no picture, and the process ends at once (no flush at exit), as a killed one would.
+PRINTS_THEN_RAISES = """
+import os, sys
+from pathlib import Path
+from glsandbox.grading.isolate import Job, Render
+from glsandbox.grading.worker import render_job
+root = Path(sys.argv[1])
+(root / "spy.py").write_text("from glsandbox import Lesson\\n\\nclass Spy(Lesson):\\n    def build(self):\\n"
+                             "        print('printed before it raised')\\n        raise RuntimeError('looked')\\n")
+job = Job(0, str(root / "spy.py"), "spy.py", (Render((), (4, 2)),), copy=False)
+class Renderer:  # draws nothing: builds the scene, as a frame does first
+    def render(self, lesson, size, samples):
+        return lesson.scene()
+read_end, write_end = os.pipe()
+render_job(job, Renderer(), str(root), "spy.py", write_end)
+os.write(2, os.read(read_end, 1 << 16))  # what it sent, for the test to read
+os._exit(0)
+"""
+
+
+def test_what_a_submission_printed_is_written_before_why_it_has_no_picture(tmp_path: Path) -> None:
+    """The supervisor reads the output file as soon as the last picture's message arrives and then
+    kills the renderer: every message, a BROKEN one too, goes after the prints are written out
+    (stdout to a file is block-buffered: the line was lost when the grader was quicker)."""
+    log = tmp_path / "output.txt"
+    with log.open("wb") as out:
+        # block-buffered, as in a renderer (whose environment has no PYTHONUNBUFFERED)
+        env = {k: v for k, v in os.environ.items() if k != "PYTHONUNBUFFERED"}
+        proc = subprocess.run([sys.executable, "-c", PRINTS_THEN_RAISES, str(tmp_path)], stdout=out,
+                              stderr=subprocess.PIPE, check=True, timeout=60, env=env)
+    assert b'"broken"' in proc.stderr and b"looked" in proc.stderr  # the message: why there is no picture
+    assert "printed before it raised" in log.read_text()
