@@ -19,6 +19,9 @@ from glsandbox.interrupt_watch import GRACE_S
 SWALLOWS = textwrap.dedent("""
     import signal, sys, time
     from glsandbox.interrupt_watch import watch_interrupts
+    # Python's own handler, as in a terminal's foreground command (a test run started as a
+    # background job hands its children SIGINT ignored, and then the watch stays out)
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     {before}
     said = "ready" if watch_interrupts() else "not installed"
     while True:
@@ -90,6 +93,7 @@ def test_a_forked_childs_interrupt_does_not_end_the_parent() -> None:
     script = textwrap.dedent("""
         import os, signal, sys, time
         from glsandbox.interrupt_watch import watch_interrupts
+        signal.signal(signal.SIGINT, signal.default_int_handler)  # as in a foreground command
         assert watch_interrupts()
         pid = os.fork()
         if pid == 0:
