@@ -29,6 +29,7 @@ import json
 import os
 import platform
 import statistics
+import signal
 import subprocess
 import sys
 import time
@@ -251,14 +252,32 @@ def same_pixels(a: Any, b: Any) -> str:
     return f"max {int(diff.max())} levels, {np.count_nonzero(diff) / diff.size:.2%} px"
 
 
+#: Seconds an interrupted side's process gets to clean up after its own Ctrl-C before it is killed.
+CHILD_GRACE_S = 1.0
+
+
 def run_process(command: list[str]) -> Callable[[int], None]:
-    """A side that starts a process and waits for it (cold start, tour); its CPU is the process's."""
+    """A side that starts a process and waits for it (cold start, tour); its CPU is the process's.
+    Ctrl-C while it runs is passed on to it (a ``glsandbox`` command removes its temporary
+    folders), and it is killed only if it has not ended :data:`CHILD_GRACE_S` later."""
 
     def side(_: int) -> None:
-        proc = subprocess.run(command, capture_output=True, text=True)
+        with subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as proc:
+            try:
+                _, errors = proc.communicate()
+            except KeyboardInterrupt:
+                try:
+                    proc.send_signal(signal.SIGINT)
+                except (ValueError, OSError):  # Windows takes no SIGINT for a process: killed below
+                    pass
+                try:
+                    proc.wait(timeout=CHILD_GRACE_S)
+                except subprocess.TimeoutExpired:
+                    proc.kill()
+                raise
         if proc.returncode != 0:
             raise SandboxError(f"bench: {' '.join(command[:4])}... failed: "
-                               f"{(proc.stderr.strip().splitlines() or ['?'])[-1]}")
+                               f"{(errors.strip().splitlines() or ['?'])[-1]}")
 
     return side
 

@@ -77,3 +77,40 @@ def test_a_quantity_case_records_what_its_sides_return() -> None:
     assert "110.000 MiB (100.000-120.000)" in row and "330.000 MiB (300.000-360.000)" in row
     assert "3.00x" in row and "<=3.00x met" in row
     assert result.to_dict()["subject_time"] == {"median": 330.0, "min": 300.0, "max": 360.0}
+
+
+#: A bench whose process side is interrupted: the side's process cleans up on its own SIGINT
+#: (a marker file), as a glsandbox command removes its temporary folders.
+INTERRUPTED_SIDE = """
+import sys
+from glsandbox.measure.bench import run_process
+child = ("import signal, sys, time\\n"
+         "def cleaned(*_):\\n"
+         "    open(sys.argv[1], 'w').write('cleaned up')\\n"
+         "    sys.exit(130)\\n"
+         "signal.signal(signal.SIGINT, cleaned)\\n"
+         "print('started', flush=True)\\n"
+         "time.sleep(60)\\n")
+print("running", flush=True)
+try:
+    run_process([sys.executable, "-c", child, sys.argv[1]])(0)
+except KeyboardInterrupt:
+    sys.exit(130)
+"""
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="SIGINT to a process is POSIX")
+def test_ctrl_c_reaches_a_process_side_which_cleans_up_before_the_bench_ends(tmp_path) -> None:
+    """Ctrl-C to the bench alone (not its group): the side's process gets the interrupt too and
+    ends on its own (its clean-up runs) instead of being killed with its temporary files left."""
+    import signal
+    import subprocess
+
+    marker = tmp_path / "cleaned.txt"
+    proc = subprocess.Popen([sys.executable, "-c", INTERRUPTED_SIDE, str(marker)], stdout=subprocess.PIPE,
+                            text=True, start_new_session=True)
+    assert proc.stdout is not None and proc.stdout.readline().strip() == "running"
+    time.sleep(1.0)  # the side's child has started its sleep (its own start takes a few ms)
+    proc.send_signal(signal.SIGINT)
+    assert proc.wait(timeout=10) == 130
+    assert marker.read_text() == "cleaned up"
