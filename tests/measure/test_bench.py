@@ -82,8 +82,9 @@ def test_a_quantity_case_records_what_its_sides_return() -> None:
 #: A bench whose process side is interrupted: the side's process cleans up on its own SIGINT
 #: (a marker file), as a glsandbox command removes its temporary folders.
 INTERRUPTED_SIDE = """
-import sys
+import signal, sys
 from glsandbox.measure.bench import run_process
+signal.signal(signal.SIGINT, signal.default_int_handler)  # a foreground command's (a background job's is ignored)
 child = ("import signal, sys, time\\n"
          "def cleaned(*_):\\n"
          "    open(sys.argv[1], 'w').write('cleaned up')\\n"
