@@ -44,7 +44,6 @@ from __future__ import annotations
 
 import functools
 import os
-import signal
 import subprocess
 import sys
 import tempfile
@@ -173,7 +172,7 @@ def grade_class(folder: Path, ref: Path, jobs: int = 2) -> dict[str, object]:
     import psutil
 
     from glsandbox.grading.portable import tree_rss
-    from glsandbox.measure.bench import CHILD_GRACE_S
+    from glsandbox.measure.bench import interrupt_child
 
     mark = uuid.uuid4().hex
     tmp = Path(tempfile.gettempdir())
@@ -198,13 +197,7 @@ def grade_class(folder: Path, ref: Path, jobs: int = 2) -> dict[str, object]:
     finally:  # also on Ctrl-C: no sampler left running into the interpreter's exit, no check left behind
         done.set()
         sampler.join()
-        if proc.poll() is None:  # interrupted: the check's own Ctrl-C removes its run folder, then it ends
-            proc.send_signal(signal.SIGINT)
-            try:
-                proc.wait(timeout=CHILD_GRACE_S)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait()
+        interrupt_child(proc)  # interrupted: the check's own Ctrl-C removes its run folder, then it ends
     seconds = time.perf_counter() - started
     if proc.returncode not in (0, 1):
         raise RuntimeError(f"check ended with {proc.returncode}: {errors.decode(errors='replace')[-400:]}")

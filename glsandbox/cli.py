@@ -26,6 +26,7 @@ from glsandbox.errors import SandboxError, parse_size_text
 from glsandbox.files import save_png, write_text
 from glsandbox.frame import DEFAULT_SIZE, Frame, HeadlessRenderer, with_samples
 from glsandbox.gl.context import BACKENDS
+from glsandbox.interrupt_watch import EXIT_INTERRUPTED, watch_interrupts
 from glsandbox.lesson import Lesson, all_lessons, find_lesson, lesson_description, lesson_files
 from glsandbox.plan import plan
 from glsandbox.progress import progress, say
@@ -34,8 +35,6 @@ from glsandbox.scene import Scene
 EXIT_USAGE = 2
 #: What a Unix tool exits with when its reader went away (128 + SIGPIPE).
 EXIT_BROKEN_PIPE = 141
-#: What a Unix tool exits with on Ctrl-C (128 + SIGINT).
-EXIT_INTERRUPTED = 130
 
 
 class ArgumentParser(argparse.ArgumentParser):
@@ -946,8 +945,6 @@ def main(argv: list[str] | None = None) -> int:
     named = words[0] if words and words[0] in COMMANDS else None  # else: the whole parser (--help, a mistake)
     args = build_parser(named).parse_args(argv)
     if argv is None:  # the process's own command line: Ctrl-C ends it within a bound, stuck or not
-        from glsandbox.interrupt_watch import watch_interrupts
-
         watch_interrupts()
     status = run_guarded(lambda: args.func(args))
     supervise.finished()

@@ -25,13 +25,13 @@ import signal
 import threading
 import time
 
-__all__ = ["GRACE_S", "watch_interrupts"]
+__all__ = ["EXIT_INTERRUPTED", "GRACE_S", "watch_interrupts"]
 
 #: Seconds from the first SIGINT to the forced exit: the command's own unwinding
 #: (a timing child killed, temporary files removed) takes milliseconds.
 GRACE_S = 1.5
-#: What a Unix tool exits with on Ctrl-C (128 + SIGINT), as glsandbox.cli.
-_EXIT_INTERRUPTED = 130
+#: What a Unix tool exits with on Ctrl-C (128 + SIGINT): every glsandbox command's status then.
+EXIT_INTERRUPTED = 130
 
 _installed: list[int] = []  # the pipe's two ends, once installed
 
@@ -94,4 +94,4 @@ def _watch(read_end: int, grace_s: float) -> None:
         os.write(2, line.encode())
     except OSError:
         pass
-    os._exit(_EXIT_INTERRUPTED)
+    os._exit(EXIT_INTERRUPTED)

@@ -171,8 +171,9 @@ def render_job(job: Job, renderer, root: str, target: str, out: int,
         try:
             from glsandbox.lesson import lesson_description
 
-            _flushed_send(out, {"kind": "meta", "title": str(cls.title)[:500], "course_section": str(cls.course_section)[:500],
-                       "description": str(lesson_description(cls))[:2000]})
+            _flushed_send(out, {"kind": "meta", "title": str(cls.title)[:500],
+                                "course_section": str(cls.course_section)[:500],
+                                "description": str(lesson_description(cls))[:2000]})
         except BaseException:  # noqa: BLE001 - a class whose attributes raise: its card says less
             pass
     clean = True

@@ -256,24 +256,32 @@ def same_pixels(a: Any, b: Any) -> str:
 CHILD_GRACE_S = 1.0
 
 
+def interrupt_child(proc: subprocess.Popen) -> None:
+    """Pass Ctrl-C on to a case's process that is still running (a ``glsandbox`` command then
+    removes its temporary folders) and kill it if it has not ended :data:`CHILD_GRACE_S` later."""
+    if proc.poll() is not None:
+        return
+    try:
+        proc.send_signal(signal.SIGINT)
+    except (ValueError, OSError):  # Windows takes no SIGINT for a process: killed below
+        pass
+    try:
+        proc.wait(timeout=CHILD_GRACE_S)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait()
+
+
 def run_process(command: list[str]) -> Callable[[int], None]:
     """A side that starts a process and waits for it (cold start, tour); its CPU is the process's.
-    Ctrl-C while it runs is passed on to it (a ``glsandbox`` command removes its temporary
-    folders), and it is killed only if it has not ended :data:`CHILD_GRACE_S` later."""
+    Ctrl-C while it runs is passed on to it (:func:`interrupt_child`)."""
 
     def side(_: int) -> None:
         with subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as proc:
             try:
                 _, errors = proc.communicate()
             except KeyboardInterrupt:
-                try:
-                    proc.send_signal(signal.SIGINT)
-                except (ValueError, OSError):  # Windows takes no SIGINT for a process: killed below
-                    pass
-                try:
-                    proc.wait(timeout=CHILD_GRACE_S)
-                except subprocess.TimeoutExpired:
-                    proc.kill()
+                interrupt_child(proc)
                 raise
         if proc.returncode != 0:
             raise SandboxError(f"bench: {' '.join(command[:4])}... failed: "

@@ -3,6 +3,7 @@ still ends with 130 soon after the key, and the watch takes nothing that is not 
 
 from __future__ import annotations
 
+import os
 import signal
 import subprocess
 import sys
@@ -88,7 +89,7 @@ def test_the_watch_takes_nothing_that_is_not_its_own(before) -> None:
     assert said == "not installed"
 
 
-@pytest.mark.skipif(not hasattr(__import__("os"), "fork"), reason="fork is POSIX")
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="fork is POSIX")
 def test_a_forked_childs_interrupt_does_not_end_the_parent() -> None:
     script = textwrap.dedent("""
         import os, signal, sys, time
