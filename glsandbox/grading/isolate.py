@@ -144,12 +144,22 @@ def wide_pipe(fd: int) -> None:
         pass
 
 
-def send(fd: int, header: dict, payload: bytes = b"") -> None:
+def send(fd: int, header: dict, payload: bytes | memoryview | Sequence[bytes | memoryview] = b"") -> None:
+    """Frame ``header`` and ``payload`` (raw bytes, or several buffers sent one after another:
+    each picture's pixels as they lie, never joined) on ``fd``, in one gathered write where the
+    pipe has room. A 320x240 picture is 300 KiB: every copy of it is fresh memory to fault in, so
+    the pixels go from the array to the pipe with no copy of their own."""
+    pieces = [memoryview(piece).cast("B") for piece in (payload if isinstance(payload, (list, tuple)) else [payload])]
     data = json.dumps(header).encode()
-    message = _HEADER.pack(_MAGIC, len(data), len(payload)) + data + payload
-    view = memoryview(message)
-    while view:
-        view = view[os.write(fd, view):]
+    pending = [_HEADER.pack(_MAGIC, len(data), sum(len(piece) for piece in pieces)) + data,
+               *[piece for piece in pieces if len(piece)]]
+    while pending:
+        written = os.writev(fd, pending)
+        while pending and written >= len(pending[0]):
+            written -= len(pending[0])
+            pending.pop(0)
+        if written:
+            pending[0] = memoryview(pending[0])[written:]
 
 
 #: The most of a pixel's story a submission's renderer may send back (characters).
@@ -164,23 +174,85 @@ def story_of(header: dict) -> dict:
 
 
 class Reader:
-    """The framed messages of the renderer's pipe, read as they arrive."""
+    """The framed messages of the renderer's pipe, read as they arrive.
+
+    A big payload (a picture) is read straight into a buffer of its own size once its header
+    has come: the pipe's bytes are copied once, into the bytes the pixels are read from, not
+    gathered in :attr:`buffer` and cut out of it. What arrives otherwise (and what a caller
+    adds to :attr:`buffer` itself) is framed from :attr:`buffer`."""
+
+    #: Payloads of these sizes are read into a buffer of their own (a bigger claim is read as it comes).
+    DIRECT = (1 << 16, 1 << 28)
 
     def __init__(self, fd: int) -> None:
         self.fd, self.buffer, self.closed = fd, bytearray(), False
+        #: A big payload being filled: its header, its buffer and how much of it has come.
+        self._pending: tuple[dict, bytearray] | None = None
+        self._filled = 0
+        #: The biggest payload the last :meth:`messages` call allowed: none bigger gets a buffer.
+        self._limit = 0
 
     def pump(self, timeout: float) -> None:
+        """Read what has come within ``timeout`` seconds: while no picture is pending, at most a
+        header's worth (:attr:`DIRECT`), so that a picture behind it is read into its own buffer."""
         ready, _, _ = select.select([self.fd], [], [], max(timeout, 0.0))
-        if ready:
-            chunk = os.read(self.fd, 1 << 20)
+        if not ready:
+            return
+        if self._pending is None:
+            chunk = os.read(self.fd, self.DIRECT[0])
             self.closed = not chunk
             self.buffer += chunk
+            self._begin_payload()
+            if self._pending is None or self.buffer or not select.select([self.fd], [], [], 0)[0]:
+                return
+        got = os.readv(self.fd, [memoryview(self._pending[1])[self._filled:]])
+        self.closed = not got
+        self._filled += got
 
-    def messages(self, limit: int) -> Iterator[tuple[dict, bytes]]:
-        while len(self.buffer) >= _HEADER.size:
+    def _begin_payload(self) -> None:
+        """Where :attr:`buffer` starts with the header of a big payload: that payload's own buffer,
+        what came of it moved there. (A malformed header is left for :meth:`messages` to refuse.)"""
+        if self._pending is not None or len(self.buffer) < _HEADER.size:
+            return
+        magic, head, size = _HEADER.unpack_from(self.buffer)
+        start = _HEADER.size + head
+        direct = self.DIRECT[0] <= size <= min(self.DIRECT[1], self._limit)
+        if magic != _MAGIC or head > 1 << 16 or not direct or len(self.buffer) < start:
+            return
+        header = json.loads(bytes(self.buffer[_HEADER.size:start]))
+        payload = bytearray(size)
+        taken = min(len(self.buffer) - start, size)
+        payload[:taken] = memoryview(self.buffer)[start:start + taken]
+        del self.buffer[:start + taken]
+        self._pending, self._filled = (header, payload), taken
+
+    def messages(self, limit: int) -> Iterator[tuple[dict, bytes | bytearray]]:
+        """Each whole message that has come, with payloads of at most ``limit`` bytes; a
+        ValueError for a malformed one, or one past the limit."""
+        self._limit = limit
+        while True:
+            if self._pending is not None:
+                header, payload = self._pending
+                if len(payload) > limit:
+                    raise ValueError("a malformed message on the result pipe")
+                taken = min(len(self.buffer), len(payload) - self._filled)
+                if taken:  # (bytes a caller added to the buffer itself)
+                    payload[self._filled:self._filled + taken] = memoryview(self.buffer)[:taken]
+                    del self.buffer[:taken]
+                    self._filled += taken
+                if self._filled < len(payload):
+                    return
+                self._pending, self._filled = None, 0
+                yield header, payload
+                continue
+            if len(self.buffer) < _HEADER.size:
+                return
             magic, head, size = _HEADER.unpack_from(self.buffer)
             if magic != _MAGIC or head > 1 << 16 or size > limit:
                 raise ValueError("a malformed message on the result pipe")
+            self._begin_payload()
+            if self._pending is not None:
+                continue
             end = _HEADER.size + head + size
             if len(self.buffer) < end:
                 return

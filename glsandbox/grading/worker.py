@@ -135,7 +135,7 @@ def flush_output() -> None:
             pass  # no atexit handler, no thread, no finaliser of the submission runs
 
 
-def _flushed_send(out: int, header: dict, payload: bytes = b"") -> None:
+def _flushed_send(out: int, header: dict, payload: bytes | np.ndarray = b"") -> None:
     """:func:`send` once what the submission printed is written out: the supervisor reads the
     output file as soon as the last picture's message (an image, or why there is none) arrives."""
     flush_output()
@@ -196,7 +196,7 @@ def render_job(job: Job, renderer, root: str, target: str, out: int,
                 header["info"] = {"plan": frame.plan.to_dict(), "plan_text": frame.plan.describe()}
             if render.explain is not None:
                 header["story"] = _story(cls, render, renderer)
-            _flushed_send(out, header, image.tobytes())
+            _flushed_send(out, header, image)
         except MemoryError as exc:
             clean = False
             _flushed_send(out, {"kind": "oom", "index": index, "error": str(user_code_error(exc))})
@@ -402,7 +402,7 @@ def _supervise(job: Job, out: int) -> None:
 
 def _send_result(out: int, result: dict, pictures: list[Picture] | None) -> None:
     """The supervisor's one result message: ``result`` with each picture's outcome, and the pixels."""
-    payload = b""
+    payload: list[np.ndarray] = []
     if pictures is not None:
         result["pictures"] = []
         for picture in pictures:
@@ -410,7 +410,8 @@ def _send_result(out: int, result: dict, pictures: list[Picture] | None) -> None
             result["pictures"].append({"status": picture.status, "error": picture.error,
                                        "seconds": picture.seconds, "info": picture.info,
                                        "shape": None if image is None else list(image.shape)})
-            payload += b"" if image is None else image.tobytes()
+            if image is not None:
+                payload.append(np.ascontiguousarray(image, dtype=np.uint8))
     send(out, result, payload)
 
 

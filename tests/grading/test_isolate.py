@@ -60,6 +60,48 @@ def test_a_half_message_waits_and_a_malformed_or_oversized_one_is_refused() -> N
         os.close(write_end)
 
 
+def test_a_picture_comes_whole_in_a_buffer_of_its_own_however_it_is_cut() -> None:
+    import numpy as np
+    import threading
+
+    picture = np.arange(240 * 320 * 4, dtype=np.uint32).astype(np.uint8).reshape(240, 320, 4)
+    read_end, write_end = os.pipe()
+    whole: list[bytes] = []
+
+    def framed(fd: int) -> None:
+        send(fd, {"kind": "image", "shape": [240, 320, 4]}, [picture[:100], picture[100:]])
+        send(fd, {"kind": "served"})
+        os.close(fd)
+
+    def write_in_pieces() -> None:  # the pipe's bytes passed on in uneven pieces
+        first, second = os.pipe()
+        sender = threading.Thread(target=framed, args=(second,))
+        sender.start()
+        while chunk := os.read(first, 70_001):
+            whole.append(chunk)
+            os.write(write_end, chunk)
+        sender.join()
+        os.close(first)
+        os.close(write_end)
+
+    writer = threading.Thread(target=write_in_pieces)
+    writer.start()
+    try:
+        found = _read_all(read_end)
+    finally:
+        writer.join()
+        os.close(read_end)
+    assert [header["kind"] for header, _ in found] == ["image", "served"]
+    assert isinstance(found[0][1], bytearray) and found[0][1] == picture.tobytes()
+    # what a caller adds to the buffer itself (the portable path's reading thread) frames the same
+    reader = Reader(-1)
+    reader.buffer += b"".join(whole)
+    assert [(h["kind"], bytes(p)) for h, p in reader.messages(1 << 20)] == [("image", picture.tobytes()), ("served", b"")]
+    reader.buffer += b"".join(whole)
+    with pytest.raises(ValueError, match="malformed"):  # past the limit, however big a buffer it would get
+        list(reader.messages(picture.nbytes - 1))
+
+
 def test_a_job_goes_to_the_zygote_and_back_unchanged() -> None:
     assert job_from(_job_data(JOB)) == JOB
 
