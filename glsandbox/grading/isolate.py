@@ -300,7 +300,7 @@ class _Zygote:
         code = ("import sys; from glsandbox.grading.resident import zygote_main; "
                 "zygote_main(int(sys.argv[1]), sys.argv[2])")
         # a fresh program with only what rendering reads: every fork's /proc/self/environ is this one
-        from glsandbox.grading.layers import minimal_environment
+        from glsandbox.grading.layers import renderer_environment
 
         package_parent = str(Path(__file__).resolve().parents[2])
         code = f"import sys; sys.path.insert(0, {package_parent!r}); " + code
@@ -308,7 +308,7 @@ class _Zygote:
                                         pass_fds=[theirs.fileno()],
                                         # never the grader's stdout
                                         stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                                        env=minimal_environment())
+                                        env=renderer_environment())
         theirs.close()
 
     def start(self, job: Job) -> int:

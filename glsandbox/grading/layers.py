@@ -30,7 +30,7 @@ import os
 import struct
 import sys
 
-__all__ = ["minimal_environment", "submission_ids", "hand_over", "reading_kept", "drop_privileges", "close_network",
+__all__ = ["minimal_environment", "renderer_environment", "submission_ids", "hand_over", "reading_kept", "drop_privileges", "close_network",
            "install_seccomp", "describe"]
 
 #: The environment a renderer keeps (by prefix): the drivers', the locale's and glsandbox's own.
@@ -52,6 +52,20 @@ def minimal_environment(environ: dict[str, str] | os._Environ | None = None) -> 
     """Of ``environ`` (the grader's), only the variables rendering and the locale read (:data:`ENV_KEPT`)."""
     source = os.environ if environ is None else environ
     return {key: value for key, value in source.items() if key.startswith(ENV_KEPT)}
+
+
+#: What a renderer's environment sets besides what it keeps: numpy's BLAS on one thread. Its
+#: threads would only spin (a renderer's arrays are a few matrices and its pixels; the job slots
+#: are the parallelism), about 0.1 s of a core each time numpy is imported, on a machine whose
+#: cores the renderers want.
+RENDERER_SETS = {"OPENBLAS_NUM_THREADS": "1"}
+
+
+def renderer_environment(environ: dict[str, str] | os._Environ | None = None) -> dict[str, str]:
+    """The environment a renderer's program starts with (the zygote's, which every renderer it
+    forks keeps, or a fresh Python's on the portable path): :func:`minimal_environment` of
+    ``environ`` and :data:`RENDERER_SETS`."""
+    return {**minimal_environment(environ), **RENDERER_SETS}
 
 
 def _libc() -> ctypes.CDLL | None:

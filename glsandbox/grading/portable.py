@@ -4,7 +4,7 @@ Where the fork-based tree of :mod:`glsandbox.grading.isolate` cannot run (a
 teacher's Windows laptop: no ``fork``), or when ``GLSANDBOX_ISOLATION=portable``
 asks for it, each submission is a new interpreter started with
 :mod:`subprocess` in a private copy of its folder, with only the environment
-rendering needs (:func:`glsandbox.grading.layers.minimal_environment`). It
+rendering needs (:func:`glsandbox.grading.layers.renderer_environment`). It
 reads its job on stdin, sends its pictures framed on stdout (what it prints
 goes to a log file instead) and loads the lesson under the same audit hook
 (and, on Linux, Landlock) as the full path (:func:`glsandbox.grading.sandbox.confine`).
@@ -162,7 +162,7 @@ class _Submission:
     """One running submission: its interpreter, the bytes it sent, its clock and its pictures."""
 
     def __init__(self, job: Job) -> None:
-        from glsandbox.grading.layers import minimal_environment
+        from glsandbox.grading.layers import renderer_environment
         from glsandbox.grading.worker import _copy_submission
 
         self.job, self.work = job, tempfile.mkdtemp(prefix="glsandbox-grade-")
@@ -183,7 +183,7 @@ class _Submission:
                 "from glsandbox.grading.portable import child_main; child_main()")
         flags = getattr(subprocess, "CREATE_NEW_PROCESS_GROUP", 0)
         self.process = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                                        stderr=self.log, cwd=root if job.copy else cwd, env=minimal_environment(),
+                                        stderr=self.log, cwd=root if job.copy else cwd, env=renderer_environment(),
                                         start_new_session=hasattr(os, "setsid"), creationflags=flags)
         self.process.stdin.write(json.dumps({"job": _job_data(job), "root": root, "cwd": cwd}).encode() + b"\n")
         self.process.stdin.close()

@@ -175,6 +175,23 @@ def test_the_zygote_starts_from_a_minimal_environment() -> None:
     assert kept == {"PATH": "/bin", "LANG": "C", "MESA_DEBUG": "1", "LC_ALL": "C"}
 
 
+def test_a_renderer_starts_with_blas_on_one_thread_and_the_zygote_with_that_environment() -> None:
+    import shutil
+
+    from glsandbox.grading.isolate import _Zygote
+
+    assert layers.renderer_environment({"PATH": "/bin", "GITHUB_TOKEN": "t", "OPENBLAS_NUM_THREADS": "8"}) == \
+        {"PATH": "/bin", "OPENBLAS_NUM_THREADS": "1"}
+    zygote = _Zygote()
+    try:
+        environ = Path(f"/proc/{zygote.process.pid}/environ").read_bytes().split(b"\0")
+    finally:
+        zygote.close()
+        shutil.rmtree(zygote.folder, ignore_errors=True)
+    assert b"OPENBLAS_NUM_THREADS=1" in environ
+    assert sorted(e for e in environ if e) == sorted(f"{k}={v}".encode() for k, v in layers.renderer_environment().items())
+
+
 SECCOMP = """
 import errno, socket, sys
 from glsandbox.grading import layers
