@@ -87,7 +87,12 @@ def _waves(points: NDArray[np.float64], seed: int, count: int = 24) -> NDArray[n
     amp = 1.0 / freq
     total = np.zeros(points.shape[0])
     for k in range(count):  # one pass per wave, not per point
-        total += amp[k] * np.sin(freq[k] * (points @ u[k]) + phase[k])
+        # p·u as plain products and sums, not a matrix product: BLAS's kernel for this CPU may
+        # fuse them (FMA) or not, and the same seed would give other last bits on other machines
+        along = points[:, 0] * u[k, 0]
+        for axis in range(1, points.shape[1]):
+            along = along + points[:, axis] * u[k, axis]
+        total += amp[k] * np.sin(freq[k] * along + phase[k])
     return total / amp.sum() * 2.5
 
 

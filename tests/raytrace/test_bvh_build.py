@@ -198,13 +198,13 @@ BOULDER = Path(__file__).resolve().parents[2] / "glsandbox" / "models" / "boulde
 #: them (and TREES says whether its SAH is better).
 NODE_ARRAYS = [
     ("boulder", lambda: mesh_world_triangles(load_mesh(BOULDER)), None, "97a8c9288e8d550f1ffc3eab"),
-    ("rock5", lambda: mesh_world_triangles(meshgen.rock(5)), None, "66ab87e7ec40f2ce355a168f"),
-    ("terrain64", lambda: mesh_world_triangles(meshgen.terrain(64)), None, "72f66cf6c2f428ae5ee919cd"),
+    ("rock5", lambda: mesh_world_triangles(meshgen.rock(5)), None, "8d6e8b95b0a7259fe6f387c9"),
+    ("terrain64", lambda: mesh_world_triangles(meshgen.terrain(64)), None, "8c749f25213d0cffb7fd09b4"),
     ("random20000", lambda: random_triangles(20000, 3), None, "4bb1cee14ed0ae22181e7912"),
     ("terrain40k", lambda: mesh_world_triangles(meshgen.terrain(meshgen.terrain_cells_for(40_000))), None,
-     "47bb5869507f5aa104016408"),
+     "75eea07613a50594ff6a4134"),
     ("terrain40k parts", lambda: mesh_world_triangles(meshgen.terrain(meshgen.terrain_cells_for(40_000))), 4096,
-     "641aff7ce44b3032f772525f"),
+     "4ab62ea96f0984bb27a0b9fa"),
 ]
 
 
