@@ -18,8 +18,9 @@ submissions right so every run exits 0):
   without the zygote's warm template, so a ratio against it flatters the
   isolation (shown, not a goal).
 
-Subject: ``glsandbox check DIR`` as it is, with ``--jobs 1`` and ``--jobs 2``:
-scene files, which run no code, are drawn by one confined renderer kept
+Subject: ``glsandbox check DIR`` as it is (``python -m glsandbox``, the console
+script's way in: :mod:`glsandbox.launch` starts the zygote before the
+command line's modules are imported), with ``--jobs 1`` and ``--jobs 2``: scene files, which run no code, are drawn by one confined renderer kept
 per job slot (its supervisor copies each submission into a fresh folder
 and replaces the renderer after any TIMEOUT, crash or OUT OF MEMORY:
 :mod:`glsandbox.grading.resident`); a lesson file gets a supervisor and a
@@ -109,7 +110,7 @@ def cases(env) -> list:
 
     def isolated(jobs: int) -> Side:
         return Side(f"isolated --jobs {jobs}", _made_first(ready, run_process([
-            sys.executable, "-m", "glsandbox.cli", "check", str(folder), "--golden", str(ref), "--backend", "egl",
+            sys.executable, "-m", "glsandbox", "check", str(folder), "--golden", str(ref), "--backend", "egl",
             "--jobs", str(jobs)])))
 
     name = f"{count} scene files {SIZE}"
@@ -179,7 +180,7 @@ def grade_class(folder: Path, ref: Path, jobs: int = 2) -> dict[str, object]:
     before = {p.name for p in tmp.iterdir()}
     env = {**os.environ, "GLSANDBOX_BENCH_MARK": mark}
     started = time.perf_counter()
-    proc = psutil.Popen([sys.executable, "-m", "glsandbox.cli", "check", str(folder), "--golden", str(ref),
+    proc = psutil.Popen([sys.executable, "-m", "glsandbox", "check", str(folder), "--golden", str(ref),
                          "--backend", "egl", "--jobs", str(jobs), "--timeout", "2", "--memory", "1024"],
                         env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     peak = [0]

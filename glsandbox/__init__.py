@@ -25,31 +25,22 @@ The layers below (the table in docs/how-it-works.md) import downwards only;
 :func:`run` is the one door up to the command line, opened when called.
 """
 
+from __future__ import annotations
+
 import importlib
 
-from glsandbox import geometry, transforms
-from glsandbox.errors import SandboxError
+from glsandbox import course_lessons  # noqa: F401 - the course's lessons found in a checkout (python -m glsandbox.lessons.X)
 from glsandbox.version import __version__
-from glsandbox.geometry import Mesh
-from glsandbox.lesson import Lesson, Param, register
-from glsandbox.overlay import Overlay, WorldLine, WorldLines, WorldMark, text_image
-from glsandbox.scene import (
-    COURSE_BLUE,
-    DEPTH_MODES,
-    LIT_SHADINGS,
-    NORMAL_MODES,
-    TEXTURE_FILTERS,
-    TEXTURE_WRAPS,
-    Camera,
-    Light,
-    Material,
-    Motion,
-    Node,
-    Scene,
-    ShadowMap,
-    Texture,
-    Viewport,
-)
+
+TYPE_CHECKING = False  # (typing's own would import typing: 15 ms of a cold start)
+if TYPE_CHECKING:  # the names, for type checkers and editors; at run time each is imported on first use
+    from glsandbox import geometry, transforms
+    from glsandbox.errors import SandboxError
+    from glsandbox.geometry import Mesh
+    from glsandbox.lesson import Lesson, Param, register
+    from glsandbox.overlay import Overlay, WorldLine, WorldLines, WorldMark, text_image
+    from glsandbox.scene import (COURSE_BLUE, DEPTH_MODES, LIT_SHADINGS, NORMAL_MODES, TEXTURE_FILTERS, TEXTURE_WRAPS,
+                                 Camera, Light, Material, Motion, Node, Scene, ShadowMap, Texture, Viewport)
 
 __all__ = [
     "COURSE_BLUE", "DEPTH_MODES", "LIT_SHADINGS", "NORMAL_MODES", "TEXTURE_FILTERS", "TEXTURE_WRAPS",
@@ -60,10 +51,22 @@ __all__ = [
 ]
 
 
-# Names whose modules a plain ``glsandbox render`` does not need (model files, the model
-# generators, texture checks, the window's camera controls, the planar effects): imported on
-# first use (PEP 562), so a cold start skips them.
+# Every name is imported on first use (PEP 562): ``import glsandbox`` costs nothing, so the
+# command line can start what a long command starts early (the grading zygote,
+# :mod:`glsandbox.launch`) before numpy and moderngl are imported, and a cold start skips the
+# modules it never uses (model files, the model generators, the window's camera controls).
+_SCENE_NAMES = ("COURSE_BLUE", "DEPTH_MODES", "LIT_SHADINGS", "NORMAL_MODES", "TEXTURE_FILTERS", "TEXTURE_WRAPS",
+                "Camera", "Light", "Material", "Motion", "Node", "Scene", "ShadowMap", "Texture", "Viewport")
 _LAZY = {
+    "geometry": ("glsandbox.geometry", None),
+    "transforms": ("glsandbox.transforms", None),
+    "SandboxError": ("glsandbox.errors", "SandboxError"),
+    "Mesh": ("glsandbox.geometry", "Mesh"),
+    "Lesson": ("glsandbox.lesson", "Lesson"),
+    "Param": ("glsandbox.lesson", "Param"),
+    "register": ("glsandbox.lesson", "register"),
+    **{name: ("glsandbox.overlay", name) for name in ("Overlay", "WorldLine", "WorldLines", "WorldMark", "text_image")},
+    **{name: ("glsandbox.scene", name) for name in _SCENE_NAMES},
     "camera": ("glsandbox.camera", None),
     "exercise": ("glsandbox.exercises", "exercise"),
     "Mirror": ("glsandbox.planar", "Mirror"),

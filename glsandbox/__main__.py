@@ -2,7 +2,7 @@
 
 import sys
 
-from glsandbox.cli import main
+from glsandbox.launch import main
 
 if __name__ == "__main__":
     sys.exit(main())

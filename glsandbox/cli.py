@@ -481,12 +481,9 @@ def cmd_check_merge(argv: list[str]) -> int:
 def cmd_check(args: argparse.Namespace) -> int:
     """``glsandbox check``: render, compare with reference PNGs by the golden rule; 0 all pass, 1 not."""
     if Path(args.lesson).is_dir() and not args.update:  # a class: its zygote starts while the rest gets ready
-        from glsandbox.grading import portable
+        from glsandbox.grading.runner import prestart  # (started already where glsandbox.launch ran first)
 
-        if not portable.wanted():
-            from glsandbox.grading.isolate import prestart
-
-            prestart()
+        prestart()
     from glsandbox.grading.check import Limits, check_folder, check_one, default_jobs, summary_table
     from glsandbox.grading.reports import REPORTS, write_reports
 
@@ -522,10 +519,11 @@ def cmd_check(args: argparse.Namespace) -> int:
 
         from glsandbox.grading import portable
         from glsandbox.grading.layers import describe
+        from glsandbox.grading.runner import portable_wanted
 
 
         # which layers confine a submission on this machine
-        layers_line = portable.describe() if portable.wanted() else describe()
+        layers_line = portable.describe() if portable_wanted() else describe()
         bars = []  # the progress bar, made when the first submission reports (the total known then)
 
         def report(done: int, total: int, result) -> None:

@@ -21,6 +21,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, ClassVar, NoReturn
 
+from glsandbox.course_lessons import BUILTIN_LESSONS, COURSE_PACKAGE
 from glsandbox.errors import NUMBER_LIMIT, SandboxError, plain
 from glsandbox.files import read_user_file
 from glsandbox.scene import RENDERERS
@@ -503,32 +504,6 @@ def register(cls: type[Lesson]) -> type[Lesson]:
         raise ValueError(f"{cls.__qualname__} has no name")
     _REGISTRY[cls.name] = cls
     return cls
-
-
-#: The course's own lessons are the package ``glsandbox.lessons``, under glsandbox's own name,
-#: so that a user's ``lessons/`` folder neither hides them nor is hidden by them. The wheel
-#: installs the repository's top-level ``lessons/`` folder as ``glsandbox/lessons/``; a
-#: checkout keeps it at the top, where :class:`CourseLessonsFinder` finds it.
-COURSE_PACKAGE = "glsandbox.lessons"
-_PACKAGE_DIR = Path(__file__).resolve().parent
-BUILTIN_LESSONS = next((folder for folder in (_PACKAGE_DIR / "lessons", _PACKAGE_DIR.parent / "lessons")
-                        if (folder / "__init__.py").is_file()), _PACKAGE_DIR / "lessons")
-
-
-class CourseLessonsFinder:
-    """A ``sys.meta_path`` finder for ``glsandbox.lessons`` in a checkout: the folder is at the
-    repository's top, not inside the package. Asked last, so an installed wheel's
-    ``glsandbox/lessons/`` is found the ordinary way first."""
-
-    def find_spec(self, fullname: str, path: object = None, target: object = None) -> Any:
-        if fullname != COURSE_PACKAGE or not (BUILTIN_LESSONS / "__init__.py").is_file():
-            return None
-        return importlib.util.spec_from_file_location(fullname, BUILTIN_LESSONS / "__init__.py",
-                                                      submodule_search_locations=[str(BUILTIN_LESSONS)])
-
-
-if not any(type(finder).__name__ == CourseLessonsFinder.__name__ for finder in sys.meta_path):
-    sys.meta_path.append(CourseLessonsFinder())
 
 
 def builtin_lessons() -> types.ModuleType:

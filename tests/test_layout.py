@@ -20,7 +20,7 @@ ROOT = Path(__file__).resolve().parents[1]
 LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("core", ("glsandbox.errors", "glsandbox.transforms", "glsandbox.mesh.normals", "glsandbox.mesh.looks",
               "glsandbox.mesh.precheck", "glsandbox.geometry", "glsandbox.mesh.generate", "glsandbox.files",
-              "glsandbox.progress", "glsandbox.version")),
+              "glsandbox.progress", "glsandbox.version", "glsandbox.course_lessons")),
     # glsandbox.mesh: its package and the model-file loader here, the rest of it in the core
     ("scene data", ("glsandbox.scene", "glsandbox.planar", "glsandbox.images",
                     "glsandbox.overlay", "glsandbox.mesh")),
@@ -37,7 +37,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
                            "glsandbox.exercises.dxmath", "glsandbox.story")),
     ("grading", ("glsandbox.grading", "glsandbox.exercises")),
     ("command line", ("glsandbox.cli", "glsandbox.supervise", "glsandbox.interrupt_watch", "glsandbox.pytest_plugin",
-                      "glsandbox.__main__")),
+                      "glsandbox.__main__", "glsandbox.launch")),
 ]
 
 #: The two doors up, each opened only when called: lesson discovery

@@ -49,8 +49,6 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
-
 from glsandbox.grading.processes import descendants, kill_tree, killpg, set_subreaper
 
 __all__ = ["Render", "Job", "Picture", "JobResult", "run_jobs", "wide_pipe"]
@@ -529,6 +527,8 @@ def _drain(closing: dict[int, _Running], ready: Sequence[int]) -> None:
 
 
 def _result(job: Job, message: tuple[dict, bytes] | None) -> JobResult:
+    import numpy as np  # (not at the top: this module is light, for the zygote's early start)
+
     if message is None or (message[0].get("pictures") is None and not message[0].get("no_gl")):
         pictures = [Picture(status=CRASHED, error="its grading process ended without a result") for _ in job.renders]
         return JobResult(job, pictures)

@@ -38,17 +38,12 @@ import numpy as np
 from glsandbox.grading.isolate import (BROKEN, CRASHED, OOM, TIMEOUT, Job, JobResult, Picture, Reader, _job_data,
                                        job_from, send, settle, story_of)
 
-__all__ = ["wanted", "describe", "run_jobs_portable", "child_main", "tree_rss"]
+__all__ = ["describe", "run_jobs_portable", "child_main", "tree_rss"]
 
 #: Seconds a new interpreter may take to import glsandbox and open its context before its clock starts.
 STARTUP_SECONDS = 60.0
 #: How often the grader looks at each running submission (its messages, clock and memory).
 POLL_SECONDS = 0.02
-
-
-def wanted() -> bool:
-    """Whether ``check`` grades the portable way: asked for (``GLSANDBOX_ISOLATION=portable``), or no ``fork``."""
-    return os.environ.get("GLSANDBOX_ISOLATION", "").strip().lower() == "portable" or not hasattr(os, "fork")
 
 
 def describe() -> str:

@@ -74,7 +74,7 @@ def _base_roots() -> tuple[str, ...]:
         if path:
             roots.add(path)
     roots.update(p for p in sys.path if p.endswith(("site-packages", "dist-packages")))
-    from glsandbox.lesson import BUILTIN_LESSONS
+    from glsandbox.course_lessons import BUILTIN_LESSONS
 
     roots.add(str(BUILTIN_LESSONS))  # the course's lessons, which a submission may subclass
     from glsandbox.gl.shaders import shader_roots

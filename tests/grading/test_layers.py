@@ -102,7 +102,7 @@ def grade(tmp_path: Path, env: dict[str, str]) -> tuple[subprocess.CompletedProc
     """The spy (and a right submission) graded with every report; (process, what the spy saw, reports' text)."""
     ref = tmp_path / "ref.png"
     (tmp_path / "model.toml").write_text(RIGHT)
-    run = [sys.executable, "-m", "glsandbox.cli", "check"]
+    run = [sys.executable, "-m", "glsandbox", "check"]  # the command as the console script runs it (glsandbox.launch)
     made = subprocess.run([*run, str(tmp_path / "model.toml"), "--golden", str(ref), "--update", "--size", "64x48"],
                           capture_output=True, text=True, env=env, cwd=REPO_ROOT, timeout=300)
     assert made.returncode == 0, made.stderr
