@@ -20,7 +20,8 @@ submissions right so every run exits 0):
 
 Subject: ``glsandbox check DIR`` as it is (``python -m glsandbox``, the console
 script's way in: :mod:`glsandbox.launch` starts the zygote before the
-command line's modules are imported), with ``--jobs 1`` and ``--jobs 2``: scene files, which run no code, are drawn by one confined renderer kept
+command line's modules are imported), with ``--jobs 1`` and ``--jobs 2``:
+scene files, which run no code, are drawn by one confined renderer kept
 per job slot (its supervisor copies each submission into a fresh folder
 and replaces the renderer after any TIMEOUT, crash or OUT OF MEMORY:
 :mod:`glsandbox.grading.resident`); a lesson file gets a supervisor and a

@@ -9,7 +9,6 @@ so it renders the same moment exactly, headless or in a window.
 from __future__ import annotations
 
 import importlib
-import importlib.util
 import inspect
 import itertools
 import math

@@ -30,8 +30,8 @@ import os
 import struct
 import sys
 
-__all__ = ["minimal_environment", "renderer_environment", "submission_ids", "hand_over", "reading_kept", "drop_privileges", "close_network",
-           "install_seccomp", "describe"]
+__all__ = ["minimal_environment", "renderer_environment", "submission_ids", "hand_over", "reading_kept",
+           "drop_privileges", "close_network", "install_seccomp", "describe"]
 
 #: The environment a renderer keeps (by prefix): the drivers', the locale's and glsandbox's own.
 ENV_KEPT = ("PATH", "HOME", "LANG", "LC_", "TZ", "DISPLAY", "WAYLAND_", "XDG_", "MESA_", "LIBGL_", "GALLIUM_",
