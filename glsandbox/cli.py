@@ -29,7 +29,7 @@ from glsandbox.gl.context import BACKENDS
 from glsandbox.interrupt_watch import EXIT_INTERRUPTED, watch_interrupts
 from glsandbox.lesson import Lesson, all_lessons, find_lesson, lesson_description, lesson_files
 from glsandbox.plan import plan
-from glsandbox.progress import progress, say
+from glsandbox.progress import progress, ready, say
 from glsandbox.scene import Scene
 
 EXIT_USAGE = 2
@@ -521,7 +521,7 @@ def cmd_check(args: argparse.Namespace) -> int:
         from glsandbox.grading.layers import describe
         from glsandbox.grading.runner import portable_wanted
 
-
+        ready()  # the bar's module, while the zygote starts
         # which layers confine a submission on this machine
         layers_line = portable.describe() if portable_wanted() else describe()
         bars = []  # the progress bar, made when the first submission reports (the total known then)

@@ -63,3 +63,19 @@ def test_the_portable_way_starts_no_zygote_and_the_user_keeps_their_blas_threads
 def test_both_ways_in_run_the_same_command(entry: list[str]) -> None:
     proc = subprocess.run([sys.executable, *entry, "--version"], capture_output=True, text=True, cwd=REPO, timeout=120)
     assert proc.returncode == 0 and proc.stdout.split()[-1] == __import__("glsandbox").__version__
+
+
+def test_the_command_leaves_its_objects_to_the_system_and_still_runs_its_exit_handlers() -> None:
+    script = ("import atexit, gc, json, sys, tempfile\n"
+              "import glsandbox.cli\n"
+              "glsandbox.cli.main = lambda argv=None: 3\n"
+              "from glsandbox import launch\n"
+              "folder = tempfile.TemporaryDirectory()\n"
+              "path = folder.name\n"
+              "atexit.register(lambda: print(json.dumps({'frozen': gc.get_freeze_count(), 'folder': path})))\n"
+              "sys.exit(launch.main(['render', 'x']))\n")
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=REPO, timeout=120)
+    assert proc.returncode == 3, proc.stderr
+    seen = json.loads(proc.stdout)
+    assert seen["frozen"] > 1000  # the interpreter's last collections walk none of them
+    assert not Path(seen["folder"]).exists()  # a temporary folder's finaliser still ran

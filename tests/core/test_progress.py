@@ -139,3 +139,17 @@ def test_check_a_folder_counts_each_submission(recorded, tmp_path, gl, capsys) -
     assert recorded.bars == [{"total": 3, "what": "check", "done": 3, "closed": True}]
     out = capsys.readouterr().out
     assert [f"[{n}/3]" in out for n in (1, 2, 3)] == [True] * 3  # the lines stay, on stdout
+
+
+def test_ready_imports_the_bar_before_the_first_line() -> None:
+    import subprocess
+    import sys
+
+    script = ("import sys\n"
+              "from glsandbox import progress\n"
+              "before = 'tqdm' in sys.modules\n"
+              "progress.ready()\n"
+              "print(before, 'tqdm' in sys.modules)\n")
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.split() == ["False", "True"]
