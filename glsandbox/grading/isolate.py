@@ -414,6 +414,9 @@ class _NoSlots:
     def collect(self, *_: object) -> bool:
         return False
 
+    def last_given(self) -> None:
+        pass
+
     def close(self) -> None:
         pass
 
@@ -463,6 +466,8 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
                     fd = zygote_process.start(job)
                 # a supervisor that hangs (it should not) is given up after every picture's time and a margin
                 running[fd] = _Running(job, Reader(fd), time.monotonic() + job.timeout * len(job.renders) + 60)
+            if not pending:  # every job handed out: the slots clean up as they finish theirs
+                slots.last_given()
             ready, _, _ = select.select([*running, *closing, *slots.fds()], [], [], 1.0)
             _drain(closing, ready)
             if slots.collect(ready, pending, retried, results, done):

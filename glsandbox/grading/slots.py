@@ -12,6 +12,10 @@ margin, or whose pipe closes without a result, is killed: its job is
 CRASHED, as a one-shot supervisor's would be, and the next scene file
 opens a fresh slot. A job the slot answers ``own_process`` (a scene file
 with a shader of its own) goes back to the queue for a supervisor of its own.
+Once the run has no job left to hand out, every slot is told so
+(:meth:`Slots.last_given`: its jobs' pipe closed), and its supervisor
+cleans up as soon as it sent its last result, while the grader still
+settles the last ones.
 """
 
 from __future__ import annotations
@@ -76,6 +80,14 @@ class Slot:
         self.pid = 0
         self.queue: list[Job] = []
         self.deadline = 0.0
+        #: Whether it was told it gets no more jobs (its jobs' pipe closed).
+        self.told = False
+
+    def tell_done(self) -> None:
+        """No more jobs for it: its jobs' pipe closed, so the supervisor ends after those it holds."""
+        if not self.told:
+            self.told = True
+            os.close(self.jobs)
 
     def give(self, job: Job) -> None:
         send(self.jobs, _job_data(job))
@@ -106,7 +118,7 @@ class Slot:
         if self.pid:
             kill_tree(self.pid)
             killpg(self.pid)
-        os.close(self.jobs)
+        self.tell_done()
         os.close(self.reader.fd)
 
 
@@ -133,7 +145,7 @@ class Slots:
         """Give ``job`` to an idle slot (opened if need be); False: not a slot's job, or every slot busy."""
         if not self._theirs(job):
             return False
-        slot = next((s for s in self.open if not s.queue), None)
+        slot = next((s for s in self.open if not s.queue and not s.told), None)
         if slot is None:
             if len(self.open) >= self.workers:
                 return False
@@ -152,7 +164,7 @@ class Slots:
     def queue(self, job: Job) -> bool:
         """Send ``job`` to a slot drawing one job, to start when that one is done (no slot more
         is opened: the run is at ``workers``); False where none can take it."""
-        slot = next((s for s in self.open if len(s.queue) == 1), None) if self._theirs(job) else None
+        slot = next((s for s in self.open if len(s.queue) == 1 and not s.told), None) if self._theirs(job) else None
         if slot is None:
             return False
         try:
@@ -160,6 +172,14 @@ class Slots:
         except OSError:  # its supervisor is gone: collect() finds the pipe closed
             return False
         return True
+
+    def last_given(self) -> None:
+        """The run has no job left to hand out: every slot told (:meth:`Slot.tell_done`), so each
+        supervisor removes its renderer and folder while the last results are settled, not after.
+        A job that comes back later (a retry, a slot lost) is graded all the same: by a fresh slot,
+        or a supervisor of its own."""
+        for slot in self.open:
+            slot.tell_done()
 
     def collect(self, ready: Sequence[int], pending: deque[Job], retried: set[int], results: dict[int, JobResult],
                 done: Callable[[JobResult], object]) -> bool:
@@ -178,7 +198,7 @@ class Slots:
         """The first job of ``slot`` settled if its result came (True: the run must stop); None
         (and ``slot`` kept) when there is nothing more to settle now."""
         if not slot.queue:
-            if slot.reader.closed:  # an idle supervisor that ended (it should not): forgotten
+            if slot.reader.closed:  # an idle supervisor that ended (told it is done, or lost): forgotten
                 self.open.remove(slot)
                 slot.kill()
             return None
@@ -207,7 +227,7 @@ class Slots:
             if slot.queue:
                 slot.kill()
                 continue
-            os.close(slot.jobs)
+            slot.tell_done()
             waiting.append((slot, time.monotonic() + 10))
         self.open = []
         _wait_closed(waiting)

@@ -183,3 +183,30 @@ def test_a_slot_whose_supervisor_is_gone_crashes_its_job_and_is_replaced(zygote:
     assert [p.status for p in done[0].pictures] == [CRASHED]
     assert slots.open == [] and slots.take(_job(1)) and len(zygote.slots) == 2
     slots.close()
+
+
+def test_once_every_job_is_handed_out_a_slot_ends_after_its_last_result(zygote: FakeZygote) -> None:
+    """The supervisor reads the job it holds and then the end of its jobs' pipe (it cleans up
+    while the grader settles the last results); a told slot takes no job, and its end is no crash."""
+    from glsandbox.grading.isolate import Reader
+
+    slots = Slots(1, zygote.request)
+    assert slots.take(_job(0))
+    slots.last_given()
+    assert not slots.take(_job(1)) and not slots.queue(_job(1)) and len(zygote.slots) == 1
+    jobs_end, results_end = zygote.slots[0]
+    reader = Reader(jobs_end)
+    while not reader.closed:
+        reader.pump(5.0)
+    assert [h["index"] for h, _ in reader.messages(0)] == [0]  # its job, then the pipe's end
+    send(results_end, {"kind": "result", "pictures": [{"status": "", "error": "", "seconds": 0.1, "shape": [1, 2, 4]}],
+                       "output": [], "root": "", "meta": {}}, bytes(8))
+    os.close(results_end)  # the supervisor cleaned up and ended
+    os.close(jobs_end)
+    zygote.slots[0] = (-1, -1)
+    pending, results, done = deque(), {}, []
+    while slots.open:
+        assert not _collect(slots, pending, results, done)
+    assert [p.status for p in done[0].pictures] == [""] and not pending
+    slots.last_given()  # nothing open: nothing to tell
+    slots.close()
