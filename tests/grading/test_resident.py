@@ -158,6 +158,50 @@ def test_a_renderer_killed_mid_batch_is_a_crash_and_the_next_one_passes(gl, tmp_
     assert np.array_equal(resident[0].pictures[0].image, resident[2].pictures[0].image)
 
 
+def test_a_resident_renderer_reads_mesas_shader_cache_with_its_thread_on_the_main_heap(gl, tmp_path: Path) -> None:
+    """Mesa's cache thread (``disk$N``) runs in the resident renderer (the model answer's compiled
+    shaders are read, never written: confine), and that thread reserved no malloc arena of its
+    own (64 MB of address space, most of it reserved and untouched)."""
+    from glsandbox.grading.sandbox import shader_cache_dirs
+
+    if os.environ.get("MESA_SHADER_CACHE_DISABLE", "").lower() in ("1", "true", "yes"):
+        pytest.skip("Mesa's shader cache is turned off in this environment")
+    assert shader_cache_dirs(), "the gl fixture's context made Mesa's cache folder"
+    jobs = _numbered([_scene(tmp_path / "a", "first", SCENE.format(mesh="cube24", shading="phong")),
+                      _scene(tmp_path / "slow", "slow", _slow_scene(4000))])
+    seen: list[tuple[list[str], list[int]]] = []
+
+    def look_at_the_slow_ones_renderer() -> None:
+        deadline = time.monotonic() + 60
+        while not seen and time.monotonic() < deadline:
+            for pid in _resident_renderers():
+                try:
+                    if not os.readlink(f"/proc/{pid}/cwd").endswith(os.sep + "2"):
+                        continue
+                    names = [Path(f"/proc/{pid}/task/{t}/comm").read_text().strip()
+                             for t in os.listdir(f"/proc/{pid}/task")]
+                    reserved = []  # anonymous mappings nothing may touch: the unused part of a heap
+                    for line in Path(f"/proc/{pid}/maps").read_text().splitlines():
+                        fields = line.split()
+                        start, end = (int(x, 16) for x in fields[0].split("-"))
+                        if fields[1] == "---p" and len(fields) == 5:
+                            reserved.append(end - start)
+                except OSError:
+                    continue
+                seen.append((names, reserved))
+            time.sleep(0.02)
+
+    watcher = threading.Thread(target=look_at_the_slow_ones_renderer, daemon=True)
+    watcher.start()
+    run_jobs(jobs, 1, lambda result: None)
+    watcher.join()
+    assert seen, "the renderer drawing the slow scene was found"
+    names, reserved = seen[0]
+    assert any("disk$" in name for name in names), names
+    # a thread's own arena: 64 MB of address space, of which all but what it used is reserved
+    assert not any(size >= 32 << 20 for size in reserved), [size >> 20 for size in reserved]
+
+
 @pytest.mark.slow
 def test_out_of_memory_mid_batch_replaces_the_renderer_and_the_next_one_passes(gl, tmp_path: Path) -> None:
     """A scene file too big for the memory limit to read (nine million numbers, under 460 MB: out
