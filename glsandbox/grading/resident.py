@@ -110,14 +110,14 @@ def _resident(job: Job, work: str, inbox: str, cwd: str, out: int, commands: int
 
     code = 0
     try:
-        # As the warm template draws (glsandbox.grading.warm): no rasterizer threads. Mesa's
-        # on-disk shader cache is read, as every confined renderer reads it (never written:
-        # glsandbox.grading.sandbox.confine): with the model answer's shaders in it, the first
-        # picture takes about 60 ms instead of 160 of llvmpipe compiling. Its one thread allocates
-        # from the main heap (_one_malloc_arena), so the renderer holds about 7 MB (the thread's
-        # stack) more address space under --memory than without it, not 72.
+        # The warm template's drawing (glsandbox.grading.warm): no rasterizer threads and no
+        # on-disk shader cache, so no thread at all: the context opens before confinement, and
+        # Landlock and seccomp bind only the thread that enters them and those it starts later
+        # (Mesa's cache thread, started with the context, could write the cache). And so a
+        # resident renderer's address space (what --memory bounds) is that of the renderers
+        # forked from the template, and an OUT OF MEMORY the same verdict.
         os.environ["LP_NUM_THREADS"] = "0"
-        _one_malloc_arena()
+        os.environ["MESA_SHADER_CACHE_DISABLE"] = "true"
         budget = cpu_budget(job)
         renderer = enter_renderer(job, inbox, cwd, [cwd], work, out, ids, keep=commands,
                                   cpu=(budget, budget * (RETIRE_AFTER + 1)))
@@ -140,18 +140,6 @@ def _resident(job: Job, work: str, inbox: str, cwd: str, out: int, commands: int
     finally:
         flush_output()
         os._exit(code)
-
-
-def _one_malloc_arena() -> None:
-    """glibc's allocator on one arena for every thread of this process (``mallopt(M_ARENA_MAX,
-    1)``): a thread's first allocation would otherwise reserve an arena of its own (64 MB of
-    address space on 64-bit systems). Nothing where the C library has no ``mallopt``."""
-    import ctypes
-
-    try:
-        ctypes.CDLL(None).mallopt(-8, 1)  # M_ARENA_MAX (malloc.h)
-    except (AttributeError, OSError):
-        pass
 
 
 def _next(reader: Reader) -> dict | None:
