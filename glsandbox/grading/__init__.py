@@ -6,6 +6,7 @@
 - :mod:`~glsandbox.grading.exercise`, :mod:`~glsandbox.grading.states`: students' functions and
   state tables graded for a class;
 - :mod:`~glsandbox.grading.isolate`: a process per submission, the grader's side and the messages;
+  :mod:`~glsandbox.grading.zygote`: the grader's handle on the zygote, started ahead of its run;
   :mod:`~glsandbox.grading.portable`: the portable way (a fresh Python per submission);
   :mod:`~glsandbox.grading.runner`: which of the two this machine takes;
 - :mod:`~glsandbox.grading.worker`: the zygote, supervisor and renderer;

@@ -28,8 +28,8 @@ replacing ``sys.stdout`` or glsandbox's functions) reaches the grader: the
 worst it can do is lose its own pictures.
 
 This module is the grader's side and what both sides share (the jobs, the
-framed messages); :mod:`glsandbox.grading.worker` is the zygote, supervisor
-and renderer; :mod:`glsandbox.grading.processes` finds and kills a tree.
+framed messages); :mod:`glsandbox.grading.zygote` starts the zygote and asks
+it; :mod:`glsandbox.grading.worker` is the zygote, supervisor and renderer; :mod:`glsandbox.grading.processes` finds and kills a tree.
 A scene file (data, no code) goes instead to a job slot: a supervisor and a
 renderer kept for many scene files, confined as these are
 (:mod:`glsandbox.grading.slots`, :mod:`glsandbox.grading.resident`).
@@ -280,98 +280,6 @@ def job_from(data: dict) -> Job:
 # --- the grader's side -----------------------------------------------------------------------
 
 
-class _Zygote:
-    """The zygote process and the grader's end of its socket pair."""
-
-    def __init__(self) -> None:
-        import socket
-        import subprocess
-        import tempfile
-
-        # Every private folder of the run is made in this one (the zygote's temporary folder),
-        # removed by the grader when the run ends: none is left by a supervisor killed before
-        # its own clean-up (past its deadline, or the run stopped). Others may pass through it
-        # to the folders a submission's user owns, not list it.
-        self.folder = tempfile.mkdtemp(prefix="glsandbox-grade-run-")
-        os.chmod(self.folder, 0o711)
-        self.channel, theirs = socket.socketpair()
-        code = ("import sys; from glsandbox.grading.resident import zygote_main; "
-                "zygote_main(int(sys.argv[1]), sys.argv[2])")
-        # a fresh program with only what rendering reads: every fork's /proc/self/environ is this one
-        from glsandbox.grading.layers import renderer_environment
-
-        package_parent = str(Path(__file__).resolve().parents[2])
-        code = f"import sys; sys.path.insert(0, {package_parent!r}); " + code
-        self.process = subprocess.Popen([sys.executable, "-c", code, str(theirs.fileno()), self.folder],
-                                        pass_fds=[theirs.fileno()],
-                                        # never the grader's stdout
-                                        stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                                        env=renderer_environment())
-        theirs.close()
-
-    def start(self, job: Job) -> int:
-        """Ask for a supervisor for ``job``; the read end of its result pipe."""
-        read_end, write_end = os.pipe()
-        wide_pipe(write_end)
-        try:
-            self.request(_job_data(job), [write_end])
-        finally:
-            os.close(write_end)
-        return read_end
-
-    def request(self, data: dict, fds: list[int]) -> None:
-        """Send the zygote ``data`` (a job, or a slot's request) and ``fds`` (the caller keeps its copies)."""
-        import socket
-
-        encoded = json.dumps(data).encode()
-        self.channel.sendall(struct.pack("!I", len(encoded)))
-        socket.send_fds(self.channel, [encoded], fds)
-
-    def close(self) -> None:
-        self.channel.close()
-        try:
-            self.process.wait(timeout=10)
-        except Exception:  # noqa: BLE001 - it is killed with the rest of the run
-            pass
-
-
-#: A zygote started ahead of its run (:func:`prestart`), taken by the next :func:`run_jobs`.
-_prestarted: _Zygote | None = None
-
-
-def prestart() -> None:
-    """Start the zygote now, so that its start (a fresh Python importing glsandbox, numpy and
-    moderngl: about half a second) overlaps the grader's own preparation (the references read,
-    the submissions listed); the next :func:`run_jobs` uses it. Nothing where the system cannot fork."""
-    global _prestarted
-    if _prestarted is None and hasattr(os, "fork"):
-        import atexit
-
-        _prestarted = _Zygote()
-        atexit.register(_discard_prestarted)
-
-
-def _discard_prestarted() -> None:
-    """At exit: a prestarted zygote no run took (the command stopped first: a missing reference,
-    a rubric of exercises only) is closed and its folder removed."""
-    global _prestarted
-    found, _prestarted = _prestarted, None
-    if found is not None:
-        found.close()
-        shutil.rmtree(found.folder, ignore_errors=True)
-
-
-def _zygote() -> _Zygote:
-    """The prestarted zygote if there is one (and it lives), else a fresh one."""
-    global _prestarted
-    found, _prestarted = _prestarted, None
-    if found is not None and found.process.poll() is None:
-        return found
-    if found is not None:
-        found.close()
-    return _Zygote()
-
-
 @dataclass
 class _Running:
     job: Job
@@ -421,6 +329,17 @@ class _NoSlots:
         pass
 
 
+def _supervised(zygote_process, job: Job) -> int:  # noqa: ANN001 - a glsandbox.grading.zygote.Zygote
+    """Ask the zygote for a supervisor for ``job``; the read end of its result pipe."""
+    read_end, write_end = os.pipe()
+    wide_pipe(write_end)
+    try:
+        zygote_process.request(_job_data(job), [write_end])
+    finally:
+        os.close(write_end)
+    return read_end
+
+
 def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None],
              slots: Callable[[int, Callable[[dict, list[int]], None]], object] | None = None) -> list[JobResult]:
     """Run every job, ``workers`` at once; ``done`` is called as each finishes; results in job order.
@@ -437,7 +356,9 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
 
         raise SandboxError("glsandbox check runs each submission in a process of its own, which needs a POSIX "
                            "system (Linux, macOS); on Windows run it in WSL or a container")
-    ahead = _prestarted.process.pid if _prestarted is not None else None
+    from glsandbox.grading import zygote
+
+    ahead = zygote.ahead_pid()
     before = set(descendants(os.getpid())) - {ahead}
     set_subreaper()
     pending = deque(jobs)
@@ -447,7 +368,7 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
     # Supervisors that sent their result and are cleaning up (killing their renderer's tree,
     # removing their private folder): their pipes close when they end; the run waits for that.
     closing: dict[int, _Running] = {}
-    zygote_process = _zygote()
+    zygote_process = zygote.take()
     folders = [zygote_process.folder]
     # Scene files go to job slots, each a supervisor with a renderer kept for many (glsandbox.grading.slots).
     slots = _NoSlots() if slots is None else slots(workers, lambda data, fds: zygote_process.request(data, fds))
@@ -458,12 +379,12 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
                 if len(running) + slots.busy() >= max(1, workers) or slots.take(job):
                     continue  # (queued behind a slot's job, or taken by an idle slot)
                 try:
-                    fd = zygote_process.start(job)
+                    fd = _supervised(zygote_process, job)
                 except OSError:  # the zygote is gone (it should not be): a fresh one, once
                     zygote_process.close()
-                    zygote_process = _Zygote()
+                    zygote_process = zygote.Zygote()
                     folders.append(zygote_process.folder)
-                    fd = zygote_process.start(job)
+                    fd = _supervised(zygote_process, job)
                 # a supervisor that hangs (it should not) is given up after every picture's time and a margin
                 running[fd] = _Running(job, Reader(fd), time.monotonic() + job.timeout * len(job.renders) + 60)
             if not pending:  # every job handed out: the slots clean up as they finish theirs

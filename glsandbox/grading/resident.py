@@ -122,6 +122,7 @@ def _resident(job: Job, work: str, inbox: str, cwd: str, out: int, commands: int
         renderer = enter_renderer(job, inbox, cwd, [cwd], work, out, ids, keep=commands,
                                   cpu=(budget, budget * (RETIRE_AFTER + 1)))
         reader = Reader(4)
+        also = (cwd, *shader_roots())  # the folders glsandbox's own file checks allow besides a submission's
         while renderer is not None:
             command = _next(reader)
             if command is None:  # the supervisor is done with it
@@ -129,7 +130,7 @@ def _resident(job: Job, work: str, inbox: str, cwd: str, out: int, commands: int
             job = job_from(command["job"])
             root = os.path.join(inbox, str(command["folder"]))
             start_afresh(renderer)
-            files.set_sandbox_root(root, also=(cwd, *shader_roots()))
+            files.set_sandbox_root(root, also=also)
             os.chdir(root)
             _cpu_limit(cpu_budget(job))
             clean = render_job(job, renderer, root, job.target, 3, own_process=names_own_shader)

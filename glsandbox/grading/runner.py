@@ -4,17 +4,19 @@
 :mod:`glsandbox.grading.isolate` where the system can fork, else (Windows) or
 when ``GLSANDBOX_ISOLATION=portable`` asks (:func:`portable_wanted`), a fresh
 Python per submission (:mod:`glsandbox.grading.portable`). Light to import
-(neither way's modules until a run): the command line asks it before it
-imports numpy (:mod:`glsandbox.launch`).
+(neither way's modules until a run): the command line asks it to start the
+zygote before it imports anything else (:mod:`glsandbox.launch`).
 """
 
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Sequence
 
-from glsandbox.grading import isolate
-from glsandbox.grading.isolate import Job, JobResult
+TYPE_CHECKING = False  # (typing's own is an import this early start does without)
+if TYPE_CHECKING:
+    from collections.abc import Callable, Sequence
+
+    from glsandbox.grading.isolate import Job, JobResult
 
 __all__ = ["run_jobs", "portable_wanted", "prestart"]
 
@@ -26,9 +28,11 @@ def portable_wanted() -> bool:
 
 def prestart() -> None:
     """Where this machine grades the fork-based way, start the zygote now
-    (:func:`glsandbox.grading.isolate.prestart`): the next run takes it."""
+    (:func:`glsandbox.grading.zygote.prestart`): the next run takes it."""
     if not portable_wanted():
-        isolate.prestart()
+        from glsandbox.grading import zygote
+
+        zygote.prestart()
 
 
 def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None]) -> list[JobResult]:
@@ -38,6 +42,7 @@ def run_jobs(jobs: Sequence[Job], workers: int, done: Callable[[JobResult], None
         from glsandbox.grading import portable
 
         return portable.run_jobs_portable(jobs, workers, done)
+    from glsandbox.grading import isolate
     from glsandbox.grading.slots import Slots
 
     return isolate.run_jobs(jobs, workers, done, slots=Slots)  # scene files: a renderer kept per slot

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from glsandbox import launch
-from glsandbox.grading import isolate, runner
+from glsandbox.grading import runner, zygote
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -31,22 +31,24 @@ def test_the_zygote_starts_before_numpy_and_a_run_that_takes_none_leaves_nothing
     (tmp_path / "subs").mkdir()
     script = ("import json, os, sys\n"
               "from glsandbox import launch\n"
-              "from glsandbox.grading import isolate\n"
+              "from glsandbox.grading import zygote\n"
               f"launch.start_early(['check', {str(tmp_path / 'subs')!r}])\n"
-              "z = isolate._prestarted\n"
+              "z = zygote._prestarted\n"
               "print(json.dumps({'started': z is not None and z.process.poll() is None, 'folder': z.folder,\n"
-              "                  'numpy': 'numpy' in sys.modules, 'blas': os.environ.get('OPENBLAS_NUM_THREADS')}))\n")
+              "                  'numpy': 'numpy' in sys.modules, 'blas': os.environ.get('OPENBLAS_NUM_THREADS'),\n"
+              "                  'isolate': 'glsandbox.grading.isolate' in sys.modules}))\n")
     env = {"PATH": "/usr/bin:/bin", "GLSANDBOX_ISOLATION": ""}
     proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=REPO, env=env, timeout=120)
     assert proc.returncode == 0, proc.stderr
     seen = json.loads(proc.stdout)
     assert seen["started"] and not seen["numpy"] and seen["blas"] == "1"
+    assert not seen["isolate"]  # started with the standard library's process modules, before the grader's own
     assert not Path(seen["folder"]).exists()  # closed at exit, its folder removed
 
 
 def test_the_portable_way_starts_no_zygote_and_the_user_keeps_their_blas_threads(monkeypatch, tmp_path) -> None:
     started: list[str] = []
-    monkeypatch.setattr(isolate, "prestart", lambda: started.append("zygote"))
+    monkeypatch.setattr(zygote, "prestart", lambda: started.append("zygote"))
     monkeypatch.setenv("OPENBLAS_NUM_THREADS", "4")
     monkeypatch.setenv("GLSANDBOX_ISOLATION", "portable")
     launch.start_early(["check", str(tmp_path)])

@@ -15,6 +15,7 @@ import socket
 import subprocess
 import sys
 import textwrap
+import time
 import uuid
 from pathlib import Path
 
@@ -178,13 +179,18 @@ def test_the_zygote_starts_from_a_minimal_environment() -> None:
 def test_a_renderer_starts_with_blas_on_one_thread_and_the_zygote_with_that_environment() -> None:
     import shutil
 
-    from glsandbox.grading.isolate import _Zygote
+    from glsandbox.grading.zygote import Zygote
 
     assert layers.renderer_environment({"PATH": "/bin", "GITHUB_TOKEN": "t", "OPENBLAS_NUM_THREADS": "8"}) == \
         {"PATH": "/bin", "OPENBLAS_NUM_THREADS": "1"}
-    zygote = _Zygote()
+    zygote = Zygote()
     try:
-        environ = Path(f"/proc/{zygote.process.pid}/environ").read_bytes().split(b"\0")
+        # Popen returns once the exec closed its error pipe, a moment before the kernel records
+        # where the new program's environment lies: until then the file reads empty
+        deadline = time.monotonic() + 10
+        while not (raw := Path(f"/proc/{zygote.process.pid}/environ").read_bytes()) and time.monotonic() < deadline:
+            time.sleep(0.01)
+        environ = raw.split(b"\0")
     finally:
         zygote.close()
         shutil.rmtree(zygote.folder, ignore_errors=True)
