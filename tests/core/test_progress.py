@@ -141,15 +141,26 @@ def test_check_a_folder_counts_each_submission(recorded, tmp_path, gl, capsys) -
     assert [f"[{n}/3]" in out for n in (1, 2, 3)] == [True] * 3  # the lines stay, on stdout
 
 
-def test_ready_imports_the_bar_before_the_first_line() -> None:
+def test_ready_imports_the_bar_only_where_one_is_drawn() -> None:
+    """On a terminal, tqdm is imported by ready(), before the first line; elsewhere never, and a
+    bar there is one that draws nothing."""
     import subprocess
     import sys
 
-    script = ("import sys\n"
+    script = ("import io, sys\n"
               "from glsandbox import progress\n"
-              "before = 'tqdm' in sys.modules\n"
               "progress.ready()\n"
-              "print(before, 'tqdm' in sys.modules)\n")
+              "with progress.progress(3, 'check', 'submission') as bar:\n"
+              "    bar.update(1)\n"
+              "    progress.say('a line')\n"
+              "piped = 'tqdm' in sys.modules\n"
+              "class Terminal(io.StringIO):\n"
+              "    def isatty(self):\n"
+              "        return True\n"
+              "sys.stderr = Terminal()\n"
+              "progress.ready()\n"
+              "print(piped, 'tqdm' in sys.modules)\n")
     proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.split() == ["False", "True"]
+    assert proc.stderr == "a line\n"
