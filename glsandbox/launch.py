@@ -1,7 +1,7 @@
 """The ``glsandbox`` command's first step: start early what a long command can start early, then run it.
 
 ``glsandbox check DIR`` grades a class through a zygote (a fresh Python that
-imports glsandbox, numpy and moderngl once, :mod:`glsandbox.grading.isolate`):
+imports glsandbox, numpy and moderngl once, :mod:`glsandbox.grading.zygote`):
 about 0.3 s of a core before the first submission can be drawn. Started here,
 before the command line's own modules are imported (:mod:`glsandbox.cli`:
 numpy, the renderers; ``import glsandbox`` itself imports nothing), the two

@@ -29,7 +29,8 @@ worst it can do is lose its own pictures.
 
 This module is the grader's side and what both sides share (the jobs, the
 framed messages); :mod:`glsandbox.grading.zygote` starts the zygote and asks
-it; :mod:`glsandbox.grading.worker` is the zygote, supervisor and renderer; :mod:`glsandbox.grading.processes` finds and kills a tree.
+it; :mod:`glsandbox.grading.worker` is the zygote, supervisor and renderer;
+:mod:`glsandbox.grading.processes` finds and kills a tree.
 A scene file (data, no code) goes instead to a job slot: a supervisor and a
 renderer kept for many scene files, confined as these are
 (:mod:`glsandbox.grading.slots`, :mod:`glsandbox.grading.resident`).

@@ -11,7 +11,8 @@ import pytest
 
 from glsandbox.grading import zygote
 
-pytestmark = pytest.mark.skipif(not hasattr(os, "fork"), reason="the zygote forks (POSIX)")
+# No fork (Windows: the portable path grades there) is a machine without the zygote; on CI, a failure
+pytestmark = pytest.mark.skipif(not hasattr(os, "fork") and not os.environ.get("CI"), reason="the zygote forks (POSIX)")
 
 
 @pytest.fixture(autouse=True)
